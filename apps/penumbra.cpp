@@ -1,0 +1,415 @@
+// The `penumbra` command: `render` a glTF scene to EXR (+ display PNG) and print its `info`.
+// Exit codes: 0 success, 2 bad input or usage, 1 internal failure. Only main() exits.
+#include <CLI/CLI.hpp>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "io/atomic_file.h"
+#include "io/error.h"
+#include "io/gltf_loader.h"
+#include "io/image_output.h"
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/embree.h"
+#include "renderer/camera.h"
+#include "renderer/render.h"
+
+namespace fs = std::filesystem;
+using namespace penumbra;
+
+namespace {
+
+constexpr int kExitOk = 0, kExitInternal = 1, kExitInput = 2;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Bad command-line values: reported like bad files, exit 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+extern "C" void on_signal(int sig) {
+  remove_pending_temporaries();
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+double peak_memory_mib() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) / 1024.0;  // ru_maxrss is KiB on Linux
+}
+
+uint64_t default_memory_budget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 8ull << 30;
+  return uint64_t(pages) * uint64_t(page) / 2;  // half the machine's RAM
+}
+
+/// "512M", "4G", "1073741824" -> bytes.
+uint64_t parse_bytes(const std::string& s) {
+  size_t pos = 0;
+  double v = 0;
+  try {
+    v = std::stod(s, &pos);
+  } catch (...) {
+    throw UsageError("--max-memory: cannot parse '" + s + "'");
+  }
+  const std::string unit = s.substr(pos);
+  double mul = 1;
+  if (unit == "K" || unit == "k") mul = 1024.0;
+  else if (unit == "M" || unit == "m") mul = 1024.0 * 1024;
+  else if (unit == "G" || unit == "g") mul = 1024.0 * 1024 * 1024;
+  else if (!unit.empty()) throw UsageError("--max-memory: unknown unit '" + unit + "' (use K, M or G)");
+  if (!(v > 0) || !std::isfinite(v * mul) || v * mul > 1e15) throw UsageError("--max-memory: out of range: " + s);
+  return uint64_t(v * mul);
+}
+
+/// "r,g,b" or a single grey value -> Vec3f, each finite and >= 0.
+Vec3f parse_colour(const std::string& s, const char* option) {
+  std::vector<float> v;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t pos = 0;
+      v.push_back(std::stof(item, &pos));
+      if (pos != item.size()) throw std::invalid_argument(item);
+    } catch (...) {
+      throw UsageError(std::string(option) + ": cannot parse '" + s + "' (expected r,g,b or one value)");
+    }
+  }
+  if (v.size() == 1) v = {v[0], v[0], v[0]};
+  if (v.size() != 3) throw UsageError(std::string(option) + ": expected r,g,b or one value, got '" + s + "'");
+  for (float x : v)
+    if (!std::isfinite(x) || x < 0) throw UsageError(std::string(option) + ": values must be finite and >= 0");
+  return {v[0], v[1], v[2]};
+}
+
+std::string human_count(uint64_t n) {
+  char buf[32];
+  if (n >= 1000000) std::snprintf(buf, sizeof buf, "%.2fM", double(n) / 1e6);
+  else if (n >= 1000) std::snprintf(buf, sizeof buf, "%.1fk", double(n) / 1e3);
+  else std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(n));
+  return buf;
+}
+
+/// Progress on stderr: a self-overwriting line on a terminal, or a line per 10% in logs.
+class ProgressReporter {
+ public:
+  explicit ProgressReporter(bool enabled) : m_enabled(enabled), m_tty(isatty(STDERR_FILENO)) {}
+  void operator()(int done, int total) {
+    if (!m_enabled) return;
+    std::lock_guard lock(m_mutex);
+    const double elapsed = seconds_since(m_start);
+    const double frac = double(done) / double(total);
+    const int decile = int(frac * 10);
+    if (m_tty) {
+      if (done != total && elapsed - m_last < 0.1) return;
+      m_last = elapsed;
+    } else {
+      if (decile <= m_last_decile) return;
+      m_last_decile = decile;
+    }
+    const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+    std::fprintf(stderr, "%srender %5.1f%%  elapsed %6.1fs  eta %6.1fs%s", m_tty ? "\r" : "",
+                 100 * frac, elapsed, eta, m_tty ? (done == total ? "\n" : "") : "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool m_enabled, m_tty;
+  std::mutex m_mutex;
+  Clock::time_point m_start = Clock::now();
+  double m_last = -1;
+  int m_last_decile = 0;
+};
+
+struct RenderArgs {
+  std::string scene_file, output, png;
+  bool no_png = false, use_float = false, quiet = false, allow_external = false;
+  int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1, camera = -1;
+  uint64_t seed = 0;
+  float exposure = 0;
+  std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
+  std::string accel = "embree", max_memory, debug_pixel;
+};
+
+LoadedScene load_scene(const std::string& file, int scene, bool allow_external,
+                       const std::string& max_memory, bool quiet) {
+  GltfLoadOptions opt;
+  opt.scene = scene;
+  opt.allow_external_uris = allow_external;
+  opt.max_memory_bytes = max_memory.empty() ? default_memory_budget() : parse_bytes(max_memory);
+  LoadedScene loaded = load_gltf(file, opt);
+  if (!quiet) {
+    const size_t shown = std::min<size_t>(loaded.warnings.size(), 20);
+    for (size_t i = 0; i < shown; ++i) std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), loaded.warnings[i].c_str());
+    if (loaded.warnings.size() > shown)
+      std::fprintf(stderr, "warning: %s: ... and %zu more warnings\n", file.c_str(), loaded.warnings.size() - shown);
+  }
+  return loaded;
+}
+
+int run_render(const RenderArgs& a) {
+  // Validate everything the user typed before spending time on loading.
+  fs::path out(a.output);
+  std::string ext = out.extension().string();
+  for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr") throw UsageError("-o " + a.output + ": the output must be an .exr file");
+  auto check_dir = [](const fs::path& p, const char* opt) {
+    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir)) throw UsageError(std::string(opt) + " " + p.string() + ": directory '" + dir.string() + "' does not exist");
+  };
+  check_dir(out, "-o");
+  std::optional<fs::path> png;
+  if (!a.no_png) png = a.png.empty() ? fs::path(out).replace_extension(".png") : fs::path(a.png);
+  if (png) check_dir(*png, "--png");
+  if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) throw UsageError("--exposure must be finite and within [-64, 64]");
+  const Vec3f background = parse_colour(a.background, "--background");
+  const Vec3f ambient = parse_colour(a.ambient, "--ambient");
+  int debug_x = -1, debug_y = -1;
+  if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
+    throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
+  bool known_accel = false;
+  for (const auto& n : accelerator_names()) known_accel |= n == a.accel;
+  if (!known_accel) throw UsageError("--accel: unknown accelerator '" + a.accel + "'");
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  // Load.
+  const auto t_load = Clock::now();
+  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.max_memory, a.quiet);
+  Scene& scene = loaded.scene;
+  const double load_s = seconds_since(t_load);
+
+  // Camera and resolution (the image aspect follows the camera's hint unless both are given).
+  if (a.camera >= int(scene.cameras.size()))
+    throw InputError(a.scene_file, "--camera", "camera " + std::to_string(a.camera) + " does not exist (" +
+                                                   std::to_string(scene.cameras.size()) + " camera instances; see penumbra info)");
+  const int cam_index = a.camera >= 0 ? a.camera : (scene.cameras.empty() ? -1 : 0);
+  const float hint = cam_index >= 0 && scene.cameras[size_t(cam_index)].aspect > 0 ? scene.cameras[size_t(cam_index)].aspect : 16.0f / 9.0f;
+  RenderConfig cfg;
+  cfg.width = a.width;
+  cfg.height = a.height;
+  if (!cfg.width && !cfg.height) cfg.width = 960;
+  if (!cfg.height) cfg.height = std::max(1, int(std::lround(cfg.width / hint)));
+  if (!cfg.width) cfg.width = std::max(1, int(std::lround(cfg.height * hint)));
+  if (cfg.width > 16384 || cfg.height > 16384)
+    throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
+  const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
+                                       : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
+  bool default_light = false;
+  if (scene.lights.empty()) {
+    scene.lights.push_back(default_key_light(camera));
+    default_light = true;
+  }
+  cfg.spp = a.spp;
+  cfg.threads = a.threads;
+  cfg.seed = a.seed;
+  cfg.whitted.max_depth = a.max_depth;
+  cfg.whitted.background = background;
+  cfg.whitted.ambient = ambient;
+
+  // Build.
+  const auto views = mesh_views(scene);
+  const auto t_build = Clock::now();
+  auto accel = make_accelerator(a.accel, views);
+  const double build_s = seconds_since(t_build);
+
+  if (debug_x >= 0 || debug_y >= 0) {
+    if (debug_x < 0 || debug_y < 0 || debug_x >= cfg.width || debug_y >= cfg.height)
+      throw UsageError("--debug-pixel " + a.debug_pixel + " is outside the " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
+    float rgba[4];
+    RayCounts counts;
+    render_whitted_pixel(scene, *accel, camera, cfg, debug_x, debug_y, rgba, counts);
+    std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, reflection %llu)\n", debug_x, debug_y,
+                rgba[0], rgba[1], rgba[2], rgba[3], static_cast<unsigned long long>(counts.camera),
+                static_cast<unsigned long long>(counts.shadow), static_cast<unsigned long long>(counts.reflection));
+    return kExitOk;
+  }
+
+  // Render.
+  ProgressReporter reporter(!a.quiet);
+  RenderStats stats;
+  Film film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+
+  // Write.
+  const auto t_write = Clock::now();
+  ExrOptions exr;
+  exr.half = !a.use_float;
+  exr.compression = a.compression;
+  exr.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:camera", camera.name},
+                  {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", "whitted"}};
+  write_exr(film, out, exr);
+  if (png) {
+    DisplayOptions d;
+    d.ocio_config = a.ocio_config;
+    d.display = a.display;
+    d.view = a.view;
+    d.exposure = a.exposure;
+    write_display_image(film, *png, d);
+  }
+  const double write_s = seconds_since(t_write);
+
+  if (!a.quiet) {
+    const uint64_t total = stats.rays.total();
+    std::fprintf(stderr,
+                 "penumbra render %s\n"
+                 "  scene    %zu meshes, %s triangles, %zu materials, %zu lights%s\n"
+                 "  camera   %s (%s)\n"
+                 "  image    %dx%d, %d spp, whitted max-depth %d, %d threads, accel %s\n"
+                 "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
+                 "  rays     camera %s  shadow %s  reflection %s  total %s  (%.2f Mrays/s)\n"
+                 "  memory   peak %.1f MiB\n",
+                 a.scene_file.c_str(), scene.meshes.size(), human_count(count_triangles(scene)).c_str(),
+                 scene.materials.size(), scene.lights.size(), default_light ? " (default key light)" : "",
+                 camera.name.c_str(), camera.projection == Projection::Perspective ? "perspective" : "orthographic",
+                 cfg.width, cfg.height, cfg.spp, cfg.whitted.max_depth, stats.threads, a.accel.c_str(),
+                 load_s, build_s, stats.seconds, write_s, human_count(stats.rays.camera).c_str(),
+                 human_count(stats.rays.shadow).c_str(), human_count(stats.rays.reflection).c_str(),
+                 human_count(total).c_str(), stats.seconds > 0 ? double(total) / stats.seconds / 1e6 : 0.0,
+                 peak_memory_mib());
+  }
+  std::printf("%s\n", out.string().c_str());
+  if (png) std::printf("%s\n", png->string().c_str());
+  return kExitOk;
+}
+
+int run_info(const std::string& file, int scene_index, bool allow_external, const std::string& accel_name) {
+  LoadedScene loaded = load_scene(file, scene_index, allow_external, "", false);
+  const Scene& s = loaded.scene;
+  const GltfInfo& i = loaded.info;
+  std::printf("file         %s\n", file.c_str());
+  std::printf("asset        glTF %s%s%s\n", i.version.c_str(), i.generator.empty() ? "" : ", generator: ", i.generator.c_str());
+  std::printf("scenes       %d", i.scene_count);
+  for (int k = 0; k < i.scene_count; ++k)
+    std::printf("%s%d: %s%s", k ? ", " : " (", k, i.scene_names[size_t(k)].c_str(), k == i.scene_index ? " [rendered]" : "");
+  std::printf("%s\n", i.scene_count ? ")" : "");
+  std::printf("nodes        %d\n", i.node_count);
+  std::printf("meshes       %d (%d primitives); instantiated: %zu triangle meshes, %llu triangles\n", i.mesh_count,
+              i.primitive_count, s.meshes.size(), static_cast<unsigned long long>(count_triangles(s)));
+  std::printf("materials    %zu\n", s.materials.size());
+  for (size_t k = 0; k < s.materials.size(); ++k) {
+    const auto& m = s.materials[k];
+    std::printf("  [%zu] %s: base (%.3g %.3g %.3g) metallic %.3g roughness %.3g emissive (%.3g %.3g %.3g)\n", k,
+                m.name.c_str(), m.base_color.x, m.base_color.y, m.base_color.z, m.metallic, m.roughness,
+                m.emissive.x, m.emissive.y, m.emissive.z);
+  }
+  std::printf("cameras      %d defined, %zu in the scene (use --camera N)\n", i.gltf_camera_count, i.camera_instances.size());
+  for (size_t k = 0; k < i.camera_instances.size(); ++k) std::printf("  [%zu] %s\n", k, i.camera_instances[k].c_str());
+  std::printf("lights       %d defined, %zu in the scene\n", i.gltf_light_count, s.lights.size());
+  for (size_t k = 0; k < s.lights.size(); ++k) {
+    const auto& l = s.lights[k];
+    const char* type = l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
+    std::printf("  [%zu] %s: %s, intensity %.4g %s\n", k, l.name.c_str(), type, l.intensity,
+                l.type == LightType::Directional ? "lux" : "cd");
+  }
+  std::printf("images       %d (textures not yet used by the renderer)\n", i.image_count);
+  std::printf("animations   %d\n", i.animation_count);
+  auto join = [](const std::vector<std::string>& v) {
+    std::string r;
+    for (const auto& x : v) r += (r.empty() ? "" : ", ") + x;
+    return r.empty() ? std::string("none") : r;
+  };
+  std::printf("extensions   used: %s; required: %s\n", join(i.extensions_used).c_str(), join(i.extensions_required).c_str());
+  const Bounds3f b = compute_bounds(s);
+  if (!b.empty())
+    std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  else
+    std::printf("bounds       empty\n");
+  const auto views = mesh_views(s);
+  auto accel = make_accelerator(accel_name, views);
+  const AccelStats st = accel->stats();
+  std::printf("accelerator  %s: %llu triangles, build %.3fs, %.1f MiB\n", st.name.c_str(),
+              static_cast<unsigned long long>(st.triangles), st.build_seconds, double(st.bytes) / (1 << 20));
+  std::printf("warnings     %zu\n", loaded.warnings.size());
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Penumbra: glTF 2.0 batch renderer (Embree + TBB, OpenEXR + OpenColorIO output)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("penumbra " PENUMBRA_VERSION));
+
+  RenderArgs r;
+  auto* render = app.add_subcommand("render", "Render a glTF scene to a scene-linear EXR and a display image");
+  render->add_option("scene", r.scene_file, "glTF scene (.gltf or .glb)")->required();
+  render->add_option("-o,--output", r.output, "output EXR path (written atomically)")->required();
+  render->add_option("--png", r.png, "display image path (.png/.jpg/.tif); default: the EXR path with .png");
+  render->add_flag("--no-png", r.no_png, "write only the EXR");
+  render->add_option("--width", r.width, "image width in pixels (default 960, or from --height and the camera aspect)")->check(CLI::Range(1, 16384));
+  render->add_option("--height", r.height, "image height in pixels (default: width / camera aspect)")->check(CLI::Range(1, 16384));
+  render->add_option("--spp", r.spp, "samples per pixel, stratified jittered (default 4)")->check(CLI::Range(1, 65536));
+  render->add_option("--max-depth", r.max_depth, "maximum mirror bounces (default 5)")->check(CLI::Range(0, 64));
+  render->add_option("--threads", r.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
+  render->add_option("--scene", r.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
+  render->add_option("--camera", r.camera, "camera instance index, as listed by `penumbra info` (default 0; none: frame the bounds)")->check(CLI::Range(0, 1 << 30));
+  render->add_option("--accel", r.accel, "acceleration structure: embree (default) or brute");
+  render->add_flag("--float", r.use_float, "write 32-bit float EXR channels (default half)");
+  render->add_option("--compression", r.compression, "EXR compression (default zip)")
+      ->check(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}));
+  render->add_option("--exposure", r.exposure, "exposure in stops for the display image (default 0)");
+  render->add_option("--ocio-config", r.ocio_config, "OpenColorIO config (default: $OCIO, else the shipped config)");
+  render->add_option("--display", r.display, "OCIO display (default: the config's default)");
+  render->add_option("--view", r.view, "OCIO view (default: the display's default)");
+  render->add_option("--background", r.background, "background radiance r,g,b or grey (default 0); background alpha stays 0");
+  render->add_option("--ambient", r.ambient, "ambient intensity Ia, r,g,b or grey (default 0.05)");
+  render->add_option("--seed", r.seed, "sampler seed (default 0)");
+  render->add_option("--max-memory", r.max_memory, "budget for decoded geometry, e.g. 4G (default: half the RAM)");
+  render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
+  render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");
+  render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
+
+  std::string info_file, info_accel = "embree";
+  int info_scene = -1;
+  bool info_external = false;
+  auto* info = app.add_subcommand("info", "Describe a glTF scene: scenes, meshes, materials, cameras, lights, bounds");
+  info->add_option("scene", info_file, "glTF scene (.gltf or .glb)")->required();
+  info->add_option("--scene", info_scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
+  info->add_option("--accel", info_accel, "acceleration structure to build and describe (default embree)");
+  info->add_flag("--allow-external-uris", info_external, "let buffer URIs reach files outside the scene's folder");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitInput;
+  }
+
+  try {
+    if (*render) return run_render(r);
+    if (*info) return run_info(info_file, info_scene, info_external, info_accel);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "penumbra: error: %s\n", e.what());
+    return kExitInput;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "penumbra: error: %s\n", e.what());
+    return kExitInput;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "penumbra: error: %s\n", e.what());
+    return kExitInput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "penumbra: internal error: out of memory\n");
+    return kExitInternal;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "penumbra: internal error: %s\n", e.what());
+    return kExitInternal;
+  }
+  return kExitInternal;
+}

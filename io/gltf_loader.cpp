@@ -1,0 +1,860 @@
+// glTF 2.0 loader: file checks, JSON depth guard, tinygltf with sandboxed file callbacks, then
+// validation and flattening of the node hierarchy into world-space meshes.
+#include "io/gltf_loader.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <new>
+#include <set>
+
+#include "io/error.h"
+
+namespace penumbra {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> supported_gltf_extensions() {
+  return {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+}
+
+int json_nesting_depth(std::string_view json, int limit) {
+  int depth = 0, max_depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (c == '\\') ++i;  // skip the escaped character
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '{' || c == '[') {
+      max_depth = std::max(max_depth, ++depth);
+      if (max_depth > limit) return limit + 1;
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return max_depth;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Overflow-safe arithmetic for sizes read from the file.
+bool add_ok(uint64_t a, uint64_t b, uint64_t& r) { return !__builtin_add_overflow(a, b, &r); }
+bool mul_ok(uint64_t a, uint64_t b, uint64_t& r) { return !__builtin_mul_overflow(a, b, &r); }
+
+std::string idx(const char* array, size_t i) { return std::string(array) + "[" + std::to_string(i) + "]"; }
+
+// ---------------------------------------------------------------------------------------------
+// Sandboxed file access for tinygltf: external URIs may only reach regular files inside the
+// scene's folder, no bigger than the per-file limit.
+struct FsSandbox {
+  fs::path root;  // canonical folder of the scene file
+  bool allow_external = false;
+  uint64_t max_bytes = 0;
+  std::string first_denial;  // why the first refused path was refused
+};
+
+bool sandbox_allows(FsSandbox& box, const std::string& path) {
+  std::error_code ec;
+  const fs::path canon = fs::weakly_canonical(fs::path(path), ec);
+  if (ec) return false;
+  if (!box.allow_external) {
+    const auto rel = canon.lexically_relative(box.root);
+    if (rel.empty() || *rel.begin() == "..") {
+      if (box.first_denial.empty())
+        box.first_denial = "URI resolves to '" + canon.string() +
+                           "', outside the scene folder (use --allow-external-uris to permit)";
+      return false;
+    }
+  }
+  const auto st = fs::status(canon, ec);
+  if (ec || !fs::is_regular_file(st)) return false;
+  return true;
+}
+
+bool sandbox_file_exists(const std::string& path, void* user) {
+  return sandbox_allows(*static_cast<FsSandbox*>(user), path);
+}
+
+std::string sandbox_expand(const std::string& path, void*) { return path; }  // no ~ or $VAR
+
+bool read_file_limited(const fs::path& path, uint64_t max_bytes, std::vector<unsigned char>& out,
+                       std::string& err) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) {
+    err = "cannot read file size: " + ec.message();
+    return false;
+  }
+  if (size > max_bytes) {
+    err = "file is " + std::to_string(size) + " bytes, over the limit of " +
+          std::to_string(max_bytes);
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    err = "cannot open file";
+    return false;
+  }
+  out.resize(size_t(size));
+  if (size && !in.read(reinterpret_cast<char*>(out.data()), std::streamsize(size))) {
+    err = "read failed";
+    return false;
+  }
+  return true;
+}
+
+bool sandbox_read(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                  void* user) {
+  auto& box = *static_cast<FsSandbox*>(user);
+  if (!sandbox_allows(box, path)) {
+    if (err) *err = box.first_denial.empty() ? "not a readable regular file" : box.first_denial;
+    return false;
+  }
+  std::string e;
+  if (!read_file_limited(path, box.max_bytes, *out, e)) {
+    if (err) *err = e;
+    return false;
+  }
+  return true;
+}
+
+bool sandbox_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not allowed";
+  return false;
+}
+
+// Images are decoded later through OpenImageIO; tinygltf's decoding is switched off.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                const unsigned char*, int, void*) {
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// GLB container checks (glTF 2.0 spec, "GLB File Format Specification").
+std::string_view glb_json_chunk(const std::string& file, const std::vector<unsigned char>& bytes) {
+  auto u32 = [&](size_t off) {
+    uint32_t v;
+    std::memcpy(&v, bytes.data() + off, 4);
+    return v;
+  };
+  if (bytes.size() < 20) throw InputError(file, "GLB header", "file too short for a GLB header");
+  if (u32(4) != 2)
+    throw InputError(file, "GLB header", "version " + std::to_string(u32(4)) + " is not 2");
+  const uint64_t total = u32(8);
+  if (total > bytes.size())
+    throw InputError(file, "GLB header", "declared length " + std::to_string(total) +
+                                             " exceeds file size " + std::to_string(bytes.size()));
+  const uint64_t json_len = u32(12);
+  if (u32(16) != 0x4E4F534Au) throw InputError(file, "GLB chunk 0", "first chunk is not JSON");
+  if (20 + json_len > total)
+    throw InputError(file, "GLB chunk 0", "JSON chunk length " + std::to_string(json_len) +
+                                              " exceeds the file");
+  uint64_t off = 20 + ((json_len + 3) & ~uint64_t(3));
+  if (off + 8 <= total) {
+    const uint64_t bin_len = u32(size_t(off));
+    if (u32(size_t(off + 4)) == 0x004E4942u && off + 8 + bin_len > total)
+      throw InputError(file, "GLB chunk 1", "BIN chunk length " + std::to_string(bin_len) +
+                                                " exceeds the file");
+  }
+  return {reinterpret_cast<const char*>(bytes.data()) + 20, size_t(json_len)};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validated accessor access.
+struct AccessorLayout {
+  const unsigned char* data = nullptr;  // nullptr: all zeros (no bufferView)
+  uint64_t stride = 0;
+  uint64_t count = 0;
+  int component_type = 0;
+  int components = 0;
+  bool normalized = false;
+  std::vector<std::pair<uint64_t, std::vector<double>>> sparse;  // sorted (index, values)
+};
+
+class Converter {
+ public:
+  Converter(const tinygltf::Model& model, std::string file, const GltfLoadOptions& options,
+            LoadedScene& out)
+      : m_model(model), m_file(std::move(file)), m_options(options), m_out(out) {}
+
+  void run();
+
+ private:
+  [[noreturn]] void fail(const std::string& element, const std::string& message) const {
+    throw InputError(m_file, element, message);
+  }
+  void warn(const std::string& element, const std::string& message) {
+    m_out.warnings.push_back(element + ": " + message);
+  }
+  void charge_memory(uint64_t bytes, const std::string& element) {
+    if (!add_ok(m_memory, bytes, m_memory) || m_memory > m_options.max_memory_bytes)
+      fail(element, "decoded geometry exceeds the memory budget of " +
+                        std::to_string(m_options.max_memory_bytes) + " bytes");
+  }
+
+  AccessorLayout layout(int accessor, const std::string& user);
+  double component(const AccessorLayout& l, uint64_t element, int c) const;
+  std::vector<double> read(int accessor, const std::string& user, std::initializer_list<int> types,
+                           std::initializer_list<int> component_types, bool allow_normalized);
+  std::vector<uint32_t> read_indices(int accessor, const std::string& user);
+
+  void check_extensions();
+  void convert_materials();
+  void validate_cameras();
+  void validate_lights();
+  void traverse(const std::vector<int>& roots);
+  void add_mesh(int mesh_index, int node, const Transform& world);
+  void add_camera(int camera_index, int node, const Transform& world);
+  void add_light(int light_index, int node, const Transform& world);
+  Transform local_transform(int node);
+
+  const tinygltf::Model& m_model;
+  std::string m_file;
+  const GltfLoadOptions& m_options;
+  LoadedScene& m_out;
+  uint64_t m_memory = 0;
+};
+
+AccessorLayout Converter::layout(int accessor, const std::string& user) {
+  const std::string where = idx("accessors", size_t(accessor));
+  if (accessor < 0 || size_t(accessor) >= m_model.accessors.size())
+    fail(user, "accessor index " + std::to_string(accessor) + " out of range (" +
+                   std::to_string(m_model.accessors.size()) + " accessors)");
+  const tinygltf::Accessor& a = m_model.accessors[size_t(accessor)];
+  AccessorLayout l;
+  const int comp_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+  l.components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+  if (comp_size <= 0) fail(where, "invalid componentType " + std::to_string(a.componentType));
+  if (l.components <= 0) fail(where, "invalid type");
+  l.component_type = a.componentType;
+  l.normalized = a.normalized;
+  l.count = a.count;
+  if (l.count == 0) fail(where, "count must be >= 1");
+  const uint64_t elem = uint64_t(comp_size) * uint64_t(l.components);
+
+  uint64_t decoded = 0;
+  if (!mul_ok(l.count, uint64_t(l.components) * 8, decoded))
+    fail(where, "count " + std::to_string(l.count) + " overflows");
+  charge_memory(decoded, where);
+
+  if (a.bufferView >= 0) {
+    if (size_t(a.bufferView) >= m_model.bufferViews.size())
+      fail(where, "bufferView " + std::to_string(a.bufferView) + " out of range (" +
+                      std::to_string(m_model.bufferViews.size()) + " bufferViews)");
+    const std::string bv_where = idx("bufferViews", size_t(a.bufferView));
+    const tinygltf::BufferView& bv = m_model.bufferViews[size_t(a.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
+      fail(bv_where, "buffer " + std::to_string(bv.buffer) + " out of range (" +
+                         std::to_string(m_model.buffers.size()) + " buffers)");
+    const auto& buffer = m_model.buffers[size_t(bv.buffer)].data;
+    uint64_t bv_end = 0;
+    if (!add_ok(bv.byteOffset, bv.byteLength, bv_end) || bv_end > buffer.size())
+      fail(bv_where, "byteOffset " + std::to_string(bv.byteOffset) + " + byteLength " +
+                         std::to_string(bv.byteLength) + " exceeds buffer " +
+                         std::to_string(bv.buffer) + " of " + std::to_string(buffer.size()) +
+                         " bytes");
+    l.stride = bv.byteStride ? uint64_t(bv.byteStride) : elem;
+    if (bv.byteStride != 0 && (bv.byteStride < elem || bv.byteStride > 252 || bv.byteStride % 4))
+      fail(bv_where, "byteStride " + std::to_string(bv.byteStride) + " invalid for " +
+                         std::to_string(elem) + "-byte elements of " + where);
+    uint64_t last = 0, end = 0;
+    if (!mul_ok(l.count - 1, l.stride, last) || !add_ok(last, a.byteOffset, end) ||
+        !add_ok(end, elem, end) || end > bv.byteLength)
+      fail(where, "byteOffset " + std::to_string(a.byteOffset) + " + " + std::to_string(l.count) +
+                      " elements (stride " + std::to_string(l.stride) + ") read past the end of " +
+                      bv_where + " (" + std::to_string(bv.byteLength) + " bytes)");
+    if (a.byteOffset % uint64_t(comp_size) != 0)
+      warn(where, "byteOffset " + std::to_string(a.byteOffset) +
+                      " is not a multiple of the component size");
+    l.data = buffer.data() + bv.byteOffset + a.byteOffset;
+  } else if (!a.sparse.isSparse) {
+    warn(where, "no bufferView: values are all zero");
+  }
+
+  if (a.sparse.isSparse) {
+    const std::string sw = where + ".sparse";
+    if (a.sparse.count <= 0 || uint64_t(a.sparse.count) > l.count)
+      fail(sw, "count " + std::to_string(a.sparse.count) + " not in [1, " + std::to_string(l.count) + "]");
+    const uint64_t n = uint64_t(a.sparse.count);
+    auto view_span = [&](int view, uint64_t offset, uint64_t bytes, const std::string& what) {
+      if (view < 0 || size_t(view) >= m_model.bufferViews.size())
+        fail(what, "bufferView " + std::to_string(view) + " out of range");
+      const auto& bv = m_model.bufferViews[size_t(view)];
+      if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
+        fail(idx("bufferViews", size_t(view)), "buffer out of range");
+      const auto& buf = m_model.buffers[size_t(bv.buffer)].data;
+      uint64_t e1 = 0, e2 = 0;
+      if (!add_ok(bv.byteOffset, bv.byteLength, e1) || e1 > buf.size() ||
+          !add_ok(offset, bytes, e2) || e2 > bv.byteLength)
+        fail(what, "reads past the end of its bufferView");
+      return buf.data() + bv.byteOffset + offset;
+    };
+    const int ict = a.sparse.indices.componentType;
+    const int isz = tinygltf::GetComponentSizeInBytes(uint32_t(ict));
+    if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(sw + ".indices", "componentType must be an unsigned integer type");
+    const unsigned char* ip = view_span(a.sparse.indices.bufferView, uint64_t(a.sparse.indices.byteOffset),
+                                        n * uint64_t(isz), sw + ".indices");
+    const unsigned char* vp = view_span(a.sparse.values.bufferView, uint64_t(a.sparse.values.byteOffset),
+                                        n * elem, sw + ".values");
+    AccessorLayout values;
+    values.data = vp;
+    values.stride = elem;
+    values.count = n;
+    values.component_type = l.component_type;
+    values.components = l.components;
+    values.normalized = l.normalized;
+    for (uint64_t i = 0; i < n; ++i) {
+      uint64_t target = 0;
+      if (isz == 1) target = ip[i];
+      if (isz == 2) { uint16_t v; std::memcpy(&v, ip + i * 2, 2); target = v; }
+      if (isz == 4) { uint32_t v; std::memcpy(&v, ip + i * 4, 4); target = v; }
+      if (target >= l.count)
+        fail(sw + ".indices", "index " + std::to_string(target) + " >= accessor count " + std::to_string(l.count));
+      std::vector<double> vals(size_t(l.components));
+      for (int c = 0; c < l.components; ++c) vals[size_t(c)] = component(values, i, c);
+      l.sparse.emplace_back(target, std::move(vals));
+    }
+    std::stable_sort(l.sparse.begin(), l.sparse.end(),
+                     [](const auto& x, const auto& y) { return x.first < y.first; });
+  }
+  return l;
+}
+
+double Converter::component(const AccessorLayout& l, uint64_t element, int c) const {
+  if (!l.data) return 0.0;
+  const int size = tinygltf::GetComponentSizeInBytes(uint32_t(l.component_type));
+  const unsigned char* p = l.data + element * l.stride + uint64_t(c) * uint64_t(size);
+  switch (l.component_type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { const uint8_t v = *p; return l.normalized ? v / 255.0 : v; }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return l.normalized ? std::max(v / 127.0, -1.0) : v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return l.normalized ? v / 65535.0 : v; }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return l.normalized ? std::max(v / 32767.0, -1.0) : v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+    default: return 0.0;
+  }
+}
+
+std::vector<double> Converter::read(int accessor, const std::string& user,
+                                    std::initializer_list<int> types,
+                                    std::initializer_list<int> component_types, bool allow_normalized) {
+  AccessorLayout l = layout(accessor, user);
+  const auto& a = m_model.accessors[size_t(accessor)];
+  const std::string where = user + " (" + idx("accessors", size_t(accessor)) + ")";
+  if (std::find(types.begin(), types.end(), a.type) == types.end())
+    fail(where, "unexpected accessor type");
+  const bool ok_component = std::find(component_types.begin(), component_types.end(),
+                                      a.componentType) != component_types.end();
+  const bool is_float = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+  if (!ok_component || (!is_float && !(allow_normalized && a.normalized)))
+    fail(where, "unsupported componentType " + std::to_string(a.componentType) +
+                    (a.normalized ? " (normalized)" : ""));
+  std::vector<double> out(size_t(l.count) * size_t(l.components));
+  for (uint64_t i = 0; i < l.count; ++i)
+    for (int c = 0; c < l.components; ++c) out[size_t(i) * size_t(l.components) + size_t(c)] = component(l, i, c);
+  for (const auto& [target, vals] : l.sparse)
+    for (int c = 0; c < l.components; ++c) out[size_t(target) * size_t(l.components) + size_t(c)] = vals[size_t(c)];
+  return out;
+}
+
+std::vector<uint32_t> Converter::read_indices(int accessor, const std::string& user) {
+  AccessorLayout l = layout(accessor, user);
+  const auto& a = m_model.accessors[size_t(accessor)];
+  const std::string where = user + " (" + idx("accessors", size_t(accessor)) + ")";
+  if (a.type != TINYGLTF_TYPE_SCALAR) fail(where, "indices must be SCALAR");
+  if (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+      a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    fail(where, "indices componentType must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
+  if (a.normalized) fail(where, "indices must not be normalized");
+  std::vector<uint32_t> out(size_t(l.count));
+  for (uint64_t i = 0; i < l.count; ++i) out[size_t(i)] = uint32_t(component(l, i, 0));
+  for (const auto& [target, vals] : l.sparse) out[size_t(target)] = uint32_t(vals[0]);
+  return out;
+}
+
+void Converter::check_extensions() {
+  const auto supported = supported_gltf_extensions();
+  for (const auto& e : m_model.extensionsRequired)
+    if (std::find(supported.begin(), supported.end(), e) == supported.end())
+      fail("extensionsRequired", "extension " + e + " is required by the file but not supported");
+  for (const auto& e : m_model.extensionsUsed)
+    if (std::find(supported.begin(), supported.end(), e) == supported.end())
+      warn("extensionsUsed", "extension " + e + " is not supported and will be ignored");
+}
+
+void Converter::convert_materials() {
+  auto finite_or_fail = [&](double v, const std::string& where) {
+    if (!std::isfinite(v)) fail(where, "value is not finite");
+    return v;
+  };
+  for (size_t i = 0; i < m_model.materials.size(); ++i) {
+    const auto& src = m_model.materials[i];
+    const std::string where = idx("materials", i);
+    Material m;
+    m.name = src.name.empty() ? where : src.name;
+    const auto& pbr = src.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() != 4) fail(where + ".pbrMetallicRoughness.baseColorFactor", "must have 4 values");
+    for (int c = 0; c < 3; ++c)
+      m.base_color[c] = float(std::clamp(finite_or_fail(pbr.baseColorFactor[size_t(c)], where + ".pbrMetallicRoughness.baseColorFactor"), 0.0, 1.0));
+    m.alpha = float(std::clamp(finite_or_fail(pbr.baseColorFactor[3], where + ".pbrMetallicRoughness.baseColorFactor"), 0.0, 1.0));
+    m.metallic = float(std::clamp(finite_or_fail(pbr.metallicFactor, where + ".pbrMetallicRoughness.metallicFactor"), 0.0, 1.0));
+    m.roughness = float(std::clamp(finite_or_fail(pbr.roughnessFactor, where + ".pbrMetallicRoughness.roughnessFactor"), 0.0, 1.0));
+    if (!src.emissiveFactor.empty()) {
+      if (src.emissiveFactor.size() != 3) fail(where + ".emissiveFactor", "must have 3 values");
+      for (int c = 0; c < 3; ++c)
+        m.emissive[c] = float(std::clamp(finite_or_fail(src.emissiveFactor[size_t(c)], where + ".emissiveFactor"), 0.0, 1.0));
+    }
+    if (auto it = src.extensions.find("KHR_materials_emissive_strength"); it != src.extensions.end()) {
+      const auto& s = it->second.Get("emissiveStrength");
+      if (s.IsNumber()) {
+        const double strength = finite_or_fail(s.GetNumberAsDouble(), where + ".extensions.KHR_materials_emissive_strength");
+        if (strength < 0) fail(where + ".extensions.KHR_materials_emissive_strength", "emissiveStrength must be >= 0");
+        m.emissive *= float(strength);
+      }
+    }
+    m_out.scene.materials.push_back(m);
+  }
+}
+
+void Converter::validate_cameras() {
+  for (size_t i = 0; i < m_model.cameras.size(); ++i) {
+    const auto& c = m_model.cameras[i];
+    const std::string where = idx("cameras", i) + (c.name.empty() ? "" : " '" + c.name + "'");
+    auto positive = [&](double v, const char* field) {
+      if (!(std::isfinite(v) && v > 0))
+        fail(where, std::string(field) + " must be a finite number > 0 (got " + std::to_string(v) + ")");
+    };
+    if (c.type == "perspective") {
+      const auto& p = c.perspective;
+      positive(p.yfov, "perspective.yfov");
+      if (p.yfov >= kPi) fail(where, "perspective.yfov must be < pi (got " + std::to_string(p.yfov) + ")");
+      positive(p.znear, "perspective.znear");
+      if (p.aspectRatio != 0) positive(p.aspectRatio, "perspective.aspectRatio");
+      if (p.zfar != 0) {
+        positive(p.zfar, "perspective.zfar");
+        if (p.zfar <= p.znear) fail(where, "perspective.zfar must be greater than znear");
+      }
+    } else if (c.type == "orthographic") {
+      const auto& o = c.orthographic;
+      positive(o.xmag, "orthographic.xmag");
+      positive(o.ymag, "orthographic.ymag");
+      if (!(std::isfinite(o.znear) && o.znear >= 0)) fail(where, "orthographic.znear must be >= 0");
+      positive(o.zfar, "orthographic.zfar");
+      if (o.zfar <= o.znear) fail(where, "orthographic.zfar must be greater than znear");
+    } else {
+      fail(where, "unknown camera type '" + c.type + "'");
+    }
+  }
+}
+
+void Converter::validate_lights() {
+  for (size_t i = 0; i < m_model.lights.size(); ++i) {
+    const auto& l = m_model.lights[i];
+    const std::string where = "extensions.KHR_lights_punctual." + idx("lights", i);
+    if (l.type != "point" && l.type != "spot" && l.type != "directional")
+      fail(where, "unknown light type '" + l.type + "'");
+    if (!l.color.empty()) {
+      if (l.color.size() != 3) fail(where + ".color", "must have 3 values");
+      for (double v : l.color)
+        if (!(std::isfinite(v) && v >= 0)) fail(where + ".color", "values must be finite and >= 0");
+    }
+    if (!(std::isfinite(l.intensity) && l.intensity >= 0)) fail(where + ".intensity", "must be finite and >= 0");
+    if (!(std::isfinite(l.range) && l.range >= 0)) fail(where + ".range", "must be finite and > 0");
+    if (l.type == "spot") {
+      const double in = l.spot.innerConeAngle, out = l.spot.outerConeAngle;
+      if (!(std::isfinite(in) && std::isfinite(out) && in >= 0 && in < out && out <= kPi / 2 + 1e-6))
+        fail(where + ".spot", "cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2");
+    }
+  }
+}
+
+Transform Converter::local_transform(int node) {
+  const auto& n = m_model.nodes[size_t(node)];
+  const std::string where = idx("nodes", size_t(node));
+  if (!n.matrix.empty()) {
+    if (n.matrix.size() != 16) fail(where + ".matrix", "must have 16 values");
+    Transform t = from_column_major(n.matrix.data());
+    if (!is_finite(t)) fail(where + ".matrix", "contains NaN or infinite values");
+    return t;
+  }
+  std::array<double, 3> tr{0, 0, 0}, sc{1, 1, 1};
+  Quat q;
+  if (!n.translation.empty()) {
+    if (n.translation.size() != 3) fail(where + ".translation", "must have 3 values");
+    std::copy(n.translation.begin(), n.translation.end(), tr.begin());
+  }
+  if (!n.scale.empty()) {
+    if (n.scale.size() != 3) fail(where + ".scale", "must have 3 values");
+    std::copy(n.scale.begin(), n.scale.end(), sc.begin());
+  }
+  if (!n.rotation.empty()) {
+    if (n.rotation.size() != 4) fail(where + ".rotation", "must have 4 values");
+    q = {n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};
+    const double len = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    if (!std::isfinite(len) || len < 1e-6) fail(where + ".rotation", "is not a unit quaternion (length " + std::to_string(len) + ")");
+    if (std::fabs(len - 1) > 1e-3) warn(where + ".rotation", "quaternion not normalised (length " + std::to_string(len) + "); normalising");
+  }
+  for (double v : tr) if (!std::isfinite(v)) fail(where + ".translation", "contains NaN or infinite values");
+  for (double v : sc) if (!std::isfinite(v)) fail(where + ".scale", "contains NaN or infinite values");
+  return compose_trs(tr, q, sc);
+}
+
+void Converter::traverse(const std::vector<int>& roots) {
+  const size_t n = m_model.nodes.size();
+  // Phase 1: validate child references, parent uniqueness and acyclicity without recursion.
+  std::vector<int> parent(n, -1);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c : m_model.nodes[i].children) {
+      if (c < 0 || size_t(c) >= n)
+        fail(idx("nodes", i) + ".children", "node index " + std::to_string(c) + " out of range (" + std::to_string(n) + " nodes)");
+      if (size_t(c) == i) fail(idx("nodes", i) + ".children", "node is its own child");
+      if (parent[size_t(c)] >= 0)
+        fail(idx("nodes", size_t(c)), "has more than one parent (nodes[" + std::to_string(parent[size_t(c)]) +
+                                          "] and nodes[" + std::to_string(i) + "])");
+      parent[size_t(c)] = int(i);
+    }
+  }
+  // With at most one parent each, a cycle is a loop of parent links; find one iteratively.
+  std::vector<uint8_t> state(n, 0);  // 0 unvisited, 1 on the current parent chain, 2 done
+  std::vector<size_t> path;
+  for (size_t i = 0; i < n; ++i) {
+    path.clear();
+    size_t cur = i;
+    bool cycle = false;
+    while (state[cur] != 2) {
+      if (state[cur] == 1) {
+        cycle = true;
+        break;
+      }
+      state[cur] = 1;
+      path.push_back(cur);
+      if (parent[cur] < 0) break;
+      cur = size_t(parent[cur]);
+    }
+    if (cycle) fail(idx("nodes", cur), "is part of a node cycle");
+    for (size_t p : path) state[p] = 2;
+  }
+  // Phase 2: depth-first traversal accumulating parent * local, with an explicit stack.
+  std::set<int> seen_roots;
+  struct Item { int node; Transform parent_world; };
+  std::vector<Item> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
+    const int r = *it;
+    if (r < 0 || size_t(r) >= n) fail("scenes.nodes", "node index " + std::to_string(r) + " out of range (" + std::to_string(n) + " nodes)");
+    if (parent[size_t(r)] >= 0) fail(idx("nodes", size_t(r)), "is listed as a scene root but is a child of nodes[" + std::to_string(parent[size_t(r)]) + "]");
+    if (!seen_roots.insert(r).second) fail(idx("nodes", size_t(r)), "listed twice as a scene root");
+    stack.push_back({r, Transform{}});
+  }
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    const auto& node = m_model.nodes[size_t(item.node)];
+    const Transform world = item.parent_world * local_transform(item.node);
+    if (!is_finite(world)) fail(idx("nodes", size_t(item.node)), "world transform overflows to non-finite values");
+    if (node.mesh >= 0 || node.mesh < -1) add_mesh(node.mesh, item.node, world);
+    if (node.camera >= 0 || node.camera < -1) add_camera(node.camera, item.node, world);
+    if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
+      const auto& li = it->second.Get("light");
+      if (!li.IsNumber()) fail(idx("nodes", size_t(item.node)) + ".extensions.KHR_lights_punctual.light", "must be an integer");
+      add_light(int(li.GetNumberAsInt()), item.node, world);
+    }
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+  }
+}
+
+void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
+  const std::string node_where = idx("nodes", size_t(node));
+  if (mesh_index < 0 || size_t(mesh_index) >= m_model.meshes.size())
+    fail(node_where + ".mesh", "mesh index " + std::to_string(mesh_index) + " out of range (" +
+                                   std::to_string(m_model.meshes.size()) + " meshes)");
+  const auto& mesh = m_model.meshes[size_t(mesh_index)];
+  Transform inv;
+  if (!inverse(world, inv)) {
+    warn(node_where, "singular transform; mesh " + std::to_string(mesh_index) + " skipped");
+    return;
+  }
+  const bool flip = determinant3x3(world) < 0;
+  for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+    const auto& prim = mesh.primitives[pi];
+    const std::string where = idx("meshes", size_t(mesh_index)) + "." + idx("primitives", pi);
+    if (prim.mode >= 0 && prim.mode <= 3) {
+      warn(where, "points/lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
+      continue;
+    }
+    if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6) fail(where, "invalid mode " + std::to_string(prim.mode));
+    const auto pos_it = prim.attributes.find("POSITION");
+    if (pos_it == prim.attributes.end()) {
+      warn(where, "no POSITION attribute; skipped");
+      continue;
+    }
+    const auto pos = read(pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                          {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    const size_t nv = pos.size() / 3;
+    if (nv >= 0xffffffffu) fail(where, "too many vertices");
+
+    // Indices (or the implicit 0..n-1), validated against the vertex count.
+    std::vector<uint32_t> raw;
+    if (prim.indices >= 0 || prim.indices < -1) {
+      raw = read_indices(prim.indices, where + ".indices");
+      for (uint32_t i : raw)
+        if (i >= nv) fail(where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(nv));
+    } else {
+      raw.resize(nv);
+      for (size_t i = 0; i < nv; ++i) raw[i] = uint32_t(i);
+    }
+    // Triangle list from the topology (glTF spec 3.7.2.1, "Topology Types").
+    std::vector<uint32_t> tris;
+    if (prim.mode == 4) {
+      if (raw.size() % 3) warn(where, "index count " + std::to_string(raw.size()) + " not a multiple of 3; extra indices ignored");
+      tris.assign(raw.begin(), raw.begin() + ptrdiff_t(raw.size() / 3 * 3));
+    } else if (prim.mode == 5) {
+      for (size_t i = 0; i + 2 < raw.size(); ++i) {
+        const bool odd = i % 2;
+        tris.insert(tris.end(), {raw[i], raw[i + (odd ? 2 : 1)], raw[i + (odd ? 1 : 2)]});
+      }
+    } else {
+      for (size_t i = 1; i + 1 < raw.size(); ++i) tris.insert(tris.end(), {raw[i], raw[i + 1], raw[0]});
+    }
+    if (tris.empty()) {
+      warn(where, "no triangles; skipped");
+      continue;
+    }
+    charge_memory(uint64_t(tris.size()) * 4 + uint64_t(nv) * 32, where);
+
+    Mesh out;
+    out.name = (mesh.name.empty() ? idx("meshes", size_t(mesh_index)) : mesh.name) + "[" + std::to_string(pi) + "]";
+    out.node = node;
+    out.material = prim.material;
+    if (prim.material < -1 || prim.material >= int(m_model.materials.size()))
+      fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
+                                    std::to_string(m_model.materials.size()) + " materials)");
+    out.positions.resize(nv);
+    bool bad = false;
+    for (size_t i = 0; i < nv; ++i) {
+      const Vec3f p{float(pos[i * 3]), float(pos[i * 3 + 1]), float(pos[i * 3 + 2])};
+      out.positions[i] = transform_point(world, p);
+      if (!is_finite(out.positions[i]) || max_component(abs(out.positions[i])) > 1e18f) bad = true;
+    }
+    if (bad) {
+      warn(where, "POSITION has NaN, infinite or huge (> 1e18) values; primitive dropped");
+      continue;
+    }
+    if (flip)
+      for (size_t i = 0; i < tris.size(); i += 3) std::swap(tris[i + 1], tris[i + 2]);
+    out.indices = std::move(tris);
+
+    if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
+      const auto nrm = read(it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
+                            {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+      if (nrm.size() != pos.size()) fail(where + ".attributes.NORMAL", "count differs from POSITION count");
+      out.normals.resize(nv);
+      bool bad_normal = false;
+      for (size_t i = 0; i < nv; ++i) {
+        const Vec3f n{float(nrm[i * 3]), float(nrm[i * 3 + 1]), float(nrm[i * 3 + 2])};
+        out.normals[i] = normalize(transform_normal(inv, n));
+        if (!is_finite(out.normals[i]) || !(dot(out.normals[i], out.normals[i]) > 0)) bad_normal = true;
+      }
+      if (bad_normal) {
+        warn(where + ".attributes.NORMAL", "zero, NaN or infinite normals; computing smooth normals instead");
+        out.normals.clear();
+      }
+    }
+    if (out.normals.empty()) out.normals = compute_smooth_normals(out.positions, out.indices);
+
+    if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
+      const auto uv = read(it->second, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
+                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+      if (uv.size() / 2 != nv) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION count");
+      out.uvs.resize(nv);
+      for (size_t i = 0; i < nv; ++i) out.uvs[i] = {float(uv[i * 2]), float(uv[i * 2 + 1])};
+    }
+    m_out.scene.meshes.push_back(std::move(out));
+  }
+}
+
+void Converter::add_camera(int camera_index, int node, const Transform& world) {
+  const std::string node_where = idx("nodes", size_t(node));
+  if (camera_index < 0 || size_t(camera_index) >= m_model.cameras.size())
+    fail(node_where + ".camera", "camera index " + std::to_string(camera_index) + " out of range (" +
+                                     std::to_string(m_model.cameras.size()) + " cameras)");
+  const auto& src = m_model.cameras[size_t(camera_index)];
+  Camera cam;
+  cam.name = src.name.empty() ? idx("cameras", size_t(camera_index)) : src.name;
+  cam.eye = transform_point(world, {0, 0, 0});
+  // Orthonormalise the node's axes (scale is not part of a camera placement).
+  const Vec3f w = normalize(transform_vector(world, {0, 0, 1}));
+  Vec3f u = transform_vector(world, {1, 0, 0});
+  u = normalize(u - w * dot(u, w));
+  if (!(dot(w, w) > 0) || !(dot(u, u) > 0) || !is_finite(cam.eye))
+    fail(node_where, "camera transform is singular");
+  cam.w = w;
+  cam.u = u;
+  cam.v = cross(w, u);
+  if (src.type == "perspective") {
+    cam.projection = Projection::Perspective;
+    cam.yfov = float(src.perspective.yfov);
+    cam.aspect = float(src.perspective.aspectRatio);
+    cam.znear = float(src.perspective.znear);
+    cam.zfar = src.perspective.zfar > 0 ? float(src.perspective.zfar) : kInfinity;
+  } else {
+    cam.projection = Projection::Orthographic;
+    cam.xmag = float(src.orthographic.xmag);
+    cam.ymag = float(src.orthographic.ymag);
+    cam.aspect = cam.xmag / cam.ymag;
+    cam.znear = float(src.orthographic.znear);
+    cam.zfar = float(src.orthographic.zfar);
+  }
+  m_out.scene.cameras.push_back(cam);
+  m_out.info.camera_instances.push_back(cam.name + " (" + src.type + ", " + node_where +
+                                        (m_model.nodes[size_t(node)].name.empty() ? "" : " '" + m_model.nodes[size_t(node)].name + "'") + ")");
+}
+
+void Converter::add_light(int light_index, int node, const Transform& world) {
+  const std::string node_where = idx("nodes", size_t(node));
+  if (light_index < 0 || size_t(light_index) >= m_model.lights.size())
+    fail(node_where + ".extensions.KHR_lights_punctual.light", "light index " + std::to_string(light_index) +
+                                                                   " out of range (" + std::to_string(m_model.lights.size()) + " lights)");
+  const auto& src = m_model.lights[size_t(light_index)];
+  Light l;
+  l.name = src.name.empty() ? "lights[" + std::to_string(light_index) + "]" : src.name;
+  l.type = src.type == "point" ? LightType::Point : (src.type == "spot" ? LightType::Spot : LightType::Directional);
+  if (src.color.size() == 3) l.color = {float(src.color[0]), float(src.color[1]), float(src.color[2])};
+  l.intensity = float(src.intensity);
+  l.range = src.range > 0 ? float(src.range) : kInfinity;
+  l.inner_cone = float(src.spot.innerConeAngle);
+  l.outer_cone = float(src.spot.outerConeAngle);
+  l.position = transform_point(world, {0, 0, 0});
+  l.direction = normalize(transform_vector(world, {0, 0, -1}));
+  if (l.type != LightType::Point && !(dot(l.direction, l.direction) > 0))
+    fail(node_where, "light transform is singular");
+  m_out.scene.lights.push_back(l);
+}
+
+void Converter::run() {
+  auto& info = m_out.info;
+  info.generator = m_model.asset.generator;
+  info.version = m_model.asset.version;
+  info.scene_count = int(m_model.scenes.size());
+  for (size_t i = 0; i < m_model.scenes.size(); ++i)
+    info.scene_names.push_back(m_model.scenes[i].name.empty() ? idx("scenes", i) : m_model.scenes[i].name);
+  info.node_count = int(m_model.nodes.size());
+  info.mesh_count = int(m_model.meshes.size());
+  for (const auto& m : m_model.meshes) info.primitive_count += int(m.primitives.size());
+  info.gltf_camera_count = int(m_model.cameras.size());
+  info.gltf_light_count = int(m_model.lights.size());
+  info.image_count = int(m_model.images.size());
+  info.animation_count = int(m_model.animations.size());
+  info.extensions_used = m_model.extensionsUsed;
+  info.extensions_required = m_model.extensionsRequired;
+
+  if (!m_model.asset.version.empty() && m_model.asset.version.rfind("2.", 0) != 0)
+    fail("asset.version", "version '" + m_model.asset.version + "' is not glTF 2.x");
+  check_extensions();
+  convert_materials();
+  validate_cameras();
+  validate_lights();
+
+  // Which scene: --scene N, else the file's default, else scenes[0], else every root node.
+  int scene = m_options.scene >= 0 ? m_options.scene : m_model.defaultScene;
+  if (m_options.scene >= 0 && size_t(m_options.scene) >= m_model.scenes.size())
+    throw InputError(m_file, "--scene", "scene " + std::to_string(m_options.scene) + " does not exist (" +
+                                            std::to_string(m_model.scenes.size()) + " scenes)");
+  if (scene >= int(m_model.scenes.size()) || scene < -1)
+    fail("scene", "default scene " + std::to_string(scene) + " out of range (" + std::to_string(m_model.scenes.size()) + " scenes)");
+  if (scene < 0 && !m_model.scenes.empty()) scene = 0;
+  info.scene_index = scene;
+  std::vector<int> roots;
+  if (scene >= 0) {
+    roots = m_model.scenes[size_t(scene)].nodes;
+  } else {
+    std::vector<bool> is_child(m_model.nodes.size(), false);
+    for (const auto& n : m_model.nodes)
+      for (int c : n.children)
+        if (c >= 0 && size_t(c) < is_child.size()) is_child[size_t(c)] = true;
+    for (size_t i = 0; i < is_child.size(); ++i)
+      if (!is_child[i]) roots.push_back(int(i));
+    if (!m_model.nodes.empty()) warn("scenes", "file has no scene; rendering all root nodes");
+  }
+  traverse(roots);
+}
+
+}  // namespace
+
+LoadedScene load_gltf(const fs::path& file, const GltfLoadOptions& options) {
+  const std::string name = file.string();
+  std::error_code ec;
+  const auto st = fs::status(file, ec);
+  if (ec || !fs::exists(st)) throw InputError(name, "", "file not found");
+  if (!fs::is_regular_file(st)) throw InputError(name, "", "not a regular file");
+
+  std::vector<unsigned char> bytes;
+  std::string err;
+  if (!read_file_limited(file, options.max_file_bytes, bytes, err)) throw InputError(name, "", err);
+  if (bytes.size() >= 0xffffffffu) throw InputError(name, "", "file too large for glTF (>= 4 GiB)");
+
+  const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  const std::string_view json =
+      is_glb ? glb_json_chunk(name, bytes)
+             : std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  if (json_nesting_depth(json, options.max_json_depth) > options.max_json_depth)
+    throw InputError(name, "JSON", "nesting deeper than " + std::to_string(options.max_json_depth) +
+                                       " levels (refused before parsing)");
+
+  FsSandbox box;
+  box.root = fs::weakly_canonical(fs::absolute(file).parent_path(), ec);
+  box.allow_external = options.allow_external_uris;
+  box.max_bytes = options.max_file_bytes;
+  tinygltf::TinyGLTF parser;
+  parser.SetFsCallbacks({sandbox_file_exists, sandbox_expand, sandbox_read, sandbox_write, &box});
+  parser.SetImageLoader(skip_image, nullptr);
+
+  tinygltf::Model model;
+  std::string terr, twarn;
+  bool ok = false;
+  try {
+    const std::string base_dir = box.root.string();
+    ok = is_glb ? parser.LoadBinaryFromMemory(&model, &terr, &twarn, bytes.data(),
+                                              unsigned(bytes.size()), base_dir)
+                : parser.LoadASCIIFromString(&model, &terr, &twarn,
+                                             reinterpret_cast<const char*>(bytes.data()),
+                                             unsigned(bytes.size()), base_dir);
+  } catch (const std::bad_alloc&) {
+    throw InputError(name, "", "out of memory while parsing (file too large or malformed)");
+  } catch (const std::exception& e) {
+    throw InputError(name, "", std::string("parse error: ") + e.what());
+  }
+  auto trim = [](std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    for (auto& c : s) if (c == '\n') c = ';';
+    return s;
+  };
+  if (!ok) {
+    std::string msg = terr.empty() ? "tinygltf could not parse the file" : trim(terr);
+    if (!box.first_denial.empty()) msg += " (" + box.first_denial + ")";
+    throw InputError(name, "", msg);
+  }
+
+  LoadedScene out;
+  if (!twarn.empty()) out.warnings.push_back("tinygltf: " + trim(twarn));
+  if (!box.first_denial.empty()) out.warnings.push_back("uri: " + box.first_denial);
+  try {
+    Converter(model, name, options, out).run();
+  } catch (const std::bad_alloc&) {
+    throw InputError(name, "", "out of memory while converting the scene");
+  }
+  return out;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,55 @@
+// glTF 2.0 loading (.gltf with external or data-URI buffers, .glb) into a renderer Scene.
+// tinygltf parses; this module validates everything tinygltf does not (indices, accessor
+// ranges with overflow-safe arithmetic, node cycles, NaN data, URI escapes, JSON depth,
+// camera and light parameters) and flattens the node hierarchy into world-space meshes.
+// Textures are not decoded yet (images are skipped).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "renderer/scene.h"
+
+namespace penumbra {
+
+/// Loader limits and choices, with their defaults.
+struct GltfLoadOptions {
+  int scene = -1;                     ///< glTF scene index; -1 = the file's default (or 0)
+  bool allow_external_uris = false;   ///< allow URIs that resolve outside the file's folder
+  uint64_t max_file_bytes = 2ull << 30;   ///< per file read (glTF, GLB, .bin)
+  uint64_t max_memory_bytes = 8ull << 30; ///< budget for decoded geometry
+  int max_json_depth = 64;            ///< deeper JSON nesting is rejected before parsing
+};
+
+/// Descriptive facts about the file, for `penumbra info`.
+struct GltfInfo {
+  std::string generator, version;
+  int scene_count = 0, scene_index = -1;
+  std::vector<std::string> scene_names;
+  int node_count = 0, mesh_count = 0, primitive_count = 0;
+  int gltf_camera_count = 0, gltf_light_count = 0, image_count = 0, animation_count = 0;
+  std::vector<std::string> extensions_used, extensions_required;
+  std::vector<std::string> camera_instances;  ///< "name (perspective, node 3)" in scene order
+};
+
+struct LoadedScene {
+  Scene scene;
+  GltfInfo info;
+  std::vector<std::string> warnings;  ///< each names the element it concerns
+};
+
+/// Loads `file`. Throws InputError (file + JSON path + reason) for anything malformed or
+/// hostile; degenerate but harmless content (points/lines primitives, NaN vertices, missing
+/// images) produces a warning instead and is skipped.
+LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options = {});
+
+/// Maximum nesting depth of arrays/objects in a JSON text (strings are skipped correctly).
+/// Stops counting once `limit` is exceeded and returns limit + 1.
+int json_nesting_depth(std::string_view json, int limit);
+
+/// The extensions this loader implements (an extensionsRequired entry outside it is an error).
+std::vector<std::string> supported_gltf_extensions();
+
+}  // namespace penumbra

@@ -1,0 +1,44 @@
+// Image output: scene-linear RGBA OpenEXR through OpenImageIO, and display-referred images
+// (PNG, JPEG, TIFF) through an OpenColorIO display/view transform. Both written atomically.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "renderer/film.h"
+
+namespace penumbra {
+
+struct ExrOptions {
+  bool half = true;                  ///< 16-bit half channels; false = 32-bit float
+  std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts
+  std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
+};
+
+/// Writes channels R, G, B, A (colour premultiplied by A) to `path`. Throws
+/// std::runtime_error naming the file if OpenImageIO fails.
+void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options);
+
+struct DisplayOptions {
+  std::string ocio_config;  ///< config file; empty = $OCIO if set, else Penumbra's shipped config
+  std::string display;      ///< empty = the config's default display
+  std::string view;         ///< empty = the display's default view
+  float exposure = 0;       ///< stops applied in scene-linear before the view transform
+};
+
+/// Writes the beauty (over black) through the display/view transform as 8-bit RGB (16-bit for
+/// TIFF). The format follows the extension (.png, .jpg/.jpeg, .tif/.tiff). Throws InputError
+/// for a bad config/display/view and std::runtime_error for write failures.
+void write_display_image(const Film& film, const std::filesystem::path& path,
+                         const DisplayOptions& options);
+
+/// Penumbra's shipped OCIO config text (io/ocio/config.ocio, embedded at build time).
+const char* shipped_ocio_config();
+
+/// Applies the display transform to `rgb` (width*height*3 floats, in place).
+void apply_display_transform(std::vector<float>& rgb, int width, int height,
+                             const DisplayOptions& options);
+
+}  // namespace penumbra

@@ -1,0 +1,22 @@
+// The accelerator factory: the one place that maps a back-end name to a builder.
+#include "renderer/accel/accelerator.h"
+
+#include <stdexcept>
+
+#include "renderer/accel/brute.h"
+#include "renderer/accel/embree.h"
+
+namespace penumbra {
+
+std::vector<std::string> accelerator_names() { return {"embree", "brute"}; }
+
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
+                                              std::span<const TriangleMeshView> meshes) {
+  if (name == "embree") return make_embree_accelerator(meshes);
+  if (name == "brute") return make_brute_accelerator(meshes);
+  std::string known;
+  for (const auto& n : accelerator_names()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown accelerator '" + std::string(name) + "' (known: " + known + ")");
+}
+
+}  // namespace penumbra

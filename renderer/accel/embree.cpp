@@ -1,0 +1,182 @@
+// Embree 3 back end. Embree reports errors through a C callback, which only records them;
+// the build function converts a recorded error into an exception at this one boundary.
+#include "renderer/accel/embree.h"
+
+#include <embree3/rtcore.h>
+
+#include <chrono>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+namespace penumbra {
+namespace {
+
+struct DeviceErrors {
+  std::mutex mutex;
+  std::string first;  // first error since the last take(); empty if none
+};
+
+DeviceErrors& device_errors() {
+  static DeviceErrors errors;
+  return errors;
+}
+
+void record_error(void*, RTCError code, const char* str) {
+  auto& e = device_errors();
+  std::lock_guard lock(e.mutex);
+  if (e.first.empty()) e.first = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
+}
+
+std::string take_error() {
+  auto& e = device_errors();
+  std::lock_guard lock(e.mutex);
+  std::string s;
+  std::swap(s, e.first);
+  return s;
+}
+
+RTCDevice device() {
+  static RTCDevice dev = [] {
+    RTCDevice d = rtcNewDevice(nullptr);
+    if (!d) throw std::runtime_error("embree: cannot create device (rtcNewDevice failed)");
+    rtcSetDeviceErrorFunction(d, record_error, nullptr);
+    return d;
+  }();
+  return dev;
+}
+
+void throw_if_error(const char* what) {
+  std::string e = take_error();
+  if (!e.empty()) throw std::runtime_error(std::string("embree: ") + what + ": " + e);
+}
+
+class EmbreeAccelerator final : public Accelerator {
+ public:
+  explicit EmbreeAccelerator(std::span<const TriangleMeshView> meshes) {
+    const auto t0 = std::chrono::steady_clock::now();
+    RTCDevice dev = device();
+    take_error();
+    m_scene = rtcNewScene(dev);
+    throw_if_error("rtcNewScene");
+    rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+    for (size_t i = 0; i < meshes.size(); ++i) {
+      const TriangleMeshView& mesh = meshes[i];
+      RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+      const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
+      // Embree wants at least one element per buffer; an empty mesh still occupies its id.
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, nv ? nv : 1));
+      auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, nt ? nt : 1));
+      throw_if_error("allocating geometry buffers");
+      if (nv) std::memcpy(v, mesh.positions.data(), nv * sizeof(float) * 3);
+      if (nt) {
+        std::memcpy(idx, mesh.indices.data(), nt * sizeof(uint32_t) * 3);
+      } else {
+        std::memset(v, 0, sizeof(float) * 3);
+        std::memset(idx, 0, sizeof(uint32_t) * 3);  // one degenerate triangle: never hit
+      }
+      rtcCommitGeometry(geom);
+      const unsigned id = rtcAttachGeometry(m_scene, geom);
+      rtcReleaseGeometry(geom);
+      throw_if_error("attaching geometry");
+      if (id != i) throw std::runtime_error("embree: unexpected geometry id");
+      m_triangles += nt;
+      m_bytes += nv * 12 + nt * 12;
+    }
+    rtcCommitScene(m_scene);
+    throw_if_error("building the scene (rtcCommitScene)");
+    RTCBounds b;
+    rtcGetSceneBounds(m_scene, &b);
+    if (m_triangles > 0) m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  ~EmbreeAccelerator() override {
+    if (m_scene) rtcReleaseScene(m_scene);
+  }
+  EmbreeAccelerator(const EmbreeAccelerator&) = delete;
+  EmbreeAccelerator& operator=(const EmbreeAccelerator&) = delete;
+
+  bool intersect(const Ray& ray, Hit& hit) const override {
+    hit = Hit{};
+    if (!valid_ray(ray)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    fill_ray(ray, rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(m_scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit.t = rh.ray.tfar;
+    hit.u = rh.hit.u;
+    hit.v = rh.hit.v;
+    hit.geom_id = rh.hit.geomID;
+    hit.prim_id = rh.hit.primID;
+    return true;
+  }
+
+  bool occluded(const Ray& ray) const override {
+    if (!valid_ray(ray)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    fill_ray(ray, r);
+    rtcOccluded1(m_scene, &ctx, &r);
+    return r.tfar < 0;  // Embree sets tfar = -inf on occlusion
+  }
+
+  Bounds3f bounds() const override { return m_bounds; }
+
+  AccelStats stats() const override {
+    AccelStats s;
+    s.name = "embree";
+    s.triangles = m_triangles;
+    s.bytes = m_bytes;
+    s.build_seconds = m_build_seconds;
+    return s;
+  }
+
+ private:
+  static bool valid_ray(const Ray& r) {
+    return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
+           r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
+  }
+  static void fill_ray(const Ray& in, RTCRay& r) {
+    r.org_x = in.org.x;
+    r.org_y = in.org.y;
+    r.org_z = in.org.z;
+    r.tnear = std::max(in.tnear, 0.0f);
+    r.dir_x = in.dir.x;
+    r.dir_y = in.dir.y;
+    r.dir_z = in.dir.z;
+    r.time = 0;
+    r.tfar = in.tfar;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+  }
+
+  RTCScene m_scene = nullptr;
+  Bounds3f m_bounds;
+  uint64_t m_triangles = 0;
+  uint64_t m_bytes = 0;
+  double m_build_seconds = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes) {
+  return std::make_unique<EmbreeAccelerator>(meshes);
+}
+
+std::string embree_version() {
+  const auto v = rtcGetDeviceProperty(device(), RTC_DEVICE_PROPERTY_VERSION);
+  return std::to_string(v / 10000) + "." + std::to_string((v / 100) % 100) + "." +
+         std::to_string(v % 100);
+}
+
+}  // namespace penumbra

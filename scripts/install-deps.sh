@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs Penumbra's build and runtime dependencies from Debian 12's archive.
+# Idempotent: only packages that are missing are installed. Needs root (or sudo).
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libembree-dev libtbb-dev
+  libopenimageio-dev openimageio-tools libopenexr-dev openexr
+  libopencolorio-dev opencolorio-tools
+  libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
+  catch2 libcli11-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "penumbra: all ${#PACKAGES[@]} Debian packages already installed" >&2
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "penumbra: installing ${missing[*]}" >&2
+$SUDO apt-get update -q
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
