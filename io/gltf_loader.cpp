@@ -17,7 +17,7 @@ namespace penumbra {
 namespace fs = std::filesystem;
 
 std::vector<std::string> supported_gltf_extensions() {
-  return {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+  return {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {
@@ -68,7 +68,9 @@ bool sandbox_allows(FsSandbox& box, const std::string& path) {
   if (!box.allow_external) {
     const auto rel = canon.lexically_relative(box.root);
     if (rel.empty() || *rel.begin() == "..") {
-      if (box.first_denial.empty())
+      // Only a file that really exists out there is worth reporting (tinygltf also probes
+      // the working directory for every URI).
+      if (box.first_denial.empty() && fs::is_regular_file(canon, ec))
         box.first_denial = "URI resolves to '" + canon.string() +
                            "', outside the scene folder (use --allow-external-uris to permit)";
       return false;
@@ -206,7 +208,20 @@ class Converter {
                            std::initializer_list<int> component_types, bool allow_normalized);
   std::vector<uint32_t> read_indices(int accessor, const std::string& user);
 
+  /// One glTF primitive decoded and validated in its mesh's local space.
+  struct LocalPrimitive {
+    std::vector<Vec3f> positions, normals;  // normals empty if absent or unusable
+    std::vector<Vec2f> uvs;
+    std::vector<uint32_t> indices;          // triangle list
+    int material = -1;
+    bool usable = false;                    // false: skipped with a warning
+  };
+
   void check_extensions();
+  void validate_accessors();
+  void validate_textures();
+  void decode_meshes();
+  LocalPrimitive decode_primitive(size_t mesh, size_t prim);
   void convert_materials();
   void validate_cameras();
   void validate_lights();
@@ -221,6 +236,7 @@ class Converter {
   const GltfLoadOptions& m_options;
   LoadedScene& m_out;
   uint64_t m_memory = 0;
+  std::vector<std::vector<LocalPrimitive>> m_meshes;  // [mesh][primitive]
 };
 
 AccessorLayout Converter::layout(int accessor, const std::string& user) {
@@ -423,6 +439,11 @@ void Converter::convert_materials() {
         m.emissive *= float(strength);
       }
     }
+    if (src.emissiveTexture.index >= 0 && max_component(m.emissive) > 0) {
+      warn(where + ".emissiveTexture", "textures are not decoded yet; texture-driven emission ignored");
+      m.emissive = {0, 0, 0};
+    }
+    m.unlit = src.extensions.count("KHR_materials_unlit") > 0;
     m_out.scene.materials.push_back(m);
   }
 }
@@ -573,6 +594,101 @@ void Converter::traverse(const std::vector<int>& roots) {
   }
 }
 
+Converter::LocalPrimitive Converter::decode_primitive(size_t mesh_index, size_t pi) {
+  const auto& prim = m_model.meshes[mesh_index].primitives[pi];
+  const std::string where = idx("meshes", mesh_index) + "." + idx("primitives", pi);
+  LocalPrimitive out;
+  if (prim.mode >= 0 && prim.mode <= 3) {
+    warn(where, "points/lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
+    return out;
+  }
+  if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6) fail(where, "invalid mode " + std::to_string(prim.mode));
+  if (prim.material < -1 || prim.material >= int(m_model.materials.size()))
+    fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
+                                  std::to_string(m_model.materials.size()) + " materials)");
+  out.material = prim.material;
+  const auto pos_it = prim.attributes.find("POSITION");
+  if (pos_it == prim.attributes.end()) {
+    warn(where, "no POSITION attribute; skipped");
+    return out;
+  }
+  const auto pos = read(pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+  const size_t nv = pos.size() / 3;
+  if (nv >= 0xffffffffu) fail(where, "too many vertices");
+
+  // Indices (or the implicit 0..n-1), validated against the vertex count.
+  std::vector<uint32_t> raw;
+  if (prim.indices >= 0 || prim.indices < -1) {
+    raw = read_indices(prim.indices, where + ".indices");
+    for (uint32_t i : raw)
+      if (i >= nv) fail(where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(nv));
+  } else {
+    raw.resize(nv);
+    for (size_t i = 0; i < nv; ++i) raw[i] = uint32_t(i);
+  }
+  // Triangle list from the topology (glTF spec 3.7.2.1, "Topology Types").
+  auto& tris = out.indices;
+  if (prim.mode == 4) {
+    if (raw.size() % 3) warn(where, "index count " + std::to_string(raw.size()) + " not a multiple of 3; extra indices ignored");
+    tris.assign(raw.begin(), raw.begin() + ptrdiff_t(raw.size() / 3 * 3));
+  } else if (prim.mode == 5) {
+    for (size_t i = 0; i + 2 < raw.size(); ++i) {
+      const bool odd = i % 2;
+      tris.insert(tris.end(), {raw[i], raw[i + (odd ? 2 : 1)], raw[i + (odd ? 1 : 2)]});
+    }
+  } else {
+    for (size_t i = 1; i + 1 < raw.size(); ++i) tris.insert(tris.end(), {raw[i], raw[i + 1], raw[0]});
+  }
+
+  // Attributes must all have the POSITION count; read them before deciding to drop anything.
+  std::vector<double> nrm, uv;
+  if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
+    nrm = read(it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    if (nrm.size() != pos.size()) fail(where + ".attributes.NORMAL", "count differs from POSITION count");
+  }
+  if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
+    uv = read(it->second, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
+              {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+    if (uv.size() / 2 != nv) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION count");
+  }
+  if (tris.empty()) {
+    warn(where, "no triangles; skipped");
+    return out;
+  }
+  out.positions.resize(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    out.positions[i] = {float(pos[i * 3]), float(pos[i * 3 + 1]), float(pos[i * 3 + 2])};
+    if (!is_finite(out.positions[i]) || max_component(abs(out.positions[i])) > 1e18f) {
+      warn(where, "POSITION has NaN, infinite or huge (> 1e18) values; primitive dropped");
+      return out;
+    }
+  }
+  if (!nrm.empty()) {
+    out.normals.resize(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      out.normals[i] = {float(nrm[i * 3]), float(nrm[i * 3 + 1]), float(nrm[i * 3 + 2])};
+      if (!is_finite(out.normals[i]) || !(dot(out.normals[i], out.normals[i]) > 0)) {
+        warn(where + ".attributes.NORMAL", "zero, NaN or infinite normals; computing smooth normals instead");
+        out.normals.clear();
+        break;
+      }
+    }
+  }
+  if (!uv.empty()) {
+    out.uvs.resize(nv);
+    for (size_t i = 0; i < nv; ++i) out.uvs[i] = {float(uv[i * 2]), float(uv[i * 2 + 1])};
+  }
+  out.usable = true;
+  return out;
+}
+
+void Converter::decode_meshes() {
+  m_meshes.resize(m_model.meshes.size());
+  for (size_t m = 0; m < m_model.meshes.size(); ++m)
+    for (size_t p = 0; p < m_model.meshes[m].primitives.size(); ++p) m_meshes[m].push_back(decode_primitive(m, p));
+}
+
 void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
   const std::string node_where = idx("nodes", size_t(node));
   if (mesh_index < 0 || size_t(mesh_index) >= m_model.meshes.size())
@@ -584,103 +700,77 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
     warn(node_where, "singular transform; mesh " + std::to_string(mesh_index) + " skipped");
     return;
   }
-  const bool flip = determinant3x3(world) < 0;
+  const bool flip = determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
   for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-    const auto& prim = mesh.primitives[pi];
+    const LocalPrimitive& local = m_meshes[size_t(mesh_index)][pi];
+    if (!local.usable) continue;
     const std::string where = idx("meshes", size_t(mesh_index)) + "." + idx("primitives", pi);
-    if (prim.mode >= 0 && prim.mode <= 3) {
-      warn(where, "points/lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
-      continue;
-    }
-    if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6) fail(where, "invalid mode " + std::to_string(prim.mode));
-    const auto pos_it = prim.attributes.find("POSITION");
-    if (pos_it == prim.attributes.end()) {
-      warn(where, "no POSITION attribute; skipped");
-      continue;
-    }
-    const auto pos = read(pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
-                          {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-    const size_t nv = pos.size() / 3;
-    if (nv >= 0xffffffffu) fail(where, "too many vertices");
-
-    // Indices (or the implicit 0..n-1), validated against the vertex count.
-    std::vector<uint32_t> raw;
-    if (prim.indices >= 0 || prim.indices < -1) {
-      raw = read_indices(prim.indices, where + ".indices");
-      for (uint32_t i : raw)
-        if (i >= nv) fail(where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(nv));
-    } else {
-      raw.resize(nv);
-      for (size_t i = 0; i < nv; ++i) raw[i] = uint32_t(i);
-    }
-    // Triangle list from the topology (glTF spec 3.7.2.1, "Topology Types").
-    std::vector<uint32_t> tris;
-    if (prim.mode == 4) {
-      if (raw.size() % 3) warn(where, "index count " + std::to_string(raw.size()) + " not a multiple of 3; extra indices ignored");
-      tris.assign(raw.begin(), raw.begin() + ptrdiff_t(raw.size() / 3 * 3));
-    } else if (prim.mode == 5) {
-      for (size_t i = 0; i + 2 < raw.size(); ++i) {
-        const bool odd = i % 2;
-        tris.insert(tris.end(), {raw[i], raw[i + (odd ? 2 : 1)], raw[i + (odd ? 1 : 2)]});
-      }
-    } else {
-      for (size_t i = 1; i + 1 < raw.size(); ++i) tris.insert(tris.end(), {raw[i], raw[i + 1], raw[0]});
-    }
-    if (tris.empty()) {
-      warn(where, "no triangles; skipped");
-      continue;
-    }
-    charge_memory(uint64_t(tris.size()) * 4 + uint64_t(nv) * 32, where);
-
+    charge_memory(uint64_t(local.indices.size()) * 4 + uint64_t(local.positions.size()) * 32, where);
     Mesh out;
     out.name = (mesh.name.empty() ? idx("meshes", size_t(mesh_index)) : mesh.name) + "[" + std::to_string(pi) + "]";
     out.node = node;
-    out.material = prim.material;
-    if (prim.material < -1 || prim.material >= int(m_model.materials.size()))
-      fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
-                                    std::to_string(m_model.materials.size()) + " materials)");
-    out.positions.resize(nv);
-    bool bad = false;
-    for (size_t i = 0; i < nv; ++i) {
-      const Vec3f p{float(pos[i * 3]), float(pos[i * 3 + 1]), float(pos[i * 3 + 2])};
-      out.positions[i] = transform_point(world, p);
-      if (!is_finite(out.positions[i]) || max_component(abs(out.positions[i])) > 1e18f) bad = true;
+    out.material = local.material;
+    out.positions.resize(local.positions.size());
+    for (size_t i = 0; i < local.positions.size(); ++i) {
+      out.positions[i] = transform_point(world, local.positions[i]);
+      if (!is_finite(out.positions[i]) || max_component(abs(out.positions[i])) > 1e18f) {
+        warn(where + " in " + node_where, "world-space positions are NaN, infinite or huge; dropped");
+        out.positions.clear();
+        break;
+      }
     }
-    if (bad) {
-      warn(where, "POSITION has NaN, infinite or huge (> 1e18) values; primitive dropped");
-      continue;
-    }
+    if (out.positions.empty()) continue;
+    out.indices = local.indices;
     if (flip)
-      for (size_t i = 0; i < tris.size(); i += 3) std::swap(tris[i + 1], tris[i + 2]);
-    out.indices = std::move(tris);
-
-    if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-      const auto nrm = read(it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
-                            {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-      if (nrm.size() != pos.size()) fail(where + ".attributes.NORMAL", "count differs from POSITION count");
-      out.normals.resize(nv);
-      bool bad_normal = false;
-      for (size_t i = 0; i < nv; ++i) {
-        const Vec3f n{float(nrm[i * 3]), float(nrm[i * 3 + 1]), float(nrm[i * 3 + 2])};
-        out.normals[i] = normalize(transform_normal(inv, n));
-        if (!is_finite(out.normals[i]) || !(dot(out.normals[i], out.normals[i]) > 0)) bad_normal = true;
-      }
-      if (bad_normal) {
-        warn(where + ".attributes.NORMAL", "zero, NaN or infinite normals; computing smooth normals instead");
-        out.normals.clear();
-      }
+      for (size_t i = 0; i < out.indices.size(); i += 3) std::swap(out.indices[i + 1], out.indices[i + 2]);
+    if (!local.normals.empty()) {
+      out.normals.resize(local.normals.size());
+      for (size_t i = 0; i < local.normals.size(); ++i) out.normals[i] = normalize(transform_normal(inv, local.normals[i]));
+    } else {
+      out.normals = compute_smooth_normals(out.positions, out.indices);
     }
-    if (out.normals.empty()) out.normals = compute_smooth_normals(out.positions, out.indices);
-
-    if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-      const auto uv = read(it->second, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
-                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
-      if (uv.size() / 2 != nv) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION count");
-      out.uvs.resize(nv);
-      for (size_t i = 0; i < nv; ++i) out.uvs[i] = {float(uv[i * 2]), float(uv[i * 2 + 1])};
-    }
+    out.uvs = local.uvs;
     m_out.scene.meshes.push_back(std::move(out));
+  }
+}
+
+void Converter::validate_accessors() {
+  for (size_t i = 0; i < m_model.accessors.size(); ++i) {
+    const std::string where = idx("accessors", i);
+    const uint64_t charged = m_memory;
+    AccessorLayout l = layout(int(i), where);
+    m_memory = charged;  // validation decodes nothing; only decoding is charged to the budget
+    if (l.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || !l.data) continue;
+    for (uint64_t e = 0; e < l.count; ++e)
+      for (int c = 0; c < l.components; ++c)
+        if (!std::isfinite(component(l, e, c))) {
+          warn(where, "element " + std::to_string(e) + " is NaN or infinite");
+          e = l.count;
+          break;
+        }
+  }
+}
+
+void Converter::validate_textures() {
+  const int n = int(m_model.textures.size());
+  for (size_t i = 0; i < m_model.textures.size(); ++i) {
+    const auto& t = m_model.textures[i];
+    if (t.source < -1 || t.source >= int(m_model.images.size()))
+      warn(idx("textures", i) + ".source", "image index " + std::to_string(t.source) + " out of range; texture ignored");
+    if (t.sampler < -1 || t.sampler >= int(m_model.samplers.size()))
+      warn(idx("textures", i) + ".sampler", "sampler index " + std::to_string(t.sampler) + " out of range; default sampler used");
+  }
+  for (size_t i = 0; i < m_model.materials.size(); ++i) {
+    const auto& m = m_model.materials[i];
+    const std::pair<const char*, int> refs[] = {
+        {"pbrMetallicRoughness.baseColorTexture", m.pbrMetallicRoughness.baseColorTexture.index},
+        {"pbrMetallicRoughness.metallicRoughnessTexture", m.pbrMetallicRoughness.metallicRoughnessTexture.index},
+        {"normalTexture", m.normalTexture.index}, {"occlusionTexture", m.occlusionTexture.index},
+        {"emissiveTexture", m.emissiveTexture.index}};
+    for (const auto& [field, index] : refs)
+      if (index < -1 || index >= n)
+        warn(idx("materials", i) + "." + field, "texture index " + std::to_string(index) + " out of range (" +
+                                                   std::to_string(n) + " textures); ignored");
   }
 }
 
@@ -762,9 +852,12 @@ void Converter::run() {
   if (!m_model.asset.version.empty() && m_model.asset.version.rfind("2.", 0) != 0)
     fail("asset.version", "version '" + m_model.asset.version + "' is not glTF 2.x");
   check_extensions();
+  validate_accessors();
+  validate_textures();
   convert_materials();
   validate_cameras();
   validate_lights();
+  decode_meshes();
 
   // Which scene: --scene N, else the file's default, else scenes[0], else every root node.
   int scene = m_options.scene >= 0 ? m_options.scene : m_model.defaultScene;
@@ -788,6 +881,8 @@ void Converter::run() {
     if (!m_model.nodes.empty()) warn("scenes", "file has no scene; rendering all root nodes");
   }
   traverse(roots);
+  if (m_out.scene.meshes.empty())
+    warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes", "no renderable triangles; the image shows only the background");
 }
 
 }  // namespace

@@ -20,6 +20,7 @@ struct Material {
   float metallic = 1;   ///< glTF default
   float roughness = 1;  ///< glTF default
   Vec3f emissive{0, 0, 0};  ///< emissiveFactor x KHR_materials_emissive_strength
+  bool unlit = false;       ///< KHR_materials_unlit: radiance = base_color, no lighting
 };
 
 /// A world-space triangle mesh (one glTF primitive instantiated by one node).

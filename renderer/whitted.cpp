@@ -42,6 +42,10 @@ Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const Whitt
     if (depth == 0) coverage = 1;
     const SurfaceInteraction si = make_interaction(scene, ray, hit);
     const Material& mat = si.material >= 0 ? scene.materials[size_t(si.material)] : kDefaultMaterial;
+    if (mat.unlit) {  // KHR_materials_unlit: the base colour is the outgoing radiance
+      radiance += throughput * mat.base_color;
+      break;
+    }
     const WhittedParams w = whitted_params(mat);
     const Vec3f v = normalize(-ray.dir);
 

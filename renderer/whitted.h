@@ -26,6 +26,7 @@ struct WhittedParams {
 ///        Blinn-Phong exponent, Walter et al. 2007)
 ///   kr = f0 x (1 - roughness)^2               smooth metals mirror, smooth plastics glint
 ///   emission = emissive
+/// Materials with `unlit` skip all of this: their radiance is base_color.
 WhittedParams whitted_params(const Material& m);
 
 /// Integrator settings, validated by the CLI.
