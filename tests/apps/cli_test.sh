@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# End-to-end test of the `penumbra` command: exit codes (0 ok, 2 bad input/usage), messages
+# that name the file and element, and the output files. Usage: cli_test.sh PENUMBRA SRC WORK
+set -u
+bin="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"
+corpus="${PENUMBRA_CORPUS:-${PENUMBRA_CORPUS_DEFAULT:-$src/../shared/corpus}}"
+fails=0; passes=0
+
+expect() {  # expect CODE PATTERN -- command...
+  local code="$1" pattern="$2"; shift 3
+  "$@" >"$work/out" 2>"$work/err"; local rc=$?
+  if [ "$rc" -ne "$code" ] || ! grep -qE -- "$pattern" "$work/out" "$work/err"; then
+    echo "FAIL: [$*] exit $rc (want $code), pattern '$pattern'"; sed 's/^/  | /' "$work/err" | head -5
+    fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+expect 0 "penumbra [0-9]" -- "$bin" --version
+expect 2 "render|info" -- "$bin"
+expect 2 "no-such-flag" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --no-such-flag
+expect 2 "missing.gltf: file not found" -- "$bin" render "$work/missing.gltf" -o "$work/a.exr"
+expect 2 "must be an .exr" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.png"
+expect 2 "does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/nodir/a.exr"
+expect 2 "spp" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --spp 0
+expect 2 "camera 7 does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera 7
+expect 2 "background" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --background nan
+[ ! -e "$work/a.exr" ] || { echo "FAIL: a failed run left $work/a.exr"; fails=$((fails + 1)); }
+
+# A real render: both paths on stdout, files readable, RGBA half EXR.
+expect 0 "small.png" -- "$bin" render "$src/scenes/default.gltf" -o "$work/small.exr" --width 64 --spp 1 -q
+if command -v oiiotool >/dev/null; then
+  expect 0 "64 x +36, 4 channel, half" -- oiiotool --info -v "$work/small.exr"
+  expect 0 "R, G, B, A" -- oiiotool --info -v "$work/small.exr"
+  expect 0 "64 x +36, 3 channel, uint8 png" -- oiiotool --info "$work/small.png"
+fi
+expect 0 "render|rays" -- "$bin" render "$src/scenes/default.gltf" -o "$work/f.exr" --float --no-png --height 20 --threads 1
+[ ! -e "$work/f.png" ] || { echo "FAIL: --no-png wrote a PNG"; fails=$((fails + 1)); }
+expect 0 "pixel 10,10: R" -- "$bin" render "$src/scenes/default.gltf" -o "$work/d.exr" --debug-pixel 10,10 --width 64
+expect 0 "4646 triangles" -- "$bin" info "$src/scenes/default.gltf"
+expect 0 "brute" -- "$bin" info "$src/scenes/default.gltf" --accel brute
+[ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
+
+# Hostile files from the shared corpus (skipped visibly without it).
+if [ -d "$corpus/invalid" ]; then
+  expect 2 "nodes\[0\]: is part of a node cycle" -- "$bin" render "$corpus/invalid/validator/base/node/node_loop.gltf" -o "$work/x.exr"
+  expect 2 "cameras\[0\]: orthographic.ymag" -- "$bin" info "$corpus/invalid/validator/base/camera/orthographic_xy.gltf"
+  expect 2 "GLB" -- "$bin" render "$corpus/invalid/validator/base/glb/length_mismatch.glb" -o "$work/x.exr"
+  expect 0 "warning: .*points/lines" -- "$bin" render "$corpus/valid/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf" -o "$work/m.exr" --width 32
+  [ ! -e "$work/x.exr" ] || { echo "FAIL: an error left $work/x.exr"; fails=$((fails + 1)); }
+else
+  echo "PENUMBRA_SKIP: corpus checks skipped ($corpus not found)"
+fi
+
+echo "cli: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]

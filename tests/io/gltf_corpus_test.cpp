@@ -1,0 +1,92 @@
+// io/gltf_loader on the shared corpus of third-party files: valid models load with the
+// triangle, camera and light counts the files hold (corpus README and the files' JSON);
+// every invalid file ends in an InputError or loads with warnings, never anything else.
+#include <catch2/catch.hpp>
+
+#include "io/error.h"
+#include "io/gltf_loader.h"
+#include "test_util.h"
+
+using namespace penumbra;
+namespace fs = std::filesystem;
+
+namespace {
+std::vector<fs::path> gltf_files(const fs::path& root) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.is_regular_file() && (e.path().extension() == ".gltf" || e.path().extension() == ".glb")) out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+}  // namespace
+
+TEST_CASE("corpus: valid models load with the expected counts", "[io][corpus]") {
+  const auto corpus = test::corpus_dir();
+  if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
+  struct Expect {
+    const char* file;
+    uint64_t triangles;
+    size_t cameras, lights;
+  };
+  const Expect expected[] = {
+      {"Box/glTF-Binary/Box.glb", 12, 0, 0},
+      {"Box/glTF-Embedded/Box.gltf", 12, 0, 0},
+      {"Triangle/glTF/Triangle.gltf", 1, 0, 0},
+      {"TriangleWithoutIndices/glTF/TriangleWithoutIndices.gltf", 1, 0, 0},
+      {"Cameras/glTF/Cameras.gltf", 2, 2, 0},
+      {"SimpleMeshes/glTF/SimpleMeshes.gltf", 2, 0, 0},
+      {"SimpleSparseAccessor/glTF/SimpleSparseAccessor.gltf", 12, 0, 0},
+      {"MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf", 16, 0, 0},
+      {"LightsPunctualLamp/glTF/LightsPunctualLamp.gltf", 6000, 0, 5},
+      {"CornellBox-Vinc3r/glTF/cornellBox-2.80-Eevee-gltf.gltf", 4410, 0, 0},
+      {"DamagedHelmet/glTF-Binary/DamagedHelmet.glb", 15452, 0, 0},
+      {"Suzanne/glTF/Suzanne.gltf", 3936, 0, 0},
+      {"Duck/glTF-Binary/Duck.glb", 4212, 1, 0},
+  };
+  for (const auto& e : expected) {
+    INFO(e.file);
+    const LoadedScene l = load_gltf(*corpus / "valid" / e.file);
+    CHECK(count_triangles(l.scene) == e.triangles);
+    CHECK(l.scene.cameras.size() == e.cameras);
+    CHECK(l.scene.lights.size() == e.lights);
+  }
+  // MultipleScenes: scene 0 and scene 1 hold different nodes.
+  const fs::path ms = *corpus / "valid/MultipleScenes/glTF/MultipleScenes.gltf";
+  GltfLoadOptions opt;
+  opt.scene = 1;
+  CHECK(load_gltf(ms).info.scene_count == 2);
+  CHECK(count_triangles(load_gltf(ms, opt).scene) > 0);
+  opt.scene = 2;
+  CHECK_THROWS_AS(load_gltf(ms, opt), InputError);
+}
+
+TEST_CASE("corpus: every valid file loads", "[io][corpus]") {
+  const auto corpus = test::corpus_dir();
+  if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
+  for (const auto& f : gltf_files(*corpus / "valid")) {
+    INFO(f.string());
+    LoadedScene l;
+    REQUIRE_NOTHROW(l = load_gltf(f));
+    CHECK(count_triangles(l.scene) > 0);
+  }
+}
+
+TEST_CASE("corpus: every invalid file ends in a clear error or warnings, never a crash", "[io][corpus][hostile]") {
+  const auto corpus = test::corpus_dir();
+  if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
+  int errors = 0, loaded = 0;
+  for (const auto& f : gltf_files(*corpus / "invalid")) {
+    INFO(f.string());
+    try {
+      const LoadedScene l = load_gltf(f);
+      ++loaded;
+    } catch (const InputError& e) {
+      ++errors;
+      CHECK(std::string(e.what()).find(f.string()) == 0);  // the message starts with the file
+    } catch (const std::exception& e) {
+      FAIL("unexpected exception type: " << e.what());
+    }
+  }
+  CHECK(errors > 80);  // most of the corpus is structurally broken
+  CHECK(errors + loaded > 150);
+}

@@ -1,0 +1,119 @@
+// Tests for io/image_output and io/atomic_file: EXR and PNG round trips through OpenImageIO,
+// the OCIO sRGB view, and atomic writes.
+#include "io/image_output.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <catch2/catch.hpp>
+#include <fstream>
+
+#include "io/atomic_file.h"
+#include "io/error.h"
+#include "test_util.h"
+
+using namespace penumbra;
+
+namespace {
+Film ramp(int w, int h) {
+  Film f = make_film(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float* p = f.pixel(x, y);
+      p[0] = float(x) / float(w);
+      p[1] = float(y) / float(h) * 4.0f;  // HDR values above 1
+      p[2] = 0.5f;
+      p[3] = x < w / 2 ? 1.0f : 0.25f;
+    }
+  return f;
+}
+
+std::vector<float> read_all(const std::filesystem::path& p, OIIO::ImageSpec& spec) {
+  auto in = OIIO::ImageInput::open(p.string());
+  REQUIRE(in);
+  spec = in->spec();
+  std::vector<float> px(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  return px;
+}
+
+size_t files_in(const std::filesystem::path& dir) {
+  return size_t(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+}  // namespace
+
+TEST_CASE("EXR round trip: RGBA channels, size, half and float precision", "[io][image][quick]") {
+  const auto dir = test::temp_dir("exr");
+  const Film f = ramp(37, 21);
+  for (bool half : {true, false}) {
+    ExrOptions opt;
+    opt.half = half;
+    opt.metadata = {{"penumbra:test", "yes"}};
+    const auto path = dir / (half ? "h.exr" : "f.exr");
+    write_exr(f, path, opt);
+    OIIO::ImageSpec spec;
+    const auto px = read_all(path, spec);
+    CHECK(spec.width == 37);
+    CHECK(spec.height == 21);
+    REQUIRE(spec.nchannels == 4);
+    CHECK(spec.channelnames == std::vector<std::string>{"R", "G", "B", "A"});
+    CHECK(spec.alpha_channel == 3);
+    CHECK(spec.format == (half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT));
+    CHECK(spec.get_string_attribute("penumbra:test") == "yes");
+    for (size_t i = 0; i < px.size(); ++i) {
+      if (half) REQUIRE(px[i] == Approx(f.rgba[i]).epsilon(1e-3).margin(1e-4));
+      else REQUIRE(px[i] == f.rgba[i]);
+    }
+  }
+  CHECK(files_in(dir) == 2);  // no temporaries left behind
+}
+
+TEST_CASE("display PNG: 8-bit RGB through the shipped config's sRGB view", "[io][image][ocio][quick]") {
+  const auto dir = test::temp_dir("png");
+  Film f = make_film(4, 1);
+  const float values[4] = {0.0f, 0.5f, 1.0f, 0.25f};
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 4; ++c) f.pixel(x, 0)[c] = c == 3 ? 1.0f : values[x];
+  DisplayOptions opt;
+  write_display_image(f, dir / "a.png", opt);
+  OIIO::ImageSpec spec;
+  const auto px = read_all(dir / "a.png", spec);
+  CHECK(spec.nchannels == 3);
+  CHECK(spec.format == OIIO::TypeDesc::UINT8);
+  auto srgb = [](double l) { return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1 / 2.4) - 0.055; };
+  for (int x = 0; x < 4; ++x) CHECK(px[size_t(x) * 3] == Approx(std::round(srgb(values[x]) * 255) / 255).margin(1.0 / 255));
+  // +1 stop of exposure makes 0.25 display like 0.5.
+  opt.exposure = 1;
+  write_display_image(f, dir / "b.png", opt);
+  const auto px2 = read_all(dir / "b.png", spec);
+  CHECK(px2[9] == Approx(px[3]).margin(1.0 / 255));
+}
+
+TEST_CASE("a missing OCIO config or view is an input error and nothing is written", "[io][image][ocio][quick]") {
+  const auto dir = test::temp_dir("ocio-bad");
+  const Film f = ramp(4, 4);
+  DisplayOptions opt;
+  opt.ocio_config = (dir / "nope.ocio").string();
+  CHECK_THROWS_AS(write_display_image(f, dir / "x.png", opt), InputError);
+  opt.ocio_config.clear();
+  opt.view = "No Such View";
+  CHECK_THROWS_AS(write_display_image(f, dir / "x.png", opt), InputError);
+  CHECK(files_in(dir) == 0);
+}
+
+TEST_CASE("atomic writes leave the old file intact and no temporary on failure", "[io][image][quick]") {
+  const auto dir = test::temp_dir("atomic");
+  const auto dest = dir / "out.exr";
+  std::ofstream(dest) << "previous";
+  CHECK_THROWS(write_atomically(dest, [](const std::filesystem::path& temp) {
+    std::ofstream(temp) << "half-written";
+    throw std::runtime_error("interrupted");
+  }));
+  std::ifstream in(dest);
+  std::string content;
+  in >> content;
+  CHECK(content == "previous");
+  CHECK(files_in(dir) == 1);
+  // A write into a folder that does not exist fails without creating anything.
+  CHECK_THROWS(write_exr(ramp(2, 2), dir / "missing" / "x.exr", {}));
+  CHECK(files_in(dir) == 1);
+}

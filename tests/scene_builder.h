@@ -1,0 +1,52 @@
+// Test scenes built directly as renderer data (no files): quads and lights at known places.
+#pragma once
+
+#include "renderer/scene.h"
+
+namespace penumbra::test {
+
+/// Adds an axis-aligned rectangle with normal +z (or -z if `flip`) at height z, spanning
+/// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index.
+inline int add_quad_z(Scene& s, float x0, float x1, float y0, float y1, float z, int material, bool flip = false) {
+  Mesh m;
+  m.name = "quad";
+  m.positions = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
+  m.indices = flip ? std::vector<uint32_t>{0, 2, 1, 0, 3, 2} : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
+  m.normals = compute_smooth_normals(m.positions, m.indices);
+  m.material = material;
+  s.meshes.push_back(std::move(m));
+  return int(s.meshes.size()) - 1;
+}
+
+/// Adds a rectangle in the plane x = const facing -x, spanning [y0, y1] x [z0, z1].
+inline int add_quad_x(Scene& s, float x, float y0, float y1, float z0, float z1, int material) {
+  Mesh m;
+  m.name = "wall";
+  m.positions = {{x, y0, z0}, {x, y1, z0}, {x, y1, z1}, {x, y0, z1}};
+  m.indices = {0, 2, 1, 0, 3, 2};
+  m.normals = compute_smooth_normals(m.positions, m.indices);
+  m.material = material;
+  s.meshes.push_back(std::move(m));
+  return int(s.meshes.size()) - 1;
+}
+
+inline int add_material(Scene& s, Vec3f base, float metallic, float roughness, bool unlit = false) {
+  Material m;
+  m.base_color = base;
+  m.metallic = metallic;
+  m.roughness = roughness;
+  m.unlit = unlit;
+  s.materials.push_back(m);
+  return int(s.materials.size()) - 1;
+}
+
+inline Light point_light(Vec3f position, float intensity, Vec3f color = {1, 1, 1}) {
+  Light l;
+  l.type = LightType::Point;
+  l.position = position;
+  l.intensity = intensity;
+  l.color = color;
+  return l;
+}
+
+}  // namespace penumbra::test
