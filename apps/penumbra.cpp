@@ -176,7 +176,15 @@ int run_render(const RenderArgs& a) {
   check_dir(out, "-o");
   std::optional<fs::path> png;
   if (!a.no_png) png = a.png.empty() ? fs::path(out).replace_extension(".png") : fs::path(a.png);
-  if (png) check_dir(*png, "--png");
+  DisplayOptions display;
+  display.ocio_config = a.ocio_config;
+  display.display = a.display;
+  display.view = a.view;
+  display.exposure = a.exposure;
+  if (png) {
+    check_dir(*png, "--png");
+    check_display_output(*png, display);  // a typo must not cost a whole render
+  }
   if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) throw UsageError("--exposure must be finite and within [-64, 64]");
   const Vec3f background = parse_colour(a.background, "--background");
   const Vec3f ambient = parse_colour(a.ambient, "--ambient");
@@ -230,7 +238,7 @@ int run_render(const RenderArgs& a) {
   auto accel = make_accelerator(a.accel, views);
   const double build_s = seconds_since(t_build);
 
-  if (debug_x >= 0 || debug_y >= 0) {
+  if (!a.debug_pixel.empty()) {
     if (debug_x < 0 || debug_y < 0 || debug_x >= cfg.width || debug_y >= cfg.height)
       throw UsageError("--debug-pixel " + a.debug_pixel + " is outside the " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
     float rgba[4];
@@ -255,14 +263,7 @@ int run_render(const RenderArgs& a) {
   exr.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:camera", camera.name},
                   {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", "whitted"}};
   write_exr(film, out, exr);
-  if (png) {
-    DisplayOptions d;
-    d.ocio_config = a.ocio_config;
-    d.display = a.display;
-    d.view = a.view;
-    d.exposure = a.exposure;
-    write_display_image(film, *png, d);
-  }
+  if (png) write_display_image(film, *png, display);
   const double write_s = seconds_since(t_write);
 
   if (!a.quiet) {

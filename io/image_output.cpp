@@ -45,13 +45,21 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   });
 }
 
-void apply_display_transform(std::vector<float>& rgb, int width, int height,
-                             const DisplayOptions& options) {
-  OCIO::ConstConfigRcPtr config;
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return ext;
+}
+
+/// The one place that turns DisplayOptions into a CPU processor (config, display, view).
+OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
   const char* env = std::getenv("OCIO");
   const std::string source = !options.ocio_config.empty() ? options.ocio_config
                              : (env && *env)              ? std::string(env)
                                                           : std::string("<shipped config>");
+  OCIO::ConstConfigRcPtr config;
   try {
     if (!options.ocio_config.empty()) {
       config = OCIO::Config::CreateFromFile(options.ocio_config.c_str());
@@ -61,16 +69,49 @@ void apply_display_transform(std::vector<float>& rgb, int width, int height,
       std::istringstream in(shipped_ocio_config());
       config = OCIO::Config::CreateFromStream(in);
     }
-    const char* display = options.display.empty() ? config->getDefaultDisplay() : options.display.c_str();
-    const char* view = options.view.empty() ? config->getDefaultView(display) : options.view.c_str();
-    auto processor = config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display, view,
-                                          OCIO::TRANSFORM_DIR_FORWARD);
-    auto cpu = processor->getDefaultCPUProcessor();
-    OCIO::PackedImageDesc desc(rgb.data(), width, height, 3);
-    cpu->apply(desc);
+  } catch (const OCIO::Exception& e) {
+    throw InputError(source, "OpenColorIO config", e.what());
+  }
+  const std::string display = options.display.empty() ? config->getDefaultDisplay() : options.display;
+  std::string displays;
+  bool display_found = false;
+  for (int i = 0; i < config->getNumDisplays(); ++i) {
+    displays += std::string(displays.empty() ? "" : ", ") + config->getDisplay(i);
+    display_found |= display == config->getDisplay(i);
+  }
+  if (!display_found)
+    throw InputError(source, "--display", "no display '" + display + "' (available: " + displays + ")");
+  const std::string view = options.view.empty() ? config->getDefaultView(display.c_str()) : options.view;
+  std::string views;
+  bool view_found = false;
+  for (int i = 0; i < config->getNumViews(display.c_str()); ++i) {
+    views += std::string(views.empty() ? "" : ", ") + config->getView(display.c_str(), i);
+    view_found |= view == config->getView(display.c_str(), i);
+  }
+  if (!view_found)
+    throw InputError(source, "--view", "display '" + display + "' has no view '" + view + "' (available: " + views + ")");
+  try {
+    return config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
+        ->getDefaultCPUProcessor();
   } catch (const OCIO::Exception& e) {
     throw InputError(source, "OpenColorIO", e.what());
   }
+}
+
+}  // namespace
+
+void check_display_output(const std::filesystem::path& path, const DisplayOptions& options) {
+  const std::string ext = lower_extension(path);
+  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".tif" && ext != ".tiff")
+    throw InputError(path.string(), "", "unsupported display image format '" + ext + "' (use .png, .jpg, .jpeg, .tif or .tiff)");
+  display_processor(options);
+}
+
+void apply_display_transform(std::vector<float>& rgb, int width, int height,
+                             const DisplayOptions& options) {
+  const auto cpu = display_processor(options);
+  OCIO::PackedImageDesc desc(rgb.data(), width, height, 3);
+  cpu->apply(desc);
 }
 
 void write_display_image(const Film& film, const std::filesystem::path& path,
@@ -81,8 +122,7 @@ void write_display_image(const Film& film, const std::filesystem::path& path,
   for (size_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) rgb[i * 3 + size_t(c)] = film.rgba[i * 4 + size_t(c)] * gain;
   apply_display_transform(rgb, film.width, film.height, options);
-  std::string ext = path.extension().string();
-  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  const std::string ext = lower_extension(path);
   const bool sixteen = ext == ".tif" || ext == ".tiff";
   OIIO::ImageSpec spec(film.width, film.height, 3, sixteen ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");

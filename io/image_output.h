@@ -34,6 +34,11 @@ struct DisplayOptions {
 void write_display_image(const Film& film, const std::filesystem::path& path,
                          const DisplayOptions& options);
 
+/// Checks, before any rendering, that `path` has a display-image extension (.png, .jpg,
+/// .jpeg, .tif, .tiff) and that the config, display and view resolve. Throws InputError
+/// naming the file or config and, for an unknown display or view, listing the valid ones.
+void check_display_output(const std::filesystem::path& path, const DisplayOptions& options);
+
 /// Penumbra's shipped OCIO config text (io/ocio/config.ocio, embedded at build time).
 const char* shipped_ocio_config();
 

@@ -27,6 +27,12 @@ expect 2 "does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/
 expect 2 "spp" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --spp 0
 expect 2 "camera 7 does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera 7
 expect 2 "background" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --background nan
+# Display-output mistakes are caught before rendering, so they cost no render and write no EXR.
+expect 2 "no view 'Typo' \(available: Standard, Raw\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --view Typo
+expect 2 "no display 'P3'" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --display P3
+expect 2 "a.xyz: unsupported display image format" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --png "$work/a.xyz"
+expect 2 "nope.ocio" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --ocio-config "$work/nope.ocio"
+expect 2 "debug-pixel -1,-1 is outside" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --debug-pixel=-1,-1
 [ ! -e "$work/a.exr" ] || { echo "FAIL: a failed run left $work/a.exr"; fails=$((fails + 1)); }
 
 # A real render: both paths on stdout, files readable, RGBA half EXR.

@@ -98,6 +98,16 @@ TEST_CASE("a missing OCIO config or view is an input error and nothing is writte
   opt.view = "No Such View";
   CHECK_THROWS_AS(write_display_image(f, dir / "x.png", opt), InputError);
   CHECK(files_in(dir) == 0);
+  // The up-front check: same failures, with the valid choices listed, and a bad extension.
+  using Catch::Matchers::Contains;
+  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no view 'No Such View'") && Contains("Standard, Raw"));
+  opt.view.clear();
+  CHECK_NOTHROW(check_display_output(dir / "x.PNG", opt));
+  CHECK_NOTHROW(check_display_output(dir / "x.tiff", opt));
+  CHECK_THROWS_WITH(check_display_output(dir / "x.bmp", opt), Contains("x.bmp") && Contains("unsupported display image format"));
+  opt.display = "P3";
+  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no display 'P3'") && Contains("sRGB"));
+  CHECK(files_in(dir) == 0);
 }
 
 TEST_CASE("atomic writes leave the old file intact and no temporary on failure", "[io][image][quick]") {
