@@ -18,7 +18,7 @@
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
-#include "renderer/accel/accelerator.h"
+#include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
 #include "renderer/render.h"

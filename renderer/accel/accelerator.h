@@ -1,13 +1,12 @@
-// The one ray-query interface of Penumbra. Every back end (Embree, brute force, and the
-// reference structures to come) builds from triangle geometry only and answers closest-hit and
-// occlusion queries with the same Hit record. Accelerators know nothing of materials or film.
+// The one ray-query interface of Penumbra. Every back end (Embree, BVH, kD-tree, grid, brute
+// force) builds from triangle geometry only and answers closest-hit and occlusion queries with
+// the same Hit record. Accelerators know nothing of materials or film. Back ends are chosen by
+// name through accel/factory.h.
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "renderer/geometry.h"
@@ -21,36 +20,35 @@ struct TriangleMeshView {
   std::span<const uint32_t> indices;  ///< 3 per triangle, each < positions.size()
 };
 
-/// Build and size statistics of an accelerator (fields not meaningful for a back end are 0).
+/// Build and size statistics of an accelerator. Fields a back end cannot report are 0 (Embree
+/// does not expose its node counts). For the grid, "nodes" and "leaves" are cells.
 struct AccelStats {
   std::string name;
-  uint64_t triangles = 0;
-  uint64_t nodes = 0;
-  uint64_t leaves = 0;
-  uint64_t max_depth = 0;
-  uint64_t bytes = 0;
+  std::string config;            ///< the build parameters, human readable
+  uint64_t triangles = 0;        ///< triangles given to the builder
+  uint64_t nodes = 0;            ///< all nodes (interior + leaves), or grid cells
+  uint64_t leaves = 0;           ///< leaves, or grid cells
+  uint64_t empty_leaves = 0;     ///< leaves or cells with no triangle
+  uint64_t references = 0;       ///< triangle references summed over leaves/cells
+  uint64_t max_leaf_prims = 0;   ///< largest leaf or cell
+  double avg_leaf_prims = 0;     ///< references / non-empty leaves
+  uint64_t max_depth = 0;        ///< deepest leaf (root = depth 0)
+  double sah_cost = 0;           ///< SAH cost of the tree with the builder's constants (0: n/a)
+  uint64_t bytes = 0;            ///< memory held by the structure
   double build_seconds = 0;
 };
 
 class Accelerator {
  public:
   virtual ~Accelerator() = default;
-  /// Closest hit with t in [ray.tnear, ray.tfar]. Returns hit.valid(). NaN/Inf rays miss.
+  /// Closest hit with t in [max(ray.tnear, 0), ray.tfar]. Returns hit.valid(). Rays with a
+  /// NaN/Inf origin or direction, a zero direction or tnear > tfar miss.
   /// Thread-safe; never allocates, throws or logs.
   virtual bool intersect(const Ray& ray, Hit& hit) const = 0;
-  /// True iff some triangle is hit with t in [ray.tnear, ray.tfar]. Thread-safe.
+  /// True iff some triangle is hit with t in [max(ray.tnear, 0), ray.tfar]. Thread-safe.
   virtual bool occluded(const Ray& ray) const = 0;
   virtual Bounds3f bounds() const = 0;
   virtual AccelStats stats() const = 0;
 };
-
-/// Names accepted by make_accelerator, default first.
-std::vector<std::string> accelerator_names();
-
-/// Builds the named back end over `meshes` (which must outlive the accelerator only for
-/// "brute"; Embree copies the data). Throws std::invalid_argument for an unknown name and
-/// std::runtime_error if the back end reports an error (message names the back end).
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
-                                              std::span<const TriangleMeshView> meshes);
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 // Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "renderer/geometry.h"
@@ -13,7 +14,8 @@ namespace penumbra {
 struct WatertightRay {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
-  bool valid = false;  ///< false for NaN/Inf/zero directions: such rays miss everything
+  float tnear = 0;     ///< max(ray.tnear, 0): every back end treats t < 0 as behind the origin
+  bool valid = false;  ///< false for NaN/Inf/zero directions or tnear > tfar: such rays miss
 };
 
 inline WatertightRay prepare_watertight(const Ray& ray) {
@@ -21,6 +23,8 @@ inline WatertightRay prepare_watertight(const Ray& ray) {
   const Vec3f d = ray.dir;
   if (!is_finite(d) || !is_finite(ray.org) || std::isnan(ray.tnear) || std::isnan(ray.tfar))
     return w;
+  w.tnear = std::max(ray.tnear, 0.0f);
+  if (w.tnear > ray.tfar) return w;
   const Vec3f ad = abs(d);
   w.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
   if (d[w.kz] == 0) return w;
@@ -61,7 +65,7 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   const float T = U * Az + V * Bz + W * Cz;
   const float inv = 1.0f / det;
   const float t = T * inv;
-  if (!(t >= ray.tnear && t <= tfar)) return false;
+  if (!(t >= w.tnear && t <= tfar)) return false;
   t_out = t;
   u_out = V * inv;  // weight of b
   v_out = W * inv;  // weight of c

@@ -91,6 +91,8 @@ TEST_CASE("NaN and degenerate inputs never hit", "[geometry][quick]") {
   REQUIRE_FALSE(prepare_watertight(zero_dir).valid);
   const Ray r{{0.2f, 0.2f, 1}, 0, {0, 0, -1}, kInfinity};
   REQUIRE_FALSE(intersect_triangle_watertight(r, prepare_watertight(r), a, a, a, kInfinity, t, u, v));
+  REQUIRE(intersect_triangle_watertight(r, prepare_watertight(r), a, b, c, kInfinity, t, u, v));  // control
+  CHECK(t == 1.0f);
   REQUIRE_FALSE(intersect_triangle_cramer(r, a, b, b * 2.0f, t, u, v));  // collinear: det 0
 }
 

@@ -1,5 +1,6 @@
 // Tests for renderer/render: bitwise determinism across thread counts, coverage alpha,
 // stratified sampling.
+#include "renderer/accel/factory.h"
 #include "renderer/render.h"
 
 #include <catch2/catch.hpp>

@@ -1,4 +1,5 @@
 // Tests for renderer/whitted: the material mapping and closed-form shading of simple scenes.
+#include "renderer/accel/factory.h"
 #include "renderer/whitted.h"
 
 #include <catch2/catch.hpp>

@@ -1,0 +1,174 @@
+// Pieces shared by Penumbra's own acceleration structures (BVH, kD-tree, grid): the packed
+// triangle array they all build over, the robust ray-box slab test, and the leaf loop that
+// calls the one watertight triangle test. Not used by Embree; nothing here knows materials.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <span>
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/triangle.h"
+
+namespace penumbra {
+
+/// One world-space triangle copied out of a TriangleMeshView, with the ids a Hit reports.
+/// 44 bytes: a, b, c (3 x 12) + geom_id (4) + prim_id (4).
+struct TriangleRecord {
+  Vec3f a, b, c;
+  uint32_t geom_id = 0;  ///< index of the mesh in the span given to the builder
+  uint32_t prim_id = 0;  ///< triangle index within that mesh
+};
+static_assert(sizeof(TriangleRecord) == 44);
+
+/// Copies every triangle of `meshes` in (mesh, triangle) order. Triangles with a non-finite
+/// vertex are dropped (the watertight test can never hit them); degenerate ones are kept so
+/// every structure sees exactly what the brute-force oracle sees.
+std::vector<TriangleRecord> gather_triangles(std::span<const TriangleMeshView> meshes);
+
+/// Triangles in `meshes` as given (before dropping non-finite ones): what stats() reports.
+inline uint64_t count_input_triangles(std::span<const TriangleMeshView> meshes) {
+  uint64_t n = 0;
+  for (const auto& m : meshes) n += m.indices.size() / 3;
+  return n;
+}
+
+inline Bounds3f triangle_bounds(const TriangleRecord& t) {
+  return merge(merge(Bounds3f{t.a, t.a}, t.b), t.c);
+}
+
+/// Surface area of a box; 0 for an empty box.
+inline float surface_area(const Bounds3f& b) {
+  if (b.empty()) return 0;
+  const Vec3f d = b.extent();
+  return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+/// Width of the band around a surface within which the watertight test's rounding can still
+/// report a hit near t = 0 for a ray starting there: 2^-20 of the box's largest coordinate plus
+/// its size. Boxes are widened by it, and a kD-tree treats origins that close to a split plane
+/// as lying on it, so no structure culls what the brute-force scan would report.
+inline float rounding_band(const Bounds3f& b) {
+  if (b.empty()) return 0;
+  const float m = std::max(max_component(abs(b.lo)), max_component(abs(b.hi)));
+  return (m + max_component(b.extent())) * 0x1p-20f;
+}
+
+inline Bounds3f widen_for_rounding(const Bounds3f& b) {
+  const float band = rounding_band(b);
+  const Vec3f w{band, band, band};
+  return b.empty() ? b : Bounds3f{b.lo - w, b.hi + w};
+}
+
+/// Per-ray constants of the slab test.
+struct RayBoxQuery {
+  Vec3f org, inv_dir;
+  int dir_neg[3] = {0, 0, 0};  ///< 1 where the direction component is negative
+};
+
+inline RayBoxQuery prepare_box_query(const Ray& ray) {
+  RayBoxQuery q;
+  q.org = ray.org;
+  q.inv_dir = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};  // +-inf for 0
+  for (int k = 0; k < 3; ++k) q.dir_neg[k] = ray.dir[k] < 0 || (ray.dir[k] == 0 && std::signbit(ray.dir[k]));
+  return q;
+}
+
+/// Relative widening of slab distances so that rounding never culls a box the ray touches:
+/// 1 + 2 gamma(3) as in pbrt-v4 (Pharr, Jakob & Humphreys, 4th ed., sec. 6.8), with margin.
+inline constexpr float kSlabPad = 1.0f + 4 * 3 * 0.5f * 1.1920929e-7f;
+
+/// Slab test (Kay & Kajiya 1986) of the box [lo, hi] against the ray over [t0, t1]. On overlap
+/// narrows t0/t1 to the entry and exit distances and returns true. A ray parallel to a slab
+/// (direction component 0, so 1/d is infinite) overlaps it iff its origin lies within it, faces
+/// included: the IEEE arithmetic alone would give NaN there (0 * inf).
+inline bool intersect_box(const Vec3f& lo, const Vec3f& hi, const RayBoxQuery& q, float& t0,
+                          float& t1) {
+  for (int k = 0; k < 3; ++k) {
+    if (std::isinf(q.inv_dir[k])) {
+      if (q.org[k] < lo[k] || q.org[k] > hi[k]) return false;
+      continue;
+    }
+    float tn = (lo[k] - q.org[k]) * q.inv_dir[k];
+    float tf = (hi[k] - q.org[k]) * q.inv_dir[k];
+    if (tn > tf) std::swap(tn, tf);
+    tf = tf > 0 ? tf * kSlabPad : tf * (2.0f - kSlabPad);
+    tn = tn > 0 ? tn * (2.0f - kSlabPad) : tn * kSlabPad;
+    t0 = tn > t0 ? tn : t0;
+    t1 = tf < t1 ? tf : t1;
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+/// Pads a positive distance upward by the slab margin (used when a traversal compares a hit
+/// distance with a cell or node exit distance).
+inline float pad_up(float t) { return t * kSlabPad; }
+
+/// Closest-hit leaf loop: tests `tris[refs[i]]` and narrows `tfar`. Returns true on any hit.
+inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri,
+                           float& tfar, Hit& hit) {
+  float t, u, v;
+  if (!intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, tfar, t, u, v)) return false;
+  tfar = t;
+  hit = {t, u, v, tri.geom_id, tri.prim_id};
+  return true;
+}
+
+inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri) {
+  float t, u, v;
+  return intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, ray.tfar, t, u, v);
+}
+
+/// intersect() and occluded() of the reference structures, written once: each structure
+/// provides `template <class Visit> bool traverse(const Ray&, const float& best, Visit&&) const`,
+/// which walks the cells or leaves the ray may meet (skipping those beyond `best`) and calls
+/// visit(w, tri) on their triangles until it returns true (CRTP, so the visitors inline).
+template <typename Derived>
+class TraversalAccelerator : public Accelerator {
+ public:
+  bool intersect(const Ray& ray, Hit& hit) const final {
+    hit = Hit{};
+    float best = ray.tfar;
+    static_cast<const Derived*>(this)->traverse(ray, best, [&](const WatertightRay& w, const TriangleRecord& tri) {
+      intersect_leaf(ray, w, tri, best, hit);
+      return false;
+    });
+    return hit.valid();
+  }
+
+  bool occluded(const Ray& ray) const final {
+    const float tfar = ray.tfar;
+    return static_cast<const Derived*>(this)->traverse(
+        ray, tfar, [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); });
+  }
+};
+
+/// A number as printf's %g would print it (for the human-readable AccelStats::config).
+inline std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+/// Summary of a leaf-size histogram, filled by each structure's statistics pass.
+struct LeafTally {
+  uint64_t leaves = 0, empty_leaves = 0, references = 0, max_prims = 0;
+  void add(uint64_t n) {
+    ++leaves;
+    empty_leaves += n == 0;
+    references += n;
+    max_prims = std::max(max_prims, n);
+  }
+  void fill(AccelStats& s) const {
+    s.leaves = leaves;
+    s.empty_leaves = empty_leaves;
+    s.references = references;
+    s.max_leaf_prims = max_prims;
+    s.avg_leaf_prims = leaves > empty_leaves ? double(references) / double(leaves - empty_leaves) : 0;
+  }
+};
+
+}  // namespace penumbra

@@ -1,0 +1,36 @@
+// Choosing an acceleration structure by name: the one place that maps "embree", "bvh",
+// "kdtree", "grid" and "brute" to their builders, with each builder's configuration.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "renderer/accel/accelerator.h"
+#include "renderer/accel/bvh.h"
+#include "renderer/accel/grid.h"
+#include "renderer/accel/kdtree.h"
+
+namespace penumbra {
+
+/// Build parameters of every back end; only the chosen one's are used.
+struct AccelConfig {
+  BvhConfig bvh;
+  KdTreeConfig kdtree;
+  GridConfig grid;
+};
+
+/// Names accepted by make_accelerator, default ("embree") first.
+std::vector<std::string> accelerator_names();
+
+/// Builds the named back end over `meshes`. Every back end except "brute" copies what it needs;
+/// for "brute" the meshes must outlive the accelerator. Throws std::invalid_argument for an
+/// unknown name or an invalid configuration, std::runtime_error if the build fails (the message
+/// names the back end).
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
+                                              std::span<const TriangleMeshView> meshes,
+                                              const AccelConfig& config = {});
+
+}  // namespace penumbra

@@ -1,0 +1,457 @@
+// SAH kD-tree. Build: I. Wald and V. Havran, "On building fast kd-Trees for Ray Tracing, and on
+// doing that in O(N log N)", IEEE Symposium on Interactive Ray Tracing 2006 (events sorted once,
+// split lists kept sorted, straddling triangles clipped to the child boxes: "perfect splits").
+// Node layout and traversal after pbrt-v3's KdTreeAccel (Pharr, Jakob & Humphreys, 3rd ed.,
+// sec. 4.4).
+#include "renderer/accel/kdtree.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "renderer/accel/common.h"
+
+namespace penumbra {
+namespace {
+
+/// Flattened node, 8 bytes. The child below the split is the next node in the array.
+struct KdNode {
+  union {
+    float split;          // 4 bytes: interior: split position along `axis`
+    uint32_t one_prim;    //          leaf with one triangle: its index
+    uint32_t prim_offset; //          leaf with several: first entry in the reference array
+  };
+  uint32_t flags;  // 4 bytes: low 2 bits: 0/1/2 = split axis, 3 = leaf;
+                   //          high 30 bits: interior: index of the above child; leaf: count
+  bool leaf() const { return (flags & 3u) == 3u; }
+  int axis() const { return int(flags & 3u); }
+  uint32_t count() const { return flags >> 2; }
+  uint32_t above() const { return flags >> 2; }
+};
+static_assert(sizeof(KdNode) == 8, "KdNode must stay 8 bytes");
+
+constexpr int kMaxDepth = 64;
+constexpr uint32_t kMaxIndex = (1u << 30) - 1;  // node and count fields are 30 bits
+
+// ---- Build-time types -------------------------------------------------------------------------
+
+enum EventType : uint8_t { kEnd = 0, kPlanar = 1, kStart = 2 };
+
+struct Event {
+  float pos;
+  uint32_t tri;
+  uint8_t axis;
+  uint8_t type;
+};
+
+/// Sort order of the event lists: axis, position, type (end < planar < start), triangle.
+bool operator<(const Event& a, const Event& b) {
+  if (a.axis != b.axis) return a.axis < b.axis;
+  if (a.pos != b.pos) return a.pos < b.pos;
+  if (a.type != b.type) return a.type < b.type;
+  return a.tri < b.tri;
+}
+
+void add_events(std::vector<Event>& out, uint32_t tri, const Bounds3f& b) {
+  for (uint8_t k = 0; k < 3; ++k) {
+    if (b.lo[k] == b.hi[k]) {
+      out.push_back({b.lo[k], tri, k, kPlanar});
+    } else {
+      out.push_back({b.lo[k], tri, k, kStart});
+      out.push_back({b.hi[k], tri, k, kEnd});
+    }
+  }
+}
+
+struct BuildNode {
+  std::unique_ptr<BuildNode> below, above;
+  std::vector<uint32_t> tris;  // leaf only
+  Bounds3f box;
+  float split = 0;
+  int axis = -1;  // -1 for a leaf
+};
+
+/// Bounds of the part of triangle t inside `box` (Sutherland-Hodgman clipping in double),
+/// rounded outward to float and intersected with `box`. Empty if nothing is inside.
+Bounds3f clip_triangle(const TriangleRecord& t, const Bounds3f& box) {
+  struct P {
+    double v[3];
+  };
+  P poly[16], tmp[16];
+  int n = 3;
+  for (int k = 0; k < 3; ++k) {
+    poly[0].v[k] = t.a[k];
+    poly[1].v[k] = t.b[k];
+    poly[2].v[k] = t.c[k];
+  }
+  for (int k = 0; k < 3 && n > 0; ++k) {
+    for (int side = 0; side < 2 && n > 0; ++side) {
+      // Keep points with s * (x - plane) >= 0: s = +1 for the lower face, -1 for the upper.
+      const double plane = side == 0 ? box.lo[k] : box.hi[k];
+      const double s = side == 0 ? 1.0 : -1.0;
+      int m = 0;
+      for (int i = 0; i < n; ++i) {
+        const P& a = poly[i];
+        const P& b = poly[(i + 1) % n];
+        const double da = s * (a.v[k] - plane), db = s * (b.v[k] - plane);
+        if (da >= 0) tmp[m++] = a;
+        if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+          const double f = da / (da - db);
+          P c;
+          for (int j = 0; j < 3; ++j) c.v[j] = a.v[j] + f * (b.v[j] - a.v[j]);
+          c.v[k] = plane;
+          tmp[m++] = c;
+        }
+      }
+      n = m;
+      std::copy(tmp, tmp + m, poly);
+    }
+  }
+  Bounds3f out;
+  if (n == 0) return out;
+  double lo[3] = {poly[0].v[0], poly[0].v[1], poly[0].v[2]}, hi[3] = {lo[0], lo[1], lo[2]};
+  for (int i = 1; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], poly[i].v[k]);
+      hi[k] = std::max(hi[k], poly[i].v[k]);
+    }
+  for (int k = 0; k < 3; ++k) {
+    float l = float(lo[k]), h = float(hi[k]);
+    if (double(l) > lo[k]) l = std::nextafter(l, -kInfinity);
+    if (double(h) < hi[k]) h = std::nextafter(h, kInfinity);
+    out.lo[k] = std::max(l, box.lo[k]);
+    out.hi[k] = std::min(h, box.hi[k]);
+    if (out.lo[k] > out.hi[k]) return Bounds3f{};
+  }
+  return out;
+}
+
+class Builder {
+ public:
+  Builder(const KdTreeConfig& c, const std::vector<TriangleRecord>& tris, int max_depth)
+      : m_config(c), m_tris(tris), m_max_depth(max_depth) {}
+
+  std::unique_ptr<BuildNode> build(std::vector<Event> events, uint32_t n, const Bounds3f& box, int depth) {
+    auto node = std::make_unique<BuildNode>();
+    node->box = box;
+    // Phase 1: find the cheapest plane by sweeping the sorted events (Wald & Havran, alg. 4).
+    Split best;
+    if (depth < m_max_depth && n > 0 && surface_area(box) > 0) best = find_plane(events, n, box);
+    if (best.axis < 0 || best.cost >= m_config.intersection_cost * float(n)) {
+      make_leaf(*node, events);
+      return node;
+    }
+    // Phase 2: classify triangles as left only, right only or both (alg. 5).
+    auto& cls = m_classes.local();
+    if (cls.size() < m_tris.size()) cls.resize(m_tris.size());
+    for (const Event& e : events) cls[e.tri] = kBoth;
+    for (const Event& e : events) {
+      if (e.axis != best.axis) continue;
+      if (e.type == kEnd && e.pos <= best.pos) cls[e.tri] = kLeftOnly;
+      else if (e.type == kStart && e.pos >= best.pos) cls[e.tri] = kRightOnly;
+      else if (e.type == kPlanar) {
+        if (e.pos < best.pos || (e.pos == best.pos && best.planar_left)) cls[e.tri] = kLeftOnly;
+        if (e.pos > best.pos || (e.pos == best.pos && !best.planar_left)) cls[e.tri] = kRightOnly;
+      }
+    }
+    // Phase 3: split the event list; the one-sided events stay sorted.
+    Bounds3f lbox = box, rbox = box;
+    lbox.hi[best.axis] = best.pos;
+    rbox.lo[best.axis] = best.pos;
+    std::vector<Event> left, right, left_new, right_new;
+    uint32_t nl = 0, nr = 0;
+    for (const Event& e : events) {
+      const bool first = e.axis == 0 && e.type != kEnd;  // exactly one per triangle
+      if (cls[e.tri] == kLeftOnly) {
+        left.push_back(e);
+        nl += first;
+      } else if (cls[e.tri] == kRightOnly) {
+        right.push_back(e);
+        nr += first;
+      } else if (first) {
+        // Straddling triangle: clip it to each child box (perfect splits, sec. 4.3).
+        const Bounds3f lb = clip_triangle(m_tris[e.tri], lbox), rb = clip_triangle(m_tris[e.tri], rbox);
+        if (!lb.empty()) {
+          add_events(left_new, e.tri, lb);
+          ++nl;
+        }
+        if (!rb.empty()) {
+          add_events(right_new, e.tri, rb);
+          ++nr;
+        }
+      }
+    }
+    std::vector<Event>().swap(events);
+    std::sort(left_new.begin(), left_new.end());
+    std::sort(right_new.begin(), right_new.end());
+    left = merge_sorted(std::move(left), left_new);
+    right = merge_sorted(std::move(right), right_new);
+    node->axis = best.axis;
+    node->split = best.pos;
+    // Phase 4: recurse; large nodes build their children in parallel. The tree's shape never
+    // depends on scheduling.
+    if (n >= m_config.parallel_threshold) {
+      tbb::parallel_invoke([&] { node->below = build(std::move(left), nl, lbox, depth + 1); },
+                           [&] { node->above = build(std::move(right), nr, rbox, depth + 1); });
+    } else {
+      node->below = build(std::move(left), nl, lbox, depth + 1);
+      node->above = build(std::move(right), nr, rbox, depth + 1);
+    }
+    return node;
+  }
+
+ private:
+  enum Class : uint8_t { kBoth = 0, kLeftOnly = 1, kRightOnly = 2 };
+
+  struct Split {
+    int axis = -1;
+    float pos = 0;
+    float cost = kInfinity;
+    bool planar_left = true;
+  };
+
+  float sah(float pl, float pr, uint32_t nl, uint32_t nr) const {
+    const float lambda = (nl == 0 || nr == 0) ? 1.0f - m_config.empty_bonus : 1.0f;
+    return lambda * (m_config.traversal_cost + m_config.intersection_cost * (pl * float(nl) + pr * float(nr)));
+  }
+
+  Split find_plane(const std::vector<Event>& ev, uint32_t n, const Bounds3f& box) const {
+    Split best;
+    const float inv_area = 1.0f / surface_area(box);
+    const Vec3f d = box.extent();
+    uint32_t nl[3] = {0, 0, 0}, np[3] = {0, 0, 0}, nr[3] = {n, n, n};
+    for (size_t i = 0; i < ev.size();) {
+      const int k = ev[i].axis;
+      const float p = ev[i].pos;
+      uint32_t ends = 0, planars = 0, starts = 0;
+      while (i < ev.size() && ev[i].axis == k && ev[i].pos == p && ev[i].type == kEnd) ++ends, ++i;
+      while (i < ev.size() && ev[i].axis == k && ev[i].pos == p && ev[i].type == kPlanar) ++planars, ++i;
+      while (i < ev.size() && ev[i].axis == k && ev[i].pos == p && ev[i].type == kStart) ++starts, ++i;
+      np[k] = planars;
+      nr[k] -= planars + ends;
+      // Only planes strictly inside the box: a split on a face cuts off nothing.
+      if (p > box.lo[k] && p < box.hi[k]) {
+        const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        const float cap = d[k1] * d[k2];
+        const float pl = 2 * (cap + (p - box.lo[k]) * (d[k1] + d[k2])) * inv_area;
+        const float pr = 2 * (cap + (box.hi[k] - p) * (d[k1] + d[k2])) * inv_area;
+        const float cl = sah(pl, pr, nl[k] + np[k], nr[k]);
+        const float cr = sah(pl, pr, nl[k], nr[k] + np[k]);
+        if (cl < best.cost) best = {k, p, cl, true};
+        if (cr < best.cost) best = {k, p, cr, false};
+      }
+      nl[k] += starts + planars;
+      np[k] = 0;
+    }
+    return best;
+  }
+
+  static void make_leaf(BuildNode& node, const std::vector<Event>& events) {
+    for (const Event& e : events)
+      if (e.axis == 0 && e.type != kEnd) node.tris.push_back(e.tri);
+    std::sort(node.tris.begin(), node.tris.end());
+  }
+
+  static std::vector<Event> merge_sorted(std::vector<Event> a, const std::vector<Event>& b) {
+    if (b.empty()) return a;
+    std::vector<Event> out(a.size() + b.size());
+    std::merge(a.begin(), a.end(), b.begin(), b.end(), out.begin());
+    return out;
+  }
+
+  const KdTreeConfig& m_config;
+  const std::vector<TriangleRecord>& m_tris;
+  int m_max_depth;
+  tbb::enumerable_thread_specific<std::vector<uint8_t>> m_classes;
+};
+
+// ---- The accelerator ----------------------------------------------------------------------------
+
+class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
+  friend class TraversalAccelerator<KdTreeAccelerator>;
+
+ public:
+  KdTreeAccelerator(std::span<const TriangleMeshView> meshes, const KdTreeConfig& config) : m_config(config) {
+    validate(config);
+    const auto t0 = std::chrono::steady_clock::now();
+    m_tris = gather_triangles(meshes);
+    m_input_triangles = count_input_triangles(meshes);
+    if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many triangles (max 2^30 - 1)");
+    m_max_depth = config.max_depth > 0
+                      ? config.max_depth
+                      : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(m_tris.size(), 1)))));
+    if (!m_tris.empty()) {
+      std::vector<Event> events;
+      events.reserve(m_tris.size() * 6);
+      for (uint32_t i = 0; i < m_tris.size(); ++i) {
+        const Bounds3f b = triangle_bounds(m_tris[i]);
+        m_bounds = merge(m_bounds, b);
+        add_events(events, i, b);
+      }
+      std::sort(events.begin(), events.end());
+      Builder builder(m_config, m_tris, m_max_depth);
+      auto root = builder.build(std::move(events), uint32_t(m_tris.size()), m_bounds, 0);
+      m_root_area = surface_area(m_bounds);
+      m_clip = widen_for_rounding(m_bounds);
+      m_band = rounding_band(m_bounds);
+      flatten(*root, 0);
+      if (m_nodes.size() > kMaxIndex || m_refs.size() > kMaxIndex)
+        throw std::runtime_error("kdtree: tree too large (more than 2^30 nodes or references)");
+      m_tally.fill(m_stats);
+    }
+    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  Bounds3f bounds() const override { return m_bounds; }
+
+  AccelStats stats() const override {
+    AccelStats s = m_stats;
+    s.name = "kdtree";
+    s.config = "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
+               format_number(m_config.intersection_cost) + ", empty_bonus " +
+               format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth);
+    s.triangles = m_input_triangles;
+    s.nodes = m_nodes.size();
+    s.bytes = m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) +
+              m_tris.size() * sizeof(TriangleRecord);
+    s.build_seconds = m_build_seconds;
+    return s;
+  }
+
+ private:
+  struct Todo {
+    uint32_t node;
+    float tmin, tmax;
+  };
+
+  /// Front-to-back traversal with early exit: stops once `best` (narrowed by closest-hit
+  /// visitors) lies before the next node's entry. `visit(w, tri)` returns true to stop
+  /// (any-hit). Returns true iff a visitor stopped it.
+  template <typename Visit>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit) const {
+    const WatertightRay w = prepare_watertight(ray);
+    if (!w.valid || m_nodes.empty()) return false;
+    const RayBoxQuery q = prepare_box_query(ray);
+    float tmin = w.tnear, tmax = ray.tfar;
+    if (!intersect_box(m_clip.lo, m_clip.hi, q, tmin, tmax)) return false;
+    Todo todo[kMaxDepth + 1];
+    int sp = 0;
+    uint32_t idx = 0;
+    for (;;) {
+      if (best < tmin) return false;  // nothing further can be closer
+      const KdNode& node = m_nodes[idx];
+      if (!node.leaf()) {
+        idx = step(node, idx, ray, q, tmin, tmax, todo, sp);
+        continue;
+      }
+      const uint32_t cnt = node.count();
+      if (cnt == 1) {
+        if (visit(w, m_tris[node.one_prim])) return true;
+      } else {
+        for (uint32_t i = 0; i < cnt; ++i)
+          if (visit(w, m_tris[m_refs[node.prim_offset + i]])) return true;
+      }
+      if (sp == 0) return false;
+      --sp;
+      idx = todo[sp].node;
+      tmin = todo[sp].tmin;
+      tmax = todo[sp].tmax;
+    }
+  }
+
+  /// One interior-node step (pbrt-v3 KdTreeAccel::Intersect): returns the node to visit next,
+  /// narrowing [tmin, tmax] and pushing the far child when the ray crosses the plane.
+  uint32_t step(const KdNode& node, uint32_t idx, const Ray& ray, const RayBoxQuery& q, float& tmin,
+                float& tmax, Todo* todo, int& sp) const {
+    const int axis = node.axis();
+    const float o = q.org[axis], d = ray.dir[axis];
+    const bool below_first = o < node.split || (o == node.split && d <= 0);
+    const uint32_t first = below_first ? idx + 1 : node.above();
+    const uint32_t second = below_first ? node.above() : idx + 1;
+    const float tplane = (node.split - o) * q.inv_dir[axis];
+    const bool on_plane = std::fabs(node.split - o) <= m_band;
+    if (d == 0 || std::isnan(tplane)) {  // parallel to the plane: the origin's side, or both
+      if (on_plane) todo[sp++] = {second, tmin, tmax};
+      return first;
+    }
+    if (on_plane) {
+      // Origin on the plane (within rounding): the ray heads into `into`, but surfaces lying in
+      // the plane may be stored on the other side. Visit that side first, over [tmin, tplane]
+      // (at least tmin), then `into`, so the stack stays ordered front to back.
+      const uint32_t into = d > 0 ? node.above() : idx + 1;
+      const uint32_t other = d > 0 ? idx + 1 : node.above();
+      todo[sp++] = {into, tmin, tmax};
+      tmax = std::clamp(tplane, tmin, tmax);
+      return other;
+    }
+    if (tplane > pad_up(tmax) || tplane < 0) return first;
+    if (tplane < tmin * (2.0f - kSlabPad)) return second;
+    todo[sp++] = {second, tplane, tmax};
+    tmax = tplane;
+    return first;
+  }
+
+  uint32_t flatten(const BuildNode& b, uint64_t depth) {
+    const uint32_t idx = uint32_t(m_nodes.size());
+    m_nodes.push_back({});
+    m_stats.max_depth = std::max(m_stats.max_depth, depth);
+    const double rel = m_root_area > 0 ? surface_area(b.box) / m_root_area : 1.0;
+    if (b.axis < 0) {
+      const uint32_t n = uint32_t(b.tris.size());
+      m_tally.add(n);
+      m_stats.sah_cost += rel * m_config.intersection_cost * n;
+      if (n == 1) {
+        m_nodes[idx].one_prim = b.tris[0];
+      } else {
+        m_nodes[idx].prim_offset = uint32_t(m_refs.size());
+        m_refs.insert(m_refs.end(), b.tris.begin(), b.tris.end());
+      }
+      m_nodes[idx].flags = (n << 2) | 3u;
+      return idx;
+    }
+    m_stats.sah_cost += rel * m_config.traversal_cost;
+    m_nodes[idx].split = b.split;
+    flatten(*b.below, depth + 1);
+    const uint32_t above = flatten(*b.above, depth + 1);
+    m_nodes[idx].flags = (above << 2) | uint32_t(b.axis);
+    return idx;
+  }
+
+  KdTreeConfig m_config;
+  int m_max_depth = 0;
+  std::vector<KdNode> m_nodes;  // depth-first; node 0 is the root
+  std::vector<uint32_t> m_refs;
+  std::vector<TriangleRecord> m_tris;
+  Bounds3f m_bounds;     // exact bounds of the triangles
+  Bounds3f m_clip;       // m_bounds widened by m_band, for clipping rays
+  float m_band = 0;      // origins this close to a split plane count as on it
+  uint64_t m_input_triangles = 0;
+  double m_root_area = 0;
+  LeafTally m_tally;
+  AccelStats m_stats;
+  double m_build_seconds = 0;
+};
+
+}  // namespace
+
+void validate(const KdTreeConfig& c) {
+  if (!(c.traversal_cost > 0) || !(c.intersection_cost > 0))
+    throw std::invalid_argument("kdtree: traversal_cost and intersection_cost must be > 0");
+  if (!(c.empty_bonus >= 0 && c.empty_bonus < 1))
+    throw std::invalid_argument("kdtree: empty_bonus must be in [0, 1)");
+  if (c.max_depth < 0 || c.max_depth > kMaxDepth)
+    throw std::invalid_argument("kdtree: max_depth must be in [0, 64], got " + std::to_string(c.max_depth));
+}
+
+std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     const KdTreeConfig& config) {
+  return std::make_unique<KdTreeAccelerator>(meshes, config);
+}
+
+}  // namespace penumbra

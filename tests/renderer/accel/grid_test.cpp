@@ -1,0 +1,116 @@
+// Tests for renderer/accel/grid: the triangle-box overlap test on known configurations, the
+// resolution rule (cells ~ lambda N), references per overlapped cell only, and exact agreement
+// with brute force for other densities.
+#include "renderer/accel/grid.h"
+
+#include <catch2/catch.hpp>
+
+#include "cross_check.h"
+#include "io/gltf_loader.h"
+#include "renderer/scene.h"
+#include "test_util.h"
+
+using namespace penumbra;
+using namespace penumbra::test;
+
+TEST_CASE("grid: triangle-box overlap on known configurations", "[accel][grid][quick]") {
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  // Inside, straddling a face, far away.
+  CHECK(triangle_box_overlap(lo, hi, {0.2f, 0.2f, 0.5f}, {0.8f, 0.2f, 0.5f}, {0.5f, 0.8f, 0.5f}));
+  CHECK(triangle_box_overlap(lo, hi, {-1, 0.5f, 0.5f}, {2, 0.5f, 0.4f}, {0.5f, 0.5f, 3}));
+  CHECK_FALSE(triangle_box_overlap(lo, hi, {2, 2, 2}, {3, 2, 2}, {2, 3, 2}));
+  // A big triangle whose plane cuts the box although no vertex is inside.
+  CHECK(triangle_box_overlap(lo, hi, {-10, -10, 0.5f}, {10, -10, 0.5f}, {0, 10, 0.5f}));
+  // Touching a face exactly counts.
+  CHECK(triangle_box_overlap(lo, hi, {1, 0.2f, 0.2f}, {2, 0.2f, 0.2f}, {1, 0.8f, 0.8f}));
+  // The triangle's bounding box overlaps the box but the triangle does not (plane test):
+  // the plane x + y + z = 3.2 passes beyond the corner (1, 1, 1).
+  CHECK_FALSE(triangle_box_overlap(lo, hi, {3.2f, 0, 0}, {0, 3.2f, 0}, {0, 0, 3.2f}));
+  // Beside the edge x = y = 1, in the plane x + y = 2.1: the bounding boxes touch, the plane
+  // test separates.
+  CHECK_FALSE(triangle_box_overlap(lo, hi, {1.1f, 1.0f, -1}, {1.0f, 1.1f, -1}, {1.05f, 1.05f, 2}));
+  // Separated only by an edge x box-axis cross product: in the plane z = 0.5 (which cuts the
+  // box), bounding box overlapping the box's corner column, but entirely beyond x + y = 2.
+  CHECK_FALSE(triangle_box_overlap(lo, hi, {1.5f, 0.8f, 0.5f}, {0.8f, 1.5f, 0.5f}, {1.5f, 1.5f, 0.5f}));
+}
+
+TEST_CASE("grid: about lambda cells per triangle, references only where triangles overlap", "[accel][grid]") {
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  for (float lambda : {1.0f, 4.0f, 16.0f}) {
+    GridConfig c;
+    c.lambda = lambda;
+    const AccelStats s = make_grid_accelerator(views, c)->stats();
+    const double target = lambda * double(s.triangles);
+    INFO("lambda " << lambda << ": " << s.nodes << " cells, " << s.config);
+    CHECK(double(s.nodes) >= target / 3);
+    CHECK(double(s.nodes) <= target * 3);
+    CHECK(s.leaves == s.nodes);
+    CHECK(s.references >= s.triangles);
+    CHECK(s.empty_leaves < s.nodes);
+  }
+  // A single diagonal triangle across a fine grid of small ones: with the exact overlap test it
+  // is listed in O(n) cells of the n x n layer it spans, not in all n^2 its bounding box covers.
+  std::vector<Vec3f> pos{{0, 0, 0}, {20, 20, 0}, {20, 20.01f, 0}};
+  std::vector<uint32_t> idx{0, 1, 2};
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 20; ++x) {
+      const uint32_t b = uint32_t(pos.size());
+      const Vec3f o{x + 0.1f, y + 0.1f, 0.0f};
+      pos.insert(pos.end(), {o, o + Vec3f{0.1f, 0, 0}, o + Vec3f{0, 0.1f, 0}});
+      idx.insert(idx.end(), {b, b + 1, b + 2});
+    }
+  const TriangleMeshView view{pos, idx};
+  GridConfig c;
+  c.lambda = 1;
+  const AccelStats s = make_grid_accelerator(std::span(&view, 1), c)->stats();
+  INFO(s.config << ", " << s.references << " references for " << s.triangles << " triangles");
+  CHECK(s.references < s.triangles + s.nodes / 4);
+}
+
+TEST_CASE("grid: coarse, fine and capped grids give brute force's answers", "[accel][grid]") {
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  const auto brute = make_accelerator("brute", views);
+  const Bounds3f b = compute_bounds(l.scene);
+  const Reference ref = reference(*brute, all_rays(*brute, views, b, lights_around(b), 1, 11));
+  for (auto [lambda, max_res] : {std::pair{0.01f, 1024u}, std::pair{32.0f, 1024u}, std::pair{4.0f, 3u}}) {
+    GridConfig c;
+    c.lambda = lambda;
+    c.max_resolution = max_res;
+    const auto grid = make_grid_accelerator(views, c);
+    const auto r = cross_check(*grid, ref, views, length(b.extent()), true, 0.0f);
+    INFO(summary("grid " + grid->stats().config, r));
+    CHECK(r.failures() == 0);
+  }
+}
+
+TEST_CASE("grid: a flat scene gets one cell across its thickness", "[accel][grid]") {
+  std::vector<Vec3f> pos;
+  std::vector<uint32_t> idx;
+  for (int i = 0; i < 50; ++i) {
+    const uint32_t b = uint32_t(pos.size());
+    pos.insert(pos.end(), {{float(i), 0, 0}, {float(i) + 1, 0, 0}, {float(i), 0, 1}});
+    idx.insert(idx.end(), {b, b + 1, b + 2});
+  }
+  const TriangleMeshView view{pos, idx};
+  const auto grid = make_grid_accelerator(std::span(&view, 1));
+  CHECK_THAT(grid->stats().config, Catch::Contains("x1x"));
+  Hit h;
+  REQUIRE(grid->intersect({{10.25f, 1, 0.25f}, 0, {0, -1, 0}, kInfinity}, h));
+  CHECK(h.t == 1);
+  CHECK(h.prim_id == 10);
+}
+
+TEST_CASE("grid: configuration is validated", "[accel][grid][quick]") {
+  GridConfig c;
+  c.lambda = 0;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("lambda"));
+  c = {};
+  c.max_resolution = 0;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("max_resolution"));
+  c = {};
+  c.max_cells = 0;
+  CHECK_THROWS_AS(validate(c), std::invalid_argument);
+  CHECK_NOTHROW(validate(GridConfig{}));
+}
