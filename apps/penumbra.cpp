@@ -18,6 +18,7 @@
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
+#include "io/accel_params.h"
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
@@ -145,7 +146,32 @@ struct RenderArgs {
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel;
+  std::vector<std::string> accel_params;
 };
+
+/// The accelerator name and "key=value" parameters, checked before any loading: exit 2 with
+/// the list of valid names or keys.
+AccelConfig parse_accel(const std::string& name, const std::vector<std::string>& params) {
+  bool known = false;
+  std::string names;
+  for (const auto& n : accelerator_names()) {
+    known |= n == name;
+    names += (names.empty() ? "" : ", ") + n;
+  }
+  if (!known) throw UsageError("--accel: unknown accelerator '" + name + "' (known: " + names + ")");
+  AccelConfig config;
+  for (const auto& p : params) apply_accel_param(config, p);
+  validate(config.bvh);
+  validate(config.kdtree);
+  validate(config.grid);
+  return config;
+}
+
+std::string accel_param_help() {
+  std::string h = "accelerator build parameter key=value (repeatable):";
+  for (const auto& k : accel_param_keys()) h += "\n  " + k.key + " (default " + k.default_value + "): " + k.description;
+  return h;
+}
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external,
                        const std::string& max_memory, bool quiet) {
@@ -191,9 +217,7 @@ int run_render(const RenderArgs& a) {
   int debug_x = -1, debug_y = -1;
   if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
     throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
-  bool known_accel = false;
-  for (const auto& n : accelerator_names()) known_accel |= n == a.accel;
-  if (!known_accel) throw UsageError("--accel: unknown accelerator '" + a.accel + "'");
+  const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -235,7 +259,7 @@ int run_render(const RenderArgs& a) {
   // Build.
   const auto views = mesh_views(scene);
   const auto t_build = Clock::now();
-  auto accel = make_accelerator(a.accel, views);
+  auto accel = make_accelerator(a.accel, views, accel_config);
   const double build_s = seconds_since(t_build);
 
   if (!a.debug_pixel.empty()) {
@@ -290,7 +314,9 @@ int run_render(const RenderArgs& a) {
   return kExitOk;
 }
 
-int run_info(const std::string& file, int scene_index, bool allow_external, const std::string& accel_name) {
+int run_info(const std::string& file, int scene_index, bool allow_external, const std::string& accel_name,
+             const std::vector<std::string>& accel_params) {
+  const AccelConfig accel_config = parse_accel(accel_name, accel_params);
   LoadedScene loaded = load_scene(file, scene_index, allow_external, "", false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
@@ -333,10 +359,28 @@ int run_info(const std::string& file, int scene_index, bool allow_external, cons
   else
     std::printf("bounds       empty\n");
   const auto views = mesh_views(s);
-  auto accel = make_accelerator(accel_name, views);
+  auto accel = make_accelerator(accel_name, views, accel_config);
   const AccelStats st = accel->stats();
-  std::printf("accelerator  %s: %llu triangles, build %.3fs, %.1f MiB\n", st.name.c_str(),
-              static_cast<unsigned long long>(st.triangles), st.build_seconds, double(st.bytes) / (1 << 20));
+  std::printf("accelerator  %s%s%s%s\n", st.name.c_str(), st.config.empty() ? "" : " (", st.config.c_str(),
+              st.config.empty() ? "" : ")");
+  std::printf("  triangles  %llu\n", static_cast<unsigned long long>(st.triangles));
+  std::printf("  build      %.3f s\n", st.build_seconds);
+  std::printf("  memory     %.2f MiB\n", double(st.bytes) / (1 << 20));
+  if (st.nodes > 0) {
+    const bool grid = st.name == "grid";
+    std::printf("  %s      %llu%s\n", grid ? "cells" : "nodes", static_cast<unsigned long long>(st.nodes),
+                grid ? "" : (" (" + std::to_string(st.nodes - st.leaves) + " interior)").c_str());
+    if (!grid) std::printf("  leaves     %llu\n", static_cast<unsigned long long>(st.leaves));
+    std::printf("  empty      %llu %s\n", static_cast<unsigned long long>(st.empty_leaves), grid ? "cells" : "leaves");
+    std::printf("  references %llu (%.2f per triangle)\n", static_cast<unsigned long long>(st.references),
+                st.triangles ? double(st.references) / double(st.triangles) : 0.0);
+    std::printf("  per %s   avg %.2f, max %llu triangles (non-empty)\n", grid ? "cell" : "leaf", st.avg_leaf_prims,
+                static_cast<unsigned long long>(st.max_leaf_prims));
+    if (!grid) std::printf("  max depth  %llu\n", static_cast<unsigned long long>(st.max_depth));
+    if (st.sah_cost > 0) std::printf("  SAH cost   %.2f\n", st.sah_cost);
+  } else if (st.name == "embree") {
+    std::printf("  (Embree does not report its node statistics)\n");
+  }
   std::printf("warnings     %zu\n", loaded.warnings.size());
   return kExitOk;
 }
@@ -361,7 +405,8 @@ int main(int argc, char** argv) {
   render->add_option("--threads", r.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
   render->add_option("--scene", r.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
   render->add_option("--camera", r.camera, "camera instance index, as listed by `penumbra info` (default 0; none: frame the bounds)")->check(CLI::Range(0, 1 << 30));
-  render->add_option("--accel", r.accel, "acceleration structure: embree (default) or brute");
+  render->add_option("--accel", r.accel, "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
+  render->add_option("--accel-param", r.accel_params, accel_param_help())->type_name("KEY=VALUE");
   render->add_flag("--float", r.use_float, "write 32-bit float EXR channels (default half)");
   render->add_option("--compression", r.compression, "EXR compression (default zip)")
       ->check(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}));
@@ -378,12 +423,14 @@ int main(int argc, char** argv) {
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
 
   std::string info_file, info_accel = "embree";
+  std::vector<std::string> info_accel_params;
   int info_scene = -1;
   bool info_external = false;
   auto* info = app.add_subcommand("info", "Describe a glTF scene: scenes, meshes, materials, cameras, lights, bounds");
   info->add_option("scene", info_file, "glTF scene (.gltf or .glb)")->required();
   info->add_option("--scene", info_scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
-  info->add_option("--accel", info_accel, "acceleration structure to build and describe (default embree)");
+  info->add_option("--accel", info_accel, "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, brute");
+  info->add_option("--accel-param", info_accel_params, accel_param_help())->type_name("KEY=VALUE");
   info->add_flag("--allow-external-uris", info_external, "let buffer URIs reach files outside the scene's folder");
 
   try {
@@ -395,7 +442,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*render) return run_render(r);
-    if (*info) return run_info(info_file, info_scene, info_external, info_accel);
+    if (*info) return run_info(info_file, info_scene, info_external, info_accel, info_accel_params);
   } catch (const InputError& e) {
     std::fprintf(stderr, "penumbra: error: %s\n", e.what());
     return kExitInput;

@@ -59,6 +59,10 @@ class BruteAccelerator final : public Accelerator {
     s.triangles = m_triangles;
     s.leaves = 1;
     s.nodes = 1;
+    s.references = m_triangles;
+    s.max_leaf_prims = m_triangles;
+    s.avg_leaf_prims = double(m_triangles);
+    s.empty_leaves = m_triangles == 0;
     return s;
   }
 

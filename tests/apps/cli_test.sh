@@ -47,6 +47,24 @@ expect 0 "render|rays" -- "$bin" render "$src/scenes/default.gltf" -o "$work/f.e
 expect 0 "pixel 10,10: R" -- "$bin" render "$src/scenes/default.gltf" -o "$work/d.exr" --debug-pixel 10,10 --width 64
 expect 0 "4646 triangles" -- "$bin" info "$src/scenes/default.gltf"
 expect 0 "brute" -- "$bin" info "$src/scenes/default.gltf" --accel brute
+# Every accelerator renders; its statistics print; bad names and parameters exit 2 up front.
+for accel in embree bvh kdtree grid; do
+  expect 0 "accel $accel" -- "$bin" render "$src/scenes/default.gltf" -o "$work/acc-$accel.exr" --width 48 --spp 1 --no-png --accel "$accel"
+done
+if command -v oiiotool >/dev/null; then
+  for accel in bvh kdtree grid; do  # same image as Embree (half-float EXR; ties aside, bit-identical)
+    expect 0 "PASS" -- oiiotool "$work/acc-embree.exr" "$work/acc-$accel.exr" --warn 0.004 --fail 0.004 --diff
+  done
+fi
+expect 0 "SAH cost" -- "$bin" info "$src/scenes/default.gltf" --accel bvh
+expect 0 "max_leaf_size 2, bin_count 32" -- "$bin" info "$src/scenes/default.gltf" --accel bvh --accel-param bvh.max_leaf_size=2 --accel-param bvh.bin_count=32
+expect 0 "empty .* leaves" -- "$bin" info "$src/scenes/default.gltf" --accel kdtree
+expect 0 "resolution [0-9]+x[0-9]+x[0-9]+" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=2
+expect 2 "unknown accelerator 'octree' \(known: embree, bvh, kdtree, grid, brute\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --accel octree
+expect 2 "unknown key 'grid.lamda'" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --accel grid --accel-param grid.lamda=2
+expect 2 "lambda must be in" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=-1
+expect 2 "'2x' is not a valid" -- "$bin" info "$src/scenes/default.gltf" --accel-param bvh.bin_count=2x
+expect 2 "expected key=value" -- "$bin" info "$src/scenes/default.gltf" --accel-param bvh
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Hostile files from the shared corpus (skipped visibly without it).

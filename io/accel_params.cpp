@@ -1,0 +1,75 @@
+// Parsing "key=value" accelerator parameters into AccelConfig.
+#include "io/accel_params.h"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace penumbra {
+namespace {
+
+template <typename T>
+T parse_value(std::string_view key, std::string_view text) {
+  T v{};
+  const char* end = text.data() + text.size();
+  std::from_chars_result r;
+  if constexpr (std::is_floating_point_v<T>) {
+    r = std::from_chars(text.data(), end, v);
+    if (r.ec == std::errc() && r.ptr == end && !std::isfinite(v)) r.ec = std::errc::invalid_argument;
+  } else {
+    r = std::from_chars(text.data(), end, v);
+  }
+  if (text.empty() || r.ec != std::errc() || r.ptr != end)
+    throw std::invalid_argument("--accel-param " + std::string(key) + ": '" + std::string(text) + "' is not a valid " +
+                                (std::is_floating_point_v<T> ? "number" : "non-negative integer"));
+  return v;
+}
+
+}  // namespace
+
+std::vector<AccelParamInfo> accel_param_keys() {
+  const AccelConfig d;
+  auto num = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  return {
+      {"bvh.max_leaf_size", std::to_string(d.bvh.max_leaf_size), "largest leaf, [1, 255]"},
+      {"bvh.bin_count", std::to_string(d.bvh.bin_count), "SAH bins per axis, [2, 256]"},
+      {"bvh.traversal_cost", num(d.bvh.traversal_cost), "SAH cost of a node visit, > 0"},
+      {"bvh.intersection_cost", num(d.bvh.intersection_cost), "SAH cost of a triangle test, > 0"},
+      {"kdtree.traversal_cost", num(d.kdtree.traversal_cost), "K_T, > 0"},
+      {"kdtree.intersection_cost", num(d.kdtree.intersection_cost), "K_I, > 0"},
+      {"kdtree.empty_bonus", num(d.kdtree.empty_bonus), "cost reduction for an empty side, [0, 1)"},
+      {"kdtree.max_depth", std::to_string(d.kdtree.max_depth), "[0, 64]; 0 = 8 + 1.3 log2 N"},
+      {"grid.lambda", num(d.grid.lambda), "cells per triangle, (0, 64]"},
+      {"grid.max_resolution", std::to_string(d.grid.max_resolution), "cells along one axis, [1, 4096]"},
+      {"grid.max_cells", std::to_string(d.grid.max_cells), "total cells, [1, 2^30]"},
+  };
+}
+
+void apply_accel_param(AccelConfig& c, std::string_view kv) {
+  const size_t eq = kv.find('=');
+  if (eq == std::string_view::npos)
+    throw std::invalid_argument("--accel-param: expected key=value, got '" + std::string(kv) + "'");
+  const std::string_view key = kv.substr(0, eq), value = kv.substr(eq + 1);
+  if (key == "bvh.max_leaf_size") c.bvh.max_leaf_size = parse_value<int>(key, value);
+  else if (key == "bvh.bin_count") c.bvh.bin_count = parse_value<int>(key, value);
+  else if (key == "bvh.traversal_cost") c.bvh.traversal_cost = parse_value<float>(key, value);
+  else if (key == "bvh.intersection_cost") c.bvh.intersection_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.traversal_cost") c.kdtree.traversal_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.intersection_cost") c.kdtree.intersection_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.empty_bonus") c.kdtree.empty_bonus = parse_value<float>(key, value);
+  else if (key == "kdtree.max_depth") c.kdtree.max_depth = parse_value<int>(key, value);
+  else if (key == "grid.lambda") c.grid.lambda = parse_value<float>(key, value);
+  else if (key == "grid.max_resolution") c.grid.max_resolution = parse_value<uint32_t>(key, value);
+  else if (key == "grid.max_cells") c.grid.max_cells = parse_value<uint64_t>(key, value);
+  else {
+    std::string known;
+    for (const auto& k : accel_param_keys()) known += (known.empty() ? "" : ", ") + k.key;
+    throw std::invalid_argument("--accel-param: unknown key '" + std::string(key) + "' (known: " + known + ")");
+  }
+}
+
+}  // namespace penumbra

@@ -1,0 +1,52 @@
+// Tests for io/accel_params: every documented key sets its field, bad keys and values are
+// refused with the key named, defaults listed match the config structs.
+#include "io/accel_params.h"
+
+#include <catch2/catch.hpp>
+
+using namespace penumbra;
+
+TEST_CASE("accel params: each key sets its field", "[io][quick]") {
+  AccelConfig c;
+  for (const char* kv : {"bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
+                         "kdtree.traversal_cost=1", "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5",
+                         "kdtree.max_depth=30", "grid.lambda=8", "grid.max_resolution=64", "grid.max_cells=4096"})
+    apply_accel_param(c, kv);
+  CHECK(c.bvh.max_leaf_size == 3);
+  CHECK(c.bvh.bin_count == 32);
+  CHECK(c.bvh.traversal_cost == 2.5f);
+  CHECK(c.bvh.intersection_cost == 0.5f);
+  CHECK(c.kdtree.traversal_cost == 1);
+  CHECK(c.kdtree.intersection_cost == 80);
+  CHECK(c.kdtree.empty_bonus == 0.5f);
+  CHECK(c.kdtree.max_depth == 30);
+  CHECK(c.grid.lambda == 8);
+  CHECK(c.grid.max_resolution == 64);
+  CHECK(c.grid.max_cells == 4096);
+  CHECK(accel_param_keys().size() == 11);
+}
+
+TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {
+  AccelConfig c;
+  CHECK_THROWS_WITH(apply_accel_param(c, "bvh.leaf=3"), Catch::Contains("unknown key 'bvh.leaf'") && Catch::Contains("bvh.max_leaf_size"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "bvh.max_leaf_size"), Catch::Contains("expected key=value"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "bvh.max_leaf_size=3.5"), Catch::Contains("bvh.max_leaf_size"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "grid.max_cells=-1"), Catch::Contains("grid.max_cells"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda=nan"), Catch::Contains("grid.lambda"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda="), Catch::Contains("grid.lambda"));
+  CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);  // failed assignments leave it alone
+}
+
+TEST_CASE("accel params: listed defaults are the config structs' defaults", "[io][quick]") {
+  for (const auto& k : accel_param_keys()) {
+    AccelConfig c;
+    apply_accel_param(c, k.key + "=" + k.default_value);
+    INFO(k.key);
+    CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);
+    CHECK(c.bvh.bin_count == BvhConfig{}.bin_count);
+    CHECK(c.kdtree.empty_bonus == KdTreeConfig{}.empty_bonus);
+    CHECK(c.kdtree.max_depth == KdTreeConfig{}.max_depth);
+    CHECK(c.grid.lambda == GridConfig{}.lambda);
+    CHECK(c.grid.max_cells == GridConfig{}.max_cells);
+  }
+}
