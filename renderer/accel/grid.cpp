@@ -174,8 +174,11 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
         m_res[k] = flat ? 1u : uint32_t(std::clamp(std::ceil(ext[k] / s), 1.0, double(m_config.max_resolution)));
         cells *= m_res[k];
       }
-      if (cells <= m_config.max_cells) break;
-      s *= 1.1;  // too many cells: coarsen
+      // Too many cells, or (for scenes of large overlapping triangles) too many candidate
+      // cell references, bounded by the triangles' bounding boxes: coarsen. This bounds both
+      // build time and memory, whatever the input.
+      if (cells <= m_config.max_cells && bbox_references(ext, s) <= kMaxCandidateRefs) break;
+      s *= 1.25;
     }
     double max_abs = 0;
     for (int k = 0; k < 3; ++k) {
@@ -248,6 +251,25 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     tally.fill(m_stats);
     m_stats.nodes = ncells;
   }
+
+  /// Upper bound on the cell references with cell size s: the cells each triangle's bounding
+  /// box covers, summed (stops counting past the limit).
+  uint64_t bbox_references(const Vec3f& ext, double s) const {
+    uint64_t total = 0;
+    for (const auto& t : m_tris) {
+      const Bounds3f b = triangle_bounds(t);
+      uint64_t c = 1;
+      for (int k = 0; k < 3; ++k) {
+        const double res = std::ceil(ext[k] / s);
+        c *= uint64_t(std::min(res, std::floor((b.hi[k] - b.lo[k]) / s) + 2.0));
+      }
+      total += c;
+      if (total > kMaxCandidateRefs) break;
+    }
+    return total;
+  }
+
+  static constexpr uint64_t kMaxCandidateRefs = 1ull << 26;  // 256 MiB of references at most
 
   GridConfig m_config;
   std::vector<TriangleRecord> m_tris;
