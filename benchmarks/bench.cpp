@@ -1,0 +1,321 @@
+// penumbra-bench: measures acceleration structures on the same scenes and the same pre-generated
+// ray sets (primary, shadow, diffuse, random), verifies every structure's answers against Embree
+// on those rays, and prints a table (optionally CSV and JSON). First part of issue 4: charts,
+// heat maps and the generated stress scenes are still to come (see README, "Benchmarks").
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "io/accel_params.h"
+#include "io/error.h"
+#include "io/gltf_loader.h"
+#include "renderer/accel/factory.h"
+#include "renderer/camera.h"
+#include "renderer/scene.h"
+
+using namespace penumbra;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+}
+
+struct RaySet {
+  std::string kind;  // primary, shadow, diffuse, random
+  std::vector<Ray> rays;
+  bool any_hit = false;  // shadow rays are occlusion queries
+};
+
+Vec3f random_direction(std::mt19937& rng) {
+  std::normal_distribution<float> g;
+  for (;;) {
+    const Vec3f d{g(rng), g(rng), g(rng)};
+    if (dot(d, d) > 1e-8f) return normalize(d);
+  }
+}
+
+/// The four ray kinds of issue 4, generated once per scene from a fixed seed. Primary rays come
+/// from the scene's first camera (or one framing the bounds) on a w x h grid; shadow and diffuse
+/// rays start at the primary hits (found with Embree), offset along the geometric normal.
+std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
+                                  std::span<const TriangleMeshView> views, int w, int h,
+                                  const std::vector<std::string>& kinds) {
+  const Bounds3f b = compute_bounds(scene);
+  const Camera cam = scene.cameras.empty() ? frame_bounds(b, float(w) / float(h)) : scene.cameras[0];
+  std::vector<Ray> primary;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) primary.push_back(generate_camera_ray(cam, w, h, x + 0.5f, y + 0.5f));
+  struct Surface {
+    Vec3f p, n;
+  };
+  std::vector<Surface> surf;
+  for (const Ray& r : primary) {
+    Hit hit;
+    if (!embree.intersect(r, hit)) continue;
+    const auto& m = views[hit.geom_id];
+    const Vec3f a = m.positions[m.indices[hit.prim_id * 3]], bb = m.positions[m.indices[hit.prim_id * 3 + 1]],
+                c = m.positions[m.indices[hit.prim_id * 3 + 2]];
+    Vec3f n = triangle_normal(a, bb, c);
+    if (dot(n, n) == 0) continue;
+    if (dot(n, r.dir) > 0) n = -n;
+    surf.push_back({a * (1 - hit.u - hit.v) + bb * hit.u + c * hit.v, n});
+  }
+  std::vector<Vec3f> lights;
+  for (const auto& l : scene.lights)
+    if (l.type != LightType::Directional) lights.push_back(l.position);
+  if (lights.empty()) {
+    const Vec3f e = b.extent() * 0.5f;
+    lights = {b.hi + e, Vec3f{b.lo.x - e.x, b.hi.y + e.y, b.hi.z}};
+  }
+  std::mt19937 rng(20261122u);
+  std::vector<RaySet> sets;
+  for (const auto& kind : kinds) {
+    RaySet s{kind, {}, kind == "shadow"};
+    if (kind == "primary") {
+      s.rays = primary;
+    } else if (kind == "shadow") {
+      for (size_t i = 0; i < surf.size(); ++i) {
+        const Vec3f l = lights[i % lights.size()];
+        const Vec3f d = l - surf[i].p;
+        const float dist = length(d);
+        if (!(dist > 0)) continue;
+        const Vec3f dir = d / dist;
+        s.rays.push_back({offset_ray_origin(surf[i].p, surf[i].n, dir), 0, dir, dist * (1 - 1e-4f)});
+      }
+    } else if (kind == "diffuse") {
+      for (const auto& p : surf) {
+        Vec3f dir = normalize(p.n + random_direction(rng));
+        if (!(dot(dir, p.n) > 0)) dir = p.n;
+        s.rays.push_back({offset_ray_origin(p.p, p.n, dir), 0, dir, kInfinity});
+      }
+    } else if (kind == "random") {
+      std::uniform_real_distribution<float> u(0, 1);
+      for (size_t i = 0; i < primary.size(); ++i) {
+        Vec3f o;
+        for (int k = 0; k < 3; ++k) o[k] = b.lo[k] + u(rng) * (b.hi[k] - b.lo[k]);
+        s.rays.push_back({o, 0, random_direction(rng), kInfinity});
+      }
+    } else {
+      throw std::invalid_argument("--rays: unknown ray kind '" + kind + "' (known: primary, shadow, diffuse, random)");
+    }
+    sets.push_back(std::move(s));
+  }
+  return sets;
+}
+
+/// Seconds to answer every ray of `set` with `threads` threads (0: one TBB task per chunk on all).
+double trace_seconds(const Accelerator& a, const RaySet& set, int threads, uint64_t& hits) {
+  std::vector<uint8_t> result(set.rays.size());
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(std::max(threads, 1)));
+  const auto t0 = Clock::now();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (set.any_hit) {
+        result[i] = a.occluded(set.rays[i]);
+      } else {
+        Hit h;
+        result[i] = a.intersect(set.rays[i], h);
+      }
+    }
+  });
+  const double s = seconds_since(t0);
+  hits = 0;
+  for (uint8_t v : result) hits += v;
+  return s;
+}
+
+/// Rays on which `a` and Embree disagree: hit/miss, or t beyond 1e-4 relative (with a floor of
+/// 1e-3 of the scene size) for closest-hit rays. Must be 0 for a result to count.
+uint64_t mismatches(const Accelerator& a, const Accelerator& embree, const RaySet& set, float scale) {
+  uint64_t bad = 0;
+  for (const Ray& r : set.rays) {
+    if (set.any_hit) {
+      bad += a.occluded(r) != embree.occluded(r);
+      continue;
+    }
+    Hit ha, he;
+    const bool x = a.intersect(r, ha), y = embree.intersect(r, he);
+    if (x != y) ++bad;
+    else if (x && std::fabs(ha.t - he.t) > 1e-4f * std::max({ha.t, he.t, 1e-3f * scale})) ++bad;
+  }
+  return bad;
+}
+
+struct Row {
+  std::string scene, accel, kind;
+  uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0;
+  double build_s = 0, sah = 0;
+  std::vector<std::pair<int, double>> mrays;  // threads -> Mrays/s
+  std::vector<double> vs_embree;              // per thread count
+};
+
+std::string json_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"penumbra-bench: acceleration structures on the same scenes and rays, verified against Embree"};
+  std::vector<std::string> scenes, accels{"embree", "bvh", "kdtree", "grid"}, kinds{"primary", "shadow", "diffuse", "random"},
+      params;
+  std::vector<int> threads{1, 0};
+  int width = 512, height = 288, builds = 5, repeats = 3;
+  std::string csv, json;
+  app.add_option("scenes", scenes, "glTF scenes (default: scenes/default.gltf)");
+  app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")->delimiter(',');
+  app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
+  app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")->delimiter(',');
+  app.add_option("--width", width, "primary rays per row (default 512)")->check(CLI::Range(1, 8192));
+  app.add_option("--height", height, "primary rays per column (default 288)")->check(CLI::Range(1, 8192));
+  app.add_option("--builds", builds, "builds per structure; the median is reported (default 5)")->check(CLI::Range(1, 100));
+  app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")->check(CLI::Range(1, 100));
+  app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
+  app.add_option("--csv", csv, "also write the table as CSV");
+  app.add_option("--json", json, "also write the results, machine and command line as JSON");
+  CLI11_PARSE(app, argc, argv);
+  if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
+  std::string command;
+  for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
+
+  try {
+    AccelConfig config;
+    for (const auto& p : params) apply_accel_param(config, p);
+    for (const auto& a : accels) {
+      const auto names = accelerator_names();
+      if (std::find(names.begin(), names.end(), a) == names.end())
+        throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
+    }
+    std::vector<Row> rows;
+    for (const auto& file : scenes) {
+      const LoadedScene loaded = load_gltf(file);
+      const auto views = mesh_views(loaded.scene);
+      const auto embree = make_accelerator("embree", views);
+      const auto sets = make_ray_sets(loaded.scene, *embree, views, width, height, kinds);
+      const float scale = length(compute_bounds(loaded.scene).extent());
+      const std::string name = std::filesystem::path(file).filename().string();
+      std::vector<Row> embree_rows;
+      for (const auto& accel_name : accels) {
+        // Build: median of `builds` builds (the last one is measured).
+        std::vector<double> times;
+        std::unique_ptr<Accelerator> accel;
+        for (int i = 0; i < builds; ++i) {
+          accel.reset();
+          const auto t0 = Clock::now();
+          accel = make_accelerator(accel_name, views, config);
+          times.push_back(seconds_since(t0));
+        }
+        const AccelStats st = accel->stats();
+        for (const auto& set : sets) {
+          Row row{name, accel_name, set.kind, st.triangles, set.rays.size()};
+          row.bytes = st.bytes;
+          row.build_s = median(times);
+          row.sah = st.sah_cost;
+          row.mismatches = accel_name == "embree" ? 0 : mismatches(*accel, *embree, set, scale);
+          for (int t : threads) {
+            const int n = t > 0 ? t : int(tbb::info::default_concurrency());
+            uint64_t hits = 0;
+            trace_seconds(*accel, set, n, hits);  // warm-up
+            std::vector<double> secs;
+            for (int r = 0; r < repeats; ++r) secs.push_back(trace_seconds(*accel, set, n, hits));
+            row.hits = hits;
+            row.mrays.push_back({n, double(set.rays.size()) / median(secs) / 1e6});
+          }
+          rows.push_back(row);
+        }
+      }
+      // Ratios to Embree on the same rays.
+      for (auto& r : rows) {
+        if (r.scene != name) continue;
+        for (const auto& e : rows)
+          if (e.scene == name && e.accel == "embree" && e.kind == r.kind) {
+            r.vs_embree.clear();
+            for (size_t i = 0; i < r.mrays.size(); ++i) r.vs_embree.push_back(r.mrays[i].second / e.mrays[i].second);
+          }
+      }
+    }
+
+    // Table.
+    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
+                "SAH", "count", "wrong");
+    for (int t : threads) std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
+    std::printf("\n");
+    for (const auto& r : rows) {
+      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu", r.scene.c_str(), r.accel.c_str(),
+                  r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
+                  r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
+                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches));
+      for (size_t i = 0; i < r.mrays.size(); ++i)
+        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second, i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
+      std::printf("\n");
+    }
+    uint64_t wrong = 0;
+    for (const auto& r : rows) wrong += r.mismatches;
+    if (!csv.empty()) {
+      std::ofstream f(csv);
+      f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches";
+      for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
+        f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
+      f << "\n";
+      for (const auto& r : rows) {
+        f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.build_s << ',' << r.bytes << ','
+          << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches;
+        for (size_t i = 0; i < r.mrays.size(); ++i) f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+        f << "\n";
+      }
+      if (!f) throw std::runtime_error(csv + ": cannot write");
+    }
+    if (!json.empty()) {
+      std::ofstream f(json);
+      f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"compiler\": \"" << json_escape(__VERSION__)
+        << "\",\n  \"hardware_threads\": " << tbb::info::default_concurrency() << ",\n  \"results\": [\n";
+      for (size_t i = 0; i < rows.size(); ++i) {
+        const auto& r = rows[i];
+        f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel << "\", \"rays\": \"" << r.kind
+          << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes
+          << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches
+          << ", \"mrays\": {";
+        for (size_t k = 0; k < r.mrays.size(); ++k)
+          f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;
+        f << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
+      }
+      f << "  ]\n}\n";
+      if (!f) throw std::runtime_error(json + ": cannot write");
+    }
+    if (wrong > 0) {
+      std::fprintf(stderr, "penumbra-bench: %llu rays disagree with Embree: these results do not count\n",
+                   static_cast<unsigned long long>(wrong));
+      return 1;
+    }
+    return 0;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+    return 1;
+  }
+}
