@@ -10,16 +10,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "io/accel_params.h"
+#include "io/atomic_file.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "renderer/accel/factory.h"
 #include "renderer/camera.h"
+#include "renderer/sampling.h"
 #include "renderer/scene.h"
 
 using namespace penumbra;
@@ -42,11 +45,9 @@ struct RaySet {
 };
 
 Vec3f random_direction(std::mt19937& rng) {
-  std::normal_distribution<float> g;
-  for (;;) {
-    const Vec3f d{g(rng), g(rng), g(rng)};
-    if (dot(d, d) > 1e-8f) return normalize(d);
-  }
+  std::uniform_real_distribution<float> u(0, 1);
+  const float a = u(rng), b = u(rng);
+  return sample_uniform_sphere({a, b});
 }
 
 /// The four ray kinds of issue 4, generated once per scene from a fixed seed. Primary rays come
@@ -185,20 +186,36 @@ int main(int argc, char** argv) {
   app.add_option("scenes", scenes, "glTF scenes (default: scenes/default.gltf)");
   app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")->delimiter(',');
   app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
-  app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")->delimiter(',');
+  app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1024));
   app.add_option("--width", width, "primary rays per row (default 512)")->check(CLI::Range(1, 8192));
   app.add_option("--height", height, "primary rays per column (default 288)")->check(CLI::Range(1, 8192));
   app.add_option("--builds", builds, "builds per structure; the median is reported (default 5)")->check(CLI::Range(1, 100));
   app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")->check(CLI::Range(1, 100));
   app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
-  app.add_option("--csv", csv, "also write the table as CSV");
-  app.add_option("--json", json, "also write the results, machine and command line as JSON");
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--csv", csv, "also write the table as CSV (written atomically)");
+  app.add_option("--json", json, "also write the results, machine and command line as JSON (written atomically)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // usage errors exit 2, as for penumbra
+  }
   if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
   std::string command;
   for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
 
   try {
+    // Check the output folders before measuring for minutes.
+    for (const std::string* out : {&csv, &json}) {
+      if (out->empty()) continue;
+      const std::filesystem::path dir = std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
+      if (!std::filesystem::is_directory(dir))
+        throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
+    }
+    for (const auto& k : kinds)
+      if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
+        throw std::invalid_argument("--rays: unknown ray kind '" + k + "' (known: primary, shadow, diffuse, random)");
     AccelConfig config;
     for (const auto& p : params) apply_accel_param(config, p);
     for (const auto& a : accels) {
@@ -271,8 +288,8 @@ int main(int argc, char** argv) {
     }
     uint64_t wrong = 0;
     for (const auto& r : rows) wrong += r.mismatches;
-    if (!csv.empty()) {
-      std::ofstream f(csv);
+    if (!csv.empty()) write_atomically(csv, [&](const std::filesystem::path& tmp) {
+      std::ofstream f(tmp);
       f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches";
       for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
         f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
@@ -284,9 +301,9 @@ int main(int argc, char** argv) {
         f << "\n";
       }
       if (!f) throw std::runtime_error(csv + ": cannot write");
-    }
-    if (!json.empty()) {
-      std::ofstream f(json);
+    });
+    if (!json.empty()) write_atomically(json, [&](const std::filesystem::path& tmp) {
+      std::ofstream f(tmp);
       f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"compiler\": \"" << json_escape(__VERSION__)
         << "\",\n  \"hardware_threads\": " << tbb::info::default_concurrency() << ",\n  \"results\": [\n";
       for (size_t i = 0; i < rows.size(); ++i) {
@@ -301,7 +318,7 @@ int main(int argc, char** argv) {
       }
       f << "  ]\n}\n";
       if (!f) throw std::runtime_error(json + ": cannot write");
-    }
+    });
     if (wrong > 0) {
       std::fprintf(stderr, "penumbra-bench: %llu rays disagree with Embree: these results do not count\n",
                    static_cast<unsigned long long>(wrong));

@@ -4,6 +4,8 @@
 // Random Number Generation", 2014; seed mixing with SplitMix64 (Steele et al. 2014).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "renderer/math.h"
@@ -54,6 +56,15 @@ inline Vec2f stratified_sample(uint32_t s, uint32_t n, Rng& rng) {
   const uint32_t rows = n / cols;
   if (s >= cols * rows) return {jx, jy};
   return {(float(s % cols) + jx) / float(cols), (float(s / cols) + jy) / float(rows)};
+}
+
+/// Uniform direction on the unit sphere from u in [0,1)^2 (Archimedes' projection; pbrt-v4
+/// SampleUniformSphere).
+inline Vec3f sample_uniform_sphere(Vec2f u) {
+  const float z = 1 - 2 * u.x;
+  const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+  const float phi = 2 * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
 }  // namespace penumbra

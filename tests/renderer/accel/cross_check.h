@@ -16,6 +16,7 @@
 #include "renderer/accel/factory.h"
 #include "renderer/camera.h"
 #include "renderer/geometry.h"
+#include "renderer/sampling.h"
 
 namespace penumbra::test {
 
@@ -235,11 +236,9 @@ inline CrossCheckResult cross_check(const Accelerator& a, const Reference& ref,
 // ---- Ray sets -----------------------------------------------------------------------------------
 
 inline Vec3f random_direction(std::mt19937& rng) {
-  std::normal_distribution<float> g;
-  for (;;) {
-    const Vec3f d{g(rng), g(rng), g(rng)};
-    if (dot(d, d) > 1e-8f) return normalize(d);
-  }
+  std::uniform_real_distribution<float> u(0, 1);
+  const float a = u(rng), b = u(rng);
+  return sample_uniform_sphere({a, b});
 }
 
 inline Bounds3f grown(const Bounds3f& b, float f) {
