@@ -19,7 +19,9 @@
 #include "io/accel_params.h"
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "benchmarks/scenegen.h"
 #include "io/gltf_loader.h"
+#include "io/ply_loader.h"
 #include "renderer/accel/factory.h"
 #include "renderer/camera.h"
 #include "renderer/sampling.h"
@@ -157,6 +159,28 @@ uint64_t mismatches(const Accelerator& a, const Accelerator& embree, const RaySe
   return bad;
 }
 
+/// A benchmark scene: "gen:NAME" or "gen:NAME:TRIANGLES" (seeded generator), a .ply file, or a
+/// glTF file. Returns the scene and the name used in the table.
+Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name) {
+  if (spec.rfind("gen:", 0) == 0) {
+    const std::string rest = spec.substr(4);
+    const size_t colon = rest.find(':');
+    uint64_t n = 0;
+    if (colon != std::string::npos) {
+      const std::string count = rest.substr(colon + 1);
+      char* end = nullptr;
+      n = std::strtoull(count.c_str(), &end, 10);
+      if (count.empty() || *end != 0) throw std::invalid_argument(spec + ": triangle count '" + count + "' is not a number");
+    }
+    Scene scene = bench::generate_scene(rest.substr(0, colon), seed, n);
+    name = rest.substr(0, colon) + "-" + std::to_string(count_triangles(scene) / 1000) + "k";
+    return scene;
+  }
+  name = std::filesystem::path(spec).filename().string();
+  if (std::filesystem::path(spec).extension() == ".ply") return load_ply(spec);
+  return load_gltf(spec).scene;
+}
+
 struct Row {
   std::string scene, accel, kind;
   uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0;
@@ -183,7 +207,11 @@ int main(int argc, char** argv) {
   std::vector<int> threads{1, 0};
   int width = 512, height = 288, builds = 5, repeats = 3;
   std::string csv, json;
-  app.add_option("scenes", scenes, "glTF scenes (default: scenes/default.gltf)");
+  uint64_t seed = 1;
+  app.add_option("scenes", scenes,
+                 "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
+                 "stadium, slivers, terrain (default: scenes/default.gltf)");
+  app.add_option("--seed", seed, "seed of the generated scenes (default 1)");
   app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")->delimiter(',');
   app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
   app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
@@ -225,12 +253,12 @@ int main(int argc, char** argv) {
     }
     std::vector<Row> rows;
     for (const auto& file : scenes) {
-      const LoadedScene loaded = load_gltf(file);
-      const auto views = mesh_views(loaded.scene);
+      std::string name;
+      const Scene scene = load_bench_scene(file, seed, name);
+      const auto views = mesh_views(scene);
       const auto embree = make_accelerator("embree", views);
-      const auto sets = make_ray_sets(loaded.scene, *embree, views, width, height, kinds);
-      const float scale = length(compute_bounds(loaded.scene).extent());
-      const std::string name = std::filesystem::path(file).filename().string();
+      const auto sets = make_ray_sets(scene, *embree, views, width, height, kinds);
+      const float scale = length(compute_bounds(scene).extent());
       std::vector<Row> embree_rows;
       for (const auto& accel_name : accels) {
         // Build: median of `builds` builds (the last one is measured).

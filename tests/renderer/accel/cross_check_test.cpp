@@ -85,57 +85,6 @@ Soup icosphere(int level, float r, Vec3f c) {
   return s;
 }
 
-Bounds3f bounds_of(std::span<const TriangleMeshView> views) {
-  Bounds3f b;
-  for (const auto& m : views)
-    for (Vec3f p : m.positions) b = merge(b, p);
-  if (b.empty()) b = {{-1, -1, -1}, {1, 1, 1}};
-  return b;
-}
-
-/// Runs the cross-check of every back end against brute force and against Embree on `rays`.
-/// Back ends sharing the watertight test must match brute force exactly (u, v bit for bit).
-/// Brute force costs rays x triangles, so on big models it answers every k-th ray only
-/// (at most ~2e8 triangle tests); Embree answers all of them.
-void check_all(const std::string& scene, std::span<const TriangleMeshView> views, const std::vector<Ray>& rays,
-               const AccelConfig& config = {}) {
-  const auto all = build_all(views, config);
-  const Accelerator& brute = find(all, "brute");
-  const Accelerator& embree = find(all, "embree");
-  const float scale = length(bounds_of(views).extent());
-  const uint64_t tris = std::max<uint64_t>(1, brute.stats().triangles);
-  const size_t stride = std::max<size_t>(1, size_t(tris * rays.size() / 200'000'000ull) + 1);
-  std::vector<Ray> subset;
-  for (size_t i = 0; i < rays.size(); i += stride) subset.push_back(rays[i]);
-  const Reference by_brute = reference(brute, subset);
-  const Reference by_embree = reference(embree, rays);
-  const Reference by_embree_subset = reference(embree, subset);
-  for (const auto& a : all) {
-    const bool own = a.name != "embree";
-    if (a.name != "brute") {
-      const auto rb = cross_check(*a.accel, by_brute, views, scale, own, own ? 0.0f : 1e-4f);
-      INFO(summary(scene + ": " + a.name + " vs brute", rb));
-      CHECK(rb.failures() == 0);
-    }
-    const bool slow = a.name == "brute";  // brute force answers the subset only
-    const auto re = cross_check(*a.accel, slow ? by_embree_subset : by_embree, views, scale, a.name == "embree", 1e-4f);
-    INFO(summary(scene + ": " + a.name + " vs embree", re));
-    CHECK(re.failures() == 0);
-    CHECK(a.accel->stats().triangles == brute.stats().triangles);
-  }
-}
-
-/// The standard ray collection (camera, random, bounces, on-surface, shadow, bad) for a scene.
-void check_scene(const std::string& scene, std::span<const TriangleMeshView> views, std::vector<Vec3f> lights,
-                 int scale = 1, std::vector<Ray> extra = {}) {
-  const Bounds3f b = bounds_of(views);
-  if (lights.empty()) lights = lights_around(b);
-  const auto embree = make_accelerator("embree", views);
-  std::vector<Ray> rays = all_rays(*embree, views, b, lights, scale, 20261122u);
-  rays.insert(rays.end(), extra.begin(), extra.end());
-  check_all(scene, views, rays);
-}
-
 std::vector<Vec3f> light_positions(const Scene& s) {
   std::vector<Vec3f> out;
   for (const auto& l : s.lights)

@@ -1,0 +1,199 @@
+// glTF 2.0 writer: see gltf_writer.h.
+#include "io/gltf_writer.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "io/atomic_file.h"
+#include "io/error.h"
+
+namespace penumbra {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kFloat = 5126, kUint32 = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+
+struct Writer {
+  json j;
+  std::vector<uint8_t> bin;
+  std::string file;
+
+  int accessor(const void* data, size_t bytes, int component_type, size_t count, const char* type, int target,
+               const json& minmax = nullptr) {
+    while (bin.size() % 4) bin.push_back(0);
+    const size_t offset = bin.size();
+    if (offset + bytes > (size_t(1) << 32) - 1) throw InputError(file, "buffers[0]", "geometry exceeds 4 GiB");
+    bin.resize(offset + bytes);
+    if (bytes) std::memcpy(bin.data() + offset, data, bytes);
+    j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
+    json a = {{"bufferView", j["bufferViews"].size() - 1}, {"componentType", component_type}, {"count", count}, {"type", type}};
+    if (!minmax.is_null()) {
+      a["min"] = minmax[0];
+      a["max"] = minmax[1];
+    }
+    j["accessors"].push_back(a);
+    return int(j["accessors"].size()) - 1;
+  }
+};
+
+/// Column-major 4x4 matrix of the frame (u, v, w) at `origin`.
+json frame_matrix(Vec3f u, Vec3f v, Vec3f w, Vec3f origin) {
+  return json::array({u.x, u.y, u.z, 0, v.x, v.y, v.z, 0, w.x, w.y, w.z, 0, origin.x, origin.y, origin.z, 1});
+}
+
+/// A right-handed frame whose -w is `dir` (a light or camera looking along dir).
+void frame_from_direction(Vec3f dir, Vec3f& u, Vec3f& v, Vec3f& w) {
+  w = -normalize(dir);
+  const Vec3f up = std::fabs(w.y) < 0.999f ? Vec3f{0, 1, 0} : Vec3f{1, 0, 0};
+  u = normalize(cross(up, w));
+  v = cross(w, u);
+}
+
+}  // namespace
+
+void write_gltf(const Scene& scene, const std::filesystem::path& file) {
+  Writer wr;
+  wr.file = file.string();
+  const std::string bin_name = file.stem().string() + ".bin";
+  wr.j = {{"asset", {{"version", "2.0"}, {"generator", "Penumbra write_gltf"}}},
+          {"accessors", json::array()},
+          {"bufferViews", json::array()},
+          {"meshes", json::array()},
+          {"nodes", json::array()},
+          {"scenes", {{{"nodes", json::array()}}}},
+          {"scene", 0}};
+  auto add_root = [&](json node) {
+    wr.j["nodes"].push_back(std::move(node));
+    wr.j["scenes"][0]["nodes"].push_back(wr.j["nodes"].size() - 1);
+  };
+
+  if (!scene.materials.empty()) wr.j["materials"] = json::array();
+  bool emissive_strength = false, unlit = false;
+  for (const Material& m : scene.materials) {
+    json mat = {{"pbrMetallicRoughness",
+                 {{"baseColorFactor", {m.base_color.x, m.base_color.y, m.base_color.z, m.alpha}},
+                  {"metallicFactor", m.metallic},
+                  {"roughnessFactor", m.roughness}}}};
+    if (!m.name.empty()) mat["name"] = m.name;
+    const float e = max_component(m.emissive);
+    if (e > 0) {
+      const float s = std::max(e, 1.0f);
+      mat["emissiveFactor"] = {m.emissive.x / s, m.emissive.y / s, m.emissive.z / s};
+      if (s > 1) {
+        mat["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", s}};
+        emissive_strength = true;
+      }
+    }
+    if (m.alpha < 1) mat["alphaMode"] = "BLEND";
+    if (m.unlit) {
+      mat["extensions"]["KHR_materials_unlit"] = json::object();
+      unlit = true;
+    }
+    wr.j["materials"].push_back(mat);
+  }
+
+  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const Mesh& m = scene.meshes[mi];
+    const std::string where = "meshes[" + std::to_string(mi) + "]";
+    Bounds3f b;
+    for (const Vec3f& p : m.positions) {
+      if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
+        throw InputError(wr.file, where, "non-finite position");
+      b = merge(b, p);
+    }
+    for (uint32_t i : m.indices)
+      if (i >= m.positions.size())
+        throw InputError(wr.file, where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(m.positions.size()));
+    if (m.positions.empty() || m.indices.size() < 3) continue;  // glTF has no empty primitives
+    const json minmax = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
+    json attributes = {{"POSITION", wr.accessor(m.positions.data(), m.positions.size() * 12, kFloat, m.positions.size(),
+                                                "VEC3", kArrayBuffer, minmax)}};
+    if (m.normals.size() == m.positions.size())
+      attributes["NORMAL"] = wr.accessor(m.normals.data(), m.normals.size() * 12, kFloat, m.normals.size(), "VEC3", kArrayBuffer);
+    if (m.uvs.size() == m.positions.size())
+      attributes["TEXCOORD_0"] = wr.accessor(m.uvs.data(), m.uvs.size() * 8, kFloat, m.uvs.size(), "VEC2", kArrayBuffer);
+    json prim = {{"attributes", attributes},
+                 {"indices", wr.accessor(m.indices.data(), m.indices.size() * 4, kUint32, m.indices.size(), "SCALAR",
+                                         kElementArrayBuffer)},
+                 {"mode", 4}};
+    if (m.material >= 0 && size_t(m.material) < scene.materials.size()) prim["material"] = m.material;
+    json mesh = {{"primitives", {prim}}};
+    if (!m.name.empty()) mesh["name"] = m.name;
+    wr.j["meshes"].push_back(mesh);
+    add_root({{"mesh", wr.j["meshes"].size() - 1}, {"name", m.name.empty() ? where : m.name}});
+  }
+
+  if (!scene.cameras.empty()) wr.j["cameras"] = json::array();
+  for (size_t ci = 0; ci < scene.cameras.size(); ++ci) {
+    const Camera& c = scene.cameras[ci];
+    json cam;
+    if (c.projection == Projection::Perspective) {
+      json p = {{"yfov", c.yfov}, {"znear", c.znear > 0 ? c.znear : 1e-3f}};
+      if (c.aspect > 0) p["aspectRatio"] = c.aspect;
+      if (std::isfinite(c.zfar)) p["zfar"] = c.zfar;
+      cam = {{"type", "perspective"}, {"perspective", p}};
+    } else {
+      json o = {{"xmag", c.xmag}, {"ymag", c.ymag}, {"znear", c.znear},
+                {"zfar", std::isfinite(c.zfar) ? c.zfar : 1e30f}};
+      cam = {{"type", "orthographic"}, {"orthographic", o}};
+    }
+    if (!c.name.empty()) cam["name"] = c.name;
+    wr.j["cameras"].push_back(cam);
+    add_root({{"camera", ci}, {"matrix", frame_matrix(c.u, c.v, c.w, c.eye)},
+              {"name", c.name.empty() ? "camera" + std::to_string(ci) : c.name}});
+  }
+
+  if (!scene.lights.empty()) {
+    json lights = json::array();
+    for (size_t li = 0; li < scene.lights.size(); ++li) {
+      const Light& l = scene.lights[li];
+      json light = {{"color", {l.color.x, l.color.y, l.color.z}}, {"intensity", l.intensity}};
+      light["type"] = l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
+      if (l.type != LightType::Directional && std::isfinite(l.range)) light["range"] = l.range;
+      if (l.type == LightType::Spot) light["spot"] = {{"innerConeAngle", l.inner_cone}, {"outerConeAngle", l.outer_cone}};
+      if (!l.name.empty()) light["name"] = l.name;
+      lights.push_back(light);
+      Vec3f u{1, 0, 0}, v{0, 1, 0}, w{0, 0, 1};
+      if (l.type != LightType::Point) frame_from_direction(l.direction, u, v, w);
+      add_root({{"matrix", frame_matrix(u, v, w, l.type == LightType::Directional ? Vec3f{} : l.position)},
+                {"extensions", {{"KHR_lights_punctual", {{"light", li}}}}},
+                {"name", l.name.empty() ? "light" + std::to_string(li) : l.name}});
+    }
+    wr.j["extensions"]["KHR_lights_punctual"]["lights"] = lights;
+  }
+  json used = json::array();
+  if (!scene.lights.empty()) used.push_back("KHR_lights_punctual");
+  if (emissive_strength) used.push_back("KHR_materials_emissive_strength");
+  if (unlit) used.push_back("KHR_materials_unlit");
+  if (!used.empty()) wr.j["extensionsUsed"] = used;
+  if (!wr.bin.empty()) wr.j["buffers"] = {{{"byteLength", wr.bin.size()}, {"uri", bin_name}}};
+
+  auto write_bytes = [&](const std::filesystem::path& tmp, const char* data, size_t n, const std::string& name) {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(data, std::streamsize(n));
+    f.close();
+    if (!f) throw InputError(name, "", "cannot write");
+  };
+  try {
+    if (!wr.bin.empty()) {
+      const auto bin_path = file.parent_path() / bin_name;
+      write_atomically(bin_path, [&](const std::filesystem::path& tmp) {
+        write_bytes(tmp, reinterpret_cast<const char*>(wr.bin.data()), wr.bin.size(), bin_path.string());
+      });
+    }
+    const std::string text = wr.j.dump(1);
+    write_atomically(file, [&](const std::filesystem::path& tmp) { write_bytes(tmp, text.data(), text.size(), wr.file); });
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(wr.file, "", e.what());
+  }
+}
+
+}  // namespace penumbra

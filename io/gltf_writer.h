@@ -1,0 +1,20 @@
+// glTF 2.0 writing: a renderer Scene (world-space meshes, metallic-roughness factors, punctual
+// lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it. Used by
+// the benchmark scene generator and the PLY converter; load_gltf() reads the result back.
+#pragma once
+
+#include <filesystem>
+
+#include "renderer/scene.h"
+
+namespace penumbra {
+
+/// Writes `scene` to `file` (.gltf) and "<stem>.bin" in the same folder, both atomically
+/// (a failure leaves neither half-written). Each mesh becomes one node with one primitive
+/// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices); lights use
+/// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
+/// Throws InputError naming the file if it cannot be written or the scene cannot be expressed
+/// (a buffer over 4 GiB, an index out of range, a non-finite position).
+void write_gltf(const Scene& scene, const std::filesystem::path& file);
+
+}  // namespace penumbra

@@ -1,0 +1,19 @@
+// PLY (Stanford polygon file format) loading: ASCII and binary little/big-endian files with a
+// "vertex" element (float or double x, y, z) and a "face" element (a vertex_indices or
+// vertex_index list). Polygons are triangulated as fans. Other elements and properties are
+// skipped. Used to bring the Stanford models into the benchmark; writes nothing.
+#pragma once
+
+#include <filesystem>
+
+#include "renderer/scene.h"
+
+namespace penumbra {
+
+/// Loads `file` as one mesh (no materials, lights or cameras). Throws InputError naming the
+/// file and the element ("face[812]: index 9312 >= vertex count 4000", "header line 3: ...")
+/// for anything malformed: unknown format, truncated data, non-finite coordinates, out-of-range
+/// indices, counts over 2^31.
+Scene load_ply(const std::filesystem::path& file);
+
+}  // namespace penumbra

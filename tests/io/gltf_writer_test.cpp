@@ -1,0 +1,144 @@
+// write_gltf: everything it writes comes back through load_gltf (geometry bit for bit,
+// materials, lights and cameras), and bad scenes or folders fail without leaving files.
+#include <catch2/catch.hpp>
+#include <cstring>
+
+#include "io/error.h"
+#include "io/gltf_loader.h"
+#include "io/gltf_writer.h"
+#include "renderer/camera.h"
+#include "test_util.h"
+
+using namespace penumbra;
+using namespace penumbra::test;
+
+namespace {
+
+Scene sample_scene() {
+  Scene s;
+  Material plain;
+  plain.name = "plain";
+  plain.base_color = {0.25f, 0.5f, 0.75f};
+  plain.metallic = 0.125f;
+  plain.roughness = 0.625f;
+  Material glow;
+  glow.name = "glow";
+  glow.emissive = {5, 2.5f, 0};  // needs KHR_materials_emissive_strength
+  Material flat;
+  flat.unlit = true;
+  flat.base_color = {1, 0, 0};
+  s.materials = {plain, glow, flat};
+  Mesh a;
+  a.name = "tri";
+  a.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5f}};
+  a.indices = {0, 1, 2};
+  a.normals = compute_smooth_normals(a.positions, a.indices);
+  a.uvs = {{0, 0}, {1, 0}, {0, 1}};
+  a.material = 0;
+  Mesh b;
+  b.name = "quad";
+  b.positions = {{-1, -1, -2}, {1, -1, -2}, {1, 1, -2}, {-1, 1, -2}};
+  b.indices = {0, 1, 2, 0, 2, 3};
+  b.material = 1;
+  Mesh c = b;
+  c.material = 2;
+  for (auto& p : c.positions) p.z = -3;
+  s.meshes = {a, b, c};
+  Light point;
+  point.type = LightType::Point;
+  point.position = {1, 2, 3};
+  point.intensity = 40;
+  point.color = {1, 0.5f, 0.25f};
+  point.range = 10;
+  Light spot;
+  spot.type = LightType::Spot;
+  spot.position = {0, 5, 0};
+  spot.direction = normalize(Vec3f{0.3f, -1, 0.2f});
+  spot.inner_cone = 0.2f;
+  spot.outer_cone = 0.5f;
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = normalize(Vec3f{0, -1, 0});  // straight down: the frame's degenerate case
+  sun.intensity = 3;
+  s.lights = {point, spot, sun};
+  Camera cam = look_at({3, 2, 5}, {0, 0, 0}, {0, 1, 0}, 0.7f);
+  cam.name = "main";
+  cam.aspect = 1.5f;
+  cam.znear = 0.05f;
+  Camera ortho = look_at({0, 10, 0}, {0, 0, 0}, {0, 0, -1}, 0.5f);
+  ortho.projection = Projection::Orthographic;
+  ortho.xmag = 3;
+  ortho.ymag = 2;
+  ortho.zfar = 100;
+  s.cameras = {cam, ortho};
+  return s;
+}
+
+void check_vec(Vec3f a, Vec3f b, float eps = 1e-6f) {
+  CHECK(a.x == Approx(b.x).margin(eps));
+  CHECK(a.y == Approx(b.y).margin(eps));
+  CHECK(a.z == Approx(b.z).margin(eps));
+}
+
+}  // namespace
+
+TEST_CASE("write_gltf: a scene comes back through load_gltf", "[gltf][writer]") {
+  const Scene s = sample_scene();
+  const auto dir = temp_dir("gltf-writer");
+  write_gltf(s, dir / "scene.gltf");
+  CHECK(std::filesystem::exists(dir / "scene.bin"));
+  const LoadedScene l = load_gltf(dir / "scene.gltf");
+  CHECK(l.warnings.empty());
+  const Scene& r = l.scene;
+  REQUIRE(r.meshes.size() == 3);
+  for (size_t i = 0; i < 3; ++i) {
+    CHECK(r.meshes[i].indices == s.meshes[i].indices);
+    REQUIRE(r.meshes[i].positions.size() == s.meshes[i].positions.size());
+    CHECK(std::memcmp(r.meshes[i].positions.data(), s.meshes[i].positions.data(), s.meshes[i].positions.size() * 12) == 0);
+    CHECK(r.meshes[i].material == s.meshes[i].material);
+  }
+  for (int k = 0; k < 3; ++k) check_vec(r.meshes[0].normals[size_t(k)], s.meshes[0].normals[size_t(k)], 1e-6f);
+  REQUIRE(r.meshes[0].uvs.size() == 3);
+  CHECK(r.meshes[0].uvs[2].y == 1.0f);
+  REQUIRE(r.materials.size() == 3);
+  check_vec(r.materials[0].base_color, s.materials[0].base_color);
+  CHECK(r.materials[0].metallic == 0.125f);
+  CHECK(r.materials[0].roughness == 0.625f);
+  check_vec(r.materials[1].emissive, {5, 2.5f, 0}, 1e-5f);
+  CHECK(r.materials[2].unlit);
+  REQUIRE(r.lights.size() == 3);
+  check_vec(r.lights[0].position, {1, 2, 3});
+  CHECK(r.lights[0].intensity == 40);
+  CHECK(r.lights[0].range == 10);
+  check_vec(r.lights[0].color, {1, 0.5f, 0.25f});
+  CHECK(r.lights[1].type == LightType::Spot);
+  check_vec(r.lights[1].direction, s.lights[1].direction, 1e-5f);
+  CHECK(r.lights[1].outer_cone == Approx(0.5f));
+  CHECK(r.lights[2].type == LightType::Directional);
+  check_vec(r.lights[2].direction, {0, -1, 0}, 1e-5f);
+  REQUIRE(r.cameras.size() == 2);
+  for (size_t i = 0; i < 2; ++i) {
+    check_vec(r.cameras[i].eye, s.cameras[i].eye, 1e-5f);
+    check_vec(r.cameras[i].u, s.cameras[i].u, 1e-5f);
+    check_vec(r.cameras[i].w, s.cameras[i].w, 1e-5f);
+  }
+  CHECK(r.cameras[0].name == "main");
+  CHECK(r.cameras[0].yfov == Approx(0.7f));
+  CHECK(r.cameras[0].aspect == Approx(1.5f));
+  CHECK(r.cameras[1].projection == Projection::Orthographic);
+  CHECK(r.cameras[1].ymag == 2);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("write_gltf: bad scenes and folders fail with the element named and leave no file", "[gltf][writer]") {
+  const auto dir = temp_dir("gltf-writer-bad");
+  Scene s = sample_scene();
+  s.meshes[1].positions[2].y = std::nanf("");
+  CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[1]: non-finite position"));
+  s = sample_scene();
+  s.meshes[2].indices[4] = 9;
+  CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[2]: index 9 >= vertex count 4"));
+  CHECK(std::filesystem::is_empty(dir));
+  CHECK_THROWS_AS(write_gltf(sample_scene(), dir / "missing" / "x.gltf"), InputError);
+  std::filesystem::remove_all(dir);
+}
