@@ -161,6 +161,7 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
   if (!known) throw UsageError("--accel: unknown accelerator '" + name + "' (known: " + names + ")");
   AccelConfig config;
   for (const auto& p : params) apply_accel_param(config, p);
+  validate(config.embree);
   validate(config.bvh);
   validate(config.kdtree);
   validate(config.grid);

@@ -3,7 +3,9 @@
 // on those rays, and prints a table (optionally CSV and JSON). First part of issue 4: charts,
 // heat maps and the generated stress scenes are still to come (see README, "Benchmarks").
 #include <tbb/global_control.h>
+#include <sys/utsname.h>
 #include <tbb/parallel_for.h>
+#include <tbb/version.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -12,7 +14,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <ctime>
 #include <random>
+#include <sstream>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -22,6 +27,7 @@
 #include "benchmarks/scenegen.h"
 #include "io/gltf_loader.h"
 #include "io/ply_loader.h"
+#include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 #include "renderer/camera.h"
 #include "renderer/sampling.h"
@@ -182,7 +188,7 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
 }
 
 struct Row {
-  std::string scene, accel, kind;
+  std::string scene, accel, kind, config;
   uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0;
   double build_s = 0, sah = 0;
   std::vector<std::pair<int, double>> mrays;  // threads -> Mrays/s
@@ -193,9 +199,131 @@ std::string json_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
     if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
     o += c;
   }
   return o;
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+/// The first line of `file` starting with `key`, with the key and separators stripped.
+std::string read_field(const char* file, const std::string& key) {
+  std::ifstream f(file);
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind(key, 0) != 0) continue;
+    std::string v = line.substr(key.size());
+    const size_t b = v.find_first_not_of(" \t:=\"");
+    v = b == std::string::npos ? "" : v.substr(b);
+    while (!v.empty() && (v.back() == '"' || v.back() == ' ')) v.pop_back();
+    return v;
+  }
+  return "unknown";
+}
+
+/// The machine, build and library versions, as the body of a JSON object.
+std::string machine_json() {
+  utsname u{};
+  uname(&u);
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  std::string s;
+  auto field = [&](const char* k, const std::string& v, bool last = false) {
+    s += std::string("    \"") + k + "\": \"" + json_escape(v) + "\"" + (last ? "\n" : ",\n");
+  };
+  field("date", date);
+  field("cpu", read_field("/proc/cpuinfo", "model name"));
+  field("hardware_threads", std::to_string(std::thread::hardware_concurrency()));
+  field("memory", read_field("/proc/meminfo", "MemTotal"));
+  field("os", read_field("/etc/os-release", "PRETTY_NAME"));
+  field("kernel", std::string(u.sysname) + " " + u.release + " " + u.machine);
+  field("compiler", __VERSION__);
+  field("build_type", PENUMBRA_BUILD_TYPE);
+  field("flags", PENUMBRA_CXX_FLAGS);
+  field("penumbra", PENUMBRA_VERSION);
+  field("embree", embree_version());
+  field("tbb", TBB_runtime_version());
+  field("tbb_interface", std::to_string(TBB_runtime_interface_version()), true);
+  return s;
+}
+
+/// A bar chart per scene: Mrays/s per ray kind and structure for each thread count, and build
+/// time per structure. Plain SVG 1.1, no scripts or external fonts.
+std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thread_counts) {
+  std::vector<std::string> scenes, accels, kinds;
+  auto add = [](std::vector<std::string>& v, const std::string& x) {
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  };
+  for (const auto& r : rows) {
+    add(scenes, r.scene);
+    add(accels, r.accel);
+    add(kinds, r.kind);
+  }
+  static const char* colors[] = {"#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#b07aa1"};
+  const int charts = int(thread_counts.size()) + 1, chart_w = 340, chart_h = 200, panel_h = chart_h + 90;
+  const int width = charts * (chart_w + 30) + 40, height = int(scenes.size()) * panel_h + 70;
+  std::ostringstream o;
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  o << "<text x=\"20\" y=\"22\" font-size=\"15\" font-weight=\"bold\">penumbra-bench: throughput (Mrays/s, higher is better) "
+       "and build time (ms, lower is better)</text>\n";
+  for (size_t a = 0; a < accels.size(); ++a)  // legend
+    o << "<rect x=\"" << 20 + a * 90 << "\" y=\"34\" width=\"12\" height=\"12\" fill=\"" << colors[a % 6] << "\"/><text x=\""
+      << 36 + a * 90 << "\" y=\"44\">" << xml_escape(accels[a]) << "</text>\n";
+  for (size_t si = 0; si < scenes.size(); ++si) {
+    const int y0 = 70 + int(si) * panel_h;
+    o << "<text x=\"20\" y=\"" << y0 + 14 << "\" font-size=\"13\" font-weight=\"bold\">" << xml_escape(scenes[si]) << "</text>\n";
+    for (int c = 0; c < charts; ++c) {
+      const bool build = c == int(thread_counts.size());
+      const int x0 = 40 + c * (chart_w + 30), top = y0 + 40, base = top + chart_h;
+      // Groups: ray kinds (throughput) or a single group (build time).
+      const size_t groups = build ? 1 : kinds.size();
+      auto value = [&](size_t g, size_t a) -> double {
+        for (const auto& r : rows)
+          if (r.scene == scenes[si] && r.accel == accels[a] && (build || r.kind == kinds[g]))
+            return build ? r.build_s * 1e3 : (size_t(c) < r.mrays.size() ? r.mrays[size_t(c)].second : 0);
+        return 0;
+      };
+      double vmax = 0;
+      for (size_t g = 0; g < groups; ++g)
+        for (size_t a = 0; a < accels.size(); ++a) vmax = std::max(vmax, value(g, a));
+      if (!(vmax > 0)) vmax = 1;
+      const std::string title = build ? "build time (ms)" : std::to_string(thread_counts[size_t(c)]) + " thread" +
+                                                                (thread_counts[size_t(c)] == 1 ? "" : "s") + ", Mrays/s";
+      o << "<text x=\"" << x0 << "\" y=\"" << top - 8 << "\" font-weight=\"bold\">" << title << "</text>\n";
+      o << "<line x1=\"" << x0 << "\" y1=\"" << base << "\" x2=\"" << x0 + chart_w << "\" y2=\"" << base << "\" stroke=\"black\"/>\n";
+      const double gw = double(chart_w) / double(groups), bw = gw * 0.8 / double(accels.size());
+      for (size_t g = 0; g < groups; ++g) {
+        for (size_t a = 0; a < accels.size(); ++a) {
+          const double v = value(g, a), h = v / vmax * (chart_h - 14);
+          const double x = x0 + double(g) * gw + gw * 0.1 + double(a) * bw;
+          char buf[64];
+          std::snprintf(buf, sizeof buf, v >= 100 ? "%.0f" : (v >= 10 ? "%.1f" : "%.2f"), v);
+          o << "<rect x=\"" << x << "\" y=\"" << base - h << "\" width=\"" << bw * 0.92 << "\" height=\"" << h << "\" fill=\""
+            << colors[a % 6] << "\"><title>" << xml_escape(scenes[si] + " " + accels[a] + (build ? "" : " " + kinds[g])) << ": "
+            << buf << "</title></rect>\n";
+          if (bw >= 14)
+            o << "<text x=\"" << x + bw * 0.46 << "\" y=\"" << base - h - 3 << "\" font-size=\"8\" text-anchor=\"middle\">" << buf
+              << "</text>\n";
+        }
+        o << "<text x=\"" << x0 + double(g) * gw + gw / 2 << "\" y=\"" << base + 14 << "\" text-anchor=\"middle\">"
+          << (build ? "build" : xml_escape(kinds[g])) << "</text>\n";
+      }
+    }
+  }
+  o << "</svg>\n";
+  return o.str();
 }
 
 }  // namespace
@@ -206,7 +334,7 @@ int main(int argc, char** argv) {
       params;
   std::vector<int> threads{1, 0};
   int width = 512, height = 288, builds = 5, repeats = 3;
-  std::string csv, json;
+  std::string csv, json, svg;
   uint64_t seed = 1;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
@@ -223,7 +351,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")->check(CLI::Range(1, 100));
   app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
   app.add_option("--csv", csv, "also write the table as CSV (written atomically)");
-  app.add_option("--json", json, "also write the results, machine and command line as JSON (written atomically)");
+  app.add_option("--json", json, "also write the results, machine, build, versions and command line as JSON (written atomically)");
+  app.add_option("--svg", svg, "also write a bar chart of throughput and build time as SVG (written atomically)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -235,7 +364,7 @@ int main(int argc, char** argv) {
 
   try {
     // Check the output folders before measuring for minutes.
-    for (const std::string* out : {&csv, &json}) {
+    for (const std::string* out : {&csv, &json, &svg}) {
       if (out->empty()) continue;
       const std::filesystem::path dir = std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
       if (!std::filesystem::is_directory(dir))
@@ -252,11 +381,13 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
     }
     std::vector<Row> rows;
+    std::string embree_reference;  // the settings of the Embree that every answer is checked against
     for (const auto& file : scenes) {
       std::string name;
       const Scene scene = load_bench_scene(file, seed, name);
       const auto views = mesh_views(scene);
       const auto embree = make_accelerator("embree", views);
+      embree_reference = embree->stats().config;
       const auto sets = make_ray_sets(scene, *embree, views, width, height, kinds);
       const float scale = length(compute_bounds(scene).extent());
       std::vector<Row> embree_rows;
@@ -272,11 +403,11 @@ int main(int argc, char** argv) {
         }
         const AccelStats st = accel->stats();
         for (const auto& set : sets) {
-          Row row{name, accel_name, set.kind, st.triangles, set.rays.size()};
+          Row row{name, accel_name, set.kind, st.config, st.triangles, set.rays.size()};
           row.bytes = st.bytes;
           row.build_s = median(times);
           row.sah = st.sah_cost;
-          row.mismatches = accel_name == "embree" ? 0 : mismatches(*accel, *embree, set, scale);
+          row.mismatches = mismatches(*accel, *embree, set, scale);
           for (int t : threads) {
             const int n = t > 0 ? t : int(tbb::info::default_concurrency());
             uint64_t hits = 0;
@@ -332,11 +463,12 @@ int main(int argc, char** argv) {
     });
     if (!json.empty()) write_atomically(json, [&](const std::filesystem::path& tmp) {
       std::ofstream f(tmp);
-      f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"compiler\": \"" << json_escape(__VERSION__)
-        << "\",\n  \"hardware_threads\": " << tbb::info::default_concurrency() << ",\n  \"results\": [\n";
+      f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"machine\": {\n" << machine_json() << "  },\n"
+        << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n  \"results\": [\n";
       for (size_t i = 0; i < rows.size(); ++i) {
         const auto& r = rows[i];
-        f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel << "\", \"rays\": \"" << r.kind
+        f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel << "\", \"config\": \""
+          << json_escape(r.config) << "\", \"rays\": \"" << r.kind
           << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes
           << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches
           << ", \"mrays\": {";
@@ -346,6 +478,13 @@ int main(int argc, char** argv) {
       }
       f << "  ]\n}\n";
       if (!f) throw std::runtime_error(json + ": cannot write");
+    });
+    if (!svg.empty()) write_atomically(svg, [&](const std::filesystem::path& tmp) {
+      std::vector<int> counts;
+      for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays) counts.push_back(m.first);
+      std::ofstream f(tmp);
+      f << svg_chart(rows, counts);
+      if (!f) throw std::runtime_error(svg + ": cannot write");
     });
     if (wrong > 0) {
       std::fprintf(stderr, "penumbra-bench: %llu rays disagree with Embree: these results do not count\n",

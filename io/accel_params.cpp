@@ -35,6 +35,8 @@ std::vector<AccelParamInfo> accel_param_keys() {
     return std::string(buf);
   };
   return {
+      {"embree.robust", d.embree.robust ? "1" : "0", "RTC_SCENE_FLAG_ROBUST, 0 or 1"},
+      {"embree.quality", std::to_string(d.embree.quality), "build quality: 0 low, 1 medium, 2 high"},
       {"bvh.max_leaf_size", std::to_string(d.bvh.max_leaf_size), "largest leaf, [1, 255]"},
       {"bvh.bin_count", std::to_string(d.bvh.bin_count), "SAH bins per axis, [2, 256]"},
       {"bvh.traversal_cost", num(d.bvh.traversal_cost), "SAH cost of a node visit, > 0"},
@@ -54,7 +56,12 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
   if (eq == std::string_view::npos)
     throw std::invalid_argument("--accel-param: expected key=value, got '" + std::string(kv) + "'");
   const std::string_view key = kv.substr(0, eq), value = kv.substr(eq + 1);
-  if (key == "bvh.max_leaf_size") c.bvh.max_leaf_size = parse_value<int>(key, value);
+  if (key == "embree.robust") {
+    const int v = parse_value<int>(key, value);
+    if (v != 0 && v != 1) throw std::invalid_argument("--accel-param embree.robust: must be 0 or 1, got '" + std::string(value) + "'");
+    c.embree.robust = v == 1;
+  } else if (key == "embree.quality") c.embree.quality = parse_value<int>(key, value);
+  else if (key == "bvh.max_leaf_size") c.bvh.max_leaf_size = parse_value<int>(key, value);
   else if (key == "bvh.bin_count") c.bvh.bin_count = parse_value<int>(key, value);
   else if (key == "bvh.traversal_cost") c.bvh.traversal_cost = parse_value<float>(key, value);
   else if (key == "bvh.intersection_cost") c.bvh.intersection_cost = parse_value<float>(key, value);

@@ -54,13 +54,16 @@ void throw_if_error(const char* what) {
 
 class EmbreeAccelerator final : public Accelerator {
  public:
-  explicit EmbreeAccelerator(std::span<const TriangleMeshView> meshes) {
+  EmbreeAccelerator(std::span<const TriangleMeshView> meshes, const EmbreeConfig& config) : m_config(config) {
+    validate(config);
     const auto t0 = std::chrono::steady_clock::now();
     RTCDevice dev = device();
     take_error();
     m_scene = rtcNewScene(dev);
     throw_if_error("rtcNewScene");
-    rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+    if (config.robust) rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+    const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH};
+    rtcSetSceneBuildQuality(m_scene, quality[config.quality]);
     for (size_t i = 0; i < meshes.size(); ++i) {
       const TriangleMeshView& mesh = meshes[i];
       RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -134,6 +137,8 @@ class EmbreeAccelerator final : public Accelerator {
   AccelStats stats() const override {
     AccelStats s;
     s.name = "embree";
+    s.config = std::string("robust ") + (m_config.robust ? "1" : "0") + ", quality " +
+               (m_config.quality == 0 ? "low" : m_config.quality == 1 ? "medium" : "high");
     s.triangles = m_triangles;
     s.bytes = m_bytes;
     s.build_seconds = m_build_seconds;
@@ -160,6 +165,7 @@ class EmbreeAccelerator final : public Accelerator {
     r.flags = 0;
   }
 
+  EmbreeConfig m_config;
   RTCScene m_scene = nullptr;
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
@@ -169,8 +175,14 @@ class EmbreeAccelerator final : public Accelerator {
 
 }  // namespace
 
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes) {
-  return std::make_unique<EmbreeAccelerator>(meshes);
+void validate(const EmbreeConfig& c) {
+  if (c.quality < 0 || c.quality > 2)
+    throw std::invalid_argument("embree: quality must be 0 (low), 1 (medium) or 2 (high), got " + std::to_string(c.quality));
+}
+
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     const EmbreeConfig& config) {
+  return std::make_unique<EmbreeAccelerator>(meshes, config);
 }
 
 std::string embree_version() {

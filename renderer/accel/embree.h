@@ -1,17 +1,29 @@
 // Embree 3 back end of the Accelerator interface: one RTCDevice per process, one triangle
-// geometry per mesh (geometry id == mesh index), robust scene flag, default (medium) build quality.
+// geometry per mesh (geometry id == mesh index); by default the robust scene flag and medium
+// build quality (EmbreeConfig).
 #pragma once
 
 #include <memory>
 #include <span>
+#include <string>
 
 #include "renderer/accel/accelerator.h"
 
 namespace penumbra {
 
+/// Embree scene settings.
+struct EmbreeConfig {
+  bool robust = true;  ///< RTC_SCENE_FLAG_ROBUST: no cracks on shared edges (slower traversal)
+  int quality = 1;     ///< build quality: 0 low, 1 medium (Embree's default), 2 high
+};
+
+/// Throws std::invalid_argument naming the field if a value is out of range.
+void validate(const EmbreeConfig& config);
+
 /// Builds an Embree scene over the meshes (data is copied into Embree-owned buffers).
 /// Throws std::runtime_error with Embree's message if the device or build fails.
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes);
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     const EmbreeConfig& config = {});
 
 /// The process-wide Embree device's version string (e.g. "3.13.5").
 std::string embree_version();

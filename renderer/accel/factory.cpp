@@ -13,7 +13,7 @@ std::vector<std::string> accelerator_names() { return {"embree", "bvh", "kdtree"
 std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
                                               std::span<const TriangleMeshView> meshes,
                                               const AccelConfig& config) {
-  if (name == "embree") return make_embree_accelerator(meshes);
+  if (name == "embree") return make_embree_accelerator(meshes, config.embree);
   if (name == "bvh") return make_bvh_accelerator(meshes, config.bvh);
   if (name == "kdtree") return make_kdtree_accelerator(meshes, config.kdtree);
   if (name == "grid") return make_grid_accelerator(meshes, config.grid);

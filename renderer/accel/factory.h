@@ -10,6 +10,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/accel/bvh.h"
+#include "renderer/accel/embree.h"
 #include "renderer/accel/grid.h"
 #include "renderer/accel/kdtree.h"
 
@@ -17,6 +18,7 @@ namespace penumbra {
 
 /// Build parameters of every back end; only the chosen one's are used.
 struct AccelConfig {
+  EmbreeConfig embree;
   BvhConfig bvh;
   KdTreeConfig kdtree;
   GridConfig grid;

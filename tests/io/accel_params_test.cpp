@@ -8,10 +8,12 @@ using namespace penumbra;
 
 TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   AccelConfig c;
-  for (const char* kv : {"bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
+  for (const char* kv : {"embree.robust=0", "embree.quality=2", "bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
                          "kdtree.traversal_cost=1", "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5",
                          "kdtree.max_depth=30", "grid.lambda=8", "grid.max_resolution=64", "grid.max_cells=4096"})
     apply_accel_param(c, kv);
+  CHECK_FALSE(c.embree.robust);
+  CHECK(c.embree.quality == 2);
   CHECK(c.bvh.max_leaf_size == 3);
   CHECK(c.bvh.bin_count == 32);
   CHECK(c.bvh.traversal_cost == 2.5f);
@@ -23,7 +25,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.grid.lambda == 8);
   CHECK(c.grid.max_resolution == 64);
   CHECK(c.grid.max_cells == 4096);
-  CHECK(accel_param_keys().size() == 11);
+  CHECK(accel_param_keys().size() == 13);
 }
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {
@@ -34,6 +36,7 @@ TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][q
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.max_cells=-1"), Catch::Contains("grid.max_cells"));
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda=nan"), Catch::Contains("grid.lambda"));
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda="), Catch::Contains("grid.lambda"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "embree.robust=2"), Catch::Contains("embree.robust: must be 0 or 1"));
   CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);  // failed assignments leave it alone
 }
 
@@ -42,6 +45,8 @@ TEST_CASE("accel params: listed defaults are the config structs' defaults", "[io
     AccelConfig c;
     apply_accel_param(c, k.key + "=" + k.default_value);
     INFO(k.key);
+    CHECK(c.embree.robust == EmbreeConfig{}.robust);
+    CHECK(c.embree.quality == EmbreeConfig{}.quality);
     CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);
     CHECK(c.bvh.bin_count == BvhConfig{}.bin_count);
     CHECK(c.kdtree.empty_bonus == KdTreeConfig{}.empty_bonus);

@@ -252,6 +252,28 @@ TEST_CASE("cross-check: the default scene", "[accel][crosscheck]") {
   check_scene("default.gltf", views, light_positions(l.scene));
 }
 
+TEST_CASE("cross-check: Embree without the robust flag and at low and high build quality",
+          "[accel][crosscheck]") {
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  for (const auto& [robust, quality] : {std::pair{false, 1}, std::pair{true, 0}, std::pair{true, 2}}) {
+    AccelConfig config;
+    config.embree.robust = robust;
+    config.embree.quality = quality;
+    const auto embree = make_accelerator("embree", views, config);
+    CHECK(embree->stats().config.find(robust ? "robust 1" : "robust 0") != std::string::npos);
+    std::mt19937 rng(7);
+    const Bounds3f b = bounds_of(views);
+    std::vector<Ray> rays = camera_rays(b, 32);
+    const auto rnd = random_rays(b, 2000, rng);
+    rays.insert(rays.end(), rnd.begin(), rnd.end());
+    const auto brute = make_accelerator("brute", views);
+    const auto res = cross_check(*embree, reference(*brute, rays), views, length(b.extent()), false, 1e-4f);
+    INFO(summary("embree " + embree->stats().config + " vs brute", res));
+    CHECK(res.failures() == 0);
+  }
+}
+
 TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus]") {
   const auto corpus = corpus_dir();
   if (!corpus) return skip("no corpus (set PENUMBRA_CORPUS)");

@@ -51,6 +51,9 @@ TEST_CASE("the factory knows five back ends, embree first, and refuses bad confi
   AccelConfig bad_grid;
   bad_grid.grid.lambda = 0;
   CHECK_THROWS_AS(make_accelerator("grid", {}, bad_grid), std::invalid_argument);
+  AccelConfig bad_embree;
+  bad_embree.embree.quality = 3;
+  CHECK_THROWS_WITH(make_accelerator("embree", {}, bad_embree), Catch::Contains("embree: quality"));
 }
 
 TEST_CASE("every back end reports its statistics", "[accel][quick]") {
