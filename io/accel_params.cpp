@@ -37,6 +37,7 @@ std::vector<AccelParamInfo> accel_param_keys() {
   return {
       {"embree.robust", d.embree.robust ? "1" : "0", "RTC_SCENE_FLAG_ROBUST, 0 or 1"},
       {"embree.quality", std::to_string(d.embree.quality), "build quality: 0 low, 1 medium, 2 high"},
+      {"bvh.width", std::to_string(d.bvh.width), "node width: 2 (binary) or 4 (SSE, 4 boxes per test)"},
       {"bvh.max_leaf_size", std::to_string(d.bvh.max_leaf_size), "largest leaf, [1, 255]"},
       {"bvh.bin_count", std::to_string(d.bvh.bin_count), "SAH bins per axis, [2, 256]"},
       {"bvh.traversal_cost", num(d.bvh.traversal_cost), "SAH cost of a node visit, > 0"},
@@ -61,6 +62,7 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     if (v != 0 && v != 1) throw std::invalid_argument("--accel-param embree.robust: must be 0 or 1, got '" + std::string(value) + "'");
     c.embree.robust = v == 1;
   } else if (key == "embree.quality") c.embree.quality = parse_value<int>(key, value);
+  else if (key == "bvh.width") c.bvh.width = parse_value<int>(key, value);
   else if (key == "bvh.max_leaf_size") c.bvh.max_leaf_size = parse_value<int>(key, value);
   else if (key == "bvh.bin_count") c.bvh.bin_count = parse_value<int>(key, value);
   else if (key == "bvh.traversal_cost") c.bvh.traversal_cost = parse_value<float>(key, value);

@@ -38,6 +38,13 @@ struct AccelStats {
   double build_seconds = 0;
 };
 
+/// Work done by queries: nodes (or grid cells) visited and triangles tested. Summed by
+/// intersect_counted(); the cost heat map (penumbra render --aov cost) shows it per pixel.
+struct TraversalCost {
+  uint64_t nodes = 0;      ///< interior and leaf nodes (BVH, kD-tree) or cells (grid) visited
+  uint64_t triangles = 0;  ///< ray-triangle tests
+};
+
 class Accelerator {
  public:
   virtual ~Accelerator() = default;
@@ -47,6 +54,14 @@ class Accelerator {
   virtual bool intersect(const Ray& ray, Hit& hit) const = 0;
   /// True iff some triangle is hit with t in [max(ray.tnear, 0), ray.tfar]. Thread-safe.
   virtual bool occluded(const Ray& ray) const = 0;
+  /// intersect(), also adding the work it did to `cost`. Back ends that cannot count (Embree
+  /// keeps no statistics in release builds) answer without counting: see counts_traversal().
+  virtual bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const {
+    (void)cost;
+    return intersect(ray, hit);
+  }
+  /// True iff intersect_counted() fills in TraversalCost.
+  virtual bool counts_traversal() const { return false; }
   virtual Bounds3f bounds() const = 0;
   virtual AccelStats stats() const = 0;
 };

@@ -18,6 +18,12 @@ class BruteAccelerator final : public Accelerator {
     }
   }
 
+  bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const override {
+    if (prepare_watertight(ray).valid) cost.triangles += m_triangles;
+    return intersect(ray, hit);
+  }
+  bool counts_traversal() const override { return true; }
+
   bool intersect(const Ray& ray, Hit& hit) const override {
     hit = Hit{};
     const WatertightRay w = prepare_watertight(ray);

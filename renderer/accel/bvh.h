@@ -1,6 +1,8 @@
-// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007), flattened into
-// 32-byte nodes in depth-first order, traversed front to back with a fixed stack. It builds from
-// triangle bounds only and calls the shared watertight triangle test in its leaves.
+// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007) of a binary tree,
+// then either flattened into 32-byte binary nodes (width 2) or collapsed into 4-wide nodes whose
+// four boxes are tested at once with SSE (width 4, the default), traversed front to back with a
+// fixed stack. It builds from triangle bounds only and calls the shared watertight triangle test
+// in its leaves.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +20,7 @@ struct BvhConfig {
   float traversal_cost = 1.0f;    ///< > 0: cost of visiting one node
   float intersection_cost = 1.0f; ///< > 0: cost of one triangle test
   size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks
+  int width = 4;                  ///< 2 (binary nodes) or 4 (4-wide nodes, SSE box tests)
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.

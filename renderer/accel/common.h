@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <type_traits>
 #include <span>
 #include <vector>
 
@@ -122,27 +123,53 @@ inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const Triangle
   return intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, ray.tfar, t, u, v);
 }
 
-/// intersect() and occluded() of the reference structures, written once: each structure
-/// provides `template <class Visit> bool traverse(const Ray&, const float& best, Visit&&) const`,
-/// which walks the cells or leaves the ray may meet (skipping those beyond `best`) and calls
-/// visit(w, tri) on their triangles until it returns true (CRTP, so the visitors inline).
+/// Node counters for traversals: NoCount compiles away; CountNodes adds to a TraversalCost.
+struct NoCount {
+  void node() const {}
+};
+struct CountNodes {
+  TraversalCost& cost;
+  void node() const { ++cost.nodes; }
+};
+
+/// intersect(), intersect_counted() and occluded() of the reference structures, written once:
+/// each structure provides
+///   template <class Visit, class Counter>
+///   bool traverse(const Ray&, const float& best, Visit&&, const Counter&) const,
+/// which walks the cells or leaves the ray may meet (skipping those beyond `best`), calls
+/// counter.node() per node or cell visited, and calls visit(w, tri) on their triangles until it
+/// returns true (CRTP, so the visitors inline).
 template <typename Derived>
 class TraversalAccelerator : public Accelerator {
  public:
-  bool intersect(const Ray& ray, Hit& hit) const final {
-    hit = Hit{};
-    float best = ray.tfar;
-    static_cast<const Derived*>(this)->traverse(ray, best, [&](const WatertightRay& w, const TriangleRecord& tri) {
-      intersect_leaf(ray, w, tri, best, hit);
-      return false;
-    });
-    return hit.valid();
+  bool intersect(const Ray& ray, Hit& hit) const final { return closest(ray, hit, NoCount{}, nullptr); }
+
+  bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const final {
+    return closest(ray, hit, CountNodes{cost}, &cost.triangles);
   }
+  bool counts_traversal() const final { return true; }
 
   bool occluded(const Ray& ray) const final {
     const float tfar = ray.tfar;
     return static_cast<const Derived*>(this)->traverse(
-        ray, tfar, [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); });
+        ray, tfar, [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); },
+        NoCount{});
+  }
+
+ private:
+  template <typename Counter>
+  bool closest(const Ray& ray, Hit& hit, const Counter& counter, uint64_t* tests) const {
+    hit = Hit{};
+    float best = ray.tfar;
+    static_cast<const Derived*>(this)->traverse(
+        ray, best,
+        [&](const WatertightRay& w, const TriangleRecord& tri) {
+          if constexpr (!std::is_same_v<Counter, NoCount>) ++*tests;
+          intersect_leaf(ray, w, tri, best, hit);
+          return false;
+        },
+        counter);
+    return hit.valid();
   }
 };
 

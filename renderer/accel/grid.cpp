@@ -99,8 +99,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   /// triangle (mailboxed) and returns true to stop (any-hit). `best` is the current closest hit
   /// distance (updated by the visitor for closest-hit queries): traversal stops as soon as it
   /// lies within the current cell. Returns true iff a visitor returned true.
-  template <typename Visit>
-  bool traverse(const Ray& ray, const float& best, Visit&& visit) const {
+  template <typename Visit, typename Counter>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid || m_tris.empty()) return false;
     const RayBoxQuery q = prepare_box_query(ray);
@@ -136,6 +136,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     // Walk.
     for (;;) {
       const size_t c = (size_t(cell[2]) * m_res[1] + size_t(cell[1])) * m_res[0] + size_t(cell[0]);
+      counter.node();
       for (uint32_t i = m_offsets[c], e = m_offsets[c + 1]; i < e; ++i) {
         const uint32_t r = m_refs[i];
         uint32_t& slot = mailbox[r & (kMailboxSize - 1)];

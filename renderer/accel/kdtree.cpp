@@ -333,8 +333,8 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   /// Front-to-back traversal with early exit: stops once `best` (narrowed by closest-hit
   /// visitors) lies before the next node's entry. `visit(w, tri)` returns true to stop
   /// (any-hit). Returns true iff a visitor stopped it.
-  template <typename Visit>
-  bool traverse(const Ray& ray, const float& best, Visit&& visit) const {
+  template <typename Visit, typename Counter>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid || m_nodes.empty()) return false;
     const RayBoxQuery q = prepare_box_query(ray);
@@ -346,6 +346,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     for (;;) {
       if (best < tmin) return false;  // nothing further can be closer
       const KdNode& node = m_nodes[idx];
+      counter.node();
       if (!node.leaf()) {
         idx = step(node, idx, ray, q, tmin, tmax, todo, sp);
         continue;

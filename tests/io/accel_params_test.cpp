@@ -8,12 +8,13 @@ using namespace penumbra;
 
 TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   AccelConfig c;
-  for (const char* kv : {"embree.robust=0", "embree.quality=2", "bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
+  for (const char* kv : {"embree.robust=0", "embree.quality=2", "bvh.width=2", "bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
                          "kdtree.traversal_cost=1", "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5",
                          "kdtree.max_depth=30", "grid.lambda=8", "grid.max_resolution=64", "grid.max_cells=4096"})
     apply_accel_param(c, kv);
   CHECK_FALSE(c.embree.robust);
   CHECK(c.embree.quality == 2);
+  CHECK(c.bvh.width == 2);
   CHECK(c.bvh.max_leaf_size == 3);
   CHECK(c.bvh.bin_count == 32);
   CHECK(c.bvh.traversal_cost == 2.5f);
@@ -25,7 +26,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.grid.lambda == 8);
   CHECK(c.grid.max_resolution == 64);
   CHECK(c.grid.max_cells == 4096);
-  CHECK(accel_param_keys().size() == 13);
+  CHECK(accel_param_keys().size() == 14);
 }
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {
@@ -47,6 +48,7 @@ TEST_CASE("accel params: listed defaults are the config structs' defaults", "[io
     INFO(k.key);
     CHECK(c.embree.robust == EmbreeConfig{}.robust);
     CHECK(c.embree.quality == EmbreeConfig{}.quality);
+    CHECK(c.bvh.width == BvhConfig{}.width);
     CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);
     CHECK(c.bvh.bin_count == BvhConfig{}.bin_count);
     CHECK(c.kdtree.empty_bonus == KdTreeConfig{}.empty_bonus);

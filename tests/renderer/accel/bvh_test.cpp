@@ -25,6 +25,7 @@ TEST_CASE("bvh: leaves respect max_leaf_size, every triangle is referenced once,
   const auto views = mesh_views(l.scene);
   for (int leaf : {1, 4, 8}) {
     BvhConfig c;
+    c.width = 2;
     c.max_leaf_size = leaf;
     const AccelStats s = make_bvh_accelerator(views, c)->stats();
     INFO("max_leaf_size " << leaf);
@@ -41,20 +42,91 @@ TEST_CASE("bvh: leaves respect max_leaf_size, every triangle is referenced once,
   }
 }
 
+TEST_CASE("bvh: width 4 collapses the same leaves into 4-wide nodes of 128 bytes", "[accel][bvh]") {
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  for (int leaf : {1, 4, 8}) {
+    BvhConfig c2, c4;
+    c2.width = 2;
+    c2.max_leaf_size = c4.max_leaf_size = leaf;
+    const AccelStats s2 = make_bvh_accelerator(views, c2)->stats(), s4 = make_bvh_accelerator(views, c4)->stats();
+    INFO("max_leaf_size " << leaf);
+    CHECK(s4.config.find("width 4") != std::string::npos);
+    // The same binary build underneath: the same leaves.
+    CHECK(s4.leaves == s2.leaves);
+    CHECK(s4.references == s2.references);
+    CHECK(s4.max_leaf_prims == s2.max_leaf_prims);
+    // Every 4-wide node has 2 to 4 children and all but the root are someone's child.
+    const uint64_t interior = s4.nodes - s4.leaves;
+    CHECK(s4.nodes - 1 <= 4 * interior);
+    CHECK(s4.nodes - 1 >= 2 * interior);
+    // Shallower, and no shallower than a perfect 4-ary tree.
+    CHECK(s4.max_depth < s2.max_depth);
+    CHECK(s4.max_depth >= uint64_t(std::ceil(std::log(double(s4.triangles) / leaf) / std::log(4.0))));
+    CHECK(s4.bytes == interior * 128 + s4.triangles * 44);
+    CHECK(s4.sah_cost > 0);
+    CHECK(s4.sah_cost < s2.sah_cost);  // fewer node visits for the same leaves
+  }
+}
+
+TEST_CASE("bvh: axis-parallel rays through the faces and edges of 4-wide node boxes", "[accel][bvh]") {
+  // A 4 x 4 x 4 lattice of small cubes: node boxes share planes with the lattice rays, which
+  // start on box faces and run inside them (0 * inf in the SSE slab test).
+  std::vector<Vec3f> pos;
+  std::vector<uint32_t> idx;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) {
+        const uint32_t base = uint32_t(pos.size());
+        for (int c = 0; c < 8; ++c)
+          pos.push_back({float(2 * i + (c & 1)), float(2 * j + ((c >> 1) & 1)), float(2 * k + ((c >> 2) & 1))});
+        const uint32_t f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 4, 6}, {0, 6, 2},
+                                   {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3}};
+        for (const auto& t : f) idx.insert(idx.end(), {base + t[0], base + t[1], base + t[2]});
+      }
+  const TriangleMeshView view{pos, idx};
+  const std::span<const TriangleMeshView> views(&view, 1);
+  std::vector<Ray> rays;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float a = 0; a <= 8; a += 0.5f)
+      for (float b = 0; b <= 8; b += 0.5f)
+        for (float start : {-1.0f, 0.0f, 1.0f, 9.0f})
+          for (float sign : {1.0f, -1.0f}) {
+            Vec3f o, d;
+            o[axis] = start;
+            o[(axis + 1) % 3] = a;
+            o[(axis + 2) % 3] = b;
+            d[axis] = sign;
+            rays.push_back({o, 0, d, kInfinity});
+          }
+  const auto brute = make_accelerator("brute", views);
+  const Reference ref = reference(*brute, rays);
+  for (int leaf : {1, 2, 8}) {
+    BvhConfig c;
+    c.max_leaf_size = leaf;
+    const auto bvh = make_bvh_accelerator(views, c);
+    const auto r = cross_check(*bvh, ref, views, 14, true, 0.0f);
+    INFO(summary("bvh4 lattice leaf " + std::to_string(leaf), r));
+    CHECK(r.failures() == 0);
+    CHECK(r.hits > rays.size() / 4);
+  }
+}
+
 TEST_CASE("bvh: any leaf size and bin count gives brute force's answers", "[accel][bvh]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   const auto views = mesh_views(l.scene);
   const auto brute = make_accelerator("brute", views);
   const Reference ref = reference(*brute, scene_rays(l, *brute, views));
   const float scale = length(compute_bounds(l.scene).extent());
-  for (auto [leaf, bins] : {std::pair{1, 2}, std::pair{2, 7}, std::pair{255, 256}}) {
+  for (auto [leaf, bins] : {std::pair{1, 2}, std::pair{2, 7}, std::pair{255, 256}, std::pair{-4, 16}}) {
     BvhConfig c;
-    c.max_leaf_size = leaf;
+    c.width = leaf < 0 ? 2 : 4;  // -4: the binary layout with leaves of 4
+    c.max_leaf_size = std::abs(leaf);
     c.bin_count = bins;
     c.parallel_threshold = 64;  // exercise the parallel build on a small scene
     const auto bvh = make_bvh_accelerator(views, c);
     const auto r = cross_check(*bvh, ref, views, scale, true, 0.0f);
-    INFO(summary("bvh leaf " + std::to_string(leaf) + " bins " + std::to_string(bins), r));
+    INFO(summary("bvh width " + std::to_string(c.width) + " leaf " + std::to_string(leaf) + " bins " + std::to_string(bins), r));
     CHECK(r.failures() == 0);
   }
 }
@@ -95,5 +167,8 @@ TEST_CASE("bvh: configuration is validated", "[accel][bvh][quick]") {
   c = {};
   c.traversal_cost = 0;
   CHECK_THROWS_AS(validate(c), std::invalid_argument);
+  c = {};
+  c.width = 8;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("width must be 2 or 4"));
   CHECK_NOTHROW(validate(BvhConfig{}));
 }
