@@ -22,6 +22,7 @@
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
+#include "renderer/cost_map.h"
 #include "renderer/render.h"
 
 namespace fs = std::filesystem;
@@ -145,8 +146,8 @@ struct RenderArgs {
   uint64_t seed = 0;
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
-  std::string accel = "embree", max_memory, debug_pixel;
-  std::vector<std::string> accel_params;
+  std::string accel = "embree", max_memory, debug_pixel, cost_png;
+  std::vector<std::string> accel_params, aovs;
 };
 
 /// The accelerator name and "key=value" parameters, checked before any loading: exit 2 with
@@ -219,6 +220,23 @@ int run_render(const RenderArgs& a) {
   if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
     throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
   const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
+  bool cost_aov = false;
+  for (const auto& aov : a.aovs) {
+    if (aov != "cost") throw UsageError("--aov: unknown AOV '" + aov + "' (known: cost)");
+    cost_aov = true;
+  }
+  std::optional<fs::path> cost_png;
+  if (cost_aov) {
+    if (a.accel == "embree")
+      throw UsageError("--aov cost: Embree does not report traversal counts; use --accel bvh, kdtree, grid or brute");
+    if (!a.no_png) {
+      cost_png = a.cost_png.empty() ? fs::path(out).replace_extension(".cost.png") : fs::path(a.cost_png);
+      check_dir(*cost_png, "--cost-png");
+      check_display_output(*cost_png, display);
+    }
+  } else if (!a.cost_png.empty()) {
+    throw UsageError("--cost-png needs --aov cost");
+  }
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -287,8 +305,17 @@ int run_render(const RenderArgs& a) {
   exr.compression = a.compression;
   exr.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:camera", camera.name},
                   {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", "whitted"}};
+  CostImage cost;
+  if (cost_aov) {
+    cost = render_cost(*accel, camera, cfg);
+    exr.extra = {{"cost.nodes", &cost.nodes}, {"cost.triangles", &cost.triangles}};
+  }
   write_exr(film, out, exr);
   if (png) write_display_image(film, *png, display);
+  if (cost_png) {
+    write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png,
+                  a.accel + ": nodes + triangles per camera ray");
+  }
   const double write_s = seconds_since(t_write);
 
   if (!a.quiet) {
@@ -312,6 +339,7 @@ int run_render(const RenderArgs& a) {
   }
   std::printf("%s\n", out.string().c_str());
   if (png) std::printf("%s\n", png->string().c_str());
+  if (cost_png) std::printf("%s\n", cost_png->string().c_str());
   return kExitOk;
 }
 
@@ -422,6 +450,10 @@ int main(int argc, char** argv) {
   render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
   render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
+  render->add_option("--aov", r.aovs,
+                     "extra outputs (repeatable): cost = traversal cost of the camera rays, as EXR channels "
+                     "cost.nodes and cost.triangles and a heat map with a legend (not with --accel embree)");
+  render->add_option("--cost-png", r.cost_png, "heat map path for --aov cost (default: the EXR path with .cost.png)");
 
   std::string info_file, info_accel = "embree";
   std::vector<std::string> info_accel_params;

@@ -26,10 +26,12 @@
 #include "io/error.h"
 #include "benchmarks/scenegen.h"
 #include "io/gltf_loader.h"
+#include "io/image_output.h"
 #include "io/ply_loader.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 #include "renderer/camera.h"
+#include "renderer/cost_map.h"
 #include "renderer/sampling.h"
 #include "renderer/scene.h"
 
@@ -334,7 +336,7 @@ int main(int argc, char** argv) {
       params;
   std::vector<int> threads{1, 0};
   int width = 512, height = 288, builds = 5, repeats = 3;
-  std::string csv, json, svg;
+  std::string csv, json, svg, heatmaps;
   uint64_t seed = 1;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
@@ -352,6 +354,9 @@ int main(int argc, char** argv) {
   app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
   app.add_option("--csv", csv, "also write the table as CSV (written atomically)");
   app.add_option("--json", json, "also write the results, machine, build, versions and command line as JSON (written atomically)");
+  app.add_option("--heatmaps", heatmaps,
+                 "also write a traversal-cost heat map (nodes + triangles per primary ray) per scene and structure "
+                 "into this folder: SCENE.ACCEL.cost.png (not for embree, which does not count)");
   app.add_option("--svg", svg, "also write a bar chart of throughput and build time as SVG (written atomically)");
   try {
     app.parse(argc, argv);
@@ -370,6 +375,8 @@ int main(int argc, char** argv) {
       if (!std::filesystem::is_directory(dir))
         throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
     }
+    if (!heatmaps.empty() && !std::filesystem::is_directory(heatmaps))
+      throw std::invalid_argument("--heatmaps: directory '" + heatmaps + "' does not exist");
     for (const auto& k : kinds)
       if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
         throw std::invalid_argument("--rays: unknown ray kind '" + k + "' (known: primary, shadow, diffuse, random)");
@@ -402,6 +409,17 @@ int main(int argc, char** argv) {
           times.push_back(seconds_since(t0));
         }
         const AccelStats st = accel->stats();
+        if (!heatmaps.empty() && accel->counts_traversal()) {
+          RenderConfig rc;
+          rc.width = width;
+          rc.height = height;
+          rc.spp = 1;
+          const Camera cam = scene.cameras.empty() ? frame_bounds(compute_bounds(scene), float(width) / float(height))
+                                                   : scene.cameras[0];
+          const CostImage cost = render_cost(*accel, cam, rc);
+          write_heatmap(total_cost(cost), width, height, std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
+                        name + " " + accel_name + ": nodes + triangles per ray");
+        }
         for (const auto& set : sets) {
           Row row{name, accel_name, set.kind, st.config, st.triangles, set.rays.size()};
           row.bytes = st.bytes;

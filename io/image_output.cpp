@@ -4,7 +4,10 @@
 #include <OpenColorIO/OpenColorIO.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -33,15 +36,157 @@ void write_with_oiio(const std::filesystem::path& final_path, const std::filesys
 }  // namespace
 
 void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options) {
-  OIIO::ImageSpec spec(film.width, film.height, 4, options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  const int nc = 4 + int(options.extra.size());
+  OIIO::ImageSpec spec(film.width, film.height, nc, options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R", "G", "B", "A"};
+  const size_t pixels = size_t(film.width) * size_t(film.height);
+  for (const auto& c : options.extra) {
+    if (!c.data || c.data->size() != pixels)
+      throw std::invalid_argument(path.string() + ": channel " + c.name + " does not match the image size");
+    spec.channelnames.push_back(c.name);
+  }
+  if (!options.extra.empty()) {
+    spec.channelformats.assign(size_t(nc), options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+    for (size_t i = 4; i < size_t(nc); ++i) spec.channelformats[i] = OIIO::TypeDesc::FLOAT;
+  }
   spec.alpha_channel = 3;
   spec.attribute("compression", options.compression);
   spec.attribute("oiio:ColorSpace", "lin_rec709");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
   for (const auto& [k, v] : options.metadata) spec.attribute(k, v);
+  if (options.extra.empty()) {
+    write_atomically(path, [&](const std::filesystem::path& temp) {
+      write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
+    });
+    return;
+  }
+  std::vector<float> interleaved(pixels * size_t(nc));
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int k = 0; k < 4; ++k) interleaved[i * size_t(nc) + size_t(k)] = film.rgba[i * 4 + size_t(k)];
+    for (size_t k = 0; k < options.extra.size(); ++k) interleaved[i * size_t(nc) + 4 + k] = (*options.extra[k].data)[i];
+  }
   write_atomically(path, [&](const std::filesystem::path& temp) {
-    write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
+    write_with_oiio(path, temp, spec, interleaved.data(), OIIO::TypeDesc::FLOAT);
+  });
+}
+
+namespace {
+
+/// 5 x 7 pixel glyphs (rows top to bottom, bit 4 = leftmost column) for the heat-map legend.
+struct Glyph {
+  char c;
+  uint8_t rows[7];
+};
+constexpr Glyph kFont[] = {
+    {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}}, {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}}, {'3', {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E}},
+    {'4', {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}}, {'5', {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+    {'6', {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}}, {'7', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+    {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}}, {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+    {'A', {0x0E, 0x11, 0x11, 0x11, 0x1F, 0x11, 0x11}}, {'B', {0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E}},
+    {'C', {0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E}}, {'D', {0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C}},
+    {'E', {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F}}, {'F', {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10}},
+    {'G', {0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F}}, {'H', {0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11}},
+    {'I', {0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}}, {'J', {0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C}},
+    {'K', {0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11}}, {'L', {0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F}},
+    {'M', {0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11}}, {'N', {0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11}},
+    {'O', {0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E}}, {'P', {0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10}},
+    {'Q', {0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D}}, {'R', {0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11}},
+    {'S', {0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E}}, {'T', {0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04}},
+    {'U', {0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E}}, {'V', {0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04}},
+    {'W', {0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A}}, {'X', {0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11}},
+    {'Y', {0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04}}, {'Z', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F}},
+    {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}}, {',', {0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08}},
+    {':', {0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00}}, {'-', {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00}},
+    {'+', {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}}, {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},
+    {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}}, {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}},
+    {'=', {0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00}}, {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
+    {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F}},
+};
+
+/// An 8-bit RGB canvas for the legend.
+struct Canvas {
+  int w, h;
+  std::vector<uint8_t> rgb;
+  void set(int x, int y, const uint8_t c[3]) {
+    if (x < 0 || y < 0 || x >= w || y >= h) return;
+    std::copy(c, c + 3, &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3]);
+  }
+  /// Draws `text` (upper-cased; unknown characters as spaces) at scale `s`; returns its width.
+  int text(int x, int y, const std::string& t, int s, const uint8_t c[3], bool draw = true) {
+    int cx = x;
+    for (char ch : t) {
+      const char u = char(std::toupper(static_cast<unsigned char>(ch)));
+      for (const Glyph& g : kFont) {
+        if (g.c != u || !draw) continue;
+        for (int r = 0; r < 7; ++r)
+          for (int col = 0; col < 5; ++col)
+            if (g.rows[r] & (0x10 >> col))
+              for (int dy = 0; dy < s; ++dy)
+                for (int dx = 0; dx < s; ++dx) set(cx + col * s + dx, y + r * s + dy, c);
+      }
+      cx += 6 * s;
+    }
+    return cx - x;
+  }
+};
+
+/// The viridis colour map (van der Walt & Smith, matplotlib 2015), five sRGB stops.
+void viridis(float t, uint8_t out[3]) {
+  static const float stops[5][3] = {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  t = std::clamp(std::isfinite(t) ? t : 0.0f, 0.0f, 1.0f) * 4;
+  const int i = std::min(int(t), 3);
+  const float f = t - float(i);
+  for (int k = 0; k < 3; ++k) out[k] = uint8_t(std::lround(stops[i][k] + (stops[i + 1][k] - stops[i][k]) * f));
+}
+
+std::string legend_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, v >= 100 || v == std::floor(v) ? "%.0f" : "%.1f", v);
+  return buf;
+}
+
+}  // namespace
+
+void write_heatmap(const std::vector<float>& values, int width, int height, const std::filesystem::path& path,
+                   const std::string& title) {
+  if (values.size() != size_t(width) * size_t(height))
+    throw std::invalid_argument(path.string() + ": heat map values do not match the image size");
+  float vmax = 0;
+  for (float v : values)
+    if (std::isfinite(v)) vmax = std::max(vmax, v);
+  const float scale = vmax > 0 ? 1.0f / vmax : 0.0f;
+  const int s = width >= 480 ? 2 : 1;  // font scale
+  const int legend = 7 * s * 2 + 12 * s + 14;
+  Canvas c{width, height + legend, std::vector<uint8_t>(size_t(width) * size_t(height + legend) * 3, 255)};
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      uint8_t col[3];
+      viridis(values[size_t(y) * size_t(width) + size_t(x)] * scale, col);
+      c.set(x, y, col);
+    }
+  const uint8_t black[3] = {0, 0, 0};
+  const int margin = 4 * s, y_title = height + 3, y_bar = y_title + 7 * s + 3, bar_h = 8 * s;
+  c.text(margin, y_title, title, s, black);
+  const int x0 = margin, x1 = std::max(x0 + 1, width - margin);
+  for (int x = x0; x < x1; ++x) {
+    uint8_t col[3];
+    viridis(float(x - x0) / float(std::max(1, x1 - x0 - 1)), col);
+    for (int y = y_bar; y < y_bar + bar_h; ++y) c.set(x, y, col);
+  }
+  for (int q = 0; q <= 4; ++q) {  // ticks and labels at 0, 1/4, 1/2, 3/4, max
+    const int x = x0 + (x1 - 1 - x0) * q / 4;
+    for (int y = y_bar + bar_h; y < y_bar + bar_h + 3; ++y) c.set(x, y, black);
+    const std::string label = legend_number(double(vmax) * q / 4);
+    const int w = c.text(0, 0, label, s, black, false);
+    const int lx = std::clamp(x - w / 2, 0, std::max(0, width - w));
+    c.text(lx, y_bar + bar_h + 4, label, s, black);
+  }
+  OIIO::ImageSpec spec(width, height + legend, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
+  write_atomically(path, [&](const std::filesystem::path& temp) {
+    write_with_oiio(path, temp, spec, c.rgb.data(), OIIO::TypeDesc::UINT8);
   });
 }
 

@@ -11,14 +11,23 @@
 
 namespace penumbra {
 
+/// An extra EXR channel (an AOV such as "cost.nodes"): width x height floats, row-major, top row
+/// first; always stored as 32-bit float so counts stay exact.
+struct ExrChannel {
+  std::string name;
+  const std::vector<float>* data = nullptr;
+};
+
 struct ExrOptions {
-  bool half = true;                  ///< 16-bit half channels; false = 32-bit float
+  bool half = true;                  ///< 16-bit half R, G, B, A; false = 32-bit float
+  std::vector<ExrChannel> extra;     ///< AOV channels after R, G, B, A
   std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts
   std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
 };
 
-/// Writes channels R, G, B, A (colour premultiplied by A) to `path`. Throws
-/// std::runtime_error naming the file if OpenImageIO fails.
+/// Writes channels R, G, B, A (colour premultiplied by A) and the extra channels to `path`.
+/// Throws std::runtime_error naming the file if OpenImageIO fails, std::invalid_argument if an
+/// extra channel has the wrong size.
 void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options);
 
 struct DisplayOptions {
@@ -38,6 +47,13 @@ void write_display_image(const Film& film, const std::filesystem::path& path,
 /// .jpeg, .tif, .tiff) and that the config, display and view resolve. Throws InputError
 /// naming the file or config and, for an unknown display or view, listing the valid ones.
 void check_display_output(const std::filesystem::path& path, const DisplayOptions& options);
+
+/// Writes `values` (width x height, row-major) as an 8-bit sRGB heat map (.png, .jpg, .tif):
+/// linear from 0 (dark blue) to the image's maximum (yellow) on the viridis ramp, with a legend
+/// strip below it: `title`, the colour bar and its scale (0, quarters, maximum). Written
+/// atomically. Throws std::runtime_error naming the file if OpenImageIO fails.
+void write_heatmap(const std::vector<float>& values, int width, int height,
+                   const std::filesystem::path& path, const std::string& title);
 
 /// Penumbra's shipped OCIO config text (io/ocio/config.ocio, embedded at build time).
 const char* shipped_ocio_config();

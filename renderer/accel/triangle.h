@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "renderer/geometry.h"
 
@@ -46,6 +47,14 @@ inline WatertightRay prepare_watertight(const Ray& ray) {
   return w;
 }
 
+/// Component i of v as an indexed load (Vec3f::operator[] is a chain of selects, slow with a
+/// per-ray permutation index in the innermost loop).
+inline float component(const Vec3f& v, int i) {
+  float f[3];
+  std::memcpy(f, &v, sizeof f);
+  return f[i];
+}
+
 /// Tests triangle (a, b, c) against the ray; on a hit with t in [tnear, tfar] writes t, u, v
 /// (p = (1-u-v) a + u b + v c) and returns true. Degenerate triangles never hit.
 inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, Vec3f a,
@@ -53,9 +62,9 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
                                           float& u_out, float& v_out) {
   // Translate to the ray origin, then shear so the ray is the +z axis.
   const Vec3f A = a - ray.org, B = b - ray.org, C = c - ray.org;
-  const float Ax = A[w.kx] - w.sx * A[w.kz], Ay = A[w.ky] - w.sy * A[w.kz];
-  const float Bx = B[w.kx] - w.sx * B[w.kz], By = B[w.ky] - w.sy * B[w.kz];
-  const float Cx = C[w.kx] - w.sx * C[w.kz], Cy = C[w.ky] - w.sy * C[w.kz];
+  const float Ax = component(A, w.kx) - w.sx * component(A, w.kz), Ay = component(A, w.ky) - w.sy * component(A, w.kz);
+  const float Bx = component(B, w.kx) - w.sx * component(B, w.kz), By = component(B, w.ky) - w.sy * component(B, w.kz);
+  const float Cx = component(C, w.kx) - w.sx * component(C, w.kz), Cy = component(C, w.ky) - w.sy * component(C, w.kz);
   // Scaled barycentrics (edge functions).
   float U = Cx * By - Cy * Bx;
   float V = Ax * Cy - Ay * Cx;
@@ -68,9 +77,9 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return false;
   if (U + V + W == 0.0f) return false;
   // The ray passes through the triangle: its distance and barycentrics in double.
-  const double ax = double(a[w.kx]) - ray.org[w.kx], ay = double(a[w.ky]) - ray.org[w.ky], az = double(a[w.kz]) - ray.org[w.kz];
-  const double bx = double(b[w.kx]) - ray.org[w.kx], by = double(b[w.ky]) - ray.org[w.ky], bz = double(b[w.kz]) - ray.org[w.kz];
-  const double cx = double(c[w.kx]) - ray.org[w.kx], cy = double(c[w.ky]) - ray.org[w.ky], cz = double(c[w.kz]) - ray.org[w.kz];
+  const double ax = double(component(a, w.kx)) - component(ray.org, w.kx), ay = double(component(a, w.ky)) - component(ray.org, w.ky), az = double(component(a, w.kz)) - component(ray.org, w.kz);
+  const double bx = double(component(b, w.kx)) - component(ray.org, w.kx), by = double(component(b, w.ky)) - component(ray.org, w.ky), bz = double(component(b, w.kz)) - component(ray.org, w.kz);
+  const double cx = double(component(c, w.kx)) - component(ray.org, w.kx), cy = double(component(c, w.ky)) - component(ray.org, w.ky), cz = double(component(c, w.kz)) - component(ray.org, w.kz);
   const double dAx = ax - w.dsx * az, dAy = ay - w.dsy * az;
   const double dBx = bx - w.dsx * bz, dBy = by - w.dsy * bz;
   const double dCx = cx - w.dsx * cz, dCy = cy - w.dsy * cz;

@@ -127,3 +127,60 @@ TEST_CASE("atomic writes leave the old file intact and no temporary on failure",
   CHECK_THROWS(write_exr(ramp(2, 2), dir / "missing" / "x.exr", {}));
   CHECK(files_in(dir) == 1);
 }
+
+TEST_CASE("EXR AOV channels are written as exact 32-bit floats after R, G, B, A", "[io][exr][aov]") {
+  const auto dir = penumbra::test::temp_dir("exr-aov");
+  const Film f = ramp(16, 8);
+  std::vector<float> nodes(16 * 8), tris(16 * 8);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    nodes[i] = float(i) + 4097.0f;  // not representable in half
+    tris[i] = float(i % 5);
+  }
+  ExrOptions opt;
+  opt.extra = {{"cost.nodes", &nodes}, {"cost.triangles", &tris}};
+  write_exr(f, dir / "aov.exr", opt);
+  OIIO::ImageSpec spec;
+  const auto px = read_all(dir / "aov.exr", spec);
+  REQUIRE(spec.nchannels == 6);
+  CHECK(spec.channelnames[4] == "cost.nodes");
+  CHECK(spec.channelnames[5] == "cost.triangles");
+  CHECK(spec.channelformat(0) == OIIO::TypeDesc::HALF);
+  CHECK(spec.channelformat(4) == OIIO::TypeDesc::FLOAT);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    REQUIRE(px[i * 6 + 4] == nodes[i]);
+    REQUIRE(px[i * 6 + 5] == tris[i]);
+  }
+  CHECK(px[(3 * 16 + 5) * 6 + 2] == 0.5f);  // the beauty is still there
+  std::vector<float> wrong(7);
+  opt.extra = {{"bad", &wrong}};
+  CHECK_THROWS_WITH(write_exr(f, dir / "bad.exr", opt), Catch::Contains("channel bad does not match"));
+  CHECK_FALSE(std::filesystem::exists(dir / "bad.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a legend below", "[io][heatmap]") {
+  const auto dir = penumbra::test::temp_dir("heatmap");
+  const int w = 100, h = 40;
+  std::vector<float> v(size_t(w) * h, 0.0f);
+  for (int y = 0; y < h; ++y) v[size_t(y) * w + 99] = 250;  // the last column is the maximum
+  v[0] = std::nanf("");                                     // non-finite counts as 0
+  write_heatmap(v, w, h, dir / "heat.png", "bvh: nodes");
+  OIIO::ImageSpec spec;
+  const auto px = read_all(dir / "heat.png", spec);
+  CHECK(spec.width == w);
+  CHECK(spec.height > h);  // legend strip
+  CHECK(spec.nchannels == 3);
+  auto at = [&](int x, int y, int c) { return std::lround(px[(size_t(y) * size_t(spec.width) + size_t(x)) * 3 + size_t(c)] * 255); };
+  CHECK(at(10, 10, 0) == 68);  // viridis at 0
+  CHECK(at(10, 10, 2) == 84);
+  CHECK(at(0, 0, 0) == 68);
+  CHECK(at(99, 10, 0) == 253);  // viridis at 1
+  CHECK(at(99, 10, 1) == 231);
+  // The legend has dark text pixels on white.
+  int dark = 0;
+  for (int y = h; y < spec.height; ++y)
+    for (int x = 0; x < w; ++x) dark += at(x, y, 0) == 0 && at(x, y, 1) == 0 && at(x, y, 2) == 0;
+  CHECK(dark > 50);
+  CHECK_THROWS(write_heatmap(std::vector<float>(3), w, h, dir / "bad.png", "x"));
+  std::filesystem::remove_all(dir);
+}
