@@ -387,6 +387,23 @@ int main(int argc, char** argv) {
       if (std::find(names.begin(), names.end(), a) == names.end())
         throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
     }
+    // Embree first, so every later row can show its ratio as soon as it is measured.
+    if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end()) std::rotate(accels.begin(), it, it + 1);
+    // The table, one row as soon as it is measured (long runs show progress).
+    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
+                "SAH", "count", "wrong");
+    for (int t : threads) std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
+    std::printf("\n");
+    auto print_row = [](const Row& r) {
+      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu", r.scene.c_str(), r.accel.c_str(),
+                  r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
+                  r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
+                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches));
+      for (size_t i = 0; i < r.mrays.size(); ++i)
+        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second, i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
+      std::printf("\n");
+      std::fflush(stdout);
+    };
     std::vector<Row> rows;
     std::string embree_reference;  // the settings of the Embree that every answer is checked against
     for (const auto& file : scenes) {
@@ -435,34 +452,18 @@ int main(int argc, char** argv) {
             row.hits = hits;
             row.mrays.push_back({n, double(set.rays.size()) / median(secs) / 1e6});
           }
+          // Ratio to Embree on the same rays (Embree is measured first, see above).
+          for (const auto& e : rows)
+            if (e.scene == name && e.accel == "embree" && e.kind == row.kind)
+              for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(row.mrays[i].second / e.mrays[i].second);
+          if (accel_name == "embree")
+            for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(1.0);
+          print_row(row);
           rows.push_back(row);
         }
       }
-      // Ratios to Embree on the same rays.
-      for (auto& r : rows) {
-        if (r.scene != name) continue;
-        for (const auto& e : rows)
-          if (e.scene == name && e.accel == "embree" && e.kind == r.kind) {
-            r.vs_embree.clear();
-            for (size_t i = 0; i < r.mrays.size(); ++i) r.vs_embree.push_back(r.mrays[i].second / e.mrays[i].second);
-          }
-      }
     }
 
-    // Table.
-    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
-                "SAH", "count", "wrong");
-    for (int t : threads) std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
-    std::printf("\n");
-    for (const auto& r : rows) {
-      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu", r.scene.c_str(), r.accel.c_str(),
-                  r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
-                  r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
-                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches));
-      for (size_t i = 0; i < r.mrays.size(); ++i)
-        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second, i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
-      std::printf("\n");
-    }
     uint64_t wrong = 0;
     for (const auto& r : rows) wrong += r.mismatches;
     if (!csv.empty()) write_atomically(csv, [&](const std::filesystem::path& tmp) {

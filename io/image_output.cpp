@@ -167,7 +167,8 @@ void write_heatmap(const std::vector<float>& values, int width, int height, cons
     }
   const uint8_t black[3] = {0, 0, 0};
   const int margin = 4 * s, y_title = height + 3, y_bar = y_title + 7 * s + 3, bar_h = 8 * s;
-  c.text(margin, y_title, title, s, black);
+  const int ts = c.text(0, 0, title, s, black, false) <= width - 2 * margin ? s : 1;  // a long title: small font
+  c.text(margin, y_title + (s - ts) * 7, title, ts, black);
   const int x0 = margin, x1 = std::max(x0 + 1, width - margin);
   for (int x = x0; x < x1; ++x) {
     uint8_t col[3];
