@@ -150,21 +150,34 @@ double trace_seconds(const Accelerator& a, const RaySet& set, int threads, uint6
   return s;
 }
 
-/// Rays on which `a` and Embree disagree: hit/miss, or t beyond 1e-4 relative (with a floor of
-/// 1e-3 of the scene size) for closest-hit rays. Must be 0 for a result to count.
-uint64_t mismatches(const Accelerator& a, const Accelerator& embree, const RaySet& set, float scale) {
-  uint64_t bad = 0;
+struct Agreement {
+  uint64_t wrong = 0;  ///< rays where `a` differs from Embree and from the exact scan: must be 0
+  uint64_t ties = 0;   ///< rays where `a` differs from Embree but gives the exact scan's answer
+};
+
+/// Whether two answers to `r` agree: same hit/miss (occluded or not), and for closest hits t
+/// within 1e-4 relative (with a floor of 1e-3 of the scene size).
+bool same_answer(const Accelerator& a, const Accelerator& b, const Ray& r, bool any_hit, float scale) {
+  if (any_hit) return a.occluded(r) == b.occluded(r);
+  Hit ha, hb;
+  const bool x = a.intersect(r, ha), y = b.intersect(r, hb);
+  return x == y && (!x || std::fabs(ha.t - hb.t) <= 1e-4f * std::max({ha.t, hb.t, 1e-3f * scale}));
+}
+
+/// Checks `a` against Embree on every ray of `set`. A disagreement is settled by the brute-force
+/// scan with the watertight test (the exact answer of the triangle test the own structures
+/// share): if `a` gives the scan's answer, Embree's own triangle test rounded the other way on
+/// that ray (a hit exactly on an edge, or at the end of the ray) and it is counted as a tie;
+/// otherwise `a` is wrong.
+Agreement check_against_embree(const Accelerator& a, const Accelerator& embree, const Accelerator& exact,
+                               const RaySet& set, float scale) {
+  Agreement g;
   for (const Ray& r : set.rays) {
-    if (set.any_hit) {
-      bad += a.occluded(r) != embree.occluded(r);
-      continue;
-    }
-    Hit ha, he;
-    const bool x = a.intersect(r, ha), y = embree.intersect(r, he);
-    if (x != y) ++bad;
-    else if (x && std::fabs(ha.t - he.t) > 1e-4f * std::max({ha.t, he.t, 1e-3f * scale})) ++bad;
+    if (same_answer(a, embree, r, set.any_hit, scale)) continue;
+    if (same_answer(a, exact, r, set.any_hit, scale)) ++g.ties;
+    else ++g.wrong;
   }
-  return bad;
+  return g;
 }
 
 /// A benchmark scene: "gen:NAME" or "gen:NAME:TRIANGLES" (seeded generator), a .ply file, or a
@@ -191,7 +204,7 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
 
 struct Row {
   std::string scene, accel, kind, config;
-  uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0;
+  uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
   double build_s = 0, sah = 0;
   std::vector<std::pair<int, double>> mrays;  // threads -> Mrays/s
   std::vector<double> vs_embree;              // per thread count
@@ -390,15 +403,16 @@ int main(int argc, char** argv) {
     // Embree first, so every later row can show its ratio as soon as it is measured.
     if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end()) std::rotate(accels.begin(), it, it + 1);
     // The table, one row as soon as it is measured (long runs show progress).
-    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
-                "SAH", "count", "wrong");
+    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
+                "SAH", "count", "wrong", "ties");
     for (int t : threads) std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
     std::printf("\n");
     auto print_row = [](const Row& r) {
-      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu", r.scene.c_str(), r.accel.c_str(),
+      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu %5llu", r.scene.c_str(), r.accel.c_str(),
                   r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
                   r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
-                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches));
+                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches),
+                  static_cast<unsigned long long>(r.ties));
       for (size_t i = 0; i < r.mrays.size(); ++i)
         std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second, i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
       std::printf("\n");
@@ -411,6 +425,7 @@ int main(int argc, char** argv) {
       const Scene scene = load_bench_scene(file, seed, name);
       const auto views = mesh_views(scene);
       const auto embree = make_accelerator("embree", views);
+      const auto exact = make_accelerator("brute", views);  // settles disagreements with Embree
       embree_reference = embree->stats().config;
       const auto sets = make_ray_sets(scene, *embree, views, width, height, kinds);
       const float scale = length(compute_bounds(scene).extent());
@@ -442,7 +457,9 @@ int main(int argc, char** argv) {
           row.bytes = st.bytes;
           row.build_s = median(times);
           row.sah = st.sah_cost;
-          row.mismatches = mismatches(*accel, *embree, set, scale);
+          const Agreement g = check_against_embree(*accel, *embree, *exact, set, scale);
+          row.mismatches = g.wrong;
+          row.ties = g.ties;
           for (int t : threads) {
             const int n = t > 0 ? t : int(tbb::info::default_concurrency());
             uint64_t hits = 0;
@@ -468,13 +485,13 @@ int main(int argc, char** argv) {
     for (const auto& r : rows) wrong += r.mismatches;
     if (!csv.empty()) write_atomically(csv, [&](const std::filesystem::path& tmp) {
       std::ofstream f(tmp);
-      f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches";
+      f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties";
       for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
         f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
       f << "\n";
       for (const auto& r : rows) {
         f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.build_s << ',' << r.bytes << ','
-          << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches;
+          << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ',' << r.ties;
         for (size_t i = 0; i < r.mrays.size(); ++i) f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
         f << "\n";
       }
@@ -489,7 +506,7 @@ int main(int argc, char** argv) {
         f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel << "\", \"config\": \""
           << json_escape(r.config) << "\", \"rays\": \"" << r.kind
           << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes
-          << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches
+          << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties
           << ", \"mrays\": {";
         for (size_t k = 0; k < r.mrays.size(); ++k)
           f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;

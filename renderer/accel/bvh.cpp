@@ -255,9 +255,10 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   /// Depth-first traversal, nearer child first (by the sign of the ray direction along the
   /// node's split axis), culling boxes beyond `best`. `visit(w, tri)` returns true to stop
   /// (any-hit); closest-hit visitors narrow `best`. Returns true iff a visitor stopped it.
-  template <typename Visit, typename Counter>
-  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter) const {
-    return m_config.width == 2 ? traverse2(ray, best, visit, counter) : traverse4(ray, best, visit, counter);
+  template <typename Visit, typename Counter, bool AnyHit>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
+                std::bool_constant<AnyHit>) const {
+    return m_config.width == 2 ? traverse2(ray, best, visit, counter) : traverse4<AnyHit>(ray, best, visit, counter);
   }
 
   /// 4-wide traversal: the four child boxes are slab-tested at once; the children met are
@@ -267,7 +268,9 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   /// On an axis the ray is parallel to (1/d infinite) the distances are +-inf, or NaN
   /// (0 * inf) when the origin lies exactly on a face: such a lane is inside the slab, faces
   /// included, so NaN lanes become the unrestricted interval [-inf, inf].
-  template <typename Visit, typename Counter>
+  /// For occlusion (AnyHit) the leaves met are tested at once, before any node is pushed, and
+  /// nothing is sorted: the first hit ends the query, wherever it is.
+  template <bool AnyHit, typename Visit, typename Counter>
   bool traverse4(const Ray& ray, const float& best, Visit& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid || m_nodes4.empty()) return false;
@@ -321,6 +324,22 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       }
       int mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1));
       if (mask == 0) continue;
+      if constexpr (AnyHit) {
+        for (int m = mask; m; m &= m - 1) {
+          const int c = __builtin_ctz(unsigned(m));
+          if (n.count[c] == 0) {
+            stack[sp++] = {n.child[c], 0, w.tnear};
+            const char* p = reinterpret_cast<const char*>(&m_nodes4[n.child[c]]);
+            _mm_prefetch(p, _MM_HINT_T0);
+            _mm_prefetch(p + 64, _MM_HINT_T0);
+            continue;
+          }
+          counter.node();
+          for (uint32_t i = n.child[c], end = n.child[c] + n.count[c]; i < end; ++i)
+            if (visit(w, m_tris[i])) return true;
+        }
+        continue;
+      }
       alignas(16) float tn[4];
       _mm_store_ps(tn, t0);
       // Children met, sorted far to near (at most 4: insertion sort), then pushed.

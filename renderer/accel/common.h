@@ -134,11 +134,13 @@ struct CountNodes {
 
 /// intersect(), intersect_counted() and occluded() of the reference structures, written once:
 /// each structure provides
-///   template <class Visit, class Counter>
-///   bool traverse(const Ray&, const float& best, Visit&&, const Counter&) const,
+///   template <class Visit, class Counter, bool AnyHit>
+///   bool traverse(const Ray&, const float& best, Visit&&, const Counter&,
+///                 std::bool_constant<AnyHit>) const,
 /// which walks the cells or leaves the ray may meet (skipping those beyond `best`), calls
 /// counter.node() per node or cell visited, and calls visit(w, tri) on their triangles until it
-/// returns true (CRTP, so the visitors inline).
+/// returns true (CRTP, so the visitors inline). AnyHit is true for occlusion queries, where any
+/// triangle hit ends the query and visiting order does not matter.
 template <typename Derived>
 class TraversalAccelerator : public Accelerator {
  public:
@@ -153,7 +155,7 @@ class TraversalAccelerator : public Accelerator {
     const float tfar = ray.tfar;
     return static_cast<const Derived*>(this)->traverse(
         ray, tfar, [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); },
-        NoCount{});
+        NoCount{}, std::true_type{});
   }
 
  private:
@@ -168,7 +170,7 @@ class TraversalAccelerator : public Accelerator {
           intersect_leaf(ray, w, tri, best, hit);
           return false;
         },
-        counter);
+        counter, std::false_type{});
     return hit.valid();
   }
 };

@@ -99,8 +99,9 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   /// triangle (mailboxed) and returns true to stop (any-hit). `best` is the current closest hit
   /// distance (updated by the visitor for closest-hit queries): traversal stops as soon as it
   /// lies within the current cell. Returns true iff a visitor returned true.
-  template <typename Visit, typename Counter>
-  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter) const {
+  template <typename Visit, typename Counter, bool AnyHit>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
+                std::bool_constant<AnyHit>) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid || m_tris.empty()) return false;
     const RayBoxQuery q = prepare_box_query(ray);

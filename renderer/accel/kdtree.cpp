@@ -333,8 +333,9 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   /// Front-to-back traversal with early exit: stops once `best` (narrowed by closest-hit
   /// visitors) lies before the next node's entry. `visit(w, tri)` returns true to stop
   /// (any-hit). Returns true iff a visitor stopped it.
-  template <typename Visit, typename Counter>
-  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter) const {
+  template <typename Visit, typename Counter, bool AnyHit>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
+                std::bool_constant<AnyHit>) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid || m_nodes.empty()) return false;
     const RayBoxQuery q = prepare_box_query(ray);
