@@ -4,6 +4,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <mutex>
@@ -37,11 +39,25 @@ std::string take_error() {
   return s;
 }
 
+/// Bytes the Embree device holds, kept by its memory monitor callback (called with the size of
+/// each allocation, and negated after each free). A scene's footprint is the difference across
+/// its build; concurrent builds in one process would blur it (the benchmark builds one at a time).
+std::atomic<int64_t>& device_bytes() {
+  static std::atomic<int64_t> bytes{0};
+  return bytes;
+}
+
+bool monitor_memory(void*, ssize_t bytes, bool) {
+  device_bytes() += int64_t(bytes);
+  return true;  // never refuse an allocation
+}
+
 RTCDevice device() {
   static RTCDevice dev = [] {
     RTCDevice d = rtcNewDevice(nullptr);
     if (!d) throw std::runtime_error("embree: cannot create device (rtcNewDevice failed)");
     rtcSetDeviceErrorFunction(d, record_error, nullptr);
+    rtcSetDeviceMemoryMonitorFunction(d, monitor_memory, nullptr);
     return d;
   }();
   return dev;
@@ -58,6 +74,7 @@ class EmbreeAccelerator final : public Accelerator {
     validate(config);
     const auto t0 = std::chrono::steady_clock::now();
     RTCDevice dev = device();
+    const int64_t bytes_before = device_bytes();
     take_error();
     m_scene = rtcNewScene(dev);
     throw_if_error("rtcNewScene");
@@ -87,10 +104,10 @@ class EmbreeAccelerator final : public Accelerator {
       throw_if_error("attaching geometry");
       if (id != i) throw std::runtime_error("embree: unexpected geometry id");
       m_triangles += nt;
-      m_bytes += nv * 12 + nt * 12;
     }
     rtcCommitScene(m_scene);
     throw_if_error("building the scene (rtcCommitScene)");
+    m_bytes = uint64_t(std::max<int64_t>(0, device_bytes() - bytes_before));
     RTCBounds b;
     rtcGetSceneBounds(m_scene, &b);
     if (m_triangles > 0) m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};

@@ -75,7 +75,23 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
     W = float(double(Bx) * Ay - double(By) * Ax);
   }
   if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return false;
-  if (U + V + W == 0.0f) return false;
+  const float fdet = U + V + W;
+  if (fdet == 0.0f) return false;
+  // Early out in float when the triangle is certainly behind tnear or beyond tfar, so only
+  // near-range cases pay for the double computation below. Error bound: the sheared coordinates
+  // carry an absolute error of ~2 eps M (M the largest translated coordinate, |sx|, |sy| <= 1),
+  // so U, V, W of ~4 eps M S (S the largest sheared coordinate) and T of ~12 eps M S Z (Z the
+  // largest |Az|, |Bz|, |Cz|); 1e-4 M S Z is about 70x that.
+  {
+    const float Az = w.sz * component(A, w.kz), Bz = w.sz * component(B, w.kz), Cz = w.sz * component(C, w.kz);
+    const float T = U * Az + V * Bz + W * Cz;
+    const float M = std::max({max_component(abs(A)), max_component(abs(B)), max_component(abs(C))});
+    const float S = std::max({std::fabs(Ax), std::fabs(Ay), std::fabs(Bx), std::fabs(By), std::fabs(Cx), std::fabs(Cy)});
+    const float Z = std::max({std::fabs(Az), std::fabs(Bz), std::fabs(Cz)});
+    const float err = 1e-4f * M * S * Z;
+    const float lo = (T - err) / fdet, hi = (T + err) / fdet;  // fdet may be negative: order them
+    if (std::max(lo, hi) < w.tnear || std::min(lo, hi) > tfar) return false;  // NaN: no early out
+  }
   // The ray passes through the triangle: its distance and barycentrics in double.
   const double ax = double(component(a, w.kx)) - component(ray.org, w.kx), ay = double(component(a, w.ky)) - component(ray.org, w.ky), az = double(component(a, w.kz)) - component(ray.org, w.kz);
   const double bx = double(component(b, w.kx)) - component(ray.org, w.kx), by = double(component(b, w.ky)) - component(ray.org, w.ky), bz = double(component(b, w.kz)) - component(ray.org, w.kz);

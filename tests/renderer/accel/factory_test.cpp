@@ -58,7 +58,7 @@ TEST_CASE("the factory knows five back ends, embree first, and refuses bad confi
 
 TEST_CASE("every back end reports its statistics", "[accel][quick]") {
   // Two clusters of 8 triangles far apart: every hierarchy must separate them (with two lone
-  // triangles, the BVH's SAH rightly keeps one leaf: a 4-wide node visit costs 3 tests).
+  // triangles and bvh.traversal_cost=3, the BVH's SAH would rightly keep one leaf).
   std::vector<Vec3f> pos;
   std::vector<uint32_t> idx;
   for (float x0 : {0.0f, 10.0f})
