@@ -175,10 +175,14 @@ void write_heatmap(const std::vector<float>& values, int width, int height, cons
     viridis(float(x - x0) / float(std::max(1, x1 - x0 - 1)), col);
     for (int y = y_bar; y < y_bar + bar_h; ++y) c.set(x, y, col);
   }
-  for (int q = 0; q <= 4; ++q) {  // ticks and labels at 0, 1/4, 1/2, 3/4, max
-    const int x = x0 + (x1 - 1 - x0) * q / 4;
+  // Ticks at 0, 1/4, 1/2, 3/4 and the maximum, fewer on narrow images so labels never overlap.
+  const int label_w = c.text(0, 0, legend_number(double(vmax)), s, black, false) + 6 * s;
+  int intervals = std::clamp((x1 - x0) / std::max(1, 2 * label_w), 1, 4);
+  if (intervals == 3) intervals = 2;  // keep ticks at round fractions
+  for (int q = 0; q <= intervals; ++q) {
+    const int x = x0 + (x1 - 1 - x0) * q / intervals;
     for (int y = y_bar + bar_h; y < y_bar + bar_h + 3; ++y) c.set(x, y, black);
-    const std::string label = legend_number(double(vmax) * q / 4);
+    const std::string label = legend_number(double(vmax) * q / intervals);
     const int w = c.text(0, 0, label, s, black, false);
     const int lx = std::clamp(x - w / 2, 0, std::max(0, width - w));
     c.text(lx, y_bar + bar_h + 4, label, s, black);
