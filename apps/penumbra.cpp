@@ -227,8 +227,6 @@ int run_render(const RenderArgs& a) {
   }
   std::optional<fs::path> cost_png;
   if (cost_aov) {
-    if (a.accel == "embree")
-      throw UsageError("--aov cost: Embree does not report traversal counts; use --accel bvh, kdtree, grid or brute");
     if (!a.no_png) {
       cost_png = a.cost_png.empty() ? fs::path(out).replace_extension(".cost.png") : fs::path(a.cost_png);
       check_dir(*cost_png, "--cost-png");
@@ -308,13 +306,13 @@ int run_render(const RenderArgs& a) {
   CostImage cost;
   if (cost_aov) {
     cost = render_cost(*accel, camera, cfg);
-    exr.extra = {{"cost.nodes", &cost.nodes}, {"cost.triangles", &cost.triangles}};
+    if (cost.counted) exr.extra = {{"cost.nodes", &cost.nodes}, {"cost.triangles", &cost.triangles}};
+    exr.extra.push_back({"cost.ns", &cost.nanoseconds});
   }
   write_exr(film, out, exr);
   if (png) write_display_image(film, *png, display);
   if (cost_png) {
-    write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png,
-                  a.accel + ": nodes + triangles per camera ray");
+    write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png, cost_caption(cost, a.accel));
   }
   const double write_s = seconds_since(t_write);
 
@@ -452,7 +450,8 @@ int main(int argc, char** argv) {
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
   render->add_option("--aov", r.aovs,
                      "extra outputs (repeatable): cost = traversal cost of the camera rays, as EXR channels "
-                     "cost.nodes and cost.triangles and a heat map with a legend (not with --accel embree)");
+                     "cost.nodes, cost.triangles (not for embree, which keeps no counts) and cost.ns (wall clock), "
+                     "and a heat map with a legend (counts, or time for embree)");
   render->add_option("--cost-png", r.cost_png, "heat map path for --aov cost (default: the EXR path with .cost.png)");
 
   std::string info_file, info_accel = "embree";

@@ -369,7 +369,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", json, "also write the results, machine, build, versions and command line as JSON (written atomically)");
   app.add_option("--heatmaps", heatmaps,
                  "also write a traversal-cost heat map (nodes + triangles per primary ray) per scene and structure "
-                 "into this folder: SCENE.ACCEL.cost.png (not for embree, which does not count)");
+                 "into this folder: SCENE.ACCEL.cost.png (for embree, which keeps no counts: nanoseconds per ray)");
   app.add_option("--svg", svg, "also write a bar chart of throughput and build time as SVG (written atomically)");
   try {
     app.parse(argc, argv);
@@ -441,7 +441,7 @@ int main(int argc, char** argv) {
           times.push_back(seconds_since(t0));
         }
         const AccelStats st = accel->stats();
-        if (!heatmaps.empty() && accel->counts_traversal()) {
+        if (!heatmaps.empty()) {
           RenderConfig rc;
           rc.width = width;
           rc.height = height;
@@ -450,7 +450,7 @@ int main(int argc, char** argv) {
                                                    : scene.cameras[0];
           const CostImage cost = render_cost(*accel, cam, rc);
           write_heatmap(total_cost(cost), width, height, std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
-                        name + " " + accel_name + ": nodes + triangles per ray");
+                        name + " " + cost_caption(cost, accel_name));
         }
         for (const auto& set : sets) {
           Row row{name, accel_name, set.kind, st.config, st.triangles, set.rays.size()};

@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <chrono>
+
 #include "renderer/sampling.h"
 
 namespace penumbra {
@@ -14,6 +16,8 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
   const size_t n = size_t(config.width) * size_t(config.height);
   img.nodes.assign(n, 0.0f);
   img.triangles.assign(n, 0.0f);
+  img.nanoseconds.assign(n, 0.0f);
+  img.counted = accel.counts_traversal();
   const uint32_t spp = uint32_t(config.spp);
   const int threads = config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
@@ -22,14 +26,18 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < config.width; ++x) {
           TraversalCost cost;
+          double seconds = 0;
           for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
             Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
             const Vec2f j = stratified_sample(s, spp, rng);
             const Ray ray = generate_camera_ray(camera, config.width, config.height, float(x) + j.x, float(y) + j.y);
             Hit hit;
+            const auto t0 = std::chrono::steady_clock::now();
             accel.intersect_counted(ray, hit, cost);
+            seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           }
           const size_t i = size_t(y) * size_t(config.width) + size_t(x);
+          img.nanoseconds[i] = float(seconds * 1e9 / spp);
           img.nodes[i] = float(double(cost.nodes) / spp);
           img.triangles[i] = float(double(cost.triangles) / spp);
         }
@@ -39,9 +47,14 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
 }
 
 std::vector<float> total_cost(const CostImage& cost) {
+  if (!cost.counted) return cost.nanoseconds;
   std::vector<float> total(cost.nodes.size());
   for (size_t i = 0; i < total.size(); ++i) total[i] = cost.nodes[i] + cost.triangles[i];
   return total;
+}
+
+std::string cost_caption(const CostImage& cost, const std::string& accel_name) {
+  return accel_name + (cost.counted ? ": nodes + triangles per camera ray" : ": nanoseconds per camera ray (wall clock)");
 }
 
 }  // namespace penumbra

@@ -59,17 +59,18 @@ fi
 expect 0 "SAH cost" -- "$bin" info "$src/scenes/default.gltf" --accel bvh
 expect 0 "max_leaf_size 2, bin_count 32" -- "$bin" info "$src/scenes/default.gltf" --accel bvh --accel-param bvh.max_leaf_size=2 --accel-param bvh.bin_count=32
 expect 0 "empty .* leaves" -- "$bin" info "$src/scenes/default.gltf" --accel kdtree
-# Traversal-cost AOV: EXR channels and a heat map; refused up front with Embree or unknown AOVs.
-expect 2 "Embree does not report traversal counts" -- "$bin" render "$src/scenes/default.gltf" -o "$work/c.exr" --aov cost
+# Traversal-cost AOV: EXR channels and a heat map (time for Embree, which keeps no counts);
+# unknown AOVs and a stray --cost-png are refused up front.
 expect 2 "unknown AOV 'normals'" -- "$bin" render "$src/scenes/default.gltf" -o "$work/c.exr" --aov normals --accel bvh
 expect 2 "--cost-png needs --aov cost" -- "$bin" render "$src/scenes/default.gltf" -o "$work/c.exr" --cost-png "$work/c.png"
 expect 2 "directory '$work/nodir' does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/c.exr" --aov cost --accel bvh --cost-png "$work/nodir/c.png"
 [ ! -e "$work/c.exr" ] || { echo "FAIL: a refused --aov run left $work/c.exr"; fails=$((fails + 1)); }
-for accel in bvh kdtree grid; do
+for accel in embree bvh kdtree grid; do
   expect 0 "cost-$accel.cost.png" -- "$bin" render "$src/scenes/default.gltf" -o "$work/cost-$accel.exr" --width 64 --spp 1 -q --aov cost --accel "$accel"
 done
 if command -v oiiotool >/dev/null; then
-  expect 0 "cost.nodes \(float\), cost.triangles \(float\)" -- oiiotool --info -v "$work/cost-bvh.exr"
+  expect 0 "cost.nodes \(float\), cost.ns \(float\), cost.triangles \(float\)" -- oiiotool --info -v "$work/cost-bvh.exr"
+  expect 0 "A \(half\), cost.ns \(float\)" -- oiiotool --info -v "$work/cost-embree.exr"
   expect 0 "64 x +[0-9]+, 3 channel, uint8 png" -- oiiotool --info "$work/cost-grid.cost.png"
 fi
 expect 0 "resolution [0-9]+x[0-9]+x[0-9]+" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=2

@@ -91,6 +91,32 @@ TEST_CASE("cost map: matches intersect_counted per ray, the same for 1 and 2 thr
   CHECK(image_total == double(direct.nodes + direct.triangles));
 }
 
+TEST_CASE("cost map: Embree gets a time map; counted back ends get counts and times", "[cost][quick]") {
+  const Scene s = two_quads();
+  const auto views = mesh_views(s);
+  RenderConfig cfg;
+  cfg.width = 16;
+  cfg.height = 9;
+  cfg.spp = 2;
+  const Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8f);
+  const CostImage e = render_cost(*make_accelerator("embree", views), cam, cfg);
+  CHECK_FALSE(e.counted);
+  CHECK(cost_caption(e, "embree") == "embree: nanoseconds per camera ray (wall clock)");
+  REQUIRE(e.nanoseconds.size() == 144);
+  double total_ns = 0;
+  for (float ns : e.nanoseconds) {
+    CHECK(ns >= 0);
+    total_ns += ns;
+  }
+  CHECK(total_ns > 0);
+  CHECK(total_cost(e) == e.nanoseconds);
+  const CostImage b = render_cost(*make_accelerator("bvh", views), cam, cfg);
+  CHECK(b.counted);
+  CHECK(cost_caption(b, "bvh") == "bvh: nodes + triangles per camera ray");
+  const auto t = total_cost(b);
+  for (size_t i = 0; i < t.size(); ++i) CHECK(t[i] == b.nodes[i] + b.triangles[i]);
+}
+
 TEST_CASE("cost map: Embree answers but does not count", "[cost][quick]") {
   const Scene s = two_quads();
   const auto views = mesh_views(s);
