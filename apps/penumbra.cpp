@@ -142,7 +142,8 @@ class ProgressReporter {
 struct RenderArgs {
   std::string scene_file, output, png;
   bool no_png = false, use_float = false, quiet = false, allow_external = false;
-  int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1, camera = -1;
+  int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
+  std::string camera;  ///< index or name; empty = the first camera, or framing
   uint64_t seed = 0;
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
@@ -173,6 +174,30 @@ std::string accel_param_help() {
   std::string h = "accelerator build parameter key=value (repeatable):";
   for (const auto& k : accel_param_keys()) h += "\n  " + k.key + " (default " + k.default_value + "): " + k.description;
   return h;
+}
+
+/// The camera instance `spec` names: an index as `penumbra info` lists them, or a camera name.
+/// Throws InputError listing the cameras if there is no such camera or the name is ambiguous.
+int find_camera(const Scene& scene, const std::string& spec, const std::string& file) {
+  std::string known;
+  for (size_t i = 0; i < scene.cameras.size(); ++i)
+    known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + scene.cameras[i].name + "'";
+  const std::string listing = scene.cameras.empty() ? "the scene has no camera" : "cameras: " + known;
+  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
+    const unsigned long long i = spec.size() <= 9 ? std::stoull(spec) : ~0ull;
+    if (i >= scene.cameras.size())
+      throw InputError(file, "--camera", "camera " + spec + " does not exist (" + listing + ")");
+    return int(i);
+  }
+  int found = -1;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    if (scene.cameras[i].name != spec) continue;
+    if (found >= 0)
+      throw InputError(file, "--camera", "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
+    found = int(i);
+  }
+  if (found < 0) throw InputError(file, "--camera", "no camera named '" + spec + "' (" + listing + ")");
+  return found;
 }
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external,
@@ -246,10 +271,7 @@ int run_render(const RenderArgs& a) {
   const double load_s = seconds_since(t_load);
 
   // Camera and resolution (the image aspect follows the camera's hint unless both are given).
-  if (a.camera >= int(scene.cameras.size()))
-    throw InputError(a.scene_file, "--camera", "camera " + std::to_string(a.camera) + " does not exist (" +
-                                                   std::to_string(scene.cameras.size()) + " camera instances; see penumbra info)");
-  const int cam_index = a.camera >= 0 ? a.camera : (scene.cameras.empty() ? -1 : 0);
+  const int cam_index = a.camera.empty() ? (scene.cameras.empty() ? -1 : 0) : find_camera(scene, a.camera, a.scene_file);
   const float hint = cam_index >= 0 && scene.cameras[size_t(cam_index)].aspect > 0 ? scene.cameras[size_t(cam_index)].aspect : 16.0f / 9.0f;
   RenderConfig cfg;
   cfg.width = a.width;
@@ -363,7 +385,7 @@ int run_info(const std::string& file, int scene_index, bool allow_external, cons
                 m.name.c_str(), m.base_color.x, m.base_color.y, m.base_color.z, m.metallic, m.roughness,
                 m.emissive.x, m.emissive.y, m.emissive.z);
   }
-  std::printf("cameras      %d defined, %zu in the scene (use --camera N)\n", i.gltf_camera_count, i.camera_instances.size());
+  std::printf("cameras      %d defined, %zu in the scene (use --camera N or NAME)\n", i.gltf_camera_count, i.camera_instances.size());
   for (size_t k = 0; k < i.camera_instances.size(); ++k) std::printf("  [%zu] %s\n", k, i.camera_instances[k].c_str());
   std::printf("lights       %d defined, %zu in the scene\n", i.gltf_light_count, s.lights.size());
   for (size_t k = 0; k < s.lights.size(); ++k) {
@@ -431,7 +453,7 @@ int main(int argc, char** argv) {
   render->add_option("--max-depth", r.max_depth, "maximum mirror bounces (default 5)")->check(CLI::Range(0, 64));
   render->add_option("--threads", r.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
   render->add_option("--scene", r.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
-  render->add_option("--camera", r.camera, "camera instance index, as listed by `penumbra info` (default 0; none: frame the bounds)")->check(CLI::Range(0, 1 << 30));
+  render->add_option("--camera", r.camera, "camera instance: index as listed by `penumbra info`, or name (default 0; none in the file: frame the bounds)");
   render->add_option("--accel", r.accel, "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
   render->add_option("--accel-param", r.accel_params, accel_param_help())->type_name("KEY=VALUE");
   render->add_flag("--float", r.use_float, "write 32-bit float EXR channels (default half)");

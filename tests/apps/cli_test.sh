@@ -25,7 +25,9 @@ expect 2 "missing.gltf: file not found" -- "$bin" render "$work/missing.gltf" -o
 expect 2 "must be an .exr" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.png"
 expect 2 "does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/nodir/a.exr"
 expect 2 "spp" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --spp 0
-expect 2 "camera 7 does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera 7
+expect 2 "camera 7 does not exist \(cameras: 0 'room camera'\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera 7
+expect 2 "camera 99999999999 does not exist" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera 99999999999
+expect 2 "no camera named 'side' \(cameras: 0 'room camera'\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera side
 expect 2 "background" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --background nan
 # Display-output mistakes are caught before rendering, so they cost no render and write no EXR.
 expect 2 "no view 'Typo' \(available: Standard, Raw\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --view Typo
@@ -44,6 +46,10 @@ if command -v oiiotool >/dev/null; then
 fi
 expect 0 "render|rays" -- "$bin" render "$src/scenes/default.gltf" -o "$work/f.exr" --float --no-png --height 20 --threads 1
 [ ! -e "$work/f.png" ] || { echo "FAIL: --no-png wrote a PNG"; fails=$((fails + 1)); }
+expect 0 "small-named.png" -- "$bin" render "$src/scenes/default.gltf" -o "$work/small-named.exr" --camera "room camera" --width 64 --spp 1 -q
+if command -v oiiotool >/dev/null; then  # the camera chosen by name is camera 0: the same image
+  expect 0 "PASS" -- oiiotool "$work/small.exr" "$work/small-named.exr" --fail 0 --diff
+fi
 expect 0 "pixel 10,10: R" -- "$bin" render "$src/scenes/default.gltf" -o "$work/d.exr" --debug-pixel 10,10 --width 64
 expect 0 "4646 triangles" -- "$bin" info "$src/scenes/default.gltf"
 expect 0 "brute" -- "$bin" info "$src/scenes/default.gltf" --accel brute
@@ -87,6 +93,15 @@ if [ -d "$corpus/invalid" ]; then
   expect 2 "cameras\[0\]: orthographic.ymag" -- "$bin" info "$corpus/invalid/validator/base/camera/orthographic_xy.gltf"
   expect 2 "GLB" -- "$bin" render "$corpus/invalid/validator/base/glb/length_mismatch.glb" -o "$work/x.exr"
   expect 0 "warning: .*points/lines" -- "$bin" render "$corpus/valid/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf" -o "$work/m.exr" --width 32
+  # --camera by name picks the same instance as by index (the second camera is orthographic).
+  cams="$corpus/valid/Cameras/glTF/Cameras.gltf"
+  expect 0 "cam1.exr" -- "$bin" render "$cams" -o "$work/cam1.exr" --camera 1 --width 48 --spp 1 -q --no-png
+  expect 0 "camn.exr" -- "$bin" render "$cams" -o "$work/camn.exr" --camera "cameras[1]" --width 48 --spp 1 -q --no-png
+  expect 0 "cam0.exr" -- "$bin" render "$cams" -o "$work/cam0.exr" --camera "cameras[0]" --width 48 --spp 1 -q --no-png
+  if command -v oiiotool >/dev/null; then
+    expect 0 "PASS" -- oiiotool "$work/cam1.exr" "$work/camn.exr" --fail 0 --diff
+    expect 1 "FAILURE" -- oiiotool "$work/cam0.exr" "$work/camn.exr" --fail 0.01 --diff
+  fi
   [ ! -e "$work/x.exr" ] || { echo "FAIL: an error left $work/x.exr"; fails=$((fails + 1)); }
 else
   echo "PENUMBRA_SKIP: corpus checks skipped ($corpus not found)"
