@@ -62,9 +62,10 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
                                           float& u_out, float& v_out) {
   // Translate to the ray origin, then shear so the ray is the +z axis.
   const Vec3f A = a - ray.org, B = b - ray.org, C = c - ray.org;
-  const float Ax = component(A, w.kx) - w.sx * component(A, w.kz), Ay = component(A, w.ky) - w.sy * component(A, w.kz);
-  const float Bx = component(B, w.kx) - w.sx * component(B, w.kz), By = component(B, w.ky) - w.sy * component(B, w.kz);
-  const float Cx = component(C, w.kx) - w.sx * component(C, w.kz), Cy = component(C, w.ky) - w.sy * component(C, w.kz);
+  const float Az0 = component(A, w.kz), Bz0 = component(B, w.kz), Cz0 = component(C, w.kz);
+  const float Ax = component(A, w.kx) - w.sx * Az0, Ay = component(A, w.ky) - w.sy * Az0;
+  const float Bx = component(B, w.kx) - w.sx * Bz0, By = component(B, w.ky) - w.sy * Bz0;
+  const float Cx = component(C, w.kx) - w.sx * Cz0, Cy = component(C, w.ky) - w.sy * Cz0;
   // Scaled barycentrics (edge functions).
   float U = Cx * By - Cy * Bx;
   float V = Ax * Cy - Ay * Cx;
@@ -83,19 +84,22 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   // so U, V, W of ~4 eps M S (S the largest sheared coordinate) and T of ~12 eps M S Z (Z the
   // largest |Az|, |Bz|, |Cz|); 1e-4 M S Z is about 70x that.
   {
-    const float Az = w.sz * component(A, w.kz), Bz = w.sz * component(B, w.kz), Cz = w.sz * component(C, w.kz);
+    const float Az = w.sz * Az0, Bz = w.sz * Bz0, Cz = w.sz * Cz0;
     const float T = U * Az + V * Bz + W * Cz;
     const float M = std::max({max_component(abs(A)), max_component(abs(B)), max_component(abs(C))});
-    const float S = std::max({std::fabs(Ax), std::fabs(Ay), std::fabs(Bx), std::fabs(By), std::fabs(Cx), std::fabs(Cy)});
+    const float S =
+        std::max({std::fabs(Ax), std::fabs(Ay), std::fabs(Bx), std::fabs(By), std::fabs(Cx), std::fabs(Cy)});
     const float Z = std::max({std::fabs(Az), std::fabs(Bz), std::fabs(Cz)});
     const float err = 1e-4f * M * S * Z;
     const float lo = (T - err) / fdet, hi = (T + err) / fdet;  // fdet may be negative: order them
     if (std::max(lo, hi) < w.tnear || std::min(lo, hi) > tfar) return false;  // NaN: no early out
   }
   // The ray passes through the triangle: its distance and barycentrics in double.
-  const double ax = double(component(a, w.kx)) - component(ray.org, w.kx), ay = double(component(a, w.ky)) - component(ray.org, w.ky), az = double(component(a, w.kz)) - component(ray.org, w.kz);
-  const double bx = double(component(b, w.kx)) - component(ray.org, w.kx), by = double(component(b, w.ky)) - component(ray.org, w.ky), bz = double(component(b, w.kz)) - component(ray.org, w.kz);
-  const double cx = double(component(c, w.kx)) - component(ray.org, w.kx), cy = double(component(c, w.ky)) - component(ray.org, w.ky), cz = double(component(c, w.kz)) - component(ray.org, w.kz);
+  // Vertex minus origin in double: exact unless their magnitudes differ by more than 2^29.
+  const auto rel = [&](Vec3f p, int k) { return double(component(p, k)) - double(component(ray.org, k)); };
+  const double ax = rel(a, w.kx), ay = rel(a, w.ky), az = rel(a, w.kz);
+  const double bx = rel(b, w.kx), by = rel(b, w.ky), bz = rel(b, w.kz);
+  const double cx = rel(c, w.kx), cy = rel(c, w.ky), cz = rel(c, w.kz);
   const double dAx = ax - w.dsx * az, dAy = ay - w.dsy * az;
   const double dBx = bx - w.dsx * bz, dBy = by - w.dsy * bz;
   const double dCx = cx - w.dsx * cz, dCy = cy - w.dsy * cz;
