@@ -1,9 +1,10 @@
-// penumbra-bench: measures acceleration structures on the same scenes and the same pre-generated
-// ray sets (primary, shadow, diffuse, random), verifies every structure's answers against Embree
-// on those rays, and prints a table (optionally CSV and JSON). First part of issue 4: charts,
-// heat maps and the generated stress scenes are still to come (see README, "Benchmarks").
-#include <tbb/global_control.h>
+// penumbra-bench (issue 4): measures acceleration structures on the same scenes (glTF, PLY or
+// seeded generated scenes) and the same pre-generated ray sets (primary, shadow, diffuse,
+// random), verifies every structure's answers against Embree (disagreements settled by the exact
+// brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
+// SVG chart and traversal-cost heat maps. See README, "Benchmarks", and benchmarks/RESULTS.md.
 #include <sys/utsname.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/version.h>
 
