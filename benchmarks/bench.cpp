@@ -61,6 +61,11 @@ Vec3f random_direction(std::mt19937& rng) {
   return sample_uniform_sphere({a, b});
 }
 
+/// The camera the primary rays and heat maps use: the scene's first, or one framing the bounds.
+Camera bench_camera(const Scene& scene, int w, int h) {
+  return scene.cameras.empty() ? frame_bounds(compute_bounds(scene), float(w) / float(h)) : scene.cameras[0];
+}
+
 /// The four ray kinds of issue 4, generated once per scene from a fixed seed. Primary rays come
 /// from the scene's first camera (or one framing the bounds) on a w x h grid; shadow and diffuse
 /// rays start at the primary hits (found with Embree), offset along the geometric normal.
@@ -68,7 +73,7 @@ std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
                                   std::span<const TriangleMeshView> views, int w, int h,
                                   const std::vector<std::string>& kinds) {
   const Bounds3f b = compute_bounds(scene);
-  const Camera cam = scene.cameras.empty() ? frame_bounds(b, float(w) / float(h)) : scene.cameras[0];
+  const Camera cam = bench_camera(scene, w, h);
   std::vector<Ray> primary;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) primary.push_back(generate_camera_ray(cam, w, h, x + 0.5f, y + 0.5f));
@@ -447,9 +452,7 @@ int main(int argc, char** argv) {
           rc.width = width;
           rc.height = height;
           rc.spp = 1;
-          const Camera cam = scene.cameras.empty() ? frame_bounds(compute_bounds(scene), float(width) / float(height))
-                                                   : scene.cameras[0];
-          const CostImage cost = render_cost(*accel, cam, rc);
+          const CostImage cost = render_cost(*accel, bench_camera(scene, width, height), rc);
           write_heatmap(total_cost(cost), width, height, std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
                         name + " " + cost_caption(cost, accel_name));
         }

@@ -7,19 +7,20 @@
 #include <stdexcept>
 
 #include "renderer/camera.h"
+#include "renderer/sampling.h"
 
 namespace penumbra::bench {
 namespace {
 
-/// SplitMix64 (Steele, Lea & Flood 2014): a portable, seedable integer generator.
-struct Rng {
+/// The SplitMix64 sequence (Steele, Lea & Flood 2014) over the renderer's splitmix64 mixer: a
+/// portable, seedable generator (the sample generator, PCG32, is seeded per pixel instead).
+struct SceneRng {
   uint64_t state;
-  explicit Rng(uint64_t seed) : state(seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull) {}
+  explicit SceneRng(uint64_t seed) : state(seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull) {}
   uint64_t next() {
-    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+    const uint64_t z = splitmix64(state);  // mixes state + golden ratio
+    state += 0x9E3779B97F4A7C15ull;
+    return z;
   }
   /// Uniform in [0, 1) with 24 random bits (exact in float).
   float uniform() { return float(next() >> 40) * 0x1p-24f; }
@@ -135,7 +136,7 @@ Camera camera(const char* name, Vec3f eye, Vec3f target, float yfov_deg) {
 Scene atrium(uint64_t seed, float s) {
   Scene sc;
   sc.meshes.reserve(8);  // MeshBuilders hold references into sc.meshes
-  Rng rng(seed);
+  SceneRng rng(seed);
   const int stone = material(sc, "stone", {0.62f, 0.58f, 0.52f}, 0, 0.8f);
   const int marble = material(sc, "marble", {0.85f, 0.84f, 0.8f}, 0, 0.3f);
   const int cloth = material(sc, "cloth", {0.55f, 0.08f, 0.06f}, 0, 0.9f);
@@ -217,7 +218,7 @@ Scene atrium(uint64_t seed, float s) {
 
 Scene soup(uint64_t seed, uint64_t triangles) {
   Scene sc;
-  Rng rng(seed);
+  SceneRng rng(seed);
   MeshBuilder b{new_mesh(sc, "soup", material(sc, "grey", {0.6f, 0.6f, 0.6f}, 0, 0.6f))};
   // Edge length ~2.5x the mean spacing: triangles overlap their neighbours somewhat.
   const float size = 2.5f * 2.0f / std::cbrt(float(triangles));
@@ -281,7 +282,7 @@ void teapot(MeshBuilder& b, float s) {
 Scene stadium(uint64_t seed, float s) {
   Scene sc;
   sc.meshes.reserve(8);  // MeshBuilders hold references into sc.meshes
-  Rng rng(seed);
+  SceneRng rng(seed);
   MeshBuilder pot{new_mesh(sc, "teapot", material(sc, "porcelain", {0.9f, 0.9f, 0.95f}, 0, 0.15f))};
   teapot(pot, s);
   MeshBuilder bowl{new_mesh(sc, "stadium", material(sc, "concrete", {0.5f, 0.5f, 0.48f}, 0, 0.9f))};
@@ -318,7 +319,7 @@ Scene stadium(uint64_t seed, float s) {
 
 Scene slivers(uint64_t seed, uint64_t triangles) {
   Scene sc;
-  Rng rng(seed);
+  SceneRng rng(seed);
   MeshBuilder b{new_mesh(sc, "slivers", material(sc, "steel", {0.7f, 0.7f, 0.72f}, 0, 0.4f))};
   b.m.positions.reserve(triangles * 3);
   b.m.indices.reserve(triangles * 3);
@@ -344,7 +345,7 @@ Scene slivers(uint64_t seed, uint64_t triangles) {
 /// Ebert et al., "Texturing and Modeling: A Procedural Approach", ch. 2.
 float value_noise(float x, float z, uint64_t seed) {
   auto lattice = [&](int64_t i, int64_t j) {
-    Rng r(seed ^ (uint64_t(i) * 0x8DA6B343ull) ^ (uint64_t(j) * 0xD8163841ull));
+    SceneRng r(seed ^ (uint64_t(i) * 0x8DA6B343ull) ^ (uint64_t(j) * 0xD8163841ull));
     return r.uniform();
   };
   const float fx = std::floor(x), fz = std::floor(z);

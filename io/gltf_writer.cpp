@@ -10,6 +10,7 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "renderer/camera.h"
 
 namespace penumbra {
 namespace {
@@ -47,13 +48,6 @@ json frame_matrix(Vec3f u, Vec3f v, Vec3f w, Vec3f origin) {
   return json::array({u.x, u.y, u.z, 0, v.x, v.y, v.z, 0, w.x, w.y, w.z, 0, origin.x, origin.y, origin.z, 1});
 }
 
-/// A right-handed frame whose -w is `dir` (a light or camera looking along dir).
-void frame_from_direction(Vec3f dir, Vec3f& u, Vec3f& v, Vec3f& w) {
-  w = -normalize(dir);
-  const Vec3f up = std::fabs(w.y) < 0.999f ? Vec3f{0, 1, 0} : Vec3f{1, 0, 0};
-  u = normalize(cross(up, w));
-  v = cross(w, u);
-}
 
 }  // namespace
 
@@ -107,6 +101,8 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
         throw InputError(wr.file, where, "non-finite position");
       b = merge(b, p);
     }
+    if (m.indices.size() % 3 != 0)
+      throw InputError(wr.file, where, "index count " + std::to_string(m.indices.size()) + " is not a multiple of 3");
     for (uint32_t i : m.indices)
       if (i >= m.positions.size())
         throw InputError(wr.file, where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(m.positions.size()));
@@ -159,9 +155,10 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
       if (l.type == LightType::Spot) light["spot"] = {{"innerConeAngle", l.inner_cone}, {"outerConeAngle", l.outer_cone}};
       if (!l.name.empty()) light["name"] = l.name;
       lights.push_back(light);
-      Vec3f u{1, 0, 0}, v{0, 1, 0}, w{0, 0, 1};
-      if (l.type != LightType::Point) frame_from_direction(l.direction, u, v, w);
-      add_root({{"matrix", frame_matrix(u, v, w, l.type == LightType::Directional ? Vec3f{} : l.position)},
+      // The light shines down its local -Z: the frame of a camera looking along its direction.
+      Camera frame;
+      if (l.type != LightType::Point) frame = look_at({0, 0, 0}, l.direction, {0, 1, 0}, 0);
+      add_root({{"matrix", frame_matrix(frame.u, frame.v, frame.w, l.type == LightType::Directional ? Vec3f{} : l.position)},
                 {"extensions", {{"KHR_lights_punctual", {{"light", li}}}}},
                 {"name", l.name.empty() ? "light" + std::to_string(li) : l.name}});
     }

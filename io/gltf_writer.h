@@ -14,7 +14,8 @@ namespace penumbra {
 /// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices); lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
 /// Throws InputError naming the file if it cannot be written or the scene cannot be expressed
-/// (a buffer over 4 GiB, an index out of range, a non-finite position).
+/// (a buffer over 4 GiB, an index out of range, an index count not a multiple of 3, a non-finite
+/// position).
 void write_gltf(const Scene& scene, const std::filesystem::path& file);
 
 }  // namespace penumbra

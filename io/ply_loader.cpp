@@ -3,6 +3,7 @@
 
 #include <bit>
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -149,6 +150,8 @@ Scene load_ply(const std::filesystem::path& path) {
   }
   if (!have_format) header_error("no format line");
 
+  std::error_code size_error;
+  const uint64_t file_bytes = std::filesystem::file_size(path, size_error);
   Scene scene;
   Mesh mesh;
   mesh.name = path.stem().string();
@@ -170,7 +173,10 @@ Scene load_ply(const std::filesystem::path& path) {
     if (is_face && iface < 0) throw InputError(file, "element face", "needs a vertex_indices list");
     if (is_face && !have_vertices) throw InputError(file, "element face", "comes before element vertex");
     if (is_vertex) {
-      mesh.positions.reserve(e.count);
+      // Reserve no more than the rest of the file can hold (a hostile header may claim 2^31
+      // vertices): at least 6 bytes per ASCII vertex ("0 0 0\n"), 12 per binary one.
+      const uint64_t per_vertex = format == Format::Ascii ? 6 : 12;
+      mesh.positions.reserve(size_t(std::min<uint64_t>(e.count, file_bytes / per_vertex)));
       have_vertices = true;
     }
     std::vector<uint32_t> poly;

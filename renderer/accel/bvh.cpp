@@ -239,8 +239,9 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   AccelStats stats() const override {
     AccelStats s = m_stats;
     s.name = "bvh";
-    s.config = "width " + std::to_string(m_config.width) + ", max_leaf_size " + std::to_string(m_config.max_leaf_size) + ", bin_count " +
-               std::to_string(m_config.bin_count) + ", traversal_cost " +
+    s.config = "width " + std::to_string(m_config.width) + ", max_leaf_size " +
+               std::to_string(m_config.max_leaf_size) + ", bin_count " + std::to_string(m_config.bin_count) +
+               ", traversal_cost " +
                format_number(m_config.traversal_cost) + ", intersection_cost " +
                format_number(m_config.intersection_cost);
     s.triangles = m_input_triangles;
@@ -252,9 +253,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   }
 
  private:
-  /// Depth-first traversal, nearer child first (by the sign of the ray direction along the
-  /// node's split axis), culling boxes beyond `best`. `visit(w, tri)` returns true to stop
-  /// (any-hit); closest-hit visitors narrow `best`. Returns true iff a visitor stopped it.
+  /// The traversal of the configured layout. `visit(w, tri)` returns true to stop (any-hit);
+  /// closest-hit visitors narrow `best`. Returns true iff a visitor stopped it.
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
@@ -372,6 +372,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     return false;
   }
 
+  /// Binary traversal: depth first, nearer child first (by the sign of the ray direction along
+  /// the node's split axis), culling boxes beyond `best`.
   template <typename Visit, typename Counter>
   bool traverse2(const Ray& ray, const float& best, Visit& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);

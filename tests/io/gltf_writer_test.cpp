@@ -138,6 +138,9 @@ TEST_CASE("write_gltf: bad scenes and folders fail with the element named and le
   s = sample_scene();
   s.meshes[2].indices[4] = 9;
   CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[2]: index 9 >= vertex count 4"));
+  s = sample_scene();
+  s.meshes[0].indices.push_back(0);
+  CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[0]: index count 4 is not a multiple of 3"));
   CHECK(std::filesystem::is_empty(dir));
   CHECK_THROWS_AS(write_gltf(sample_scene(), dir / "missing" / "x.gltf"), InputError);
   std::filesystem::remove_all(dir);

@@ -86,6 +86,10 @@ TEST_CASE("load_ply: malformed files name the file and the element", "[ply]") {
   fails_with("solid cube\n", "not a PLY file");
   fails_with(header("binary_middle_endian"), "header line 2: unknown format 'binary_middle_endian'");
   fails_with("ply\nformat ascii 1.0\nelement vertex 99999999999\n", "count in [0, 2^31]");
+  // A header claiming 2^31 vertices in a tiny file: a clean error, not a 24 GiB allocation.
+  fails_with("ply\nformat binary_little_endian 1.0\nelement vertex 2147483648\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n",
+             "vertex[0]: unexpected end of file");
   fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "unexpected end of file in the header");
   fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n", "needs x, y and z");
   CHECK_THROWS_WITH(load_ply(dir / "missing.ply"), Catch::Contains("missing.ply: file not found"));
