@@ -2,12 +2,15 @@
 // validation and flattening of the node hierarchy into world-space meshes.
 #include "io/gltf_loader.h"
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <new>
+#include <map>
 #include <set>
 
 #include "io/error.h"
@@ -17,7 +20,8 @@ namespace penumbra {
 namespace fs = std::filesystem;
 
 std::vector<std::string> supported_gltf_extensions() {
-  return {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"};
+  return {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit",
+          "KHR_texture_transform"};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {
@@ -133,11 +137,25 @@ bool sandbox_write(std::string* err, const std::string&, const std::vector<unsig
   return false;
 }
 
-// Images are decoded later through OpenImageIO; tinygltf's decoding is switched off.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
+// Images are decoded later through OpenImageIO; tinygltf's decoding is switched off. For URI
+// images (files, data URIs) tinygltf hands over the bytes it read: keep them, encoded, in
+// Image::image. For bufferView images it passes a pointer computed without a bounds check,
+// so those bytes are not touched here; the converter reads the validated bufferView itself.
+bool capture_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                   const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
   return true;
 }
+
+// Decoded image: linear-or-encoded RGBA floats in [0,1] exactly as stored in the file.
+struct DecodedImage {
+  bool ok = false;
+  int width = 0, height = 0;
+  std::vector<float> rgba;
+};
+
+// Largest texture edge accepted (larger images are ignored with a warning).
+constexpr int kMaxTextureSize = 16384;
 
 // ---------------------------------------------------------------------------------------------
 // GLB container checks (glTF 2.0 spec, "GLB File Format Specification").
@@ -211,13 +229,17 @@ class Converter {
   /// One glTF primitive decoded and validated in its mesh's local space.
   struct LocalPrimitive {
     std::vector<Vec3f> positions, normals;  // normals empty if absent or unusable
-    std::vector<Vec2f> uvs;
+    std::vector<Vec4f> tangents, colors;    // empty if absent
+    std::vector<Vec2f> uvs, uvs1;
     std::vector<uint32_t> indices;          // triangle list
     int material = -1;
     bool usable = false;                    // false: skipped with a warning
   };
 
   void check_extensions();
+  const DecodedImage& decoded_image(int image, const std::string& user);
+  TextureRef texture_ref(int texture, int texcoord, const tinygltf::ExtensionMap& extensions,
+                         bool srgb, const std::string& where);
   void validate_accessors();
   void validate_textures();
   void decode_meshes();
@@ -237,6 +259,8 @@ class Converter {
   LoadedScene& m_out;
   uint64_t m_memory = 0;
   std::vector<std::vector<LocalPrimitive>> m_meshes;  // [mesh][primitive]
+  std::map<int, DecodedImage> m_images;                // decoded on first use
+  std::map<std::pair<int, bool>, int> m_textures;      // (glTF texture, sRGB) -> Scene::textures
 };
 
 AccessorLayout Converter::layout(int accessor, const std::string& user) {
@@ -409,6 +433,182 @@ void Converter::check_extensions() {
       warn("extensionsUsed", "extension " + e + " is not supported and will be ignored");
 }
 
+const DecodedImage& Converter::decoded_image(int image_index, const std::string& user) {
+  if (auto it = m_images.find(image_index); it != m_images.end()) return it->second;
+  DecodedImage& out = m_images[image_index];
+  const auto& img = m_model.images[size_t(image_index)];
+  const std::string where = idx("images", size_t(image_index)) + (img.name.empty() ? "" : " '" + img.name + "'");
+  // The encoded bytes: a validated bufferView, or what tinygltf read from the URI.
+  const unsigned char* data = nullptr;
+  uint64_t size = 0;
+  if (img.bufferView >= 0) {
+    if (size_t(img.bufferView) >= m_model.bufferViews.size())
+      fail(where + ".bufferView", "bufferView " + std::to_string(img.bufferView) + " out of range (" +
+                                      std::to_string(m_model.bufferViews.size()) + " bufferViews)");
+    const auto& bv = m_model.bufferViews[size_t(img.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
+      fail(idx("bufferViews", size_t(img.bufferView)), "buffer " + std::to_string(bv.buffer) + " out of range");
+    const auto& buf = m_model.buffers[size_t(bv.buffer)].data;
+    uint64_t end = 0;
+    if (!add_ok(bv.byteOffset, bv.byteLength, end) || end > buf.size())
+      fail(idx("bufferViews", size_t(img.bufferView)), "byteOffset + byteLength exceeds buffer " +
+                                                          std::to_string(bv.buffer) + " of " + std::to_string(buf.size()) + " bytes");
+    data = buf.data() + bv.byteOffset;
+    size = bv.byteLength;
+  } else {
+    data = img.image.data();
+    size = img.image.size();
+  }
+  if (size == 0) {
+    warn(where, "image data could not be read" + (img.uri.empty() ? std::string() : " from '" + img.uri + "'") +
+                    "; textures using it (" + user + ") are ignored");
+    return out;
+  }
+  // Format from the magic bytes (the mimeType and file extension are only hints).
+  std::string ext;
+  if (size >= 8 && std::memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0) ext = "png";
+  else if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) ext = "jpg";
+  if (ext.empty()) {
+    warn(where, "not a PNG or JPEG image; textures using it (" + user + ") are ignored");
+    return out;
+  }
+  OIIO::Filesystem::IOMemReader reader(data, size_t(size));
+  OIIO::ImageSpec config;  // glTF colour is not premultiplied: keep RGB where alpha is 0
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open("image." + ext, &config, &reader);
+  if (!in) {
+    warn(where, "cannot decode " + ext + " image: " + OIIO::geterror() + "; textures using it are ignored");
+    return out;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.width > kMaxTextureSize || spec.height > kMaxTextureSize ||
+      spec.nchannels < 1 || spec.nchannels > 64) {
+    warn(where, "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " with " +
+                    std::to_string(spec.nchannels) + " channels (limit " + std::to_string(kMaxTextureSize) +
+                    " per side); textures using it are ignored");
+    return out;
+  }
+  const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
+  charge_memory(texels * uint64_t(spec.nchannels) * 4 + texels * 16, where);
+  std::vector<float> pixels(size_t(texels) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    warn(where, "cannot decode " + ext + " image: " + in->geterror() + "; textures using it are ignored");
+    return out;
+  }
+  in->close();
+  m_memory -= texels * uint64_t(spec.nchannels) * 4;  // the channel buffer is freed below
+  const int nc = spec.nchannels;
+  out.rgba.resize(size_t(texels) * 4);
+  for (size_t i = 0; i < size_t(texels); ++i) {
+    const float* p = &pixels[i * size_t(nc)];
+    float* q = &out.rgba[i * 4];
+    if (nc <= 2) {
+      q[0] = q[1] = q[2] = p[0];
+      q[3] = nc == 2 ? p[1] : 1.0f;
+    } else {
+      q[0] = p[0];
+      q[1] = p[1];
+      q[2] = p[2];
+      q[3] = nc >= 4 ? p[3] : 1.0f;
+    }
+  }
+  out.width = spec.width;
+  out.height = spec.height;
+  out.ok = true;
+  return out;
+}
+
+TextureRef Converter::texture_ref(int texture, int texcoord, const tinygltf::ExtensionMap& extensions,
+                                  bool srgb, const std::string& where) {
+  TextureRef ref;
+  if (texture < 0 || size_t(texture) >= m_model.textures.size()) return ref;  // warned by validate_textures
+  const auto& t = m_model.textures[size_t(texture)];
+  if (t.source < 0 || size_t(t.source) >= m_model.images.size()) {
+    if (t.source < 0) warn(idx("textures", size_t(texture)), "has no image source; ignored");
+    return ref;
+  }
+  // KHR_texture_transform: uv' = T R S uv (spec: offset, rotation counter-clockwise, scale).
+  if (auto it = extensions.find("KHR_texture_transform"); it != extensions.end()) {
+    const auto& x = it->second;
+    const std::string xw = where + ".extensions.KHR_texture_transform";
+    double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+    auto read_pair = [&](const char* key, double* v) {
+      const auto& a = x.Get(key);
+      if (!a.IsArray()) return;
+      if (a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) fail(xw + "." + key, "must be 2 numbers");
+      v[0] = a.Get(0).GetNumberAsDouble();
+      v[1] = a.Get(1).GetNumberAsDouble();
+    };
+    read_pair("offset", off);
+    read_pair("scale", sc);
+    if (x.Get("rotation").IsNumber()) rot = x.Get("rotation").GetNumberAsDouble();
+    if (!std::isfinite(off[0] + off[1] + sc[0] + sc[1] + rot)) fail(xw, "values must be finite");
+    if (x.Get("texCoord").IsNumber()) texcoord = x.Get("texCoord").GetNumberAsInt();
+    const double c = std::cos(rot), sn = std::sin(rot);
+    ref.m[0][0] = float(sc[0] * c);
+    ref.m[0][1] = float(sc[1] * sn);
+    ref.m[0][2] = float(off[0]);
+    ref.m[1][0] = float(-sc[0] * sn);
+    ref.m[1][1] = float(sc[1] * c);
+    ref.m[1][2] = float(off[1]);
+  }
+  if (texcoord < 0 || texcoord > 1) {
+    warn(where + ".texCoord", "TEXCOORD_" + std::to_string(texcoord) + " is not supported (only 0 and 1); texture ignored");
+    return ref;
+  }
+  ref.texcoord = texcoord;
+  if (auto it = m_textures.find({texture, srgb}); it != m_textures.end()) {
+    ref.texture = it->second;
+    return ref;
+  }
+  const DecodedImage& img = decoded_image(t.source, where);
+  if (!img.ok) {
+    m_textures[{texture, srgb}] = -1;
+    return ref;
+  }
+  TextureSampler smp;
+  if (t.sampler >= 0 && size_t(t.sampler) < m_model.samplers.size()) {
+    const auto& s = m_model.samplers[size_t(t.sampler)];
+    const std::string sw = idx("samplers", size_t(t.sampler));
+    auto wrap = [&](int mode, const char* field) {
+      switch (mode) {
+        case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+        default:
+          warn(sw + "." + field, "unknown wrap mode " + std::to_string(mode) + "; REPEAT used");
+          return TextureWrap::Repeat;
+      }
+    };
+    smp.wrap_s = wrap(s.wrapS, "wrapS");
+    smp.wrap_t = wrap(s.wrapT, "wrapT");
+    if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) smp.mag = TextureFilter::Nearest;
+    switch (s.minFilter) {
+      case TINYGLTF_TEXTURE_FILTER_NEAREST: smp.min = TextureFilter::Nearest; smp.mipmaps = false; break;
+      case TINYGLTF_TEXTURE_FILTER_LINEAR: smp.mipmaps = false; break;
+      case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST: smp.min = TextureFilter::Nearest; smp.mip = TextureFilter::Nearest; break;
+      case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST: smp.mip = TextureFilter::Nearest; break;
+      case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR: smp.min = TextureFilter::Nearest; break;
+      default: break;  // LINEAR_MIPMAP_LINEAR or unspecified: trilinear
+    }
+  }
+  std::vector<float> rgba = img.rgba;
+  if (srgb)
+    for (size_t i = 0; i < rgba.size(); i += 4)
+      for (size_t c = 0; c < 3; ++c) rgba[i + c] = srgb_to_linear(std::clamp(rgba[i + c], 0.0f, 1.0f));
+  const auto& image = m_model.images[size_t(t.source)];
+  charge_memory(texture_bytes_for(img.width, img.height), where);
+  ref.texture = int(m_out.scene.textures.size());
+  m_out.scene.textures.push_back(make_texture(
+      idx("textures", size_t(texture)) + " (" + idx("images", size_t(t.source)) +
+          (image.name.empty() ? (image.uri.empty() ? "" : " '" + image.uri + "'") : " '" + image.name + "'") + ")",
+      img.width, img.height, rgba, smp));
+  m_textures[{texture, srgb}] = ref.texture;
+  return ref;
+}
+
 void Converter::convert_materials() {
   auto finite_or_fail = [&](double v, const std::string& where) {
     if (!std::isfinite(v)) fail(where, "value is not finite");
@@ -439,11 +639,28 @@ void Converter::convert_materials() {
         m.emissive *= float(strength);
       }
     }
-    if (src.emissiveTexture.index >= 0 && max_component(m.emissive) > 0) {
-      warn(where + ".emissiveTexture", "textures are not decoded yet; texture-driven emission ignored");
-      m.emissive = {0, 0, 0};
-    }
     m.unlit = src.extensions.count("KHR_materials_unlit") > 0;
+    if (src.alphaMode == "OPAQUE" || src.alphaMode.empty()) m.alpha_mode = AlphaMode::Opaque;
+    else if (src.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
+    else if (src.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
+    else fail(where + ".alphaMode", "'" + src.alphaMode + "' is not OPAQUE, MASK or BLEND");
+    m.alpha_cutoff = float(finite_or_fail(src.alphaCutoff, where + ".alphaCutoff"));
+    if (m.alpha_cutoff < 0) fail(where + ".alphaCutoff", "must be >= 0");
+    m.double_sided = src.doubleSided;
+    m.base_color_tex = texture_ref(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                   pbr.baseColorTexture.extensions, true, where + ".pbrMetallicRoughness.baseColorTexture");
+    m.metallic_roughness_tex = texture_ref(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                                           pbr.metallicRoughnessTexture.extensions, false,
+                                           where + ".pbrMetallicRoughness.metallicRoughnessTexture");
+    m.normal_tex = texture_ref(src.normalTexture.index, src.normalTexture.texCoord, src.normalTexture.extensions,
+                               false, where + ".normalTexture");
+    m.normal_scale = float(finite_or_fail(src.normalTexture.scale, where + ".normalTexture.scale"));
+    m.occlusion_tex = texture_ref(src.occlusionTexture.index, src.occlusionTexture.texCoord,
+                                  src.occlusionTexture.extensions, false, where + ".occlusionTexture");
+    m.occlusion_strength = float(std::clamp(finite_or_fail(src.occlusionTexture.strength, where + ".occlusionTexture.strength"), 0.0, 1.0));
+    if (max_component(m.emissive) > 0)
+      m.emissive_tex = texture_ref(src.emissiveTexture.index, src.emissiveTexture.texCoord,
+                                   src.emissiveTexture.extensions, true, where + ".emissiveTexture");
     m_out.scene.materials.push_back(m);
   }
 }
@@ -647,10 +864,25 @@ Converter::LocalPrimitive Converter::decode_primitive(size_t mesh_index, size_t 
     nrm = read(it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
     if (nrm.size() != pos.size()) fail(where + ".attributes.NORMAL", "count differs from POSITION count");
   }
-  if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-    uv = read(it->second, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
-              {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
-    if (uv.size() / 2 != nv) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION count");
+  std::vector<double> uv1, tan, col;
+  int col_components = 0;
+  for (const char* name : {"TEXCOORD_0", "TEXCOORD_1"}) {
+    auto it = prim.attributes.find(name);
+    if (it == prim.attributes.end()) continue;
+    auto& dst = name[9] == '0' ? uv : uv1;
+    dst = read(it->second, where + ".attributes." + name, {TINYGLTF_TYPE_VEC2},
+               {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+    if (dst.size() / 2 != nv) fail(where + ".attributes." + name, "count differs from POSITION count");
+  }
+  if (auto it = prim.attributes.find("TANGENT"); it != prim.attributes.end()) {
+    tan = read(it->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    if (tan.size() / 4 != nv) fail(where + ".attributes.TANGENT", "count differs from POSITION count");
+  }
+  if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
+    col = read(it->second, where + ".attributes.COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4},
+               {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+    col_components = m_model.accessors[size_t(it->second)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+    if (col.size() / size_t(col_components) != nv) fail(where + ".attributes.COLOR_0", "count differs from POSITION count");
   }
   if (tris.empty()) {
     warn(where, "no triangles; skipped");
@@ -675,9 +907,34 @@ Converter::LocalPrimitive Converter::decode_primitive(size_t mesh_index, size_t 
       }
     }
   }
+  auto finite_or_zero = [](double v) { return std::isfinite(v) ? float(v) : 0.0f; };
   if (!uv.empty()) {
     out.uvs.resize(nv);
-    for (size_t i = 0; i < nv; ++i) out.uvs[i] = {float(uv[i * 2]), float(uv[i * 2 + 1])};
+    for (size_t i = 0; i < nv; ++i) out.uvs[i] = {finite_or_zero(uv[i * 2]), finite_or_zero(uv[i * 2 + 1])};
+  }
+  if (!uv1.empty()) {
+    out.uvs1.resize(nv);
+    for (size_t i = 0; i < nv; ++i) out.uvs1[i] = {finite_or_zero(uv1[i * 2]), finite_or_zero(uv1[i * 2 + 1])};
+  }
+  if (!tan.empty()) {
+    out.tangents.resize(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      const Vec3f t{float(tan[i * 4]), float(tan[i * 4 + 1]), float(tan[i * 4 + 2])};
+      if (!is_finite(t) || !(dot(t, t) > 0) || !std::isfinite(tan[i * 4 + 3])) {
+        warn(where + ".attributes.TANGENT", "zero, NaN or infinite tangents; generating tangents instead");
+        out.tangents.clear();
+        break;
+      }
+      out.tangents[i] = {t.x, t.y, t.z, tan[i * 4 + 3] < 0 ? -1.0f : 1.0f};
+    }
+  }
+  if (!col.empty()) {
+    out.colors.resize(nv);
+    const size_t k = size_t(col_components);
+    for (size_t i = 0; i < nv; ++i) {
+      auto c = [&](size_t j) { return std::clamp(finite_or_zero(col[i * k + j]), 0.0f, 1.0f); };
+      out.colors[i] = {c(0), c(1), c(2), k == 4 ? c(3) : 1.0f};
+    }
   }
   out.usable = true;
   return out;
@@ -705,7 +962,7 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
     const LocalPrimitive& local = m_meshes[size_t(mesh_index)][pi];
     if (!local.usable) continue;
     const std::string where = idx("meshes", size_t(mesh_index)) + "." + idx("primitives", pi);
-    charge_memory(uint64_t(local.indices.size()) * 4 + uint64_t(local.positions.size()) * 32, where);
+    charge_memory(uint64_t(local.indices.size()) * 4 + uint64_t(local.positions.size()) * 96, where);
     Mesh out;
     out.name = (mesh.name.empty() ? idx("meshes", size_t(mesh_index)) : mesh.name) + "[" + std::to_string(pi) + "]";
     out.node = node;
@@ -730,6 +987,26 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
       out.normals = compute_smooth_normals(out.positions, out.indices);
     }
     out.uvs = local.uvs;
+    out.uvs1 = local.uvs1;
+    out.colors = local.colors;
+    // Tangents only where a normal map needs them: the file's (to world space; a mirroring
+    // transform flips the bitangent sign), else generated from the map's UV set.
+    if (local.material >= 0) {
+      const TextureRef& nt = m_out.scene.materials[size_t(local.material)].normal_tex;
+      const auto& nuv = nt.texcoord == 1 ? out.uvs1 : out.uvs;
+      if (nt.texture >= 0 && !local.tangents.empty()) {
+        out.tangents.resize(local.tangents.size());
+        for (size_t i = 0; i < local.tangents.size(); ++i) {
+          const Vec4f t = local.tangents[i];
+          const Vec3f tw = normalize(transform_vector(world, {t.x, t.y, t.z}));
+          out.tangents[i] = {tw.x, tw.y, tw.z, flip ? -t.w : t.w};
+        }
+      } else if (nt.texture >= 0 && !nuv.empty()) {
+        out.tangents = compute_tangents(out.positions, out.normals, nuv, out.indices);
+      } else if (nt.texture >= 0) {
+        warn(where, "normal texture without TEXCOORD_" + std::to_string(nt.texcoord) + "; normal map ignored");
+      }
+    }
     m_out.scene.meshes.push_back(std::move(out));
   }
 }
@@ -913,7 +1190,7 @@ LoadedScene load_gltf(const fs::path& file, const GltfLoadOptions& options) {
   box.max_bytes = options.max_file_bytes;
   tinygltf::TinyGLTF parser;
   parser.SetFsCallbacks({sandbox_file_exists, sandbox_expand, sandbox_read, sandbox_write, &box});
-  parser.SetImageLoader(skip_image, nullptr);
+  parser.SetImageLoader(capture_image, nullptr);
 
   tinygltf::Model model;
   std::string terr, twarn;

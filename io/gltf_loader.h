@@ -2,7 +2,8 @@
 // tinygltf parses; this module validates everything tinygltf does not (indices, accessor
 // ranges with overflow-safe arithmetic, node cycles, NaN data, URI escapes, JSON depth,
 // camera and light parameters) and flattens the node hierarchy into world-space meshes.
-// Textures are not decoded yet (images are skipped).
+// Images (PNG, JPEG from files, data URIs or bufferViews) are decoded through OpenImageIO
+// into MIP-mapped textures.
 #pragma once
 
 #include <cstdint>

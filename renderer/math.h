@@ -18,6 +18,10 @@ struct Vec2f {
   float x = 0, y = 0;
 };
 
+struct Vec4f {
+  float x = 0, y = 0, z = 0, w = 0;
+};
+
 struct Vec3f {
   float x = 0, y = 0, z = 0;
   constexpr float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }

@@ -16,15 +16,20 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
                           const RenderConfig& config, int x, int y, float rgba[4],
                           RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
+  // Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
+  const float step = std::max(0.125f, 1.0f / std::sqrt(float(n)));
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
     Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
     const Vec2f j = stratified_sample(s, n, rng);
-    const Ray ray = generate_camera_ray(camera, config.width, config.height, float(x) + j.x,
-                                        float(y) + j.y);
+    const float px = float(x) + j.x, py = float(y) + j.y;
+    const Ray ray = generate_camera_ray(camera, config.width, config.height, px, py);
+    const Ray rx = generate_camera_ray(camera, config.width, config.height, px + step, py);
+    const Ray ry = generate_camera_ray(camera, config.width, config.height, px, py + step);
+    const RayDifferential rd{true, rx.org, rx.dir, ry.org, ry.dir};
     float coverage = 0;
-    sum += whitted_radiance(scene, accel, config.whitted, ray, coverage, counts);
+    sum += whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts);
     alpha += coverage;
   }
   // Box filter: the plain mean of the pixel's samples.
@@ -36,7 +41,9 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
 }
 
 Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& camera,
-                    const RenderConfig& config, RenderStats* stats, const ProgressFn& progress) {
+                    const RenderConfig& user_config, RenderStats* stats, const ProgressFn& progress) {
+  RenderConfig config = user_config;
+  config.whitted.hit_filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
   const auto t0 = std::chrono::steady_clock::now();
   Film film = make_film(config.width, config.height);
   const int ts = config.tile_size;

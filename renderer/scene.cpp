@@ -41,4 +41,38 @@ std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
   return n;
 }
 
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
+                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
+                                    std::span<const uint32_t> indices) {
+  std::vector<Vec3f> tu(positions.size()), tv(positions.size());
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+    const Vec3f e1 = positions[b] - positions[a], e2 = positions[c] - positions[a];
+    const float du1 = uvs[b].x - uvs[a].x, dv1 = uvs[b].y - uvs[a].y;
+    const float du2 = uvs[c].x - uvs[a].x, dv2 = uvs[c].y - uvs[a].y;
+    const float r = du1 * dv2 - du2 * dv1;
+    if (!(std::fabs(r) > 0) || !std::isfinite(r)) continue;
+    // dp/du and dp/dv of the triangle, weighted by its area.
+    const float area = length(cross(e1, e2));
+    const Vec3f dpdu = normalize((e1 * dv2 - e2 * dv1) / r) * area;
+    const Vec3f dpdv = normalize((e2 * du1 - e1 * du2) / r) * area;
+    for (uint32_t v : {a, b, c}) {
+      tu[v] += dpdu;
+      tv[v] += dpdv;
+    }
+  }
+  std::vector<Vec4f> out(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const Vec3f n = normals[v];
+    Vec3f t = normalize(tu[v] - n * dot(n, tu[v]));
+    if (!(dot(t, t) > 0)) {  // no UV gradient here: any tangent orthogonal to n
+      const Vec3f axis = std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
+      t = normalize(cross(axis, n));
+    }
+    const float w = dot(cross(n, t), tv[v]) > 0 ? -1.0f : 1.0f;
+    out[v] = {t.x, t.y, t.z, w};
+  }
+  return out;
+}
+
 }  // namespace penumbra

@@ -1,5 +1,5 @@
-// The scene as plain data: world-space triangle meshes, materials, punctual lights and cameras,
-// addressed by int handles. Built by io/ from glTF (or by tests directly); consumed by the
+// The scene as plain data: world-space triangle meshes, materials, textures, punctual lights
+// and cameras, addressed by int handles. Built by io/ from glTF (or by tests directly); consumed by the
 // integrators. No behaviour here beyond small free functions.
 #pragma once
 
@@ -9,18 +9,41 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/math.h"
+#include "renderer/texture.h"
 
 namespace penumbra {
 
-/// glTF metallic-roughness parameters (factors only; textures come later).
+/// A material's reference to a texture: which UV set, and KHR_texture_transform's affine map
+/// uv' = [m00 m01 m02; m10 m11 m12] (u, v, 1), the identity by default.
+struct TextureRef {
+  int texture = -1;   ///< index into Scene::textures; -1 = none
+  int texcoord = 0;   ///< 0 = TEXCOORD_0, 1 = TEXCOORD_1
+  float m[2][3] = {{1, 0, 0}, {0, 1, 0}};
+};
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+/// glTF metallic-roughness material: factors times textures (glTF 2.0 spec 3.9).
+/// Colour textures are stored linear (io/ decodes sRGB).
 struct Material {
   std::string name;
-  Vec3f base_color{1, 1, 1};  ///< linear RGB
-  float alpha = 1;
+  Vec3f base_color{1, 1, 1};  ///< linear RGB factor
+  float alpha = 1;            ///< baseColorFactor.a
   float metallic = 1;   ///< glTF default
   float roughness = 1;  ///< glTF default
   Vec3f emissive{0, 0, 0};  ///< emissiveFactor x KHR_materials_emissive_strength
   bool unlit = false;       ///< KHR_materials_unlit: radiance = base_color, no lighting
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;  ///< Mask: coverage < cutoff is a hole
+  bool double_sided = true;   ///< false: back faces are invisible to camera and mirror rays
+                              ///< (glTF's default is false; io/ sets it from the file)
+  TextureRef base_color_tex;          ///< RGBA, multiplies base_color and alpha
+  TextureRef metallic_roughness_tex;  ///< B = metallic, G = roughness (linear)
+  TextureRef normal_tex;              ///< tangent-space normal map (linear)
+  float normal_scale = 1;             ///< scales the map's X and Y
+  TextureRef occlusion_tex;           ///< R = ambient occlusion (linear)
+  float occlusion_strength = 1;       ///< 1 + strength (R - 1)
+  TextureRef emissive_tex;            ///< RGB, multiplies emissive
 };
 
 /// A world-space triangle mesh (one glTF primitive instantiated by one node).
@@ -28,7 +51,11 @@ struct Mesh {
   std::string name;                ///< "meshName[prim]" for messages
   std::vector<Vec3f> positions;
   std::vector<Vec3f> normals;      ///< unit, one per position (computed if the file has none)
+  std::vector<Vec4f> tangents;     ///< xyz unit tangent along +u, w = +-1 bitangent sign
+                                   ///< (bitangent = w cross(n, t)); empty if not needed
   std::vector<Vec2f> uvs;          ///< TEXCOORD_0, empty if absent
+  std::vector<Vec2f> uvs1;         ///< TEXCOORD_1, empty if absent
+  std::vector<Vec4f> colors;       ///< COLOR_0 as linear RGBA, empty if absent
   std::vector<uint32_t> indices;   ///< 3 per triangle, counter-clockwise = front
   int material = -1;               ///< index into Scene::materials, -1 = default material
   int node = -1;                   ///< glTF node index, -1 if not from glTF
@@ -69,6 +96,7 @@ struct Camera {
 struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
+  std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
 };
@@ -82,5 +110,14 @@ std::vector<TriangleMeshView> mesh_views(const Scene& scene);
 /// non-degenerate triangle gets +Z).
 std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
                                           std::span<const uint32_t> indices);
+/// Per-vertex tangents for normal mapping from positions, unit normals and the UV set the
+/// normal map uses: per-triangle dp/du and dp/dv accumulated (area-weighted) per vertex,
+/// Gram-Schmidt orthogonalised against the normal; w = +1 when cross(n, t) points along
+/// -dp/dv (glTF's V axis points down the image, so +Y of the map is -v), else -1, which is
+/// the MikkTSpace convention for glTF. Vertices without usable UVs get any unit tangent
+/// orthogonal to n.
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
+                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
+                                    std::span<const uint32_t> indices);
 
 }  // namespace penumbra

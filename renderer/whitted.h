@@ -4,7 +4,8 @@
 #pragma once
 
 #include "renderer/accel/accelerator.h"
-#include "renderer/scene.h"
+#include "renderer/interaction.h"
+#include "renderer/material.h"
 
 namespace penumbra {
 
@@ -27,6 +28,9 @@ struct WhittedParams {
 ///   kr = f0 x (1 - roughness)^2               smooth metals mirror, smooth plastics glint
 ///   emission = emissive
 /// Materials with `unlit` skip all of this: their radiance is base_color.
+/// The inputs are the material's values at the shaded point (factors x textures).
+WhittedParams whitted_params(const MaterialPoint& m);
+/// The same for a material's factors alone (no textures, no vertex colours).
 WhittedParams whitted_params(const Material& m);
 
 /// Integrator settings, validated by the CLI.
@@ -35,6 +39,10 @@ struct WhittedConfig {
   Vec3f ambient{0.05f, 0.05f, 0.05f};  ///< ambient intensity Ia (radiance units)
   Vec3f background{0, 0, 0};       ///< radiance of rays that escape (alpha stays 0)
   float min_reflectance = 1e-3f;   ///< mirror rays with path weight below this are not traced
+  int max_blend_layers = 16;       ///< alpha-blended surfaces composited along one ray; deeper
+                                   ///< layers count as opaque
+  bool hit_filter = true;          ///< false skips alpha/back-face filtering of hits: a speed-up,
+                                   ///< valid only when scene_needs_hit_filter() is false
 };
 
 struct RayCounts {
@@ -48,16 +56,19 @@ struct RayCounts {
   }
 };
 
-/// Radiance along a camera ray (counted as one camera ray) and its coverage (1 if it hit
-/// geometry, else 0). The outgoing radiance at a hit is
-///   L = emission + ka Ia + sum_lights V E [ kd/pi max(0, n.l)
+/// Radiance along a camera ray (counted as one camera ray) with its differentials (for texture
+/// filtering; may be invalid), and its coverage (1 if it hit opaque geometry, 0 if it
+/// escaped, alpha-composited over Blend layers). The outgoing radiance at a hit is
+///   L = emission + ka Ia occlusion + sum_lights V E [ kd/pi max(0, n.l)
 ///                                           + ks (p+8)/(8 pi) max(0, n.h)^p max(0, n.l) ]
 ///       + kr L(reflected ray)
-/// with E the light's irradiance (lights.h), V its shadow-ray visibility and
-/// h = (v + l)/|v + l|. The 1/pi and (p+8)/(8 pi) factors normalise the lobes so that kd and
+/// with E the light's irradiance (lights.h), V its shadow-ray transmittance (material.h) and
+/// h = (v + l)/|v + l|; n is the normal-mapped shading normal. A Blend surface of coverage a
+/// contributes a L + (1 - a) L(behind), front to back. The 1/pi and (p+8)/(8 pi) factors normalise the lobes so that kd and
 /// ks are albedos under glTF's physical light units.
 /// Thread-safe; never allocates, throws or logs.
 Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const WhittedConfig& cfg,
-                       const Ray& camera_ray, float& coverage, RayCounts& counts);
+                       const Ray& camera_ray, const RayDifferential& rd, float& coverage,
+                       RayCounts& counts);
 
 }  // namespace penumbra

@@ -13,7 +13,7 @@ namespace {
 Vec3f shade(const Scene& s, const WhittedConfig& cfg, const Ray& r, float& coverage, RayCounts& counts) {
   const auto views = mesh_views(s);
   const auto accel = make_accelerator("embree", views);
-  return whitted_radiance(s, *accel, cfg, r, coverage, counts);
+  return whitted_radiance(s, *accel, cfg, r, RayDifferential{}, coverage, counts);
 }
 }  // namespace
 
