@@ -90,3 +90,66 @@ TEST_CASE("corpus: every invalid file ends in a clear error or warnings, never a
   CHECK(errors > 80);  // most of the corpus is structurally broken
   CHECK(errors + loaded > 150);
 }
+
+TEST_CASE("corpus: materials, alpha modes and textures load as the files say", "[io][corpus][texture]") {
+  const auto corpus = test::corpus_dir();
+  if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
+  auto find = [](const Scene& s, const std::string& name) -> const Material& {
+    for (const auto& m : s.materials)
+      if (m.name == name) return m;
+    FAIL("no material " << name);
+    return s.materials[0];
+  };
+  {
+    const LoadedScene ls = load_gltf(*corpus / "valid/AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb");
+    const Scene& s = ls.scene;
+    CHECK(s.materials.size() == 6);
+    CHECK(find(s, "MatBlend").alpha_mode == AlphaMode::Blend);
+    CHECK(find(s, "MatCutoff25").alpha_mode == AlphaMode::Mask);
+    CHECK(find(s, "MatCutoff25").alpha_cutoff == Approx(0.25));
+    CHECK(find(s, "MatCutoff75").alpha_cutoff == Approx(0.75));
+    CHECK(find(s, "MatCutoffDefault").alpha_cutoff == Approx(0.5));
+    CHECK(find(s, "MatOpaque").alpha_mode == AlphaMode::Opaque);
+    CHECK(find(s, "MatOpaque").double_sided);
+    const Material& bed = find(s, "MatBed");
+    CHECK_FALSE(bed.double_sided);
+    CHECK(bed.base_color_tex.texture >= 0);
+    CHECK(bed.normal_tex.texture >= 0);
+    CHECK(bed.occlusion_tex.texture >= 0);
+    // Texture 1 serves both occlusion and metallic-roughness (both linear): stored once.
+    CHECK(bed.metallic_roughness_tex.texture == bed.occlusion_tex.texture);
+    // The blend material's texture is the 4-channel PNG: straight alpha, a ramp from 0 to 1.
+    const Texture& t = s.textures[size_t(find(s, "MatBlend").base_color_tex.texture)];
+    float lo = 1, hi = 0;
+    for (size_t i = 3; i < t.levels[0].texels.size(); i += 4) {
+      lo = std::min(lo, t.levels[0].texels[i] / 65535.0f);
+      hi = std::max(hi, t.levels[0].texels[i] / 65535.0f);
+    }
+    CHECK(lo == 0);
+    CHECK(hi == 1);
+    CHECK(ls.info.image_count == 4);
+  }
+  {
+    const LoadedScene ls = load_gltf(*corpus / "valid/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
+    const Material& m = ls.scene.materials.at(0);
+    for (const TextureRef* r : {&m.base_color_tex, &m.metallic_roughness_tex, &m.normal_tex, &m.occlusion_tex, &m.emissive_tex})
+      CHECK(r->texture >= 0);
+    CHECK(ls.scene.textures.size() == 5);
+    CHECK(ls.scene.textures[0].levels[0].width == 2048);
+    CHECK(ls.scene.textures[0].levels.size() == 12);  // 2048 .. 1
+    REQUIRE(ls.scene.meshes.size() == 1);
+    CHECK(ls.scene.meshes[0].tangents.size() == ls.scene.meshes[0].positions.size());  // generated
+  }
+  {
+    const LoadedScene ls = load_gltf(*corpus / "valid/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb");
+    float strongest = 0;
+    for (const auto& m : ls.scene.materials) strongest = std::max(strongest, max_component(m.emissive));
+    CHECK(strongest > 1);  // KHR_materials_emissive_strength scales beyond the [0,1] factor
+  }
+  {
+    const LoadedScene ls = load_gltf(*corpus / "valid/BoxVertexColors/glTF-Binary/BoxVertexColors.glb");
+    bool any = false;
+    for (const auto& m : ls.scene.meshes) any = any || !m.colors.empty();
+    CHECK(any);
+  }
+}
