@@ -149,6 +149,9 @@ struct RenderArgs {
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
+  std::optional<double> time;   ///< --time, seconds
+  std::optional<long> frame;    ///< --frame, converted with --fps
+  double fps = 24;
 };
 
 /// The accelerator name and "key=value" parameters, checked before any loading: exit 2 with
@@ -201,8 +204,9 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
 }
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external,
-                       const std::string& max_memory, bool quiet) {
+                       const std::string& max_memory, bool quiet, std::optional<double> time = {}) {
   GltfLoadOptions opt;
+  opt.time = time;
   opt.scene = scene;
   opt.allow_external_uris = allow_external;
   opt.max_memory_bytes = max_memory.empty() ? default_memory_budget() : parse_bytes(max_memory);
@@ -261,12 +265,17 @@ int run_render(const RenderArgs& a) {
     throw UsageError("--cost-png needs --aov cost");
   }
 
+  std::optional<double> time = a.time;
+  if (time && !std::isfinite(*time)) throw UsageError("--time must be a finite number of seconds");
+  if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
+  if (a.frame) time = double(*a.frame) / a.fps;
+
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
   // Load.
   const auto t_load = Clock::now();
-  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.max_memory, a.quiet);
+  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.max_memory, a.quiet, time);
   Scene& scene = loaded.scene;
   const double load_s = seconds_since(t_load);
 
@@ -466,6 +475,9 @@ int main(int argc, char** argv) {
   render->add_option("--background", r.background, "background radiance r,g,b or grey (default 0); background alpha stays 0");
   render->add_option("--ambient", r.ambient, "ambient intensity Ia, r,g,b or grey (default 0.05)");
   render->add_option("--seed", r.seed, "sampler seed (default 0)");
+  auto* time_opt = render->add_option("--time", r.time, "animation time in seconds: animations (node TRS, skins, morph weights) are evaluated there (default: the file's static pose)");
+  render->add_option("--frame", r.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
+  render->add_option("--fps", r.fps, "frames per second for --frame (default 24)");
   render->add_option("--max-memory", r.max_memory, "budget for decoded geometry, e.g. 4G (default: half the RAM)");
   render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
   render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");

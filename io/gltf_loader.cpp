@@ -14,6 +14,7 @@
 #include <set>
 
 #include "io/error.h"
+#include "renderer/animation.h"
 
 namespace penumbra {
 
@@ -223,7 +224,8 @@ class Converter {
   AccessorLayout layout(int accessor, const std::string& user);
   double component(const AccessorLayout& l, uint64_t element, int c) const;
   std::vector<double> read(int accessor, const std::string& user, std::initializer_list<int> types,
-                           std::initializer_list<int> component_types, bool allow_normalized);
+                           std::initializer_list<int> component_types, bool allow_normalized,
+                           bool allow_integer = false);
   std::vector<uint32_t> read_indices(int accessor, const std::string& user);
 
   /// One glTF primitive decoded and validated in its mesh's local space.
@@ -232,9 +234,26 @@ class Converter {
     std::vector<Vec4f> tangents, colors;    // empty if absent
     std::vector<Vec2f> uvs, uvs1;
     std::vector<uint32_t> indices;          // triangle list
+    std::vector<std::vector<Vec3f>> target_positions, target_normals;  // morph target deltas
+    std::vector<std::array<uint16_t, 4>> joints;  // JOINTS_0 (skinning), empty if absent
+    std::vector<Vec4f> weights;                   // WEIGHTS_0
     int material = -1;
     bool usable = false;                    // false: skipped with a warning
   };
+
+  /// Animated values of one node at the requested time (unset fields keep the file's).
+  struct NodePose {
+    bool has_t = false, has_r = false, has_s = false, has_w = false;
+    std::array<double, 3> t{}, s{};
+    Quat r;
+    std::vector<double> weights;
+  };
+  void evaluate_animations(double time);
+  const Transform& world_of(int node);
+  std::vector<NodePose> m_pose;                  // per node
+  std::vector<Transform> m_world;                // per node, valid where m_has_world
+  std::vector<uint8_t> m_has_world;
+  std::vector<int> m_parent;
 
   void check_extensions();
   const DecodedImage& decoded_image(int image, const std::string& user);
@@ -387,7 +406,8 @@ double Converter::component(const AccessorLayout& l, uint64_t element, int c) co
 
 std::vector<double> Converter::read(int accessor, const std::string& user,
                                     std::initializer_list<int> types,
-                                    std::initializer_list<int> component_types, bool allow_normalized) {
+                                    std::initializer_list<int> component_types, bool allow_normalized,
+                                    bool allow_integer) {
   AccessorLayout l = layout(accessor, user);
   const auto& a = m_model.accessors[size_t(accessor)];
   const std::string where = user + " (" + idx("accessors", size_t(accessor)) + ")";
@@ -396,7 +416,7 @@ std::vector<double> Converter::read(int accessor, const std::string& user,
   const bool ok_component = std::find(component_types.begin(), component_types.end(),
                                       a.componentType) != component_types.end();
   const bool is_float = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-  if (!ok_component || (!is_float && !(allow_normalized && a.normalized)))
+  if (!ok_component || (!is_float && !(allow_normalized && a.normalized) && !(allow_integer && !a.normalized)))
     fail(where, "unsupported componentType " + std::to_string(a.componentType) +
                     (a.normalized ? " (normalized)" : ""));
   std::vector<double> out(size_t(l.count) * size_t(l.components));
@@ -743,9 +763,93 @@ Transform Converter::local_transform(int node) {
     if (!std::isfinite(len) || len < 1e-6) fail(where + ".rotation", "is not a unit quaternion (length " + std::to_string(len) + ")");
     if (std::fabs(len - 1) > 1e-3) warn(where + ".rotation", "quaternion not normalised (length " + std::to_string(len) + "); normalising");
   }
+  if (size_t(node) < m_pose.size()) {  // animation channels override the static TRS
+    const NodePose& pose = m_pose[size_t(node)];
+    if (pose.has_t) tr = pose.t;
+    if (pose.has_r) q = pose.r;
+    if (pose.has_s) sc = pose.s;
+  }
   for (double v : tr) if (!std::isfinite(v)) fail(where + ".translation", "contains NaN or infinite values");
   for (double v : sc) if (!std::isfinite(v)) fail(where + ".scale", "contains NaN or infinite values");
   return compose_trs(tr, q, sc);
+}
+
+const Transform& Converter::world_of(int node) {
+  // Walk up to the first ancestor with a known world transform (or a root), then down.
+  std::vector<int> chain;
+  for (int cur = node; cur >= 0 && !m_has_world[size_t(cur)]; cur = m_parent[size_t(cur)]) chain.push_back(cur);
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    const int p = m_parent[size_t(*it)];
+    const Transform world = (p >= 0 ? m_world[size_t(p)] : Transform{}) * local_transform(*it);
+    if (!is_finite(world)) fail(idx("nodes", size_t(*it)), "world transform overflows to non-finite values");
+    m_world[size_t(*it)] = world;
+    m_has_world[size_t(*it)] = 1;
+  }
+  return m_world[size_t(node)];
+}
+
+void Converter::evaluate_animations(double time) {
+  m_pose.assign(m_model.nodes.size(), NodePose{});
+  for (size_t ai = 0; ai < m_model.animations.size(); ++ai) {
+    const auto& anim = m_model.animations[ai];
+    const std::string aw = idx("animations", ai);
+    for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
+      const auto& ch = anim.channels[ci];
+      const std::string cw = aw + "." + idx("channels", ci);
+      if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
+        fail(cw + ".sampler", "sampler index " + std::to_string(ch.sampler) + " out of range (" +
+                                  std::to_string(anim.samplers.size()) + " samplers)");
+      if (ch.target_node < 0) continue;  // no target node: nothing to animate (spec allows it)
+      if (size_t(ch.target_node) >= m_model.nodes.size())
+        fail(cw + ".target.node", "node index " + std::to_string(ch.target_node) + " out of range (" +
+                                      std::to_string(m_model.nodes.size()) + " nodes)");
+      const auto& smp = anim.samplers[size_t(ch.sampler)];
+      const std::string sw = aw + "." + idx("samplers", size_t(ch.sampler));
+      Interpolation interp = Interpolation::Linear;
+      if (smp.interpolation == "STEP") interp = Interpolation::Step;
+      else if (smp.interpolation == "CUBICSPLINE") interp = Interpolation::CubicSpline;
+      else if (smp.interpolation != "LINEAR" && !smp.interpolation.empty())
+        fail(sw + ".interpolation", "'" + smp.interpolation + "' is not STEP, LINEAR or CUBICSPLINE");
+      const std::string& path = ch.target_path;
+      size_t width = 0;
+      if (path == "translation" || path == "scale") width = 3;
+      else if (path == "rotation") width = 4;
+      else if (path == "weights") width = 0;  // from the counts below
+      else {
+        warn(cw + ".target.path", "path '" + path + "' is not supported; channel ignored");
+        continue;
+      }
+      const auto in = read(smp.input, sw + ".input", {TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+      const auto outv = read(smp.output, sw + ".output",
+                             {width == 3 ? TINYGLTF_TYPE_VEC3 : (width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_SCALAR)},
+                             {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                              TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+      std::vector<float> times(in.begin(), in.end()), values(outv.begin(), outv.end());
+      for (size_t k = 0; k < times.size(); ++k)
+        if (!std::isfinite(times[k]) || (k > 0 && times[k] < times[k - 1]))
+          fail(sw + ".input", "key times must be finite and non-decreasing (key " + std::to_string(k) + ")");
+      for (float v : values)
+        if (!std::isfinite(v)) fail(sw + ".output", "values must be finite");
+      const size_t per_key = interp == Interpolation::CubicSpline ? 3 : 1;
+      if (width == 0) {  // weights: one value per morph target per key
+        if (values.size() % (times.size() * per_key) != 0)
+          fail(sw + ".output", "count " + std::to_string(values.size()) + " is not a multiple of " +
+                                   std::to_string(times.size() * per_key) + " (keys x morph targets)");
+        width = values.size() / (times.size() * per_key);
+      } else if (values.size() != times.size() * per_key * width) {
+        fail(sw + ".output", "has " + std::to_string(values.size() / width) + " elements; " +
+                                 std::to_string(times.size() * per_key) + " expected for " +
+                                 std::to_string(times.size()) + " keys");
+      }
+      std::vector<double> v(width);
+      sample_track(times, values, width, interp, path == "rotation", time, v.data());
+      NodePose& pose = m_pose[size_t(ch.target_node)];
+      if (path == "translation") { pose.has_t = true; pose.t = {v[0], v[1], v[2]}; }
+      else if (path == "scale") { pose.has_s = true; pose.s = {v[0], v[1], v[2]}; }
+      else if (path == "rotation") { pose.has_r = true; pose.r = {v[0], v[1], v[2], v[3]}; }
+      else { pose.has_w = true; pose.weights = v; }
+    }
+  }
 }
 
 void Converter::traverse(const std::vector<int>& roots) {
@@ -783,6 +887,9 @@ void Converter::traverse(const std::vector<int>& roots) {
     if (cycle) fail(idx("nodes", cur), "is part of a node cycle");
     for (size_t p : path) state[p] = 2;
   }
+  m_parent = parent;
+  m_world.assign(n, Transform{});
+  m_has_world.assign(n, 0);
   // Phase 2: depth-first traversal accumulating parent * local, with an explicit stack.
   std::set<int> seen_roots;
   struct Item { int node; Transform parent_world; };
@@ -800,6 +907,8 @@ void Converter::traverse(const std::vector<int>& roots) {
     const auto& node = m_model.nodes[size_t(item.node)];
     const Transform world = item.parent_world * local_transform(item.node);
     if (!is_finite(world)) fail(idx("nodes", size_t(item.node)), "world transform overflows to non-finite values");
+    m_world[size_t(item.node)] = world;
+    m_has_world[size_t(item.node)] = 1;
     if (node.mesh >= 0 || node.mesh < -1) add_mesh(node.mesh, item.node, world);
     if (node.camera >= 0 || node.camera < -1) add_camera(node.camera, item.node, world);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
@@ -908,6 +1017,37 @@ Converter::LocalPrimitive Converter::decode_primitive(size_t mesh_index, size_t 
     }
   }
   auto finite_or_zero = [](double v) { return std::isfinite(v) ? float(v) : 0.0f; };
+  // Morph targets: POSITION and NORMAL displacements (glTF 3.7.2.2).
+  for (size_t ti = 0; ti < prim.targets.size(); ++ti) {
+    const std::string tw = where + "." + idx("targets", ti);
+    std::vector<Vec3f> dp(nv), dn;
+    for (const auto& [name, accessor] : prim.targets[ti]) {
+      if (name != "POSITION" && name != "NORMAL") continue;
+      const auto d = read(accessor, tw + "." + name, {TINYGLTF_TYPE_VEC3},
+                          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
+      if (d.size() != nv * 3) fail(tw + "." + name, "count differs from POSITION count");
+      auto& dst = name == "POSITION" ? dp : dn;
+      dst.resize(nv);
+      for (size_t i = 0; i < nv; ++i) dst[i] = {finite_or_zero(d[i * 3]), finite_or_zero(d[i * 3 + 1]), finite_or_zero(d[i * 3 + 2])};
+    }
+    out.target_positions.push_back(std::move(dp));
+    out.target_normals.push_back(std::move(dn));
+  }
+  // Skinning attributes (glTF 3.7.3): JOINTS_0 with WEIGHTS_0.
+  if (auto jt = prim.attributes.find("JOINTS_0"), wt = prim.attributes.find("WEIGHTS_0");
+      jt != prim.attributes.end() && wt != prim.attributes.end()) {
+    const auto j = read(jt->second, where + ".attributes.JOINTS_0", {TINYGLTF_TYPE_VEC4},
+                        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, false, true);
+    const auto w = read(wt->second, where + ".attributes.WEIGHTS_0", {TINYGLTF_TYPE_VEC4},
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, true);
+    if (j.size() != nv * 4 || w.size() != nv * 4) fail(where + ".attributes.JOINTS_0", "JOINTS_0/WEIGHTS_0 counts differ from POSITION count");
+    out.joints.resize(nv);
+    out.weights.resize(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      for (size_t c = 0; c < 4; ++c) out.joints[i][c] = uint16_t(j[i * 4 + c]);
+      out.weights[i] = {finite_or_zero(w[i * 4]), finite_or_zero(w[i * 4 + 1]), finite_or_zero(w[i * 4 + 2]), finite_or_zero(w[i * 4 + 3])};
+    }
+  }
   if (!uv.empty()) {
     out.uvs.resize(nv);
     for (size_t i = 0; i < nv; ++i) out.uvs[i] = {finite_or_zero(uv[i * 2]), finite_or_zero(uv[i * 2 + 1])};
@@ -957,7 +1097,38 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
     warn(node_where, "singular transform; mesh " + std::to_string(mesh_index) + " skipped");
     return;
   }
-  const bool flip = determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
+  bool flip = determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
+  const auto& gnode = m_model.nodes[size_t(node)];
+  // Morph weights: animated, else the node's, else the mesh's defaults (glTF 3.7.2.2).
+  std::vector<double> morph = mesh.weights;
+  if (!gnode.weights.empty()) morph = gnode.weights;
+  if (size_t(node) < m_pose.size() && m_pose[size_t(node)].has_w) morph = m_pose[size_t(node)].weights;
+  // Skin: joint matrices J_k = world(joint k) x inverseBindMatrix k; a skinned mesh ignores its
+  // node's own transform (glTF 3.7.3.3).
+  std::vector<Transform> joint_mats;
+  if (gnode.skin >= 0 || gnode.skin < -1) {
+    if (gnode.skin < 0 || size_t(gnode.skin) >= m_model.skins.size())
+      fail(node_where + ".skin", "skin index " + std::to_string(gnode.skin) + " out of range (" +
+                                     std::to_string(m_model.skins.size()) + " skins)");
+    const auto& skin = m_model.skins[size_t(gnode.skin)];
+    const std::string sw = idx("skins", size_t(gnode.skin));
+    if (skin.joints.empty()) fail(sw + ".joints", "must not be empty");
+    std::vector<double> ibm;
+    if (skin.inverseBindMatrices >= 0) {
+      ibm = read(skin.inverseBindMatrices, sw + ".inverseBindMatrices", {TINYGLTF_TYPE_MAT4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+      if (ibm.size() < skin.joints.size() * 16)
+        fail(sw + ".inverseBindMatrices", "has fewer matrices than the skin has joints");
+    }
+    for (size_t k = 0; k < skin.joints.size(); ++k) {
+      const int j = skin.joints[k];
+      if (j < 0 || size_t(j) >= m_model.nodes.size())
+        fail(sw + ".joints", "node index " + std::to_string(j) + " out of range");
+      Transform inv_bind;
+      if (!ibm.empty()) inv_bind = from_column_major(&ibm[k * 16]);
+      joint_mats.push_back(world_of(j) * inv_bind);
+    }
+    flip = determinant3x3(joint_mats[0]) < 0;
+  }
   for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
     const LocalPrimitive& local = m_meshes[size_t(mesh_index)][pi];
     if (!local.usable) continue;
@@ -967,9 +1138,39 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
     out.name = (mesh.name.empty() ? idx("meshes", size_t(mesh_index)) : mesh.name) + "[" + std::to_string(pi) + "]";
     out.node = node;
     out.material = local.material;
-    out.positions.resize(local.positions.size());
-    for (size_t i = 0; i < local.positions.size(); ++i) {
-      out.positions[i] = transform_point(world, local.positions[i]);
+    // Morphed local positions and normals.
+    std::vector<Vec3f> lp = local.positions, ln = local.normals;
+    for (size_t t = 0; t < local.target_positions.size() && t < morph.size(); ++t) {
+      const float w = float(morph[t]);
+      if (w == 0 || !std::isfinite(w)) continue;
+      for (size_t i = 0; i < lp.size(); ++i) lp[i] += local.target_positions[t][i] * w;
+      if (!ln.empty() && !local.target_normals[t].empty())
+        for (size_t i = 0; i < ln.size(); ++i) ln[i] += local.target_normals[t][i] * w;
+    }
+    // Per-vertex transforms: the node's world transform, or the blended joint matrices.
+    const bool skinned = !joint_mats.empty() && !local.joints.empty();
+    std::vector<Transform> vertex_xf;
+    if (skinned) {
+      vertex_xf.resize(lp.size());
+      for (size_t i = 0; i < lp.size(); ++i) {
+        Transform b;
+        b.m = {};
+        const float wsum = local.weights[i].x + local.weights[i].y + local.weights[i].z + local.weights[i].w;
+        const float wk[4] = {local.weights[i].x, local.weights[i].y, local.weights[i].z, local.weights[i].w};
+        for (size_t k = 0; k < 4; ++k) {
+          if (wk[k] == 0) continue;
+          const size_t j = local.joints[i][k];
+          if (j >= joint_mats.size())
+            fail(where + ".attributes.JOINTS_0", "joint " + std::to_string(j) + " >= skin joint count " + std::to_string(joint_mats.size()));
+          for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) b.m[size_t(r)][size_t(c)] += double(wk[k] / (wsum > 0 ? wsum : 1)) * joint_mats[j].m[size_t(r)][size_t(c)];
+        }
+        vertex_xf[i] = wsum > 0 ? b : world;
+      }
+    }
+    out.positions.resize(lp.size());
+    for (size_t i = 0; i < lp.size(); ++i) {
+      out.positions[i] = transform_point(skinned ? vertex_xf[i] : world, lp[i]);
       if (!is_finite(out.positions[i]) || max_component(abs(out.positions[i])) > 1e18f) {
         warn(where + " in " + node_where, "world-space positions are NaN, infinite or huge; dropped");
         out.positions.clear();
@@ -980,9 +1181,13 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
     out.indices = local.indices;
     if (flip)
       for (size_t i = 0; i < out.indices.size(); i += 3) std::swap(out.indices[i + 1], out.indices[i + 2]);
-    if (!local.normals.empty()) {
-      out.normals.resize(local.normals.size());
-      for (size_t i = 0; i < local.normals.size(); ++i) out.normals[i] = normalize(transform_normal(inv, local.normals[i]));
+    if (!ln.empty()) {
+      out.normals.resize(ln.size());
+      for (size_t i = 0; i < ln.size(); ++i) {
+        Transform vinv = inv;
+        if (skinned && !inverse(vertex_xf[i], vinv)) vinv = inv;
+        out.normals[i] = normalize(transform_normal(vinv, ln[i]));
+      }
     } else {
       out.normals = compute_smooth_normals(out.positions, out.indices);
     }
@@ -1135,6 +1340,7 @@ void Converter::run() {
   validate_cameras();
   validate_lights();
   decode_meshes();
+  if (m_options.time) evaluate_animations(*m_options.time);
 
   // Which scene: --scene N, else the file's default, else scenes[0], else every root node.
   int scene = m_options.scene >= 0 ? m_options.scene : m_model.defaultScene;

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct GltfLoadOptions {
   uint64_t max_file_bytes = 2ull << 30;   ///< per file read (glTF, GLB, .bin)
   uint64_t max_memory_bytes = 8ull << 30; ///< budget for decoded geometry
   int max_json_depth = 64;            ///< deeper JSON nesting is rejected before parsing
+  /// Animation time in seconds: every animation's channels (node TRS, morph weights; skins
+  /// follow their joints) are evaluated at this time before the scene is built. Unset: the
+  /// file's static pose (no channel applied).
+  std::optional<double> time;
 };
 
 /// Descriptive facts about the file, for `penumbra info`.
