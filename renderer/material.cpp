@@ -13,6 +13,12 @@ Ray past(const Ray& ray, float t) {
   r.tnear = std::nextafter(std::max(t, ray.tnear), kInfinity);
   return r;
 }
+// KHR_texture_transform's affine map applied to a point (with offset) or a derivative.
+Vec2f transform_uv(const TextureRef& ref, Vec2f uv, bool offset) {
+  const auto& m = ref.m;
+  return {m[0][0] * uv.x + m[0][1] * uv.y + (offset ? m[0][2] : 0.0f),
+          m[1][0] * uv.x + m[1][1] * uv.y + (offset ? m[1][2] : 0.0f)};
+}
 }  // namespace
 
 const Material& default_material() {
@@ -24,12 +30,9 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
   if (ref.texture < 0) return {1, 1, 1, 1};
   const Texture& tex = scene.textures[size_t(ref.texture)];
   const int set = ref.texcoord == 1 ? 1 : 0;
-  const Vec2f uv = si.uv[set], dx = si.duvdx[set], dy = si.duvdy[set];
-  const auto& m = ref.m;
-  const Vec2f tuv{m[0][0] * uv.x + m[0][1] * uv.y + m[0][2], m[1][0] * uv.x + m[1][1] * uv.y + m[1][2]};
-  const Vec2f tdx{m[0][0] * dx.x + m[0][1] * dx.y, m[1][0] * dx.x + m[1][1] * dx.y};
-  const Vec2f tdy{m[0][0] * dy.x + m[0][1] * dy.y, m[1][0] * dy.x + m[1][1] * dy.y};
-  return sample_texture(tex, tuv, texture_lod(tex, tdx, tdy));
+  return sample_texture(tex, transform_uv(ref, si.uv[set], true),
+                        texture_lod(tex, transform_uv(ref, si.duvdx[set], false),
+                                    transform_uv(ref, si.duvdy[set], false)));
 }
 
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
@@ -78,9 +81,7 @@ float eval_alpha(const Scene& scene, uint32_t mesh_index, uint32_t prim, float u
     Vec2f uv;
     if (!uvs.empty())
       uv = {uvs[i0].x * w + uvs[i1].x * u + uvs[i2].x * v, uvs[i0].y * w + uvs[i1].y * u + uvs[i2].y * v};
-    const auto& m = ref.m;
-    const Vec2f tuv{m[0][0] * uv.x + m[0][1] * uv.y + m[0][2], m[1][0] * uv.x + m[1][1] * uv.y + m[1][2]};
-    alpha *= sample_texture(scene.textures[size_t(ref.texture)], tuv, 0).w;
+    alpha *= sample_texture(scene.textures[size_t(ref.texture)], transform_uv(ref, uv, true), 0).w;
   }
   if (mat.alpha_mode == AlphaMode::Mask) return alpha >= mat.alpha_cutoff ? 1.0f : 0.0f;
   return std::clamp(alpha, 0.0f, 1.0f);

@@ -279,3 +279,41 @@ TEST_CASE("missing and non-regular files are clear errors", "[io][gltf][hostile]
   std::ofstream(dir / "x.glb", std::ios::binary) << std::string("glTF\x02\0\0\0\xff\xff\xff\x7f", 12);
   REQUIRE_THROWS_AS(load_gltf(dir / "x.glb"), InputError);
 }
+
+TEST_CASE("gltf: unreadable images are warnings naming the image; an image bufferView past its buffer is an error", "[io][texture][quick]") {
+  const auto dir = test::temp_dir("badimages");
+  auto file_with = [&](nlohmann::json images, int view_bytes) {
+    test::GltfWriter w;
+    const int pos = w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const std::vector<float> uv = {0, 0, 1, 0, 0, 1};
+    const int tc = w.accessor(uv.data(), 24, 5126, 3, "VEC2");
+    w.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 0}, {"byteLength", view_bytes}});
+    w.j["images"] = images;
+    w.j["textures"] = nlohmann::json::array();
+    w.j["materials"] = nlohmann::json::array();
+    for (size_t i = 0; i < images.size(); ++i) {
+      w.j["textures"].push_back({{"source", i}});
+      w.j["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", i}}}}}});
+      const int m = w.mesh(pos);
+      w.j["meshes"][size_t(m)]["primitives"][0]["attributes"]["TEXCOORD_0"] = tc;
+      w.j["meshes"][size_t(m)]["primitives"][0]["material"] = i;
+      w.node({{"mesh", m}});
+    }
+    w.write_embedded(dir / "t.gltf");
+    return dir / "t.gltf";
+  };
+  const int view = 2;  // the bufferView added above (after POSITION's and TEXCOORD_0's)
+  const auto ok = file_with({{{"uri", "missing.png"}}, {{"uri", "../../etc/passwd"}},
+                             {{"bufferView", view}, {"mimeType", "image/png"}}},
+                            24);
+  const LoadedScene ls = load_gltf(ok);
+  CHECK(ls.scene.textures.empty());
+  for (const char* needle : {"images[0]: image data could not be read from 'missing.png'",
+                             "images[1]: image data could not be read", "images[2]: not a PNG or JPEG image"}) {
+    bool found = false;
+    for (const auto& w : ls.warnings) found = found || w.find(needle) != std::string::npos;
+    CHECK(found);
+  }
+  CHECK_THROWS_WITH(load_gltf(file_with({{{"bufferView", view}}}, 60000)),
+                    Catch::Contains("bufferViews[2]: byteOffset + byteLength exceeds buffer 0"));
+}
