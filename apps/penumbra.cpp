@@ -141,7 +141,7 @@ class ProgressReporter {
 
 struct RenderArgs {
   std::string scene_file, output, png;
-  bool no_png = false, use_float = false, quiet = false, allow_external = false;
+  bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
   int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
   std::string camera;  ///< index or name; empty = the first camera, or framing
   uint64_t seed = 0;
@@ -203,10 +203,11 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
   return found;
 }
 
-LoadedScene load_scene(const std::string& file, int scene, bool allow_external,
+LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
                        const std::string& max_memory, bool quiet, std::optional<double> time = {}) {
   GltfLoadOptions opt;
   opt.time = time;
+  opt.flatten = flatten;
   opt.scene = scene;
   opt.allow_external_uris = allow_external;
   opt.max_memory_bytes = max_memory.empty() ? default_memory_budget() : parse_bytes(max_memory);
@@ -275,7 +276,7 @@ int run_render(const RenderArgs& a) {
 
   // Load.
   const auto t_load = Clock::now();
-  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.max_memory, a.quiet, time);
+  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, a.max_memory, a.quiet, time);
   Scene& scene = loaded.scene;
   const double load_s = seconds_since(t_load);
 
@@ -305,9 +306,8 @@ int run_render(const RenderArgs& a) {
   cfg.whitted.ambient = ambient;
 
   // Build.
-  const auto views = mesh_views(scene);
   const auto t_build = Clock::now();
-  auto accel = make_accelerator(a.accel, views, accel_config);
+  auto accel = make_scene_accelerator(a.accel, scene, accel_config);
   const double build_s = seconds_since(t_build);
 
   if (!a.debug_pixel.empty()) {
@@ -351,13 +351,14 @@ int run_render(const RenderArgs& a) {
     const uint64_t total = stats.rays.total();
     std::fprintf(stderr,
                  "penumbra render %s\n"
-                 "  scene    %zu meshes, %s triangles, %zu materials, %zu lights%s\n"
+                 "  scene    %zu meshes in %zu instances, %s triangles (%s stored), %zu materials, %zu lights%s\n"
                  "  camera   %s (%s)\n"
                  "  image    %dx%d, %d spp, whitted max-depth %d, %d threads, accel %s\n"
                  "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
                  "  rays     camera %s  shadow %s  reflection %s  total %s  (%.2f Mrays/s)\n"
                  "  memory   peak %.1f MiB\n",
-                 a.scene_file.c_str(), scene.meshes.size(), human_count(count_triangles(scene)).c_str(),
+                 a.scene_file.c_str(), scene.meshes.size(), scene.instances.size(), human_count(count_triangles(scene)).c_str(),
+                 human_count(count_stored_triangles(scene)).c_str(),
                  scene.materials.size(), scene.lights.size(), default_light ? " (default key light)" : "",
                  camera.name.c_str(), camera.projection == Projection::Perspective ? "perspective" : "orthographic",
                  cfg.width, cfg.height, cfg.spp, cfg.whitted.max_depth, stats.threads, a.accel.c_str(),
@@ -372,10 +373,10 @@ int run_render(const RenderArgs& a) {
   return kExitOk;
 }
 
-int run_info(const std::string& file, int scene_index, bool allow_external, const std::string& accel_name,
+int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten, const std::string& accel_name,
              const std::vector<std::string>& accel_params) {
   const AccelConfig accel_config = parse_accel(accel_name, accel_params);
-  LoadedScene loaded = load_scene(file, scene_index, allow_external, "", false);
+  LoadedScene loaded = load_scene(file, scene_index, allow_external, flatten, "", false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
   std::printf("file         %s\n", file.c_str());
@@ -385,8 +386,11 @@ int run_info(const std::string& file, int scene_index, bool allow_external, cons
     std::printf("%s%d: %s%s", k ? ", " : " (", k, i.scene_names[size_t(k)].c_str(), k == i.scene_index ? " [rendered]" : "");
   std::printf("%s\n", i.scene_count ? ")" : "");
   std::printf("nodes        %d\n", i.node_count);
-  std::printf("meshes       %d (%d primitives); instantiated: %zu triangle meshes, %llu triangles\n", i.mesh_count,
-              i.primitive_count, s.meshes.size(), static_cast<unsigned long long>(count_triangles(s)));
+  std::printf("meshes       %d (%d primitives); stored: %zu triangle meshes, %llu triangles\n", i.mesh_count,
+              i.primitive_count, s.meshes.size(), static_cast<unsigned long long>(count_stored_triangles(s)));
+  const size_t placed = size_t(std::count_if(s.instances.begin(), s.instances.end(), [](const Instance& x) { return !x.identity; }));
+  std::printf("instances    %zu (%zu in world space, %zu placed by a transform), %llu triangles rendered\n",
+              s.instances.size(), s.instances.size() - placed, placed, static_cast<unsigned long long>(count_triangles(s)));
   std::printf("materials    %zu\n", s.materials.size());
   for (size_t k = 0; k < s.materials.size(); ++k) {
     const auto& m = s.materials[k];
@@ -403,7 +407,7 @@ int run_info(const std::string& file, int scene_index, bool allow_external, cons
     std::printf("  [%zu] %s: %s, intensity %.4g %s\n", k, l.name.c_str(), type, l.intensity,
                 l.type == LightType::Directional ? "lux" : "cd");
   }
-  std::printf("images       %d (textures not yet used by the renderer)\n", i.image_count);
+  std::printf("images       %d, %zu textures decoded\n", i.image_count, s.textures.size());
   std::printf("animations   %d\n", i.animation_count);
   auto join = [](const std::vector<std::string>& v) {
     std::string r;
@@ -416,12 +420,12 @@ int run_info(const std::string& file, int scene_index, bool allow_external, cons
     std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   else
     std::printf("bounds       empty\n");
-  const auto views = mesh_views(s);
-  auto accel = make_accelerator(accel_name, views, accel_config);
+  auto accel = make_scene_accelerator(accel_name, s, accel_config);
   const AccelStats st = accel->stats();
   std::printf("accelerator  %s%s%s%s\n", st.name.c_str(), st.config.empty() ? "" : " (", st.config.c_str(),
               st.config.empty() ? "" : ")");
   std::printf("  triangles  %llu\n", static_cast<unsigned long long>(st.triangles));
+  if (st.instances > 0) std::printf("  instances  %llu (two levels)\n", static_cast<unsigned long long>(st.instances));
   std::printf("  build      %.3f s\n", st.build_seconds);
   std::printf("  memory     %.2f MiB\n", double(st.bytes) / (1 << 20));
   if (st.nodes > 0) {
@@ -480,6 +484,7 @@ int main(int argc, char** argv) {
   render->add_option("--fps", r.fps, "frames per second for --frame (default 24)");
   render->add_option("--max-memory", r.max_memory, "budget for decoded geometry, e.g. 4G (default: half the RAM)");
   render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
+  render->add_flag("--flatten", r.flatten, "give every placement of a mesh its own world-space copy instead of instancing it");
   render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
   render->add_option("--aov", r.aovs,
@@ -491,13 +496,14 @@ int main(int argc, char** argv) {
   std::string info_file, info_accel = "embree";
   std::vector<std::string> info_accel_params;
   int info_scene = -1;
-  bool info_external = false;
+  bool info_external = false, info_flatten = false;
   auto* info = app.add_subcommand("info", "Describe a glTF scene: scenes, meshes, materials, cameras, lights, bounds");
   info->add_option("scene", info_file, "glTF scene (.gltf or .glb)")->required();
   info->add_option("--scene", info_scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
   info->add_option("--accel", info_accel, "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, brute");
   info->add_option("--accel-param", info_accel_params, accel_param_help())->type_name("KEY=VALUE");
   info->add_flag("--allow-external-uris", info_external, "let buffer URIs reach files outside the scene's folder");
+  info->add_flag("--flatten", info_flatten, "as for render: no instancing");
 
   try {
     app.parse(argc, argv);
@@ -508,7 +514,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*render) return run_render(r);
-    if (*info) return run_info(info_file, info_scene, info_external, info_accel, info_accel_params);
+    if (*info) return run_info(info_file, info_scene, info_external, info_flatten, info_accel, info_accel_params);
   } catch (const InputError& e) {
     std::fprintf(stderr, "penumbra: error: %s\n", e.what());
     return kExitInput;

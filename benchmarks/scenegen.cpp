@@ -95,10 +95,10 @@ int material(Scene& s, const char* name, Vec3f color, float metallic, float roug
 }
 
 Mesh& new_mesh(Scene& s, const char* name, int mat) {
-  s.meshes.emplace_back();
-  s.meshes.back().name = name;
-  s.meshes.back().material = mat;
-  return s.meshes.back();
+  Mesh m;
+  m.name = name;
+  m.material = mat;
+  return s.meshes[size_t(add_world_mesh(s, std::move(m)))];
 }
 
 Light point_light(const char* name, Vec3f p, float intensity, Vec3f color = {1, 1, 1}) {

@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> supported_gltf_extensions() {
   return {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit",
-          "KHR_texture_transform"};
+          "KHR_texture_transform", "EXT_mesh_gpu_instancing"};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {
@@ -267,7 +267,22 @@ class Converter {
   void validate_cameras();
   void validate_lights();
   void traverse(const std::vector<int>& roots);
-  void add_mesh(int mesh_index, int node, const Transform& world);
+  /// A node's mesh placed by `placements` (the node's world transform, or one per
+  /// EXT_mesh_gpu_instancing instance). shared: stored once in object space and instanced;
+  /// else one world-space copy per placement (skinned meshes always).
+  void add_mesh(int mesh_index, int node, const std::vector<Transform>& placements, bool shared);
+  /// Emits the usable primitives of a mesh (morphed, placed by `world` or skinned by the joint
+  /// matrices). object_ids == nullptr: world-space meshes with identity instances; else the
+  /// meshes are appended without instances and their indices recorded there.
+  void emit_primitives(int mesh_index, int node, const Transform& world, const std::vector<double>& morph,
+                       const std::vector<Transform>& joint_mats, std::vector<int>* object_ids);
+  /// EXT_mesh_gpu_instancing: world x T_i R_i S_i per instance, or {world} without the extension.
+  std::vector<Transform> placements_of(int node, const Transform& world);
+  struct MeshUse {
+    int mesh, node;
+  };
+  std::vector<MeshUse> m_mesh_uses;  // in traversal order
+  std::map<std::pair<int, std::vector<double>>, std::vector<int>> m_object_meshes;  // (mesh, morph) -> Scene::meshes
   void add_camera(int camera_index, int node, const Transform& world);
   void add_light(int light_index, int node, const Transform& world);
   Transform local_transform(int node);
@@ -909,7 +924,7 @@ void Converter::traverse(const std::vector<int>& roots) {
     if (!is_finite(world)) fail(idx("nodes", size_t(item.node)), "world transform overflows to non-finite values");
     m_world[size_t(item.node)] = world;
     m_has_world[size_t(item.node)] = 1;
-    if (node.mesh >= 0 || node.mesh < -1) add_mesh(node.mesh, item.node, world);
+    if (node.mesh >= 0 || node.mesh < -1) m_mesh_uses.push_back({node.mesh, item.node});
     if (node.camera >= 0 || node.camera < -1) add_camera(node.camera, item.node, world);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
       const auto& li = it->second.Get("light");
@@ -917,6 +932,19 @@ void Converter::traverse(const std::vector<int>& roots) {
       add_light(int(li.GetNumberAsInt()), item.node, world);
     }
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+  }
+  // Meshes placed more than once are stored once and instanced (unless flattening is asked
+  // for); a mesh placed once is put in world space, as Cycles applies the transform of a mesh
+  // with one user, so single-level scenes keep single-level structures.
+  std::vector<std::vector<Transform>> placements;
+  std::map<int, uint64_t> uses;
+  for (const MeshUse& u : m_mesh_uses) {
+    placements.push_back(placements_of(u.node, m_world[size_t(u.node)]));
+    if (u.mesh >= 0) uses[u.mesh] += placements.back().size();
+  }
+  for (size_t k = 0; k < m_mesh_uses.size(); ++k) {
+    const MeshUse& u = m_mesh_uses[k];
+    add_mesh(u.mesh, u.node, placements[k], !m_options.flatten && uses[u.mesh] > 1);
   }
 }
 
@@ -1086,18 +1114,12 @@ void Converter::decode_meshes() {
     for (size_t p = 0; p < m_model.meshes[m].primitives.size(); ++p) m_meshes[m].push_back(decode_primitive(m, p));
 }
 
-void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
+void Converter::add_mesh(int mesh_index, int node, const std::vector<Transform>& placements, bool shared) {
   const std::string node_where = idx("nodes", size_t(node));
   if (mesh_index < 0 || size_t(mesh_index) >= m_model.meshes.size())
     fail(node_where + ".mesh", "mesh index " + std::to_string(mesh_index) + " out of range (" +
                                    std::to_string(m_model.meshes.size()) + " meshes)");
   const auto& mesh = m_model.meshes[size_t(mesh_index)];
-  Transform inv;
-  if (!inverse(world, inv)) {
-    warn(node_where, "singular transform; mesh " + std::to_string(mesh_index) + " skipped");
-    return;
-  }
-  bool flip = determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
   const auto& gnode = m_model.nodes[size_t(node)];
   // Morph weights: animated, else the node's, else the mesh's defaults (glTF 3.7.2.2).
   std::vector<double> morph = mesh.weights;
@@ -1127,8 +1149,126 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
       if (!ibm.empty()) inv_bind = from_column_major(&ibm[k * 16]);
       joint_mats.push_back(world_of(j) * inv_bind);
     }
-    flip = determinant3x3(joint_mats[0]) < 0;
+    if (placements.size() != 1) warn(node_where, "EXT_mesh_gpu_instancing on a skinned mesh is ignored");
+    emit_primitives(mesh_index, node, m_world[size_t(node)], morph, joint_mats, nullptr);
+    return;
   }
+  uint64_t singular = 0;
+  if (!shared) {
+    for (const Transform& world : placements) {
+      Transform inv;
+      if (!inverse(world, inv)) {
+        ++singular;
+        continue;
+      }
+      emit_primitives(mesh_index, node, world, morph, {}, nullptr);
+    }
+  } else {
+    auto [it, inserted] = m_object_meshes.try_emplace({mesh_index, morph});
+    if (inserted) emit_primitives(mesh_index, -1, Transform{}, morph, {}, &it->second);
+    charge_memory(uint64_t(placements.size()) * it->second.size() * sizeof(Instance), node_where);
+    std::vector<Bounds3f> object_bounds;
+    for (int id : it->second) {
+      Bounds3f b;
+      for (Vec3f p : m_out.scene.meshes[size_t(id)].positions) b = merge(b, p);
+      object_bounds.push_back(b);
+    }
+    for (size_t k = 0; k < placements.size(); ++k) {
+      Instance inst;
+      try {
+        inst = make_instance(0, to_affine(placements[k]), node);
+      } catch (const std::invalid_argument&) {
+        ++singular;
+        continue;
+      }
+      inst.copy = gnode.extensions.count("EXT_mesh_gpu_instancing") ? int(k) : -1;
+      bool usable = true;  // world-space corners finite and not huge, as for flattened meshes
+      for (const Bounds3f& b : object_bounds) {
+        const Bounds3f w = transform_bounds(inst.to_world, b);
+        usable = usable && (b.empty() || (is_finite(w.lo) && is_finite(w.hi) &&
+                                          std::max(max_component(abs(w.lo)), max_component(abs(w.hi))) <= 1e18f));
+      }
+      if (!usable) {
+        ++singular;
+        continue;
+      }
+      for (int id : it->second) {
+        inst.mesh = id;
+        m_out.scene.instances.push_back(inst);
+      }
+    }
+  }
+  if (singular == 1 && placements.size() == 1)
+    warn(node_where, "singular, non-finite or huge transform; mesh " + std::to_string(mesh_index) + " skipped");
+  else if (singular > 0)
+    warn(node_where + ".extensions.EXT_mesh_gpu_instancing", std::to_string(singular) + " of " +
+                                                                 std::to_string(placements.size()) +
+                                                                 " instances have a singular, non-finite or huge transform; skipped");
+}
+
+std::vector<Transform> Converter::placements_of(int node, const Transform& world) {
+  const auto& gnode = m_model.nodes[size_t(node)];
+  const auto ext = gnode.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == gnode.extensions.end()) return {world};
+  const std::string where = idx("nodes", size_t(node)) + ".extensions.EXT_mesh_gpu_instancing";
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  // tinygltf stores an empty JSON object (and a missing member) as a null value.
+  if (attributes.Type() == tinygltf::NULL_TYPE) {
+    warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the mesh is placed once");
+    return {world};
+  }
+  if (!attributes.IsObject()) fail(where + ".attributes", "must be an object");
+  // TRANSLATION (VEC3 float), ROTATION (VEC4 float or normalized byte/short), SCALE (VEC3 float).
+  std::vector<double> values[3];
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  uint64_t count = 0;
+  std::string first;
+  for (int k = 0; k < 3; ++k) {
+    if (!attributes.Has(names[k])) continue;
+    const std::string aw = where + ".attributes." + names[k];
+    const tinygltf::Value& a = attributes.Get(names[k]);
+    if (!a.IsInt()) fail(aw, "must be an accessor index");
+    if (k == 1)
+      values[k] = read(a.Get<int>(), aw, {TINYGLTF_TYPE_VEC4},
+                       {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
+    else
+      values[k] = read(a.Get<int>(), aw, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    const uint64_t n = values[k].size() / (k == 1 ? 4 : 3);
+    if (!first.empty() && n != count)
+      fail(aw, "has " + std::to_string(n) + " elements but " + first + " has " + std::to_string(count) +
+                   " (all instance attributes must have the same count)");
+    if (first.empty()) first = names[k];
+    count = n;
+  }
+  for (const auto& key : attributes.Keys())
+    if (key != "TRANSLATION" && key != "ROTATION" && key != "SCALE" && (key.empty() || key[0] != '_'))
+      warn(where + ".attributes." + key, "unknown instance attribute; ignored");
+  if (first.empty()) {
+    warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the mesh is placed once");
+    return {world};
+  }
+  charge_memory(count * sizeof(Transform), where);
+  std::vector<Transform> out;
+  out.reserve(size_t(count));
+  for (size_t i = 0; i < count; ++i) {
+    std::array<double, 3> t{0, 0, 0}, sc{1, 1, 1};
+    Quat q;
+    if (!values[0].empty()) t = {values[0][3 * i], values[0][3 * i + 1], values[0][3 * i + 2]};
+    if (!values[1].empty()) q = {values[1][4 * i], values[1][4 * i + 1], values[1][4 * i + 2], values[1][4 * i + 3]};
+    if (!values[2].empty()) sc = {values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]};
+    out.push_back(world * compose_trs(t, q, sc));  // NodeWorldXform x InstanceXform
+  }
+  return out;
+}
+
+void Converter::emit_primitives(int mesh_index, int node, const Transform& world, const std::vector<double>& morph,
+                                const std::vector<Transform>& joint_mats, std::vector<int>* object_ids) {
+  const std::string node_where = node >= 0 ? idx("nodes", size_t(node)) : "object space (instanced mesh)";
+  const auto& mesh = m_model.meshes[size_t(mesh_index)];
+  Transform inv;
+  if (!inverse(world, inv)) return;  // callers skip singular placements
+  const bool flip = !joint_mats.empty() ? determinant3x3(joint_mats[0]) < 0
+                                        : determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
   for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
     const LocalPrimitive& local = m_meshes[size_t(mesh_index)][pi];
     if (!local.usable) continue;
@@ -1212,7 +1352,12 @@ void Converter::add_mesh(int mesh_index, int node, const Transform& world) {
         warn(where, "normal texture without TEXCOORD_" + std::to_string(nt.texcoord) + "; normal map ignored");
       }
     }
-    m_out.scene.meshes.push_back(std::move(out));
+    if (object_ids) {
+      object_ids->push_back(int(m_out.scene.meshes.size()));
+      m_out.scene.meshes.push_back(std::move(out));
+    } else {
+      add_world_mesh(m_out.scene, std::move(out));
+    }
   }
 }
 

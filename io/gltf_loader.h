@@ -27,6 +27,10 @@ struct GltfLoadOptions {
   /// follow their joints) are evaluated at this time before the scene is built. Unset: the
   /// file's static pose (no channel applied).
   std::optional<double> time;
+  /// true: every placement of a mesh gets its own world-space copy (no instancing). false: a
+  /// mesh placed more than once (by several nodes or EXT_mesh_gpu_instancing) is stored once
+  /// and instanced; a mesh placed once is put in world space either way.
+  bool flatten = false;
 };
 
 /// Descriptive facts about the file, for `penumbra info`.

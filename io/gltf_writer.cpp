@@ -85,6 +85,7 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
       }
     }
     if (m.alpha < 1) mat["alphaMode"] = "BLEND";
+    if (m.double_sided) mat["doubleSided"] = true;  // glTF's default is single-sided
     if (m.unlit) {
       mat["extensions"]["KHR_materials_unlit"] = json::object();
       unlit = true;
@@ -92,6 +93,7 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
     wr.j["materials"].push_back(mat);
   }
 
+  std::vector<int> gltf_mesh(scene.meshes.size(), -1);  // scene mesh -> glTF mesh (-1: empty)
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const std::string where = "meshes[" + std::to_string(mi) + "]";
@@ -122,7 +124,24 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
     json mesh = {{"primitives", {prim}}};
     if (!m.name.empty()) mesh["name"] = m.name;
     wr.j["meshes"].push_back(mesh);
-    add_root({{"mesh", wr.j["meshes"].size() - 1}, {"name", m.name.empty() ? where : m.name}});
+    gltf_mesh[mi] = int(wr.j["meshes"].size()) - 1;
+  }
+  // One node per instance; shared meshes stay shared, placements become node matrices.
+  for (size_t ii = 0; ii < scene.instances.size(); ++ii) {
+    const Instance& inst = scene.instances[ii];
+    if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())
+      throw InputError(wr.file, "instances[" + std::to_string(ii) + "]", "mesh " + std::to_string(inst.mesh) + " out of range");
+    if (gltf_mesh[size_t(inst.mesh)] < 0) continue;
+    const Mesh& m = scene.meshes[size_t(inst.mesh)];
+    json node = {{"mesh", gltf_mesh[size_t(inst.mesh)]},
+                 {"name", m.name.empty() ? "meshes[" + std::to_string(inst.mesh) + "]" : m.name}};
+    if (!inst.identity) {
+      json matrix = json::array();  // column-major
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) matrix.push_back(r < 3 ? inst.to_world.m[r][c] : (c == 3 ? 1.0f : 0.0f));
+      node["matrix"] = matrix;
+    }
+    add_root(node);
   }
 
   if (!scene.cameras.empty()) wr.j["cameras"] = json::array();

@@ -1,5 +1,5 @@
-// glTF 2.0 writing: a renderer Scene (world-space meshes, metallic-roughness factors, punctual
-// lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it. Used by
+// glTF 2.0 writing: a renderer Scene (meshes placed by instances, metallic-roughness factors,
+// punctual lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it. Used by
 // the benchmark scene generator and the PLY converter; load_gltf() reads the result back.
 #pragma once
 
@@ -10,12 +10,13 @@
 namespace penumbra {
 
 /// Writes `scene` to `file` (.gltf) and "<stem>.bin" in the same folder, both atomically
-/// (a failure leaves neither half-written). Each mesh becomes one node with one primitive
-/// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices); lights use
+/// (a failure leaves neither half-written). Each mesh becomes one glTF mesh with one primitive
+/// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices) and each instance one node
+/// using it (with a matrix unless the identity), so shared meshes stay shared; lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
 /// Throws InputError naming the file if it cannot be written or the scene cannot be expressed
 /// (a buffer over 4 GiB, an index out of range, an index count not a multiple of 3, a non-finite
-/// position).
+/// position, an instance of a mesh that does not exist).
 void write_gltf(const Scene& scene, const std::filesystem::path& file);
 
 }  // namespace penumbra

@@ -216,7 +216,7 @@ Scene load_ply(const std::filesystem::path& path) {
   }
   if (mesh.indices.empty()) throw InputError(file, "element face", "no triangles");
   mesh.normals = compute_smooth_normals(mesh.positions, mesh.indices);
-  scene.meshes.push_back(std::move(mesh));
+  add_world_mesh(scene, std::move(mesh));
   return scene;
 }
 

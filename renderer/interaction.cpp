@@ -4,21 +4,23 @@
 namespace penumbra {
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {
-  const Mesh& mesh = scene.meshes[hit.geom_id];
-  const size_t base = size_t(hit.prim_id) * 3;
-  const uint32_t i0 = mesh.indices[base], i1 = mesh.indices[base + 1], i2 = mesh.indices[base + 2];
+  const Instance& inst = scene.instances[hit.geom_id];
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const WorldTriangle tri = world_triangle(scene, inst, hit.prim_id);
+  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const float w = 1.0f - hit.u - hit.v;
-  const Vec3f a = mesh.positions[i0], b = mesh.positions[i1], c = mesh.positions[i2];
   SurfaceInteraction si;
-  si.mesh = hit.geom_id;
+  si.instance = hit.geom_id;
+  si.mesh = uint32_t(inst.mesh);
   si.prim = hit.prim_id;
-  si.p = a * w + b * hit.u + c * hit.v;
+  si.p = tri.p[0] * w + tri.p[1] * hit.u + tri.p[2] * hit.v;
   si.material = mesh.material;
-  si.ng = triangle_normal(a, b, c);
+  si.ng = tri.ng;
   if (!(dot(si.ng, si.ng) > 0)) si.ng = normalize(-ray.dir);
   Vec3f ns = si.ng;
   if (!mesh.normals.empty()) {
-    ns = normalize(mesh.normals[i0] * w + mesh.normals[i1] * hit.u + mesh.normals[i2] * hit.v);
+    ns = normalize(world_normal(inst, mesh.normals[i0]) * w + world_normal(inst, mesh.normals[i1]) * hit.u +
+                   world_normal(inst, mesh.normals[i2]) * hit.v);
     if (!(dot(ns, ns) > 0)) ns = si.ng;
   }
   auto lerp2 = [&](const std::vector<Vec2f>& t) -> Vec2f {
@@ -33,7 +35,12 @@ SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hi
   if (!mesh.colors.empty()) si.color = lerp4(mesh.colors);
   if (!mesh.tangents.empty()) {
     si.tangent = lerp4(mesh.tangents);
-    si.tangent.w = mesh.tangents[i0].w < 0 ? -1.0f : 1.0f;  // a sign, not an interpolant
+    // The bitangent sign is a sign, not an interpolant; a mirroring placement flips it.
+    si.tangent.w = (mesh.tangents[i0].w < 0) != inst.mirrored ? -1.0f : 1.0f;
+    if (!inst.identity) {
+      const Vec3f t = normalize(apply_vector(inst.to_world, {si.tangent.x, si.tangent.y, si.tangent.z}));
+      si.tangent = {t.x, t.y, t.z, si.tangent.w};
+    }
   }
   // Face-forward: both normals towards the viewer, so back faces shade like front faces.
   si.back_face = dot(si.ng, ray.dir) > 0;
@@ -58,10 +65,11 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
   si.dpdx = dpdx;
   si.dpdy = dpdy;
   // Barycentric derivatives: least-squares solve of dp = e1 db1 + e2 db2.
-  const Mesh& mesh = scene.meshes[si.mesh];
-  const size_t base = size_t(si.prim) * 3;
-  const uint32_t i0 = mesh.indices[base], i1 = mesh.indices[base + 1], i2 = mesh.indices[base + 2];
-  const Vec3f e1 = mesh.positions[i1] - mesh.positions[i0], e2 = mesh.positions[i2] - mesh.positions[i0];
+  const Instance& inst = scene.instances[si.instance];
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const WorldTriangle tri = world_triangle(scene, inst, si.prim);
+  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
+  const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
   const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);
   const float det = a11 * a22 - a12 * a12;
   if (!(det > 0) || !std::isfinite(det)) return;
@@ -83,7 +91,8 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
     si.duvdy[1] = deriv2(mesh.uvs1, by);
   }
   if (!mesh.normals.empty()) {
-    const Vec3f n1 = mesh.normals[i1] - mesh.normals[i0], n2 = mesh.normals[i2] - mesh.normals[i0];
+    const Vec3f n0 = world_normal(inst, mesh.normals[i0]);
+    const Vec3f n1 = world_normal(inst, mesh.normals[i1]) - n0, n2 = world_normal(inst, mesh.normals[i2]) - n0;
     const float s = si.back_face ? -1.0f : 1.0f;  // si.ns was face-forwarded
     si.dndx = (n1 * bx.x + n2 * bx.y) * s;
     si.dndy = (n1 * by.x + n2 * by.y) * s;

@@ -23,6 +23,7 @@ struct SurfaceInteraction {
   Vec4f color{1, 1, 1, 1};  ///< COLOR_0 (white if absent)
   Vec4f tangent;  ///< world tangent (xyz) and bitangent sign (w); w == 0 if the mesh has none
   int material = -1;
+  uint32_t instance = 0;  ///< index into Scene::instances (the Hit's geom_id)
   uint32_t mesh = 0, prim = 0;
   bool back_face = false;  ///< true if the ray hit the triangle's back (clockwise) side
   // Screen-space derivatives, zero unless compute_differentials() found a footprint.
@@ -32,7 +33,7 @@ struct SurfaceInteraction {
 };
 
 /// Requires hit.valid() and hit ids inside the scene (as any accelerator over mesh_views()
-/// returns).
+/// and instance_views() returns). Everything is in world space.
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit);
 
 /// Fills si's derivatives by intersecting the differential rays with the tangent plane at

@@ -66,8 +66,8 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
   return mp;
 }
 
-float eval_alpha(const Scene& scene, uint32_t mesh_index, uint32_t prim, float u, float v) {
-  const Mesh& mesh = scene.meshes[mesh_index];
+float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v) {
+  const Mesh& mesh = scene.meshes[size_t(scene.instances[instance].mesh)];
   const Material& mat = material_of(scene, mesh.material);
   if (mat.alpha_mode == AlphaMode::Opaque) return 1;
   const size_t base = size_t(prim) * 3;
@@ -88,8 +88,8 @@ float eval_alpha(const Scene& scene, uint32_t mesh_index, uint32_t prim, float u
 }
 
 bool scene_needs_hit_filter(const Scene& scene) {
-  for (const auto& mesh : scene.meshes) {
-    const Material& m = material_of(scene, mesh.material);
+  for (const auto& inst : scene.instances) {
+    const Material& m = material_of(scene, scene.meshes[size_t(inst.mesh)].material);
     if (m.alpha_mode != AlphaMode::Opaque || !m.double_sided) return true;
   }
   return false;
@@ -102,15 +102,10 @@ bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& 
   for (int layer = 0; layer < kMaxLayers; ++layer) {
     hit = Hit{};
     if (!accel.intersect(r, hit)) return false;
-    const Mesh& mesh = scene.meshes[hit.geom_id];
-    const Material& m = material_of(scene, mesh.material);
+    const Instance& inst = scene.instances[hit.geom_id];
+    const Material& m = material_of(scene, scene.meshes[size_t(inst.mesh)].material);
     bool skip = false;
-    if (!m.double_sided) {
-      const size_t base = size_t(hit.prim_id) * 3;
-      const Vec3f a = mesh.positions[mesh.indices[base]], b = mesh.positions[mesh.indices[base + 1]],
-                  c = mesh.positions[mesh.indices[base + 2]];
-      skip = dot(cross(b - a, c - a), r.dir) > 0;
-    }
+    if (!m.double_sided) skip = dot(world_triangle(scene, inst, hit.prim_id).ng, r.dir) > 0;
     if (!skip && m.alpha_mode == AlphaMode::Mask)
       skip = eval_alpha(scene, hit.geom_id, hit.prim_id, hit.u, hit.v) < 1;
     if (!skip) return true;

@@ -35,9 +35,9 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
 /// from compute_differentials are optional). Never allocates.
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si);
 
-/// Coverage of the surface at barycentrics (u, v) of triangle `prim` of mesh `mesh`: alpha
+/// Coverage of the surface at barycentrics (u, v) of triangle `prim` of instance `instance`: alpha
 /// factor x base colour texture alpha (finest level) x COLOR_0 alpha. 1 for Opaque materials.
-float eval_alpha(const Scene& scene, uint32_t mesh, uint32_t prim, float u, float v);
+float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v);
 
 /// Whether any material in the scene needs the filtered queries below (Mask, Blend or
 /// single-sided); when false they reduce to one accelerator call.

@@ -146,4 +146,45 @@ Vec3f transform_normal(const Transform& inv, Vec3f n) {
           float(m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z)};
 }
 
+bool is_identity(const Affine3f& a) {
+  const Affine3f id;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (a.m[r][c] != id.m[r][c]) return false;
+  return true;
+}
+
+Affine3f to_affine(const Transform& t) {
+  Affine3f a;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) a.m[r][c] = float(t.m[size_t(r)][size_t(c)]);
+  return a;
+}
+
+Transform to_transform(const Affine3f& a) {
+  Transform t;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) t.m[size_t(r)][size_t(c)] = a.m[r][c];
+  return t;
+}
+
+bool inverse(const Affine3f& a, Affine3f& out) {
+  Transform inv;
+  if (!inverse(to_transform(a), inv)) return false;
+  const Affine3f r = to_affine(inv);
+  for (const auto& row : r.m)
+    for (float v : row)
+      if (!std::isfinite(v)) return false;
+  out = r;
+  return true;
+}
+
+Bounds3f transform_bounds(const Affine3f& a, const Bounds3f& b) {
+  if (b.empty()) return b;
+  Bounds3f out;
+  for (int k = 0; k < 8; ++k)
+    out = merge(out, apply_point(a, {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}));
+  return out;
+}
+
 }  // namespace penumbra

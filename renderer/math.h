@@ -103,6 +103,38 @@ bool inverse(const Transform& t, Transform& out);
 Transform transpose(const Transform& t);
 bool is_finite(const Transform& t);
 
+/// Single-precision affine map p -> L p + t for kernels (instance placements): row-major 3x4,
+/// m[r][0..2] = L, m[r][3] = t. The default is the identity.
+struct Affine3f {
+  float m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
+};
+
+inline Vec3f apply_point(const Affine3f& a, Vec3f p) {
+  const auto& m = a.m;
+  return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+          m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+          m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
+}
+inline Vec3f apply_vector(const Affine3f& a, Vec3f v) {
+  const auto& m = a.m;
+  return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+}
+/// Normal transform L^-T n (unnormalised), given the inverse map.
+inline Vec3f apply_normal(const Affine3f& inverse, Vec3f n) {
+  const auto& m = inverse.m;
+  return {m[0][0] * n.x + m[1][0] * n.y + m[2][0] * n.z, m[0][1] * n.x + m[1][1] * n.y + m[2][1] * n.z,
+          m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z};
+}
+bool is_identity(const Affine3f& a);
+/// The top three rows of an affine Transform, rounded to float.
+Affine3f to_affine(const Transform& t);
+Transform to_transform(const Affine3f& a);
+/// Inverse computed in double and rounded; false (out untouched) if singular or not finite.
+bool inverse(const Affine3f& a, Affine3f& out);
+/// The box holding the image of `b` under `a` (its eight corners mapped); empty stays empty.
+Bounds3f transform_bounds(const Affine3f& a, const Bounds3f& b);
+
 Vec3f transform_point(const Transform& t, Vec3f p);
 Vec3f transform_vector(const Transform& t, Vec3f v);
 /// Transforms a normal by the inverse transpose of t's upper 3x3 (n' = M^-T n), unnormalised.

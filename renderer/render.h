@@ -34,7 +34,7 @@ struct RenderStats {
 using ProgressFn = std::function<void(int done, int total)>;
 
 /// Renders the scene with the Whitted integrator. Requires a valid config (width, height,
-/// spp, tile_size >= 1) and an accelerator built over mesh_views(scene).
+/// spp, tile_size >= 1) and an accelerator built over mesh_views(scene) and instance_views(scene).
 Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& camera,
                     const RenderConfig& config, RenderStats* stats = nullptr,
                     const ProgressFn& progress = {});

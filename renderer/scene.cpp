@@ -1,16 +1,56 @@
 // Scene helpers.
 #include "renderer/scene.h"
 
+#include <stdexcept>
+#include <string>
+
 namespace penumbra {
 
+Instance make_instance(int mesh, const Affine3f& to_world, int node) {
+  Instance inst;
+  inst.mesh = mesh;
+  inst.node = node;
+  inst.to_world = to_world;
+  inst.identity = is_identity(to_world);
+  if (!inverse(to_world, inst.to_object))
+    throw std::invalid_argument("instance of mesh " + std::to_string(mesh) + ": transform is singular or not finite");
+  inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
+  return inst;
+}
+
+int add_world_mesh(Scene& scene, Mesh mesh) {
+  const int index = int(scene.meshes.size());
+  Instance inst;
+  inst.mesh = index;
+  inst.node = mesh.node;
+  scene.meshes.push_back(std::move(mesh));
+  scene.instances.push_back(inst);
+  return index;
+}
+
 Bounds3f compute_bounds(const Scene& scene) {
+  std::vector<Bounds3f> mesh_bounds(scene.meshes.size());
+  for (size_t i = 0; i < scene.meshes.size(); ++i)
+    for (Vec3f p : scene.meshes[i].positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
   Bounds3f b;
-  for (const auto& m : scene.meshes)
-    for (Vec3f p : m.positions) b = merge(b, p);
+  for (const Instance& inst : scene.instances) {
+    const Mesh& m = scene.meshes[size_t(inst.mesh)];
+    if (inst.identity) {
+      b = merge(b, mesh_bounds[size_t(inst.mesh)]);
+    } else {
+      for (Vec3f p : m.positions) b = merge(b, apply_point(inst.to_world, p));
+    }
+  }
   return b;
 }
 
 uint64_t count_triangles(const Scene& scene) {
+  uint64_t n = 0;
+  for (const Instance& inst : scene.instances) n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  return n;
+}
+
+uint64_t count_stored_triangles(const Scene& scene) {
   uint64_t n = 0;
   for (const auto& m : scene.meshes) n += m.indices.size() / 3;
   return n;
@@ -21,6 +61,32 @@ std::vector<TriangleMeshView> mesh_views(const Scene& scene) {
   views.reserve(scene.meshes.size());
   for (const auto& m : scene.meshes) views.push_back({m.positions, m.indices});
   return views;
+}
+
+std::vector<InstanceView> instance_views(const Scene& scene) {
+  std::vector<InstanceView> views;
+  views.reserve(scene.instances.size());
+  for (const Instance& inst : scene.instances) views.push_back({uint32_t(inst.mesh), inst.to_world});
+  return views;
+}
+
+std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
+                                                    const AccelConfig& config) {
+  return make_accelerator(name, mesh_views(scene), instance_views(scene), config);
+}
+
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim) {
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const size_t base = size_t(prim) * 3;
+  WorldTriangle t;
+  for (int k = 0; k < 3; ++k) {
+    t.index[k] = mesh.indices[base + size_t(k)];
+    const Vec3f p = mesh.positions[t.index[k]];
+    t.p[k] = inst.identity ? p : apply_point(inst.to_world, p);
+  }
+  t.ng = triangle_normal(t.p[0], t.p[1], t.p[2]);
+  if (inst.mirrored) t.ng = -t.ng;
+  return t;
 }
 
 std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,

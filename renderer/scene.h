@@ -3,11 +3,14 @@
 // integrators. No behaviour here beyond small free functions.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/accel/factory.h"
 #include "renderer/math.h"
 #include "renderer/texture.h"
 
@@ -46,7 +49,8 @@ struct Material {
   TextureRef emissive_tex;            ///< RGB, multiplies emissive
 };
 
-/// A world-space triangle mesh (one glTF primitive instantiated by one node).
+/// A triangle mesh (one glTF primitive): in world space when its only instance is the identity
+/// (a flattened node), else in the object space its instances place.
 struct Mesh {
   std::string name;                ///< "meshName[prim]" for messages
   std::vector<Vec3f> positions;
@@ -58,7 +62,20 @@ struct Mesh {
   std::vector<Vec4f> colors;       ///< COLOR_0 as linear RGBA, empty if absent
   std::vector<uint32_t> indices;   ///< 3 per triangle, counter-clockwise = front
   int material = -1;               ///< index into Scene::materials, -1 = default material
-  int node = -1;                   ///< glTF node index, -1 if not from glTF
+  int node = -1;                   ///< glTF node of a flattened mesh, -1 if shared or not from glTF
+};
+
+/// One placement of a mesh in the world. A Hit's geom_id is an index into Scene::instances.
+/// Make them with make_instance() so the inverse and `mirrored` agree with `to_world`.
+struct Instance {
+  int mesh = 0;        ///< index into Scene::meshes
+  Affine3f to_world;   ///< object to world
+  Affine3f to_object;  ///< its inverse
+  bool identity = true;   ///< to_world is the identity (the mesh is in world space)
+  bool mirrored = false;  ///< det(to_world) < 0: the front face is clockwise in world space
+                          ///< (glTF 3.7.4), i.e. counter-clockwise in object space
+  int node = -1;          ///< glTF node, -1 if not from glTF
+  int copy = -1;          ///< EXT_mesh_gpu_instancing instance index within the node, else -1
 };
 
 enum class LightType { Point, Spot, Directional };
@@ -95,17 +112,48 @@ struct Camera {
 
 struct Scene {
   std::vector<Mesh> meshes;
+  std::vector<Instance> instances;  ///< what is rendered: a mesh without an instance is not
   std::vector<Material> materials;
   std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
 };
 
-/// World-space bounds of all mesh positions (empty box for an empty scene).
+/// An instance of `mesh` placed by `to_world`. Throws std::invalid_argument if the map is
+/// singular or not finite.
+Instance make_instance(int mesh, const Affine3f& to_world, int node = -1);
+/// Appends a world-space mesh with its identity instance; returns the mesh index.
+int add_world_mesh(Scene& scene, Mesh mesh);
+
+/// World-space bounds of every instance's positions (empty box for an empty scene).
 Bounds3f compute_bounds(const Scene& scene);
+/// Triangles rendered: each mesh counted once per instance.
 uint64_t count_triangles(const Scene& scene);
-/// Views of every mesh for make_accelerator(); geom_id == mesh index.
+/// Triangles stored: each mesh once.
+uint64_t count_stored_triangles(const Scene& scene);
+/// Views of every mesh and of every instance for make_accelerator(name, meshes, instances);
+/// geom_id in hits == instance index.
 std::vector<TriangleMeshView> mesh_views(const Scene& scene);
+std::vector<InstanceView> instance_views(const Scene& scene);
+
+/// make_accelerator(name, mesh_views(scene), instance_views(scene), config): the structure
+/// every integrator queries (geom_id = instance index). The scene must outlive it.
+std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
+                                                    const AccelConfig& config = {});
+
+/// Triangle `prim` of instance `inst` in world space: its vertex indices, its world positions
+/// and its unit front-facing geometric normal (counter-clockwise side in object space; zero if
+/// degenerate).
+struct WorldTriangle {
+  uint32_t index[3];
+  Vec3f p[3];
+  Vec3f ng;
+};
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim);
+/// World-space vertex normal: L^-T n, normalised (n itself for identity instances).
+inline Vec3f world_normal(const Instance& inst, Vec3f n) {
+  return inst.identity ? n : normalize(apply_normal(inst.to_object, n));
+}
 /// Area-weighted smooth vertex normals of an indexed triangle list (unit; a vertex used by no
 /// non-degenerate triangle gets +Z).
 std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,

@@ -6,7 +6,7 @@
 namespace penumbra::test {
 
 /// Adds an axis-aligned rectangle with normal +z (or -z if `flip`) at height z, spanning
-/// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index.
+/// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index (== its instance index when every mesh is added this way).
 inline int add_quad_z(Scene& s, float x0, float x1, float y0, float y1, float z, int material, bool flip = false) {
   Mesh m;
   m.name = "quad";
@@ -14,8 +14,7 @@ inline int add_quad_z(Scene& s, float x0, float x1, float y0, float y1, float z,
   m.indices = flip ? std::vector<uint32_t>{0, 2, 1, 0, 3, 2} : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
   m.normals = compute_smooth_normals(m.positions, m.indices);
   m.material = material;
-  s.meshes.push_back(std::move(m));
-  return int(s.meshes.size()) - 1;
+  return add_world_mesh(s, std::move(m));
 }
 
 /// Adds a rectangle in the plane x = const facing -x, spanning [y0, y1] x [z0, z1].
@@ -26,8 +25,24 @@ inline int add_quad_x(Scene& s, float x, float y0, float y1, float z0, float z1,
   m.indices = {0, 2, 1, 0, 3, 2};
   m.normals = compute_smooth_normals(m.positions, m.indices);
   m.material = material;
-  s.meshes.push_back(std::move(m));
-  return int(s.meshes.size()) - 1;
+  return add_world_mesh(s, std::move(m));
+}
+
+/// The mesh of instance `inst` in world space (positions, normals and tangents mapped, winding
+/// reversed for a mirroring placement): the copy the loader makes when it flattens.
+inline Mesh world_copy(const Scene& s, const Instance& inst) {
+  Mesh m = s.meshes[size_t(inst.mesh)];
+  if (inst.identity) return m;
+  for (Vec3f& p : m.positions) p = apply_point(inst.to_world, p);
+  for (Vec3f& n : m.normals) n = world_normal(inst, n);
+  for (Vec4f& t : m.tangents) {
+    const Vec3f v = normalize(apply_vector(inst.to_world, {t.x, t.y, t.z}));
+    t = {v.x, v.y, v.z, inst.mirrored ? -t.w : t.w};
+  }
+  if (inst.mirrored)
+    for (size_t i = 0; i + 2 < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
+  m.node = inst.node;
+  return m;
 }
 
 inline int add_material(Scene& s, Vec3f base, float metallic, float roughness, bool unlit = false) {

@@ -20,12 +20,23 @@ struct TriangleMeshView {
   std::span<const uint32_t> indices;  ///< 3 per triangle, each < positions.size()
 };
 
+/// One placement of a mesh: the mesh's triangles mapped by `to_world` (object to world space).
+/// Builders given instances report the instance's index as a Hit's geom_id. Instances with the
+/// identity map are built in world space directly; the others share one object-space structure
+/// per mesh under a top level over their world bounds (two-level instancing). An instance whose
+/// map is singular or not finite is never hit.
+struct InstanceView {
+  uint32_t mesh = 0;  ///< index into the mesh span given to the builder
+  Affine3f to_world;
+};
+
 /// Build and size statistics of an accelerator. Fields a back end cannot report are 0 (Embree
 /// does not expose its node counts). For the grid, "nodes" and "leaves" are cells.
 struct AccelStats {
   std::string name;
   std::string config;            ///< the build parameters, human readable
-  uint64_t triangles = 0;        ///< triangles given to the builder
+  uint64_t triangles = 0;        ///< triangles given to the builder (each stored mesh once)
+  uint64_t instances = 0;        ///< placements under a top level (0: single level)
   uint64_t nodes = 0;            ///< all nodes (interior + leaves), or grid cells
   uint64_t leaves = 0;           ///< leaves, or grid cells
   uint64_t empty_leaves = 0;     ///< leaves or cells with no triangle
@@ -33,7 +44,9 @@ struct AccelStats {
   uint64_t max_leaf_prims = 0;   ///< largest leaf or cell
   double avg_leaf_prims = 0;     ///< references / non-empty leaves
   uint64_t max_depth = 0;        ///< deepest leaf (root = depth 0)
-  double sah_cost = 0;           ///< SAH cost of the tree with the builder's constants (0: n/a)
+  double sah_cost = 0;           ///< SAH cost of the tree with the builder's constants (0: n/a);
+                                 ///< two levels: top nodes at 1 plus each instance's bottom cost
+                                 ///< weighted by the area of its world box
   uint64_t bytes = 0;            ///< memory held by the structure
   double build_seconds = 0;
 };

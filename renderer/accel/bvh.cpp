@@ -6,6 +6,7 @@
 // Dammertz, Hanika & Keller, "Shallow Bounding Volume Hierarchies for Fast SIMD Ray Tracing of
 // Incoherent Rays", EGSR 2008.
 #include "renderer/accel/bvh.h"
+#include "renderer/accel/bvh_build.h"
 
 #include <tbb/parallel_invoke.h>
 #include <xmmintrin.h>
@@ -21,18 +22,6 @@
 
 namespace penumbra {
 namespace {
-
-/// Flattened node, 32 bytes. Children of an interior node: the first is the next node in the
-/// array (depth-first order), the second is at `offset`.
-struct alignas(32) BvhNode {
-  Vec3f lo;         // 12 bytes: box minimum
-  Vec3f hi;         // 12 bytes: box maximum
-  uint32_t offset;  //  4 bytes: leaf: first triangle; interior: index of the second child
-  uint16_t count;   //  2 bytes: triangles in a leaf; 0 marks an interior node
-  uint8_t axis;     //  1 byte : split axis of an interior node (visit order)
-  uint8_t pad;      //  1 byte : unused
-};
-static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
 
 /// 4-wide node, 128 bytes (two cache lines), boxes in structure-of-arrays form so one SSE
 /// register holds the same bound of all four children. Unused slots have an empty box
@@ -50,31 +39,17 @@ static_assert(sizeof(Bvh4Node) == 128, "Bvh4Node must stay 128 bytes");
 /// pops, and the collapsed tree is no deeper than the binary one (< kStackSize levels).
 constexpr int kStack4Size = 3 * 128 + 4;
 
-// Build-time types stay in this file.
-struct BuildRef {  // one triangle's bounds and centroid: all the builder ever sees
-  Bounds3f box;
-  Vec3f centroid;
-  uint32_t index;  // into the triangle array
-};
-
-struct BuildNode {
-  Bounds3f box;
-  std::unique_ptr<BuildNode> child[2];
-  uint32_t first = 0, count = 0;  // leaf range in the reordered reference array
-  int axis = 0;
-};
-
 /// SAH depth limit: below it, splits fall back to the object median, which bounds the
 /// remaining depth by log2(n) and keeps every path within kStackSize.
 constexpr int kMaxSahDepth = 64;
-constexpr int kStackSize = 128;
+constexpr int kStackSize = kBvhStackSize;
 
 class Builder {
  public:
-  Builder(const BvhConfig& c, std::vector<BuildRef>& refs) : m_config(c), m_refs(refs) {}
+  Builder(const BvhConfig& c, std::vector<BvhBuildRef>& refs) : m_config(c), m_refs(refs) {}
 
-  std::unique_ptr<BuildNode> build(uint32_t begin, uint32_t end, int depth) {
-    auto node = std::make_unique<BuildNode>();
+  std::unique_ptr<BvhBuildNode> build(uint32_t begin, uint32_t end, int depth) {
+    auto node = std::make_unique<BvhBuildNode>();
     Bounds3f box, centroids;
     for (uint32_t i = begin; i < end; ++i) {
       box = merge(box, m_refs[i].box);
@@ -99,7 +74,7 @@ class Builder {
       axis = ext.x >= ext.y ? (ext.x >= ext.z ? 0 : 2) : (ext.y >= ext.z ? 1 : 2);
       mid = begin + n / 2;
       std::nth_element(m_refs.begin() + begin, m_refs.begin() + mid, m_refs.begin() + end,
-                       [axis](const BuildRef& a, const BuildRef& b) {
+                       [axis](const BvhBuildRef& a, const BvhBuildRef& b) {
                          return a.centroid[axis] < b.centroid[axis] ||
                                 (a.centroid[axis] == b.centroid[axis] && a.index < b.index);
                        });
@@ -117,7 +92,7 @@ class Builder {
   }
 
  private:
-  static std::unique_ptr<BuildNode> make_leaf(std::unique_ptr<BuildNode> node, uint32_t begin,
+  static std::unique_ptr<BvhBuildNode> make_leaf(std::unique_ptr<BvhBuildNode> node, uint32_t begin,
                                               uint32_t n) {
     node->first = begin;
     node->count = n;
@@ -185,7 +160,7 @@ class Builder {
     const float scale = nb * (1 - 1e-6f) / ext[best_axis];
     const float cmin = centroids.lo[best_axis];
     const int axis = best_axis;
-    auto it = std::stable_partition(m_refs.begin() + begin, m_refs.begin() + end, [&](const BuildRef& r) {
+    auto it = std::stable_partition(m_refs.begin() + begin, m_refs.begin() + end, [&](const BvhBuildRef& r) {
       return bin_index(r.centroid[axis], cmin, scale, nb) <= best_bin;
     });
     mid = uint32_t(it - m_refs.begin());
@@ -198,8 +173,31 @@ class Builder {
   }
 
   const BvhConfig& m_config;
-  std::vector<BuildRef>& m_refs;
+  std::vector<BvhBuildRef>& m_refs;
 };
+
+}  // namespace
+
+std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config) {
+  Builder builder(config, refs);
+  return builder.build(0, uint32_t(refs.size()), 0);
+}
+
+uint32_t flatten_bvh(const BvhBuildNode& b, std::vector<BvhNode>& nodes) {
+  const uint32_t idx = uint32_t(nodes.size());
+  const Bounds3f box = widen_for_rounding(b.box);
+  nodes.push_back({box.lo, box.hi, 0, 0, uint8_t(b.axis), 0});
+  if (!b.child[0]) {
+    nodes[idx].offset = b.first;
+    nodes[idx].count = uint16_t(b.count);
+    return idx;
+  }
+  flatten_bvh(*b.child[0], nodes);
+  nodes[idx].offset = flatten_bvh(*b.child[1], nodes);
+  return idx;
+}
+
+namespace {
 
 class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   friend class TraversalAccelerator<BvhAccelerator>;
@@ -211,20 +209,19 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     std::vector<TriangleRecord> tris = gather_triangles(meshes);
     m_input_triangles = count_input_triangles(meshes);
     if (!tris.empty()) {
-      std::vector<BuildRef> refs(tris.size());
+      std::vector<BvhBuildRef> refs(tris.size());
       for (uint32_t i = 0; i < tris.size(); ++i) {
         const Bounds3f b = triangle_bounds(tris[i]);
         refs[i] = {b, b.center(), i};
       }
-      Builder builder(m_config, refs);
-      auto root = builder.build(0, uint32_t(refs.size()), 0);
+      auto root = build_bvh_tree(refs, m_config);
       // Reorder the triangles so each leaf is a contiguous range.
       m_tris.resize(tris.size());
       for (size_t i = 0; i < refs.size(); ++i) m_tris[i] = tris[refs[i].index];
       m_bounds = root->box;
       m_sah_root_area = surface_area(root->box);
       if (m_config.width == 2) {
-        flatten(*root);
+        flatten_bvh(*root, m_nodes);
         compute_stats(*root, 0);
       } else {
         collapse(*root, 0);
@@ -377,42 +374,13 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   template <typename Visit, typename Counter>
   bool traverse2(const Ray& ray, const float& best, Visit& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid || m_nodes.empty()) return false;
-    const RayBoxQuery q = prepare_box_query(ray);
-    uint32_t stack[kStackSize];
-    int sp = 0;
-    uint32_t idx = 0;
-    for (;;) {
-      const BvhNode& node = m_nodes[idx];
-      counter.node();
-      float t0 = w.tnear, t1 = best;
-      if (intersect_box(node.lo, node.hi, q, t0, t1)) {
-        if (node.count == 0) {
-          const bool far_first = q.dir_neg[node.axis];
-          stack[sp++] = far_first ? idx + 1 : node.offset;
-          idx = far_first ? node.offset : idx + 1;
-          continue;
-        }
-        for (uint32_t i = node.offset, e = node.offset + node.count; i < e; ++i)
-          if (visit(w, m_tris[i])) return true;
-      }
-      if (sp == 0) return false;
-      idx = stack[--sp];
-    }
-  }
-
-  uint32_t flatten(const BuildNode& b) {
-    const uint32_t idx = uint32_t(m_nodes.size());
-    const Bounds3f box = widen_for_rounding(b.box);
-    m_nodes.push_back({box.lo, box.hi, 0, 0, uint8_t(b.axis), 0});
-    if (!b.child[0]) {
-      m_nodes[idx].offset = b.first;
-      m_nodes[idx].count = uint16_t(b.count);
-      return idx;
-    }
-    flatten(*b.child[0]);
-    m_nodes[idx].offset = flatten(*b.child[1]);
-    return idx;
+    if (!w.valid) return false;
+    return walk_bvh(m_nodes, prepare_box_query(ray), w.tnear, best, [&] { counter.node(); },
+                    [&](uint32_t first, uint32_t count) {
+                      for (uint32_t i = first, e = first + count; i < e; ++i)
+                        if (visit(w, m_tris[i])) return true;
+                      return false;
+                    });
   }
 
   /// Emits the 4-wide node for interior binary node `b`: its children, with the interior child
@@ -421,12 +389,12 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   /// A node's interior children are stored next to each other (one block per parent), so
   /// siblings share pages and the hardware prefetcher's adjacent lines. Writes node `idx`
   /// (the root: 0, allocated here).
-  void collapse(const BuildNode& b, uint64_t depth, uint32_t idx = 0) {
+  void collapse(const BvhBuildNode& b, uint64_t depth, uint32_t idx = 0) {
     if (m_nodes4.empty()) m_nodes4.emplace_back();
     m_stats.max_depth = std::max(m_stats.max_depth, depth);
     const double rel = m_sah_root_area > 0 ? surface_area(b.box) / m_sah_root_area : 1.0;
     m_stats.sah_cost += rel * m_config.traversal_cost;
-    const BuildNode* kids[4];
+    const BvhBuildNode* kids[4];
     int n = 0;
     if (!b.child[0]) {
       kids[n++] = &b;  // the root is a leaf: one slot
@@ -443,7 +411,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
           open = i;
         }
       if (open < 0) break;
-      const BuildNode* o = kids[open];
+      const BvhBuildNode* o = kids[open];
       kids[open] = o->child[0].get();
       kids[n++] = o->child[1].get();
     }
@@ -477,7 +445,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     }
   }
 
-  void compute_stats(const BuildNode& b, uint64_t depth) {
+  void compute_stats(const BvhBuildNode& b, uint64_t depth) {
     m_stats.max_depth = std::max(m_stats.max_depth, depth);
     const double rel = m_sah_root_area > 0 ? surface_area(b.box) / m_sah_root_area : 1.0;
     if (!b.child[0]) {

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace penumbra {
 namespace {
@@ -68,42 +69,78 @@ void throw_if_error(const char* what) {
   if (!e.empty()) throw std::runtime_error(std::string("embree: ") + what + ": " + e);
 }
 
+/// A new triangle geometry holding a copy of `mesh` (an empty mesh gets one degenerate triangle,
+/// which is never hit, so it still occupies its id), committed and attached to `scene` as `id`.
+void attach_triangles(RTCScene scene, const TriangleMeshView& mesh, unsigned id) {
+  RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_TRIANGLE);
+  const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, nv ? nv : 1));
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, nt ? nt : 1));
+  if (!v || !idx) {
+    rtcReleaseGeometry(geom);
+    throw_if_error("allocating geometry buffers");
+    throw std::runtime_error("embree: allocating geometry buffers failed");
+  }
+  if (nv) std::memcpy(v, mesh.positions.data(), nv * sizeof(float) * 3);
+  if (nt) {
+    std::memcpy(idx, mesh.indices.data(), nt * sizeof(uint32_t) * 3);
+  } else {
+    std::memset(v, 0, sizeof(float) * 3);
+    std::memset(idx, 0, sizeof(uint32_t) * 3);
+  }
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene, geom, id);
+  rtcReleaseGeometry(geom);
+  throw_if_error("attaching geometry");
+}
+
 class EmbreeAccelerator final : public Accelerator {
  public:
-  EmbreeAccelerator(std::span<const TriangleMeshView> meshes, const EmbreeConfig& config) : m_config(config) {
+  /// Identity instances become triangle geometries of the top scene; every other instance is an
+  /// Embree instance of a per-mesh scene. Geometry id in the top scene == instance index.
+  EmbreeAccelerator(std::span<const TriangleMeshView> meshes, std::span<const InstanceView> instances,
+                    const EmbreeConfig& config)
+      : m_config(config) {
     validate(config);
     const auto t0 = std::chrono::steady_clock::now();
-    RTCDevice dev = device();
     const int64_t bytes_before = device_bytes();
     take_error();
-    m_scene = rtcNewScene(dev);
-    throw_if_error("rtcNewScene");
-    if (config.robust) rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
-    const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH};
-    rtcSetSceneBuildQuality(m_scene, quality[config.quality]);
-    for (size_t i = 0; i < meshes.size(); ++i) {
-      const TriangleMeshView& mesh = meshes[i];
-      RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-      const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
-      // Embree wants at least one element per buffer; an empty mesh still occupies its id.
-      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-          geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, nv ? nv : 1));
-      auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, nt ? nt : 1));
-      throw_if_error("allocating geometry buffers");
-      if (nv) std::memcpy(v, mesh.positions.data(), nv * sizeof(float) * 3);
-      if (nt) {
-        std::memcpy(idx, mesh.indices.data(), nt * sizeof(uint32_t) * 3);
-      } else {
-        std::memset(v, 0, sizeof(float) * 3);
-        std::memset(idx, 0, sizeof(uint32_t) * 3);  // one degenerate triangle: never hit
+    m_scene = new_scene();
+    std::vector<RTCScene> objects(meshes.size(), nullptr);
+    for (size_t i = 0; i < instances.size(); ++i) {
+      const InstanceView& inst = instances[i];
+      const TriangleMeshView& mesh = meshes[inst.mesh];
+      const unsigned id = unsigned(i);
+      Affine3f inverse_map;
+      if (is_identity(inst.to_world)) {
+        attach_triangles(m_scene, mesh, id);
+        m_triangles += mesh.indices.size() / 3;
+        continue;
       }
+      if (!inverse(inst.to_world, inverse_map)) {  // singular: an empty mesh keeps the id
+        attach_triangles(m_scene, TriangleMeshView{}, id);
+        continue;
+      }
+      RTCScene& object = objects[inst.mesh];
+      if (!object) {
+        object = new_scene();
+        m_objects.push_back(object);
+        attach_triangles(object, mesh, 0);
+        rtcCommitScene(object);
+        throw_if_error("building an instanced mesh (rtcCommitScene)");
+        m_triangles += mesh.indices.size() / 3;
+      }
+      RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, object);
+      rtcSetGeometryTimeStepCount(geom, 1);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &inst.to_world.m[0][0]);
       rtcCommitGeometry(geom);
-      const unsigned id = rtcAttachGeometry(m_scene, geom);
+      rtcAttachGeometryByID(m_scene, geom, id);
       rtcReleaseGeometry(geom);
-      throw_if_error("attaching geometry");
-      if (id != i) throw std::runtime_error("embree: unexpected geometry id");
-      m_triangles += nt;
+      throw_if_error("attaching an instance");
+      ++m_instances;
     }
     rtcCommitScene(m_scene);
     throw_if_error("building the scene (rtcCommitScene)");
@@ -116,6 +153,7 @@ class EmbreeAccelerator final : public Accelerator {
 
   ~EmbreeAccelerator() override {
     if (m_scene) rtcReleaseScene(m_scene);
+    for (RTCScene object : m_objects) rtcReleaseScene(object);
   }
   EmbreeAccelerator(const EmbreeAccelerator&) = delete;
   EmbreeAccelerator& operator=(const EmbreeAccelerator&) = delete;
@@ -134,7 +172,7 @@ class EmbreeAccelerator final : public Accelerator {
     hit.t = rh.ray.tfar;
     hit.u = rh.hit.u;
     hit.v = rh.hit.v;
-    hit.geom_id = rh.hit.geomID;
+    hit.geom_id = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
     hit.prim_id = rh.hit.primID;
     return true;
   }
@@ -157,6 +195,7 @@ class EmbreeAccelerator final : public Accelerator {
     s.config = std::string("robust ") + (m_config.robust ? "1" : "0") + ", quality " +
                (m_config.quality == 0 ? "low" : m_config.quality == 1 ? "medium" : "high");
     s.triangles = m_triangles;
+    s.instances = m_instances;
     s.bytes = m_bytes;
     s.build_seconds = m_build_seconds;
     return s;
@@ -182,10 +221,22 @@ class EmbreeAccelerator final : public Accelerator {
     r.flags = 0;
   }
 
+  /// A new scene with the configured flags and build quality (objects and the top level alike).
+  RTCScene new_scene() const {
+    RTCScene scene = rtcNewScene(device());
+    throw_if_error("rtcNewScene");
+    if (m_config.robust) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH};
+    rtcSetSceneBuildQuality(scene, quality[m_config.quality]);
+    return scene;
+  }
+
   EmbreeConfig m_config;
   RTCScene m_scene = nullptr;
+  std::vector<RTCScene> m_objects;  // per-mesh scenes of the instances
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
+  uint64_t m_instances = 0;
   uint64_t m_bytes = 0;
   double m_build_seconds = 0;
 };
@@ -199,7 +250,15 @@ void validate(const EmbreeConfig& c) {
 
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
                                                      const EmbreeConfig& config) {
-  return std::make_unique<EmbreeAccelerator>(meshes, config);
+  std::vector<InstanceView> instances(meshes.size());
+  for (size_t i = 0; i < meshes.size(); ++i) instances[i].mesh = uint32_t(i);
+  return std::make_unique<EmbreeAccelerator>(meshes, instances, config);
+}
+
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     std::span<const InstanceView> instances,
+                                                     const EmbreeConfig& config) {
+  return std::make_unique<EmbreeAccelerator>(meshes, instances, config);
 }
 
 std::string embree_version() {

@@ -1,5 +1,6 @@
 // Embree 3 back end of the Accelerator interface: one RTCDevice per process, one triangle
-// geometry per mesh (geometry id == mesh index); by default the robust scene flag and medium
+// geometry per mesh (geometry id == mesh index) or per identity instance, Embree instances for
+// the other placements; by default the robust scene flag and medium
 // build quality (EmbreeConfig).
 #pragma once
 
@@ -23,6 +24,14 @@ void validate(const EmbreeConfig& config);
 /// Builds an Embree scene over the meshes (data is copied into Embree-owned buffers).
 /// Throws std::runtime_error with Embree's message if the device or build fails.
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     const EmbreeConfig& config = {});
+
+/// Builds an Embree scene over placements of the meshes (geom_id in a Hit = instance index):
+/// identity placements as triangle geometries of the top scene, the others as Embree instances
+/// (RTC_GEOMETRY_TYPE_INSTANCE) of one scene per mesh. Instance mesh indices must be valid
+/// (the factory checks them).
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+                                                     std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config = {});
 
 /// The process-wide Embree device's version string (e.g. "3.13.5").

@@ -35,4 +35,15 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
                                               std::span<const TriangleMeshView> meshes,
                                               const AccelConfig& config = {});
 
+/// Builds the named back end over placements of `meshes`; a Hit's geom_id is the instance index.
+/// Embree uses its own instances; the other back ends go through the two-level wrapper of
+/// accel/instances.h with one structure of that back end per level. When every instance is the
+/// identity (a flattened scene) this is exactly the single-level build over the instances'
+/// meshes. Throws as above, and std::invalid_argument if an instance names a mesh outside
+/// `meshes`.
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
+                                              std::span<const TriangleMeshView> meshes,
+                                              std::span<const InstanceView> instances,
+                                              const AccelConfig& config = {});
+
 }  // namespace penumbra

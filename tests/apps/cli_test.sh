@@ -63,6 +63,15 @@ if command -v oiiotool >/dev/null; then
   done
 fi
 expect 0 "SAH cost" -- "$bin" info "$src/scenes/default.gltf" --accel bvh
+# Instancing: the default scene's "wall" mesh (floor, ceiling, front wall) is stored once; --flatten
+# gives each node its own world-space copy, and both render the same image.
+expect 0 "instances    11 \(8 in world space, 3 placed by a transform\)" -- "$bin" info "$src/scenes/default.gltf"
+expect 0 "instances  3 \(two levels\)" -- "$bin" info "$src/scenes/default.gltf" --accel kdtree
+expect 0 "instances    11 \(11 in world space, 0 placed" -- "$bin" info "$src/scenes/default.gltf" --flatten
+expect 0 "accel bvh" -- "$bin" render "$src/scenes/default.gltf" -o "$work/flat.exr" --width 48 --spp 1 --no-png --accel bvh --flatten
+if command -v oiiotool >/dev/null; then
+  expect 0 "PASS" -- oiiotool "$work/acc-bvh.exr" "$work/flat.exr" --warn 0.004 --fail 0.004 --diff
+fi
 expect 0 "max_leaf_size 2, bin_count 32" -- "$bin" info "$src/scenes/default.gltf" --accel bvh --accel-param bvh.max_leaf_size=2 --accel-param bvh.bin_count=32
 expect 0 "empty .* leaves" -- "$bin" info "$src/scenes/default.gltf" --accel kdtree
 # Traversal-cost AOV: EXR channels and a heat map (time for Embree, which keeps no counts);

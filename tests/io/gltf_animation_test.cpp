@@ -7,6 +7,7 @@
 #include "gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
+#include "scene_builder.h"
 #include "test_util.h"
 
 using namespace penumbra;
@@ -29,11 +30,12 @@ void channel(test::GltfWriter& w, int node, const char* path, const std::vector<
   a["channels"].push_back({{"sampler", int(a["samplers"].size()) - 1}, {"target", {{"node", node}, {"path", path}}}});
 }
 
-const Mesh& mesh_of_node(const Scene& s, int node) {
-  for (const auto& m : s.meshes)
-    if (m.node == node) return m;
+/// The world-space mesh a node places (its first instance).
+Mesh mesh_of_node(const Scene& s, int node) {
+  for (const auto& inst : s.instances)
+    if (inst.node == node) return test::world_copy(s, inst);
   FAIL("no mesh for node " << node);
-  return s.meshes[0];
+  return {};
 }
 
 // A file with one triangle mesh (with a +z morph target) used by several animated nodes, and a

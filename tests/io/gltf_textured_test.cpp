@@ -68,7 +68,7 @@ FrontView front_albedo(const std::filesystem::path& file, int width = 480) {
   cfg.spp = 4;
   cfg.whitted.ambient = {1, 1, 1};
   cfg.whitted.max_depth = 0;
-  const auto accel = make_accelerator("embree", mesh_views(s));
+  const auto accel = make_scene_accelerator("embree", s);
   v.film = render_whitted(s, *accel, cam, cfg);
   if (const char* dir = std::getenv("PENUMBRA_TEST_DUMP"))  // for looking at what a test sees
     write_exr(v.film, std::filesystem::path(dir) / (file.stem().string() + ".exr"), ExrOptions{});
@@ -180,7 +180,7 @@ TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCO
   CHECK(m.base_color_tex.texcoord == 0);
   // At every vertex-centred sample the evaluated emission equals the emissive texture read at
   // TEXCOORD_1, and somewhere differs from a read at TEXCOORD_0.
-  const auto accel = make_accelerator("embree", mesh_views(s));
+  const auto accel = make_scene_accelerator("embree", s);
   int differs = 0, samples = 0;
   for (int i = 0; i < 40; ++i) {
     Ray r;

@@ -43,7 +43,7 @@ Scene sample_scene() {
   Mesh c = b;
   c.material = 2;
   for (auto& p : c.positions) p.z = -3;
-  s.meshes = {a, b, c};
+  for (Mesh* m : {&a, &b, &c}) add_world_mesh(s, std::move(*m));
   Light point;
   point.type = LightType::Point;
   point.position = {1, 2, 3};

@@ -41,7 +41,7 @@ int add_uv_quad(Scene& s, float z, int material, bool flip = false) {
 struct Probe {
   Scene scene;
   std::unique_ptr<Accelerator> accel;
-  void build() { accel = make_accelerator("embree", mesh_views(scene)); }
+  void build() { accel = make_scene_accelerator("embree", scene); }
   // Material at the first visible surface straight down at (x, y).
   MaterialPoint at(float x, float y, Hit* out = nullptr) {
     Ray r;
@@ -89,7 +89,7 @@ TEST_CASE("material: COLOR_0 multiplies base colour and alpha; metallic-roughnes
   Probe p;
   const int mat = add_material(p.scene, {0.5f, 0.5f, 0.5f}, 0.8f, 0.6f);
   const int id = add_uv_quad(p.scene, 0, mat);
-  for (auto& c : p.scene.meshes[size_t(id)].positions) p.scene.meshes[size_t(id)].colors.push_back({1, 0.5f, 0.25f, 0.5f});
+  for ([[maybe_unused]] auto& c : p.scene.meshes[size_t(id)].positions) p.scene.meshes[size_t(id)].colors.push_back({1, 0.5f, 0.25f, 0.5f});
   std::vector<float> mr = {0, 0.5f, 0.25f, 1};  // 1x1: G = roughness 0.5, B = metallic 0.25
   p.scene.textures.push_back(make_texture("mr", 1, 1, mr, {}));
   p.scene.materials[size_t(mat)].metallic_roughness_tex.texture = 0;
@@ -205,7 +205,7 @@ TEST_CASE("material: Whitted composites Blend layers front to back (a c + (1 - a
   const int back = add_material(s, {0, 0, 1}, 0, 1, true);
   add_quad_z(s, -1, 1, -1, 1, 1, front);
   add_quad_z(s, -1, 1, -1, 1, 0, back);
-  auto accel = make_accelerator("embree", mesh_views(s));
+  auto accel = make_scene_accelerator("embree", s);
   WhittedConfig cfg;
   cfg.background = {0, 1, 0};
   Ray r;
@@ -219,7 +219,8 @@ TEST_CASE("material: Whitted composites Blend layers front to back (a c + (1 - a
   CHECK(coverage == Approx(1));
   // Without the back quad, the background shows through and coverage is the layer's alpha.
   s.meshes.pop_back();
-  accel = make_accelerator("embree", mesh_views(s));
+  s.instances.pop_back();
+  accel = make_scene_accelerator("embree", s);
   L = whitted_radiance(s, *accel, cfg, r, RayDifferential{}, coverage, counts);
   CHECK(L.y == Approx(0.75));
   CHECK(coverage == Approx(0.25));

@@ -15,8 +15,7 @@ using namespace penumbra;
 
 TEST_CASE("the image is bit-identical for 1, 2 and 3 threads", "[render]") {
   LoadedScene loaded = load_gltf(test::source_dir() / "scenes/default.gltf");
-  const auto views = mesh_views(loaded.scene);
-  const auto accel = make_accelerator("embree", views);
+  const auto accel = make_scene_accelerator("embree", loaded.scene);
   RenderConfig cfg;
   cfg.width = 96;
   cfg.height = 54;
@@ -55,8 +54,7 @@ TEST_CASE("alpha is pixel coverage and colour is premultiplied", "[render][quick
   Camera cam = look_at({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 1);
   cam.projection = Projection::Orthographic;
   cam.ymag = 1;
-  const auto views = mesh_views(s);
-  const auto accel = make_accelerator("embree", views);
+  const auto accel = make_scene_accelerator("embree", s);
   RenderConfig cfg;
   cfg.width = 20;
   cfg.height = 20;

@@ -11,8 +11,7 @@ using namespace penumbra::test;
 
 namespace {
 Vec3f shade(const Scene& s, const WhittedConfig& cfg, const Ray& r, float& coverage, RayCounts& counts) {
-  const auto views = mesh_views(s);
-  const auto accel = make_accelerator("embree", views);
+  const auto accel = make_scene_accelerator("embree", s);
   return whitted_radiance(s, *accel, cfg, r, RayDifferential{}, coverage, counts);
 }
 }  // namespace
@@ -88,6 +87,7 @@ TEST_CASE("a point in shadow gets ambient only, counted once for all lights", "[
   CHECK(counts.shadow == 2);
   // Remove the occluder: now the lights add to the same ambient.
   s.meshes.pop_back();
+  s.instances.pop_back();
   const Vec3f lit = shade(s, cfg, r, coverage, counts);
   CHECK(lit.x > L.x + 0.1f);
 }

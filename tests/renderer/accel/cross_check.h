@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <map>
 #include <random>
 #include <span>
 #include <string>
@@ -427,6 +428,125 @@ inline void check_scene(const std::string& scene, std::span<const TriangleMeshVi
   std::vector<Ray> rays = all_rays(*embree, views, b, lights, scale, 20261122u);
   rays.insert(rays.end(), extra.begin(), extra.end());
   check_all(scene, views, rays);
+}
+
+// ---- Synthetic geometry -------------------------------------------------------------------------
+
+/// Owns the geometry of a synthetic scene and hands out views.
+struct Soup {
+  std::vector<std::vector<Vec3f>> positions;
+  std::vector<std::vector<uint32_t>> indices;
+  std::vector<TriangleMeshView> views() const {
+    std::vector<TriangleMeshView> v;
+    for (size_t i = 0; i < positions.size(); ++i) v.push_back({positions[i], indices[i]});
+    return v;
+  }
+  void add(std::vector<Vec3f> p, std::vector<uint32_t> i) {
+    positions.push_back(std::move(p));
+    indices.push_back(std::move(i));
+  }
+  /// An n x n grid of quads in the plane axis = value, covering [lo, hi]^2 in the other two axes.
+  void add_plane(int axis, float value, float lo, float hi, int n) {
+    std::vector<Vec3f> p;
+    std::vector<uint32_t> idx;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        Vec3f v;
+        v[axis] = value;
+        v[(axis + 1) % 3] = lo + (hi - lo) * float(i) / float(n);
+        v[(axis + 2) % 3] = lo + (hi - lo) * float(j) / float(n);
+        p.push_back(v);
+      }
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+        idx.insert(idx.end(), {a, b, d, a, d, c});
+      }
+    add(std::move(p), std::move(idx));
+  }
+};
+
+/// A closed icosphere (shared vertices) of radius r around c, subdivided `level` times.
+inline Soup icosphere(int level, float r, Vec3f c) {
+  const float t = (1 + std::sqrt(5.0f)) / 2;
+  std::vector<Vec3f> v{{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  for (auto& p : v) p = normalize(p);
+  std::vector<uint32_t> f{0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,
+                          11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8,
+                          3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  for (int l = 0; l < level; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(normalize((v[a] + v[b]) * 0.5f));
+      return mid[key] = uint32_t(v.size() - 1);
+    };
+    std::vector<uint32_t> g;
+    for (size_t i = 0; i < f.size(); i += 3) {
+      const uint32_t a = f[i], b = f[i + 1], cc = f[i + 2];
+      const uint32_t ab = midpoint(a, b), bc = midpoint(b, cc), ca = midpoint(cc, a);
+      g.insert(g.end(), {a, ab, ca, b, bc, ab, cc, ca, bc, ab, bc, ca});
+    }
+    f.swap(g);
+  }
+  for (auto& p : v) p = c + p * r;
+  Soup s;
+  s.add(std::move(v), std::move(f));
+  return s;
+}
+
+// ---- Instances ----------------------------------------------------------------------------------
+
+/// World-space copies of every instance's triangles, one view per instance (geom_id = instance
+/// index): the flattened scene that two-level structures must agree with. Instances with a
+/// singular map get an empty view (they are never hit).
+struct Flattened {
+  std::vector<std::vector<Vec3f>> positions;
+  std::vector<TriangleMeshView> views;
+};
+inline Flattened flatten(std::span<const TriangleMeshView> meshes, std::span<const InstanceView> instances) {
+  Flattened f;
+  f.positions.resize(instances.size());
+  for (size_t i = 0; i < instances.size(); ++i) {
+    Affine3f inv;
+    if (!inverse(instances[i].to_world, inv)) continue;
+    for (Vec3f p : meshes[instances[i].mesh].positions) f.positions[i].push_back(apply_point(instances[i].to_world, p));
+  }
+  for (size_t i = 0; i < instances.size(); ++i)
+    f.views.push_back({f.positions[i], f.positions[i].empty() ? std::span<const uint32_t>{} : meshes[instances[i].mesh].indices});
+  return f;
+}
+
+/// Every back end built over `instances` of `meshes` against brute force over the flattened
+/// copies (rounding apart: the ray is mapped into object space rather than the triangles into
+/// world space), and Penumbra's own back ends against the two-level brute force exactly (the same
+/// object-space rays meet the same watertight test).
+inline void check_instanced(const std::string& scene, std::span<const TriangleMeshView> meshes,
+                            std::span<const InstanceView> instances, std::vector<Vec3f> lights, uint32_t seed = 7) {
+  const Flattened flat = flatten(meshes, instances);
+  const Bounds3f b = bounds_of(flat.views);
+  if (lights.empty()) lights = lights_around(b);
+  const auto flat_brute = make_accelerator("brute", flat.views);
+  const std::vector<Ray> rays = all_rays(*flat_brute, flat.views, b, lights, 1, seed);
+  const Reference by_flat = reference(*flat_brute, rays);
+  const auto brute = make_accelerator("brute", meshes, instances);
+  const Reference by_brute = reference(*brute, rays);
+  const float scale = length(b.extent());
+  for (const auto& name : accelerator_names()) {
+    const auto a = make_accelerator(name, meshes, instances);
+    const auto rf = cross_check(*a, by_flat, flat.views, scale, false, 1e-4f);
+    INFO(summary(scene + ": " + name + " over instances vs brute over the flattened scene", rf));
+    CHECK(rf.failures() == 0);
+    CHECK(rf.hits >= rf.rays / 20);  // not a scene of misses
+    if (name != "embree") {
+      const auto rb = cross_check(*a, by_brute, flat.views, scale, true, 0.0f);
+      INFO(summary(scene + ": " + name + " vs two-level brute", rb));
+      CHECK(rb.failures() == 0);
+    }
+  }
 }
 
 }  // namespace penumbra::test

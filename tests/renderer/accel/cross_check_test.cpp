@@ -19,72 +19,6 @@ using namespace penumbra::test;
 
 namespace {
 
-/// Owns the geometry of a synthetic scene and hands out views.
-struct Soup {
-  std::vector<std::vector<Vec3f>> positions;
-  std::vector<std::vector<uint32_t>> indices;
-  std::vector<TriangleMeshView> views() const {
-    std::vector<TriangleMeshView> v;
-    for (size_t i = 0; i < positions.size(); ++i) v.push_back({positions[i], indices[i]});
-    return v;
-  }
-  void add(std::vector<Vec3f> p, std::vector<uint32_t> i) {
-    positions.push_back(std::move(p));
-    indices.push_back(std::move(i));
-  }
-  /// An n x n grid of quads in the plane axis = value, covering [lo, hi]^2 in the other two axes.
-  void add_plane(int axis, float value, float lo, float hi, int n) {
-    std::vector<Vec3f> p;
-    std::vector<uint32_t> idx;
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) {
-        Vec3f v;
-        v[axis] = value;
-        v[(axis + 1) % 3] = lo + (hi - lo) * float(i) / float(n);
-        v[(axis + 2) % 3] = lo + (hi - lo) * float(j) / float(n);
-        p.push_back(v);
-      }
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
-        idx.insert(idx.end(), {a, b, d, a, d, c});
-      }
-    add(std::move(p), std::move(idx));
-  }
-};
-
-/// A closed icosphere (shared vertices) of radius r around c, subdivided `level` times.
-Soup icosphere(int level, float r, Vec3f c) {
-  const float t = (1 + std::sqrt(5.0f)) / 2;
-  std::vector<Vec3f> v{{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  for (auto& p : v) p = normalize(p);
-  std::vector<uint32_t> f{0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,
-                          11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8,
-                          3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-      const auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back(normalize((v[a] + v[b]) * 0.5f));
-      return mid[key] = uint32_t(v.size() - 1);
-    };
-    std::vector<uint32_t> g;
-    for (size_t i = 0; i < f.size(); i += 3) {
-      const uint32_t a = f[i], b = f[i + 1], cc = f[i + 2];
-      const uint32_t ab = midpoint(a, b), bc = midpoint(b, cc), ca = midpoint(cc, a);
-      g.insert(g.end(), {a, ab, ca, b, bc, ab, cc, ca, bc, ab, bc, ca});
-    }
-    f.swap(g);
-  }
-  for (auto& p : v) p = c + p * r;
-  Soup s;
-  s.add(std::move(v), std::move(f));
-  return s;
-}
-
 std::vector<Vec3f> light_positions(const Scene& s) {
   std::vector<Vec3f> out;
   for (const auto& l : s.lights)
@@ -248,8 +182,12 @@ TEST_CASE("cross-check: rays from inside a closed sphere always hit (watertightn
 
 TEST_CASE("cross-check: the default scene", "[accel][crosscheck]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
-  const auto views = mesh_views(l.scene);
-  check_scene("default.gltf", views, light_positions(l.scene));
+  const auto meshes = mesh_views(l.scene);
+  const auto instances = instance_views(l.scene);
+  // Flattened (one level), and as loaded: the "wall" mesh is instanced by three nodes.
+  check_scene("default.gltf", flatten(meshes, instances).views, light_positions(l.scene));
+  REQUIRE(l.scene.instances.size() > l.scene.meshes.size());
+  check_instanced("default.gltf", meshes, instances, light_positions(l.scene));
 }
 
 TEST_CASE("cross-check: Embree without the robust flag and at low and high build quality",
@@ -282,8 +220,12 @@ TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus]"
     const auto ext = e.path().extension();
     if (!e.is_regular_file() || (ext != ".gltf" && ext != ".glb")) continue;
     const LoadedScene l = load_gltf(e.path());
-    const auto views = mesh_views(l.scene);
-    check_scene(e.path().filename().string(), views, light_positions(l.scene));
+    const auto meshes = mesh_views(l.scene);
+    const auto instances = instance_views(l.scene);
+    const std::string name = e.path().filename().string();
+    check_scene(name, flatten(meshes, instances).views, light_positions(l.scene));
+    if (std::any_of(l.scene.instances.begin(), l.scene.instances.end(), [](const Instance& i) { return !i.identity; }))
+      check_instanced(name, meshes, instances, light_positions(l.scene));
     ++models;
   }
   CHECK(models >= 30);
@@ -291,7 +233,7 @@ TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus]"
 
 TEST_CASE("cross-check, slow: the default scene and spheres with 16x the rays", "[.][slow][accel][crosscheck]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
-  check_scene("default.gltf", mesh_views(l.scene), light_positions(l.scene), 4);
+  check_scene("default.gltf", flatten(mesh_views(l.scene), instance_views(l.scene)).views, light_positions(l.scene), 4);
   const Soup s = icosphere(3, 1.0f, {1e3f, 0, 0});
   check_scene("sphere", s.views(), {}, 4);
 }
@@ -300,13 +242,13 @@ TEST_CASE("cross-check, slow: the default scene and spheres with 16x the rays", 
 
 TEST_CASE("the default scene renders the same image with every accelerator", "[accel][render]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
-  const auto views = mesh_views(l.scene);
   RenderConfig cfg;
   cfg.width = 160;
   cfg.height = 90;
   cfg.spp = 1;
   cfg.threads = 2;
-  const auto all = build_all(views);
+  std::vector<NamedAccel> all;
+  for (const auto& name : accelerator_names()) all.push_back({name, make_scene_accelerator(name, l.scene)});
   std::vector<Film> films;
   for (const auto& a : all) films.push_back(render_whitted(l.scene, *a.accel, l.scene.cameras.at(0), cfg));
   const Film& embree = films[0];

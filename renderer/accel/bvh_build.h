@@ -1,0 +1,84 @@
+// The BVH builder of accel/bvh.cpp exposed for other structures over boxes (the instance top
+// level of accel/instances.cpp): binned SAH (Wald 2007) over bounds and centroids only, and the
+// flattening into 32-byte binary nodes in depth-first order (pbrt-v4's LinearBVHNode).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "renderer/accel/bvh.h"
+#include "renderer/accel/common.h"
+#include "renderer/math.h"
+
+namespace penumbra {
+
+/// One primitive as the builder sees it: its box, its centroid and the caller's index.
+struct BvhBuildRef {
+  Bounds3f box;
+  Vec3f centroid;
+  uint32_t index;
+};
+
+/// Binary build tree. A leaf (no children) covers refs [first, first + count).
+struct BvhBuildNode {
+  Bounds3f box;
+  std::unique_ptr<BvhBuildNode> child[2];
+  uint32_t first = 0, count = 0;
+  int axis = 0;  ///< split axis of an interior node
+};
+
+/// Flattened node, 32 bytes. Children of an interior node: the first is the next node in the
+/// array (depth-first order), the second is at `offset`.
+struct alignas(32) BvhNode {
+  Vec3f lo;         // 12 bytes: box minimum
+  Vec3f hi;         // 12 bytes: box maximum
+  uint32_t offset;  //  4 bytes: leaf: first primitive; interior: index of the second child
+  uint16_t count;   //  2 bytes: primitives in a leaf; 0 marks an interior node
+  uint8_t axis;     //  1 byte : split axis of an interior node (visit order)
+  uint8_t pad;      //  1 byte : unused
+};
+static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
+
+/// Deepest path of a tree from build_bvh_tree() is below this (SAH depth is capped, then object
+/// median splits halve the rest), so fixed traversal stacks of this size never overflow.
+inline constexpr int kBvhStackSize = 128;
+
+/// Builds the tree over `refs` (non-empty; config validated), reordering them so every leaf is
+/// a contiguous range. The shape never depends on thread scheduling.
+std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config);
+
+/// Appends `b`'s subtree to `nodes` depth first, boxes widened by widen_for_rounding(); returns
+/// the index of `b`'s node.
+uint32_t flatten_bvh(const BvhBuildNode& b, std::vector<BvhNode>& nodes);
+
+/// Depth-first walk over flattened binary nodes (node 0 the root), nearer child first by the
+/// sign of the ray direction along the split axis, culling boxes outside [tnear, best] (`best`
+/// may shrink during the walk). Calls on_node() per node visited and on_leaf(first, count) per
+/// leaf met until it returns true; returns true iff it did. Never allocates.
+template <typename OnNode, typename OnLeaf>
+bool walk_bvh(const std::vector<BvhNode>& nodes, const RayBoxQuery& q, float tnear, const float& best,
+              OnNode&& on_node, OnLeaf&& on_leaf) {
+  if (nodes.empty()) return false;
+  uint32_t stack[kBvhStackSize];
+  int sp = 0;
+  uint32_t idx = 0;
+  for (;;) {
+    const BvhNode& node = nodes[idx];
+    on_node();
+    float t0 = tnear, t1 = best;
+    if (intersect_box(node.lo, node.hi, q, t0, t1)) {
+      if (node.count == 0) {
+        const bool far_first = q.dir_neg[node.axis];
+        stack[sp++] = far_first ? idx + 1 : node.offset;
+        idx = far_first ? node.offset : idx + 1;
+        continue;
+      }
+      if (on_leaf(node.offset, uint32_t(node.count))) return true;
+    }
+    if (sp == 0) return false;
+    idx = stack[--sp];
+  }
+}
+
+}  // namespace penumbra

@@ -1,0 +1,210 @@
+// Two-level instancing: top-level BVH over instance boxes, object-space bottom levels.
+#include "renderer/accel/instances.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "renderer/accel/bvh_build.h"
+#include "renderer/accel/common.h"
+
+namespace penumbra {
+namespace {
+
+class TwoLevelAccelerator final : public Accelerator {
+ public:
+  TwoLevelAccelerator(const AcceleratorBuilder& build, std::span<const TriangleMeshView> meshes,
+                      std::span<const InstanceView> instances) {
+    validate_instances(instances, meshes.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<TriangleMeshView> world;
+    std::vector<int> object_of(meshes.size(), -1);
+    for (size_t i = 0; i < instances.size(); ++i) {
+      const InstanceView& inst = instances[i];
+      if (is_identity(inst.to_world)) {
+        world.push_back(meshes[inst.mesh]);
+        m_world_ids.push_back(uint32_t(i));
+        continue;
+      }
+      Affine3f to_object;
+      if (!inverse(inst.to_world, to_object)) continue;  // singular: never hit
+      int& object = object_of[inst.mesh];
+      if (object < 0) {
+        object = int(m_levels.size());
+        m_levels.push_back(build(meshes.subspan(inst.mesh, 1)));
+      }
+      m_items.push_back({uint32_t(object), uint32_t(i), to_object,
+                         transform_bounds(inst.to_world, m_levels[size_t(object)]->bounds())});
+      ++m_instances;
+    }
+    if (!world.empty()) {
+      m_levels.push_back(build(world));
+      m_items.push_back({uint32_t(m_levels.size() - 1), kWorld, Affine3f{}, m_levels.back()->bounds()});
+    }
+    for (const auto& level : m_levels) m_stats_bottom.push_back(level->stats());
+    build_top();
+    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  bool intersect(const Ray& ray, Hit& hit) const override { return closest(ray, hit, nullptr); }
+  bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const override {
+    return closest(ray, hit, &cost);
+  }
+  bool counts_traversal() const override {
+    return std::all_of(m_levels.begin(), m_levels.end(), [](const auto& l) { return l->counts_traversal(); });
+  }
+
+  bool occluded(const Ray& ray) const override {
+    return walk(ray, ray.tfar, nullptr, [&](const Item& item, const Ray& local) {
+      return m_levels[item.level]->occluded(local);
+    });
+  }
+
+  Bounds3f bounds() const override { return m_bounds; }
+
+  AccelStats stats() const override {
+    AccelStats s;
+    if (!m_stats_bottom.empty()) {
+      s.name = m_stats_bottom.front().name;
+      s.config = m_stats_bottom.front().config;
+    }
+    s.instances = m_instances;
+    uint64_t bottom_depth = 0;
+    for (const AccelStats& b : m_stats_bottom) {
+      s.triangles += b.triangles;
+      s.nodes += b.nodes;
+      s.leaves += b.leaves;
+      s.empty_leaves += b.empty_leaves;
+      s.references += b.references;
+      s.max_leaf_prims = std::max(s.max_leaf_prims, b.max_leaf_prims);
+      bottom_depth = std::max(bottom_depth, b.max_depth);
+      s.bytes += b.bytes;
+    }
+    s.avg_leaf_prims = s.leaves > s.empty_leaves ? double(s.references) / double(s.leaves - s.empty_leaves) : 0;
+    s.nodes += m_nodes.size();
+    s.max_depth = m_top_depth + bottom_depth;
+    s.sah_cost = m_sah_cost;
+    s.bytes += m_nodes.size() * sizeof(BvhNode) + m_items.size() * sizeof(Item);
+    s.build_seconds = m_build_seconds;
+    return s;
+  }
+
+ private:
+  static constexpr uint32_t kWorld = 0xffffffffu;  // Item::instance of the world-space level
+
+  struct Item {
+    uint32_t level;     // index into m_levels
+    uint32_t instance;  // the instance index reported in hits, or kWorld
+    Affine3f to_object;
+    Bounds3f box;       // world bounds
+  };
+
+  void build_top() {
+    std::vector<BvhBuildRef> refs;
+    for (uint32_t i = 0; i < m_items.size(); ++i)
+      if (!m_items[i].box.empty()) refs.push_back({m_items[i].box, m_items[i].box.center(), i});
+    if (refs.empty()) return;
+    BvhConfig config;
+    config.max_leaf_size = 1;  // an item costs a whole bottom-level query
+    const auto root = build_bvh_tree(refs, config);
+    std::vector<Item> ordered;
+    for (const auto& r : refs) ordered.push_back(m_items[r.index]);
+    m_items = std::move(ordered);
+    m_bounds = root->box;
+    flatten_bvh(*root, m_nodes);
+    m_top_depth = depth(*root);
+    // Expected cost of a ray through the root: top nodes at cost 1 each, and per item the
+    // probability of entering its box times its bottom level's own SAH cost. Reported only if
+    // every bottom level has one.
+    const double root_area = surface_area(root->box);
+    bool known = root_area > 0;
+    double cost = 0;
+    for (const BvhNode& n : m_nodes)
+      if (n.count == 0) cost += surface_area({n.lo, n.hi}) / root_area;
+    for (const Item& item : m_items) {
+      const double level_cost = m_stats_bottom[item.level].sah_cost;
+      known = known && level_cost > 0;
+      cost += surface_area(item.box) / root_area * level_cost;
+    }
+    m_sah_cost = known ? cost : 0;
+  }
+
+  static uint64_t depth(const BvhBuildNode& n) {
+    return n.child[0] ? 1 + std::max(depth(*n.child[0]), depth(*n.child[1])) : 0;
+  }
+
+  static bool valid_ray(const Ray& r) {
+    return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
+           r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
+  }
+
+  /// Visits the items whose boxes the ray meets within [tnear, best], nearer subtrees first,
+  /// calling query(item, ray in the item's space) until it returns true. `best` may shrink
+  /// during the walk (closest-hit queries narrow it).
+  template <typename Query>
+  bool walk(const Ray& ray, const float& best, TraversalCost* cost, Query&& query) const {
+    if (!valid_ray(ray)) return false;
+    return walk_bvh(m_nodes, prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
+                    [&] {
+                      if (cost) ++cost->nodes;
+                    },
+                    [&](uint32_t first, uint32_t count) {
+                      for (uint32_t i = first, e = first + count; i < e; ++i) {
+                        const Item& item = m_items[i];
+                        Ray local = ray;
+                        local.tfar = best;
+                        if (item.instance != kWorld) {
+                          local.org = apply_point(item.to_object, ray.org);
+                          local.dir = apply_vector(item.to_object, ray.dir);
+                        }
+                        if (query(item, local)) return true;
+                      }
+                      return false;
+                    });
+  }
+
+  bool closest(const Ray& ray, Hit& hit, TraversalCost* cost) const {
+    hit = Hit{};
+    float best = ray.tfar;
+    walk(ray, best, cost, [&](const Item& item, const Ray& local) {
+      Hit h;
+      const Accelerator& level = *m_levels[item.level];
+      if (!(cost ? level.intersect_counted(local, h, *cost) : level.intersect(local, h))) return false;
+      best = h.t;
+      hit = h;
+      hit.geom_id = item.instance == kWorld ? m_world_ids[h.geom_id] : item.instance;
+      return false;
+    });
+    return hit.valid();
+  }
+
+  std::vector<std::unique_ptr<Accelerator>> m_levels;  // bottom levels: per mesh, then world
+  std::vector<uint32_t> m_world_ids;  // world level's geom_id -> instance index
+  std::vector<Item> m_items;          // in top-level leaf order
+  std::vector<BvhNode> m_nodes;       // top level, depth first
+  std::vector<AccelStats> m_stats_bottom;
+  Bounds3f m_bounds;
+  uint64_t m_instances = 0;
+  uint64_t m_top_depth = 0;
+  double m_sah_cost = 0;
+  double m_build_seconds = 0;
+};
+
+}  // namespace
+
+void validate_instances(std::span<const InstanceView> instances, size_t mesh_count) {
+  for (size_t i = 0; i < instances.size(); ++i)
+    if (instances[i].mesh >= mesh_count)
+      throw std::invalid_argument("instance " + std::to_string(i) + ": mesh " + std::to_string(instances[i].mesh) +
+                                  " out of range (" + std::to_string(mesh_count) + " meshes)");
+}
+
+std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
+                                                        std::span<const TriangleMeshView> meshes,
+                                                        std::span<const InstanceView> instances) {
+  return std::make_unique<TwoLevelAccelerator>(build, meshes, instances);
+}
+
+}  // namespace penumbra

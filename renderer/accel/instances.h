@@ -1,0 +1,32 @@
+// Two-level instancing for the back ends that have none of their own (bvh, kdtree, grid,
+// brute): one structure per instanced mesh in object space, one over everything placed by the
+// identity in world space, and a top-level BVH over the instances' world bounds whose leaves
+// carry the ray into object space (pbrt-v4's TransformedPrimitive; Wald et al., "Distributed
+// Interactive Ray Tracing of Dynamic Scenes", IEEE PVG 2003, for the two-level scheme).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <span>
+
+#include "renderer/accel/accelerator.h"
+
+namespace penumbra {
+
+/// Builds one back end's structure over some meshes (geom_id = index in the span).
+using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<const TriangleMeshView>)>;
+
+/// Two-level structure over `instances` of `meshes`; a Hit's geom_id is the instance index and
+/// its t is measured along the world ray (object-space rays keep the parameterisation: the
+/// direction is mapped, not normalised). `build` makes every bottom level: one per mesh used by a
+/// non-identity instance, and one over the identity instances' meshes. Instances with a singular
+/// or non-finite map are left out. Throws std::invalid_argument if an instance names a mesh
+/// outside `meshes`, and whatever `build` throws.
+std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
+                                                        std::span<const TriangleMeshView> meshes,
+                                                        std::span<const InstanceView> instances);
+
+/// Throws std::invalid_argument naming the instance if it refers to a mesh outside `mesh_count`.
+void validate_instances(std::span<const InstanceView> instances, size_t mesh_count);
+
+}  // namespace penumbra

@@ -1,0 +1,122 @@
+// Two-level instancing (renderer/accel/instances.cpp and Embree's instances): hits report the
+// instance, t along the world ray and the object triangle's barycentrics (analytic answers);
+// every back end over instances agrees with brute force over the flattened scene, and
+// Penumbra's back ends agree exactly with the two-level brute force.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "cross_check.h"
+#include "renderer/accel/factory.h"
+
+using namespace penumbra;
+using namespace penumbra::test;
+
+namespace {
+
+/// Translation x rotation about a unit axis x scale, as an Affine3f.
+Affine3f placement(Vec3f t, Vec3f axis, double angle, Vec3f s) {
+  const double h = angle / 2, k = std::sin(h);
+  const Transform m = translate(t.x, t.y, t.z) * rotate(Quat{axis.x * k, axis.y * k, axis.z * k, std::cos(h)}) *
+                      scale(s.x, s.y, s.z);
+  return to_affine(m);
+}
+
+Affine3f translation(Vec3f t) { return placement(t, {0, 0, 1}, 0, {1, 1, 1}); }
+
+}  // namespace
+
+TEST_CASE("instances: a hit names the instance, t runs along the world ray, u v are the object triangle's",
+          "[accel][instances][quick]") {
+  Soup s;
+  s.add({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
+  const auto meshes = s.views();
+  // Instance 0: the triangle in place (world level). Instance 1: scaled by 2, moved to z = -5.
+  // Instance 2: scaled by 4 and mirrored in x, moved to z = -9 (behind instance 1).
+  const std::vector<InstanceView> instances = {{0, Affine3f{}},
+                                               {0, placement({0, 0, -5}, {0, 0, 1}, 0, {2, 2, 2})},
+                                               {0, placement({0, 0, -9}, {0, 0, 1}, 0, {-4, 4, 4})}};
+  for (const auto& name : accelerator_names()) {
+    INFO(name);
+    const auto a = make_accelerator(name, meshes, instances);
+    // Object point (0.25, 0.25) of instance 1 is world (0.5, 0.5, -5); the direction is not unit,
+    // so t = 5 / 2.
+    Hit h;
+    REQUIRE(a->intersect({{0.5f, 0.5f, 1e-3f}, 0.01f, {0, 0, -2}, kInfinity}, h));
+    CHECK(h.geom_id == 1);
+    CHECK(h.prim_id == 0);
+    CHECK(h.t == Approx((5 + 1e-3) / 2).epsilon(1e-6));
+    CHECK(h.u == Approx(0.25).epsilon(1e-5));
+    CHECK(h.v == Approx(0.25).epsilon(1e-5));
+    // x < 0 is only covered by the mirrored instance: object (0.25, 0.5) at world (-1, 2, -9).
+    REQUIRE(a->intersect({{-1, 2, 1}, 0, {0, 0, -1}, kInfinity}, h));
+    CHECK(h.geom_id == 2);
+    CHECK(h.t == Approx(10).epsilon(1e-6));
+    CHECK(h.u == Approx(0.25).epsilon(1e-5));
+    CHECK(h.v == Approx(0.5).epsilon(1e-5));
+    // Segments: ending before instance 2, and occlusion along the same rays.
+    CHECK_FALSE(a->intersect({{-1, 2, 1}, 0, {0, 0, -1}, 9.9f}, h));
+    CHECK_FALSE(a->occluded({{-1, 2, 1}, 0, {0, 0, -1}, 9.9f}));
+    CHECK(a->occluded({{-1, 2, 1}, 0, {0, 0, -1}, 10.1f}));
+    // The world-level triangle in front of everything.
+    REQUIRE(a->intersect({{0.1f, 0.1f, 1}, 0, {0, 0, -1}, kInfinity}, h));
+    CHECK(h.geom_id == 0);
+    CHECK(h.t == Approx(1));
+    const AccelStats st = a->stats();
+    CHECK(st.instances == 2);
+    CHECK(st.triangles == 2);  // the world copy and the shared object mesh
+    CHECK(a->bounds().lo.x == Approx(-4).margin(1e-5));
+    CHECK(a->bounds().lo.z == Approx(-9).margin(1e-5));
+  }
+}
+
+TEST_CASE("instances: identity placements build one level; bad instances are refused or never hit",
+          "[accel][instances][quick]") {
+  const Soup s = icosphere(1, 1, {0, 0, 0});
+  const auto meshes = s.views();
+  for (const auto& name : accelerator_names()) {
+    INFO(name);
+    // Identity only: the single-level structure, one geom_id per instance (the mesh twice).
+    const auto flat = make_accelerator(name, meshes, std::vector<InstanceView>{{0, {}}, {0, {}}});
+    CHECK(flat->stats().instances == 0);
+    Hit h;
+    REQUIRE(flat->intersect({{0, 0, 5}, 0, {0, 0, -1}, kInfinity}, h));
+    CHECK(h.geom_id <= 1);
+    // A singular placement (zero scale) is left out; the other instance still answers.
+    const std::vector<InstanceView> bad = {{0, placement({0, 0, 0}, {0, 0, 1}, 0, {0, 1, 1})},
+                                           {0, translation({3, 0, 0})}};
+    const auto a = make_accelerator(name, meshes, bad);
+    CHECK_FALSE(a->intersect({{0, 0, 5}, 0, {0, 0, -1}, kInfinity}, h));
+    REQUIRE(a->intersect({{3, 0, 5}, 0, {0, 0, -1}, kInfinity}, h));
+    CHECK(h.geom_id == 1);
+    CHECK(h.t == Approx(4).epsilon(1e-6));  // the icosphere has a vertex at (0, 0, 1)
+    // An instance of a mesh that does not exist.
+    CHECK_THROWS_AS(make_accelerator(name, meshes, std::vector<InstanceView>{{1, {}}}), std::invalid_argument);
+  }
+}
+
+TEST_CASE("instances: every back end agrees with brute force over the flattened scene", "[accel][instances][crosscheck]") {
+  Soup s;
+  Soup sphere = icosphere(2, 1, {0, 0, 0});
+  s.add(sphere.positions[0], sphere.indices[0]);  // mesh 0: sphere (320 triangles)
+  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);           // mesh 1: a 2 x 2 plane in y = 0
+  s.add({{0, 0, 0}, {0.3f, 0, 0}, {0, 0.3f, 0.1f}}, {0, 1, 2});  // mesh 2: one small triangle
+  const auto meshes = s.views();
+  std::vector<InstanceView> instances = {
+      {0, Affine3f{}},                                                          // in place
+      {0, placement({4, 0, 0}, normalize(Vec3f{1, 2, 3}), 0.7, {1, 0.5f, 2})},  // rotated, non-uniform
+      {0, placement({-4, 1, 0}, {0, 1, 0}, 0.3, {-1, 1, 1})},                   // mirrored
+      {1, Affine3f{}},                                                          // the plane in place
+      {1, placement({0, -2, 0}, {1, 0, 0}, 0.2, {10, 1, 10})},                  // a big floor
+      {1, placement({0, 0, -3}, {1, 0, 0}, kPi / 2, {3, 1, 3})},                // a wall
+  };
+  // A cloud of 300 small triangles (the top level's depth), some interpenetrating.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (int i = 0; i < 300; ++i)
+    instances.push_back({2, placement({u(rng) * 3, 2 + u(rng), u(rng) * 3}, normalize(Vec3f{u(rng), u(rng), u(rng) + 2}),
+                                      u(rng) * 3, {1 + u(rng) * 0.5f, 1, 1 + u(rng) * 0.5f})});
+  instances.push_back({0, placement({9, 9, 9}, {0, 0, 1}, 0, {0, 0, 0})});  // singular: never hit
+  check_instanced("instances", meshes, instances, {});
+}
