@@ -28,17 +28,26 @@ int add_world_mesh(Scene& scene, Mesh mesh) {
   return index;
 }
 
-Bounds3f compute_bounds(const Scene& scene) {
+Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   std::vector<Bounds3f> mesh_bounds(scene.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i)
     for (Vec3f p : scene.meshes[i].positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
+  // Placed meshes: every vertex mapped (exact) while that stays cheap, else the mapped corners
+  // of the mesh's box (conservative), so a million placements of a big mesh cost no more
+  // than a million boxes.
+  uint64_t placed_vertices = 0;
+  for (const Instance& inst : scene.instances)
+    if (!inst.identity) placed_vertices += scene.meshes[size_t(inst.mesh)].positions.size();
+  const bool exact = placed_vertices <= exact_vertex_limit;
   Bounds3f b;
   for (const Instance& inst : scene.instances) {
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     if (inst.identity) {
       b = merge(b, mesh_bounds[size_t(inst.mesh)]);
-    } else {
+    } else if (exact) {
       for (Vec3f p : m.positions) b = merge(b, apply_point(inst.to_world, p));
+    } else {
+      b = merge(b, transform_bounds(inst.to_world, mesh_bounds[size_t(inst.mesh)]));
     }
   }
   return b;

@@ -125,8 +125,11 @@ Instance make_instance(int mesh, const Affine3f& to_world, int node = -1);
 /// Appends a world-space mesh with its identity instance; returns the mesh index.
 int add_world_mesh(Scene& scene, Mesh mesh);
 
-/// World-space bounds of every instance's positions (empty box for an empty scene).
-Bounds3f compute_bounds(const Scene& scene);
+/// World-space bounds of every instance's positions (empty box for an empty scene); exact
+/// unless the meshes placed by non-identity instances hold more than `exact_vertex_limit`
+/// vertices in all, then each such placement contributes the mapped box of its mesh
+/// (conservative, and as cheap for a million placements as for one).
+Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64_t(1) << 24);
 /// Triangles rendered: each mesh counted once per instance.
 uint64_t count_triangles(const Scene& scene);
 /// Triangles stored: each mesh once.
