@@ -1,6 +1,8 @@
 // Test scenes built directly as renderer data (no files): quads and lights at known places.
 #pragma once
 
+#include <catch2/catch.hpp>
+
 #include "renderer/scene.h"
 
 namespace penumbra::test {
@@ -43,6 +45,13 @@ inline Mesh world_copy(const Scene& s, const Instance& inst) {
     for (size_t i = 0; i + 2 < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
   m.node = inst.node;
   return m;
+}
+
+/// Catch checks that a and b agree componentwise within eps (absolute).
+inline void check_vec(Vec3f a, Vec3f b, float eps = 1e-6f) {
+  CHECK(a.x == Approx(b.x).margin(eps));
+  CHECK(a.y == Approx(b.y).margin(eps));
+  CHECK(a.z == Approx(b.z).margin(eps));
 }
 
 inline int add_material(Scene& s, Vec3f base, float metallic, float roughness, bool unlit = false) {

@@ -28,11 +28,7 @@ LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptio
   return load_gltf(dir / "scene.gltf", opt);
 }
 
-void check_vec(Vec3f a, Vec3f b, float eps = 1e-5f) {
-  CHECK(a.x == Approx(b.x).margin(eps));
-  CHECK(a.y == Approx(b.y).margin(eps));
-  CHECK(a.z == Approx(b.z).margin(eps));
-}
+void check_vec(Vec3f a, Vec3f b, float eps = 1e-5f) { test::check_vec(a, b, eps); }
 
 /// A file whose unit quad mesh is placed by three nodes (moved, mirrored, rotated) and whose
 /// triangle mesh is placed by one node (moved).

@@ -7,9 +7,11 @@
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/camera.h"
+#include "scene_builder.h"
 #include "test_util.h"
 
 using namespace penumbra;
+using penumbra::test::check_vec;
 using namespace penumbra::test;
 
 namespace {
@@ -74,11 +76,6 @@ Scene sample_scene() {
   return s;
 }
 
-void check_vec(Vec3f a, Vec3f b, float eps = 1e-6f) {
-  CHECK(a.x == Approx(b.x).margin(eps));
-  CHECK(a.y == Approx(b.y).margin(eps));
-  CHECK(a.z == Approx(b.z).margin(eps));
-}
 
 }  // namespace
 

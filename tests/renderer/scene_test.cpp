@@ -8,16 +8,12 @@
 #include "scene_builder.h"
 
 using namespace penumbra;
+using penumbra::test::check_vec;
 
 namespace {
 
 Affine3f trs(Vec3f t, Quat q, Vec3f s) { return to_affine(compose_trs({t.x, t.y, t.z}, q, {s.x, s.y, s.z})); }
 
-void check_vec(Vec3f a, Vec3f b, float eps = 1e-6f) {
-  CHECK(a.x == Approx(b.x).margin(eps));
-  CHECK(a.y == Approx(b.y).margin(eps));
-  CHECK(a.z == Approx(b.z).margin(eps));
-}
 
 }  // namespace
 
