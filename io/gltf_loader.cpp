@@ -1125,6 +1125,10 @@ void Converter::add_mesh(int mesh_index, int node, const std::vector<Transform>&
   std::vector<double> morph = mesh.weights;
   if (!gnode.weights.empty()) morph = gnode.weights;
   if (size_t(node) < m_pose.size() && m_pose[size_t(node)].has_w) morph = m_pose[size_t(node)].weights;
+  // A non-finite weight contributes nothing (emit_primitives skips it); zeroing it keeps the
+  // weights usable as a key of m_object_meshes (NaN has no order).
+  for (double& w : morph)
+    if (!std::isfinite(w)) w = 0;
   // Skin: joint matrices J_k = world(joint k) x inverseBindMatrix k; a skinned mesh ignores its
   // node's own transform (glTF 3.7.3.3).
   std::vector<Transform> joint_mats;
