@@ -4,6 +4,7 @@
 // name through accel/factory.h.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -57,6 +58,13 @@ struct TraversalCost {
   uint64_t nodes = 0;      ///< interior and leaf nodes (BVH, kD-tree) or cells (grid) visited
   uint64_t triangles = 0;  ///< ray-triangle tests
 };
+
+/// The rays every back end answers: finite origin and direction, a non-zero direction and a
+/// non-empty [tnear, tfar] without NaN. Others miss (the interface's contract below).
+inline bool is_valid_query(const Ray& r) {
+  return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
+         r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
+}
 
 class Accelerator {
  public:

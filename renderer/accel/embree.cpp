@@ -160,7 +160,7 @@ class EmbreeAccelerator final : public Accelerator {
 
   bool intersect(const Ray& ray, Hit& hit) const override {
     hit = Hit{};
-    if (!valid_ray(ray)) return false;
+    if (!is_valid_query(ray)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -178,7 +178,7 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
   bool occluded(const Ray& ray) const override {
-    if (!valid_ray(ray)) return false;
+    if (!is_valid_query(ray)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
@@ -202,10 +202,6 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
  private:
-  static bool valid_ray(const Ray& r) {
-    return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
-           r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
-  }
   static void fill_ray(const Ray& in, RTCRay& r) {
     r.org_x = in.org.x;
     r.org_y = in.org.y;

@@ -135,17 +135,12 @@ class TwoLevelAccelerator final : public Accelerator {
     return n.child[0] ? 1 + std::max(depth(*n.child[0]), depth(*n.child[1])) : 0;
   }
 
-  static bool valid_ray(const Ray& r) {
-    return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.tnear) && !std::isnan(r.tfar) &&
-           r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
-  }
-
   /// Visits the items whose boxes the ray meets within [tnear, best], nearer subtrees first,
   /// calling query(item, ray in the item's space) until it returns true. `best` may shrink
   /// during the walk (closest-hit queries narrow it).
   template <typename Query>
   bool walk(const Ray& ray, const float& best, TraversalCost* cost, Query&& query) const {
-    if (!valid_ray(ray)) return false;
+    if (!is_valid_query(ray)) return false;
     return walk_bvh(m_nodes, prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
                     [&] {
                       if (cost) ++cost->nodes;
