@@ -19,6 +19,7 @@
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
 #include "io/accel_params.h"
+#include "io/environment_io.h"
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
@@ -149,6 +150,11 @@ struct RenderArgs {
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
+  std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
+  int rr_depth = 3, adaptive_min_spp = 16;
+  float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
+  double time_limit = 0;
+  bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
   std::optional<double> time;   ///< --time, seconds
   std::optional<long> frame;    ///< --frame, converted with --fps
   double fps = 24;
@@ -246,6 +252,30 @@ int run_render(const RenderArgs& a) {
   if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) throw UsageError("--exposure must be finite and within [-64, 64]");
   const Vec3f background = parse_colour(a.background, "--background");
   const Vec3f ambient = parse_colour(a.ambient, "--ambient");
+  const bool path = a.integrator == "path";
+  if (path && (a.background_given || a.ambient_given))
+    throw UsageError(std::string(a.background_given ? "--background" : "--ambient") +
+                     " applies to --integrator whitted; the path tracer is lit by the scene's lights and --env");
+  if (!path) {
+    for (const auto& [given, name] : {std::pair{!a.env.empty(), "--env"}, {a.time_limit > 0, "--time-limit"},
+                                      {a.adaptive > 0, "--adaptive"}, {a.clamp_indirect > 0, "--clamp-indirect"},
+                                      {a.light_sampling != "mis", "--light-sampling"}, {a.sampler != "sobol", "--sampler"}})
+      if (given) throw UsageError(std::string(name) + " needs --integrator path");
+  }
+  if (!std::isfinite(a.clamp_indirect) || a.clamp_indirect < 0) throw UsageError("--clamp-indirect must be finite and >= 0 (0 = off)");
+  if (!std::isfinite(a.adaptive) || a.adaptive < 0) throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
+  if (!std::isfinite(a.time_limit) || a.time_limit < 0) throw UsageError("--time-limit must be a finite number of seconds >= 0");
+  if (!std::isfinite(a.env_intensity) || a.env_intensity < 0) throw UsageError("--env-intensity must be finite and >= 0");
+  if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation must be finite");
+  FilterType filter_type = path ? FilterType::BlackmanHarris : FilterType::Box;
+  if (!a.filter.empty() && !parse_filter_type(a.filter, filter_type))
+    throw UsageError("--filter: unknown filter '" + a.filter + "' (known: box, tent, gaussian, blackman-harris)");
+  const float filter_width = a.filter_width > 0 ? a.filter_width : default_filter_width(filter_type);
+  if (!std::isfinite(a.filter_width) || a.filter_width < 0 || filter_width > 16)
+    throw UsageError("--filter-width must be in (0, 16] pixels");
+  // --env: a colour ("r,g,b" or one value) or an image file.
+  std::optional<Vec3f> env_colour;
+  if (!a.env.empty() && a.env.find_first_not_of("0123456789.,eE+- ") == std::string::npos) env_colour = parse_colour(a.env, "--env");
   int debug_x = -1, debug_y = -1;
   if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
     throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
@@ -293,17 +323,33 @@ int run_render(const RenderArgs& a) {
     throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
   const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
                                        : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
+  // The path tracer's lights: emissive triangles and the environment.
+  Environment environment;
+  if (env_colour) environment = make_constant_environment(*env_colour * a.env_intensity);
+  else if (!a.env.empty()) environment = load_environment(a.env, a.env_intensity, a.env_rotation);
+  AreaLights area_lights;
+  if (path) area_lights = build_area_lights(scene);
   bool default_light = false;
-  if (scene.lights.empty()) {
+  if (scene.lights.empty() && (!path || (area_lights.pmf.empty() && is_black(environment)))) {
     scene.lights.push_back(default_key_light(camera));
     default_light = true;
   }
-  cfg.spp = a.spp;
+  cfg.spp = a.spp_given ? a.spp : (path ? 64 : 4);
   cfg.threads = a.threads;
   cfg.seed = a.seed;
-  cfg.whitted.max_depth = a.max_depth;
+  cfg.filter = make_filter(filter_type, filter_width);
+  cfg.whitted.max_depth = a.depth_given ? a.max_depth : 5;
   cfg.whitted.background = background;
   cfg.whitted.ambient = ambient;
+  cfg.path.max_depth = a.depth_given ? a.max_depth : 12;
+  cfg.path.rr_depth = a.rr_depth;
+  cfg.path.clamp_indirect = a.clamp_indirect;
+  cfg.path.strategy = a.light_sampling == "bsdf" ? LightStrategy::Bsdf : (a.light_sampling == "light" ? LightStrategy::Light : LightStrategy::Mis);
+  cfg.sampler = a.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
+  cfg.time_limit = a.time_limit;
+  cfg.adaptive_threshold = a.adaptive;
+  cfg.adaptive_min_spp = a.adaptive_min_spp;
+  const PathLights path_lights{&area_lights, &environment};
 
   // Build.
   const auto t_build = Clock::now();
@@ -315,17 +361,22 @@ int run_render(const RenderArgs& a) {
       throw UsageError("--debug-pixel " + a.debug_pixel + " is outside the " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
     float rgba[4];
     RayCounts counts;
-    render_whitted_pixel(scene, *accel, camera, cfg, debug_x, debug_y, rgba, counts);
-    std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, reflection %llu)\n", debug_x, debug_y,
+    if (path) render_path_pixel(scene, *accel, path_lights, camera, cfg, debug_x, debug_y, rgba, counts);
+    else render_whitted_pixel(scene, *accel, camera, cfg, debug_x, debug_y, rgba, counts);
+    std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, %s %llu)\n", debug_x, debug_y,
                 rgba[0], rgba[1], rgba[2], rgba[3], static_cast<unsigned long long>(counts.camera),
-                static_cast<unsigned long long>(counts.shadow), static_cast<unsigned long long>(counts.reflection));
+                static_cast<unsigned long long>(counts.shadow), path ? "bounce" : "reflection",
+                static_cast<unsigned long long>(counts.reflection));
     return kExitOk;
   }
 
   // Render.
   ProgressReporter reporter(!a.quiet);
   RenderStats stats;
-  Film film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+  Film film;
+  if (path) film = std::move(render_path(scene, *accel, path_lights, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); }).film);
+  else film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+  const double mean_spp = double(stats.samples) / (double(cfg.width) * double(cfg.height));
 
   // Write.
   const auto t_write = Clock::now();
@@ -333,7 +384,14 @@ int run_render(const RenderArgs& a) {
   exr.half = !a.use_float;
   exr.compression = a.compression;
   exr.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:camera", camera.name},
-                  {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", "whitted"}};
+                  {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", a.integrator},
+                  {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
+  if (path) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", mean_spp);
+    exr.metadata.push_back({"penumbra:mean_spp", buf});
+    exr.metadata.push_back({"penumbra:passes", std::to_string(stats.passes)});
+  }
   CostImage cost;
   if (cost_aov) {
     cost = render_cost(*accel, camera, cfg);
@@ -349,21 +407,31 @@ int run_render(const RenderArgs& a) {
 
   if (!a.quiet) {
     const uint64_t total = stats.rays.total();
+    char spp_buf[160];
+    if (path)
+      std::snprintf(spp_buf, sizeof spp_buf, "%d spp max, %.2f mean in %d passes%s (sampler %s%s)", cfg.spp, mean_spp,
+                    stats.passes, stats.time_limited ? ", stopped by --time-limit" : "", a.sampler.c_str(),
+                    cfg.adaptive_threshold > 0 ? ", adaptive" : "");
+    else
+      std::snprintf(spp_buf, sizeof spp_buf, "%d spp", cfg.spp);
+    const std::string spp_text = spp_buf;
     std::fprintf(stderr,
                  "penumbra render %s\n"
                  "  scene    %zu meshes in %zu instances, %s triangles (%s stored), %zu materials, %zu lights%s\n"
                  "  camera   %s (%s)\n"
-                 "  image    %dx%d, %d spp, whitted max-depth %d, %d threads, accel %s\n"
+                 "  image    %dx%d, %s, %s max-depth %d, filter %s %.3g px, %d threads, accel %s\n"
                  "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
-                 "  rays     camera %s  shadow %s  reflection %s  total %s  (%.2f Mrays/s)\n"
+                 "  rays     camera %s  shadow %s  %s %s  total %s  (%.2f Mrays/s)\n"
                  "  memory   peak %.1f MiB\n",
                  a.scene_file.c_str(), scene.meshes.size(), scene.instances.size(), human_count(count_triangles(scene)).c_str(),
                  human_count(count_stored_triangles(scene)).c_str(),
                  scene.materials.size(), scene.lights.size(), default_light ? " (default key light)" : "",
                  camera.name.c_str(), camera.projection == Projection::Perspective ? "perspective" : "orthographic",
-                 cfg.width, cfg.height, cfg.spp, cfg.whitted.max_depth, stats.threads, a.accel.c_str(),
+                 cfg.width, cfg.height, spp_text.c_str(), a.integrator.c_str(),
+                 path ? cfg.path.max_depth : cfg.whitted.max_depth, filter_name(cfg.filter.type), double(cfg.filter.width),
+                 stats.threads, a.accel.c_str(),
                  load_s, build_s, stats.seconds, write_s, human_count(stats.rays.camera).c_str(),
-                 human_count(stats.rays.shadow).c_str(), human_count(stats.rays.reflection).c_str(),
+                 human_count(stats.rays.shadow).c_str(), path ? "bounce" : "reflection", human_count(stats.rays.reflection).c_str(),
                  human_count(total).c_str(), stats.seconds > 0 ? double(total) / stats.seconds / 1e6 : 0.0,
                  peak_memory_mib());
   }
@@ -462,8 +530,23 @@ int main(int argc, char** argv) {
   render->add_flag("--no-png", r.no_png, "write only the EXR");
   render->add_option("--width", r.width, "image width in pixels (default 960, or from --height and the camera aspect)")->check(CLI::Range(1, 16384));
   render->add_option("--height", r.height, "image height in pixels (default: width / camera aspect)")->check(CLI::Range(1, 16384));
-  render->add_option("--spp", r.spp, "samples per pixel, stratified jittered (default 4)")->check(CLI::Range(1, 65536));
-  render->add_option("--max-depth", r.max_depth, "maximum mirror bounces (default 5)")->check(CLI::Range(0, 64));
+  render->add_option("--integrator", r.integrator, "whitted (default: the course's look, fast) or path (physically based path tracer)")
+      ->check(CLI::IsMember({"whitted", "path"}));
+  render->add_option("--spp", r.spp, "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")->check(CLI::Range(1, 65536));
+  render->add_option("--max-depth", r.max_depth, "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only (default 12)")->check(CLI::Range(0, 64));
+  render->add_option("--rr-depth", r.rr_depth, "path: Russian roulette from this bounce on (default 3)")->check(CLI::Range(1, 64));
+  render->add_option("--clamp-indirect", r.clamp_indirect, "path: clamp each indirect sample's largest channel to this radiance; biased, trades fireflies for energy (default 0 = off)");
+  render->add_option("--light-sampling", r.light_sampling, "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single techniques are for validation")
+      ->check(CLI::IsMember({"mis", "bsdf", "light"}));
+  render->add_option("--sampler", r.sampler, "path: sobol (Owen-scrambled, default) or independent (PCG32)")->check(CLI::IsMember({"sobol", "independent"}));
+  render->add_option("--env", r.env, "path: environment light: a radiance r,g,b or grey, or an equirectangular map (.exr, .hdr, any float image OpenImageIO reads)");
+  render->add_option("--env-intensity", r.env_intensity, "path: multiplies --env (default 1)");
+  render->add_option("--env-rotation", r.env_rotation, "path: turns the --env map about +Y, degrees (default 0)");
+  render->add_option("--time-limit", r.time_limit, "path: stop after the pass that would run past this many seconds (default 0 = none)");
+  render->add_option("--adaptive", r.adaptive, "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is below it (default 0 = off)");
+  render->add_option("--adaptive-min-spp", r.adaptive_min_spp, "path: samples every pixel takes before --adaptive may stop it (default 16)")->check(CLI::Range(2, 65536));
+  render->add_option("--filter", r.filter, "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, blackman-harris for path)");
+  render->add_option("--filter-width", r.filter_width, "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
   render->add_option("--threads", r.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
   render->add_option("--scene", r.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
   render->add_option("--camera", r.camera, "camera instance: index as listed by `penumbra info`, or name (default 0; none in the file: frame the bounds)");
@@ -476,8 +559,8 @@ int main(int argc, char** argv) {
   render->add_option("--ocio-config", r.ocio_config, "OpenColorIO config (default: $OCIO, else the shipped config)");
   render->add_option("--display", r.display, "OCIO display (default: the config's default)");
   render->add_option("--view", r.view, "OCIO view (default: the display's default)");
-  render->add_option("--background", r.background, "background radiance r,g,b or grey (default 0); background alpha stays 0");
-  render->add_option("--ambient", r.ambient, "ambient intensity Ia, r,g,b or grey (default 0.05)");
+  render->add_option("--background", r.background, "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
+  render->add_option("--ambient", r.ambient, "whitted: ambient intensity Ia, r,g,b or grey (default 0.05)");
   render->add_option("--seed", r.seed, "sampler seed (default 0)");
   auto* time_opt = render->add_option("--time", r.time, "animation time in seconds: animations (node TRS, skins, morph weights) are evaluated there (default: the file's static pose)");
   render->add_option("--frame", r.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
@@ -512,6 +595,10 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitInput;
   }
 
+  r.spp_given = render->count("--spp") > 0;
+  r.depth_given = render->count("--max-depth") > 0;
+  r.background_given = render->count("--background") > 0;
+  r.ambient_given = render->count("--ambient") > 0;
   try {
     if (*render) return run_render(r);
     if (*info) return run_info(info_file, info_scene, info_external, info_flatten, info_accel, info_accel_params);

@@ -22,6 +22,7 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> supported_gltf_extensions() {
   return {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit",
+          "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission",
           "KHR_texture_transform", "EXT_mesh_gpu_instancing"};
 }
 
@@ -675,6 +676,35 @@ void Converter::convert_materials() {
       }
     }
     m.unlit = src.extensions.count("KHR_materials_unlit") > 0;
+    // A number in [lo, hi] at extensions.EXT.key (absent: keep the default).
+    auto ext_number = [&](const char* ext, const char* key, float& out, double lo, double hi, const char* range) {
+      auto it = src.extensions.find(ext);
+      if (it == src.extensions.end()) return;
+      const auto& v = it->second.Get(key);
+      if (v.Type() == tinygltf::NULL_TYPE) return;
+      const std::string w = where + ".extensions." + ext + "." + key;
+      if (!v.IsNumber()) fail(w, "must be a number");
+      const double x = finite_or_fail(v.GetNumberAsDouble(), w);
+      if (x < lo || x > hi) fail(w, std::string("must be ") + range);
+      out = float(x);
+    };
+    // ior: >= 1, or 0 (the extension's special case: f0 = 1).
+    ext_number("KHR_materials_ior", "ior", m.ior, 0.0, 1e6, "0 or in [1, 1e6]");
+    if (m.ior > 0 && m.ior < 1) fail(where + ".extensions.KHR_materials_ior.ior", "must be 0 or in [1, 1e6]");
+    ext_number("KHR_materials_specular", "specularFactor", m.specular, 0.0, 1.0, "in [0, 1]");
+    ext_number("KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0, 1.0, "in [0, 1]");
+    if (auto it = src.extensions.find("KHR_materials_transmission"); it != src.extensions.end() && m.transmission > 0) {
+      const auto& info = it->second.Get("transmissionTexture");
+      if (info.IsObject() && info.Get("index").IsInt()) {
+        tinygltf::ExtensionMap texture_extensions;
+        const auto& e = info.Get("extensions");
+        if (e.IsObject())
+          for (const auto& key : e.Keys()) texture_extensions[key] = e.Get(key);
+        const int tc = info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
+        m.transmission_tex = texture_ref(info.Get("index").GetNumberAsInt(), tc, texture_extensions, false,
+                                         where + ".extensions.KHR_materials_transmission.transmissionTexture");
+      }
+    }
     if (src.alphaMode == "OPAQUE" || src.alphaMode.empty()) m.alpha_mode = AlphaMode::Opaque;
     else if (src.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
     else if (src.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;

@@ -87,9 +87,14 @@ Vec3f sample_ggx_vndf(Vec3f v, float alpha, Vec2f u) {
   return normalize(Vec3f{alpha * nh.x, alpha * nh.y, std::max(1e-6f, nh.z)});
 }
 
+float dielectric_fresnel(const GltfBrdf& b, float cos_theta) {
+  return b.specular * schlick(Vec3f{b.f0, b.f0, b.f0}, cos_theta).x;
+}
+
 float specular_probability(const GltfBrdf& b) {
-  const float spec = luminance(mix(Vec3f{0.04f, 0.04f, 0.04f}, b.base_color, b.metallic));
-  const float diff = (1 - b.metallic) * 0.96f * luminance(b.base_color);
+  const float sf0 = b.specular * b.f0;
+  const float spec = luminance(mix(Vec3f{sf0, sf0, sf0}, b.base_color, b.metallic));
+  const float diff = (1 - b.metallic) * (1 - b.transmission) * (1 - sf0) * luminance(b.base_color);
   if (!(diff > 0)) return 1;
   if (!(spec > 0)) return 0;
   return std::clamp(spec / (spec + diff), 0.1f, 0.9f);  // never starve either lobe
@@ -103,9 +108,10 @@ Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
   const float alpha = alpha_of(b);
   const float v_dot_h = std::max(0.0f, dot(v, h));
   const float dv = ggx_d(h, alpha) * smith_visibility(l.z, v.z, alpha);
-  const Vec3f f_dielectric = schlick({0.04f, 0.04f, 0.04f}, v_dot_h);
+  const float fd = dielectric_fresnel(b, v_dot_h);
+  const Vec3f f_dielectric{fd, fd, fd};
   const Vec3f f_metal = schlick(b.base_color, v_dot_h);
-  const Vec3f diffuse = (Vec3f{1, 1, 1} - f_dielectric) * b.base_color * ((1 - b.metallic) / kPi);
+  const Vec3f diffuse = b.base_color * ((1 - fd) * (1 - b.metallic) * (1 - b.transmission) / kPi);
   const Vec3f specular = mix(f_dielectric, f_metal, b.metallic) * dv;
   return diffuse + specular;
 }

@@ -2,7 +2,10 @@
 // distribution with alpha = roughness^2, height-correlated Smith visibility, Schlick Fresnel,
 // Lambert diffuse under the dielectric's Fresnel layer, and the dielectric/metal mix by
 // `metallic`:
-//   f = (1 - m) (1 - F(0.04)) c / pi + [(1 - m) F(0.04) + m F(c)] D V
+//   f = (1 - m)(1 - t)(1 - s F(f0)) c / pi + [(1 - m) s F(f0) + m F(c)] D V
+// with f0 = 0.04 for the core model (KHR_materials_ior: ((ior - 1)/(ior + 1))^2), s the
+// KHR_materials_specular factor (1 by default) and t the KHR_materials_transmission factor (0 by
+// default; the transmitted part is a delta lobe the integrator handles, see path.h).
 // Sampling picks the diffuse or the specular lobe, the specular one by its distribution of
 // visible normals (Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018);
 // pdf() is the combined density of both, so estimators may use any of the three functions.
@@ -19,7 +22,13 @@ struct GltfBrdf {
   float metallic = 1;
   float roughness = 1;
   Vec3f n{0, 0, 1};
+  float f0 = 0.04f;        ///< dielectric reflectance at normal incidence
+  float specular = 1;      ///< KHR_materials_specular factor: scales the dielectric Fresnel
+  float transmission = 0;  ///< KHR_materials_transmission: share of the diffuse base removed
 };
+
+/// Fresnel reflectance of the dielectric layer at cos(theta) = cos_theta: s Schlick(f0).
+float dielectric_fresnel(const GltfBrdf& b, float cos_theta);
 
 /// Smallest alpha used: roughness 0 would make D a Dirac delta (below 1e-3 the lobe is
 /// narrower than float directions resolve anyway).
@@ -40,7 +49,7 @@ struct BrdfSample {
 bool brdf_sample(const GltfBrdf& b, Vec3f wo, float u1, Vec2f u, BrdfSample& out);
 
 /// Probability of choosing the specular lobe: its share of the Fresnel-at-normal-incidence
-/// reflectance, (1 - m) 0.04 + m c against (1 - m)(1 - 0.04) c (luminances).
+/// reflectance, (1 - m) s f0 + m c against (1 - m)(1 - t)(1 - s f0) c (luminances).
 float specular_probability(const GltfBrdf& b);
 
 /// The GGX pieces, in the local frame where the normal is +z (exposed for tests).

@@ -48,6 +48,11 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
   mp.roughness = std::clamp(mat.roughness * mr.y, 0.0f, 1.0f);
   const Vec4f em = eval_texture(scene, mat.emissive_tex, si);
   mp.emissive = mat.emissive * Vec3f{em.x, em.y, em.z};
+  mp.f0 = ior_to_f0(mat.ior);
+  mp.specular = mat.specular;
+  mp.transmission = mat.transmission;
+  if (mat.transmission > 0 && mat.transmission_tex.texture >= 0)
+    mp.transmission *= eval_texture(scene, mat.transmission_tex, si).x;
   if (mat.occlusion_tex.texture >= 0)
     mp.occlusion = 1 + mat.occlusion_strength * (eval_texture(scene, mat.occlusion_tex, si).x - 1);
   mp.ns = si.ns;

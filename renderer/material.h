@@ -19,7 +19,17 @@ struct MaterialPoint {
   float occlusion = 1;        ///< 1 + strength (texture.r - 1); ambient-only (not path traced)
   Vec3f ns;                   ///< unit shading normal after normal mapping, facing the viewer
   bool unlit = false;
+  float f0 = 0.04f;           ///< dielectric reflectance at normal incidence, from the ior
+  float specular = 1;         ///< KHR_materials_specular factor
+  float transmission = 0;     ///< factor x texture (R)
 };
+
+/// Dielectric reflectance at normal incidence for an index of refraction (glTF's 1.5 gives
+/// 0.04): ((ior - 1) / (ior + 1))^2.
+inline float ior_to_f0(float ior) {
+  const float r = (ior - 1) / (ior + 1);
+  return r * r;
+}
 
 /// The material used by meshes without one (glTF's default: white, metallic 1, roughness 1).
 const Material& default_material();

@@ -1,4 +1,4 @@
-// Tile renderer.
+// Tile renderer: Whitted (one pass) and path tracer (progressive passes).
 #include "renderer/render.h"
 
 #include <tbb/blocked_range.h>
@@ -12,27 +12,85 @@
 
 namespace penumbra {
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool is_plain_box(const PixelFilter& f) { return f.type == FilterType::Box && f.width == 1; }
+
+// A camera ray at raster position (px, py) with differentials `step` pixels apart.
+Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float py, float step,
+               RayDifferential& rd) {
+  const Ray ray = generate_camera_ray(camera, config.width, config.height, px, py);
+  const Ray rx = generate_camera_ray(camera, config.width, config.height, px + step, py);
+  const Ray ry = generate_camera_ray(camera, config.width, config.height, px, py + step);
+  rd = RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
+  return ray;
+}
+
+// Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
+float differential_step(int spp) { return std::max(0.125f, 1.0f / std::sqrt(float(spp))); }
+
+struct RayCounters {
+  std::atomic<uint64_t> camera{0}, shadow{0}, reflection{0};
+  void add(const RayCounts& c) {
+    camera += c.camera;
+    shadow += c.shadow;
+    reflection += c.reflection;
+  }
+  RayCounts load() const { return {camera.load(), shadow.load(), reflection.load()}; }
+};
+
+// Runs fn(x0, y0, x1, y1) over every tile of the image on `arena`.
+template <class Fn>
+void for_each_tile(tbb::task_arena& arena, const RenderConfig& config, Fn&& fn) {
+  const int ts = config.tile_size;
+  const int tiles_x = (config.width + ts - 1) / ts, tiles_y = (config.height + ts - 1) / ts;
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
+      for (int tile = r.begin(); tile != r.end(); ++tile) {
+        const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
+        fn(x0, y0, std::min(x0 + ts, config.width), std::min(y0 + ts, config.height));
+      }
+    });
+  });
+}
+
+int tile_count(const RenderConfig& config) {
+  const int ts = config.tile_size;
+  return ((config.width + ts - 1) / ts) * ((config.height + ts - 1) / ts);
+}
+
+int thread_count(const RenderConfig& config) {
+  return config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
+}
+
+}  // namespace
+
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4],
                           RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
-  // Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
-  const float step = std::max(0.125f, 1.0f / std::sqrt(float(n)));
+  const float step = differential_step(config.spp);
+  const bool box = is_plain_box(config.filter);
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
     Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
     const Vec2f j = stratified_sample(s, n, rng);
-    const float px = float(x) + j.x, py = float(y) + j.y;
-    const Ray ray = generate_camera_ray(camera, config.width, config.height, px, py);
-    const Ray rx = generate_camera_ray(camera, config.width, config.height, px + step, py);
-    const Ray ry = generate_camera_ray(camera, config.width, config.height, px, py + step);
-    const RayDifferential rd{true, rx.org, rx.dir, ry.org, ry.dir};
+    float px = float(x) + j.x, py = float(y) + j.y;
+    if (!box) {  // filter importance sampling of the stratified position
+      const Vec2f o = sample_filter(config.filter, j);
+      px = float(x) + 0.5f + o.x;
+      py = float(y) + 0.5f + o.y;
+    }
+    RayDifferential rd;
+    const Ray ray = camera_ray(camera, config, px, py, step, rd);
     float coverage = 0;
     sum += whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts);
     alpha += coverage;
   }
-  // Box filter: the plain mean of the pixel's samples.
+  // The plain mean of the pixel's samples.
   const float inv = 1.0f / float(n);
   rgba[0] = sum.x * inv;
   rgba[1] = sum.y * inv;
@@ -44,40 +102,182 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
                     const RenderConfig& user_config, RenderStats* stats, const ProgressFn& progress) {
   RenderConfig config = user_config;
   config.whitted.hit_filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   Film film = make_film(config.width, config.height);
-  const int ts = config.tile_size;
-  const int tiles_x = (config.width + ts - 1) / ts, tiles_y = (config.height + ts - 1) / ts;
-  const int tiles = tiles_x * tiles_y;
-  const int threads = config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
-
-  std::atomic<uint64_t> camera_rays{0}, shadow_rays{0}, reflection_rays{0};
+  const int tiles = tile_count(config);
+  const int threads = thread_count(config);
+  RayCounters rays;
   std::atomic<int> done{0};
   tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-        const int x1 = std::min(x0 + ts, config.width), y1 = std::min(y0 + ts, config.height);
-        RayCounts counts;
-        for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x)
-            render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x, y), counts);
-        camera_rays += counts.camera;
-        shadow_rays += counts.shadow;
-        reflection_rays += counts.reflection;
-        const int d = ++done;
-        if (progress) progress(d, tiles);
-      }
-    });
+  for_each_tile(arena, config, [&](int x0, int y0, int x1, int y1) {
+    RayCounts counts;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x)
+        render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x, y), counts);
+    rays.add(counts);
+    const int d = ++done;
+    if (progress) progress(d, tiles);
   });
-
   if (stats) {
-    stats->rays = {camera_rays.load(), shadow_rays.load(), reflection_rays.load()};
-    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats->rays = rays.load();
+    stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->threads = threads;
+    stats->passes = 1;
+    stats->samples = uint64_t(config.width) * uint64_t(config.height) * uint64_t(config.spp);
   }
   return film;
+}
+
+std::vector<int> path_pass_ends(int spp) {
+  std::vector<int> ends;
+  int n = 0;
+  while (n < spp) {
+    n = std::min(spp, n + std::max(1, std::min(n, 16)));
+    ends.push_back(n);
+  }
+  return ends;
+}
+
+float pixel_error(double sum_y, double sum_y2, uint32_t n) {
+  if (n < 2) return kInfinity;
+  const double mean = sum_y / n;
+  const double var = std::max(0.0, (sum_y2 - sum_y * mean) / double(n - 1));
+  const double standard_error = std::sqrt(var / n);
+  return float(standard_error / std::sqrt(std::max(mean, 1e-4)));
+}
+
+namespace {
+
+// Per-pixel accumulators of the path tracer.
+struct PixelAccum {
+  double rgba[4] = {0, 0, 0, 0};
+  double sum_y = 0, sum_y2 = 0;
+  uint32_t n = 0;
+  bool active = true;
+};
+
+// Adds samples [s0, s1) of pixel (x, y) to `acc`.
+void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                  const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x,
+                  int y, uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts) {
+  const float step = differential_step(config.spp);
+  for (uint32_t s = s0; s < s1; ++s) {
+    SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
+    const Vec2f o = sample_filter(config.filter, samples.get2d());
+    RayDifferential rd;
+    const Ray ray = camera_ray(camera, config, float(x) + 0.5f + o.x, float(y) + 0.5f + o.y, step, rd);
+    float coverage = 0;
+    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts);
+    acc.rgba[0] += l.x;
+    acc.rgba[1] += l.y;
+    acc.rgba[2] += l.z;
+    acc.rgba[3] += coverage;
+    const double y_lum = luminance(l);
+    acc.sum_y += y_lum;
+    acc.sum_y2 += y_lum * y_lum;
+    ++acc.n;
+  }
+}
+
+void resolve(const PixelAccum& acc, float rgba[4]) {
+  const double inv = acc.n ? 1.0 / acc.n : 0.0;
+  for (int c = 0; c < 4; ++c) rgba[c] = float(acc.rgba[c] * inv);
+}
+
+}  // namespace
+
+void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                       const Camera& camera, const RenderConfig& config, int x, int y,
+                       float rgba[4], RayCounts& counts) {
+  PathConfig pc = config.path;
+  pc.hit_filter = pc.hit_filter && scene_needs_hit_filter(scene);
+  PixelAccum acc;
+  path_samples(scene, accel, lights, camera, config, pc, x, y, 0, uint32_t(config.spp), acc, counts);
+  resolve(acc, rgba);
+}
+
+PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                      const Camera& camera, const RenderConfig& config, RenderStats* stats,
+                      const ProgressFn& progress) {
+  PathConfig pc = config.path;
+  pc.hit_filter = pc.hit_filter && scene_needs_hit_filter(scene);
+  const auto t0 = Clock::now();
+  const size_t npix = size_t(config.width) * size_t(config.height);
+  std::vector<PixelAccum> accum(npix);
+  const std::vector<int> ends = path_pass_ends(config.spp);
+  const int tiles = tile_count(config);
+  const int total_units = tiles * int(ends.size());
+  const int threads = thread_count(config);
+  const bool adaptive = config.adaptive_threshold > 0;
+  const uint32_t min_spp = uint32_t(std::max(2, std::min(config.adaptive_min_spp, config.spp)));
+  RayCounters rays;
+  std::atomic<int> done{0};
+  std::atomic<uint64_t> active_pixels{0};
+  tbb::task_arena arena(threads);
+  int passes = 0;
+  bool time_limited = false;
+  uint32_t begin = 0;
+  for (size_t pass = 0; pass < ends.size(); ++pass) {
+    const auto pass_start = Clock::now();
+    const uint32_t end = uint32_t(ends[pass]);
+    active_pixels = 0;
+    for_each_tile(arena, config, [&](int x0, int y0, int x1, int y1) {
+      RayCounts counts;
+      uint64_t active = 0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          PixelAccum& acc = accum[size_t(y) * size_t(config.width) + size_t(x)];
+          if (!acc.active) continue;
+          path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts);
+          if (adaptive && acc.n >= min_spp && pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
+            acc.active = false;
+          active += acc.active;
+        }
+      rays.add(counts);
+      active_pixels += active;
+      const int d = ++done;
+      if (progress) progress(d, total_units);
+    });
+    ++passes;
+    begin = end;
+    if (end >= uint32_t(config.spp) || (adaptive && active_pixels.load() == 0)) break;
+    if (config.time_limit > 0) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+      const double last = std::chrono::duration<double>(Clock::now() - pass_start).count();
+      // Stop unless the next pass (at most as long as this one, scaled by its sample count)
+      // still fits in the limit.
+      const double next = last * double(uint32_t(ends[pass + 1]) - end) / double(end - (pass ? uint32_t(ends[pass - 1]) : 0u));
+      if (elapsed + next > config.time_limit) {
+        time_limited = true;
+        break;
+      }
+    }
+  }
+
+  PathImage image;
+  image.film = make_film(config.width, config.height);
+  image.samples.resize(npix);
+  image.variance.resize(npix);
+  uint64_t total_samples = 0;
+  for (size_t i = 0; i < npix; ++i) {
+    const PixelAccum& acc = accum[i];
+    resolve(acc, &image.film.rgba[i * 4]);
+    image.samples[i] = acc.n;
+    total_samples += acc.n;
+    if (acc.n >= 2) {
+      const double mean = acc.sum_y / acc.n;
+      image.variance[i] = float(std::max(0.0, (acc.sum_y2 - acc.sum_y * mean) / double(acc.n - 1)) / acc.n);
+    }
+  }
+  if (stats) {
+    stats->rays = rays.load();
+    stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    stats->threads = threads;
+    stats->passes = passes;
+    stats->samples = total_samples;
+    stats->time_limited = time_limited;
+  }
+  return image;
 }
 
 }  // namespace penumbra

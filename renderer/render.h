@@ -1,32 +1,53 @@
-// The multi-threaded tile renderer: square tiles scheduled with TBB, stratified jittered
-// supersampling with a box filter, one RNG per (pixel, sample) so the image is bit-identical
-// for any thread count.
+// The multi-threaded tile renderer: square tiles scheduled with TBB, one sample stream per
+// (pixel, sample) so the image is bit-identical for any thread count.
+//
+// Whitted: stratified jittered supersampling of each pixel, box filtered (or any pixel filter,
+// applied by filter importance sampling). Path: progressive passes over the image (1, 2, 4, 8,
+// 16 samples, then 16 per pass), each pixel the mean of its samples, with an optional time limit
+// (checked after each whole pass) and optional adaptive sampling that stops pixels whose
+// estimated error falls below a threshold. Each pixel's value depends only on its own
+// samples, so neither threads, tiles nor the pass schedule change it.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "renderer/camera.h"
 #include "renderer/film.h"
+#include "renderer/filter.h"
+#include "renderer/path.h"
 #include "renderer/whitted.h"
 
 namespace penumbra {
+
+enum class IntegratorType : uint8_t { Whitted, Path };
 
 /// Render settings with their defaults (the CLI validates user values before use).
 struct RenderConfig {
   int width = 960;
   int height = 540;
-  int spp = 4;            ///< samples per pixel, >= 1; perfect squares stratify fully
+  int spp = 4;            ///< samples per pixel, >= 1 (path: the maximum with --adaptive)
   int threads = 0;        ///< worker threads; 0 = all hardware threads
   int tile_size = 32;     ///< square tile edge in pixels
   uint64_t seed = 0;      ///< decorrelates whole renders; same seed => same image
+  PixelFilter filter;     ///< box, 1 pixel wide by default
   WhittedConfig whitted;
+  // Path tracer only.
+  PathConfig path;
+  SamplerType sampler = SamplerType::Sobol;
+  double time_limit = 0;          ///< seconds; > 0: stop after the pass that reaches it
+  float adaptive_threshold = 0;   ///< > 0: stop a pixel once its error estimate is below this
+  int adaptive_min_spp = 16;      ///< samples every pixel takes before it may stop
 };
 
 struct RenderStats {
   RayCounts rays;
   double seconds = 0;
   int threads = 0;
+  int passes = 0;           ///< path: passes rendered
+  uint64_t samples = 0;     ///< camera samples taken in all
+  bool time_limited = false;  ///< path: the time limit ended the render early
 };
 
 /// Called after each finished tile with (tiles done, tiles total), from worker threads;
@@ -44,5 +65,33 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4],
                           RayCounts& counts);
+
+/// A path-traced image with its per-pixel statistics.
+struct PathImage {
+  Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied)
+  std::vector<uint32_t> samples;   ///< samples taken per pixel
+  std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
+};
+
+/// Renders with the path tracer. Same requirements as render_whitted; `lights` must be built
+/// from the same scene (build_area_lights) with a non-null environment.
+PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                      const Camera& camera, const RenderConfig& config,
+                      RenderStats* stats = nullptr, const ProgressFn& progress = {});
+
+/// One pixel exactly as render_path computes it with all `config.spp` samples (no adaptive
+/// stop): the replay behind --debug-pixel.
+void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                       const Camera& camera, const RenderConfig& config, int x, int y,
+                       float rgba[4], RayCounts& counts);
+
+/// The pass schedule of render_path: sample index where pass k ends (1, 2, 4, 8, 16, 32, 48,
+/// ... capped at spp).
+std::vector<int> path_pass_ends(int spp);
+
+/// Error estimate of a pixel for adaptive sampling (as Cycles weighs it): the standard error
+/// of its mean luminance divided by sqrt(mean luminance), so that dark pixels, where the
+/// display transform stretches noise, need a proportionally smaller absolute error.
+float pixel_error(double sum_y, double sum_y2, uint32_t n);
 
 }  // namespace penumbra

@@ -47,6 +47,10 @@ struct Material {
   TextureRef occlusion_tex;           ///< R = ambient occlusion (linear)
   float occlusion_strength = 1;       ///< 1 + strength (R - 1)
   TextureRef emissive_tex;            ///< RGB, multiplies emissive
+  float ior = 1.5f;                   ///< KHR_materials_ior: dielectric f0 = ((ior-1)/(ior+1))^2
+  float specular = 1;                 ///< KHR_materials_specular specularFactor
+  float transmission = 0;             ///< KHR_materials_transmission factor (thin-walled)
+  TextureRef transmission_tex;        ///< R multiplies transmission (linear)
 };
 
 /// A triangle mesh (one glTF primitive): in world space when its only instance is the identity

@@ -9,7 +9,8 @@ namespace penumbra {
 WhittedParams whitted_params(const MaterialPoint& m) {
   const float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
   const float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
-  const Vec3f f0 = Vec3f{0.04f, 0.04f, 0.04f} * (1 - metallic) + m.base_color * metallic;
+  const float d0 = m.specular * m.f0;  // 0.04 for the core glTF model
+  const Vec3f f0 = Vec3f{d0, d0, d0} * (1 - metallic) + m.base_color * metallic;
   WhittedParams w;
   w.kd = m.base_color * (1 - metallic);
   w.ka = w.kd;
@@ -27,6 +28,8 @@ WhittedParams whitted_params(const Material& m) {
   mp.metallic = m.metallic;
   mp.roughness = m.roughness;
   mp.emissive = m.emissive;
+  mp.f0 = ior_to_f0(m.ior);
+  mp.specular = m.specular;
   return whitted_params(mp);
 }
 

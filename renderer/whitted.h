@@ -20,7 +20,8 @@ struct WhittedParams {
 };
 
 /// The documented mapping from glTF factors (README "Whitted material mapping"):
-///   f0 = mix(0.04, base_color, metallic)      specular colour at normal incidence
+///   f0 = mix(s d0, base_color, metallic)      specular colour at normal incidence (d0 = 0.04
+///        from the ior, s = KHR_materials_specular's factor, 1 by default)
 ///   kd = ka = base_color x (1 - metallic)
 ///   ks = f0
 ///   p  = clamp(2 / alpha^2 - 2, 1, 10000), alpha = roughness^2 (Beckmann-equivalent

@@ -73,4 +73,45 @@ inline Light point_light(Vec3f position, float intensity, Vec3f color = {1, 1, 1
   return l;
 }
 
+/// A pure Lambertian material (KHR_materials_specular factor 0: no Fresnel layer), with
+/// optional emission; double-sided unless told.
+inline int add_lambert(Scene& s, Vec3f albedo, Vec3f emissive = {0, 0, 0}, bool double_sided = true) {
+  const int m = add_material(s, albedo, 0, 1);
+  s.materials[size_t(m)].specular = 0;
+  s.materials[size_t(m)].emissive = emissive;
+  s.materials[size_t(m)].double_sided = double_sided;
+  return m;
+}
+
+/// A closed, flat-shaded sphere of radius r around c: an octahedron subdivided `level` times
+/// with its vertices pushed onto the sphere (8 * 4^level triangles, outward counter-clockwise).
+inline int add_sphere(Scene& s, Vec3f c, float r, int level, int material) {
+  std::vector<Vec3f> tris{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  std::vector<Vec3f> all;
+  for (int sx : {1, -1})
+    for (int sy : {1, -1})
+      for (int sz : {1, -1}) {
+        Vec3f a{float(sx), 0, 0}, b{0, float(sy), 0}, d{0, 0, float(sz)};
+        if (sx * sy * sz < 0) std::swap(a, b);  // keep the winding outward
+        all.insert(all.end(), {a, b, d});
+      }
+  for (int l = 0; l < level; ++l) {
+    std::vector<Vec3f> next;
+    for (size_t i = 0; i < all.size(); i += 3) {
+      const Vec3f a = all[i], b = all[i + 1], d = all[i + 2];
+      const Vec3f ab = normalize(a + b), bd = normalize(b + d), da = normalize(d + a);
+      next.insert(next.end(), {a, ab, da, ab, b, bd, da, bd, d, ab, bd, da});
+    }
+    all.swap(next);
+  }
+  Mesh m;
+  m.name = "sphere";
+  for (const Vec3f& p : all) {
+    m.indices.push_back(uint32_t(m.positions.size()));
+    m.positions.push_back(c + p * r);
+  }
+  m.material = material;
+  return add_world_mesh(s, std::move(m));
+}
+
 }  // namespace penumbra::test

@@ -1,0 +1,44 @@
+// Environment map loading through OpenImageIO.
+#include "io/environment_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+
+#include "io/error.h"
+
+namespace penumbra {
+
+Environment load_environment(const std::filesystem::path& path, float intensity,
+                             float rotation_degrees) {
+  const std::string file = path.string();
+  if (!std::isfinite(intensity) || intensity < 0)
+    throw InputError(file, "--env-intensity", "must be finite and >= 0");
+  if (!std::isfinite(rotation_degrees)) throw InputError(file, "--env-rotation", "must be finite");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "", "environment map not found");
+  auto in = OIIO::ImageInput::open(file);
+  if (!in) throw InputError(file, "", "cannot read environment map: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  const int w = spec.width, h = spec.height, nc = spec.nchannels;
+  if (w < 1 || h < 1 || nc < 1) throw InputError(file, "", "environment map has no pixels");
+  if (w > kMaxEnvironmentSide || h > kMaxEnvironmentSide)
+    throw InputError(file, "", "environment map " + std::to_string(w) + "x" + std::to_string(h) + " exceeds " +
+                                   std::to_string(kMaxEnvironmentSide) + " per side");
+  std::vector<float> pixels(size_t(w) * size_t(h) * size_t(nc));
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw InputError(file, "", "cannot decode environment map: " + in->geterror());
+  in->close();
+  std::vector<Vec3f> texels(size_t(w) * size_t(h));
+  for (size_t i = 0; i < texels.size(); ++i) {
+    const float* p = &pixels[i * size_t(nc)];
+    const Vec3f c = nc >= 3 ? Vec3f{p[0], p[1], p[2]} : Vec3f{p[0], p[0], p[0]};
+    if (!is_finite(c) || c.x < 0 || c.y < 0 || c.z < 0)
+      throw InputError(file, "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)),
+                       "environment texels must be finite and >= 0");
+    texels[i] = c;
+  }
+  return make_map_environment(w, h, std::move(texels), intensity, rotation_degrees * kPi / 180.0f);
+}
+
+}  // namespace penumbra
