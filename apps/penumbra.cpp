@@ -321,6 +321,14 @@ int run_render(const RenderArgs& a) {
   if (!cfg.width) cfg.width = std::max(1, int(std::lround(cfg.height * hint)));
   if (cfg.width > 16384 || cfg.height > 16384)
     throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
+  if (path) {  // the path tracer keeps per-pixel accumulators (render.h PixelAccum) and statistics
+    const uint64_t bytes = uint64_t(cfg.width) * uint64_t(cfg.height) * 88;
+    const uint64_t budget = a.max_memory.empty() ? default_memory_budget() : parse_bytes(a.max_memory);
+    if (bytes > budget)
+      throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " needs " +
+                       std::to_string(bytes >> 20) + " MiB of path tracer accumulators, over the memory budget of " +
+                       std::to_string(budget >> 20) + " MiB (--max-memory)");
+  }
   const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
                                        : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
   // The path tracer's lights: emissive triangles and the environment.

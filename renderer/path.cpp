@@ -156,7 +156,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
             lh.v = ls.v;
             lh.geom_id = ls.instance;
             lh.prim_id = ls.prim;
-            const Vec3f le = eval_material(scene, make_interaction(scene, to_light, lh)).emissive;
+            // The emission there, times the light's own coverage: a Blend emitter is hit by
+            // BSDF-sampled rays with probability alpha, a Mask hole not at all.
+            const MaterialPoint lp = eval_material(scene, make_interaction(scene, to_light, lh));
+            const Vec3f le = lp.emissive * lp.alpha;
             if (max_component(le) > 0) {
               ++counts.shadow;
               const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, dist), cfg.hit_filter);

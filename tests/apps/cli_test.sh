@@ -94,6 +94,37 @@ expect 2 "unknown key 'grid.lamda'" -- "$bin" render "$src/scenes/default.gltf" 
 expect 2 "lambda must be in" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=-1
 expect 2 "'2x' is not a valid" -- "$bin" info "$src/scenes/default.gltf" --accel-param bvh.bin_count=2x
 expect 2 "expected key=value" -- "$bin" info "$src/scenes/default.gltf" --accel-param bvh
+# The path tracer: its options, their mistakes, environment maps and the deterministic replay.
+d="$src/scenes/default.gltf"
+expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --env 1
+expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --adaptive 0.01
+expect 2 "--background applies to --integrator whitted" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --background 1
+expect 2 "integrator" -- "$bin" render "$d" -o "$work/p.exr" --integrator bidir
+expect 2 "unknown filter 'mitchell'" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --filter mitchell
+expect 2 "filter-width" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --filter-width 100
+expect 2 "env: values must be finite" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --env=-1
+expect 2 "sky.exr: environment map not found" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --env "$work/sky.exr"
+expect 2 "clamp-indirect" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --clamp-indirect nan
+expect 2 "time-limit" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --time-limit=-1
+expect 2 "needs [0-9]+ MiB of path tracer accumulators" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --width 16384 --height 16384 --max-memory 1G
+[ ! -e "$work/p.exr" ] || { echo "FAIL: a refused path render left $work/p.exr"; fails=$((fails + 1)); }
+expect 0 "path max-depth 12, filter blackman-harris 1.5 px" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --width 48 --spp 4
+expect 0 "path max-depth 3, filter gaussian 3 px" -- "$bin" render "$d" -o "$work/q.exr" --integrator path --width 48 --spp 4 \
+  --max-depth 3 --filter gaussian --sampler independent --light-sampling bsdf --clamp-indirect 10 --env 0.2,0.3,0.4
+expect 0 "stopped by --time-limit" -- "$bin" render "$d" -o "$work/t.exr" --integrator path --width 48 --spp 4096 --time-limit 0.000001 --no-png
+expect 0 "adaptive" -- "$bin" render "$d" -o "$work/ad.exr" --integrator path --width 48 --spp 64 --adaptive 0.05 --no-png
+if command -v oiiotool >/dev/null; then
+  # An environment map: a 16 x 8 EXR sky made by oiiotool, rotated and scaled.
+  oiiotool --pattern fill:top=4,4,5:bottom=0.2,0.1,0 16x8 3 -d float -o "$work/sky.exr" >/dev/null 2>&1
+  expect 0 "sky.png" -- "$bin" render "$d" -o "$work/sky.exr.out.exr" --png "$work/sky.png" --integrator path --width 48 --spp 4 --env "$work/sky.exr" --env-rotation 45 --env-intensity 2
+  expect 0 "penumbra:integrator: \"path\"" -- oiiotool --info -v "$work/p.exr"
+  # --debug-pixel replays exactly the pixel of the full render.
+  "$bin" render "$d" -o "$work/dp.exr" --integrator path --width 48 --spp 4 --filter box --no-png --float -q >/dev/null
+  want=$(oiiotool "$work/dp.exr" --cut 1x1+20+14 --printstats 2>/dev/null | awk '/Stats Avg/ {print $3}')
+  got=$("$bin" render "$d" -o "$work/dp2.exr" --integrator path --width 48 --spp 4 --filter box --debug-pixel 20,14 | awk '{print $4}')
+  if awk -v a="$want" -v b="$got" 'BEGIN {d = a - b; exit !(a > 0 && d * d <= 1e-10 * a * a)}'; then passes=$((passes + 1));
+  else echo "FAIL: --debug-pixel 20,14 gave R $got, the render has $want"; fails=$((fails + 1)); fi
+fi
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Hostile files from the shared corpus (skipped visibly without it).

@@ -317,3 +317,32 @@ TEST_CASE("gltf: unreadable images are warnings naming the image; an image buffe
   CHECK_THROWS_WITH(load_gltf(file_with({{{"bufferView", view}}}, 60000)),
                     Catch::Contains("bufferViews[2]: byteOffset + byteLength exceeds buffer 0"));
 }
+
+TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field", "[io][gltf][quick]") {
+  GltfWriter w;
+  const int m = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
+  w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
+  w.node({{"mesh", m}});
+  w.j["materials"] = {{{"extensions",
+                        {{"KHR_materials_ior", {{"ior", 2.0}}},
+                         {"KHR_materials_specular", {{"specularFactor", 0.5}}},
+                         {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}}}}}};
+  w.j["extensionsUsed"] = {"KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission"};
+  w.j["extensionsRequired"] = {"KHR_materials_transmission"};
+  const LoadedScene loaded = write_and_load(w, "extmat");
+  const Material& mat = loaded.scene.materials.at(0);
+  CHECK(mat.ior == 2);
+  CHECK(mat.specular == 0.5f);
+  CHECK(mat.transmission == 0.75f);
+  // ior 0 is the extension's special case (f0 = 1); between 0 and 1 it is an error.
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.0;
+  CHECK(write_and_load(w, "ior0").scene.materials.at(0).ior == 0);
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.5;
+  REQUIRE_THROWS_WITH(write_and_load(w, "iorbad"), Contains("materials[0].extensions.KHR_materials_ior.ior"));
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 1.5;
+  w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 1.5;
+  REQUIRE_THROWS_WITH(write_and_load(w, "trbad"), Contains("KHR_materials_transmission.transmissionFactor") && Contains("[0, 1]"));
+  w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 0.5;
+  w.j["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"] = "shiny";
+  REQUIRE_THROWS_WITH(write_and_load(w, "spbad"), Contains("KHR_materials_specular.specularFactor") && Contains("number"));
+}

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Penumbra's path tracer against Blender Cycles (CPU) on the same scenes, camera, resolution,
+# spp, threads and constant world, in the same run on the same machine (issue 6's benchmark).
+# For each scene and renderer: a REF_SPP reference, then renders at each of SPPS, timed by the
+# renderer itself (render only, no loading), with the RMSE of R, G, B against its own
+# reference (oiiotool --diff). Writes benchmarks/results/cycles-<date>.txt.
+#
+# usage: benchmarks/cycles/run.sh [PENUMBRA_BINARY]   (env: REF_SPP=1024 SPPS="16 64 256" THREADS=2)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+penumbra=${1:-$root/build/apps/penumbra}
+corpus=${PENUMBRA_CORPUS:-$root/../shared/corpus}
+REF_SPP=${REF_SPP:-1024}
+SPPS=${SPPS:-"16 64 256"}
+THREADS=${THREADS:-2}
+W=640 H=360
+work=$(mktemp -d /tmp/penumbra-cycles.XXXXXX)
+out="$root/benchmarks/results/cycles-$(date +%Y-%m-%d).txt"
+command -v blender >/dev/null || { echo "blender not installed (apt-get install blender python3-numpy)"; exit 2; }
+
+# name, file, eye x y z, yfov, pitch (degrees about +X), world radiance
+scenes=(
+  "cornell|$corpus/valid/CornellBox-Vinc3r/glTF/cornellBox-2.80-Eevee-gltf.gltf|0 1.5 5.6|0.75|0|0"
+  "helmet|$corpus/valid/DamagedHelmet/glTF-Binary/DamagedHelmet.glb|0 0 2.7|0.75|0|1"
+)
+
+rmse() { oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | awk '/RMS error/ {print $4}'; }
+pen() {  # scene out spp bg -> seconds
+  "$penumbra" render "$1" -o "$2" --no-png --integrator path --spp "$3" --width $W --height $H --camera bench \
+    --threads "$THREADS" --env "$4" --float 2>&1 | awk '/render [0-9.]+s/ {for (i=1;i<=NF;i++) if ($i=="render") {sub("s","",$(i+1)); print $(i+1)}}'
+}
+cyc() {
+  blender -b --factory-startup -P "$here/render_cycles.py" -- "$1" "$2" $W $H "$3" "$THREADS" "$4" 2>&1 |
+    awk '/cycles_render_seconds/ {print $2}'
+}
+
+{
+  echo "# Penumbra path tracer vs Blender Cycles, $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "# command: benchmarks/cycles/run.sh  (REF_SPP=$REF_SPP SPPS=\"$SPPS\" THREADS=$THREADS, ${W}x${H})"
+  echo "# machine: $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo); $(blender --version 2>/dev/null | head -1); penumbra $("$penumbra" --version | awk '{print $2}')"
+  echo "# columns: scene renderer spp render_seconds samples_per_second rmse_vs_own_reference"
+} > "$out"
+
+for s in "${scenes[@]}"; do
+  IFS='|' read -r name file eye fov pitch bg <<<"$s"
+  scene=$(python3 "$here/add_camera.py" "$file" "$work/$name" $eye "$fov" "$pitch")
+  for r in penumbra cycles; do
+    f=$([ $r = penumbra ] && echo pen || echo cyc)
+    t=$($f "$scene" "$work/$name-$r-ref.exr" "$REF_SPP" "$bg")
+    echo "$name $r $REF_SPP $t reference" | tee -a "$out"
+    for spp in $SPPS; do
+      t=$($f "$scene" "$work/$name-$r-$spp.exr" "$spp" "$bg")
+      sps=$(awk -v t="$t" -v n=$((W * H * spp)) 'BEGIN {printf "%.0f", n / t}')
+      echo "$name $r $spp $t $sps $(rmse "$work/$name-$r-$spp.exr" "$work/$name-$r-ref.exr")" | tee -a "$out"
+    done
+  done
+done
+echo "results: $out"
+echo "images: $work"
