@@ -11,6 +11,7 @@
 #include <iostream>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -23,6 +24,7 @@
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
+#include "renderer/aov.h"
 #include "renderer/cost_map.h"
 #include "renderer/render.h"
 
@@ -126,14 +128,23 @@ class ProgressReporter {
       if (decile <= m_last_decile) return;
       m_last_decile = decile;
     }
+    m_open = m_tty && done != total;
     const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
     std::fprintf(stderr, "%srender %5.1f%%  elapsed %6.1fs  eta %6.1fs%s", m_tty ? "\r" : "",
                  100 * frac, elapsed, eta, m_tty ? (done == total ? "\n" : "") : "\n");
     std::fflush(stderr);
   }
 
+  /// Ends a terminal progress line left open by a render that stopped early (--time-limit,
+  /// --adaptive), so the summary starts on its own line.
+  void finish() {
+    std::lock_guard lock(m_mutex);
+    if (m_open) std::fputc('\n', stderr);
+    m_open = false;
+  }
+
  private:
-  bool m_enabled, m_tty;
+  bool m_enabled, m_tty, m_open = false;
   std::mutex m_mutex;
   Clock::time_point m_start = Clock::now();
   double m_last = -1;
@@ -150,6 +161,7 @@ struct RenderArgs {
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
+  std::string command_line;
   std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
   int rr_depth = 3, adaptive_min_spp = 16;
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
@@ -207,6 +219,70 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
   }
   if (found < 0) throw InputError(file, "--camera", "no camera named '" + spec + "' (" + listing + ")");
   return found;
+}
+
+/// The AOV names --aov accepts (besides "all").
+constexpr const char* kAovNames[] = {"albedo", "N", "P", "Z", "UV", "id", "samples", "variance", "light", "cost"};
+
+std::string json_string(const std::string& v) {
+  std::string r = "\"";
+  for (unsigned char c : v) {
+    if (c == '"' || c == '\\') r += '\\', r += char(c);
+    else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      r += buf;
+    } else r += char(c);
+  }
+  return r + "\"";
+}
+
+/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind id.object
+/// (glTF node index + 1) and id.material (material index + 1); 0 is the background.
+std::string id_manifest(const Scene& scene, const GltfInfo& info) {
+  std::set<int> nodes;
+  for (const auto& inst : scene.instances)
+    if (inst.node >= 0) nodes.insert(inst.node);
+  std::string j = "{\"object\": {";
+  bool first = true;
+  for (int n : nodes) {
+    const std::string name = size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
+    j += (first ? "" : ", ") + json_string(std::to_string(n + 1)) + ": " + json_string(name);
+    first = false;
+  }
+  j += "}, \"material\": {";
+  for (size_t m = 0; m < scene.materials.size(); ++m)
+    j += (m ? ", " : "") + json_string(std::to_string(m + 1)) + ": " + json_string(scene.materials[m].name);
+  return j + "}}";
+}
+
+/// OpenEXR's standard camera attributes (row vectors, p' = p M; camera space looks down -Z):
+/// worldToCamera, and worldToNDC mapping the image to x, y in [-1, 1] (y up) after the
+/// homogeneous divide, as Nuke reads them; plus the field of view and clip distances.
+void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int height) {
+  const Vec3f u = cam.u, v = cam.v, w = cam.w, e = cam.eye;
+  const std::array<float, 16> w2c = {u.x, v.x, w.x, 0, u.y, v.y, w.y, 0, u.z, v.z, w.z, 0,
+                                     -dot(e, u), -dot(e, v), -dot(e, w), 1};
+  const float aspect = float(width) / float(height);
+  std::array<float, 16> proj{};  // camera space -> clip space (row vectors)
+  if (cam.projection == Projection::Perspective) {
+    const float ty = std::tan(0.5f * cam.yfov), tx = ty * aspect;
+    proj = {1 / tx, 0, 0, 0, 0, 1 / ty, 0, 0, 0, 0, -1, -1, 0, 0, 0, 0};
+  } else {
+    proj = {1 / (cam.ymag * aspect), 0, 0, 0, 0, 1 / cam.ymag, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
+  }
+  std::array<float, 16> w2ndc{};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) w2ndc[size_t(r * 4 + c)] += w2c[size_t(r * 4 + k)] * proj[size_t(k * 4 + c)];
+  exr.matrix_metadata.push_back({"worldToCamera", w2c});
+  exr.matrix_metadata.push_back({"worldToNDC", w2ndc});
+  if (cam.projection == Projection::Perspective) {
+    exr.float_metadata.push_back({"penumbra:yfov_degrees", cam.yfov * 180 / kPi});
+    exr.float_metadata.push_back({"penumbra:xfov_degrees", 2 * std::atan(std::tan(0.5f * cam.yfov) * aspect) * 180 / kPi});
+  }
+  exr.float_metadata.push_back({"penumbra:near", cam.znear});
+  exr.float_metadata.push_back({"penumbra:far", std::isfinite(cam.zfar) ? cam.zfar : std::numeric_limits<float>::max()});
 }
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
@@ -280,11 +356,29 @@ int run_render(const RenderArgs& a) {
   if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
     throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
   const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
-  bool cost_aov = false;
-  for (const auto& aov : a.aovs) {
-    if (aov != "cost") throw UsageError("--aov: unknown AOV '" + aov + "' (known: cost)");
-    cost_aov = true;
+  // --aov NAME[,NAME...] (repeatable); "all" = every compositing AOV of the integrator.
+  std::set<std::string> aovs;
+  for (const auto& item : a.aovs) {
+    std::stringstream ss(item);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+      if (name == "all") {
+        aovs.insert({"albedo", "N", "P", "Z", "UV", "id"});
+        if (path) aovs.insert({"samples", "variance", "light"});
+        continue;
+      }
+      if (std::find(std::begin(kAovNames), std::end(kAovNames), name) == std::end(kAovNames)) {
+        std::string known;
+        for (const char* k : kAovNames) known += (known.empty() ? "" : ", ") + std::string(k);
+        throw UsageError("--aov: unknown AOV '" + name + "' (known: " + known + ", all)");
+      }
+      if (!path && (name == "samples" || name == "variance" || name == "light"))
+        throw UsageError("--aov " + name + " needs --integrator path");
+      aovs.insert(name);
+    }
   }
+  const bool cost_aov = aovs.count("cost") > 0;
+  const bool data_aovs = aovs.count("albedo") || aovs.count("N") || aovs.count("P") || aovs.count("Z") || aovs.count("UV") || aovs.count("id");
   std::optional<fs::path> cost_png;
   if (cost_aov) {
     if (!a.no_png) {
@@ -357,6 +451,7 @@ int run_render(const RenderArgs& a) {
   cfg.time_limit = a.time_limit;
   cfg.adaptive_threshold = a.adaptive;
   cfg.adaptive_min_spp = a.adaptive_min_spp;
+  cfg.light_groups = aovs.count("light") > 0;
   const PathLights path_lights{&area_lights, &environment};
 
   // Build.
@@ -382,8 +477,14 @@ int run_render(const RenderArgs& a) {
   ProgressReporter reporter(!a.quiet);
   RenderStats stats;
   Film film;
-  if (path) film = std::move(render_path(scene, *accel, path_lights, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); }).film);
-  else film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+  PathImage path_image;
+  if (path) {
+    path_image = render_path(scene, *accel, path_lights, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+    film = std::move(path_image.film);
+  } else {
+    film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+  }
+  reporter.finish();
   const double mean_spp = double(stats.samples) / (double(cfg.width) * double(cfg.height));
 
   // Write.
@@ -400,10 +501,47 @@ int run_render(const RenderArgs& a) {
     exr.metadata.push_back({"penumbra:mean_spp", buf});
     exr.metadata.push_back({"penumbra:passes", std::to_string(stats.passes)});
   }
+  exr.metadata.push_back({"penumbra:command_line", a.command_line});
+  exr.metadata.push_back({"penumbra:version", PENUMBRA_VERSION});
+  add_camera_metadata(exr, camera, cfg.width, cfg.height);
+  exr.float_metadata.push_back({"penumbra:render_seconds", float(stats.seconds)});
+  DataAovs data;
+  std::vector<float> samples_f;
+  if (data_aovs) {
+    data = render_data_aovs(scene, *accel, camera, cfg, path ? IntegratorType::Path : IntegratorType::Whitted);
+    const ChannelType colour = a.use_float ? ChannelType::Float : ChannelType::Half;
+    if (aovs.count("albedo"))
+      for (int c = 0; c < 3; ++c) exr.extra.push_back({std::string("albedo.") + "RGB"[c], &data.albedo, colour, 3, c});
+    if (aovs.count("N"))
+      for (int c = 0; c < 3; ++c) exr.extra.push_back({std::string("N.") + "XYZ"[c], &data.normal, ChannelType::Float, 3, c});
+    if (aovs.count("P"))
+      for (int c = 0; c < 3; ++c) exr.extra.push_back({std::string("P.") + "XYZ"[c], &data.position, ChannelType::Float, 3, c});
+    if (aovs.count("Z")) exr.extra.push_back({"Z", &data.depth, ChannelType::Float});
+    if (aovs.count("UV"))
+      for (int c = 0; c < 2; ++c) exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
+    if (aovs.count("id")) {
+      exr.extra.push_back({"id.object", &data.object_id, ChannelType::Uint});
+      exr.extra.push_back({"id.material", &data.material_id, ChannelType::Uint});
+      exr.metadata.push_back({"penumbra:manifest", id_manifest(scene, loaded.info)});
+    }
+  }
+  if (aovs.count("samples")) {
+    samples_f.assign(path_image.samples.begin(), path_image.samples.end());
+    exr.extra.push_back({"samples", &samples_f, ChannelType::Uint});
+  }
+  if (aovs.count("variance")) exr.extra.push_back({"variance", &path_image.variance, ChannelType::Float});
+  if (aovs.count("light"))
+    for (int g = 0; g < 5; ++g)
+      for (int c = 0; c < 3; ++c)
+        exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &path_image.groups,
+                             a.use_float ? ChannelType::Float : ChannelType::Half, 15, g * 3 + c});
   CostImage cost;
   if (cost_aov) {
     cost = render_cost(*accel, camera, cfg);
-    if (cost.counted) exr.extra = {{"cost.nodes", &cost.nodes}, {"cost.triangles", &cost.triangles}};
+    if (cost.counted) {
+      exr.extra.push_back({"cost.nodes", &cost.nodes});
+      exr.extra.push_back({"cost.triangles", &cost.triangles});
+    }
     exr.extra.push_back({"cost.ns", &cost.nanoseconds});
   }
   write_exr(film, out, exr);
@@ -579,9 +717,10 @@ int main(int argc, char** argv) {
   render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
   render->add_option("--aov", r.aovs,
-                     "extra outputs (repeatable): cost = traversal cost of the camera rays, as EXR channels "
-                     "cost.nodes, cost.triangles (not for embree, which keeps no counts) and cost.ns (wall clock), "
-                     "and a heat map with a legend (counts, or time for embree)");
+                     "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
+                     "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
+                     "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
+                     "(cost.nodes, cost.triangles, cost.ns) and a heat map");
   render->add_option("--cost-png", r.cost_png, "heat map path for --aov cost (default: the EXR path with .cost.png)");
 
   std::string info_file, info_accel = "embree";
@@ -603,6 +742,7 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitInput;
   }
 
+  for (int i = 0; i < argc; ++i) r.command_line += (i ? " " : "") + std::string(argv[i]);
   r.spp_given = render->count("--spp") > 0;
   r.depth_given = render->count("--max-depth") > 0;
   r.background_given = render->count("--background") > 0;

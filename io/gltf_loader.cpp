@@ -1501,6 +1501,8 @@ void Converter::run() {
   for (size_t i = 0; i < m_model.scenes.size(); ++i)
     info.scene_names.push_back(m_model.scenes[i].name.empty() ? idx("scenes", i) : m_model.scenes[i].name);
   info.node_count = int(m_model.nodes.size());
+  for (size_t i = 0; i < m_model.nodes.size(); ++i)
+    info.node_names.push_back(m_model.nodes[i].name.empty() ? idx("nodes", i) : m_model.nodes[i].name);
   info.mesh_count = int(m_model.meshes.size());
   for (const auto& m : m_model.meshes) info.primitive_count += int(m.primitives.size());
   info.gltf_camera_count = int(m_model.cameras.size());

@@ -42,6 +42,7 @@ struct GltfInfo {
   int gltf_camera_count = 0, gltf_light_count = 0, image_count = 0, animation_count = 0;
   std::vector<std::string> extensions_used, extensions_required;
   std::vector<std::string> camera_instances;  ///< "name (perspective, node 3)" in scene order
+  std::vector<std::string> node_names;        ///< each node's name, or "nodes[i]" if unnamed
 };
 
 struct LoadedScene {

@@ -2,6 +2,7 @@
 #include "io/image_output.h"
 
 #include <OpenColorIO/OpenColorIO.h>
+#include <OpenImageIO/half.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include "io/atomic_file.h"
@@ -37,36 +39,67 @@ void write_with_oiio(const std::filesystem::path& final_path, const std::filesys
 
 void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options) {
   const int nc = 4 + int(options.extra.size());
-  OIIO::ImageSpec spec(film.width, film.height, nc, options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  const OIIO::TypeDesc colour = options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT;
+  OIIO::ImageSpec spec(film.width, film.height, nc, colour);
   spec.channelnames = {"R", "G", "B", "A"};
   const size_t pixels = size_t(film.width) * size_t(film.height);
   for (const auto& c : options.extra) {
-    if (!c.data || c.data->size() != pixels)
+    if (!c.data || c.stride < 1 || c.offset < 0 || c.offset >= c.stride || c.data->size() != pixels * size_t(c.stride))
       throw std::invalid_argument(path.string() + ": channel " + c.name + " does not match the image size");
     spec.channelnames.push_back(c.name);
   }
   if (!options.extra.empty()) {
-    spec.channelformats.assign(size_t(nc), options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-    for (size_t i = 4; i < size_t(nc); ++i) spec.channelformats[i] = OIIO::TypeDesc::FLOAT;
+    spec.channelformats.assign(size_t(nc), colour);
+    for (size_t i = 0; i < options.extra.size(); ++i) {
+      const ChannelType t = options.extra[i].type;
+      spec.channelformats[4 + i] = t == ChannelType::Half ? OIIO::TypeDesc::HALF
+                                   : t == ChannelType::Uint ? OIIO::TypeDesc::UINT
+                                                            : OIIO::TypeDesc::FLOAT;
+    }
   }
   spec.alpha_channel = 3;
   spec.attribute("compression", options.compression);
   spec.attribute("oiio:ColorSpace", "lin_rec709");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
   for (const auto& [k, v] : options.metadata) spec.attribute(k, v);
+  for (const auto& [k, v] : options.float_metadata) spec.attribute(k, v);
+  for (const auto& [k, m] : options.matrix_metadata) spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
   if (options.extra.empty()) {
     write_atomically(path, [&](const std::filesystem::path& temp) {
       write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
     });
     return;
   }
-  std::vector<float> interleaved(pixels * size_t(nc));
+  // Pixels in each channel's own file format (OIIO's float -> uint conversion would normalise,
+  // so integer ids are packed as raw uint32): half, float or uint per channel, interleaved.
+  std::vector<size_t> offsets(static_cast<size_t>(nc));
+  size_t stride = 0;
+  for (size_t k = 0; k < size_t(nc); ++k) {
+    offsets[k] = stride;
+    stride += spec.channelformat(int(k)).size();
+  }
+  std::vector<unsigned char> packed(pixels * stride);
+  auto put = [&](unsigned char* dst, OIIO::TypeDesc type, float v) {
+    if (type == OIIO::TypeDesc::HALF) {
+      const half h(v);
+      std::memcpy(dst, &h, sizeof h);
+    } else if (type == OIIO::TypeDesc::UINT) {
+      const uint32_t u = std::isfinite(v) && v > 0 ? uint32_t(std::min(v, 4294967295.0f)) : 0u;
+      std::memcpy(dst, &u, sizeof u);
+    } else {
+      std::memcpy(dst, &v, sizeof v);
+    }
+  };
   for (size_t i = 0; i < pixels; ++i) {
-    for (int k = 0; k < 4; ++k) interleaved[i * size_t(nc) + size_t(k)] = film.rgba[i * 4 + size_t(k)];
-    for (size_t k = 0; k < options.extra.size(); ++k) interleaved[i * size_t(nc) + 4 + k] = (*options.extra[k].data)[i];
+    unsigned char* px = &packed[i * stride];
+    for (size_t k = 0; k < 4; ++k) put(px + offsets[k], spec.channelformat(int(k)), film.rgba[i * 4 + k]);
+    for (size_t k = 0; k < options.extra.size(); ++k) {
+      const ExrChannel& c = options.extra[k];
+      put(px + offsets[4 + k], spec.channelformat(int(4 + k)), (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
+    }
   }
   write_atomically(path, [&](const std::filesystem::path& temp) {
-    write_with_oiio(path, temp, spec, interleaved.data(), OIIO::TypeDesc::FLOAT);
+    write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
   });
 }
 

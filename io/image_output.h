@@ -2,6 +2,8 @@
 // (PNG, JPEG, TIFF) through an OpenColorIO display/view transform. Both written atomically.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -11,11 +13,19 @@
 
 namespace penumbra {
 
-/// An extra EXR channel (an AOV such as "cost.nodes"): width x height floats, row-major, top row
-/// first; always stored as 32-bit float so counts stay exact.
+/// How an extra channel is stored in the file.
+enum class ChannelType : uint8_t { Half, Float, Uint };
+
+/// An extra EXR channel (an AOV such as "cost.nodes" or "N.X"): element `offset` of every
+/// `stride` floats of `data` (width x height x stride floats, row-major, top row first).
+/// Float by default so data and counts stay exact; Uint for integer ids (values must be
+/// whole numbers >= 0), Half for colour layers.
 struct ExrChannel {
   std::string name;
   const std::vector<float>* data = nullptr;
+  ChannelType type = ChannelType::Float;
+  int stride = 1;
+  int offset = 0;
 };
 
 struct ExrOptions {
@@ -23,6 +33,10 @@ struct ExrOptions {
   std::vector<ExrChannel> extra;     ///< AOV channels after R, G, B, A
   std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts
   std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
+  std::vector<std::pair<std::string, float>> float_metadata;   ///< extra float attributes
+  /// 4x4 matrix attributes (M44f, row-major, row vectors: p' = p M, as OpenEXR's
+  /// worldToCamera and worldToNDC).
+  std::vector<std::pair<std::string, std::array<float, 16>>> matrix_metadata;
 };
 
 /// Writes channels R, G, B, A (colour premultiplied by A) and the extra channels to `path`.

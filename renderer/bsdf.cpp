@@ -100,10 +100,11 @@ float specular_probability(const GltfBrdf& b) {
   return std::clamp(spec / (spec + diff), 0.1f, 0.9f);  // never starve either lobe
 }
 
-Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
+void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular) {
+  diffuse = specular = {0, 0, 0};
   const Local f = frame_of(b);
   const Vec3f v = f.to_local(wo), l = f.to_local(wi);
-  if (!(v.z > 0) || !(l.z > 0)) return {};
+  if (!(v.z > 0) || !(l.z > 0)) return;
   const Vec3f h = normalize(v + l);
   const float alpha = alpha_of(b);
   const float v_dot_h = std::max(0.0f, dot(v, h));
@@ -111,8 +112,13 @@ Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
   const float fd = dielectric_fresnel(b, v_dot_h);
   const Vec3f f_dielectric{fd, fd, fd};
   const Vec3f f_metal = schlick(b.base_color, v_dot_h);
-  const Vec3f diffuse = b.base_color * ((1 - fd) * (1 - b.metallic) * (1 - b.transmission) / kPi);
-  const Vec3f specular = mix(f_dielectric, f_metal, b.metallic) * dv;
+  diffuse = b.base_color * ((1 - fd) * (1 - b.metallic) * (1 - b.transmission) / kPi);
+  specular = mix(f_dielectric, f_metal, b.metallic) * dv;
+}
+
+Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
+  Vec3f diffuse, specular;
+  brdf_eval_parts(b, wo, wi, diffuse, specular);
   return diffuse + specular;
 }
 

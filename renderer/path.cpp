@@ -11,17 +11,41 @@ namespace {
 struct PathState {
   Vec3f radiance{0, 0, 0};
   const PathConfig& cfg;
+  LightGroups* groups = nullptr;
+  Vec3f share0{0, 0, 0};  // diffuse share (per channel) of the direction sampled at hit 0
 
   // Adds a contribution of light reaching surface hit `vertex` (-1 = the camera itself).
-  void add(Vec3f c, int vertex) {
+  // `diffuse_share`: the diffuse part's share of a light sample at hit 0 (else share0).
+  void add(Vec3f c, int vertex, const Vec3f* diffuse_share = nullptr) {
     if (!is_finite(c)) return;
     if (cfg.clamp_indirect > 0 && vertex >= 1) {
       const float m = max_component(c);
       if (m > cfg.clamp_indirect) c *= cfg.clamp_indirect / m;
     }
     radiance += c;
+    if (!groups) return;
+    if (vertex < 0) {
+      groups->emission += c;
+      return;
+    }
+    const Vec3f d = c * (diffuse_share ? *diffuse_share : share0);
+    const Vec3f sp = c - d;
+    if (vertex == 0) {
+      groups->diffuse_direct += d;
+      groups->specular_direct += sp;
+    } else {
+      groups->diffuse_indirect += d;
+      groups->specular_indirect += sp;
+    }
   }
 };
+
+// Per-channel d / (d + s), 0 where both vanish.
+Vec3f diffuse_share(Vec3f d, Vec3f s) {
+  Vec3f r;
+  for (int c = 0; c < 3; ++c) r[c] = d[c] + s[c] > 0 ? d[c] / (d[c] + s[c]) : 0.0f;
+  return r;
+}
 
 // The shadow ray from a surface point towards direction wi, up to `distance` (kInfinity
 // for lights at infinity).
@@ -38,10 +62,11 @@ Ray shadow_ray(const SurfaceInteraction& si, Vec3f wi, float distance) {
 
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts) {
+                    SampleStream& samples, float& coverage, RayCounts& counts,
+                    LightGroups* groups) {
   ++counts.camera;
   coverage = 0;
-  PathState path{{0, 0, 0}, cfg};
+  PathState path{{0, 0, 0}, cfg, groups};
   const AreaLights& area = *lights.area;
   const Environment& env = *lights.environment;
   const bool env_lit = !is_black(env);
@@ -108,6 +133,11 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     brdf.specular = mp.specular;
     brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
     const Vec3f wo = -ray.dir;
+    auto share_at = [&](Vec3f wi) {  // diffuse share of the BRDF towards wi (light groups)
+      Vec3f d, sp;
+      brdf_eval_parts(brdf, wo, wi, d, sp);
+      return diffuse_share(d, sp);
+    };
     // Thin transmission: a delta lobe straight through, chosen with probability p_t.
     const float cos_o = std::fabs(dot(mp.ns, wo));
     const Vec3f trans_weight = mp.base_color * ((1 - mp.metallic) * brdf.transmission * (1 - dielectric_fresnel(brdf, cos_o)));
@@ -131,7 +161,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       if (!(max_component(f) > 0)) continue;
       ++counts.shadow;
       const float t = shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
-      if (t > 0) path.add(beta * f * ls.irradiance * (std::max(0.0f, dot(mp.ns, ls.wi)) * t), vertex);
+      if (t > 0) {
+        const Vec3f share = groups && vertex == 0 ? share_at(ls.wi) : Vec3f{};
+        path.add(beta * f * ls.irradiance * (std::max(0.0f, dot(mp.ns, ls.wi)) * t), vertex, groups && vertex == 0 ? &share : nullptr);
+      }
     }
     if (sample_lights && !area.pmf.empty()) {
       const float u1 = samples.get1d();
@@ -165,8 +198,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
               const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, dist), cfg.hit_filter);
               const float pdf_l = ls.pdf_area * dist2 / std::fabs(cos_l);
               const float w = bsdf_lights ? power_heuristic(pdf_l, p_r * brdf_pdf(brdf, wo, wi)) : 1.0f;
-              if (t > 0 && w > 0)
-                path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_l), vertex);
+              if (t > 0 && w > 0) {
+                const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
+                path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_l), vertex, groups && vertex == 0 ? &share : nullptr);
+              }
             }
           }
         }
@@ -181,7 +216,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
           ++counts.shadow;
           const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, kInfinity), cfg.hit_filter);
           const float w = bsdf_lights ? power_heuristic(pdf_e, p_r * brdf_pdf(brdf, wo, wi)) : 1.0f;
-          if (t > 0 && w > 0) path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_e), vertex);
+          if (t > 0 && w > 0) {
+            const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
+            path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_e), vertex, groups && vertex == 0 ? &share : nullptr);
+          }
         }
       }
     }
@@ -192,6 +230,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     Vec3f wi;
     if (u_lobe < p_t) {
       wi = ray.dir;
+      if (vertex == 0) path.share0 = {0, 0, 0};  // transmission counts as specular
       beta *= trans_weight / p_t;
       prev_delta = true;
       prev_pdf = 0;
@@ -200,6 +239,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       if (!brdf_sample(brdf, wo, (u_lobe - p_t) / p_r, u_dir, bs)) break;
       if (dot(bs.wi, si.ng) <= 0) break;  // below the geometric surface
       wi = bs.wi;
+      if (vertex == 0 && groups) path.share0 = share_at(wi);
       beta *= bs.weight / p_r;
       prev_delta = false;
       prev_pdf = p_r * bs.pdf;

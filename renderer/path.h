@@ -48,14 +48,27 @@ struct PathLights {
   const Environment* environment = nullptr;  ///< never null in path_radiance
 };
 
+/// The beauty split for compositing (light-group AOVs); the five sum to path_radiance's value.
+/// emission: what the camera sees directly (emitters, the environment, unlit surfaces);
+/// direct: light arriving at the first hit straight from a light; indirect: light arriving at
+/// the first hit after further bounces; diffuse and specular split by the first hit's BRDF
+/// terms (thin transmission counts as specular).
+struct LightGroups {
+  Vec3f emission{0, 0, 0};
+  Vec3f diffuse_direct{0, 0, 0}, diffuse_indirect{0, 0, 0};
+  Vec3f specular_direct{0, 0, 0}, specular_indirect{0, 0, 0};
+};
+
 /// Radiance along a camera ray (counted as one camera ray; bounce rays are counted as
 /// `reflection`, shadow rays as `shadow`). `rd` gives texture footprints at the first hit
 /// (may be invalid). `coverage` is 1 if the path hit a surface, 0 if the camera ray escaped
 /// (then the environment is returned). Draws its random numbers from `samples`.
-/// Non-finite contributions are dropped. Thread-safe; never allocates, throws or logs.
+/// Non-finite contributions are dropped. With `groups`, also adds each contribution to its
+/// light group. Thread-safe; never allocates, throws or logs.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts);
+                    SampleStream& samples, float& coverage, RayCounts& counts,
+                    LightGroups* groups = nullptr);
 
 /// Power heuristic weight of a technique with density `a` against one with density `b`.
 inline float power_heuristic(float a, float b) {

@@ -156,10 +156,12 @@ struct PixelAccum {
   bool active = true;
 };
 
-// Adds samples [s0, s1) of pixel (x, y) to `acc`.
+// Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`, 15
+// sums, if not null).
 void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                   const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x,
-                  int y, uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts) {
+                  int y, uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts,
+                  double* groups = nullptr) {
   const float step = differential_step(config.spp);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
@@ -167,7 +169,13 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
     RayDifferential rd;
     const Ray ray = camera_ray(camera, config, float(x) + 0.5f + o.x, float(y) + 0.5f + o.y, step, rd);
     float coverage = 0;
-    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts);
+    LightGroups lg;
+    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);
+    if (groups) {
+      const Vec3f parts[5] = {lg.emission, lg.diffuse_direct, lg.diffuse_indirect, lg.specular_direct, lg.specular_indirect};
+      for (int g = 0; g < 5; ++g)
+        for (int c = 0; c < 3; ++c) groups[g * 3 + c] += parts[g][c];
+    }
     acc.rgba[0] += l.x;
     acc.rgba[1] += l.y;
     acc.rgba[2] += l.z;
@@ -204,6 +212,7 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
   const auto t0 = Clock::now();
   const size_t npix = size_t(config.width) * size_t(config.height);
   std::vector<PixelAccum> accum(npix);
+  std::vector<double> group_sums(config.light_groups ? npix * 15 : 0, 0.0);
   const std::vector<int> ends = path_pass_ends(config.spp);
   const int tiles = tile_count(config);
   const int total_units = tiles * int(ends.size());
@@ -228,7 +237,9 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
         for (int x = x0; x < x1; ++x) {
           PixelAccum& acc = accum[size_t(y) * size_t(config.width) + size_t(x)];
           if (!acc.active) continue;
-          path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts);
+          const size_t pi = size_t(y) * size_t(config.width) + size_t(x);
+          path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts,
+                       group_sums.empty() ? nullptr : &group_sums[pi * 15]);
           if (adaptive && acc.n >= min_spp && pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
             acc.active = false;
           active += acc.active;
@@ -263,6 +274,10 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
     const PixelAccum& acc = accum[i];
     resolve(acc, &image.film.rgba[i * 4]);
     image.samples[i] = acc.n;
+    if (!group_sums.empty()) {
+      if (image.groups.empty()) image.groups.assign(npix * 15, 0.0f);
+      for (size_t k = 0; k < 15; ++k) image.groups[i * 15 + k] = acc.n ? float(group_sums[i * 15 + k] / acc.n) : 0.0f;
+    }
     total_samples += acc.n;
     if (acc.n >= 2) {
       const double mean = acc.sum_y / acc.n;

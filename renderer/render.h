@@ -39,6 +39,7 @@ struct RenderConfig {
   double time_limit = 0;          ///< seconds; > 0: stop after the pass that reaches it
   float adaptive_threshold = 0;   ///< > 0: stop a pixel once its error estimate is below this
   int adaptive_min_spp = 16;      ///< samples every pixel takes before it may stop
+  bool light_groups = false;      ///< also accumulate the LightGroups split (PathImage::groups)
 };
 
 struct RenderStats {
@@ -71,7 +72,14 @@ struct PathImage {
   Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied)
   std::vector<uint32_t> samples;   ///< samples taken per pixel
   std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
+  /// With RenderConfig::light_groups: 15 floats per pixel, the means of LightGroups' emission,
+  /// diffuse_direct, diffuse_indirect, specular_direct, specular_indirect (RGB each).
+  std::vector<float> groups;
 };
+
+/// Names of the five light groups in PathImage::groups order.
+inline constexpr const char* kLightGroupNames[5] = {"emission", "diffuse_direct", "diffuse_indirect",
+                                                     "specular_direct", "specular_indirect"};
 
 /// Renders with the path tracer. Same requirements as render_whitted; `lights` must be built
 /// from the same scene (build_area_lights) with a non-null environment.

@@ -125,6 +125,29 @@ if command -v oiiotool >/dev/null; then
   if awk -v a="$want" -v b="$got" 'BEGIN {d = a - b; exit !(a > 0 && d * d <= 1e-10 * a * a)}'; then passes=$((passes + 1));
   else echo "FAIL: --debug-pixel 20,14 gave R $got, the render has $want"; fails=$((fails + 1)); fi
 fi
+# AOVs: names, refusals, the layers and metadata as compositors read them (oiiotool, exrheader).
+expect 2 "unknown AOV 'depth' \(known: albedo, N, P, Z, UV, id, samples, variance, light, cost, all\)" -- "$bin" render "$d" -o "$work/v.exr" --aov depth
+expect 2 "--aov samples needs --integrator path" -- "$bin" render "$d" -o "$work/v.exr" --aov albedo,samples
+expect 0 "wa.exr" -- "$bin" render "$d" -o "$work/wa.exr" --width 48 --spp 2 --aov all -q --no-png
+expect 0 "pa.exr" -- "$bin" render "$d" -o "$work/pa.exr" --integrator path --width 48 --spp 4 --aov all -q --no-png
+if command -v oiiotool >/dev/null; then
+  expect 0 "R \(half\), G \(half\), B \(half\), A \(half\), Z \(float\), N.X \(float\)" -- oiiotool --info -v "$work/wa.exr"
+  for layer in "albedo.R (half)" "P.Z (float)" "UV.V (float)" "id.object (uint)" "id.material (uint)"; do
+    expect 0 "$(printf '%s' "$layer" | sed 's/[()]/\\&/g')" -- oiiotool --info -v "$work/wa.exr"
+  done
+  for layer in "samples (uint)" "variance (float)" "emission.R (half)" "diffuse_direct.G (half)" "diffuse_indirect.B (half)" \
+               "specular_direct.R (half)" "specular_indirect.G (half)"; do
+    expect 0 "$(printf '%s' "$layer" | sed 's/[()]/\\&/g')" -- oiiotool --info -v "$work/pa.exr"
+  done
+  expect 0 'penumbra:manifest: ".*"object": \{"1": "floor"' -- oiiotool --info -v "$work/pa.exr"
+  expect 0 "penumbra:command_line: .*--aov all" -- oiiotool --info -v "$work/pa.exr"
+fi
+if command -v exrheader >/dev/null; then
+  expect 0 "worldToCamera \(type m44f\)" -- exrheader "$work/wa.exr"
+  expect 0 "worldToNDC \(type m44f\)" -- exrheader "$work/wa.exr"
+  expect 0 "id.object, 32-bit unsigned integer" -- exrheader "$work/wa.exr"
+  expect 0 "penumbra:yfov_degrees \(type float\)" -- exrheader "$work/wa.exr"
+fi
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Hostile files from the shared corpus (skipped visibly without it).

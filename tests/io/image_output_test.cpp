@@ -5,6 +5,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <catch2/catch.hpp>
+#include <array>
 #include <fstream>
 
 #include "io/atomic_file.h"
@@ -182,5 +183,57 @@ TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a
     for (int x = 0; x < w; ++x) dark += at(x, y, 0) == 0 && at(x, y, 1) == 0 && at(x, y, 2) == 0;
   CHECK(dark > 50);
   CHECK_THROWS(write_heatmap(std::vector<float>(3), w, h, dir / "bad.png", "x"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadata round-trip", "[io][exr][aov][quick]") {
+  const auto dir = penumbra::test::temp_dir("exr-layers");
+  const Film f = ramp(8, 4);
+  std::vector<float> normal(8 * 4 * 3), ids(8 * 4), albedo(8 * 4 * 3);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      normal[i * 3 + size_t(c)] = float(c) - 0.123456789f + float(i);
+      albedo[i * 3 + size_t(c)] = 0.25f * float(c);
+    }
+    ids[i] = float(100000 + i * 7);  // beyond half's integers
+  }
+  ExrOptions opt;
+  for (int c = 0; c < 3; ++c) opt.extra.push_back({std::string("N.") + "XYZ"[c], &normal, ChannelType::Float, 3, c});
+  for (int c = 0; c < 3; ++c) opt.extra.push_back({std::string("albedo.") + "RGB"[c], &albedo, ChannelType::Half, 3, c});
+  opt.extra.push_back({"id.object", &ids, ChannelType::Uint});
+  const std::array<float, 16> m = {1, 2, 3, 0, 4, 5, 6, 0, 7, 8, 9, 0, 10, 11, 12, 1};
+  opt.matrix_metadata.push_back({"worldToCamera", m});
+  opt.float_metadata.push_back({"penumbra:near", 0.5f});
+  write_exr(f, dir / "layers.exr", opt);
+  OIIO::ImageSpec spec;
+  const auto px = read_all(dir / "layers.exr", spec);
+  auto channel = [&](const std::string& name) {
+    const int k = spec.channelindex(name);
+    REQUIRE(k >= 0);
+    return k;
+  };
+  const int nx = channel("N.X"), nz = channel("N.Z"), ar = channel("albedo.B"), id = channel("id.object");
+  CHECK(spec.channelformat(nx) == OIIO::TypeDesc::FLOAT);
+  CHECK(spec.channelformat(ar) == OIIO::TypeDesc::HALF);
+  CHECK(spec.channelformat(id) == OIIO::TypeDesc::UINT);
+  const size_t nc = size_t(spec.nchannels);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    REQUIRE(px[i * nc + size_t(nx)] == normal[i * 3]);
+    REQUIRE(px[i * nc + size_t(nz)] == normal[i * 3 + 2]);
+    REQUIRE(px[i * nc + size_t(ar)] == 0.5f);
+  }
+  // Integer ids read back raw (a float read would normalise them).
+  auto in = OIIO::ImageInput::open((dir / "layers.exr").string());
+  REQUIRE(in);
+  std::vector<uint32_t> raw(ids.size());
+  REQUIRE(in->read_image(0, 0, id, id + 1, OIIO::TypeDesc::UINT, raw.data()));
+  for (size_t i = 0; i < ids.size(); ++i) REQUIRE(raw[i] == uint32_t(ids[i]));
+  in->close();
+  const OIIO::ParamValue* p = spec.find_attribute("worldToCamera");
+  REQUIRE(p);
+  CHECK(p->type() == OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44));
+  const float* got = static_cast<const float*>(p->data());
+  for (int k = 0; k < 16; ++k) CHECK(got[k] == m[size_t(k)]);
+  CHECK(spec.get_float_attribute("penumbra:near") == 0.5f);
   std::filesystem::remove_all(dir);
 }
