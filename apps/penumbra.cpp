@@ -21,6 +21,7 @@
 #include "io/image_output.h"
 #include "io/accel_params.h"
 #include "io/environment_io.h"
+#include "io/exr_merge.h"
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
 #include "renderer/camera.h"
@@ -162,6 +163,8 @@ struct RenderArgs {
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
   std::string command_line;
+  std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
+  std::string tile;               ///< "i/N"
   std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
   int rr_depth = 3, adaptive_min_spp = 16;
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
@@ -303,6 +306,47 @@ LoadedScene load_scene(const std::string& file, int scene, bool allow_external, 
   return loaded;
 }
 
+/// --crop x0 x1 y0 y1 (integers: pixels; with a '.': fractions of the width or height; x1, y1
+/// exclusive) or --tile i/N (stripe i of N equal bands of rows, top first).
+PixelWindow parse_window(const RenderArgs& a, int width, int height) {
+  if (!a.crop.empty() && !a.tile.empty()) throw UsageError("--crop and --tile exclude each other");
+  if (!a.crop.empty()) {
+    int v[4];
+    for (int k = 0; k < 4; ++k) {
+      const std::string& t = a.crop[size_t(k)];
+      const int extent = k < 2 ? width : height;
+      try {
+        size_t pos = 0;
+        const double x = std::stod(t, &pos);
+        if (pos != t.size() || !std::isfinite(x)) throw std::invalid_argument(t);
+        if (t.find('.') != std::string::npos) {
+          if (x < 0 || x > 1) throw UsageError("--crop: fraction " + t + " is outside [0, 1]");
+          v[k] = int(std::lround(x * extent));
+        } else {
+          if (x < 0 || x > extent) throw UsageError("--crop: " + t + " is outside [0, " + std::to_string(extent) + "]");
+          v[k] = int(x);
+        }
+      } catch (const UsageError&) {
+        throw;
+      } catch (...) {
+        throw UsageError("--crop: cannot parse '" + t + "' (expected x0 x1 y0 y1 in pixels or fractions)");
+      }
+    }
+    const PixelWindow w{v[0], v[2], v[1], v[3]};
+    if (w.empty()) throw UsageError("--crop: empty region (need x0 < x1 and y0 < y1)");
+    return w;
+  }
+  if (!a.tile.empty()) {
+    int i = -1, n = 0;
+    char extra = 0;
+    if (std::sscanf(a.tile.c_str(), "%d/%d%c", &i, &n, &extra) != 2 || n < 1 || i < 0 || i >= n)
+      throw UsageError("--tile: expected i/N with 0 <= i < N, got '" + a.tile + "'");
+    if (n > height) throw UsageError("--tile: " + std::to_string(n) + " stripes exceed the " + std::to_string(height) + " rows");
+    return {0, int(int64_t(i) * height / n), width, int(int64_t(i + 1) * height / n)};
+  }
+  return {};
+}
+
 int run_render(const RenderArgs& a) {
   // Validate everything the user typed before spending time on loading.
   fs::path out(a.output);
@@ -416,13 +460,16 @@ int run_render(const RenderArgs& a) {
   if (cfg.width > 16384 || cfg.height > 16384)
     throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
   if (path) {  // the path tracer keeps per-pixel accumulators (render.h PixelAccum) and statistics
-    const uint64_t bytes = uint64_t(cfg.width) * uint64_t(cfg.height) * 88;
+    const PixelWindow w = parse_window(a, cfg.width, cfg.height);
+    const uint64_t bytes = uint64_t(w.empty() ? cfg.width : w.width()) * uint64_t(w.empty() ? cfg.height : w.height()) * 88;
     const uint64_t budget = a.max_memory.empty() ? default_memory_budget() : parse_bytes(a.max_memory);
     if (bytes > budget)
       throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " needs " +
                        std::to_string(bytes >> 20) + " MiB of path tracer accumulators, over the memory budget of " +
                        std::to_string(budget >> 20) + " MiB (--max-memory)");
   }
+  cfg.window = parse_window(a, cfg.width, cfg.height);
+  if (!cfg.window.empty() && cost_aov) throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
   const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
                                        : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
   // The path tracer's lights: emissive triangles and the environment.
@@ -485,7 +532,7 @@ int run_render(const RenderArgs& a) {
     film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
   }
   reporter.finish();
-  const double mean_spp = double(stats.samples) / (double(cfg.width) * double(cfg.height));
+  const double mean_spp = double(stats.samples) / (double(film.width) * double(film.height));
 
   // Write.
   const auto t_write = Clock::now();
@@ -714,6 +761,9 @@ int main(int argc, char** argv) {
   render->add_option("--max-memory", r.max_memory, "budget for decoded geometry, e.g. 4G (default: half the RAM)");
   render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
   render->add_flag("--flatten", r.flatten, "give every placement of a mesh its own world-space copy instead of instancing it");
+  render->add_option("--crop", r.crop, "render only x0 x1 y0 y1 (pixels, or fractions with a '.'; x1, y1 exclusive): an EXR data window inside the full frame")
+      ->expected(4)->type_name("X0 X1 Y0 Y1");
+  render->add_option("--tile", r.tile, "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");
   render->add_option("--debug-pixel", r.debug_pixel, "render only pixel x,y and print its value");
   render->add_flag("-q,--quiet", r.quiet, "no progress, warnings or summary on stderr");
   render->add_option("--aov", r.aovs,
@@ -735,6 +785,12 @@ int main(int argc, char** argv) {
   info->add_flag("--allow-external-uris", info_external, "let buffer URIs reach files outside the scene's folder");
   info->add_flag("--flatten", info_flatten, "as for render: no instancing");
 
+  std::vector<std::string> merge_parts;
+  std::string merge_out;
+  auto* merge = app.add_subcommand("merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
+  merge->add_option("parts", merge_parts, "part EXRs (together covering the frame once)")->required();
+  merge->add_option("-o,--output", merge_out, "full-frame EXR (written atomically)")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -749,6 +805,12 @@ int main(int argc, char** argv) {
   r.ambient_given = render->count("--ambient") > 0;
   try {
     if (*render) return run_render(r);
+    if (*merge) {
+      std::vector<fs::path> parts(merge_parts.begin(), merge_parts.end());
+      merge_exr_parts(parts, merge_out);
+      std::printf("%s\n", merge_out.c_str());
+      return kExitOk;
+    }
     if (*info) return run_info(info_file, info_scene, info_external, info_flatten, info_accel, info_accel_params);
   } catch (const InputError& e) {
     std::fprintf(stderr, "penumbra: error: %s\n", e.what());

@@ -58,6 +58,13 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     }
   }
   spec.alpha_channel = 3;
+  // A crop or tile: the film is the data window inside the full display window.
+  spec.x = film.origin_x;
+  spec.y = film.origin_y;
+  spec.full_x = 0;
+  spec.full_y = 0;
+  spec.full_width = film.full_width > 0 ? film.full_width : film.width;
+  spec.full_height = film.full_height > 0 ? film.full_height : film.height;
   spec.attribute("compression", options.compression);
   spec.attribute("oiio:ColorSpace", "lin_rec709");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);

@@ -29,9 +29,10 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, IntegratorType integrator) {
   DataAovs a;
-  a.width = config.width;
-  a.height = config.height;
-  const size_t n = size_t(config.width) * size_t(config.height);
+  const PixelWindow win = render_window(config);
+  a.width = win.width();
+  a.height = win.height();
+  const size_t n = size_t(a.width) * size_t(a.height);
   a.albedo.assign(n * 3, 0.0f);
   a.normal.assign(n * 3, 0.0f);
   a.position.assign(n * 3, 0.0f);
@@ -43,11 +44,11 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
   const int threads = config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
   tbb::task_arena arena(threads);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, config.height, 8, 0, config.width, 8), [&](const tbb::blocked_range2d<int>& r) {
+    tbb::parallel_for(tbb::blocked_range2d<int>(win.y0, win.y1, 8, win.x0, win.x1, 8), [&](const tbb::blocked_range2d<int>& r) {
       std::vector<uint32_t> objects, materials;
       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
         for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-          const size_t i = size_t(y) * size_t(config.width) + size_t(x);
+          const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
           Vec3f albedo{0, 0, 0}, normal{0, 0, 0}, position{0, 0, 0};
           Vec2f uv{0, 0};
           int hits = 0;

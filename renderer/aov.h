@@ -21,7 +21,7 @@
 namespace penumbra {
 
 struct DataAovs {
-  int width = 0, height = 0;
+  int width = 0, height = 0;  ///< of render_window(config); every vector covers that window
   std::vector<float> albedo;    ///< 3 per pixel
   std::vector<float> normal;    ///< 3 per pixel, world space
   std::vector<float> position;  ///< 3 per pixel, world space

@@ -41,24 +41,37 @@ struct RayCounters {
   RayCounts load() const { return {camera.load(), shadow.load(), reflection.load()}; }
 };
 
-// Runs fn(x0, y0, x1, y1) over every tile of the image on `arena`.
+// Runs fn(x0, y0, x1, y1) (frame coordinates) over every tile of the render window on `arena`.
 template <class Fn>
 void for_each_tile(tbb::task_arena& arena, const RenderConfig& config, Fn&& fn) {
+  const PixelWindow w = render_window(config);
   const int ts = config.tile_size;
-  const int tiles_x = (config.width + ts - 1) / ts, tiles_y = (config.height + ts - 1) / ts;
+  const int tiles_x = (w.width() + ts - 1) / ts, tiles_y = (w.height() + ts - 1) / ts;
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
       for (int tile = r.begin(); tile != r.end(); ++tile) {
-        const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-        fn(x0, y0, std::min(x0 + ts, config.width), std::min(y0 + ts, config.height));
+        const int x0 = w.x0 + (tile % tiles_x) * ts, y0 = w.y0 + (tile / tiles_x) * ts;
+        fn(x0, y0, std::min(x0 + ts, w.x1), std::min(y0 + ts, w.y1));
       }
     });
   });
 }
 
 int tile_count(const RenderConfig& config) {
+  const PixelWindow w = render_window(config);
   const int ts = config.tile_size;
-  return ((config.width + ts - 1) / ts) * ((config.height + ts - 1) / ts);
+  return ((w.width() + ts - 1) / ts) * ((w.height() + ts - 1) / ts);
+}
+
+// A film covering the render window.
+Film window_film(const RenderConfig& config) {
+  const PixelWindow w = render_window(config);
+  Film f = make_film(w.width(), w.height());
+  f.origin_x = w.x0;
+  f.origin_y = w.y0;
+  f.full_width = config.width;
+  f.full_height = config.height;
+  return f;
 }
 
 int thread_count(const RenderConfig& config) {
@@ -66,6 +79,16 @@ int thread_count(const RenderConfig& config) {
 }
 
 }  // namespace
+
+PixelWindow render_window(const RenderConfig& config) {
+  PixelWindow w = config.window;
+  if (w.empty()) return {0, 0, config.width, config.height};
+  w.x0 = std::clamp(w.x0, 0, config.width);
+  w.x1 = std::clamp(w.x1, 0, config.width);
+  w.y0 = std::clamp(w.y0, 0, config.height);
+  w.y1 = std::clamp(w.y1, 0, config.height);
+  return w.empty() ? PixelWindow{0, 0, 0, 0} : w;
+}
 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4],
@@ -103,7 +126,7 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
   RenderConfig config = user_config;
   config.whitted.hit_filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
   const auto t0 = Clock::now();
-  Film film = make_film(config.width, config.height);
+  Film film = window_film(config);
   const int tiles = tile_count(config);
   const int threads = thread_count(config);
   RayCounters rays;
@@ -113,7 +136,7 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
     RayCounts counts;
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x)
-        render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x, y), counts);
+        render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x - film.origin_x, y - film.origin_y), counts);
     rays.add(counts);
     const int d = ++done;
     if (progress) progress(d, tiles);
@@ -123,7 +146,7 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->threads = threads;
     stats->passes = 1;
-    stats->samples = uint64_t(config.width) * uint64_t(config.height) * uint64_t(config.spp);
+    stats->samples = uint64_t(film.width) * uint64_t(film.height) * uint64_t(config.spp);
   }
   return film;
 }
@@ -210,7 +233,8 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
   PathConfig pc = config.path;
   pc.hit_filter = pc.hit_filter && scene_needs_hit_filter(scene);
   const auto t0 = Clock::now();
-  const size_t npix = size_t(config.width) * size_t(config.height);
+  const PixelWindow win = render_window(config);
+  const size_t npix = size_t(win.width()) * size_t(win.height());
   std::vector<PixelAccum> accum(npix);
   std::vector<double> group_sums(config.light_groups ? npix * 15 : 0, 0.0);
   const std::vector<int> ends = path_pass_ends(config.spp);
@@ -235,9 +259,9 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
       uint64_t active = 0;
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
-          PixelAccum& acc = accum[size_t(y) * size_t(config.width) + size_t(x)];
+          const size_t pi = size_t(y - win.y0) * size_t(win.width()) + size_t(x - win.x0);
+          PixelAccum& acc = accum[pi];
           if (!acc.active) continue;
-          const size_t pi = size_t(y) * size_t(config.width) + size_t(x);
           path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts,
                        group_sums.empty() ? nullptr : &group_sums[pi * 15]);
           if (adaptive && acc.n >= min_spp && pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
@@ -266,7 +290,7 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
   }
 
   PathImage image;
-  image.film = make_film(config.width, config.height);
+  image.film = window_film(config);
   image.samples.resize(npix);
   image.variance.resize(npix);
   uint64_t total_samples = 0;

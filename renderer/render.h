@@ -23,6 +23,14 @@ namespace penumbra {
 
 enum class IntegratorType : uint8_t { Whitted, Path };
 
+/// A rectangle of pixels [x0, x1) x [y0, y1) of the full frame.
+struct PixelWindow {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+};
+
 /// Render settings with their defaults (the CLI validates user values before use).
 struct RenderConfig {
   int width = 960;
@@ -40,7 +48,13 @@ struct RenderConfig {
   float adaptive_threshold = 0;   ///< > 0: stop a pixel once its error estimate is below this
   int adaptive_min_spp = 16;      ///< samples every pixel takes before it may stop
   bool light_groups = false;      ///< also accumulate the LightGroups split (PathImage::groups)
+  /// Only these pixels of the width x height frame (crops, farm tiles); empty = the whole
+  /// frame. Every pixel is computed exactly as in the whole frame, so parts merge bit for bit.
+  PixelWindow window;
 };
+
+/// config.window clamped to the frame, or the whole frame if it is empty.
+PixelWindow render_window(const RenderConfig& config);
 
 struct RenderStats {
   RayCounts rays;
@@ -69,7 +83,8 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
 
 /// A path-traced image with its per-pixel statistics.
 struct PathImage {
-  Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied)
+  Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied);
+                                   ///< all per-pixel vectors cover render_window(config)
   std::vector<uint32_t> samples;   ///< samples taken per pixel
   std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
   /// With RenderConfig::light_groups: 15 floats per pixel, the means of LightGroups' emission,

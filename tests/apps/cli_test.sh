@@ -148,6 +148,28 @@ if command -v exrheader >/dev/null; then
   expect 0 "id.object, 32-bit unsigned integer" -- exrheader "$work/wa.exr"
   expect 0 "penumbra:yfov_degrees \(type float\)" -- exrheader "$work/wa.exr"
 fi
+# Farm tiles and crops: data windows, and `merge` reassembles the frame exactly.
+expect 2 "--crop and --tile exclude each other" -- "$bin" render "$d" -o "$work/t.exr" --crop 0 10 0 10 --tile 0/2
+expect 2 "--tile: expected i/N" -- "$bin" render "$d" -o "$work/t.exr" --tile 3/3
+expect 2 "--crop: empty region" -- "$bin" render "$d" -o "$work/t.exr" --crop 10 10 0 5
+expect 2 "--crop: fraction 1.5 is outside" -- "$bin" render "$d" -o "$work/t.exr" --crop 0 1.5 0 5
+expect 2 "--aov cost renders the whole frame" -- "$bin" render "$d" -o "$work/t.exr" --crop 0 10 0 5 --aov cost
+tiles=()
+for i in 0 1 2; do
+  expect 0 "tile$i.exr" -- "$bin" render "$d" -o "$work/tile$i.exr" --integrator path --width 48 --spp 2 --aov all --tile $i/3 -q --no-png
+  tiles+=("$work/tile$i.exr")
+done
+expect 0 "whole.exr" -- "$bin" render "$d" -o "$work/whole.exr" --integrator path --width 48 --spp 2 --aov all -q --no-png
+expect 0 "merged.exr" -- "$bin" merge "${tiles[@]}" -o "$work/merged.exr"
+expect 2 "pixel 0,9 is missing" -- "$bin" merge "$work/tile0.exr" "$work/tile2.exr" -o "$work/gap.exr"
+[ ! -e "$work/gap.exr" ] || { echo "FAIL: a refused merge wrote gap.exr"; fails=$((fails + 1)); }
+expect 0 "crop.exr" -- "$bin" render "$d" -o "$work/crop.exr" --crop 0.25 0.75 3 20 --width 48 --spp 2 -q --no-png
+if command -v oiiotool >/dev/null; then
+  expect 0 "PASS" -- oiiotool "$work/whole.exr" "$work/merged.exr" --fail 0 --diff
+  expect 0 "pixel data origin: x=0, y=9" -- oiiotool --info -v "$work/tile1.exr"
+  expect 0 "full/display size: 48 x 27" -- oiiotool --info -v "$work/crop.exr"
+  expect 0 "pixel data origin: x=12, y=3" -- oiiotool --info -v "$work/crop.exr"
+fi
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Hostile files from the shared corpus (skipped visibly without it).
