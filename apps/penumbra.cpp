@@ -162,7 +162,7 @@ struct RenderArgs {
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
-  std::string command_line;
+  std::string command_line, look;
   std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
   std::string tile;               ///< "i/N"
   std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
@@ -364,6 +364,7 @@ int run_render(const RenderArgs& a) {
   display.ocio_config = a.ocio_config;
   display.display = a.display;
   display.view = a.view;
+  display.look = a.look;
   display.exposure = a.exposure;
   if (png) {
     check_dir(*png, "--png");
@@ -751,7 +752,8 @@ int main(int argc, char** argv) {
   render->add_option("--exposure", r.exposure, "exposure in stops for the display image (default 0)");
   render->add_option("--ocio-config", r.ocio_config, "OpenColorIO config (default: $OCIO, else the shipped config)");
   render->add_option("--display", r.display, "OCIO display (default: the config's default)");
-  render->add_option("--view", r.view, "OCIO view (default: the display's default)");
+  render->add_option("--view", r.view, "OCIO view: Standard (default), Filmic (ACES 1.0 SDR tone mapping) or Raw with the shipped config");
+  render->add_option("--look", r.look, "OCIO look applied before the view: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV with the shipped config");
   render->add_option("--background", r.background, "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
   render->add_option("--ambient", r.ambient, "whitted: ambient intensity Ia, r,g,b or grey (default 0.05)");
   render->add_option("--seed", r.seed, "sampler seed (default 0)");

@@ -280,9 +280,28 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
   }
   if (!view_found)
     throw InputError(source, "--view", "display '" + display + "' has no view '" + view + "' (available: " + views + ")");
+  if (!options.look.empty() && !config->getLook(options.look.c_str())) {
+    std::string looks;
+    for (int i = 0; i < config->getNumLooks(); ++i) looks += std::string(looks.empty() ? "" : ", ") + config->getLookNameByIndex(i);
+    throw InputError(source, "--look", "no look '" + options.look + "' (available: " + (looks.empty() ? "none" : looks) + ")");
+  }
   try {
-    return config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
-        ->getDefaultCPUProcessor();
+    if (options.look.empty())
+      return config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
+          ->getDefaultCPUProcessor();
+    // The look in scene-linear, then the display/view transform.
+    auto look = OCIO::LookTransform::Create();
+    look->setSrc(OCIO::ROLE_SCENE_LINEAR);
+    look->setDst(OCIO::ROLE_SCENE_LINEAR);
+    look->setLooks(options.look.c_str());
+    auto dv = OCIO::DisplayViewTransform::Create();
+    dv->setSrc(OCIO::ROLE_SCENE_LINEAR);
+    dv->setDisplay(display.c_str());
+    dv->setView(view.c_str());
+    auto group = OCIO::GroupTransform::Create();
+    group->appendTransform(look);
+    group->appendTransform(dv);
+    return config->getProcessor(group)->getDefaultCPUProcessor();
   } catch (const OCIO::Exception& e) {
     throw InputError(source, "OpenColorIO", e.what());
   }

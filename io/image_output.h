@@ -48,6 +48,7 @@ struct DisplayOptions {
   std::string ocio_config;  ///< config file; empty = $OCIO if set, else Penumbra's shipped config
   std::string display;      ///< empty = the config's default display
   std::string view;         ///< empty = the display's default view
+  std::string look;         ///< an OCIO look applied in scene-linear before the view; empty = none
   float exposure = 0;       ///< stops applied in scene-linear before the view transform
 };
 

@@ -30,7 +30,8 @@ expect 2 "camera 99999999999 does not exist" -- "$bin" render "$src/scenes/defau
 expect 2 "no camera named 'side' \(cameras: 0 'room camera'\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --camera side
 expect 2 "background" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --background nan
 # Display-output mistakes are caught before rendering, so they cost no render and write no EXR.
-expect 2 "no view 'Typo' \(available: Standard, Raw\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --view Typo
+expect 2 "no view 'Typo' \(available: Standard, Filmic, Raw\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --view Typo
+expect 2 "no look 'Bleach' \(available: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --look Bleach
 expect 2 "no display 'P3'" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --display P3
 expect 2 "a.xyz: unsupported display image format" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --png "$work/a.xyz"
 expect 2 "nope.ocio" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --ocio-config "$work/nope.ocio"
@@ -125,6 +126,7 @@ if command -v oiiotool >/dev/null; then
   if awk -v a="$want" -v b="$got" 'BEGIN {d = a - b; exit !(a > 0 && d * d <= 1e-10 * a * a)}'; then passes=$((passes + 1));
   else echo "FAIL: --debug-pixel 20,14 gave R $got, the render has $want"; fails=$((fails + 1)); fi
 fi
+expect 0 "filmic.png" -- "$bin" render "$d" -o "$work/filmic.exr" --png "$work/filmic.png" --view Filmic --look "High Contrast" --width 48 --spp 1 -q
 # AOVs: names, refusals, the layers and metadata as compositors read them (oiiotool, exrheader).
 expect 2 "unknown AOV 'depth' \(known: albedo, N, P, Z, UV, id, samples, variance, light, cost, all\)" -- "$bin" render "$d" -o "$work/v.exr" --aov depth
 expect 2 "--aov samples needs --integrator path" -- "$bin" render "$d" -o "$work/v.exr" --aov albedo,samples

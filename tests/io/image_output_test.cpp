@@ -237,3 +237,37 @@ TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadat
   CHECK(spec.get_float_attribute("penumbra:near") == 0.5f);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("display: the shipped Filmic view rolls highlights off; looks act in scene-linear", "[io][image][ocio][quick]") {
+  const std::vector<float> values = {0.0f, 0.01f, 0.05f, 0.18f, 0.5f, 1.0f, 2.0f, 4.0f, 16.0f, 64.0f};
+  auto through = [&](const std::string& view, const std::string& look) {
+    std::vector<float> rgb;
+    for (float v : values) rgb.insert(rgb.end(), {v, v, v});
+    DisplayOptions opt;
+    opt.view = view;
+    opt.look = look;
+    apply_display_transform(rgb, int(values.size()), 1, opt);
+    std::vector<float> g;
+    for (size_t i = 0; i < values.size(); ++i) g.push_back(rgb[i * 3 + 1]);
+    return g;
+  };
+  const auto standard = through("Standard", ""), filmic = through("Filmic", "");
+  for (size_t i = 1; i < values.size(); ++i) CHECK(filmic[i] >= filmic[i - 1]);  // monotone
+  CHECK(standard[6] == Approx(1));  // Standard clips everything above 1 ...
+  CHECK(filmic[6] < 0.95f);         // ... Filmic keeps 2, 4 and 16 apart
+  CHECK(filmic[8] > filmic[7] + 0.01f);
+  CHECK(filmic[3] > 0.25f);  // mid grey stays mid-tone
+  CHECK(filmic[3] < 0.55f);
+  // Looks: contrast pivots on mid grey; +1 EV equals doubling the input.
+  const auto contrast = through("Standard", "High Contrast");
+  CHECK(contrast[3] == Approx(standard[3]).margin(1e-4));
+  CHECK(contrast[4] > standard[4] + 0.01f);
+  CHECK(contrast[2] < standard[2] - 0.01f);
+  // Plus 1 EV shows 0.18 as Standard shows 0.36.
+  std::vector<float> grey = {0.36f, 0.36f, 0.36f};
+  apply_display_transform(grey, 1, 1, DisplayOptions{});
+  CHECK(through("Standard", "Plus 1 EV")[3] == Approx(grey[1]).margin(1e-4));
+  DisplayOptions bad;
+  bad.look = "Bleach";
+  CHECK_THROWS_WITH(check_display_output("x.png", bad), Catch::Contains("no look 'Bleach' (available: High Contrast"));
+}
