@@ -4,10 +4,12 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <optional>
@@ -21,6 +23,7 @@
 #include "io/image_output.h"
 #include "io/accel_params.h"
 #include "io/environment_io.h"
+#include "io/checkpoint.h"
 #include "io/exr_merge.h"
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
@@ -46,7 +49,18 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// While a path render runs, the first SIGINT/SIGTERM asks it to stop after the current pass
+// (the finished passes are then written); otherwise, or on a second signal, temporaries are
+// removed and the process dies of the signal.
+std::atomic<bool> g_graceful{false}, g_stop{false};
+std::atomic<int> g_signal{0};
+
 extern "C" void on_signal(int sig) {
+  if (g_graceful.load() && !g_stop.load()) {
+    g_signal = sig;
+    g_stop = true;
+    return;
+  }
   remove_pending_temporaries();
   std::signal(sig, SIG_DFL);
   std::raise(sig);
@@ -165,6 +179,9 @@ struct RenderArgs {
   std::string command_line, look;
   std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
   std::string tile;               ///< "i/N"
+  double checkpoint = 0;          ///< seconds between checkpoints; 0 = none
+  std::string stats_json;
+  bool resume = false;
   std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
   int rr_depth = 3, adaptive_min_spp = 16;
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
@@ -347,6 +364,27 @@ PixelWindow parse_window(const RenderArgs& a, int width, int height) {
   return {};
 }
 
+/// Everything that decides a path-traced pixel's samples, for checkpoint headers (not the
+/// spp target, threads, outputs or time limits: a resumed render may extend those).
+std::string render_fingerprint(const RenderArgs& a, const RenderConfig& cfg, const Camera& camera) {
+  std::error_code ec;
+  const auto size = fs::file_size(a.scene_file, ec);
+  const auto& p = cfg.path;
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "scene %s (%llu bytes) scene-index %d camera '%s' %dx%d window %d,%d-%d,%d seed %llu sampler %s filter %s %g "
+                "max-depth %d rr-depth %d clamp %g light-sampling %s env '%s' x%g rot %g adaptive %g min %d groups %d accel %s "
+                "flatten %d time %s",
+                a.scene_file.c_str(), static_cast<unsigned long long>(ec ? 0 : size), a.scene, camera.name.c_str(), cfg.width,
+                cfg.height, render_window(cfg).x0, render_window(cfg).y0, render_window(cfg).x1, render_window(cfg).y1,
+                static_cast<unsigned long long>(cfg.seed), a.sampler.c_str(), filter_name(cfg.filter.type),
+                double(cfg.filter.width), p.max_depth, p.rr_depth, double(p.clamp_indirect), a.light_sampling.c_str(),
+                a.env.c_str(), double(a.env_intensity), double(a.env_rotation), double(cfg.adaptive_threshold),
+                cfg.adaptive_min_spp, cfg.light_groups ? 1 : 0, a.accel.c_str(), a.flatten ? 1 : 0,
+                a.time ? std::to_string(*a.time).c_str() : (a.frame ? ("frame " + std::to_string(*a.frame)).c_str() : "static"));
+  return buf;
+}
+
 int run_render(const RenderArgs& a) {
   // Validate everything the user typed before spending time on loading.
   fs::path out(a.output);
@@ -358,6 +396,7 @@ int run_render(const RenderArgs& a) {
     if (!fs::is_directory(dir)) throw UsageError(std::string(opt) + " " + p.string() + ": directory '" + dir.string() + "' does not exist");
   };
   check_dir(out, "-o");
+  if (!a.stats_json.empty()) check_dir(fs::path(a.stats_json), "--stats-json");
   std::optional<fs::path> png;
   if (!a.no_png) png = a.png.empty() ? fs::path(out).replace_extension(".png") : fs::path(a.png);
   DisplayOptions display;
@@ -380,12 +419,14 @@ int run_render(const RenderArgs& a) {
   if (!path) {
     for (const auto& [given, name] : {std::pair{!a.env.empty(), "--env"}, {a.time_limit > 0, "--time-limit"},
                                       {a.adaptive > 0, "--adaptive"}, {a.clamp_indirect > 0, "--clamp-indirect"},
-                                      {a.light_sampling != "mis", "--light-sampling"}, {a.sampler != "sobol", "--sampler"}})
+                                      {a.light_sampling != "mis", "--light-sampling"}, {a.sampler != "sobol", "--sampler"},
+                                      {a.checkpoint > 0, "--checkpoint"}, {a.resume, "--resume"}})
       if (given) throw UsageError(std::string(name) + " needs --integrator path");
   }
   if (!std::isfinite(a.clamp_indirect) || a.clamp_indirect < 0) throw UsageError("--clamp-indirect must be finite and >= 0 (0 = off)");
   if (!std::isfinite(a.adaptive) || a.adaptive < 0) throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
   if (!std::isfinite(a.time_limit) || a.time_limit < 0) throw UsageError("--time-limit must be a finite number of seconds >= 0");
+  if (!std::isfinite(a.checkpoint) || a.checkpoint < 0) throw UsageError("--checkpoint must be a finite number of seconds >= 0");
   if (!std::isfinite(a.env_intensity) || a.env_intensity < 0) throw UsageError("--env-intensity must be finite and >= 0");
   if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation must be finite");
   FilterType filter_type = path ? FilterType::BlackmanHarris : FilterType::Box;
@@ -526,9 +567,46 @@ int run_render(const RenderArgs& a) {
   RenderStats stats;
   Film film;
   PathImage path_image;
+  int interrupted = 0;
   if (path) {
-    path_image = render_path(scene, *accel, path_lights, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
+    // Resume state beside the output; its header records what determines the pixels.
+    const fs::path state_file = fs::path(out).concat(".resume");
+    const std::string fingerprint = render_fingerprint(a, cfg, camera);
+    PathAccumulators state;
+    if (a.resume) {
+      if (fs::exists(state_file)) {
+        state = read_checkpoint(state_file, fingerprint);
+        if (!a.quiet)
+          std::fprintf(stderr, "resuming %s: %d passes done, %u spp reached\n", state_file.string().c_str(), state.passes, state.reached);
+      } else if (!a.quiet) {
+        std::fprintf(stderr, "no checkpoint at %s: starting from the beginning\n", state_file.string().c_str());
+      }
+    }
+    auto last_checkpoint = Clock::now();
+    const PassFn after_pass = [&](const PathAccumulators& st) {
+      if (!(a.checkpoint > 0) || st.complete || seconds_since(last_checkpoint) < a.checkpoint) return;
+      ExrOptions cp;
+      cp.half = !a.use_float;
+      cp.compression = a.compression;
+      cp.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:checkpoint", "passes " + std::to_string(st.passes)}};
+      write_exr(resolve_path_image(st, cfg).film, out, cp);
+      write_checkpoint(state_file, st, fingerprint);
+      last_checkpoint = Clock::now();
+    };
+    cfg.stop = &g_stop;
+    g_graceful = true;
+    path_image = render_path(scene, *accel, path_lights, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); },
+                             &state, after_pass);
+    g_graceful = false;
     film = std::move(path_image.film);
+    if (g_stop.load() && !state.complete) {
+      interrupted = g_signal.load();
+      write_checkpoint(state_file, state, fingerprint);
+    } else if (state.complete && fs::exists(state_file)) {
+      fs::remove(state_file);
+    } else if (!state.complete && (a.checkpoint > 0 || a.resume)) {
+      write_checkpoint(state_file, state, fingerprint);  // stopped by --time-limit: resumable too
+    }
   } else {
     film = render_whitted(scene, *accel, camera, cfg, &stats, [&](int d, int t) { reporter(d, t); });
   }
@@ -598,6 +676,34 @@ int run_render(const RenderArgs& a) {
     write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png, cost_caption(cost, a.accel));
   }
   const double write_s = seconds_since(t_write);
+  if (!a.stats_json.empty()) {
+    char buf[2048];
+    std::snprintf(buf, sizeof buf,
+                  "{\n  \"version\": %s,\n  \"scene\": %s,\n  \"output\": %s,\n  \"integrator\": %s,\n"
+                  "  \"width\": %d,\n  \"height\": %d,\n  \"window\": [%d, %d, %d, %d],\n  \"spp\": %d,\n"
+                  "  \"mean_spp\": %.4f,\n  \"passes\": %d,\n  \"time_limited\": %s,\n  \"interrupted\": %s,\n"
+                  "  \"threads\": %d,\n  \"accelerator\": %s,\n"
+                  "  \"seconds\": {\"load\": %.6f, \"build\": %.6f, \"render\": %.6f, \"write\": %.6f},\n"
+                  "  \"rays\": {\"camera\": %llu, \"shadow\": %llu, \"%s\": %llu, \"total\": %llu},\n"
+                  "  \"mrays_per_second\": %.4f,\n  \"peak_memory_mib\": %.2f,\n"
+                  "  \"triangles\": %llu,\n  \"instances\": %zu,\n  \"lights\": %zu\n}\n",
+                  json_string(PENUMBRA_VERSION).c_str(), json_string(a.scene_file).c_str(), json_string(out.string()).c_str(),
+                  json_string(a.integrator).c_str(), cfg.width, cfg.height, film.origin_x, film.origin_y,
+                  film.origin_x + film.width, film.origin_y + film.height, cfg.spp, mean_spp, stats.passes,
+                  stats.time_limited ? "true" : "false", interrupted ? "true" : "false", stats.threads,
+                  json_string(a.accel).c_str(), load_s, build_s, stats.seconds, write_s,
+                  static_cast<unsigned long long>(stats.rays.camera), static_cast<unsigned long long>(stats.rays.shadow),
+                  path ? "bounce" : "reflection", static_cast<unsigned long long>(stats.rays.reflection),
+                  static_cast<unsigned long long>(stats.rays.total()),
+                  stats.seconds > 0 ? double(stats.rays.total()) / stats.seconds / 1e6 : 0.0, peak_memory_mib(),
+                  static_cast<unsigned long long>(count_triangles(scene)), scene.instances.size(), scene.lights.size());
+    const std::string text = buf;
+    write_atomically(a.stats_json, [&](const fs::path& temp) {
+      std::ofstream f(temp);
+      f << text;
+      if (!f.flush()) throw std::runtime_error(a.stats_json + ": cannot write");
+    });
+  }
 
   if (!a.quiet) {
     const uint64_t total = stats.rays.total();
@@ -632,6 +738,11 @@ int run_render(const RenderArgs& a) {
   std::printf("%s\n", out.string().c_str());
   if (png) std::printf("%s\n", png->string().c_str());
   if (cost_png) std::printf("%s\n", cost_png->string().c_str());
+  if (interrupted) {
+    std::fprintf(stderr, "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
+                         "continue with the same command and --resume\n", interrupted, stats.passes, mean_spp);
+    return 128 + interrupted;
+  }
   return kExitOk;
 }
 
@@ -763,6 +874,9 @@ int main(int argc, char** argv) {
   render->add_option("--max-memory", r.max_memory, "budget for decoded geometry, e.g. 4G (default: half the RAM)");
   render->add_flag("--allow-external-uris", r.allow_external, "let buffer URIs reach files outside the scene's folder");
   render->add_flag("--flatten", r.flatten, "give every placement of a mesh its own world-space copy instead of instancing it");
+  render->add_option("--checkpoint", r.checkpoint, "path: every this many seconds (after a whole pass) write the image so far and the resume state OUT.exr.resume, atomically (default 0 = never)");
+  render->add_flag("--resume", r.resume, "path: continue from OUT.exr.resume (written by --checkpoint, --time-limit or an interrupt) to the requested spp; the result equals an uninterrupted render");
+  render->add_option("--stats-json", r.stats_json, "also write the run's statistics (times per phase, rays, spp, memory) as JSON to this file");
   render->add_option("--crop", r.crop, "render only x0 x1 y0 y1 (pixels, or fractions with a '.'; x1, y1 exclusive): an EXR data window inside the full frame")
       ->expected(4)->type_name("X0 X1 Y0 Y1");
   render->add_option("--tile", r.tile, "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");

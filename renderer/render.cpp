@@ -172,12 +172,7 @@ float pixel_error(double sum_y, double sum_y2, uint32_t n) {
 namespace {
 
 // Per-pixel accumulators of the path tracer.
-struct PixelAccum {
-  double rgba[4] = {0, 0, 0, 0};
-  double sum_y = 0, sum_y2 = 0;
-  uint32_t n = 0;
-  bool active = true;
-};
+using PixelAccum = PathAccumulators::Pixel;
 
 // Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`, 15
 // sums, if not null).
@@ -227,16 +222,53 @@ void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathL
   resolve(acc, rgba);
 }
 
+PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& config) {
+  const size_t npix = state.pixels.size();
+  PathImage image;
+  image.film = window_film(config);
+  image.samples.resize(npix);
+  image.variance.resize(npix);
+  for (size_t i = 0; i < npix && i * 4 < image.film.rgba.size(); ++i) {
+    const PixelAccum& acc = state.pixels[i];
+    resolve(acc, &image.film.rgba[i * 4]);
+    image.samples[i] = acc.n;
+    if (!state.groups.empty()) {
+      if (image.groups.empty()) image.groups.assign(npix * 15, 0.0f);
+      for (size_t k = 0; k < 15; ++k) image.groups[i * 15 + k] = acc.n ? float(state.groups[i * 15 + k] / acc.n) : 0.0f;
+    }
+    if (acc.n >= 2) {
+      const double mean = acc.sum_y / acc.n;
+      image.variance[i] = float(std::max(0.0, (acc.sum_y2 - acc.sum_y * mean) / double(acc.n - 1)) / acc.n);
+    }
+  }
+  return image;
+}
+
+bool matches(const PathAccumulators& state, const RenderConfig& config) {
+  const PixelWindow w = render_window(config);
+  return state.window.x0 == w.x0 && state.window.y0 == w.y0 && state.window.x1 == w.x1 && state.window.y1 == w.y1 &&
+         state.pixels.size() == size_t(w.width()) * size_t(w.height()) &&
+         state.groups.size() == (config.light_groups ? state.pixels.size() * 15 : 0);
+}
+
 PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                       const Camera& camera, const RenderConfig& config, RenderStats* stats,
-                      const ProgressFn& progress) {
+                      const ProgressFn& progress, PathAccumulators* resume, const PassFn& after_pass) {
   PathConfig pc = config.path;
   pc.hit_filter = pc.hit_filter && scene_needs_hit_filter(scene);
   const auto t0 = Clock::now();
   const PixelWindow win = render_window(config);
   const size_t npix = size_t(win.width()) * size_t(win.height());
-  std::vector<PixelAccum> accum(npix);
-  std::vector<double> group_sums(config.light_groups ? npix * 15 : 0, 0.0);
+  PathAccumulators local;
+  PathAccumulators& state = resume ? *resume : local;
+  if (state.pixels.empty() || !matches(state, config)) {  // a fresh start
+    state = PathAccumulators{};
+    state.window = win;
+    state.pixels.assign(npix, PixelAccum{});
+    state.groups.assign(config.light_groups ? npix * 15 : 0, 0.0);
+  }
+  std::vector<PixelAccum>& accum = state.pixels;
+  std::vector<double>& group_sums = state.groups;
   const std::vector<int> ends = path_pass_ends(config.spp);
   const int tiles = tile_count(config);
   const int total_units = tiles * int(ends.size());
@@ -249,9 +281,13 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
   tbb::task_arena arena(threads);
   int passes = 0;
   bool time_limited = false;
-  uint32_t begin = 0;
-  for (size_t pass = 0; pass < ends.size(); ++pass) {
+  uint32_t begin = state.reached;  // every pixel still sampling has taken exactly this many
+  size_t first = 0;
+  while (first < ends.size() && uint32_t(ends[first]) <= begin) ++first;
+  done = int(first) * tiles;
+  for (size_t pass = first; pass < ends.size(); ++pass) {
     const auto pass_start = Clock::now();
+    const uint32_t pass_begin = begin;
     const uint32_t end = uint32_t(ends[pass]);
     active_pixels = 0;
     for_each_tile(arena, config, [&](int x0, int y0, int x1, int y1) {
@@ -274,41 +310,33 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
       if (progress) progress(d, total_units);
     });
     ++passes;
+    ++state.passes;
     begin = end;
-    if (end >= uint32_t(config.spp) || (adaptive && active_pixels.load() == 0)) break;
+    state.reached = end;
+    if (after_pass) after_pass(state);
+    if (end >= uint32_t(config.spp) || (adaptive && active_pixels.load() == 0)) {
+      state.complete = true;
+      break;
+    }
+    if (config.stop && config.stop->load()) break;
     if (config.time_limit > 0) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
       const double last = std::chrono::duration<double>(Clock::now() - pass_start).count();
       // Stop unless the next pass (at most as long as this one, scaled by its sample count)
       // still fits in the limit.
-      const double next = last * double(uint32_t(ends[pass + 1]) - end) / double(end - (pass ? uint32_t(ends[pass - 1]) : 0u));
+      const double next = last * double(uint32_t(ends[pass + 1]) - end) / double(std::max(1u, end - pass_begin));
       if (elapsed + next > config.time_limit) {
         time_limited = true;
         break;
       }
     }
   }
+  if (first >= ends.size()) state.complete = true;  // resumed at or beyond the requested spp
 
-  PathImage image;
-  image.film = window_film(config);
-  image.samples.resize(npix);
-  image.variance.resize(npix);
-  uint64_t total_samples = 0;
-  for (size_t i = 0; i < npix; ++i) {
-    const PixelAccum& acc = accum[i];
-    resolve(acc, &image.film.rgba[i * 4]);
-    image.samples[i] = acc.n;
-    if (!group_sums.empty()) {
-      if (image.groups.empty()) image.groups.assign(npix * 15, 0.0f);
-      for (size_t k = 0; k < 15; ++k) image.groups[i * 15 + k] = acc.n ? float(group_sums[i * 15 + k] / acc.n) : 0.0f;
-    }
-    total_samples += acc.n;
-    if (acc.n >= 2) {
-      const double mean = acc.sum_y / acc.n;
-      image.variance[i] = float(std::max(0.0, (acc.sum_y2 - acc.sum_y * mean) / double(acc.n - 1)) / acc.n);
-    }
-  }
+  PathImage image = resolve_path_image(state, config);
   if (stats) {
+    uint64_t total_samples = 0;
+    for (uint32_t n : image.samples) total_samples += n;
     stats->rays = rays.load();
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->threads = threads;

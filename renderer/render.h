@@ -9,6 +9,7 @@
 // samples, so neither threads, tiles nor the pass schedule change it.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -51,6 +52,8 @@ struct RenderConfig {
   /// Only these pixels of the width x height frame (crops, farm tiles); empty = the whole
   /// frame. Every pixel is computed exactly as in the whole frame, so parts merge bit for bit.
   PixelWindow window;
+  /// Set (e.g. by a signal handler): stop after the current pass. May be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// config.window clamped to the frame, or the whole frame if it is empty.
@@ -96,11 +99,39 @@ struct PathImage {
 inline constexpr const char* kLightGroupNames[5] = {"emission", "diffuse_direct", "diffuse_indirect",
                                                      "specular_direct", "specular_indirect"};
 
+/// The path tracer's per-pixel running sums, accumulated in each pixel's sample order: what a
+/// checkpoint saves and a resumed render continues from (plain data, written as raw bytes).
+struct PathAccumulators {
+  struct Pixel {
+    double rgba[4] = {0, 0, 0, 0};
+    double sum_y = 0, sum_y2 = 0;  ///< luminance sums for the error estimate
+    uint32_t n = 0;                ///< samples taken
+    uint32_t active = 1;           ///< 0 once adaptive sampling stopped the pixel
+  };
+  PixelWindow window;              ///< the render window the pixels cover
+  std::vector<Pixel> pixels;
+  std::vector<double> groups;      ///< 15 light-group sums per pixel, or empty
+  uint32_t reached = 0;            ///< samples every still-active pixel has taken
+  int passes = 0;                  ///< passes completed
+  bool complete = false;           ///< the requested spp (or adaptive convergence) was reached
+};
+
+/// Called after every completed pass with the accumulators (for checkpoints).
+using PassFn = std::function<void(const PathAccumulators& state)>;
+
 /// Renders with the path tracer. Same requirements as render_whitted; `lights` must be built
 /// from the same scene (build_area_lights) with a non-null environment.
+/// `state`, if given, is continued from when it matches the config's window and light groups
+/// (a resumed render: passes already done are skipped, so the result is bit-identical to an
+/// uninterrupted render with the same settings), and holds the final sums afterwards.
+/// Between passes the render stops early when config.stop is set or the time limit is near.
 PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                       const Camera& camera, const RenderConfig& config,
-                      RenderStats* stats = nullptr, const ProgressFn& progress = {});
+                      RenderStats* stats = nullptr, const ProgressFn& progress = {},
+                      PathAccumulators* state = nullptr, const PassFn& after_pass = {});
+
+/// The image (means, counts, variances, light groups) of a set of accumulators.
+PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& config);
 
 /// One pixel exactly as render_path computes it with all `config.spp` samples (no adaptive
 /// stop): the replay behind --debug-pixel.

@@ -127,6 +127,35 @@ if command -v oiiotool >/dev/null; then
   else echo "FAIL: --debug-pixel 20,14 gave R $got, the render has $want"; fails=$((fails + 1)); fi
 fi
 expect 0 "filmic.png" -- "$bin" render "$d" -o "$work/filmic.exr" --png "$work/filmic.png" --view Filmic --look "High Contrast" --width 48 --spp 1 -q
+# Interrupt and resume: SIGINT ends the render after a whole pass, writes the finished passes
+# and the resume state; --resume completes it to exactly the uninterrupted image.
+ra=(render "$d" --integrator path --width 16 --height 9 --spp 2048 --float --no-png)
+expect 0 "whole-r.exr" -- "$bin" "${ra[@]}" -o "$work/whole-r.exr" -q
+"$bin" "${ra[@]}" -o "$work/int.exr" >"$work/out" 2>"$work/err" &
+pid=$!
+# Interrupt once rendering has started (the first progress line), not during start-up.
+for _ in $(seq 200); do grep -q "^render" "$work/err" 2>/dev/null && break; sleep 0.05; done
+kill -INT $pid 2>/dev/null
+wait $pid; rc=$?
+if [ -e "$work/int.exr.resume" ]; then  # interrupted in time (a very fast machine may finish first)
+  if [ "$rc" -eq 130 ] && grep -q "interrupted by signal 2" "$work/err" && [ -e "$work/int.exr" ]; then passes=$((passes + 1));
+  else echo "FAIL: interrupted render: exit $rc"; sed 's/^/  | /' "$work/err" | tail -3; fails=$((fails + 1)); fi
+  expect 2 "int.exr.resume: was written for other settings" -- "$bin" "${ra[@]}" -o "$work/int.exr" --resume --seed 7
+  expect 0 "resuming" -- "$bin" "${ra[@]}" -o "$work/int.exr" --resume
+  [ ! -e "$work/int.exr.resume" ] || { echo "FAIL: a completed resume left its state file"; fails=$((fails + 1)); }
+else
+  echo "note: the render finished before the interrupt; resume not exercised"
+fi
+if command -v oiiotool >/dev/null; then
+  expect 0 "PASS" -- oiiotool "$work/whole-r.exr" "$work/int.exr" --fail 0 --diff
+fi
+expect 0 "cp.exr" -- "$bin" render "$d" -o "$work/cp.exr" --integrator path --width 16 --spp 64 --checkpoint 0.000001 --no-png -q
+[ ! -e "$work/cp.exr.resume" ] || { echo "FAIL: a completed checkpointed render left its state file"; fails=$((fails + 1)); }
+expect 2 "--resume needs --integrator path" -- "$bin" render "$d" -o "$work/cp.exr" --resume
+expect 0 "st.exr" -- "$bin" render "$d" -o "$work/st.exr" --integrator path --width 16 --spp 4 --no-png -q --stats-json "$work/st.json"
+expect 0 '"rays": \{"camera": 576, "shadow": [0-9]+, "bounce": [0-9]+' -- cat "$work/st.json"
+expect 0 '"seconds": \{"load": [0-9.]+, "build": [0-9.]+, "render": [0-9.]+, "write": [0-9.]+\}' -- cat "$work/st.json"
+expect 2 "--stats-json .*nodir" -- "$bin" render "$d" -o "$work/st.exr" --stats-json "$work/nodir/s.json"
 # AOVs: names, refusals, the layers and metadata as compositors read them (oiiotool, exrheader).
 expect 2 "unknown AOV 'depth' \(known: albedo, N, P, Z, UV, id, samples, variance, light, cost, all\)" -- "$bin" render "$d" -o "$work/v.exr" --aov depth
 expect 2 "--aov samples needs --integrator path" -- "$bin" render "$d" -o "$work/v.exr" --aov albedo,samples

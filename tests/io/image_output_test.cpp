@@ -101,7 +101,7 @@ TEST_CASE("a missing OCIO config or view is an input error and nothing is writte
   CHECK(files_in(dir) == 0);
   // The up-front check: same failures, with the valid choices listed, and a bad extension.
   using Catch::Matchers::Contains;
-  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no view 'No Such View'") && Contains("Standard, Raw"));
+  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no view 'No Such View'") && Contains("Standard, Filmic, Raw"));
   opt.view.clear();
   CHECK_NOTHROW(check_display_output(dir / "x.PNG", opt));
   CHECK_NOTHROW(check_display_output(dir / "x.tiff", opt));

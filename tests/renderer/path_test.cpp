@@ -7,6 +7,7 @@
 #include "renderer/path.h"
 
 #include <catch2/catch.hpp>
+#include <atomic>
 #include <cstring>
 
 #include "io/gltf_loader.h"
@@ -379,4 +380,41 @@ TEST_CASE("path: clamping indirect light bounds each indirect sample", "[path][q
   // max_depth = 12 indirect contributions adds at most 0.01.
   CHECK(clamped >= 1.9 * 0.98);
   CHECK(clamped <= 1.9 + 12 * 0.01 + 0.02);
+}
+
+TEST_CASE("path: a render stopped between passes and resumed equals the uninterrupted render", "[path][resume]") {
+  LoadedScene loaded = load_gltf(test::source_dir() / "scenes/default.gltf");
+  const Scene& s = loaded.scene;
+  const auto accel = make_scene_accelerator("embree", s);
+  const AreaLights al = build_area_lights(s);
+  const Environment env = make_constant_environment({0.1f, 0.1f, 0.12f});
+  const PathLights lights{&al, &env};
+  RenderConfig cfg = small_config(24, 14, 40);
+  cfg.adaptive_threshold = 0.05f;
+  cfg.adaptive_min_spp = 4;
+  cfg.light_groups = true;
+  const PathImage whole = render_path(s, *accel, lights, s.cameras.at(0), cfg);
+
+  // Stop after the third pass (4 spp), as a signal handler would.
+  std::atomic<bool> stop{false};
+  cfg.stop = &stop;
+  PathAccumulators state;
+  RenderStats first;
+  render_path(s, *accel, lights, s.cameras.at(0), cfg, &first, {}, &state, [&](const PathAccumulators& st) {
+    if (st.passes == 3) stop = true;
+  });
+  CHECK(first.passes == 3);
+  CHECK(state.reached == 4);
+  CHECK_FALSE(state.complete);
+  // Resume (a copy, as if read back from disk) to the same spp.
+  cfg.stop = nullptr;
+  PathAccumulators copy = state;
+  RenderStats second;
+  const PathImage resumed = render_path(s, *accel, lights, s.cameras.at(0), cfg, &second, {}, &copy);
+  CHECK(copy.complete);
+  CHECK(second.passes == int(path_pass_ends(40).size()) - 3);
+  CHECK(std::memcmp(whole.film.rgba.data(), resumed.film.rgba.data(), whole.film.rgba.size() * sizeof(float)) == 0);
+  CHECK(whole.samples == resumed.samples);
+  CHECK(whole.groups == resumed.groups);
+  CHECK(whole.variance == resumed.variance);
 }
