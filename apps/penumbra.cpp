@@ -168,6 +168,7 @@ class ProgressReporter {
 
 struct RenderArgs {
   std::string scene_file, output, png;
+  bool multipart = false;
   bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
   int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
   std::string camera;  ///< index or name; empty = the first camera, or framing
@@ -618,6 +619,7 @@ int run_render(const RenderArgs& a) {
   ExrOptions exr;
   exr.half = !a.use_float;
   exr.compression = a.compression;
+  exr.multipart = a.multipart;
   exr.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:camera", camera.name},
                   {"penumbra:spp", std::to_string(cfg.spp)}, {"penumbra:integrator", a.integrator},
                   {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
@@ -857,6 +859,7 @@ int main(int argc, char** argv) {
   render->add_option("--camera", r.camera, "camera instance: index as listed by `penumbra info`, or name (default 0; none in the file: frame the bounds)");
   render->add_option("--accel", r.accel, "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
   render->add_option("--accel-param", r.accel_params, accel_param_help())->type_name("KEY=VALUE");
+  render->add_flag("--multipart", r.multipart, "write one EXR part per layer (rgba, albedo, N, Z, ...); lossy --compression then applies to colour parts only");
   render->add_flag("--float", r.use_float, "write 32-bit float EXR channels (default half)");
   render->add_option("--compression", r.compression, "EXR compression (default zip)")
       ->check(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}));

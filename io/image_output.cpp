@@ -105,8 +105,73 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
       put(px + offsets[4 + k], spec.channelformat(int(4 + k)), (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
     }
   }
+  if (!options.multipart) {
+    write_atomically(path, [&](const std::filesystem::path& temp) {
+      write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
+    });
+    return;
+  }
+  // Multi-part: "rgba" (R, G, B, A and the metadata), then one part per layer (the channel
+  // name's prefix before '.', or a lone channel such as Z), in first-appearance order.
+  std::vector<std::string> keys = {"rgba"};
+  std::vector<std::vector<size_t>> members = {{0, 1, 2, 3}};
+  for (size_t k = 0; k < options.extra.size(); ++k) {
+    const std::string& name = options.extra[k].name;
+    const std::string key = name.substr(0, name.find('.'));
+    auto it = std::find(keys.begin(), keys.end(), key);
+    if (it == keys.end()) {
+      keys.push_back(key);
+      members.emplace_back();
+      it = keys.end() - 1;
+    }
+    members[size_t(it - keys.begin())].push_back(4 + k);
+  }
+  const std::string& c = options.compression;
+  const bool lossy = c == "dwaa" || c == "dwab" || c == "b44" || c == "b44a" || c == "pxr24";
+  std::vector<OIIO::ImageSpec> specs;
+  std::vector<std::vector<unsigned char>> buffers;
+  for (size_t part = 0; part < keys.size(); ++part) {
+    OIIO::ImageSpec ps = spec;
+    ps.nchannels = int(members[part].size());
+    ps.channelnames.clear();
+    ps.channelformats.clear();
+    bool colour_part = part == 0;
+    size_t part_stride = 0;
+    for (size_t ch : members[part]) {
+      ps.channelnames.push_back(spec.channelnames[ch]);
+      ps.channelformats.push_back(spec.channelformat(int(ch)));
+      colour_part |= spec.channelformat(int(ch)) == OIIO::TypeDesc::HALF;
+      part_stride += spec.channelformat(int(ch)).size();
+    }
+    ps.alpha_channel = part == 0 ? 3 : -1;
+    ps.attribute("name", keys[part]);
+    // Lossy codecs only for colour; data layers (float N, P, Z, ids) stay lossless.
+    if (lossy && !colour_part) ps.attribute("compression", "zip");
+    std::vector<unsigned char> buf(pixels * part_stride);
+    for (size_t i = 0; i < pixels; ++i) {
+      size_t o = 0;
+      for (size_t ch : members[part]) {
+        const size_t n = spec.channelformat(int(ch)).size();
+        std::memcpy(&buf[i * part_stride + o], &packed[i * stride + offsets[ch]], n);
+        o += n;
+      }
+    }
+    specs.push_back(ps);
+    buffers.push_back(std::move(buf));
+  }
   write_atomically(path, [&](const std::filesystem::path& temp) {
-    write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
+    auto out = OIIO::ImageOutput::create(path.string());
+    if (!out || !out->supports("multiimage"))
+      throw std::runtime_error(path.string() + ": no multi-part image writer for this extension");
+    if (!out->open(temp.string(), int(specs.size()), specs.data()))
+      throw std::runtime_error(path.string() + ": cannot open for writing: " + out->geterror());
+    for (size_t part = 0; part < specs.size(); ++part) {
+      if (part > 0 && !out->open(temp.string(), specs[part], OIIO::ImageOutput::AppendSubimage))
+        throw std::runtime_error(path.string() + ": cannot start part " + keys[part] + ": " + out->geterror());
+      if (!out->write_image(OIIO::TypeDesc::UNKNOWN, buffers[part].data()))
+        throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
+    }
+    if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
   });
 }
 

@@ -31,7 +31,9 @@ struct ExrChannel {
 struct ExrOptions {
   bool half = true;                  ///< 16-bit half R, G, B, A; false = 32-bit float
   std::vector<ExrChannel> extra;     ///< AOV channels after R, G, B, A
-  std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts
+  std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts; with multipart,
+                                     ///< lossy codecs apply to colour parts only (data: zip)
+  bool multipart = false;            ///< one part per layer ("rgba", "albedo", "N", "Z", ...)
   std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
   std::vector<std::pair<std::string, float>> float_metadata;   ///< extra float attributes
   /// 4x4 matrix attributes (M44f, row-major, row vectors: p' = p M, as OpenEXR's

@@ -194,6 +194,23 @@ expect 0 "whole.exr" -- "$bin" render "$d" -o "$work/whole.exr" --integrator pat
 expect 0 "merged.exr" -- "$bin" merge "${tiles[@]}" -o "$work/merged.exr"
 expect 2 "pixel 0,9 is missing" -- "$bin" merge "$work/tile0.exr" "$work/tile2.exr" -o "$work/gap.exr"
 [ ! -e "$work/gap.exr" ] || { echo "FAIL: a refused merge wrote gap.exr"; fails=$((fails + 1)); }
+# Multi-part: one part per layer, data parts lossless under a lossy codec; tiles merge exactly.
+mp=(render "$d" --integrator path --width 40 --spp 2 --aov all -q --no-png --multipart)
+expect 0 "mp.exr" -- "$bin" "${mp[@]}" -o "$work/mp.exr"
+for i in 0 1; do expect 0 "mp$i.exr" -- "$bin" "${mp[@]}" -o "$work/mp$i.exr" --tile $i/2; done
+expect 0 "mpm.exr" -- "$bin" merge "$work/mp0.exr" "$work/mp1.exr" -o "$work/mpm.exr"
+expect 0 "mpd.exr" -- "$bin" "${mp[@]}" -o "$work/mpd.exr" --compression dwaa
+if command -v oiiotool >/dev/null; then
+  expect 0 "14 subimages" -- oiiotool --info "$work/mp.exr"
+  for k in 0 2 6 13; do expect 0 "PASS" -- oiiotool -a "$work/mp.exr" --subimage $k "$work/mpm.exr" --subimage $k --fail 0 --diff; done
+fi
+if command -v exrheader >/dev/null; then
+  expect 0 'name \(type string\): "rgba"' -- exrheader "$work/mp.exr"
+  expect 0 'name \(type string\): "id"' -- exrheader "$work/mp.exr"
+  # Under dwaa the beauty part is lossy, the N part stays zip.
+  expect 0 'dwa, small scanline blocks' -- exrheader "$work/mpd.exr"
+  expect 0 'zip, multi-scanline blocks[[:space:]]+name \(type string\): "N"' -- bash -c "exrheader '$work/mpd.exr' | grep -E 'compression|^name' | tr '\n' ' '"
+fi
 expect 0 "crop.exr" -- "$bin" render "$d" -o "$work/crop.exr" --crop 0.25 0.75 3 20 --width 48 --spp 2 -q --no-png
 if command -v oiiotool >/dev/null; then
   expect 0 "PASS" -- oiiotool "$work/whole.exr" "$work/merged.exr" --fail 0 --diff
