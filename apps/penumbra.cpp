@@ -665,7 +665,7 @@ int run_render(const RenderArgs& a) {
                              a.use_float ? ChannelType::Float : ChannelType::Half, 15, g * 3 + c});
   CostImage cost;
   if (cost_aov) {
-    cost = render_cost(*accel, camera, cfg);
+    cost = render_cost(*accel, camera, cfg, path ? IntegratorType::Path : IntegratorType::Whitted);
     if (cost.counted) {
       exr.extra.push_back({"cost.nodes", &cost.nodes});
       exr.extra.push_back({"cost.triangles", &cost.triangles});

@@ -7,11 +7,12 @@
 
 #include <chrono>
 
-#include "renderer/sampling.h"
+#include "renderer/aov.h"
 
 namespace penumbra {
 
-CostImage render_cost(const Accelerator& accel, const Camera& camera, const RenderConfig& config) {
+CostImage render_cost(const Accelerator& accel, const Camera& camera, const RenderConfig& config,
+                      IntegratorType integrator) {
   CostImage img{config.width, config.height, {}, {}};
   const size_t n = size_t(config.width) * size_t(config.height);
   img.nodes.assign(n, 0.0f);
@@ -28,9 +29,8 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
           TraversalCost cost;
           double seconds = 0;
           for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
-            Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
-            const Vec2f j = stratified_sample(s, spp, rng);
-            const Ray ray = generate_camera_ray(camera, config.width, config.height, float(x) + j.x, float(y) + j.y);
+            const Vec2f p = camera_sample_position(config, integrator, x, y, s);
+            const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
             Hit hit;
             const auto t0 = std::chrono::steady_clock::now();
             accel.intersect_counted(ray, hit, cost);

@@ -21,10 +21,12 @@ struct CostImage {
   bool counted = false;          ///< nodes and triangles are filled (accel.counts_traversal())
 };
 
-/// Traces the camera rays of `config` (width, height, spp, seed, threads) through
+/// Traces the camera rays of `config` (width, height, spp, seed, threads, filter, sampler) at
+/// the positions `integrator` samples (camera_sample_position) through
 /// accel.intersect_counted(), timing each pixel. Counts (when the back end keeps them) are the
 /// same for any thread count; times are measurements and vary.
-CostImage render_cost(const Accelerator& accel, const Camera& camera, const RenderConfig& config);
+CostImage render_cost(const Accelerator& accel, const Camera& camera, const RenderConfig& config,
+                      IntegratorType integrator = IntegratorType::Whitted);
 
 /// What the heat maps show: nodes + triangles per pixel when counted, else nanoseconds.
 std::vector<float> total_cost(const CostImage& cost);
