@@ -371,13 +371,14 @@ std::string render_fingerprint(const RenderArgs& a, const RenderConfig& cfg, con
   std::error_code ec;
   const auto size = fs::file_size(a.scene_file, ec);
   const auto& p = cfg.path;
+  const PixelWindow win = render_window(cfg);
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "scene %s (%llu bytes) scene-index %d camera '%s' %dx%d window %d,%d-%d,%d seed %llu sampler %s filter %s %g "
                 "max-depth %d rr-depth %d clamp %g light-sampling %s env '%s' x%g rot %g adaptive %g min %d groups %d accel %s "
                 "flatten %d time %s",
                 a.scene_file.c_str(), static_cast<unsigned long long>(ec ? 0 : size), a.scene, camera.name.c_str(), cfg.width,
-                cfg.height, render_window(cfg).x0, render_window(cfg).y0, render_window(cfg).x1, render_window(cfg).y1,
+                cfg.height, win.x0, win.y0, win.x1, win.y1,
                 static_cast<unsigned long long>(cfg.seed), a.sampler.c_str(), filter_name(cfg.filter.type),
                 double(cfg.filter.width), p.max_depth, p.rr_depth, double(p.clamp_indirect), a.light_sampling.c_str(),
                 a.env.c_str(), double(a.env_intensity), double(a.env_rotation), double(cfg.adaptive_threshold),
@@ -502,23 +503,23 @@ int run_render(const RenderArgs& a) {
   if (!cfg.width) cfg.width = std::max(1, int(std::lround(cfg.height * hint)));
   if (cfg.width > 16384 || cfg.height > 16384)
     throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
-  if (path) {  // the path tracer keeps per-pixel accumulators (render.h PixelAccum) and statistics
-    const PixelWindow w = parse_window(a, cfg.width, cfg.height);
-    const uint64_t bytes = uint64_t(w.empty() ? cfg.width : w.width()) * uint64_t(w.empty() ? cfg.height : w.height()) * 88;
-    const uint64_t budget = a.max_memory.empty() ? default_memory_budget() : parse_bytes(a.max_memory);
+  cfg.window = parse_window(a, cfg.width, cfg.height);
+  const uint64_t budget = a.max_memory.empty() ? default_memory_budget() : parse_bytes(a.max_memory);
+  if (path) {  // the path tracer keeps per-pixel accumulators (render.h PathAccumulators) and statistics
+    const PixelWindow w = render_window(cfg);
+    const uint64_t bytes = uint64_t(w.width()) * uint64_t(w.height()) * 88;
     if (bytes > budget)
       throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " needs " +
                        std::to_string(bytes >> 20) + " MiB of path tracer accumulators, over the memory budget of " +
                        std::to_string(budget >> 20) + " MiB (--max-memory)");
   }
-  cfg.window = parse_window(a, cfg.width, cfg.height);
   if (!cfg.window.empty() && cost_aov) throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
   const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
                                        : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
   // The path tracer's lights: emissive triangles and the environment.
   Environment environment;
   if (env_colour) environment = make_constant_environment(*env_colour * a.env_intensity);
-  else if (!a.env.empty()) environment = load_environment(a.env, a.env_intensity, a.env_rotation);
+  else if (!a.env.empty()) environment = load_environment(a.env, a.env_intensity, a.env_rotation, budget);
   AreaLights area_lights;
   if (path) area_lights = build_area_lights(scene);
   bool default_light = false;
@@ -925,6 +926,12 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(r);
     if (*merge) {
+      const fs::path merged(merge_out);
+      std::string ext = merged.extension().string();
+      for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+      if (ext != ".exr") throw UsageError("-o " + merge_out + ": the output must be an .exr file");
+      const fs::path dir = merged.has_parent_path() ? merged.parent_path() : fs::path(".");
+      if (!fs::is_directory(dir)) throw UsageError("-o " + merge_out + ": directory '" + dir.string() + "' does not exist");
       std::vector<fs::path> parts(merge_parts.begin(), merge_parts.end());
       merge_exr_parts(parts, merge_out);
       std::printf("%s\n", merge_out.c_str());

@@ -2,6 +2,7 @@
 // OpenImageIO reads) into the renderer's Environment.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include "renderer/environment.h"
@@ -11,11 +12,16 @@ namespace penumbra {
 /// Largest map accepted per side (a 16k x 8k map is 1.5 GiB of float RGB plus its tables).
 inline constexpr int kMaxEnvironmentSide = 16384;
 
+/// Bytes load_environment needs for a width x height map of `channels` channels (decoded
+/// pixels, texels and sampling tables).
+uint64_t environment_bytes(int width, int height, int channels);
+
 /// Reads RGB (the first three channels; a single channel is grey) as linear scene values,
 /// with `intensity` and `rotation_degrees` about +Y (environment.h). Throws InputError
-/// naming the file for a missing or unreadable file, a size beyond kMaxEnvironmentSide, or a
-/// NaN, infinite or negative texel (naming its pixel).
+/// naming the file for a missing or unreadable file, a size beyond kMaxEnvironmentSide or
+/// one needing more than `max_bytes` (environment_bytes), or a NaN, infinite or negative
+/// texel (naming its pixel).
 Environment load_environment(const std::filesystem::path& path, float intensity,
-                             float rotation_degrees);
+                             float rotation_degrees, uint64_t max_bytes = uint64_t(8) << 30);
 
 }  // namespace penumbra

@@ -12,20 +12,6 @@
 
 namespace penumbra {
 
-Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
-                             uint32_t s) {
-  if (integrator == IntegratorType::Path) {
-    SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Vec2f o = sample_filter(config.filter, st.get2d());
-    return {float(x) + 0.5f + o.x, float(y) + 0.5f + o.y};
-  }
-  Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
-  const Vec2f j = stratified_sample(s, uint32_t(config.spp), rng);
-  if (config.filter.type == FilterType::Box && config.filter.width == 1) return {float(x) + j.x, float(y) + j.y};
-  const Vec2f o = sample_filter(config.filter, j);
-  return {float(x) + 0.5f + o.x, float(y) + 0.5f + o.y};
-}
-
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, IntegratorType integrator) {
   DataAovs a;

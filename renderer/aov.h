@@ -36,9 +36,4 @@ struct DataAovs {
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, IntegratorType integrator);
 
-/// Raster position of sample `s` of pixel (x, y) as the integrator places it (pixel corner at
-/// integer coordinates).
-Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
-                             uint32_t s);
-
 }  // namespace penumbra

@@ -100,8 +100,13 @@ float specular_probability(const GltfBrdf& b) {
   return std::clamp(spec / (spec + diff), 0.1f, 0.9f);  // never starve either lobe
 }
 
-void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular) {
+namespace {
+// Everything about one direction pair in one shading frame: the diffuse and specular terms and
+// (if pdf is not null) the sampling density, so estimators that need f and pdf together
+// (next-event estimation with MIS) build the frame and the half vector once.
+void eval_pair(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular, float* pdf) {
   diffuse = specular = {0, 0, 0};
+  if (pdf) *pdf = 0;
   const Local f = frame_of(b);
   const Vec3f v = f.to_local(wo), l = f.to_local(wi);
   if (!(v.z > 0) || !(l.z > 0)) return;
@@ -114,21 +119,34 @@ void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3
   const Vec3f f_metal = schlick(b.base_color, v_dot_h);
   diffuse = b.base_color * ((1 - fd) * (1 - b.metallic) * (1 - b.transmission) / kPi);
   specular = mix(f_dielectric, f_metal, b.metallic) * dv;
+  if (pdf) {
+    const float ps = specular_probability(b);
+    *pdf = ps * specular_pdf(v, h, alpha) + (1 - ps) * l.z / kPi;
+  }
+}
+}  // namespace
+
+void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular) {
+  eval_pair(b, wo, wi, diffuse, specular, nullptr);
 }
 
 Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
   Vec3f diffuse, specular;
-  brdf_eval_parts(b, wo, wi, diffuse, specular);
+  eval_pair(b, wo, wi, diffuse, specular, nullptr);
+  return diffuse + specular;
+}
+
+Vec3f brdf_eval_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi, float& pdf) {
+  Vec3f diffuse, specular;
+  eval_pair(b, wo, wi, diffuse, specular, &pdf);
   return diffuse + specular;
 }
 
 float brdf_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
-  const Local f = frame_of(b);
-  const Vec3f v = f.to_local(wo), l = f.to_local(wi);
-  if (!(v.z > 0) || !(l.z > 0)) return 0;
-  const float ps = specular_probability(b);
-  const Vec3f h = normalize(v + l);
-  return ps * specular_pdf(v, h, alpha_of(b)) + (1 - ps) * l.z / kPi;
+  Vec3f diffuse, specular;
+  float pdf = 0;
+  eval_pair(b, wo, wi, diffuse, specular, &pdf);
+  return pdf;
 }
 
 bool brdf_sample(const GltfBrdf& b, Vec3f wo, float u1, Vec2f u, BrdfSample& out) {
@@ -145,9 +163,9 @@ bool brdf_sample(const GltfBrdf& b, Vec3f wo, float u1, Vec2f u, BrdfSample& out
   }
   if (!(l.z > 0)) return false;
   out.wi = normalize(f.to_world(l));
-  out.pdf = brdf_pdf(b, wo, out.wi);
+  const Vec3f value = brdf_eval_pdf(b, wo, out.wi, out.pdf);
   if (!(out.pdf > 0) || !std::isfinite(out.pdf)) return false;
-  out.weight = brdf_eval(b, wo, out.wi) * (std::max(0.0f, dot(out.wi, b.n)) / out.pdf);
+  out.weight = value * (std::max(0.0f, dot(out.wi, b.n)) / out.pdf);
   return true;
 }
 

@@ -38,6 +38,8 @@ inline constexpr float kMinGgxAlpha = 1e-3f;
 Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi);
 /// The diffuse and specular terms of brdf_eval (their sum), for light-group AOVs.
 void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular);
+/// brdf_eval and brdf_pdf together, sharing the frame and half vector (pdf is set).
+Vec3f brdf_eval_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi, float& pdf);
 /// Solid-angle density with which brdf_sample() produces wi (both lobes combined).
 float brdf_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi);
 

@@ -70,6 +70,7 @@ Environment make_map_environment(int width, int height, std::vector<Vec3f> texel
   e.marginal_cdf[h] = 1;
   // Density in the uv square: P(texel) / (1 / (w h)).
   e.texel_pdf.assign(w * h, 0.0f);
+  e.map_emits = total > 0;
   if (total > 0)
     for (size_t y = 0; y < h; ++y) {
       const double sin_theta = std::sin(kPi * (double(y) + 0.5) / double(h));
@@ -82,8 +83,7 @@ Environment make_map_environment(int width, int height, std::vector<Vec3f> texel
 
 bool is_black(const Environment& env) {
   if (env.texels.empty()) return !(max_component(env.color) > 0);
-  return !(env.intensity > 0) || env.marginal_cdf.empty() || env.texel_pdf.empty() ||
-         std::all_of(env.texel_pdf.begin(), env.texel_pdf.end(), [](float p) { return !(p > 0); });
+  return !(env.intensity > 0) || !env.map_emits;
 }
 
 Vec2f env_direction_to_uv(const Environment& env, Vec3f d) {

@@ -25,6 +25,7 @@ struct Environment {
   std::vector<float> marginal_cdf;     ///< height + 1 entries
   std::vector<float> conditional_cdf;  ///< height rows of width + 1 entries
   std::vector<float> texel_pdf;        ///< per texel: probability / (texel's uv area)
+  bool map_emits = false;              ///< some texel has luminance > 0 (set with the tables)
 };
 
 Environment make_constant_environment(Vec3f radiance);
@@ -33,7 +34,7 @@ Environment make_constant_environment(Vec3f radiance);
 Environment make_map_environment(int width, int height, std::vector<Vec3f> texels, float intensity,
                                  float rotation);
 
-/// True if the environment emits nothing (then it is neither sampled nor looked up).
+/// True if the environment emits nothing (then it is neither sampled nor looked up). O(1).
 bool is_black(const Environment& env);
 
 /// Radiance arriving from unit direction `dir` (the direction away from the scene).

@@ -178,7 +178,8 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
         const Material& lm = material_of(scene, scene.meshes[size_t(scene.instances[ls.instance].mesh)].material);
         const bool visible_side = lm.double_sided || cos_l < 0;
         if (dist2 > 0 && std::isfinite(dist) && visible_side && std::fabs(cos_l) > 0 && dot(wi, si.ng) > 0) {
-          const Vec3f f = brdf_eval(brdf, wo, wi);
+          float pdf_b = 0;
+          const Vec3f f = brdf_eval_pdf(brdf, wo, wi, pdf_b);
           if (max_component(f) > 0) {
             Ray to_light;
             to_light.org = si.p;
@@ -197,7 +198,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
               ++counts.shadow;
               const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, dist), cfg.hit_filter);
               const float pdf_l = ls.pdf_area * dist2 / std::fabs(cos_l);
-              const float w = bsdf_lights ? power_heuristic(pdf_l, p_r * brdf_pdf(brdf, wo, wi)) : 1.0f;
+              const float w = bsdf_lights ? power_heuristic(pdf_l, p_r * pdf_b) : 1.0f;
               if (t > 0 && w > 0) {
                 const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
                 path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_l), vertex, groups && vertex == 0 ? &share : nullptr);
@@ -211,11 +212,12 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       Vec3f wi, le;
       float pdf_e = 0;
       if (env_sample(env, samples.get2d(), wi, le, pdf_e) && dot(wi, si.ng) > 0) {
-        const Vec3f f = brdf_eval(brdf, wo, wi);
+        float pdf_b = 0;
+        const Vec3f f = brdf_eval_pdf(brdf, wo, wi, pdf_b);
         if (max_component(f) > 0 && max_component(le) > 0) {
           ++counts.shadow;
           const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, kInfinity), cfg.hit_filter);
-          const float w = bsdf_lights ? power_heuristic(pdf_e, p_r * brdf_pdf(brdf, wo, wi)) : 1.0f;
+          const float w = bsdf_lights ? power_heuristic(pdf_e, p_r * pdf_b) : 1.0f;
           if (t > 0 && w > 0) {
             const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
             path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_e), vertex, groups && vertex == 0 ? &share : nullptr);

@@ -18,6 +18,21 @@ using Clock = std::chrono::steady_clock;
 
 bool is_plain_box(const PixelFilter& f) { return f.type == FilterType::Box && f.width == 1; }
 
+// Raster position of a camera sample from u in [0,1)^2 by filter importance sampling.
+Vec2f filtered_position(const RenderConfig& config, int x, int y, Vec2f u) {
+  const Vec2f o = sample_filter(config.filter, u);
+  return {float(x) + 0.5f + o.x, float(y) + 0.5f + o.y};
+}
+
+// Whitted's sample s of pixel (x, y): stratified jitter, through the filter unless it is the
+// plain 1-pixel box (then the jittered position itself, as before filters existed).
+Vec2f whitted_position(const RenderConfig& config, int x, int y, uint32_t s) {
+  Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
+  const Vec2f j = stratified_sample(s, uint32_t(config.spp), rng);
+  if (is_plain_box(config.filter)) return {float(x) + j.x, float(y) + j.y};
+  return filtered_position(config, x, y, j);
+}
+
 // A camera ray at raster position (px, py) with differentials `step` pixels apart.
 Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float py, float step,
                RayDifferential& rd) {
@@ -80,6 +95,13 @@ int thread_count(const RenderConfig& config) {
 
 }  // namespace
 
+Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
+                             uint32_t s) {
+  if (integrator == IntegratorType::Whitted) return whitted_position(config, x, y, s);
+  SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
+  return filtered_position(config, x, y, st.get2d());  // the stream's first request (path_samples)
+}
+
 PixelWindow render_window(const RenderConfig& config) {
   PixelWindow w = config.window;
   if (w.empty()) return {0, 0, config.width, config.height};
@@ -95,20 +117,12 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
                           RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
   const float step = differential_step(config.spp);
-  const bool box = is_plain_box(config.filter);
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
-    Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
-    const Vec2f j = stratified_sample(s, n, rng);
-    float px = float(x) + j.x, py = float(y) + j.y;
-    if (!box) {  // filter importance sampling of the stratified position
-      const Vec2f o = sample_filter(config.filter, j);
-      px = float(x) + 0.5f + o.x;
-      py = float(y) + 0.5f + o.y;
-    }
+    const Vec2f p = whitted_position(config, x, y, s);
     RayDifferential rd;
-    const Ray ray = camera_ray(camera, config, px, py, step, rd);
+    const Ray ray = camera_ray(camera, config, p.x, p.y, step, rd);
     float coverage = 0;
     sum += whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts);
     alpha += coverage;
@@ -183,9 +197,9 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
   const float step = differential_step(config.spp);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Vec2f o = sample_filter(config.filter, samples.get2d());
+    const Vec2f p = filtered_position(config, x, y, samples.get2d());
     RayDifferential rd;
-    const Ray ray = camera_ray(camera, config, float(x) + 0.5f + o.x, float(y) + 0.5f + o.y, step, rd);
+    const Ray ray = camera_ray(camera, config, p.x, p.y, step, rd);
     float coverage = 0;
     LightGroups lg;
     const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);

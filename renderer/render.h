@@ -139,6 +139,12 @@ void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathL
                        const Camera& camera, const RenderConfig& config, int x, int y,
                        float rgba[4], RayCounts& counts);
 
+/// Raster position (pixel corner at integer coordinates) of camera sample `s` of pixel (x, y)
+/// exactly as `integrator` places it: the one definition the integrators, the data AOVs and
+/// the cost map share.
+Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
+                             uint32_t s);
+
 /// The pass schedule of render_path: sample index where pass k ends (1, 2, 4, 8, 16, 32, 48,
 /// ... capped at spp).
 std::vector<int> path_pass_ends(int spp);

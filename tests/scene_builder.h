@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "renderer/render.h"
 #include "renderer/scene.h"
 
 namespace penumbra::test {
@@ -112,6 +113,16 @@ inline int add_sphere(Scene& s, Vec3f c, float r, int level, int material) {
   }
   m.material = material;
   return add_world_mesh(s, std::move(m));
+}
+
+/// A small render configuration for tests: w x h pixels, spp samples, 8-pixel tiles.
+inline RenderConfig small_render_config(int w, int h, int spp, int tile_size = 8) {
+  RenderConfig c;
+  c.width = w;
+  c.height = h;
+  c.spp = spp;
+  c.tile_size = tile_size;
+  return c;
 }
 
 }  // namespace penumbra::test

@@ -192,6 +192,8 @@ for i in 0 1 2; do
 done
 expect 0 "whole.exr" -- "$bin" render "$d" -o "$work/whole.exr" --integrator path --width 48 --spp 2 --aov all -q --no-png
 expect 0 "merged.exr" -- "$bin" merge "${tiles[@]}" -o "$work/merged.exr"
+expect 2 "merged.png: the output must be an .exr" -- "$bin" merge "${tiles[@]}" -o "$work/merged.png"
+expect 2 "directory .*nodir' does not exist" -- "$bin" merge "${tiles[@]}" -o "$work/nodir/m.exr"
 expect 2 "pixel 0,9 is missing" -- "$bin" merge "$work/tile0.exr" "$work/tile2.exr" -o "$work/gap.exr"
 [ ! -e "$work/gap.exr" ] || { echo "FAIL: a refused merge wrote gap.exr"; fails=$((fails + 1)); }
 # Multi-part: one part per layer, data parts lossless under a lossy codec; tiles merge exactly.

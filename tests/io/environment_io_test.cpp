@@ -66,4 +66,8 @@ TEST_CASE("bad environment maps are errors naming the file", "[io][environment][
   REQUIRE_THROWS_WITH(load_environment(dir / "neg.exr", 1, 0), Contains(">= 0"));
   write_map(dir / "ok.exr", 8, 4, ramp());
   REQUIRE_THROWS_WITH(load_environment(dir / "ok.exr", -1, 0), Contains("env-intensity"));
+  // A map beyond the memory budget is refused before its pixels are decoded.
+  CHECK(environment_bytes(8, 4, 3) == 8 * 4 * (12 + 20));
+  REQUIRE_THROWS_WITH(load_environment(dir / "ok.exr", 1, 0, 512), Contains("ok.exr") && Contains("memory budget"));
+  CHECK(load_environment(dir / "ok.exr", 1, 0, 8 * 4 * 32).width == 8);
 }

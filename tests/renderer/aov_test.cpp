@@ -13,14 +13,7 @@ using namespace penumbra;
 using namespace penumbra::test;
 
 namespace {
-RenderConfig config(int w, int h, int spp) {
-  RenderConfig c;
-  c.width = w;
-  c.height = h;
-  c.spp = spp;
-  c.tile_size = 4;
-  return c;
-}
+RenderConfig config(int w, int h, int spp) { return small_render_config(w, h, spp, 4); }
 }  // namespace
 
 TEST_CASE("aov: ids, depth, normal, position and albedo are exact on a known scene", "[aov][quick]") {

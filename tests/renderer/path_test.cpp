@@ -34,14 +34,7 @@ Rendered render(const Scene& s, const Environment& env, const Camera& cam, const
   return r;
 }
 
-RenderConfig small_config(int w, int h, int spp) {
-  RenderConfig cfg;
-  cfg.width = w;
-  cfg.height = h;
-  cfg.spp = spp;
-  cfg.tile_size = 8;
-  return cfg;
-}
+RenderConfig small_config(int w, int h, int spp) { return small_render_config(w, h, spp); }
 
 double channel_mean(const Film& f, int c) {
   double sum = 0;
