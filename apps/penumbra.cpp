@@ -2,9 +2,12 @@
 // Exit codes: 0 success, 2 bad input or usage, 1 internal failure. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <charconv>
+#include <climits>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -17,7 +20,11 @@
 #include <sstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "io/atomic_file.h"
+#include "io/file_checks.h"
+#include "io/hash.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
@@ -48,6 +55,33 @@ double seconds_since(Clock::time_point t0) {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// What the program is doing, for the out-of-memory message (main() reports it).
+const char* g_phase = "parsing the command line";
+
+/// A decimal integer in [lo, hi]: digits only (a leading '-' only if lo < 0), no spaces, no
+/// wrap-around. Throws UsageError naming `option` and the valid range otherwise.
+long long parse_integer(std::string_view text, long long lo, long long hi, const std::string& option) {
+  long long v = 0;
+  const char* end = text.data() + text.size();
+  const auto r = std::from_chars(text.data(), end, v);
+  if (text.empty() || r.ptr != end || (r.ec != std::errc() && r.ec != std::errc::result_out_of_range) ||
+      text[0] == '+' || (text[0] == '-' && lo >= 0))
+    throw UsageError(option + ": '" + std::string(text) + "' is not an integer");
+  if (r.ec == std::errc::result_out_of_range || v < lo || v > hi)
+    throw UsageError(option + ": " + std::string(text) + " is outside [" + std::to_string(lo) + ", " +
+                     std::to_string(hi) + "]");
+  return v;
+}
+
+/// Splits "a<sep>b" into exactly two parts; throws UsageError with `expected` otherwise.
+std::pair<std::string, std::string> split_pair(const std::string& text, char sep, const std::string& option,
+                                               const std::string& expected) {
+  const size_t at = text.find(sep);
+  if (at == std::string::npos || text.find(sep, at + 1) != std::string::npos)
+    throw UsageError(option + ": expected " + expected + ", got '" + text + "'");
+  return {text.substr(0, at), text.substr(at + 1)};
+}
 
 // While a path render runs, the first SIGINT/SIGTERM asks it to stop after the current pass
 // (the finished passes are then written); otherwise, or on a second signal, temporaries are
@@ -172,7 +206,7 @@ struct RenderArgs {
   bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
   int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
   std::string camera;  ///< index or name; empty = the first camera, or framing
-  uint64_t seed = 0;
+  std::string seed = "0";      ///< parsed as an unsigned 64-bit integer
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string accel = "embree", max_memory, debug_pixel, cost_png;
@@ -189,7 +223,7 @@ struct RenderArgs {
   double time_limit = 0;
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
   std::optional<double> time;   ///< --time, seconds
-  std::optional<long> frame;    ///< --frame, converted with --fps
+  std::optional<std::string> frame;  ///< --frame, an integer, converted with --fps
   double fps = 24;
 };
 
@@ -204,7 +238,13 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
   }
   if (!known) throw UsageError("--accel: unknown accelerator '" + name + "' (known: " + names + ")");
   AccelConfig config;
-  for (const auto& p : params) apply_accel_param(config, p);
+  for (const auto& p : params) {
+    // A parameter of another structure would be silently unused: refuse it.
+    apply_accel_param(config, p);
+    const std::string prefix = p.substr(0, p.find('.'));
+    if (prefix != name)
+      throw UsageError("--accel-param " + p + ": a parameter of '" + prefix + "', but --accel is '" + name + "'");
+  }
   validate(config.embree);
   validate(config.bvh);
   validate(config.kdtree);
@@ -334,15 +374,15 @@ PixelWindow parse_window(const RenderArgs& a, int width, int height) {
       const std::string& t = a.crop[size_t(k)];
       const int extent = k < 2 ? width : height;
       try {
-        size_t pos = 0;
-        const double x = std::stod(t, &pos);
-        if (pos != t.size() || !std::isfinite(x)) throw std::invalid_argument(t);
         if (t.find('.') != std::string::npos) {
+          size_t pos = 0;
+          const double x = std::stod(t, &pos);
+          if (pos != t.size() || !std::isfinite(x) || t.find_first_not_of("0123456789.") != std::string::npos)
+            throw std::invalid_argument(t);
           if (x < 0 || x > 1) throw UsageError("--crop: fraction " + t + " is outside [0, 1]");
           v[k] = int(std::lround(x * extent));
         } else {
-          if (x < 0 || x > extent) throw UsageError("--crop: " + t + " is outside [0, " + std::to_string(extent) + "]");
-          v[k] = int(x);
+          v[k] = int(parse_integer(t, 0, extent, "--crop"));
         }
       } catch (const UsageError&) {
         throw;
@@ -355,14 +395,37 @@ PixelWindow parse_window(const RenderArgs& a, int width, int height) {
     return w;
   }
   if (!a.tile.empty()) {
-    int i = -1, n = 0;
-    char extra = 0;
-    if (std::sscanf(a.tile.c_str(), "%d/%d%c", &i, &n, &extra) != 2 || n < 1 || i < 0 || i >= n)
-      throw UsageError("--tile: expected i/N with 0 <= i < N, got '" + a.tile + "'");
+    const auto [index, count] = split_pair(a.tile, '/', "--tile", "i/N with 0 <= i < N");
+    const long long n = parse_integer(count, 1, 1ll << 40, "--tile N");
     if (n > height) throw UsageError("--tile: " + std::to_string(n) + " stripes exceed the " + std::to_string(height) + " rows");
+    long long i = -1;
+    try {
+      i = parse_integer(index, 0, n - 1, "--tile i");
+    } catch (const UsageError&) {
+      throw UsageError("--tile: expected i/N with 0 <= i < N, got '" + a.tile + "'");
+    }
     return {0, int(int64_t(i) * height / n), width, int(int64_t(i + 1) * height / n)};
   }
   return {};
+}
+
+/// Bytes an acceleration structure needs per stored triangle, for the budget before it is built
+/// (Embree's and the own BVH's nodes, references and triangle copies stay below this).
+constexpr uint64_t kAccelBytesPerTriangle = 96;
+
+/// Bytes per rendered pixel of every buffer a render keeps until its outputs are written: the
+/// film (RGBA float), the path tracer's accumulators and statistics, light groups (double sums
+/// and float means), data AOVs (14 floats), cost AOVs (3 floats), the EXR's packed channels
+/// (4 bytes each) and the display image (float RGB and its encoding).
+uint64_t image_bytes_per_pixel(bool path, bool data_aovs, bool light_groups, bool cost, bool display, size_t aov_count) {
+  uint64_t b = 16;
+  if (path) b += sizeof(PathAccumulators::Pixel) + 4 + 4;
+  if (light_groups) b += 15 * 8 + 15 * 4;
+  if (data_aovs) b += 14 * 4;
+  if (cost) b += 3 * 4 + 3;
+  b += (4 + (data_aovs ? 14 : 0) + (light_groups ? 15 : 0) + (cost ? 3 : 0) + (aov_count ? 2 : 0)) * 4;
+  if (display) b += 12 + 3;
+  return b;
 }
 
 /// Everything that decides a path-traced pixel's samples, for checkpoint headers (not the
@@ -383,7 +446,7 @@ std::string render_fingerprint(const RenderArgs& a, const RenderConfig& cfg, con
                 double(cfg.filter.width), p.max_depth, p.rr_depth, double(p.clamp_indirect), a.light_sampling.c_str(),
                 a.env.c_str(), double(a.env_intensity), double(a.env_rotation), double(cfg.adaptive_threshold),
                 cfg.adaptive_min_spp, cfg.light_groups ? 1 : 0, a.accel.c_str(), a.flatten ? 1 : 0,
-                a.time ? std::to_string(*a.time).c_str() : (a.frame ? ("frame " + std::to_string(*a.frame)).c_str() : "static"));
+                a.time ? std::to_string(*a.time).c_str() : (a.frame ? ("frame " + *a.frame).c_str() : "static"));
   return buf;
 }
 
@@ -393,10 +456,8 @@ int run_render(const RenderArgs& a) {
   std::string ext = out.extension().string();
   for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".exr") throw UsageError("-o " + a.output + ": the output must be an .exr file");
-  auto check_dir = [](const fs::path& p, const char* opt) {
-    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir)) throw UsageError(std::string(opt) + " " + p.string() + ": directory '" + dir.string() + "' does not exist");
-  };
+  // Each output's folder must exist and its target must be replaceable or streamable.
+  auto check_dir = [](const fs::path& p, const char* opt) { resolve_output(p, opt); };
   check_dir(out, "-o");
   if (!a.stats_json.empty()) check_dir(fs::path(a.stats_json), "--stats-json");
   std::optional<fs::path> png;
@@ -441,9 +502,16 @@ int run_render(const RenderArgs& a) {
   std::optional<Vec3f> env_colour;
   if (!a.env.empty() && a.env.find_first_not_of("0123456789.,eE+- ") == std::string::npos) env_colour = parse_colour(a.env, "--env");
   int debug_x = -1, debug_y = -1;
-  if (!a.debug_pixel.empty() && std::sscanf(a.debug_pixel.c_str(), "%d,%d", &debug_x, &debug_y) != 2)
-    throw UsageError("--debug-pixel: expected x,y, got '" + a.debug_pixel + "'");
+  if (!a.debug_pixel.empty()) {
+    const auto [x, y] = split_pair(a.debug_pixel, ',', "--debug-pixel", "x,y");
+    debug_x = int(parse_integer(x, INT_MIN, INT_MAX, "--debug-pixel x"));
+    debug_y = int(parse_integer(y, INT_MIN, INT_MAX, "--debug-pixel y"));
+  }
   const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
+  uint64_t seed = 0;
+  if (const auto r = std::from_chars(a.seed.data(), a.seed.data() + a.seed.size(), seed);
+      a.seed.empty() || a.seed[0] == '-' || a.seed[0] == '+' || r.ec != std::errc() || r.ptr != a.seed.data() + a.seed.size())
+    throw UsageError("--seed: '" + a.seed + "' is not an integer in [0, 2^64 - 1]");
   // --aov NAME[,NAME...] (repeatable); "all" = every compositing AOV of the integrator.
   std::set<std::string> aovs;
   for (const auto& item : a.aovs) {
@@ -478,15 +546,39 @@ int run_render(const RenderArgs& a) {
     throw UsageError("--cost-png needs --aov cost");
   }
 
+  // No two outputs may be one file, and no output may be a file this run reads.
+  const bool out_streams = resolve_output(out, "-o").kind == OutputKind::Stream;
+  if (out_streams && (a.checkpoint > 0 || a.resume))
+    throw UsageError("--checkpoint and --resume keep their state beside -o, which must then be a regular file");
+  std::vector<std::pair<std::string, fs::path>> outputs = {{"-o", out}};
+  if (path && !out_streams) outputs.push_back({"the resume state", fs::path(out).concat(".resume")});
+  if (png) outputs.push_back({"--png", *png});
+  if (cost_png) outputs.push_back({"--cost-png", *cost_png});
+  if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
+  std::vector<std::pair<std::string, fs::path>> inputs = {{"the scene file", a.scene_file}};
+  if (!a.env.empty() && !env_colour) inputs.push_back({"--env", a.env});
+  if (!a.ocio_config.empty()) inputs.push_back({"--ocio-config", a.ocio_config});
+  else if (const char* ocio = std::getenv("OCIO"); ocio && *ocio) inputs.push_back({"$OCIO", ocio});
+  check_distinct_files(outputs, inputs);
+  bool paths_to_stdout = true;  // stdout carries the paths written, unless an output streams there
+  struct stat stdout_stat {};
+  if (::fstat(STDOUT_FILENO, &stdout_stat) == 0)
+    for (const auto& [option, file] : outputs) {
+      const OutputTarget t = resolve_output(file, option);
+      if (t.kind == OutputKind::Stream && t.device == stdout_stat.st_dev && t.inode == stdout_stat.st_ino)
+        paths_to_stdout = false;
+    }
+
   std::optional<double> time = a.time;
   if (time && !std::isfinite(*time)) throw UsageError("--time must be a finite number of seconds");
   if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
-  if (a.frame) time = double(*a.frame) / a.fps;
+  if (a.frame) time = double(parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame")) / a.fps;
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
   // Load.
+  g_phase = "loading the scene";
   const auto t_load = Clock::now();
   LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, a.max_memory, a.quiet, time);
   Scene& scene = loaded.scene;
@@ -505,13 +597,20 @@ int run_render(const RenderArgs& a) {
     throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " exceeds 16384 per side");
   cfg.window = parse_window(a, cfg.width, cfg.height);
   const uint64_t budget = a.max_memory.empty() ? default_memory_budget() : parse_bytes(a.max_memory);
-  if (path) {  // the path tracer keeps per-pixel accumulators (render.h PathAccumulators) and statistics
+  uint64_t committed = 0;  // bytes of the budget the scene and the image buffers take
+  {
+    // The image buffers of this run, charged with the scene to the one budget before any is made.
     const PixelWindow w = render_window(cfg);
-    const uint64_t bytes = uint64_t(w.width()) * uint64_t(w.height()) * 88;
-    if (bytes > budget)
-      throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " needs " +
-                       std::to_string(bytes >> 20) + " MiB of path tracer accumulators, over the memory budget of " +
-                       std::to_string(budget >> 20) + " MiB (--max-memory)");
+    const uint64_t pixels = uint64_t(w.width()) * uint64_t(w.height());
+    const uint64_t image = pixels * image_bytes_per_pixel(path, data_aovs, aovs.count("light") > 0, cost_aov,
+                                                          png.has_value(), aovs.size());
+    const uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle;
+    if (image > budget || scene_bytes > budget - image)
+      throw UsageError("image " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " (" + a.integrator +
+                       (aovs.empty() ? "" : ", with AOVs") + ") needs " + format_bytes(image) +
+                       " for the film and output buffers, over the " + format_bytes(budget) +
+                       " budget with the rest of the scene (" + format_bytes(scene_bytes) + ") (--max-memory)");
+    committed = image + scene_bytes;
   }
   if (!cfg.window.empty() && cost_aov) throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
   const Camera camera = cam_index >= 0 ? scene.cameras[size_t(cam_index)]
@@ -519,7 +618,7 @@ int run_render(const RenderArgs& a) {
   // The path tracer's lights: emissive triangles and the environment.
   Environment environment;
   if (env_colour) environment = make_constant_environment(*env_colour * a.env_intensity);
-  else if (!a.env.empty()) environment = load_environment(a.env, a.env_intensity, a.env_rotation, budget);
+  else if (!a.env.empty()) environment = load_environment(a.env, a.env_intensity, a.env_rotation, budget - committed);
   AreaLights area_lights;
   if (path) area_lights = build_area_lights(scene);
   bool default_light = false;
@@ -529,7 +628,7 @@ int run_render(const RenderArgs& a) {
   }
   cfg.spp = a.spp_given ? a.spp : (path ? 64 : 4);
   cfg.threads = a.threads;
-  cfg.seed = a.seed;
+  cfg.seed = seed;
   cfg.filter = make_filter(filter_type, filter_width);
   cfg.whitted.max_depth = a.depth_given ? a.max_depth : 5;
   cfg.whitted.background = background;
@@ -546,6 +645,7 @@ int run_render(const RenderArgs& a) {
   const PathLights path_lights{&area_lights, &environment};
 
   // Build.
+  g_phase = "building the acceleration structure";
   const auto t_build = Clock::now();
   auto accel = make_scene_accelerator(a.accel, scene, accel_config);
   const double build_s = seconds_since(t_build);
@@ -565,11 +665,13 @@ int run_render(const RenderArgs& a) {
   }
 
   // Render.
+  g_phase = "rendering";
   ProgressReporter reporter(!a.quiet);
   RenderStats stats;
   Film film;
   PathImage path_image;
   int interrupted = 0;
+  bool frame_complete = true;
   if (path) {
     // Resume state beside the output; its header records what determines the pixels.
     const fs::path state_file = fs::path(out).concat(".resume");
@@ -601,8 +703,12 @@ int run_render(const RenderArgs& a) {
                              &state, after_pass);
     g_graceful = false;
     film = std::move(path_image.film);
-    if (g_stop.load() && !state.complete) {
-      interrupted = g_signal.load();
+    // A signal during the last pass still ends the run with 128 + signal, the image complete.
+    if (g_stop.load()) interrupted = g_signal.load();
+    frame_complete = state.complete;
+    if (out_streams) {
+      // No resume state beside a stream.
+    } else if (interrupted && !state.complete) {
       write_checkpoint(state_file, state, fingerprint);
     } else if (state.complete && fs::exists(state_file)) {
       fs::remove(state_file);
@@ -673,39 +779,49 @@ int run_render(const RenderArgs& a) {
     }
     exr.extra.push_back({"cost.ns", &cost.nanoseconds});
   }
-  write_exr(film, out, exr);
-  if (png) write_display_image(film, *png, display);
-  if (cost_png) {
-    write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png, cost_caption(cost, a.accel));
-  }
+  g_phase = "writing the outputs";
+  const bool hashes = !a.stats_json.empty();  // the stats record what they were written with
+  std::string exr_sha, png_sha, cost_sha;
+  write_exr(film, out, exr, hashes ? &exr_sha : nullptr);
+  if (png) write_display_image(film, *png, display, hashes ? &png_sha : nullptr);
+  if (cost_png)
+    write_heatmap(total_cost(cost), cfg.width, cfg.height, *cost_png, cost_caption(cost, a.accel),
+                  hashes ? &cost_sha : nullptr);
   const double write_s = seconds_since(t_write);
   if (!a.stats_json.empty()) {
-    char buf[2048];
-    std::snprintf(buf, sizeof buf,
-                  "{\n  \"version\": %s,\n  \"scene\": %s,\n  \"output\": %s,\n  \"integrator\": %s,\n"
-                  "  \"width\": %d,\n  \"height\": %d,\n  \"window\": [%d, %d, %d, %d],\n  \"spp\": %d,\n"
-                  "  \"mean_spp\": %.4f,\n  \"passes\": %d,\n  \"time_limited\": %s,\n  \"interrupted\": %s,\n"
-                  "  \"threads\": %d,\n  \"accelerator\": %s,\n"
-                  "  \"seconds\": {\"load\": %.6f, \"build\": %.6f, \"render\": %.6f, \"write\": %.6f},\n"
-                  "  \"rays\": {\"camera\": %llu, \"shadow\": %llu, \"%s\": %llu, \"total\": %llu},\n"
-                  "  \"mrays_per_second\": %.4f,\n  \"peak_memory_mib\": %.2f,\n"
-                  "  \"triangles\": %llu,\n  \"instances\": %zu,\n  \"lights\": %zu\n}\n",
-                  json_string(PENUMBRA_VERSION).c_str(), json_string(a.scene_file).c_str(), json_string(out.string()).c_str(),
-                  json_string(a.integrator).c_str(), cfg.width, cfg.height, film.origin_x, film.origin_y,
-                  film.origin_x + film.width, film.origin_y + film.height, cfg.spp, mean_spp, stats.passes,
-                  stats.time_limited ? "true" : "false", interrupted ? "true" : "false", stats.threads,
-                  json_string(a.accel).c_str(), load_s, build_s, stats.seconds, write_s,
-                  static_cast<unsigned long long>(stats.rays.camera), static_cast<unsigned long long>(stats.rays.shadow),
-                  path ? "bounce" : "reflection", static_cast<unsigned long long>(stats.rays.reflection),
-                  static_cast<unsigned long long>(stats.rays.total()),
-                  stats.seconds > 0 ? double(stats.rays.total()) / stats.seconds / 1e6 : 0.0, peak_memory_mib(),
-                  static_cast<unsigned long long>(count_triangles(scene)), scene.instances.size(), scene.lights.size());
-    const std::string text = buf;
-    write_atomically(a.stats_json, [&](const fs::path& temp) {
-      std::ofstream f(temp);
-      f << text;
-      if (!f.flush()) throw std::runtime_error(a.stats_json + ": cannot write");
-    });
+    nlohmann::ordered_json j;
+    j["version"] = PENUMBRA_VERSION;
+    j["scene"] = a.scene_file;
+    j["output"] = out.string();
+    // The SHA-256 of each image as this run wrote it: a reader can tell whether the files now
+    // at these paths are the ones these statistics describe.
+    j["outputs"]["exr"] = {{"path", out.string()}, {"sha256", exr_sha}};
+    if (png) j["outputs"]["png"] = {{"path", png->string()}, {"sha256", png_sha}};
+    if (cost_png) j["outputs"]["cost_png"] = {{"path", cost_png->string()}, {"sha256", cost_sha}};
+    j["integrator"] = a.integrator;
+    j["width"] = cfg.width;
+    j["height"] = cfg.height;
+    j["window"] = {film.origin_x, film.origin_y, film.origin_x + film.width, film.origin_y + film.height};
+    j["spp"] = cfg.spp;
+    j["mean_spp"] = mean_spp;
+    j["passes"] = stats.passes;
+    j["time_limited"] = stats.time_limited;
+    j["interrupted"] = interrupted != 0;
+    j["threads"] = stats.threads;
+    j["accelerator"] = a.accel;
+    j["seconds"] = {{"load", load_s}, {"build", build_s}, {"render", stats.seconds}, {"write", write_s}};
+    j["rays"] = {{"camera", stats.rays.camera},
+                 {"shadow", stats.rays.shadow},
+                 {path ? "bounce" : "reflection", stats.rays.reflection},
+                 {"total", stats.rays.total()}};
+    j["mrays_per_second"] = stats.seconds > 0 ? double(stats.rays.total()) / stats.seconds / 1e6 : 0.0;
+    j["peak_memory_mib"] = peak_memory_mib();
+    j["triangles"] = count_triangles(scene);
+    j["instances"] = scene.instances.size();
+    j["lights"] = scene.lights.size();
+    const std::string text = j.dump(2) + "\n";
+    write_atomically(a.stats_json,
+                     [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), a.stats_json); });
   }
 
   if (!a.quiet) {
@@ -738,12 +854,17 @@ int run_render(const RenderArgs& a) {
                  human_count(total).c_str(), stats.seconds > 0 ? double(total) / stats.seconds / 1e6 : 0.0,
                  peak_memory_mib());
   }
-  std::printf("%s\n", out.string().c_str());
-  if (png) std::printf("%s\n", png->string().c_str());
-  if (cost_png) std::printf("%s\n", cost_png->string().c_str());
+  if (paths_to_stdout) {
+    std::printf("%s\n", out.string().c_str());
+    if (png) std::printf("%s\n", png->string().c_str());
+    if (cost_png) std::printf("%s\n", cost_png->string().c_str());
+  }
   if (interrupted) {
-    std::fprintf(stderr, "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
-                         "continue with the same command and --resume\n", interrupted, stats.passes, mean_spp);
+    if (frame_complete)
+      std::fprintf(stderr, "penumbra: interrupted by signal %d during the last pass: the image is complete\n", interrupted);
+    else
+      std::fprintf(stderr, "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
+                           "continue with the same command and --resume\n", interrupted, stats.passes, mean_spp);
     return 128 + interrupted;
   }
   return kExitOk;
@@ -930,9 +1051,10 @@ int main(int argc, char** argv) {
       std::string ext = merged.extension().string();
       for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
       if (ext != ".exr") throw UsageError("-o " + merge_out + ": the output must be an .exr file");
-      const fs::path dir = merged.has_parent_path() ? merged.parent_path() : fs::path(".");
-      if (!fs::is_directory(dir)) throw UsageError("-o " + merge_out + ": directory '" + dir.string() + "' does not exist");
       std::vector<fs::path> parts(merge_parts.begin(), merge_parts.end());
+      std::vector<std::pair<std::string, fs::path>> inputs;
+      for (size_t k = 0; k < parts.size(); ++k) inputs.push_back({"part " + std::to_string(k + 1), parts[k]});
+      check_distinct_files({{"-o", merged}}, inputs);
       merge_exr_parts(parts, merge_out);
       std::printf("%s\n", merge_out.c_str());
       return kExitOk;
@@ -948,7 +1070,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "penumbra: error: %s\n", e.what());
     return kExitInput;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "penumbra: internal error: out of memory\n");
+    // Outputs are written atomically: nothing half-written is left behind.
+    std::fprintf(stderr, "penumbra: error: out of memory while %s; no file is left half-written (a lower "
+                 "--max-memory refuses oversized inputs up front)\n", g_phase);
+    return kExitInternal;
+  } catch (const std::runtime_error& e) {
+    // A failed write, sync or rename (full disk, permissions): the message names the file.
+    std::fprintf(stderr, "penumbra: error: %s\n", e.what());
     return kExitInternal;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "penumbra: internal error: %s\n", e.what());

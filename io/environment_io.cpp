@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "io/error.h"
+#include "io/file_checks.h"
 
 namespace penumbra {
 
@@ -21,8 +22,7 @@ Environment load_environment(const std::filesystem::path& path, float intensity,
   if (!std::isfinite(intensity) || intensity < 0)
     throw InputError(file, "--env-intensity", "must be finite and >= 0");
   if (!std::isfinite(rotation_degrees)) throw InputError(file, "--env-rotation", "must be finite");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "", "environment map not found");
+  check_input_file(path, "--env", kMaxEnvironmentFileBytes);
   auto in = OIIO::ImageInput::open(file);
   if (!in) throw InputError(file, "", "cannot read environment map: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();

@@ -11,6 +11,8 @@ namespace penumbra {
 
 /// Largest map accepted per side (a 16k x 8k map is 1.5 GiB of float RGB plus its tables).
 inline constexpr int kMaxEnvironmentSide = 16384;
+/// Largest environment map file read (16384 x 8192 RGBA float with room for the container).
+inline constexpr uint64_t kMaxEnvironmentFileBytes = 4ull << 30;
 
 /// Bytes load_environment needs for a width x height map of `channels` channels (decoded
 /// pixels, texels and sampling tables).

@@ -2,6 +2,7 @@
 #include "io/image_output.h"
 
 #include <OpenColorIO/OpenColorIO.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/half.h>
 #include <OpenImageIO/imageio.h>
 
@@ -15,6 +16,7 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "io/file_checks.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 
@@ -28,16 +30,24 @@ void write_with_oiio(const std::filesystem::path& final_path, const std::filesys
   if (!out)
     throw std::runtime_error(final_path.string() + ": no image writer for this extension (" +
                              OIIO::geterror() + ")");
+  // Display images are encoded into memory and written with checked system calls: OIIO's PNG
+  // writer does not report a full disk. EXR's writer checks every write itself.
+  const bool in_memory = std::string(out->format_name()) != "openexr" && out->supports("ioproxy");
+  OIIO::Filesystem::IOVecOutput memory;
+  if (in_memory && !out->set_ioproxy(&memory))
+    throw std::runtime_error(final_path.string() + ": cannot encode in memory: " + out->geterror());
   if (!out->open(temp.string(), spec))
     throw std::runtime_error(final_path.string() + ": cannot open for writing: " + out->geterror());
   if (!out->write_image(pixel_type, pixels))
     throw std::runtime_error(final_path.string() + ": write failed: " + out->geterror());
   if (!out->close()) throw std::runtime_error(final_path.string() + ": close failed: " + out->geterror());
+  if (in_memory) write_file_checked(temp, memory.buffer().data(), memory.buffer().size(), final_path);
 }
 
 }  // namespace
 
-void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options) {
+void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
+               std::string* sha256) {
   const int nc = 4 + int(options.extra.size());
   const OIIO::TypeDesc colour = options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT;
   OIIO::ImageSpec spec(film.width, film.height, nc, colour);
@@ -74,7 +84,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   if (options.extra.empty()) {
     write_atomically(path, [&](const std::filesystem::path& temp) {
       write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
-    });
+    }, sha256);
     return;
   }
   // Pixels in each channel's own file format (OIIO's float -> uint conversion would normalise,
@@ -108,7 +118,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   if (!options.multipart) {
     write_atomically(path, [&](const std::filesystem::path& temp) {
       write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
-    });
+    }, sha256);
     return;
   }
   // Multi-part: "rgba" (R, G, B, A and the metadata), then one part per layer (the channel
@@ -172,7 +182,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
         throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
     }
     if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
-  });
+  }, sha256);
 }
 
 namespace {
@@ -254,7 +264,7 @@ std::string legend_number(double v) {
 }  // namespace
 
 void write_heatmap(const std::vector<float>& values, int width, int height, const std::filesystem::path& path,
-                   const std::string& title) {
+                   const std::string& title, std::string* sha256) {
   if (values.size() != size_t(width) * size_t(height))
     throw std::invalid_argument(path.string() + ": heat map values do not match the image size");
   float vmax = 0;
@@ -297,10 +307,12 @@ void write_heatmap(const std::vector<float>& values, int width, int height, cons
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
   write_atomically(path, [&](const std::filesystem::path& temp) {
     write_with_oiio(path, temp, spec, c.rgb.data(), OIIO::TypeDesc::UINT8);
-  });
+  }, sha256);
 }
 
 namespace {
+
+constexpr uint64_t kMaxOcioConfigBytes = 64ull << 20;
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -314,6 +326,9 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
   const std::string source = !options.ocio_config.empty() ? options.ocio_config
                              : (env && *env)              ? std::string(env)
                                                           : std::string("<shipped config>");
+  // A config is a small text file; a FIFO or device named here must not block the run.
+  if (!options.ocio_config.empty()) check_input_file(options.ocio_config, "--ocio-config", kMaxOcioConfigBytes);
+  else if (env && *env) check_input_file(env, "$OCIO", kMaxOcioConfigBytes);
   OCIO::ConstConfigRcPtr config;
   try {
     if (!options.ocio_config.empty()) {
@@ -389,7 +404,7 @@ void apply_display_transform(std::vector<float>& rgb, int width, int height,
 }
 
 void write_display_image(const Film& film, const std::filesystem::path& path,
-                         const DisplayOptions& options) {
+                         const DisplayOptions& options, std::string* sha256) {
   const size_t n = size_t(film.width) * size_t(film.height);
   std::vector<float> rgb(n * 3);
   const float gain = std::exp2(options.exposure);
@@ -404,7 +419,7 @@ void write_display_image(const Film& film, const std::filesystem::path& path,
   for (float& v : rgb) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
   write_atomically(path, [&](const std::filesystem::path& temp) {
     write_with_oiio(path, temp, spec, rgb.data(), OIIO::TypeDesc::FLOAT);
-  });
+  }, sha256);
 }
 
 }  // namespace penumbra

@@ -44,7 +44,9 @@ struct ExrOptions {
 /// Writes channels R, G, B, A (colour premultiplied by A) and the extra channels to `path`.
 /// Throws std::runtime_error naming the file if OpenImageIO fails, std::invalid_argument if an
 /// extra channel has the wrong size.
-void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options);
+/// If `sha256` is not null it receives the SHA-256 of the file's bytes.
+void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
+               std::string* sha256 = nullptr);
 
 struct DisplayOptions {
   std::string ocio_config;  ///< config file; empty = $OCIO if set, else Penumbra's shipped config
@@ -57,8 +59,9 @@ struct DisplayOptions {
 /// Writes the beauty (over black) through the display/view transform as 8-bit RGB (16-bit for
 /// TIFF). The format follows the extension (.png, .jpg/.jpeg, .tif/.tiff). Throws InputError
 /// for a bad config/display/view and std::runtime_error for write failures.
+/// If `sha256` is not null it receives the SHA-256 of the file's bytes.
 void write_display_image(const Film& film, const std::filesystem::path& path,
-                         const DisplayOptions& options);
+                         const DisplayOptions& options, std::string* sha256 = nullptr);
 
 /// Checks, before any rendering, that `path` has a display-image extension (.png, .jpg,
 /// .jpeg, .tif, .tiff) and that the config, display and view resolve. Throws InputError
@@ -70,7 +73,8 @@ void check_display_output(const std::filesystem::path& path, const DisplayOption
 /// strip below it: `title`, the colour bar and its scale (0, quarters, maximum). Written
 /// atomically. Throws std::runtime_error naming the file if OpenImageIO fails.
 void write_heatmap(const std::vector<float>& values, int width, int height,
-                   const std::filesystem::path& path, const std::string& title);
+                   const std::filesystem::path& path, const std::string& title,
+                   std::string* sha256 = nullptr);
 
 /// Penumbra's shipped OCIO config text (io/ocio/config.ocio, embedded at build time).
 const char* shipped_ocio_config();

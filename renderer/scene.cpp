@@ -59,6 +59,17 @@ uint64_t count_triangles(const Scene& scene) {
   return n;
 }
 
+uint64_t scene_memory_bytes(const Scene& scene) {
+  auto bytes = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+  uint64_t total = bytes(scene.instances) + bytes(scene.materials) + bytes(scene.lights);
+  for (const Mesh& m : scene.meshes)
+    total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
+             bytes(m.colors) + bytes(m.indices);
+  for (const Texture& t : scene.textures)
+    for (const MipLevel& level : t.levels) total += bytes(level.texels);
+  return total;
+}
+
 uint64_t count_stored_triangles(const Scene& scene) {
   uint64_t n = 0;
   for (const auto& m : scene.meshes) n += m.indices.size() / 3;

@@ -138,6 +138,10 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64
 uint64_t count_triangles(const Scene& scene);
 /// Triangles stored: each mesh once.
 uint64_t count_stored_triangles(const Scene& scene);
+
+/// Bytes held by the scene's arrays (mesh attributes, instances, texture pyramids), for
+/// memory budgets.
+uint64_t scene_memory_bytes(const Scene& scene);
 /// Views of every mesh and of every instance for make_accelerator(name, meshes, instances);
 /// geom_id in hits == instance index.
 std::vector<TriangleMeshView> mesh_views(const Scene& scene);
