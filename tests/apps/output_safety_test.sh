@@ -117,6 +117,15 @@ expect 2 "image 4096x4096 \(whitted, with AOVs\) needs [0-9.]+ GiB for the film 
 expect 0 "big.exr" -- "$bin" render "$scene" -o "$work/big.exr" --width 2048 --height 2048 --spp 1 -q --no-png --max-memory 512M
 rm -f "$work/big.exr"
 
+# Memory that runs out anyway (an address-space limit below the budget) ends in a clear message,
+# exit 1 and no output. AddressSanitizer reserves terabytes of address space: not under it.
+if [ "${PENUMBRA_SANITIZED:-0}" != 1 ]; then
+  (ulimit -v 1500000; exec "$bin" render "$scene" -o "$work/oom.exr" --width 8000 --height 8000 --spp 1 --max-memory 16G -q) \
+    >"$work/out" 2>"$work/err"; rc=$?
+  if [ "$rc" -eq 1 ] && grep -q "out of memory while rendering; no file is left half-written" "$work/err" && [ ! -e "$work/oom.exr" ]; then pass
+  else fail "out of memory: exit $rc"; sed 's/^/  | /' "$work/err" | tail -3; fi
+fi
+
 # --- A signal in the last pass still ends the run with 128 + signal (143), the image complete.
 "$bin" render "$scene" -o "$work/last.exr" --integrator path --width 1280 --spp 1 --no-png >"$work/out" 2>"$work/err" &
 pid=$!
