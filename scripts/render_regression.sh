@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# A fixed set of renders that covers the whole output path (both integrators, every
+# accelerator, --aov all,cost, --multipart, crops, tiles and merge, an animation time, a
+# checkpoint and its resume), for checking that a change to the code changes no image.
+#
+#   scripts/render_regression.sh render PENUMBRA OUTDIR   render the set with one binary
+#   scripts/render_regression.sh compare DIR_A DIR_B      exit 0 iff every EXR is identical
+#
+# "Identical" means: the same parts, channels, types, windows and header attributes, except
+# the timing attribute penumbra:render_seconds and the command line (which names each run's
+# output folder), and the same value in every pixel of every channel except cost.ns
+# (wall-clock nanoseconds per ray). Compared with oiiotool with zero tolerance. The binary is
+# copied to one fixed path before rendering, so the recorded command lines start alike.
+# Corpus renders (the animation time) need ../shared/corpus or PENUMBRA_CORPUS.
+set -euo pipefail
+
+mode="${1:-}"
+case "$mode" in
+  render)
+    bin="$2"; out="$3"
+    src="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+    corpus="${PENUMBRA_CORPUS:-$src/../shared/corpus}"
+    rm -rf "$out"; mkdir -p "$out"
+    fixed="${TMPDIR:-/tmp}/penumbra-regression-bin/penumbra"
+    mkdir -p "$(dirname "$fixed")"; cp "$bin" "$fixed"
+    d="$src/scenes/default.gltf"
+    r() { "$fixed" render "$@" -q --no-png >/dev/null; }
+    for accel in embree bvh kdtree grid brute; do
+      r "$d" -o "$out/whitted-$accel.exr" --width 96 --spp 4 --accel "$accel"
+      r "$d" -o "$out/path-$accel.exr" --integrator path --width 64 --spp 16 --accel "$accel"
+    done
+    r "$d" -o "$out/whitted-aovs.exr" --width 96 --spp 4 --aov all,cost --accel bvh
+    r "$d" -o "$out/path-aovs.exr" --integrator path --width 64 --spp 16 --aov all,cost --accel bvh
+    r "$d" -o "$out/path-multipart.exr" --integrator path --width 64 --spp 16 --aov all --multipart --compression dwaa
+    r "$d" -o "$out/path-adaptive.exr" --integrator path --width 64 --spp 64 --adaptive 0.05 --aov samples
+    r "$d" -o "$out/crop.exr" --width 96 --spp 4 --crop 10 70 5 40 --aov all
+    for i in 0 1 2; do r "$d" -o "$out/tile$i.exr" --integrator path --width 64 --spp 8 --tile "$i/3" --aov all; done
+    "$fixed" merge "$out/tile0.exr" "$out/tile1.exr" "$out/tile2.exr" -o "$out/merged.exr" >/dev/null
+    # A checkpoint after exactly one pass (a time limit below any pass), then its resume.
+    r "$d" -o "$out/resumed.exr" --integrator path --width 48 --spp 32 --checkpoint 1e-9 --time-limit 1e-9
+    cp "$out/resumed.exr" "$out/checkpoint.exr"
+    r "$d" -o "$out/resumed.exr" --integrator path --width 48 --spp 32 --resume
+    if [ -d "$corpus/valid" ]; then
+      r "$corpus/valid/InterpolationTest/glTF-Binary/InterpolationTest.glb" -o "$out/anim-whitted.exr" --width 96 --spp 4 --time 0.7
+      r "$corpus/valid/InterpolationTest/glTF-Binary/InterpolationTest.glb" -o "$out/anim-path.exr" --integrator path --width 64 --spp 8 --frame 17 --fps 24
+      r "$corpus/valid/DamagedHelmet/glTF-Binary/DamagedHelmet.glb" -o "$out/helmet.exr" --integrator path --width 64 --spp 8 --aov all
+    else
+      echo "note: no corpus at $corpus: the animation and textured renders are left out" >&2
+    fi
+    ls "$out"/*.exr | wc -l | xargs echo "rendered EXRs:" >&2
+    ;;
+  compare)
+    a="$2"; b="$3"; fails=0; count=0
+    header() {  # every attribute but the run's timing and command line
+      oiiotool -a --info -v "$1" 2>&1 | grep -vE 'render_seconds|command_line|DateTime|^'"$1" | sed "s|$(dirname "$1")/||g"
+    }
+    for fa in "$a"/*.exr; do
+      name=$(basename "$fa"); fb="$b/$name"; count=$((count + 1))
+      if [ ! -e "$fb" ]; then echo "MISSING: $name"; fails=$((fails + 1)); continue; fi
+      if ! diff <(header "$fa") <(header "$fb") >/dev/null; then
+        echo "HEADER DIFFERS: $name"; diff <(header "$fa") <(header "$fb") | head -6 || true; fails=$((fails + 1)); continue
+      fi
+      sel=()
+      if oiiotool --info -v "$fa" | grep -q 'cost\.ns'; then  # single-part files only carry cost
+        chans=$(oiiotool --info -v "$fa" | sed -n 's/^ *channel list: //p' | head -1 | tr -d ' ' | sed 's/([a-z0-9]*)//g' | tr ',' '\n' | grep -v '^cost\.ns$' | paste -sd,)
+        sel=(--ch "$chans")
+      fi
+      if ! oiiotool -a "$fa" "${sel[@]}" "$fb" "${sel[@]}" --fail 0 --failpercent 0 --diff >/dev/null 2>&1; then
+        echo "PIXELS DIFFER: $name"; fails=$((fails + 1))
+      fi
+    done
+    for fb in "$b"/*.exr; do [ -e "$a/$(basename "$fb")" ] || { echo "EXTRA: $(basename "$fb")"; fails=$((fails + 1)); }; done
+    echo "compared $count EXRs: $((count - fails)) identical, $fails different"
+    [ "$fails" -eq 0 ]
+    ;;
+  *)
+    echo "usage: scripts/render_regression.sh render PENUMBRA OUTDIR | compare DIR_A DIR_B" >&2; exit 2 ;;
+esac
