@@ -48,39 +48,52 @@ constexpr uint64_t kPrefixBytes = sizeof kMagic + sizeof(Header);
 // by the file size before anything is added or multiplied, so no sum can overflow.
 void check_sizes(const std::string& file, const Header& h, uint64_t file_size) {
   if (h.pixel_bytes != sizeof(Pixel))
-    throw InputError(file, "", "truncated or corrupt checkpoint: pixel records of " + std::to_string(h.pixel_bytes) +
-                                   " bytes, expected " + std::to_string(sizeof(Pixel)));
-  const uint64_t budget = file_size < kPrefixBytes + kDigestBytes ? 0 : file_size - kPrefixBytes - kDigestBytes;
+    throw InputError(file, "",
+                     "truncated or corrupt checkpoint: pixel records of " + std::to_string(h.pixel_bytes) +
+                         " bytes, expected " + std::to_string(sizeof(Pixel)));
+  const uint64_t budget =
+      file_size < kPrefixBytes + kDigestBytes ? 0 : file_size - kPrefixBytes - kDigestBytes;
   const bool fits = h.settings_bytes <= kMaxCheckpointSettingsBytes && h.settings_bytes <= budget &&
                     h.pixels <= budget / sizeof(Pixel) && h.groups <= budget / sizeof(double) &&
                     h.settings_bytes + h.pixels * sizeof(Pixel) + h.groups * sizeof(double) == budget;
   if (!fits)
-    throw InputError(file, "", "truncated or corrupt checkpoint: its header does not describe its " +
-                                   std::to_string(file_size) + " bytes");
+    throw InputError(file, "",
+                     "truncated or corrupt checkpoint: its header does not describe its " +
+                         std::to_string(file_size) + " bytes");
 }
 
 std::string where(const PathAccumulators& s, size_t i) {
   const int64_t w = int64_t(s.window.x1) - s.window.x0;
-  return "pixel " + std::to_string(s.window.x0 + int64_t(i) % w) + "," + std::to_string(s.window.y0 + int64_t(i) / w);
+  return "pixel " + std::to_string(s.window.x0 + int64_t(i) % w) + "," +
+         std::to_string(s.window.y0 + int64_t(i) / w);
 }
 
-bool finite_non_negative(double v) { return std::isfinite(v) && v >= 0; }
+bool finite_non_negative(double v) {
+  return std::isfinite(v) && v >= 0;
+}
 
 // Throws unless one pixel's sums could have come from `s.reached` samples of the path tracer.
 void check_pixel(const std::string& file, const PathAccumulators& s, size_t i) {
   const Pixel& p = s.pixels[i];
-  const auto bad = [&](const std::string& what) { return InputError(file, where(s, i), "inconsistent checkpoint: " + what); };
+  const auto bad = [&](const std::string& what) {
+    return InputError(file, where(s, i), "inconsistent checkpoint: " + what);
+  };
   for (int c = 0; c < 4; ++c)
-    if (!finite_non_negative(p.rgba[c])) throw bad("colour sum " + std::to_string(p.rgba[c]) + " is not finite and >= 0");
+    if (!finite_non_negative(p.rgba[c]))
+      throw bad("colour sum " + std::to_string(p.rgba[c]) + " is not finite and >= 0");
   if (!finite_non_negative(p.sum_y) || !finite_non_negative(p.sum_y2))
     throw bad("luminance sums are not finite and >= 0");
-  if (p.rgba[3] > double(p.n)) throw bad("coverage sum " + std::to_string(p.rgba[3]) + " exceeds its " + std::to_string(p.n) + " samples");
+  if (p.rgba[3] > double(p.n))
+    throw bad("coverage sum " + std::to_string(p.rgba[3]) + " exceeds its " + std::to_string(p.n) +
+              " samples");
   if (p.active > 1) throw bad("active flag " + std::to_string(p.active) + " is not 0 or 1");
   if (p.n > s.reached)
     throw bad(std::to_string(p.n) + " samples, more than the " + std::to_string(s.reached) + " reached");
   if (p.active && p.n != s.reached)
-    throw bad("still sampling with " + std::to_string(p.n) + " samples, not the " + std::to_string(s.reached) + " reached");
-  if (p.n == 0 && (p.rgba[0] != 0 || p.rgba[1] != 0 || p.rgba[2] != 0 || p.rgba[3] != 0 || p.sum_y != 0 || p.sum_y2 != 0))
+    throw bad("still sampling with " + std::to_string(p.n) + " samples, not the " +
+              std::to_string(s.reached) + " reached");
+  if (p.n == 0 &&
+      (p.rgba[0] != 0 || p.rgba[1] != 0 || p.rgba[2] != 0 || p.rgba[3] != 0 || p.sum_y != 0 || p.sum_y2 != 0))
     throw bad("sums without samples");
   for (uint64_t k = 0; k < (s.groups.empty() ? 0 : kGroupsPerPixel); ++k) {
     const double g = s.groups[i * kGroupsPerPixel + k];
@@ -91,16 +104,20 @@ void check_pixel(const std::string& file, const PathAccumulators& s, size_t i) {
 
 // Throws unless the counters, the window and every pixel agree with each other.
 void check_consistency(const std::string& file, const PathAccumulators& s) {
-  const auto bad = [&](const std::string& what) { return InputError(file, "", "inconsistent checkpoint: " + what); };
+  const auto bad = [&](const std::string& what) {
+    return InputError(file, "", "inconsistent checkpoint: " + what);
+  };
   const PixelWindow& w = s.window;
   const int64_t width = int64_t(w.x1) - w.x0, height = int64_t(w.y1) - w.y0;
   if (w.x0 < 0 || w.y0 < 0 || width < 1 || height < 1)
-    throw bad("empty or negative window " + std::to_string(w.x0) + "," + std::to_string(w.y0) + "-" + std::to_string(w.x1) +
-              "," + std::to_string(w.y1));
+    throw bad("empty or negative window " + std::to_string(w.x0) + "," + std::to_string(w.y0) + "-" +
+              std::to_string(w.x1) + "," + std::to_string(w.y1));
   if (uint64_t(width) * uint64_t(height) != s.pixels.size())
-    throw bad("the window holds " + std::to_string(width * height) + " pixels, the file " + std::to_string(s.pixels.size()));
+    throw bad("the window holds " + std::to_string(width * height) + " pixels, the file " +
+              std::to_string(s.pixels.size()));
   if (!s.groups.empty() && s.groups.size() != s.pixels.size() * kGroupsPerPixel)
-    throw bad(std::to_string(s.groups.size()) + " light-group sums for " + std::to_string(s.pixels.size()) + " pixels");
+    throw bad(std::to_string(s.groups.size()) + " light-group sums for " + std::to_string(s.pixels.size()) +
+              " pixels");
   if (s.passes < 0 || uint64_t(s.passes) > s.reached)
     throw bad(std::to_string(s.passes) + " passes for " + std::to_string(s.reached) + " samples");
   if (s.passes == 0 && s.reached != 0) throw bad("samples without a completed pass");
@@ -157,9 +174,11 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
   Header h{};
   in.read(magic, sizeof magic);
   if (in && std::memcmp(magic, kOldMagic, sizeof kOldMagic) == 0)
-    throw InputError(file, "", "is a resume state in the old format (PNMBRCK1, without a checksum) that this version "
-                               "cannot verify; delete it to render from the beginning");
-  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0) throw InputError(file, "", "not a Penumbra checkpoint");
+    throw InputError(file, "",
+                     "is a resume state in the old format (PNMBRCK1, without a checksum) that this version "
+                     "cannot verify; delete it to render from the beginning");
+  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError(file, "", "not a Penumbra checkpoint");
   in.read(reinterpret_cast<char*>(&h), sizeof h);
   if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: the header is incomplete");
   check_sizes(file, h, size);
@@ -182,8 +201,10 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
   sha.update(state.pixels.data(), state.pixels.size() * sizeof(Pixel));
   sha.update(state.groups.data(), state.groups.size() * sizeof(double));
   if (sha.finish() != stored)
-    throw InputError(file, "", "checksum mismatch: the checkpoint is damaged (its SHA-256 does not match its contents); "
-                               "delete it to render from the beginning");
+    throw InputError(
+        file, "",
+        "checksum mismatch: the checkpoint is damaged (its SHA-256 does not match its contents); "
+        "delete it to render from the beginning");
 
   // The settings it was written for.
   RenderSettings settings;
@@ -193,17 +214,20 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
     throw InputError(file, "settings", std::string("malformed: ") + e.what());
   }
   if (settings.entries != expected.entries)
-    throw InputError(file, "", "was written for other settings; delete it or render with the same settings:\n" +
-                                   describe_differences(settings, expected));
+    throw InputError(file, "",
+                     "was written for other settings; delete it or render with the same settings:\n" +
+                         describe_differences(settings, expected));
 
   // The values, checked against each other.
   state.window = {h.window[0], h.window[1], h.window[2], h.window[3]};
   state.reached = h.reached;
   state.passes = h.passes;
-  if (h.complete > 1) throw InputError(file, "", "inconsistent checkpoint: complete flag " + std::to_string(h.complete));
+  if (h.complete > 1)
+    throw InputError(file, "", "inconsistent checkpoint: complete flag " + std::to_string(h.complete));
   state.complete = h.complete != 0;
   check_consistency(file, state);
-  if (state.complete && state.passes < 1) throw InputError(file, "", "inconsistent checkpoint: complete without a pass");
+  if (state.complete && state.passes < 1)
+    throw InputError(file, "", "inconsistent checkpoint: complete without a pass");
   return state;
 }
 

@@ -48,23 +48,19 @@ std::string unescape(std::string_view field, size_t line) {
       out += field[i];
       continue;
     }
-    const auto bad = [&] { return std::invalid_argument("line " + std::to_string(line) + ": invalid escape"); };
+    const auto bad = [&] {
+      return std::invalid_argument("line " + std::to_string(line) + ": invalid escape");
+    };
     if (++i >= field.size()) throw bad();
-    switch (field[i]) {
-      case '\\': out += '\\'; break;
-      case '=': out += '='; break;
-      case 'n': out += '\n'; break;
-      case 'r': out += '\r'; break;
-      case 't': out += '\t'; break;
-      case 'x': {
-        if (i + 2 >= field.size()) throw bad();
-        const int hi = hex_digit(field[i + 1]), lo = hex_digit(field[i + 2]);
-        if (hi < 0 || lo < 0) throw bad();
-        out += char(hi * 16 + lo);
-        i += 2;
-        break;
-      }
-      default: throw bad();
+    static constexpr std::string_view kNamed = "\\=nrt", kNamedBytes = "\\=\n\r\t";
+    if (const size_t named = kNamed.find(field[i]); named != std::string_view::npos) {
+      out += kNamedBytes[named];
+    } else if (field[i] == 'x' && i + 2 < field.size() && hex_digit(field[i + 1]) >= 0 &&
+               hex_digit(field[i + 2]) >= 0) {
+      out += char(hex_digit(field[i + 1]) * 16 + hex_digit(field[i + 2]));
+      i += 2;
+    } else {
+      throw bad();
     }
   }
   return out;
@@ -99,7 +95,8 @@ RenderSettings parse_canonical_text(std::string_view text) {
   for (size_t start = 0; start < text.size();) {
     ++line;
     const size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) throw std::invalid_argument("line " + std::to_string(line) + ": no final newline");
+    if (end == std::string_view::npos)
+      throw std::invalid_argument("line " + std::to_string(line) + ": no final newline");
     const std::string_view row = text.substr(start, end - start);
     // The first '=' not escaped by a backslash splits key and value.
     size_t split = std::string_view::npos;
@@ -111,7 +108,8 @@ RenderSettings parse_canonical_text(std::string_view text) {
         break;
       }
     }
-    if (split == std::string_view::npos) throw std::invalid_argument("line " + std::to_string(line) + ": no '='");
+    if (split == std::string_view::npos)
+      throw std::invalid_argument("line " + std::to_string(line) + ": no '='");
     std::string key = unescape(row.substr(0, split), line);
     std::string value = unescape(row.substr(split + 1), line);
     if (key.empty()) throw std::invalid_argument("line " + std::to_string(line) + ": empty key");
@@ -120,7 +118,8 @@ RenderSettings parse_canonical_text(std::string_view text) {
     settings.entries.emplace_hint(settings.entries.end(), std::move(key), std::move(value));
     start = end + 1;
   }
-  if (canonical_text(settings) != text) throw std::invalid_argument("not in canonical form (non-canonical escapes)");
+  if (canonical_text(settings) != text)
+    throw std::invalid_argument("not in canonical form (non-canonical escapes)");
   return settings;
 }
 

@@ -76,17 +76,21 @@ TEST_CASE("checkpoint: round trip, settings check and damaged files", "[io][chec
   CHECK(std::memcmp(back.pixels.data(), st.pixels.data(), 8 * sizeof(PathAccumulators::Pixel)) == 0);
   CHECK(back.groups == st.groups);
 
-  REQUIRE_THROWS_WITH(read_checkpoint(dir / "a.resume", settings("settings B")),
-                      Contains("a.resume") && Contains("other settings") && Contains("settings A") && Contains("settings B"));
+  REQUIRE_THROWS_WITH(
+      read_checkpoint(dir / "a.resume", settings("settings B")),
+      Contains("a.resume") && Contains("other settings") && Contains("settings A") && Contains("settings B"));
   std::filesystem::resize_file(dir / "a.resume", std::filesystem::file_size(dir / "a.resume") - 9);
-  REQUIRE_THROWS_WITH(read_checkpoint(dir / "a.resume", settings("settings A")), Contains("truncated or corrupt"));
+  REQUIRE_THROWS_WITH(read_checkpoint(dir / "a.resume", settings("settings A")),
+                      Contains("truncated or corrupt"));
   std::ofstream(dir / "junk.resume") << "hello, not a checkpoint at all";
-  REQUIRE_THROWS_WITH(read_checkpoint(dir / "junk.resume", settings("settings A")), Contains("not a Penumbra checkpoint"));
+  REQUIRE_THROWS_WITH(read_checkpoint(dir / "junk.resume", settings("settings A")),
+                      Contains("not a Penumbra checkpoint"));
   REQUIRE_THROWS_AS(read_checkpoint(dir / "none.resume", settings("x")), InputError);
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("checkpoint: complete, empty-group and single-pixel states round trip bit-exactly", "[io][checkpoint][quick]") {
+TEST_CASE("checkpoint: complete, empty-group and single-pixel states round trip bit-exactly",
+          "[io][checkpoint][quick]") {
   const auto dir = test::temp_dir("checkpoint-exact");
   PathAccumulators st;
   st.window = {7, 0, 8, 1};
@@ -151,7 +155,8 @@ TEST_CASE("checkpoint: truncated, extended and absurdly sized files are refused 
   for (const size_t keep : {size_t(0), size_t(5), size_t(8), size_t(40), size_t(64), good.size() - 1}) {
     write_bytes(dir / "t.resume", good.substr(0, keep));
     INFO("kept " << keep << " bytes");
-    CHECK_THAT(error_of(dir / "t.resume", settings("A")), Contains("t.resume") && (Contains("truncated") || Contains("not a Penumbra")));
+    CHECK_THAT(error_of(dir / "t.resume", settings("A")),
+               Contains("t.resume") && (Contains("truncated") || Contains("not a Penumbra")));
   }
   write_bytes(dir / "t.resume", good + "x");
   CHECK_THAT(error_of(dir / "t.resume", settings("A")), Contains("truncated or corrupt"));
@@ -168,27 +173,31 @@ TEST_CASE("checkpoint: truncated, extended and absurdly sized files are refused 
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("checkpoint: a FIFO, a directory and /dev/zero are refused without reading", "[io][checkpoint][quick]") {
+TEST_CASE("checkpoint: a FIFO, a directory and /dev/zero are refused without reading",
+          "[io][checkpoint][quick]") {
   const auto dir = test::temp_dir("checkpoint-fifo");
   test::make_fifo(dir / "state.resume");
-  const std::string message =
-      test::message_without_blocking([&] { (void)read_checkpoint(dir / "state.resume", settings("A")); }, dir / "state.resume");
+  const std::string message = test::message_without_blocking(
+      [&] { (void)read_checkpoint(dir / "state.resume", settings("A")); }, dir / "state.resume");
   CHECK_THAT(message, Contains("state.resume") && Contains("FIFO"));
   CHECK_THAT(error_of(dir, settings("A")), Contains("directory"));
   CHECK_THAT(error_of("/dev/zero", settings("A")), Contains("/dev/zero") && Contains("character device"));
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("checkpoint: the old format without a checksum is refused with a clear message", "[io][checkpoint][quick]") {
+TEST_CASE("checkpoint: the old format without a checksum is refused with a clear message",
+          "[io][checkpoint][quick]") {
   const auto dir = test::temp_dir("checkpoint-old");
   // PNMBRCK1: magic, a 56-byte header, the fingerprint text, raw pixels.
   std::string old = "PNMBRCK1" + std::string(56, '\0') + "settings A" + std::string(56, '\0');
   write_bytes(dir / "old.resume", old);
-  CHECK_THAT(error_of(dir / "old.resume", settings("A")), Contains("old.resume") && Contains("old format") && Contains("delete it"));
+  CHECK_THAT(error_of(dir / "old.resume", settings("A")),
+             Contains("old.resume") && Contains("old format") && Contains("delete it"));
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("checkpoint: other settings are refused listing each differing key with both values", "[io][checkpoint][quick]") {
+TEST_CASE("checkpoint: other settings are refused listing each differing key with both values",
+          "[io][checkpoint][quick]") {
   const auto dir = test::temp_dir("checkpoint-settings");
   RenderSettings stored{{{"camera", "Main"}, {"scene.sha256", "aaaa"}, {"spp.min", "4"}, {"width", "960"}}};
   write_checkpoint(dir / "s.resume", sample_state(), stored);
@@ -228,7 +237,8 @@ TEST_CASE("checkpoint: well-sealed files with impossible values are refused", "[
       {"reached far beyond the samples", [](PathAccumulators& s) { s.reached = 4096; }, "still sampling"},
       {"window too small", [](PathAccumulators& s) { s.window.x1 = 5; }, "the window holds 6 pixels"},
       {"empty window", [](PathAccumulators& s) { s.window = {}; }, "empty"},
-      {"light groups of another size", [](PathAccumulators& s) { s.groups.resize(8 * 14); }, "light-group sums for 8"},
+      {"light groups of another size", [](PathAccumulators& s) { s.groups.resize(8 * 14); },
+       "light-group sums for 8"},
       {"negative passes", [](PathAccumulators& s) { s.passes = -1; }, "passes"},
       {"more passes than samples", [](PathAccumulators& s) { s.passes = 17; }, "passes"},
       {"samples without passes", [](PathAccumulators& s) { s.passes = 0; }, "without a completed pass"},
@@ -254,7 +264,8 @@ TEST_CASE("checkpoint: well-sealed files with impossible values are refused", "[
     c.forge(st);
     write_checkpoint(dir / "f.resume", st, settings("A"));
     INFO(c.what);
-    CHECK_THAT(error_of(dir / "f.resume", settings("A")), Contains("f.resume") && Contains("inconsistent") && Contains(c.says));
+    CHECK_THAT(error_of(dir / "f.resume", settings("A")),
+               Contains("f.resume") && Contains("inconsistent") && Contains(c.says));
   }
   std::filesystem::remove_all(dir);
 }

@@ -16,13 +16,15 @@
 namespace penumbra::test {
 
 /// Creates a FIFO at `path`.
-inline void make_fifo(const std::filesystem::path& path) { REQUIRE(::mkfifo(path.c_str(), 0600) == 0); }
+inline void make_fifo(const std::filesystem::path& path) {
+  REQUIRE(::mkfifo(path.c_str(), 0600) == 0);
+}
 
 /// Runs `read` (which must throw) on another thread and returns the exception's message, or
 /// "no exception". If it is still running after `seconds` (blocked opening `fifo`), the FIFO is
 /// opened for writing so the reader sees end of file, and the test fails.
-inline std::string message_without_blocking(const std::function<void()>& read, const std::filesystem::path& fifo,
-                                            double seconds = 10) {
+inline std::string message_without_blocking(const std::function<void()>& read,
+                                            const std::filesystem::path& fifo, double seconds = 10) {
   auto result = std::async(std::launch::async, [&]() -> std::string {
     try {
       read();

@@ -63,7 +63,8 @@ TEST_CASE("settings: malformed or non-canonical text is refused naming the line"
   CHECK_THROWS_AS(parse_canonical_text("a=\t\n"), std::invalid_argument);     // so is a tab
 }
 
-TEST_CASE("settings: differences list each differing or missing key with both values", "[io][settings][quick]") {
+TEST_CASE("settings: differences list each differing or missing key with both values",
+          "[io][settings][quick]") {
   const RenderSettings a{{{"camera", "Main"}, {"seed", "1"}, {"width", "960"}}};
   RenderSettings b = a;
   CHECK(describe_differences(a, b).empty());
@@ -74,7 +75,8 @@ TEST_CASE("settings: differences list each differing or missing key with both va
         "  aov: stored (not set), this render 'N\\nZ'\n"
         "  seed: stored '1', this render (not set)\n"
         "  width: stored '960', this render '480'");
-  CHECK(describe_differences(a, b, "a.exr", "b.exr").find("  width: a.exr '960', b.exr '480'") != std::string::npos);
+  CHECK(describe_differences(a, b, "a.exr", "b.exr").find("  width: a.exr '960', b.exr '480'") !=
+        std::string::npos);
   b.entries["camera"] = std::string(1000, 'x');
   const std::string long_value = describe_differences(a, b);
   CHECK_THAT(long_value, Contains("  camera: stored 'Main', this render '" + std::string(160, 'x') + "...'"));
