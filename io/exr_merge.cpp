@@ -1,84 +1,171 @@
-// Merging crops and tiles into one EXR (single- or multi-part).
+// Merging crops and tiles into one EXR (single- or multi-part): every part is checked as a file,
+// then for its Penumbra identity, then for its windows and channels, before its pixels are
+// copied into the frame.
 #include "io/exr_merge.h"
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstring>
+#include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "io/file_checks.h"
+#include "io/render_settings.h"
 
 namespace penumbra {
 
-void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out) {
-  if (parts.empty()) throw InputError(out.string(), "", "no parts to merge");
-  std::vector<OIIO::ImageSpec> full;            // per EXR part (subimage), from the first file
-  std::vector<std::vector<unsigned char>> pixels;  // per subimage, the whole frame
-  std::vector<int> owner;                        // file that wrote each pixel, -1 = none
-  for (size_t k = 0; k < parts.size(); ++k) {
-    const std::string name = parts[k].string();
-    auto in = OIIO::ImageInput::open(name);
-    if (!in) throw InputError(name, "", "cannot read: " + OIIO::geterror());
-    std::vector<OIIO::ImageSpec> specs;
-    for (int sub = 0; in->seek_subimage(sub, 0); ++sub) specs.push_back(in->spec());
-    if (specs.empty()) throw InputError(name, "", "has no image");
-    const OIIO::ImageSpec& s0 = specs[0];
-    if (s0.full_x != 0 || s0.full_y != 0 || s0.full_width < 1 || s0.full_height < 1 || s0.full_width > 65536 ||
-        s0.full_height > 65536)
-      throw InputError(name, "", "unsupported display window");
-    if (s0.x < 0 || s0.y < 0 || s0.x + s0.width > s0.full_width || s0.y + s0.height > s0.full_height)
-      throw InputError(name, "", "data window lies outside the display window");
-    for (const auto& sp : specs)
-      if (sp.x != s0.x || sp.y != s0.y || sp.width != s0.width || sp.height != s0.height || sp.full_width != s0.full_width ||
-          sp.full_height != s0.full_height)
-        throw InputError(name, "", "its parts have different windows");
-    if (k == 0) {
-      full = specs;
-      double bytes = 0;
-      for (const auto& sp : specs) bytes += double(sp.full_width) * double(sp.full_height) * double(sp.pixel_bytes(true));
-      if (bytes > 8.0 * (1ull << 30)) throw InputError(name, "", "the full frame would need more than 8 GiB");
-      for (const auto& sp : specs) pixels.emplace_back(size_t(sp.full_width) * size_t(sp.full_height) * sp.pixel_bytes(true), 0);
-      owner.assign(size_t(s0.full_width) * size_t(s0.full_height), -1);
-    } else {
-      if (s0.full_width != full[0].full_width || s0.full_height != full[0].full_height)
-        throw InputError(name, "", "display window " + std::to_string(s0.full_width) + "x" + std::to_string(s0.full_height) +
-                                       " differs from " + parts[0].string() + "'s " + std::to_string(full[0].full_width) + "x" +
-                                       std::to_string(full[0].full_height));
-      bool same = specs.size() == full.size();
-      for (size_t sub = 0; same && sub < specs.size(); ++sub) {
-        same = specs[sub].nchannels == full[sub].nchannels;
-        for (int c = 0; same && c < specs[sub].nchannels; ++c)
-          same = specs[sub].channelnames[size_t(c)] == full[sub].channelnames[size_t(c)] &&
-                 specs[sub].channelformat(c) == full[sub].channelformat(c);
-      }
-      if (!same) throw InputError(name, "", "its parts or channels differ from " + parts[0].string() + "'s");
-    }
-    // Ownership (no overlaps), then each subimage's pixels copied unchanged.
-    for (int y = 0; y < s0.height; ++y)
-      for (int x = 0; x < s0.width; ++x) {
-        const size_t f = size_t(s0.y + y) * size_t(s0.full_width) + size_t(s0.x + x);
-        if (owner[f] >= 0)
-          throw InputError(name, "", "overlaps " + parts[size_t(owner[f])].string() + " at pixel " +
-                                         std::to_string(s0.x + x) + "," + std::to_string(s0.y + y));
-        owner[f] = int(k);
-      }
-    for (size_t sub = 0; sub < specs.size(); ++sub) {
-      const OIIO::ImageSpec& sp = specs[sub];
-      const size_t pb = sp.pixel_bytes(true);
-      std::vector<unsigned char> data(size_t(sp.width) * size_t(sp.height) * pb);
-      if (!in->read_image(int(sub), 0, 0, sp.nchannels, OIIO::TypeDesc::UNKNOWN, data.data()))
-        throw InputError(name, "", "cannot decode: " + in->geterror());
-      for (int y = 0; y < sp.height; ++y)
-        std::memcpy(&pixels[sub][(size_t(sp.y + y) * size_t(sp.full_width) + size_t(sp.x)) * pb],
-                    &data[size_t(y) * size_t(sp.width) * pb], size_t(sp.width) * pb);
-    }
+namespace {
+
+constexpr const char* kForceHint = "use --force to merge parts from other tools";
+constexpr int64_t kMaxSide = 65536;
+
+// Bytes of one EXR part's pixels: its data window, or its display window when `full`.
+double image_bytes(const OIIO::ImageSpec& spec, bool full) {
+  const double pixels =
+      full ? double(spec.full_width) * double(spec.full_height) : double(spec.width) * double(spec.height);
+  return pixels * double(spec.pixel_bytes(true));
+}
+
+std::unique_ptr<OIIO::ImageInput> open_part(const std::string& name) {
+  auto in = OIIO::ImageInput::create("openexr");
+  if (!in) throw std::runtime_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
+  OIIO::ImageSpec spec;
+  if (!in->open(name, spec)) throw InputError(name, "", "cannot read as OpenEXR: " + in->geterror());
+  return in;
+}
+
+// The specs of every EXR part in `in`, checked to share one non-empty data window inside one
+// display window at the origin.
+std::vector<OIIO::ImageSpec> read_specs(OIIO::ImageInput& in, const std::string& name) {
+  std::vector<OIIO::ImageSpec> specs;
+  for (int sub = 0; in.seek_subimage(sub, 0); ++sub) specs.push_back(in.spec());
+  if (specs.empty()) throw InputError(name, "", "has no image");
+  const OIIO::ImageSpec& s0 = specs[0];
+  if (s0.full_x != 0 || s0.full_y != 0 || s0.full_width < 1 || s0.full_height < 1 ||
+      s0.full_width > kMaxSide || s0.full_height > kMaxSide)
+    throw InputError(name, "", "unsupported display window");
+  if (s0.x < 0 || s0.y < 0 || s0.width < 1 || s0.height < 1 || int64_t(s0.x) + s0.width > s0.full_width ||
+      int64_t(s0.y) + s0.height > s0.full_height)
+    throw InputError(name, "", "data window lies outside the display window");
+  for (const auto& sp : specs) {
+    if (sp.x != s0.x || sp.y != s0.y || sp.width != s0.width || sp.height != s0.height || sp.full_x != 0 ||
+        sp.full_y != 0 || sp.full_width != s0.full_width || sp.full_height != s0.full_height ||
+        sp.depth != 1 || sp.z != 0)
+      throw InputError(name, "", "its parts have different windows");
+    if (sp.deep) throw InputError(name, "", "deep images cannot be merged");
+    if (sp.nchannels < 1) throw InputError(name, "", "a part has no channels");
   }
-  for (size_t f = 0; f < owner.size(); ++f)
-    if (owner[f] < 0)
-      throw InputError(out.string(), "", "the parts do not cover the frame: pixel " + std::to_string(f % size_t(full[0].full_width)) +
-                                             "," + std::to_string(f / size_t(full[0].full_width)) + " is missing");
-  std::vector<OIIO::ImageSpec> specs = full;
+  return specs;
+}
+
+const OIIO::ParamValue* string_attribute(const OIIO::ImageSpec& spec, const char* name) {
+  return spec.find_attribute(name, OIIO::TypeDesc::STRING);
+}
+
+// The settings a part was rendered with; throws InputError naming the part if they are absent
+// or malformed.
+RenderSettings part_settings(const std::string& name, const OIIO::ImageSpec& spec) {
+  const OIIO::ParamValue* p = string_attribute(spec, kSettingsAttribute);
+  if (!p)
+    throw InputError(
+        name, "",
+        std::string("has no ") + kSettingsAttribute + " metadata (not a Penumbra tile?); " + kForceHint);
+  try {
+    return parse_canonical_text(p->get_string());
+  } catch (const std::invalid_argument& e) {
+    throw InputError(name, kSettingsAttribute, std::string("malformed (") + e.what() + "); " + kForceHint);
+  }
+}
+
+std::string part_scene(const std::string& name, const OIIO::ImageSpec& spec) {
+  const OIIO::ParamValue* p = string_attribute(spec, kSceneHashAttribute);
+  if (!p)
+    throw InputError(
+        name, "",
+        std::string("has no ") + kSceneHashAttribute + " metadata (not a Penumbra tile?); " + kForceHint);
+  return p->get_string();
+}
+
+// What makes tiles parts of one frame: the scene and the settings they were rendered with.
+struct PartIdentity {
+  std::string scene;
+  RenderSettings settings;
+};
+
+// The identity recorded in a part's first EXR part; throws InputError naming the part if absent.
+PartIdentity part_identity(const std::string& name, const OIIO::ImageSpec& spec) {
+  return {part_scene(name, spec), part_settings(name, spec)};
+}
+
+// Throws unless part `name` was rendered from the same scene with the same settings as the
+// first part.
+void check_same_identity(const std::string& name, const PartIdentity& id, const std::string& first_name,
+                         const PartIdentity& first) {
+  if (id.scene != first.scene)
+    throw InputError(name, "",
+                     "is from another scene than " + first_name + ": " + kSceneHashAttribute + " '" +
+                         id.scene + "', " + first_name + " has '" + first.scene + "'; " + kForceHint);
+  if (id.settings.entries != first.settings.entries)
+    throw InputError(name, "",
+                     "was rendered with other settings than " + first_name + ":\n" +
+                         describe_differences(first.settings, id.settings, first_name, name) + "\n" +
+                         kForceHint);
+}
+
+// Throws unless the part has the display window and the EXR parts and channels of the first.
+void check_layout(const std::string& name, const std::vector<OIIO::ImageSpec>& specs,
+                  const std::string& first_name, const std::vector<OIIO::ImageSpec>& full) {
+  const OIIO::ImageSpec& s0 = specs[0];
+  if (s0.full_width != full[0].full_width || s0.full_height != full[0].full_height)
+    throw InputError(name, "",
+                     "display window " + std::to_string(s0.full_width) + "x" +
+                         std::to_string(s0.full_height) + " differs from " + first_name + "'s " +
+                         std::to_string(full[0].full_width) + "x" + std::to_string(full[0].full_height));
+  bool same = specs.size() == full.size();
+  for (size_t sub = 0; same && sub < specs.size(); ++sub) {
+    same = specs[sub].nchannels == full[sub].nchannels;
+    for (int c = 0; same && c < specs[sub].nchannels; ++c)
+      same = specs[sub].channelnames[size_t(c)] == full[sub].channelnames[size_t(c)] &&
+             specs[sub].channelformat(c) == full[sub].channelformat(c);
+  }
+  if (!same) throw InputError(name, "", "its parts or channels differ from " + first_name + "'s");
+}
+
+// Records part `k` as the owner of the pixels of its data window; throws if one is taken.
+void claim_pixels(const std::vector<std::filesystem::path>& parts, size_t k, const OIIO::ImageSpec& s0,
+                  std::vector<int>& owner) {
+  for (int y = 0; y < s0.height; ++y)
+    for (int x = 0; x < s0.width; ++x) {
+      const size_t f = size_t(s0.y + y) * size_t(s0.full_width) + size_t(s0.x + x);
+      if (owner[f] >= 0)
+        throw InputError(parts[k].string(), "",
+                         "overlaps " + parts[size_t(owner[f])].string() + " at pixel " +
+                             std::to_string(s0.x + x) + "," + std::to_string(s0.y + y));
+      owner[f] = int(k);
+    }
+}
+
+// Decodes every EXR part of `in` in its native channel types into its place in `pixels`.
+void copy_pixels(OIIO::ImageInput& in, const std::string& name, const std::vector<OIIO::ImageSpec>& specs,
+                 std::vector<std::vector<unsigned char>>& pixels) {
+  for (size_t sub = 0; sub < specs.size(); ++sub) {
+    const OIIO::ImageSpec& sp = specs[sub];
+    const size_t pb = sp.pixel_bytes(true);
+    std::vector<unsigned char> data(size_t(sp.width) * size_t(sp.height) * pb);
+    if (!in.read_image(int(sub), 0, 0, sp.nchannels, OIIO::TypeDesc::UNKNOWN, data.data()))
+      throw InputError(name, "", "cannot decode: " + in.geterror());
+    for (int y = 0; y < sp.height; ++y)
+      std::memcpy(&pixels[sub][(size_t(sp.y + y) * size_t(sp.full_width) + size_t(sp.x)) * pb],
+                  &data[size_t(y) * size_t(sp.width) * pb], size_t(sp.width) * pb);
+  }
+}
+
+void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> specs,
+                 const std::vector<std::vector<unsigned char>>& pixels) {
   for (auto& sp : specs) {
     sp.x = sp.y = 0;
     sp.width = sp.full_width;
@@ -93,12 +180,67 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
       throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
     for (size_t sub = 0; sub < specs.size(); ++sub) {
       if (sub > 0 && !o->open(temp.string(), specs[sub], OIIO::ImageOutput::AppendSubimage))
-        throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " + o->geterror());
+        throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " +
+                                 o->geterror());
       if (!o->write_image(OIIO::TypeDesc::UNKNOWN, pixels[sub].data()))
         throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
     }
     if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
   });
+}
+
+}  // namespace
+
+void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
+                     const MergeOptions& options) {
+  if (parts.empty()) throw InputError(out.string(), "", "no parts to merge");
+  for (const auto& part : parts) check_input_file(part, "", kMaxMergePartBytes);
+  const std::string first_name = parts[0].string();
+  std::vector<OIIO::ImageSpec> full;               // per EXR part (subimage), from the first file
+  std::vector<std::vector<unsigned char>> pixels;  // per subimage, the whole frame
+  std::vector<int> owner;                          // file that wrote each pixel, -1 = none
+  PartIdentity first_id;                           // without options.force
+  double frame_bytes = 0;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const std::string name = parts[k].string();
+    auto in = open_part(name);
+    const std::vector<OIIO::ImageSpec> specs = read_specs(*in, name);
+    if (!options.force) {
+      PartIdentity id = part_identity(name, specs[0]);
+      if (k == 0) {
+        first_id = std::move(id);
+      } else {
+        check_same_identity(name, id, first_name, first_id);
+      }
+    }
+    if (k == 0) full = specs;
+    double part_bytes = 0;
+    for (const auto& sp : specs) part_bytes = std::max(part_bytes, image_bytes(sp, false));
+    if (k == 0) {
+      for (const auto& sp : specs) frame_bytes += image_bytes(sp, true);
+      if (frame_bytes + part_bytes > double(options.max_memory_bytes))
+        throw InputError(name, "",
+                         "the full frame would need " + format_bytes(uint64_t(frame_bytes)) + ", over the " +
+                             format_bytes(options.max_memory_bytes) + " limit");
+      for (const auto& sp : specs) pixels.emplace_back(size_t(image_bytes(sp, true)), 0);
+      owner.assign(size_t(specs[0].full_width) * size_t(specs[0].full_height), -1);
+    } else {
+      check_layout(name, specs, first_name, full);
+      if (frame_bytes + part_bytes > double(options.max_memory_bytes))
+        throw InputError(name, "",
+                         "decoding it beside the full frame would exceed the " +
+                             format_bytes(options.max_memory_bytes) + " limit");
+    }
+    claim_pixels(parts, k, specs[0], owner);
+    copy_pixels(*in, name, specs, pixels);
+  }
+  for (size_t f = 0; f < owner.size(); ++f)
+    if (owner[f] < 0)
+      throw InputError(out.string(), "",
+                       "the parts do not cover the frame: pixel " +
+                           std::to_string(f % size_t(full[0].full_width)) + "," +
+                           std::to_string(f / size_t(full[0].full_width)) + " is missing");
+  write_frame(out, full, pixels);
 }
 
 }  // namespace penumbra

@@ -1,16 +1,20 @@
 // Tests for io/exr_merge and render windows: crops and farm tiles of a path-traced frame,
 // written as EXR data windows and merged, are byte-identical to the whole frame; bad part sets
-// (gaps, overlaps, mismatched frames or channels) are errors naming the part.
+// (gaps, overlaps, mismatched frames or channels, parts of other scenes or settings, FIFOs and
+// devices) are errors naming the part.
 #include "io/exr_merge.h"
 
 #include <OpenImageIO/imageio.h>
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <fstream>
 
+#include "fifo_test_util.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
+#include "io/render_settings.h"
 #include "renderer/render.h"
 #include "test_util.h"
 
@@ -18,6 +22,15 @@ using namespace penumbra;
 using Catch::Matchers::Contains;
 
 namespace {
+const std::string kScene = "5ca1ab1e";
+const RenderSettings kSettings{{{"camera", "Main"}, {"spp", "4"}, {"width", "40"}}};
+
+// The Penumbra metadata a tile of scene `scene` rendered with `settings` carries.
+std::vector<std::pair<std::string, std::string>> tile_metadata(const std::string& scene = kScene,
+                                                               const RenderSettings& settings = kSettings) {
+  return {{kSceneHashAttribute, scene}, {kSettingsAttribute, canonical_text(settings)}};
+}
+
 // All pixels of an EXR in their native channel types, and its spec.
 std::vector<unsigned char> native_pixels(const std::filesystem::path& p, OIIO::ImageSpec& spec) {
   auto in = OIIO::ImageInput::open(p.string());
@@ -43,6 +56,7 @@ void render_part(const Scene& s, const Accelerator& accel, const PathLights& lig
   std::vector<float> samples(img.samples.begin(), img.samples.end());
   ExrOptions opt;
   opt.extra = {{"samples", &samples, ChannelType::Uint}, {"variance", &img.variance}};
+  opt.metadata = tile_metadata();
   write_exr(img.film, path, opt);
 }
 }  // namespace
@@ -78,10 +92,147 @@ TEST_CASE("merge: tiles and crops reassemble the frame byte for byte", "[io][exr
   // Gaps, overlaps and foreign parts are refused, and nothing is written.
   REQUIRE_THROWS_WITH(merge_exr_parts({dir / "a.exr", dir / "c.exr", dir / "d.exr"}, dir / "x.exr"),
                       Contains("pixel 0,7 is missing"));
-  REQUIRE_THROWS_WITH(merge_exr_parts({dir / "a.exr", dir / "a.exr"}, dir / "x.exr"), Contains("a.exr: overlaps"));
-  write_exr(make_film(8, 8), dir / "small.exr", ExrOptions{});
-  REQUIRE_THROWS_WITH(merge_exr_parts({dir / "a.exr", dir / "small.exr"}, dir / "x.exr"), Contains("small.exr: display window"));
+  REQUIRE_THROWS_WITH(merge_exr_parts({dir / "a.exr", dir / "a.exr"}, dir / "x.exr"),
+                      Contains("a.exr: overlaps"));
+  ExrOptions small;
+  small.metadata = tile_metadata();
+  write_exr(make_film(8, 8), dir / "small.exr", small);
+  REQUIRE_THROWS_WITH(merge_exr_parts({dir / "a.exr", dir / "small.exr"}, dir / "x.exr"),
+                      Contains("small.exr: display window"));
   REQUIRE_THROWS_AS(merge_exr_parts({dir / "missing.exr"}, dir / "x.exr"), InputError);
   CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+namespace {
+// Rows [y0, y1) of a 6x4 frame whose pixel (x, y) holds x + 10 y in every channel, with
+// `metadata`.
+void write_stripe(const std::filesystem::path& path, int y0, int y1,
+                  const std::vector<std::pair<std::string, std::string>>& metadata) {
+  Film film = make_film(6, y1 - y0);
+  film.origin_y = y0;
+  film.full_height = 4;
+  for (int y = 0; y < film.height; ++y)
+    for (int x = 0; x < 6; ++x)
+      for (int c = 0; c < 4; ++c) film.pixel(x, y)[c] = float(x + 10 * (y0 + y));
+  ExrOptions opt;
+  opt.half = false;
+  opt.metadata = metadata;
+  write_exr(film, path, opt);
+}
+
+std::string merge_error(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
+                        const MergeOptions& options = {}) {
+  try {
+    merge_exr_parts(parts, out, options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "merged";
+}
+}  // namespace
+
+TEST_CASE("merge: parts of another scene or other settings are refused naming the part and what differs",
+          "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-identity");
+  write_stripe(dir / "top.exr", 0, 2, tile_metadata());
+  write_stripe(dir / "bottom.exr", 2, 4, tile_metadata());
+  merge_exr_parts({dir / "top.exr", dir / "bottom.exr"}, dir / "ok.exr");
+  OIIO::ImageSpec spec;
+  const auto merged = native_pixels(dir / "ok.exr", spec);
+  REQUIRE(merged.size() == 6 * 4 * 4 * sizeof(float));
+  CHECK(reinterpret_cast<const float*>(merged.data())[(3 * 6 + 5) * 4] == 35.0f);
+  CHECK(spec.get_string_attribute(kSceneHashAttribute) == kScene);
+  CHECK(spec.get_string_attribute(kSettingsAttribute) == canonical_text(kSettings));
+
+  write_stripe(dir / "other-scene.exr", 2, 4, tile_metadata("deadbeef"));
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "other-scene.exr"}, dir / "x.exr"),
+             Contains("other-scene.exr: is from another scene") && Contains("'deadbeef'") &&
+                 Contains("'" + kScene + "'") && Contains("--force"));
+
+  RenderSettings other = kSettings;
+  other.entries["spp"] = "64";
+  other.entries["seed"] = "3";
+  write_stripe(dir / "other-settings.exr", 2, 4, tile_metadata(kScene, other));
+  const std::string message = merge_error({dir / "top.exr", dir / "other-settings.exr"}, dir / "x.exr");
+  CHECK_THAT(message,
+             Contains("other-settings.exr: was rendered with other settings than") && Contains("top.exr"));
+  CHECK_THAT(message, Contains("  spp: " + (dir / "top.exr").string() + " '4', " +
+                               (dir / "other-settings.exr").string() + " '64'"));
+  CHECK_THAT(message, Contains("  seed: ") && Contains("(not set)") && Contains("--force"));
+  CHECK_THAT(message, !Contains("camera") && !Contains("width"));
+
+  write_stripe(dir / "broken.exr", 2, 4, {{kSceneHashAttribute, kScene}, {kSettingsAttribute, "spp=4"}});
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "broken.exr"}, dir / "x.exr"),
+             Contains("broken.exr: penumbra:settings: malformed") && Contains("--force"));
+
+  // With --force the metadata is not compared; the geometric checks still apply.
+  merge_exr_parts({dir / "top.exr", dir / "other-scene.exr"}, dir / "forced.exr", MergeOptions{true});
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "other-settings.exr", dir / "bottom.exr"}, dir / "x.exr",
+                         MergeOptions{true}),
+             Contains("bottom.exr: overlaps"));
+  CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("merge: parts without Penumbra metadata are refused, and accepted with force",
+          "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-foreign");
+  write_stripe(dir / "top.exr", 0, 2, tile_metadata());
+  write_stripe(dir / "foreign.exr", 2, 4, {});
+  write_stripe(dir / "no-settings.exr", 2, 4, {{kSceneHashAttribute, kScene}});
+  write_stripe(dir / "no-scene.exr", 2, 4, {{kSettingsAttribute, canonical_text(kSettings)}});
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "foreign.exr"}, dir / "x.exr"),
+             Contains("foreign.exr: has no penumbra:scene_sha256") &&
+                 Contains("use --force to merge parts from other tools"));
+  CHECK_THAT(merge_error({dir / "foreign.exr", dir / "top.exr"}, dir / "x.exr"),
+             Contains("foreign.exr: has no"));
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "no-settings.exr"}, dir / "x.exr"),
+             Contains("no-settings.exr: has no penumbra:settings"));
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "no-scene.exr"}, dir / "x.exr"),
+             Contains("no-scene.exr: has no penumbra:scene_sha256"));
+  CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
+  merge_exr_parts({dir / "foreign.exr", dir / "top.exr"}, dir / "forced.exr", MergeOptions{.force = true});
+  OIIO::ImageSpec spec;
+  const auto merged = native_pixels(dir / "forced.exr", spec);
+  CHECK(reinterpret_cast<const float*>(merged.data())[(1 * 6 + 2) * 4] == 12.0f);
+  CHECK(reinterpret_cast<const float*>(merged.data())[(2 * 6 + 2) * 4] == 22.0f);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("merge: /dev/zero, a FIFO, a directory and a non-EXR file among the parts are refused at once",
+          "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-special");
+  write_stripe(dir / "top.exr", 0, 2, tile_metadata());
+  write_stripe(dir / "bottom.exr", 2, 4, tile_metadata());
+  CHECK_THAT(merge_error({dir / "top.exr", "/dev/zero"}, dir / "x.exr"),
+             Contains("/dev/zero") && Contains("character device"));
+  CHECK_THAT(merge_error({dir / "top.exr", dir}, dir / "x.exr"), Contains("directory"));
+  test::make_fifo(dir / "fifo.exr");
+  // The FIFO is last: it is refused before the other parts are opened.
+  const std::string message = test::message_without_blocking(
+      [&] {
+        merge_exr_parts({dir / "top.exr", dir / "bottom.exr", dir / "fifo.exr"}, dir / "x.exr");
+      },
+      dir / "fifo.exr");
+  CHECK_THAT(message, Contains("fifo.exr") && Contains("FIFO"));
+  std::ofstream(dir / "text.exr") << "not an image";
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "text.exr"}, dir / "x.exr"),
+             Contains("text.exr: cannot read as OpenEXR"));
+  CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("merge: a frame over the memory bound is refused before it is allocated",
+          "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-memory");
+  write_stripe(dir / "top.exr", 0, 2, tile_metadata());
+  write_stripe(dir / "bottom.exr", 2, 4, tile_metadata());
+  MergeOptions tight;
+  tight.max_memory_bytes = 6 * 4 * 16 - 1;
+  CHECK_THAT(merge_error({dir / "top.exr", dir / "bottom.exr"}, dir / "x.exr", tight),
+             Contains("top.exr") && Contains("limit"));
+  tight.max_memory_bytes = 6 * 4 * 16 + 6 * 2 * 16;
+  merge_exr_parts({dir / "top.exr", dir / "bottom.exr"}, dir / "x.exr", tight);
   std::filesystem::remove_all(dir);
 }
