@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -28,6 +29,65 @@ double image_bytes(const OIIO::ImageSpec& spec, bool full) {
   const double pixels =
       full ? double(spec.full_width) * double(spec.full_height) : double(spec.width) * double(spec.height);
   return pixels * double(spec.pixel_bytes(true));
+}
+
+// Reads a NUL-terminated name of at most 255 bytes; false at end of file or if longer.
+bool read_name(std::istream& in, std::string& name) {
+  name.clear();
+  for (char c; in.get(c);) {
+    if (c == '\0') return true;
+    if (name.size() == 255) return false;
+    name += c;
+  }
+  return false;
+}
+
+// Walks the OpenEXR header(s) of `path` (`size` bytes) before OpenImageIO opens it, so a few
+// hostile bytes cannot make the EXR reader allocate what the file does not hold: every
+// attribute must fit in the rest of the file, and every data and display window must be at most
+// kMaxSide pixels per side. Throws InputError naming the file otherwise.
+void check_exr_header(const std::filesystem::path& path, uint64_t size) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  unsigned char start[8] = {};
+  if (!in.read(reinterpret_cast<char*>(start), sizeof start) || start[0] != 0x76 || start[1] != 0x2f ||
+      start[2] != 0x31 || start[3] != 0x01)
+    throw InputError(name, "", "is not an OpenEXR file");
+  const uint32_t flags = uint32_t(start[5]) << 8 | uint32_t(start[6]) << 16 | uint32_t(start[7]) << 24;
+  const bool multipart = flags & 0x1000;
+  if (flags & 0x800) throw InputError(name, "", "deep images cannot be merged");
+  const auto bad = [&](const std::string& what) {
+    return InputError(name, "", "invalid OpenEXR header: " + what);
+  };
+  for (int header = 0;; ++header) {
+    std::string attribute, type;
+    int attributes = 0;
+    for (;; ++attributes) {
+      if (!read_name(in, attribute)) throw bad("cut off, or an attribute name over 255 bytes");
+      if (attribute.empty()) break;
+      int32_t bytes = 0;
+      if (!read_name(in, type) || !in.read(reinterpret_cast<char*>(&bytes), 4))
+        throw bad("attribute '" + attribute + "' is cut off");
+      const uint64_t left = size - uint64_t(in.tellg());
+      if (bytes < 0 || uint64_t(bytes) > left)
+        throw bad("attribute '" + attribute + "' claims " + std::to_string(bytes) + " bytes, " +
+                  std::to_string(left) + " are left");
+      if (type == "box2i" && bytes == 16 && (attribute == "dataWindow" || attribute == "displayWindow")) {
+        int32_t box[4];
+        in.read(reinterpret_cast<char*>(box), sizeof box);
+        const int64_t w = int64_t(box[2]) - box[0] + 1, h = int64_t(box[3]) - box[1] + 1;
+        if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide)
+          throw bad(attribute + " of " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
+      } else {
+        in.seekg(bytes, std::ios::cur);
+      }
+    }
+    if (!in) throw bad("cut off");
+    if (!multipart || attributes == 0) {
+      if (header == 0 && attributes == 0) throw bad("no attributes");
+      return;
+    }
+  }
 }
 
 std::unique_ptr<OIIO::ImageInput> open_part(const std::string& name) {
@@ -194,7 +254,8 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
 void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
                      const MergeOptions& options) {
   if (parts.empty()) throw InputError(out.string(), "", "no parts to merge");
-  for (const auto& part : parts) check_input_file(part, "", kMaxMergePartBytes);
+  std::vector<uint64_t> sizes;
+  for (const auto& part : parts) sizes.push_back(check_input_file(part, "", kMaxMergePartBytes));
   const std::string first_name = parts[0].string();
   std::vector<OIIO::ImageSpec> full;               // per EXR part (subimage), from the first file
   std::vector<std::vector<unsigned char>> pixels;  // per subimage, the whole frame
@@ -203,6 +264,7 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
   double frame_bytes = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const std::string name = parts[k].string();
+    check_exr_header(parts[k], sizes[k]);
     auto in = open_part(name);
     const std::vector<OIIO::ImageSpec> specs = read_specs(*in, name);
     if (!options.force) {

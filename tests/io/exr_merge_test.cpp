@@ -218,7 +218,7 @@ TEST_CASE("merge: /dev/zero, a FIFO, a directory and a non-EXR file among the pa
   CHECK_THAT(message, Contains("fifo.exr") && Contains("FIFO"));
   std::ofstream(dir / "text.exr") << "not an image";
   CHECK_THAT(merge_error({dir / "top.exr", dir / "text.exr"}, dir / "x.exr"),
-             Contains("text.exr: cannot read as OpenEXR"));
+             Contains("text.exr: is not an OpenEXR file"));
   CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
   std::filesystem::remove_all(dir);
 }
@@ -234,5 +234,35 @@ TEST_CASE("merge: a frame over the memory bound is refused before it is allocate
              Contains("top.exr") && Contains("limit"));
   tight.max_memory_bytes = 6 * 4 * 16 + 6 * 2 * 16;
   merge_exr_parts({dir / "top.exr", dir / "bottom.exr"}, dir / "x.exr", tight);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("merge: EXR headers claiming more than the file holds are refused before decoding",
+          "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-header");
+  const auto attribute = [](const std::string& name, const std::string& type, int32_t size,
+                            const std::string& value) {
+    std::string a = name + '\0' + type + '\0';
+    a.append(reinterpret_cast<const char*>(&size), 4);
+    return a + value;
+  };
+  const std::string start("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  const auto write = [&](const std::string& file, const std::string& bytes) {
+    std::ofstream(dir / file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    return dir / file;
+  };
+  const auto huge = write("huge.exr", start + attribute(kSceneHashAttribute, "string", 0x7fffffff, "abc"));
+  CHECK_THAT(merge_error({huge}, dir / "x.exr"),
+             Contains("huge.exr: invalid OpenEXR header") &&
+                 Contains("'penumbra:scene_sha256' claims 2147483647 bytes"));
+  const int32_t box[4] = {0, 0, 1 << 30, 3};
+  const auto wide = write(
+      "wide.exr",
+      start + attribute("dataWindow", "box2i", 16, std::string(reinterpret_cast<const char*>(box), 16)) +
+          '\0');
+  CHECK_THAT(merge_error({wide}, dir / "x.exr"),
+             Contains("wide.exr: invalid OpenEXR header: dataWindow of 1073741825x4"));
+  const auto cut = write("cut.exr", start + "channels");
+  CHECK_THAT(merge_error({cut}, dir / "x.exr"), Contains("cut.exr: invalid OpenEXR header: cut off"));
   std::filesystem::remove_all(dir);
 }
