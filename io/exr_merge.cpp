@@ -42,10 +42,62 @@ bool read_name(std::istream& in, std::string& name) {
   return false;
 }
 
+// Size in bytes of the OpenEXR attribute types whose values have a fixed size (OpenEXR's reader
+// reads that many bytes whatever the size field says), or 0 for other types.
+int fixed_attribute_size(const std::string& type) {
+  // clang-format off
+  static const std::pair<const char*, int> sizes[] = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1},
+      {"double", 8}, {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1},
+      {"m33d", 72}, {"m33f", 36}, {"m44d", 128}, {"m44f", 64}, {"rational", 8}, {"tiledesc", 9},
+      {"timecode", 8}, {"v2d", 16}, {"v2f", 8}, {"v2i", 8}, {"v3d", 24}, {"v3f", 12}, {"v3i", 12}};
+  // clang-format on
+  for (const auto& [name, size] : sizes)
+    if (type == name) return size;
+  return 0;
+}
+
+int32_t int32_at(const std::string& bytes, size_t at) {
+  int32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, 4);
+  return v;
+}
+
+// Why the value of an attribute of variable size that OpenEXR's reader parses further (channel
+// lists, previews, string vectors) does not describe exactly its `value.size()` bytes, or "".
+std::string variable_attribute_problem(const std::string& type, const std::string& value) {
+  if (type == "chlist") {  // entries of name, NUL, 16 bytes; then one NUL
+    size_t at = 0;
+    while (at < value.size() && value[at] != '\0') {
+      const size_t end = value.find('\0', at);
+      if (end == std::string::npos || end - at > 255 || end + 17 > value.size())
+        return "a channel is cut off";
+      at = end + 17;
+    }
+    return at + 1 == value.size() ? "" : "the channel list does not fill its size";
+  }
+  if (type == "preview") {  // width, height, then 4 bytes per pixel
+    if (value.size() < 8) return "a preview is cut off";
+    const uint64_t w = uint32_t(int32_at(value, 0)), h = uint32_t(int32_at(value, 4));
+    return w <= kMaxSide && h <= kMaxSide && 8 + 4 * w * h == value.size() ? ""
+                                                                           : "the preview's size is wrong";
+  }
+  if (type == "stringvector") {  // (length, bytes) pairs
+    for (size_t at = 0; at < value.size();) {
+      if (at + 4 > value.size()) return "a string is cut off";
+      const int32_t n = int32_at(value, at);
+      if (n < 0 || uint64_t(n) > value.size() - at - 4) return "a string is cut off";
+      at += 4 + size_t(n);
+    }
+  }
+  return "";
+}
+
 // Walks the OpenEXR header(s) of `path` (`size` bytes) before OpenImageIO opens it, so a few
 // hostile bytes cannot make the EXR reader allocate what the file does not hold: every
-// attribute must fit in the rest of the file, and every data and display window must be at most
-// kMaxSide pixels per side. Throws InputError naming the file otherwise.
+// attribute must fit in the rest of the file with the size its type has, channel lists,
+// previews and string vectors must describe their own bytes, and every data and display window
+// must be at most kMaxSide pixels per side. Throws InputError naming the file otherwise.
 void check_exr_header(const std::filesystem::path& path, uint64_t size) {
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
@@ -72,12 +124,21 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size) {
       if (bytes < 0 || uint64_t(bytes) > left)
         throw bad("attribute '" + attribute + "' claims " + std::to_string(bytes) + " bytes, " +
                   std::to_string(left) + " are left");
-      if (type == "box2i" && bytes == 16 && (attribute == "dataWindow" || attribute == "displayWindow")) {
+      const int fixed = fixed_attribute_size(type);
+      if (fixed > 0 && bytes != fixed)
+        throw bad("attribute '" + attribute + "' of type " + type + " has " + std::to_string(bytes) +
+                  " bytes, not " + std::to_string(fixed));
+      if (type == "box2i" && (attribute == "dataWindow" || attribute == "displayWindow")) {
         int32_t box[4];
         in.read(reinterpret_cast<char*>(box), sizeof box);
         const int64_t w = int64_t(box[2]) - box[0] + 1, h = int64_t(box[3]) - box[1] + 1;
         if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide)
           throw bad(attribute + " of " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
+      } else if (type == "chlist" || type == "preview" || type == "stringvector") {
+        std::string value(size_t(bytes), '\0');
+        in.read(value.data(), bytes);
+        const std::string problem = variable_attribute_problem(type, value);
+        if (!problem.empty()) throw bad("attribute '" + attribute + "': " + problem);
       } else {
         in.seekg(bytes, std::ios::cur);
       }

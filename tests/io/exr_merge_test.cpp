@@ -262,7 +262,67 @@ TEST_CASE("merge: EXR headers claiming more than the file holds are refused befo
           '\0');
   CHECK_THAT(merge_error({wide}, dir / "x.exr"),
              Contains("wide.exr: invalid OpenEXR header: dataWindow of 1073741825x4"));
+  const auto long_box =
+      write("long-box.exr", start + attribute("displayWindow", "box2i", 24, std::string(24, '\0')) + '\0');
+  CHECK_THAT(merge_error({long_box}, dir / "x.exr"),
+             Contains("long-box.exr: invalid OpenEXR header: attribute 'displayWindow' of type box2i has 24 "
+                      "bytes, not 16"));
+  const auto channels =
+      write("channels.exr", start + attribute("channels", "chlist", 4, std::string("R\0\0\0")) + '\0');
+  CHECK_THAT(merge_error({channels}, dir / "x.exr"),
+             Contains("channels.exr: invalid OpenEXR header: attribute 'channels'"));
+  const int32_t preview_size[2] = {60000, 60000};
+  const auto preview = write(
+      "preview.exr",
+      start +
+          attribute("preview", "preview", 8, std::string(reinterpret_cast<const char*>(preview_size), 8)) +
+          '\0');
+  CHECK_THAT(merge_error({preview}, dir / "x.exr"),
+             Contains("preview.exr: invalid OpenEXR header: attribute 'preview'"));
+  const int32_t string_size = 1 << 30;
+  const auto strings = write(
+      "strings.exr",
+      start +
+          attribute("views", "stringvector", 4, std::string(reinterpret_cast<const char*>(&string_size), 4)) +
+          '\0');
+  CHECK_THAT(merge_error({strings}, dir / "x.exr"),
+             Contains("strings.exr: invalid OpenEXR header: attribute 'views'"));
   const auto cut = write("cut.exr", start + "channels");
   CHECK_THAT(merge_error({cut}, dir / "x.exr"), Contains("cut.exr: invalid OpenEXR header: cut off"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("merge: multi-part and tiled stripes pass the header walk and merge", "[io][exr][merge][quick]") {
+  const auto dir = test::temp_dir("merge-multipart");
+  for (const bool multipart : {true, false})
+    for (int y0 : {0, 3}) {
+      Film film = make_film(5, 3);
+      film.origin_y = y0;
+      film.full_height = 6;
+      std::vector<float> depth(15, float(y0));
+      ExrOptions opt;
+      opt.multipart = multipart;
+      opt.compression = multipart ? "dwaa" : "piz";
+      opt.extra = {{"Z", &depth}};
+      opt.metadata = tile_metadata();
+      opt.matrix_metadata = {{"worldToCamera", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}};
+      write_exr(film, dir / (std::to_string(multipart) + "-" + std::to_string(y0) + ".exr"), opt);
+    }
+  merge_exr_parts({dir / "1-0.exr", dir / "1-3.exr"}, dir / "multi.exr");
+  merge_exr_parts({dir / "0-0.exr", dir / "0-3.exr"}, dir / "single.exr");
+  auto in = OIIO::ImageInput::open((dir / "multi.exr").string());
+  REQUIRE(in);
+  CHECK(in->seek_subimage(1, 0));
+  // A tiled file written by OpenImageIO itself (with --force: no Penumbra metadata).
+  OIIO::ImageSpec spec(5, 6, 4, OIIO::TypeDesc::HALF);
+  spec.tile_width = spec.tile_height = 4;
+  spec.attribute("compression", "zip");
+  std::vector<float> px(5 * 6 * 4, 0.5f);
+  auto out = OIIO::ImageOutput::create((dir / "tiled.exr").string());
+  REQUIRE(out);
+  REQUIRE(out->open((dir / "tiled.exr").string(), spec));
+  REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
+  REQUIRE(out->close());
+  merge_exr_parts({dir / "tiled.exr"}, dir / "from-tiles.exr", MergeOptions{true});
   std::filesystem::remove_all(dir);
 }
