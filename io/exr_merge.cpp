@@ -66,12 +66,18 @@ int32_t int32_at(const std::string& bytes, size_t at) {
 // Why the value of an attribute of variable size that OpenEXR's reader parses further (channel
 // lists, previews, string vectors) does not describe exactly its `value.size()` bytes, or "".
 std::string variable_attribute_problem(const std::string& type, const std::string& value) {
-  if (type == "chlist") {  // entries of name, NUL, 16 bytes; then one NUL
+  if (type == "chlist") {  // entries of name, NUL, pixel type, linear, 3 reserved, x and y sampling; a NUL
     size_t at = 0;
     while (at < value.size() && value[at] != '\0') {
       const size_t end = value.find('\0', at);
       if (end == std::string::npos || end - at > 255 || end + 17 > value.size())
         return "a channel is cut off";
+      const std::string channel = "channel '" + value.substr(at, end - at) + "'";
+      const int32_t pixel_type = int32_at(value, end + 1);
+      if (pixel_type < 0 || pixel_type > 2)
+        return channel + " has unknown pixel type " + std::to_string(pixel_type);
+      if (int32_at(value, end + 9) != 1 || int32_at(value, end + 13) != 1)
+        return channel + " is subsampled, which merge does not support";
       at = end + 17;
     }
     return at + 1 == value.size() ? "" : "the channel list does not fill its size";

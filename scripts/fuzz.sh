@@ -41,15 +41,17 @@ for t in "${targets[@]}"; do
       [ -d "$corpus" ] && seeds+=("$corpus/invalid" "$corpus/valid")
       seeds+=(scenes)
       max_len=65536
+      extra=()
       ;;
     checkpoint | exr_merge)
       rm -rf "build-fuzz/seeds/$t"
       PENUMBRA_FUZZ_WRITE_SEEDS="build-fuzz/seeds/$t" "$bin"
       seeds+=("build-fuzz/seeds/$t")
       max_len=16384
+      extra=(-malloc_limit_mb=512)  # the targets bound what they decode far below this
       ;;
   esac
   echo "fuzz.sh: running $t for $seconds s" >&2
   "$bin" -max_total_time="$seconds" -max_len="$max_len" -rss_limit_mb=2048 -timeout=20 \
-    -artifact_prefix="build-fuzz/findings/$t/" "build-fuzz/work/$t" "${seeds[@]}"
+    -artifact_prefix="build-fuzz/findings/$t/" "${extra[@]}" "build-fuzz/work/$t" "${seeds[@]}"
 done

@@ -271,6 +271,18 @@ TEST_CASE("merge: EXR headers claiming more than the file holds are refused befo
       write("channels.exr", start + attribute("channels", "chlist", 4, std::string("R\0\0\0")) + '\0');
   CHECK_THAT(merge_error({channels}, dir / "x.exr"),
              Contains("channels.exr: invalid OpenEXR header: attribute 'channels'"));
+  const std::string half_r("R\0\1\0\0\0\0\0\0\0\1\0\0\0\1\0\0\0\0", 19);
+  std::string unknown_type = half_r, subsampled = half_r;
+  unknown_type[2] = 3;
+  subsampled[10] = 2;
+  const auto channel_type =
+      write("type.exr", start + attribute("channels", "chlist", 19, unknown_type) + '\0');
+  CHECK_THAT(merge_error({channel_type}, dir / "x.exr"),
+             Contains("type.exr: invalid OpenEXR header: attribute "
+                      "'channels': channel 'R' has unknown pixel type 3"));
+  const auto channel_sampling =
+      write("sampling.exr", start + attribute("channels", "chlist", 19, subsampled) + '\0');
+  CHECK_THAT(merge_error({channel_sampling}, dir / "x.exr"), Contains("channel 'R' is subsampled"));
   const int32_t preview_size[2] = {60000, 60000};
   const auto preview = write(
       "preview.exr",
