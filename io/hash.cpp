@@ -48,6 +48,7 @@ void Sha256::block(const uint8_t* p) {
 }
 
 void Sha256::update(const void* data, size_t bytes) {
+  if (bytes == 0) return;  // `data` may be null then (an empty vector's data())
   const auto* p = static_cast<const uint8_t*>(data);
   m_length += bytes;
   if (m_fill > 0) {

@@ -54,3 +54,11 @@ TEST_CASE("sha256: files agree with sha256sum; non-regular files are refused", "
   CHECK_THROWS_AS(sha256_file(dir), InputError);
   CHECK_THROWS_AS(sha256_file(dir / "missing"), InputError);
 }
+
+TEST_CASE("sha256: an empty update may pass a null pointer", "[io][hash][quick]") {
+  Sha256 h;
+  h.update(nullptr, 0);
+  h.update("abc");
+  h.update(nullptr, 0);
+  CHECK(h.finish_hex() == sha256_hex("abc"));
+}
