@@ -25,6 +25,7 @@
 #include "io/atomic_file.h"
 #include "io/file_checks.h"
 #include "io/hash.h"
+#include "io/render_settings.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
@@ -428,26 +429,51 @@ uint64_t image_bytes_per_pixel(bool path, bool data_aovs, bool light_groups, boo
   return b;
 }
 
-/// Everything that decides a path-traced pixel's samples, for checkpoint headers (not the
-/// spp target, threads, outputs or time limits: a resumed render may extend those).
-std::string render_fingerprint(const RenderArgs& a, const RenderConfig& cfg, const Camera& camera) {
-  std::error_code ec;
-  const auto size = fs::file_size(a.scene_file, ec);
-  const auto& p = cfg.path;
-  const PixelWindow win = render_window(cfg);
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "scene %s (%llu bytes) scene-index %d camera '%s' %dx%d window %d,%d-%d,%d seed %llu sampler %s filter %s %g "
-                "max-depth %d rr-depth %d clamp %g light-sampling %s env '%s' x%g rot %g adaptive %g min %d groups %d accel %s "
-                "flatten %d time %s",
-                a.scene_file.c_str(), static_cast<unsigned long long>(ec ? 0 : size), a.scene, camera.name.c_str(), cfg.width,
-                cfg.height, win.x0, win.y0, win.x1, win.y1,
-                static_cast<unsigned long long>(cfg.seed), a.sampler.c_str(), filter_name(cfg.filter.type),
-                double(cfg.filter.width), p.max_depth, p.rr_depth, double(p.clamp_indirect), a.light_sampling.c_str(),
-                a.env.c_str(), double(a.env_intensity), double(a.env_rotation), double(cfg.adaptive_threshold),
-                cfg.adaptive_min_spp, cfg.light_groups ? 1 : 0, a.accel.c_str(), a.flatten ? 1 : 0,
-                a.time ? std::to_string(*a.time).c_str() : (a.frame ? ("frame " + *a.frame).c_str() : "static"));
+/// A float as text that reads back to the same value.
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
+}
+
+/// Everything that decides the pixels of a render except its window and sample target, in
+/// canonical form: what the scene is (its content hash, scene index, camera, pose), the image
+/// size and every sampling and integrator setting. Resume state adds the window; tiles add the
+/// sample target and the layers.
+RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, const Camera& camera,
+                              const std::string& scene_sha256, const std::string& env_sha256) {
+  std::map<std::string, std::string> e;
+  e["scene.sha256"] = scene_sha256;
+  e["scene.index"] = std::to_string(a.scene);
+  e["scene.flatten"] = a.flatten ? "1" : "0";
+  e["scene.time"] = a.time ? exact(*a.time) : (a.frame ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
+  e["camera"] = a.camera.empty() ? "default '" + camera.name + "'" : a.camera;
+  e["image"] = std::to_string(cfg.width) + "x" + std::to_string(cfg.height);
+  e["integrator"] = a.integrator;
+  e["seed"] = std::to_string(cfg.seed);
+  e["filter"] = std::string(filter_name(cfg.filter.type)) + " " + exact(cfg.filter.width);
+  e["accel"] = a.accel;
+  for (const auto& p : a.accel_params) e["accel." + p.substr(0, p.find('='))] = p.substr(p.find('=') + 1);
+  if (a.integrator == "path") {
+    const auto& p = cfg.path;
+    e["path.sampler"] = a.sampler;
+    e["path.max_depth"] = std::to_string(p.max_depth);
+    e["path.rr_depth"] = std::to_string(p.rr_depth);
+    e["path.clamp_indirect"] = exact(p.clamp_indirect);
+    e["path.light_sampling"] = a.light_sampling;
+    e["path.adaptive"] = exact(cfg.adaptive_threshold) + " min " + std::to_string(cfg.adaptive_min_spp);
+    e["path.light_groups"] = cfg.light_groups ? "1" : "0";
+    e["env"] = a.env.empty() ? "none" : a.env;
+    if (!env_sha256.empty()) e["env.sha256"] = env_sha256;
+    e["env.intensity"] = exact(a.env_intensity);
+    e["env.rotation"] = exact(a.env_rotation);
+  } else {
+    const auto& w = cfg.whitted;
+    e["whitted.max_depth"] = std::to_string(w.max_depth);
+    e["whitted.background"] = exact(w.background.x) + "," + exact(w.background.y) + "," + exact(w.background.z);
+    e["whitted.ambient"] = exact(w.ambient.x) + "," + exact(w.ambient.y) + "," + exact(w.ambient.z);
+  }
+  return {e};
 }
 
 int run_render(const RenderArgs& a) {
@@ -582,6 +608,7 @@ int run_render(const RenderArgs& a) {
   const auto t_load = Clock::now();
   LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, a.max_memory, a.quiet, time);
   Scene& scene = loaded.scene;
+  const std::vector<fs::path> scene_files = {a.scene_file};
   const double load_s = seconds_since(t_load);
 
   // Camera and resolution (the image aspect follows the camera's hint unless both are given).
@@ -643,6 +670,14 @@ int run_render(const RenderArgs& a) {
   cfg.adaptive_min_spp = a.adaptive_min_spp;
   cfg.light_groups = aovs.count("light") > 0;
   const PathLights path_lights{&area_lights, &environment};
+  // What this render is, for its resume state and the metadata of crops and tiles: the content
+  // of every file it loaded and every setting that decides its pixels.
+  RenderSettings settings;
+  std::string scene_sha;
+  if (path || !cfg.window.empty()) {
+    scene_sha = sha256_of_files(scene_files);
+    settings = pixel_settings(a, cfg, camera, scene_sha, !a.env.empty() && !env_colour ? sha256_file(a.env) : "");
+  }
 
   // Build.
   g_phase = "building the acceleration structure";
@@ -675,7 +710,10 @@ int run_render(const RenderArgs& a) {
   if (path) {
     // Resume state beside the output; its header records what determines the pixels.
     const fs::path state_file = fs::path(out).concat(".resume");
-    const std::string fingerprint = render_fingerprint(a, cfg, camera);
+    RenderSettings fingerprint = settings;
+    const PixelWindow win = render_window(cfg);
+    fingerprint.entries["window"] = std::to_string(win.x0) + "," + std::to_string(win.y0) + "-" +
+                                    std::to_string(win.x1) + "," + std::to_string(win.y1);
     PathAccumulators state;
     if (a.resume) {
       if (fs::exists(state_file)) {
@@ -735,6 +773,15 @@ int run_render(const RenderArgs& a) {
     std::snprintf(buf, sizeof buf, "%.3f", mean_spp);
     exr.metadata.push_back({"penumbra:mean_spp", buf});
     exr.metadata.push_back({"penumbra:passes", std::to_string(stats.passes)});
+  }
+  if (!cfg.window.empty()) {  // merge accepts only parts of one render
+    RenderSettings part = settings;
+    part.entries["spp"] = std::to_string(cfg.spp);
+    std::string layers;
+    for (const auto& name : aovs) layers += (layers.empty() ? "" : ",") + name;
+    part.entries["aovs"] = layers;
+    exr.metadata.push_back({kSceneHashAttribute, scene_sha});
+    exr.metadata.push_back({kSettingsAttribute, canonical_text(part)});
   }
   exr.metadata.push_back({"penumbra:command_line", a.command_line});
   exr.metadata.push_back({"penumbra:version", PENUMBRA_VERSION});
@@ -1031,6 +1078,12 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand("merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   merge->add_option("parts", merge_parts, "part EXRs (together covering the frame once)")->required();
   merge->add_option("-o,--output", merge_out, "full-frame EXR (written atomically)")->required();
+  bool merge_force = false;
+  std::string merge_memory;
+  merge->add_option("--max-memory", merge_memory, "budget for the decoded full frame, e.g. 4G (default: half the RAM)");
+  merge->add_flag("--force", merge_force,
+                  "merge parts without Penumbra's scene and settings metadata, or with differing metadata (parts "
+                  "cut by other tools); the windows and channels are still checked");
 
   try {
     app.parse(argc, argv);
@@ -1055,7 +1108,10 @@ int main(int argc, char** argv) {
       std::vector<std::pair<std::string, fs::path>> inputs;
       for (size_t k = 0; k < parts.size(); ++k) inputs.push_back({"part " + std::to_string(k + 1), parts[k]});
       check_distinct_files({{"-o", merged}}, inputs);
-      merge_exr_parts(parts, merge_out);
+      MergeOptions merge_options;
+      merge_options.force = merge_force;
+      merge_options.max_memory_bytes = merge_memory.empty() ? default_memory_budget() : parse_bytes(merge_memory);
+      merge_exr_parts(parts, merge_out, merge_options);
       std::printf("%s\n", merge_out.c_str());
       return kExitOk;
     }

@@ -106,4 +106,17 @@ std::string sha256_file(const std::filesystem::path& path) {
   return h.finish_hex();
 }
 
+std::string sha256_of_files(const std::vector<std::filesystem::path>& files) {
+  Sha256 h;
+  const std::filesystem::path base = files.empty() ? std::filesystem::path() : files[0].parent_path();
+  for (const auto& f : files) {
+    const std::string name = f.lexically_relative(base).generic_string();
+    const std::string digest = sha256_file(f);
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(f, ec);
+    h.update(name + '\0' + std::to_string(ec ? 0 : size) + '\0' + digest + '\n');
+  }
+  return h.finish_hex();
+}
+
 }  // namespace penumbra

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace penumbra {
 
@@ -33,6 +34,12 @@ class Sha256 {
 
 /// SHA-256 of `data` as hex.
 std::string sha256_hex(std::string_view data);
+
+/// SHA-256 identifying a set of files by content (a scene: the glTF file and every buffer and
+/// image it loads): over each file's name relative to the first file's folder, its size and its
+/// SHA-256, in the given order. Moving the whole set elsewhere keeps the digest; editing,
+/// renaming or replacing any file changes it. Throws InputError as sha256_file does.
+std::string sha256_of_files(const std::vector<std::filesystem::path>& files);
 
 /// SHA-256 of a regular file's bytes as hex. Throws InputError naming the file if it is not
 /// a regular file or cannot be read.

@@ -150,6 +150,64 @@ rec_png=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outpu
 "$bin" render "$scene" -o "$work/st.exr" --width 40 --spp 1 -q >/dev/null  # another run replaces the EXR
 [ "$rec_exr" != "$(sum "$work/st.exr")" ] && pass || fail "a different render has the same hash"
 
+# --- Resume state is verified: a damaged state, a FIFO in its place, or a scene edited to the
+# same size since the interrupt are refused (exit 2) and neither the state nor the image changes.
+flip() {  # flip FILE OFFSET: invert one byte in place
+  python3 -c 'import sys; p, o = sys.argv[1], int(sys.argv[2]); b = bytearray(open(p, "rb").read()); b[o] ^= 0xff; open(p, "wb").write(b)' "$1" "$2"
+}
+one_pass=(--integrator path --width 24 --spp 64 --no-png -q --checkpoint 1e-9 --time-limit 1e-9)
+expect 0 "res.exr" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" "${one_pass[@]}"
+[ -e "$work/res.exr.resume" ] && pass || fail "a time-limited checkpointed render left no resume state"
+cp "$work/res.exr.resume" "$work/good.resume"
+size=$(stat -c %s "$work/res.exr.resume")
+for offset in 20 $((size / 2)) $((size - 3)); do  # header, payload, checksum
+  cp "$work/good.resume" "$work/res.exr.resume"; flip "$work/res.exr.resume" "$offset"
+  bad=$(sum "$work/res.exr.resume"); img=$(sum "$work/res.exr")
+  expect 2 "res.exr.resume: (checksum mismatch|truncated or corrupt|not a Penumbra checkpoint)" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
+  unchanged "$work/res.exr.resume" "$bad"; unchanged "$work/res.exr" "$img"
+done
+cp "$work/good.resume" "$work/res.exr.resume"
+python3 - "$work/scene.gltf" <<'PY'
+import sys
+p = sys.argv[1]; t = open(p).read()
+i = t.index('"baseColorFactor"'); j = t.index('0.', i)
+open(p, 'w').write(t[:j] + ('1.' if t[j] == '0' else '0.') + t[j + 2:])  # same size, other colour
+PY
+expect 2 "res.exr.resume: was written for other settings.*" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
+grep -q "scene.sha256: stored" "$work/err" && pass || fail "the refusal does not name scene.sha256"
+cp "$scene" "$work/scene.gltf"
+expect 0 "resuming" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png --resume
+rm -f "$work/res.exr.resume"; mkfifo "$work/res.exr.resume"
+expect 2 "res.exr.resume: .*is a FIFO, not a regular file" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
+rm -f "$work/res.exr.resume"
+
+# --- merge refuses parts of different renders (unless --force) and non-regular parts.
+tile=(--width 48 --spp 1 --no-png -q)
+"$bin" render "$scene" -o "$work/m0.exr" "${tile[@]}" --tile 0/2 >/dev/null && "$bin" render "$scene" -o "$work/m1.exr" "${tile[@]}" --tile 1/2 >/dev/null \
+  && pass || fail "tiles render"
+python3 - "$work/scene.gltf" "$work/other.gltf" <<'PY'
+import sys
+t = open(sys.argv[1]).read(); i = t.index('"baseColorFactor"'); j = t.index('0.', i)
+open(sys.argv[2], 'w').write(t[:j] + ('1.' if t[j] == '0' else '0.') + t[j + 2:])
+PY
+"$bin" render "$work/other.gltf" -o "$work/o1.exr" "${tile[@]}" --tile 1/2 >/dev/null || fail "other scene's tile"
+expect 2 "o1.exr: is from another scene than .*m0.exr: penumbra:scene_sha256" -- "$bin" merge "$work/m0.exr" "$work/o1.exr" -o "$work/mixed.exr"
+expect 0 "mixed.exr" -- "$bin" merge "$work/m0.exr" "$work/o1.exr" -o "$work/mixed.exr" --force
+"$bin" render "$scene" -o "$work/s1.exr" --width 48 --spp 2 --no-png -q --tile 1/2 >/dev/null || fail "tile with other spp"
+expect 2 "s1.exr: was rendered with other settings.*" -- "$bin" merge "$work/m0.exr" "$work/s1.exr" -o "$work/mixed2.exr"
+grep -q "spp: " "$work/err" && pass || fail "the refusal does not name spp"
+if command -v oiiotool >/dev/null; then  # crops cut by another tool carry no Penumbra metadata
+  "$bin" render "$scene" -o "$work/full.exr" "${tile[@]}" >/dev/null
+  oiiotool "$work/full.exr" --crop 48x14+0+0 -o "$work/c0.exr" && oiiotool "$work/full.exr" --crop 48x13+0+14 -o "$work/c1.exr"
+  expect 2 "c0.exr: has no penumbra:scene_sha256 metadata.*--force" -- "$bin" merge "$work/c0.exr" "$work/c1.exr" -o "$work/cut.exr"
+  expect 0 "cut.exr" -- "$bin" merge "$work/c0.exr" "$work/c1.exr" -o "$work/cut.exr" --force
+  expect 0 "PASS" -- oiiotool "$work/full.exr" "$work/cut.exr" --fail 0 --diff
+fi
+expect 2 "/dev/zero: .*is a character device, not a regular file" -- "$bin" merge /dev/zero "$work/m1.exr" -o "$work/z.exr"
+expect 2 "in.fifo: .*is a FIFO, not a regular file" -- "$bin" merge "$work/m0.exr" "$work/in.fifo" -o "$work/z.exr"
+expect 2 "would overwrite part 1" -- "$bin" merge "$work/m0.exr" "$work/m1.exr" -o "$work/m0.exr"
+[ ! -e "$work/z.exr" ] && pass || fail "a refused merge wrote its output"
+
 # --- A full disk: every writer reports it (exit 1), keeps the old file and leaves no temporary.
 if [ "$(id -u)" -eq 0 ] && mkdir -p "$work/disk" && mount -t tmpfs -o size=384k tmpfs "$work/disk" 2>/dev/null; then
   mounted="$work/disk"
