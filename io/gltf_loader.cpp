@@ -198,7 +198,7 @@ struct AccessorLayout {
   int component_type = 0;
   int components = 0;
   bool normalized = false;
-  std::vector<std::pair<uint64_t, std::vector<double>>> sparse;  // sorted (index, values)
+  std::vector<std::pair<uint64_t, std::vector<double>>> sparse;  // (index, values), indices increasing
 };
 
 class Converter {
@@ -395,12 +395,13 @@ AccessorLayout Converter::layout(int accessor, const std::string& user) {
       if (isz == 4) { uint32_t v; std::memcpy(&v, ip + i * 4, 4); target = v; }
       if (target >= l.count)
         fail(sw + ".indices", "index " + std::to_string(target) + " >= accessor count " + std::to_string(l.count));
+      if (i > 0 && target <= l.sparse.back().first)  // the spec: sparse indices MUST strictly increase
+        fail(sw + ".indices", "indices must strictly increase (index " + std::to_string(i) + " is " +
+                                  std::to_string(target) + " after " + std::to_string(l.sparse.back().first) + ")");
       std::vector<double> vals(size_t(l.components));
       for (int c = 0; c < l.components; ++c) vals[size_t(c)] = component(values, i, c);
       l.sparse.emplace_back(target, std::move(vals));
     }
-    std::stable_sort(l.sparse.begin(), l.sparse.end(),
-                     [](const auto& x, const auto& y) { return x.first < y.first; });
   }
   return l;
 }
