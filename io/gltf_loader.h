@@ -43,6 +43,8 @@ struct GltfInfo {
   std::vector<std::string> extensions_used, extensions_required;
   std::vector<std::string> camera_instances;  ///< "name (perspective, node 3)" in scene order
   std::vector<std::string> node_names;        ///< each node's name, or "nodes[i]" if unnamed
+  std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
+                                                    ///< external buffer and image file, in load order
 };
 
 struct LoadedScene {
