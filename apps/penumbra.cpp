@@ -608,7 +608,7 @@ int run_render(const RenderArgs& a) {
   const auto t_load = Clock::now();
   LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, a.max_memory, a.quiet, time);
   Scene& scene = loaded.scene;
-  const std::vector<fs::path> scene_files = {a.scene_file};
+  const std::vector<fs::path>& scene_files = loaded.info.source_files;
   const double load_s = seconds_since(t_load);
 
   // Camera and resolution (the image aspect follows the camera's hint unless both are given).

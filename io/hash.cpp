@@ -108,9 +108,10 @@ std::string sha256_file(const std::filesystem::path& path) {
 
 std::string sha256_of_files(const std::vector<std::filesystem::path>& files) {
   Sha256 h;
-  const std::filesystem::path base = files.empty() ? std::filesystem::path() : files[0].parent_path();
+  namespace fs = std::filesystem;
+  const fs::path base = files.empty() ? fs::path() : fs::absolute(files[0]).lexically_normal().parent_path();
   for (const auto& f : files) {
-    const std::string name = f.lexically_relative(base).generic_string();
+    const std::string name = fs::absolute(f).lexically_normal().lexically_relative(base).generic_string();
     const std::string digest = sha256_file(f);
     std::error_code ec;
     const uint64_t size = std::filesystem::file_size(f, ec);

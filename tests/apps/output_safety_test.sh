@@ -177,6 +177,23 @@ expect 2 "res.exr.resume: was written for other settings.*" -- "$bin" render "$w
 grep -q "scene.sha256: stored" "$work/err" && pass || fail "the refusal does not name scene.sha256"
 cp "$scene" "$work/scene.gltf"
 expect 0 "resuming" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png --resume
+# The scene's identity covers its external buffers: a triangle whose .bin is edited in place.
+python3 - "$work/tri" <<'PY'
+import json, struct, sys
+d = sys.argv[1]
+import os; os.makedirs(d, exist_ok=True)
+pos = struct.pack("<9f", -1, -1, 0, 1, -1, 0, 0, 1, 0)
+open(d + "/tri.bin", "wb").write(pos)
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]}],
+     "bufferViews": [{"buffer": 0, "byteLength": 36}], "buffers": [{"byteLength": 36, "uri": "tri.bin"}]}
+json.dump(g, open(d + "/tri.gltf", "w"))
+PY
+expect 0 "t.exr" -- "$bin" render "$work/tri/tri.gltf" -o "$work/tri/t.exr" "${one_pass[@]}"
+flip "$work/tri/tri.bin" 2
+expect 2 "t.exr.resume: was written for other settings" -- "$bin" render "$work/tri/tri.gltf" -o "$work/tri/t.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
+grep -q "scene.sha256: stored" "$work/err" && pass || fail "an edited buffer does not change scene.sha256"
 rm -f "$work/res.exr.resume"; mkfifo "$work/res.exr.resume"
 expect 2 "res.exr.resume: .*is a FIFO, not a regular file" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
 rm -f "$work/res.exr.resume"

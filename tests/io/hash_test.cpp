@@ -62,3 +62,21 @@ TEST_CASE("sha256: an empty update may pass a null pointer", "[io][hash][quick]"
   h.update(nullptr, 0);
   CHECK(h.finish_hex() == sha256_hex("abc"));
 }
+
+TEST_CASE("sha256_of_files: content and relative names, not the folder", "[io][hash][quick]") {
+  const auto a = test::temp_dir("hash_set_a"), b = test::temp_dir("hash_set_b");
+  for (const auto& dir : {a, b}) {
+    std::filesystem::create_directories(dir / "tex");
+    std::ofstream(dir / "scene.gltf") << "{\"asset\": {}}";
+    std::ofstream(dir / "tex" / "wood.png") << "pixels";
+  }
+  const auto set = [](const std::filesystem::path& d) {
+    return sha256_of_files({d / "scene.gltf", std::filesystem::canonical(d / "tex" / "wood.png")});
+  };
+  const std::string original = set(a);
+  CHECK(set(b) == original);  // the same files elsewhere
+  std::ofstream(b / "tex" / "wood.png") << "pixelz";  // same size, other bytes
+  CHECK(set(b) != original);
+  std::filesystem::rename(a / "tex" / "wood.png", a / "tex" / "pine.png");  // same bytes, other name
+  CHECK(sha256_of_files({a / "scene.gltf", a / "tex" / "pine.png"}) != original);
+}
