@@ -9,8 +9,7 @@
 # "Identical" means: the same parts, channels, types, windows and header attributes, except
 # the timing attribute penumbra:render_seconds and the command line (which names each run's
 # output folder), and the same value in every pixel of every channel except cost.ns
-# (wall-clock nanoseconds per ray). Compared with oiiotool with zero tolerance. The binary is
-# copied to one fixed path before rendering, so the recorded command lines start alike.
+# (wall-clock nanoseconds per ray). Compared with oiiotool with zero tolerance.
 # Corpus renders (the animation time) need ../shared/corpus or PENUMBRA_CORPUS.
 set -euo pipefail
 
@@ -21,8 +20,7 @@ case "$mode" in
     src="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
     corpus="${PENUMBRA_CORPUS:-$src/../shared/corpus}"
     rm -rf "$out"; mkdir -p "$out"
-    fixed="${TMPDIR:-/tmp}/penumbra-regression-bin/penumbra"
-    mkdir -p "$(dirname "$fixed")"; cp "$bin" "$fixed"
+    fixed="$bin"
     d="$src/scenes/default.gltf"
     r() { "$fixed" render "$@" -q --no-png >/dev/null; }
     for accel in embree bvh kdtree grid brute; do
