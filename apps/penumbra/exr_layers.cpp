@@ -1,0 +1,167 @@
+// EXR metadata and AOV layers of a render.
+#include "apps/penumbra/exr_layers.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <string>
+
+#include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/render_job.h"
+#include "io/exr_merge.h"
+
+namespace penumbra::cli {
+
+namespace {
+
+std::string json_string(const std::string& v) {
+  std::string r = "\"";
+  for (unsigned char c : v) {
+    if (c == '"' || c == '\\') r += '\\', r += char(c);
+    else if (c < 0x20) r += format("\\u%04x", c);
+    else r += char(c);
+  }
+  return r + "\"";
+}
+
+/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind id.object
+/// (glTF node index + 1) and id.material (material index + 1); 0 is the background.
+std::string id_manifest(const Scene& scene, const GltfInfo& info) {
+  std::set<int> nodes;
+  for (const auto& inst : scene.instances)
+    if (inst.node >= 0) nodes.insert(inst.node);
+  std::string j = "{\"object\": {";
+  bool first = true;
+  for (int n : nodes) {
+    const std::string name = size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
+    j += (first ? "" : ", ") + json_string(std::to_string(n + 1)) + ": " + json_string(name);
+    first = false;
+  }
+  j += "}, \"material\": {";
+  for (size_t m = 0; m < scene.materials.size(); ++m)
+    j += (m ? ", " : "") + json_string(std::to_string(m + 1)) + ": " + json_string(scene.materials[m].name);
+  return j + "}}";
+}
+
+/// OpenEXR's standard camera attributes (row vectors, p' = p M; camera space looks down -Z):
+/// worldToCamera, and worldToNDC mapping the image to x, y in [-1, 1] (y up) after the
+/// homogeneous divide, as Nuke reads them; plus the field of view and clip distances.
+void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int height) {
+  const Vec3f u = cam.u, v = cam.v, w = cam.w, e = cam.eye;
+  const std::array<float, 16> w2c = {u.x, v.x, w.x, 0, u.y, v.y, w.y, 0, u.z, v.z, w.z, 0,
+                                     -dot(e, u), -dot(e, v), -dot(e, w), 1};
+  const float aspect = float(width) / float(height);
+  std::array<float, 16> proj{};  // camera space -> clip space (row vectors)
+  if (cam.projection == Projection::Perspective) {
+    const float ty = std::tan(0.5f * cam.yfov), tx = ty * aspect;
+    proj = {1 / tx, 0, 0, 0, 0, 1 / ty, 0, 0, 0, 0, -1, -1, 0, 0, 0, 0};
+  } else {
+    proj = {1 / (cam.ymag * aspect), 0, 0, 0, 0, 1 / cam.ymag, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
+  }
+  std::array<float, 16> w2ndc{};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) w2ndc[size_t(r * 4 + c)] += w2c[size_t(r * 4 + k)] * proj[size_t(k * 4 + c)];
+  exr.matrix_metadata.push_back({"worldToCamera", w2c});
+  exr.matrix_metadata.push_back({"worldToNDC", w2ndc});
+  if (cam.projection == Projection::Perspective) {
+    exr.float_metadata.push_back({"penumbra:yfov_degrees", cam.yfov * 180 / kPi});
+    exr.float_metadata.push_back({"penumbra:xfov_degrees", 2 * std::atan(std::tan(0.5f * cam.yfov) * aspect) * 180 / kPi});
+  }
+  exr.float_metadata.push_back({"penumbra:near", cam.znear});
+  exr.float_metadata.push_back({"penumbra:far", std::isfinite(cam.zfar) ? cam.zfar : std::numeric_limits<float>::max()});
+}
+
+/// Crops and tiles carry their render's identity: merge accepts only parts of one render.
+void add_part_identity(ExrOptions& exr, const RenderJob& job) {
+  RenderSettings part = job.settings;
+  part.entries["spp"] = std::to_string(job.cfg.spp);
+  std::string layers;
+  for (const auto& name : job.request.aovs) layers += (layers.empty() ? "" : ",") + name;
+  part.entries["aovs"] = layers;
+  exr.metadata.push_back({kSceneHashAttribute, job.scene_sha256});
+  exr.metadata.push_back({kSettingsAttribute, canonical_text(part)});
+}
+
+/// The data AOVs' channels: colour albedo, float N, P, Z, UV, uint ids with their manifest.
+void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
+  const auto& aovs = job.request.aovs;
+  const ChannelType colour = job.args.use_float ? ChannelType::Float : ChannelType::Half;
+  if (aovs.count("albedo"))
+    for (int c = 0; c < 3; ++c) exr.extra.push_back({std::string("albedo.") + "RGB"[c], &data.albedo, colour, 3, c});
+  if (aovs.count("N"))
+    for (int c = 0; c < 3; ++c)
+      exr.extra.push_back({std::string("N.") + "XYZ"[c], &data.normal, ChannelType::Float, 3, c});
+  if (aovs.count("P"))
+    for (int c = 0; c < 3; ++c)
+      exr.extra.push_back({std::string("P.") + "XYZ"[c], &data.position, ChannelType::Float, 3, c});
+  if (aovs.count("Z")) exr.extra.push_back({"Z", &data.depth, ChannelType::Float});
+  if (aovs.count("UV"))
+    for (int c = 0; c < 2; ++c) exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
+  if (aovs.count("id")) {
+    exr.extra.push_back({"id.object", &data.object_id, ChannelType::Uint});
+    exr.extra.push_back({"id.material", &data.material_id, ChannelType::Uint});
+    exr.metadata.push_back({"penumbra:manifest", id_manifest(job.loaded.scene, job.loaded.info)});
+  }
+}
+
+/// The path tracer's layers (sample counts, variance, light groups) and the cost layers.
+void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
+  const auto& aovs = job.request.aovs;
+  const PathImage& image = job.path_image;
+  if (aovs.count("samples")) {
+    buffers.samples.assign(image.samples.begin(), image.samples.end());
+    exr.extra.push_back({"samples", &buffers.samples, ChannelType::Uint});
+  }
+  if (aovs.count("variance")) exr.extra.push_back({"variance", &image.variance, ChannelType::Float});
+  if (aovs.count("light"))
+    for (int g = 0; g < 5; ++g)
+      for (int c = 0; c < 3; ++c)
+        exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &image.groups,
+                             job.args.use_float ? ChannelType::Float : ChannelType::Half, 15, g * 3 + c});
+  if (job.request.cost_aov) {
+    if (buffers.cost.counted) {
+      exr.extra.push_back({"cost.nodes", &buffers.cost.nodes});
+      exr.extra.push_back({"cost.triangles", &buffers.cost.triangles});
+    }
+    exr.extra.push_back({"cost.ns", &buffers.cost.nanoseconds});
+  }
+}
+
+}  // namespace
+
+void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers) {
+  const IntegratorType integrator = job.request.path ? IntegratorType::Path : IntegratorType::Whitted;
+  if (job.request.data_aovs)
+    buffers.data = render_data_aovs(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator);
+  if (job.request.cost_aov) buffers.cost = render_cost(*job.accel, job.camera, job.cfg, integrator);
+}
+
+ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
+  const RenderArgs& a = job.args;
+  const RenderConfig& cfg = job.cfg;
+  ExrOptions exr;
+  exr.half = !a.use_float;
+  exr.compression = a.compression;
+  exr.multipart = a.multipart;
+  exr.metadata = {{"penumbra:scene", a.scene_file},
+                  {"penumbra:camera", job.camera.name},
+                  {"penumbra:spp", std::to_string(cfg.spp)},
+                  {"penumbra:integrator", a.integrator},
+                  {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
+  if (job.request.path) {
+    exr.metadata.push_back({"penumbra:mean_spp", format("%.3f", job.mean_spp)});
+    exr.metadata.push_back({"penumbra:passes", std::to_string(job.stats.passes)});
+  }
+  if (!cfg.window.empty()) add_part_identity(exr, job);
+  exr.metadata.push_back({"penumbra:command_line", a.command_line});
+  exr.metadata.push_back({"penumbra:version", PENUMBRA_VERSION});
+  add_camera_metadata(exr, job.camera, cfg.width, cfg.height);
+  exr.float_metadata.push_back({"penumbra:render_seconds", float(job.stats.seconds)});
+  if (job.request.data_aovs) add_data_channels(exr, job, buffers.data);
+  add_render_channels(exr, job, buffers);
+  return exr;
+}
+
+}  // namespace penumbra::cli

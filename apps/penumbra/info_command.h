@@ -1,0 +1,15 @@
+// `penumbra info`: what a glTF file holds (scenes, nodes, meshes, instances, materials,
+// cameras, lights, images, animations, extensions, bounds) and the statistics of the chosen
+// acceleration structure built over it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace penumbra::cli {
+
+/// Prints the description on stdout. Returns the exit code; throws for bad input like render.
+int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten, const std::string& accel_name,
+             const std::vector<std::string>& accel_params);
+
+}  // namespace penumbra::cli

@@ -1,0 +1,48 @@
+// One `penumbra render` run as it moves through its phases (check, load, set up, build,
+// render, write, report): the request, the scene and its lights, the renderer's configuration,
+// the accelerator, the images and the figures the summary and the statistics report.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "apps/penumbra/render_options.h"
+#include "io/gltf_loader.h"
+#include "io/render_settings.h"
+#include "renderer/area_lights.h"
+#include "renderer/environment.h"
+#include "renderer/render.h"
+
+namespace penumbra::cli {
+
+/// The SHA-256 of each image as written, when --stats-json asks for them.
+struct WrittenHashes {
+  std::string exr, png, cost_png;
+};
+
+struct RenderJob {
+  explicit RenderJob(const RenderArgs& a) : args(a) {}
+  const RenderArgs& args;
+  RenderRequest request;
+  LoadedScene loaded;
+  RenderConfig cfg;
+  Camera camera;
+  Environment environment;
+  AreaLights area_lights;
+  bool default_light = false;   ///< the scene had no light: the default key light was added
+  RenderSettings settings;      ///< what decides the pixels (path renders and windows only)
+  std::string scene_sha256;     ///< over every file the scene loaded (path renders and windows)
+  std::unique_ptr<Accelerator> accel;
+  double load_s = 0, build_s = 0, write_s = 0;
+  RenderStats stats;
+  Film film;
+  PathImage path_image;   ///< path tracer only; its film is moved into `film`
+  int interrupted = 0;    ///< the signal that ended a path render early, or 0
+  bool frame_complete = true;
+  double mean_spp = 0;
+  WrittenHashes hashes;
+
+  PathLights path_lights() const { return {&area_lights, &environment}; }
+};
+
+}  // namespace penumbra::cli

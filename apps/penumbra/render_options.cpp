@@ -1,0 +1,325 @@
+// `penumbra render`'s flags, and every check on them that needs no scene.
+#include "apps/penumbra/render_options.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/scene_setup.h"
+#include "io/atomic_file.h"
+
+namespace penumbra::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The AOV names --aov accepts (besides "all").
+constexpr const char* kAovNames[] = {"albedo", "N", "P", "Z", "UV", "id", "samples", "variance", "light", "cost"};
+
+/// -o, --png, --cost-png and --stats-json: extensions, folders and the display transform.
+void check_output_paths(const RenderArgs& a, RenderRequest& q) {
+  q.out = a.output;
+  std::string ext = q.out.extension().string();
+  for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr") throw UsageError("-o " + a.output + ": the output must be an .exr file");
+  // Each output's folder must exist and its target must be replaceable or streamable.
+  resolve_output(q.out, "-o");
+  if (!a.stats_json.empty()) resolve_output(a.stats_json, "--stats-json");
+  if (!a.no_png) q.png = a.png.empty() ? fs::path(q.out).replace_extension(".png") : fs::path(a.png);
+  q.display.ocio_config = a.ocio_config;
+  q.display.display = a.display;
+  q.display.view = a.view;
+  q.display.look = a.look;
+  q.display.exposure = a.exposure;
+  if (q.png) {
+    resolve_output(*q.png, "--png");
+    check_display_output(*q.png, q.display);  // a typo must not cost a whole render
+  }
+}
+
+/// Colours, integrator-specific flags, numbers and the pixel filter.
+void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
+  if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64)
+    throw UsageError("--exposure must be finite and within [-64, 64]");
+  q.background = parse_colour(a.background, "--background");
+  q.ambient = parse_colour(a.ambient, "--ambient");
+  q.path = a.integrator == "path";
+  if (q.path && (a.background_given || a.ambient_given))
+    throw UsageError(std::string(a.background_given ? "--background" : "--ambient") +
+                     " applies to --integrator whitted; the path tracer is lit by the scene's lights and --env");
+  if (!q.path) {
+    for (const auto& [given, name] :
+         {std::pair{!a.env.empty(), "--env"}, {a.time_limit > 0, "--time-limit"}, {a.adaptive > 0, "--adaptive"},
+          {a.clamp_indirect > 0, "--clamp-indirect"}, {a.light_sampling != "mis", "--light-sampling"},
+          {a.sampler != "sobol", "--sampler"}, {a.checkpoint > 0, "--checkpoint"}, {a.resume, "--resume"}})
+      if (given) throw UsageError(std::string(name) + " needs --integrator path");
+  }
+  if (!std::isfinite(a.clamp_indirect) || a.clamp_indirect < 0)
+    throw UsageError("--clamp-indirect must be finite and >= 0 (0 = off)");
+  if (!std::isfinite(a.adaptive) || a.adaptive < 0) throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
+  if (!std::isfinite(a.time_limit) || a.time_limit < 0)
+    throw UsageError("--time-limit must be a finite number of seconds >= 0");
+  if (!std::isfinite(a.checkpoint) || a.checkpoint < 0)
+    throw UsageError("--checkpoint must be a finite number of seconds >= 0");
+  if (!std::isfinite(a.env_intensity) || a.env_intensity < 0)
+    throw UsageError("--env-intensity must be finite and >= 0");
+  if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation must be finite");
+  q.filter_type = q.path ? FilterType::BlackmanHarris : FilterType::Box;
+  if (!a.filter.empty() && !parse_filter_type(a.filter, q.filter_type))
+    throw UsageError("--filter: unknown filter '" + a.filter + "' (known: box, tent, gaussian, blackman-harris)");
+  q.filter_width = a.filter_width > 0 ? a.filter_width : default_filter_width(q.filter_type);
+  if (!std::isfinite(a.filter_width) || a.filter_width < 0 || q.filter_width > 16)
+    throw UsageError("--filter-width must be in (0, 16] pixels");
+}
+
+/// --env as a colour, --debug-pixel, --accel with its parameters and --seed.
+void check_scalar_flags(const RenderArgs& a, RenderRequest& q) {
+  // --env: a colour ("r,g,b" or one value) or an image file.
+  if (!a.env.empty() && a.env.find_first_not_of("0123456789.,eE+- ") == std::string::npos)
+    q.env_colour = parse_colour(a.env, "--env");
+  if (!a.debug_pixel.empty()) {
+    const auto [x, y] = split_pair(a.debug_pixel, ',', "--debug-pixel", "x,y");
+    q.debug_x = int(parse_integer(x, INT_MIN, INT_MAX, "--debug-pixel x"));
+    q.debug_y = int(parse_integer(y, INT_MIN, INT_MAX, "--debug-pixel y"));
+  }
+  q.accel_config = parse_accel(a.accel, a.accel_params);
+  const char* end = a.seed.data() + a.seed.size();
+  if (const auto r = std::from_chars(a.seed.data(), end, q.seed);
+      a.seed.empty() || a.seed[0] == '-' || a.seed[0] == '+' || r.ec != std::errc() || r.ptr != end)
+    throw UsageError("--seed: '" + a.seed + "' is not an integer in [0, 2^64 - 1]");
+}
+
+/// --aov NAME[,NAME...] (repeatable); "all" = every compositing AOV of the integrator; and the
+/// heat map path of --aov cost.
+void check_aovs(const RenderArgs& a, RenderRequest& q) {
+  for (const auto& item : a.aovs) {
+    std::stringstream ss(item);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+      if (name == "all") {
+        q.aovs.insert({"albedo", "N", "P", "Z", "UV", "id"});
+        if (q.path) q.aovs.insert({"samples", "variance", "light"});
+        continue;
+      }
+      if (std::find(std::begin(kAovNames), std::end(kAovNames), name) == std::end(kAovNames)) {
+        std::string known;
+        for (const char* k : kAovNames) known += (known.empty() ? "" : ", ") + std::string(k);
+        throw UsageError("--aov: unknown AOV '" + name + "' (known: " + known + ", all)");
+      }
+      if (!q.path && (name == "samples" || name == "variance" || name == "light"))
+        throw UsageError("--aov " + name + " needs --integrator path");
+      q.aovs.insert(name);
+    }
+  }
+  q.cost_aov = q.aovs.count("cost") > 0;
+  q.data_aovs = q.aovs.count("albedo") || q.aovs.count("N") || q.aovs.count("P") || q.aovs.count("Z") ||
+                q.aovs.count("UV") || q.aovs.count("id");
+  if (q.cost_aov) {
+    if (!a.no_png) {
+      q.cost_png = a.cost_png.empty() ? fs::path(q.out).replace_extension(".cost.png") : fs::path(a.cost_png);
+      resolve_output(*q.cost_png, "--cost-png");
+      check_display_output(*q.cost_png, q.display);
+    }
+  } else if (!a.cost_png.empty()) {
+    throw UsageError("--cost-png needs --aov cost");
+  }
+}
+
+/// No two outputs may be one file, and no output may be a file this run reads; stdout carries
+/// the paths written unless an output streams there.
+void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
+  q.out_streams = resolve_output(q.out, "-o").kind == OutputKind::Stream;
+  if (q.out_streams && (a.checkpoint > 0 || a.resume))
+    throw UsageError("--checkpoint and --resume keep their state beside -o, which must then be a regular file");
+  std::vector<std::pair<std::string, fs::path>> outputs = {{"-o", q.out}};
+  if (q.path && !q.out_streams) outputs.push_back({"the resume state", fs::path(q.out).concat(".resume")});
+  if (q.png) outputs.push_back({"--png", *q.png});
+  if (q.cost_png) outputs.push_back({"--cost-png", *q.cost_png});
+  if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
+  std::vector<std::pair<std::string, fs::path>> inputs = {{"the scene file", a.scene_file}};
+  if (!a.env.empty() && !q.env_colour) inputs.push_back({"--env", a.env});
+  if (!a.ocio_config.empty()) inputs.push_back({"--ocio-config", a.ocio_config});
+  else if (const char* ocio = std::getenv("OCIO"); ocio && *ocio) inputs.push_back({"$OCIO", ocio});
+  check_distinct_files(outputs, inputs);
+  struct stat stdout_stat {};
+  if (::fstat(STDOUT_FILENO, &stdout_stat) == 0)
+    for (const auto& [option, file] : outputs) {
+      const OutputTarget t = resolve_output(file, option);
+      if (t.kind == OutputKind::Stream && t.device == stdout_stat.st_dev && t.inode == stdout_stat.st_ino)
+        q.paths_to_stdout = false;
+    }
+}
+
+}  // namespace
+
+void add_render_options(CLI::App& render, RenderArgs& args) {
+  render.add_option("scene", args.scene_file, "glTF scene (.gltf or .glb)")->required();
+  render.add_option("-o,--output", args.output, "output EXR path (written atomically)")->required();
+  render.add_option("--png", args.png, "display image path (.png/.jpg/.tif); default: the EXR path with .png");
+  render.add_flag("--no-png", args.no_png, "write only the EXR");
+  render.add_option("--width", args.width, "image width in pixels (default 960, or from --height and the camera aspect)")->check(CLI::Range(1, 16384));
+  render.add_option("--height", args.height, "image height in pixels (default: width / camera aspect)")->check(CLI::Range(1, 16384));
+  render.add_option("--integrator", args.integrator, "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast) or path (physically based path tracer)")
+      ->check(CLI::IsMember({"whitted", "path"}));
+  render.add_option("--spp", args.spp, "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")->check(CLI::Range(1, 65536));
+  render.add_option("--max-depth", args.max_depth, "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only (default 12)")->check(CLI::Range(0, 64));
+  render.add_option("--rr-depth", args.rr_depth, "path: Russian roulette from this bounce on (default 3)")->check(CLI::Range(1, 64));
+  render.add_option("--clamp-indirect", args.clamp_indirect, "path: clamp each indirect sample's largest channel to this radiance; biased, trades fireflies for energy (default 0 = off)");
+  render.add_option("--light-sampling", args.light_sampling, "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single techniques are for validation")
+      ->check(CLI::IsMember({"mis", "bsdf", "light"}));
+  render.add_option("--sampler", args.sampler, "path: sobol (Owen-scrambled, default) or independent (PCG32)")->check(CLI::IsMember({"sobol", "independent"}));
+  render.add_option("--env", args.env, "path: environment light: a radiance r,g,b or grey, or an equirectangular map (.exr, .hdr, any float image OpenImageIO reads)");
+  render.add_option("--env-intensity", args.env_intensity, "path: multiplies --env (default 1)");
+  render.add_option("--env-rotation", args.env_rotation, "path: turns the --env map about +Y, degrees (default 0)");
+  render.add_option("--time-limit", args.time_limit, "path: stop after the pass that would run past this many seconds (default 0 = none)");
+  render.add_option("--adaptive", args.adaptive, "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is below it (default 0 = off)");
+  render.add_option("--adaptive-min-spp", args.adaptive_min_spp, "path: samples every pixel takes before --adaptive may stop it (default 16)")->check(CLI::Range(2, 65536));
+  render.add_option("--filter", args.filter, "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, blackman-harris for path)");
+  render.add_option("--filter-width", args.filter_width, "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
+  render.add_option("--threads", args.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
+  render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
+  render.add_option("--camera", args.camera, "camera instance: index as listed by `penumbra info`, or name (default 0; none in the file: frame the bounds)");
+  render.add_option("--accel", args.accel, "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
+  render.add_option("--accel-param", args.accel_params, accel_param_help())->type_name("KEY=VALUE");
+  render.add_flag("--multipart", args.multipart, "write one EXR part per layer (rgba, albedo, N, Z, ...); lossy --compression then applies to colour parts only");
+  render.add_flag("--float", args.use_float, "write 32-bit float EXR channels (default half)");
+  render.add_option("--compression", args.compression, "EXR compression (default zip)")
+      ->check(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}));
+  render.add_option("--exposure", args.exposure, "exposure in stops for the display image (default 0)");
+  render.add_option("--ocio-config", args.ocio_config, "OpenColorIO config (default: $OCIO, else the shipped config)");
+  render.add_option("--display", args.display, "OCIO display (default: the config's default)");
+  render.add_option("--view", args.view, "OCIO view: Standard (default), Filmic (ACES 1.0 SDR tone mapping) or Raw with the shipped config");
+  render.add_option("--look", args.look, "OCIO look applied before the view: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV with the shipped config");
+  render.add_option("--background", args.background, "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
+  render.add_option("--ambient", args.ambient, "whitted: ambient intensity Ia, r,g,b or grey (default 0.05)");
+  render.add_option("--seed", args.seed, "sampler seed, an integer in [0, 2^64 - 1] (default 0)");
+  auto* time_opt = render.add_option("--time", args.time, "animation time in seconds: animations (node TRS, skins, morph weights) are evaluated there (default: the file's static pose)");
+  render.add_option("--frame", args.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
+  render.add_option("--fps", args.fps, "frames per second for --frame (default 24)");
+  render.add_option("--max-memory", args.max_memory, "one memory budget for the scene, the acceleration structure, --env and the image buffers, e.g. 4G; what does not fit is refused before it is allocated (default: half the RAM)");
+  render.add_flag("--allow-external-uris", args.allow_external, "let buffer URIs reach files outside the scene's folder");
+  render.add_flag("--flatten", args.flatten, "give every placement of a mesh its own world-space copy instead of instancing it");
+  render.add_option("--checkpoint", args.checkpoint, "path: every this many seconds (after a whole pass) write the image so far and the resume state OUT.exr.resume, atomically (default 0 = never)");
+  render.add_flag("--resume", args.resume, "path: continue from OUT.exr.resume (written by --checkpoint, --time-limit or an interrupt) to the requested spp; the result equals an uninterrupted render");
+  render.add_option("--stats-json", args.stats_json, "also write the run's statistics (times per phase, rays, spp, memory) as JSON to this file");
+  render.add_option("--crop", args.crop, "render only x0 x1 y0 y1 (pixels, or fractions with a '.'; x1, y1 exclusive): an EXR data window inside the full frame")
+      ->expected(4)->type_name("X0 X1 Y0 Y1");
+  render.add_option("--tile", args.tile, "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");
+  render.add_option("--debug-pixel", args.debug_pixel, "render only pixel x,y and print its value");
+  render.add_flag("-q,--quiet", args.quiet, "no progress, warnings or summary on stderr");
+  render.add_option("--aov", args.aovs,
+                     "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
+                     "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
+                     "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
+                     "(cost.nodes, cost.triangles, cost.ns) and a heat map");
+  render.add_option("--cost-png", args.cost_png, "heat map path for --aov cost (default: the EXR path with .cost.png)");
+}
+
+void note_given_options(const CLI::App& render, int argc, char** argv, RenderArgs& args) {
+  for (int i = 0; i < argc; ++i) args.command_line += (i ? " " : "") + std::string(argv[i]);
+  args.spp_given = render.count("--spp") > 0;
+  args.depth_given = render.count("--max-depth") > 0;
+  args.background_given = render.count("--background") > 0;
+  args.ambient_given = render.count("--ambient") > 0;
+}
+
+RenderRequest check_render_args(const RenderArgs& a) {
+  RenderRequest q;
+  check_output_paths(a, q);
+  check_integrator_flags(a, q);
+  check_scalar_flags(a, q);
+  check_aovs(a, q);
+  check_output_collisions(a, q);
+  q.time = a.time;
+  if (q.time && !std::isfinite(*q.time)) throw UsageError("--time must be a finite number of seconds");
+  if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
+  if (a.frame) q.time = double(parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame")) / a.fps;
+  q.budget = memory_budget(a.max_memory);
+  return q;
+}
+
+RenderConfig make_render_config(const RenderArgs& a, const RenderRequest& q, float hint) {
+  RenderConfig cfg;
+  cfg.width = a.width;
+  cfg.height = a.height;
+  if (!cfg.width && !cfg.height) cfg.width = 960;
+  if (!cfg.height) cfg.height = std::max(1, int(std::lround(cfg.width / hint)));
+  if (!cfg.width) cfg.width = std::max(1, int(std::lround(cfg.height * hint)));
+  if (cfg.width > 16384 || cfg.height > 16384)
+    throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) +
+                     " exceeds 16384 per side");
+  cfg.window = parse_window(a, cfg.width, cfg.height);
+  cfg.spp = a.spp_given ? a.spp : (q.path ? 64 : 4);
+  cfg.threads = a.threads;
+  cfg.seed = q.seed;
+  cfg.filter = make_filter(q.filter_type, q.filter_width);
+  cfg.whitted.max_depth = a.depth_given ? a.max_depth : 5;
+  cfg.whitted.background = q.background;
+  cfg.whitted.ambient = q.ambient;
+  cfg.path.max_depth = a.depth_given ? a.max_depth : 12;
+  cfg.path.rr_depth = a.rr_depth;
+  cfg.path.clamp_indirect = a.clamp_indirect;
+  cfg.path.strategy = a.light_sampling == "bsdf"    ? LightStrategy::Bsdf
+                      : a.light_sampling == "light" ? LightStrategy::Light
+                                                    : LightStrategy::Mis;
+  cfg.sampler = a.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
+  cfg.time_limit = a.time_limit;
+  cfg.adaptive_threshold = a.adaptive;
+  cfg.adaptive_min_spp = a.adaptive_min_spp;
+  cfg.light_groups = q.aovs.count("light") > 0;
+  return cfg;
+}
+
+PixelWindow parse_window(const RenderArgs& a, int width, int height) {
+  if (!a.crop.empty() && !a.tile.empty()) throw UsageError("--crop and --tile exclude each other");
+  if (!a.crop.empty()) {
+    int v[4];
+    for (int k = 0; k < 4; ++k) {
+      const std::string& t = a.crop[size_t(k)];
+      const int extent = k < 2 ? width : height;
+      try {
+        if (t.find('.') != std::string::npos) {
+          size_t pos = 0;
+          const double x = std::stod(t, &pos);
+          if (pos != t.size() || !std::isfinite(x) || t.find_first_not_of("0123456789.") != std::string::npos)
+            throw std::invalid_argument(t);
+          if (x < 0 || x > 1) throw UsageError("--crop: fraction " + t + " is outside [0, 1]");
+          v[k] = int(std::lround(x * extent));
+        } else {
+          v[k] = int(parse_integer(t, 0, extent, "--crop"));
+        }
+      } catch (const UsageError&) {
+        throw;
+      } catch (...) {
+        throw UsageError("--crop: cannot parse '" + t + "' (expected x0 x1 y0 y1 in pixels or fractions)");
+      }
+    }
+    const PixelWindow w{v[0], v[2], v[1], v[3]};
+    if (w.empty()) throw UsageError("--crop: empty region (need x0 < x1 and y0 < y1)");
+    return w;
+  }
+  if (!a.tile.empty()) {
+    const auto [index, count] = split_pair(a.tile, '/', "--tile", "i/N with 0 <= i < N");
+    const long long n = parse_integer(count, 1, 1ll << 40, "--tile N");
+    if (n > height)
+      throw UsageError("--tile: " + std::to_string(n) + " stripes exceed the " + std::to_string(height) + " rows");
+    long long i = -1;
+    try {
+      i = parse_integer(index, 0, n - 1, "--tile i");
+    } catch (const UsageError&) {
+      throw UsageError("--tile: expected i/N with 0 <= i < N, got '" + a.tile + "'");
+    }
+    return {0, int(int64_t(i) * height / n), width, int(int64_t(i + 1) * height / n)};
+  }
+  return {};
+}
+
+}  // namespace penumbra::cli

@@ -1,0 +1,89 @@
+// `penumbra render`'s flags and their validation: RenderArgs holds what was typed; check_render_args
+// turns it, before anything is loaded, into a RenderRequest of checked values (outputs resolved
+// and distinct, display transform found, integrator options consistent, AOVs known), so a typo
+// never costs a render. make_render_config maps the request onto the renderer's RenderConfig.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "io/image_output.h"
+#include "renderer/accel/factory.h"
+#include "renderer/render.h"
+
+namespace penumbra::cli {
+
+/// The flags of `penumbra render` as typed (defaults as README documents them).
+struct RenderArgs {
+  std::string scene_file, output, png;
+  bool multipart = false;
+  bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
+  int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
+  std::string camera;      ///< index or name; empty = the first camera, or framing
+  std::string seed = "0";  ///< parsed as an unsigned 64-bit integer
+  float exposure = 0;
+  std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
+  std::string accel = "embree", max_memory, debug_pixel, cost_png;
+  std::vector<std::string> accel_params, aovs;
+  std::string command_line, look;
+  std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
+  std::string tile;               ///< "i/N"
+  double checkpoint = 0;          ///< seconds between checkpoints; 0 = none
+  std::string stats_json;
+  bool resume = false;
+  std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
+  int rr_depth = 3, adaptive_min_spp = 16;
+  float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
+  double time_limit = 0;
+  bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
+  std::optional<double> time;        ///< --time, seconds
+  std::optional<std::string> frame;  ///< --frame, an integer, converted with --fps
+  double fps = 24;
+};
+
+/// Declares every flag of `render` on `render`, bound to `args`.
+void add_render_options(CLI::App& render, RenderArgs& args);
+
+/// After parsing: which defaults were overridden, and the command line for the EXR metadata.
+void note_given_options(const CLI::App& render, int argc, char** argv, RenderArgs& args);
+
+/// The checked values of a render request, everything that can be known before loading.
+struct RenderRequest {
+  bool path = false;  ///< --integrator path
+  std::filesystem::path out;
+  std::optional<std::filesystem::path> png, cost_png;
+  bool out_streams = false;      ///< -o is a device or FIFO (no resume state beside it)
+  bool paths_to_stdout = true;   ///< false when an output streams to stdout
+  DisplayOptions display;
+  Vec3f background, ambient;
+  FilterType filter_type = FilterType::Box;
+  float filter_width = 1;
+  std::optional<Vec3f> env_colour;  ///< --env as a radiance; unset: a map file or none
+  int debug_x = -1, debug_y = -1;   ///< --debug-pixel (range-checked once the size is known)
+  AccelConfig accel_config;
+  uint64_t seed = 0;
+  uint64_t budget = 0;  ///< --max-memory in bytes
+  std::set<std::string> aovs;
+  bool cost_aov = false, data_aovs = false;
+  std::optional<double> time;  ///< animation time from --time or --frame / --fps
+};
+
+/// Validates every flag in the order README lists the checks. Throws UsageError or InputError
+/// (exit 2) naming the flag; writes nothing.
+RenderRequest check_render_args(const RenderArgs& args);
+
+/// The image size (one of --width/--height follows the camera's aspect `hint`), the --crop or
+/// --tile window, and every integrator setting. Throws UsageError for a window outside the image.
+RenderConfig make_render_config(const RenderArgs& args, const RenderRequest& request, float hint);
+
+/// --crop x0 x1 y0 y1 (integers: pixels; with a '.': fractions of the width or height; x1, y1
+/// exclusive) or --tile i/N (stripe i of N equal bands of rows, top first); empty if neither.
+PixelWindow parse_window(const RenderArgs& args, int width, int height);
+
+}  // namespace penumbra::cli

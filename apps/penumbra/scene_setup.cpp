@@ -1,0 +1,84 @@
+// Scene loading, camera choice and accelerator parameters for the subcommands.
+#include "apps/penumbra/scene_setup.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "apps/penumbra/cli_support.h"
+#include "io/accel_params.h"
+#include "io/error.h"
+#include "renderer/accel/embree.h"
+
+namespace penumbra::cli {
+
+LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten, uint64_t max_memory,
+                       bool quiet, std::optional<double> time) {
+  GltfLoadOptions opt;
+  opt.time = time;
+  opt.flatten = flatten;
+  opt.scene = scene;
+  opt.allow_external_uris = allow_external;
+  opt.max_memory_bytes = max_memory;
+  LoadedScene loaded = load_gltf(file, opt);
+  if (!quiet) {
+    const size_t shown = std::min<size_t>(loaded.warnings.size(), 20);
+    for (size_t i = 0; i < shown; ++i)
+      std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), loaded.warnings[i].c_str());
+    if (loaded.warnings.size() > shown)
+      std::fprintf(stderr, "warning: %s: ... and %zu more warnings\n", file.c_str(), loaded.warnings.size() - shown);
+  }
+  return loaded;
+}
+
+int find_camera(const Scene& scene, const std::string& spec, const std::string& file) {
+  std::string known;
+  for (size_t i = 0; i < scene.cameras.size(); ++i)
+    known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + scene.cameras[i].name + "'";
+  const std::string listing = scene.cameras.empty() ? "the scene has no camera" : "cameras: " + known;
+  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
+    const unsigned long long i = spec.size() <= 9 ? std::stoull(spec) : ~0ull;
+    if (i >= scene.cameras.size())
+      throw InputError(file, "--camera", "camera " + spec + " does not exist (" + listing + ")");
+    return int(i);
+  }
+  int found = -1;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    if (scene.cameras[i].name != spec) continue;
+    if (found >= 0)
+      throw InputError(file, "--camera", "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
+    found = int(i);
+  }
+  if (found < 0) throw InputError(file, "--camera", "no camera named '" + spec + "' (" + listing + ")");
+  return found;
+}
+
+AccelConfig parse_accel(const std::string& name, const std::vector<std::string>& params) {
+  bool known = false;
+  std::string names;
+  for (const auto& n : accelerator_names()) {
+    known |= n == name;
+    names += (names.empty() ? "" : ", ") + n;
+  }
+  if (!known) throw UsageError("--accel: unknown accelerator '" + name + "' (known: " + names + ")");
+  AccelConfig config;
+  for (const auto& p : params) {
+    apply_accel_param(config, p);
+    const std::string prefix = p.substr(0, p.find('.'));
+    if (prefix != name)
+      throw UsageError("--accel-param " + p + ": a parameter of '" + prefix + "', but --accel is '" + name + "'");
+  }
+  validate(config.embree);
+  validate(config.bvh);
+  validate(config.kdtree);
+  validate(config.grid);
+  return config;
+}
+
+std::string accel_param_help() {
+  std::string h = "accelerator build parameter key=value (repeatable):";
+  for (const auto& k : accel_param_keys())
+    h += "\n  " + k.key + " (default " + k.default_value + "): " + k.description;
+  return h;
+}
+
+}  // namespace penumbra::cli
