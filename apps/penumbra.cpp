@@ -35,10 +35,10 @@
 #include "io/exr_merge.h"
 #include "renderer/accel/factory.h"
 #include "renderer/accel/embree.h"
-#include "renderer/camera.h"
-#include "renderer/aov.h"
-#include "renderer/cost_map.h"
-#include "renderer/render.h"
+#include "renderer/scene/camera.h"
+#include "renderer/film/aov.h"
+#include "renderer/film/cost_map.h"
+#include "renderer/integrators/render.h"
 
 namespace fs = std::filesystem;
 using namespace penumbra;

@@ -8,7 +8,7 @@
 #include <filesystem>
 
 #include "io/render_settings.h"
-#include "renderer/render.h"
+#include "renderer/integrators/render.h"
 
 namespace penumbra {
 

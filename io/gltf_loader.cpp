@@ -14,7 +14,7 @@
 #include <set>
 
 #include "io/error.h"
-#include "renderer/animation.h"
+#include "renderer/scene/animation.h"
 
 namespace penumbra {
 

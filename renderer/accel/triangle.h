@@ -11,7 +11,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "renderer/geometry.h"
+#include "renderer/core/geometry.h"
 
 namespace penumbra {
 

@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <map>
 
-#include "cross_check.h"
+#include "support/cross_check.h"
 #include "io/gltf_loader.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
-#include "test_util.h"
+#include "renderer/integrators/render.h"
+#include "renderer/scene/scene.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;
