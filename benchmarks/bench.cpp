@@ -31,6 +31,7 @@
 #include "io/ply_loader.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
 #include "renderer/film/cost_map.h"
 #include "renderer/core/rng.h"

@@ -1,4 +1,4 @@
-// Ray and the course's analytic intersection routines (ray-sphere, ray-triangle by Cramer's
+// Ray, the Hit record, and analytic intersection routines (ray-sphere, ray-triangle by Cramer's
 // rule). These are reference kernels for shading and tests; the accelerators use the
 // watertight test in accel/triangle.h.
 #pragma once

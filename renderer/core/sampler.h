@@ -2,13 +2,13 @@
 // Sobol sequence (Burley, "Practical Hash-based Owen Scrambling", JCGT 9(4), 2020) or
 // independent PCG32 numbers. Every stream is a pure function of (pixel, sample index, seed),
 // so images never depend on thread scheduling, passes or tile order.
-//
+#pragma once
+
 // Sobol: each request takes the next "dimension" d of the path; a hash of (pixel, seed, d)
 // shuffles the sample index by a nested uniform scramble (so dimensions are decorrelated
 // from one another and from neighbouring pixels) and Owen-scrambles the first two Sobol
 // dimensions. For any power-of-two count 2^k the first 2^k samples of a pixel form a
 // (0, k, 2)-net in every 2D request: stratified in every elementary interval.
-#pragma once
 
 #include <cstdint>
 

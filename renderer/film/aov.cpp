@@ -1,14 +1,11 @@
 // First-hit data AOVs.
 #include "renderer/film/aov.h"
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 
+#include "renderer/core/parallel.h"
+#include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"
-#include "renderer/core/sampler.h"
 
 namespace penumbra {
 
@@ -27,13 +24,11 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
   a.object_id.assign(n, 0.0f);
   a.material_id.assign(n, 0.0f);
   const bool filter = scene_needs_hit_filter(scene);
-  const int threads = config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
-  tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range2d<int>(win.y0, win.y1, 8, win.x0, win.x1, 8), [&](const tbb::blocked_range2d<int>& r) {
+  TileScheduler scheduler(win, config.tile_size, config.threads);
+  scheduler.for_each_tile([&](const PixelWindow& tile) {
       std::vector<uint32_t> objects, materials;
-      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
           const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
           Vec3f albedo{0, 0, 0}, normal{0, 0, 0}, position{0, 0, 0};
           Vec2f uv{0, 0};
@@ -95,7 +90,6 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
             a.uv[i * 2 + 1] = uv.y * inv;
           }
         }
-    });
   });
   return a;
 }

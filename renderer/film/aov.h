@@ -2,7 +2,8 @@
 // position, UV and object/material ids, taken from the same camera sample positions as the
 // beauty of either integrator (whitted: the stratified, filtered positions; path: the first
 // dimension of each sample's stream), so every layer lines up with the beauty exactly.
-//
+#pragma once
+
 // Per pixel, over the pixel's samples:
 //   albedo  mean of the first visible surface's base colour (factor x texture x COLOR_0), 0 for
 //           samples that miss: premultiplied by coverage like the beauty;
@@ -11,7 +12,6 @@
 //           reads it) among the samples that hit; +inf where every sample misses;
 //   ids     the id hit by most samples (ties: the smaller id); 0 = background. Object id = glTF
 //           node index + 1, material id = material index + 1 (0 = the default material).
-#pragma once
 
 #include <cstdint>
 #include <vector>

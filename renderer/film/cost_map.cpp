@@ -1,13 +1,9 @@
 // Traversal-cost images: see cost_map.h.
 #include "renderer/film/cost_map.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <chrono>
 
-#include "renderer/film/aov.h"
+#include "renderer/core/parallel.h"
 
 namespace penumbra {
 
@@ -20,12 +16,10 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
   img.nanoseconds.assign(n, 0.0f);
   img.counted = accel.counts_traversal();
   const uint32_t spp = uint32_t(config.spp);
-  const int threads = config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
-  tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, config.height), [&](const tbb::blocked_range<int>& rows) {
-      for (int y = rows.begin(); y != rows.end(); ++y)
-        for (int x = 0; x < config.width; ++x) {
+  TileScheduler scheduler(PixelWindow{0, 0, config.width, config.height}, config.tile_size, config.threads);
+  scheduler.for_each_tile([&](const PixelWindow& tile) {
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
           TraversalCost cost;
           double seconds = 0;
           for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
@@ -41,7 +35,6 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
           img.nodes[i] = float(double(cost.nodes) / spp);
           img.triangles[i] = float(double(cost.triangles) / spp);
         }
-    });
   });
   return img;
 }

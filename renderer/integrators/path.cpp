@@ -1,61 +1,128 @@
-// Path tracer with next-event estimation and MIS (see path.h for the model and references).
+// Path tracer with next-event estimation and MIS (see path.h for the model and references),
+// in the phases of pbrt-v4's PathIntegrator::Li and Mitsuba 3's path integrator: emitter hit,
+// next-event estimation (direct_lighting.h), BSDF sampling, Russian roulette.
 #include "renderer/integrators/path.h"
 
-#include "renderer/materials/bsdf.h"
-#include "renderer/lights/punctual.h"
+#include "renderer/integrators/direct_lighting.h"
+#include "renderer/integrators/visibility.h"
 
 namespace penumbra {
 
 namespace {
 
-struct PathState {
-  Vec3f radiance{0, 0, 0};
+// What stays fixed along a path.
+struct PathContext {
+  const Scene& scene;
+  const Accelerator& accel;
+  const PathLights& lights;
   const PathConfig& cfg;
-  LightGroups* groups = nullptr;
-  Vec3f share0{0, 0, 0};  // diffuse share (per channel) of the direction sampled at hit 0
-
-  // Adds a contribution of light reaching surface hit `vertex` (-1 = the camera itself).
-  // `diffuse_share`: the diffuse part's share of a light sample at hit 0 (else share0).
-  void add(Vec3f c, int vertex, const Vec3f* diffuse_share = nullptr) {
-    if (!is_finite(c)) return;
-    if (cfg.clamp_indirect > 0 && vertex >= 1) {
-      const float m = max_component(c);
-      if (m > cfg.clamp_indirect) c *= cfg.clamp_indirect / m;
-    }
-    radiance += c;
-    if (!groups) return;
-    if (vertex < 0) {
-      groups->emission += c;
-      return;
-    }
-    const Vec3f d = c * (diffuse_share ? *diffuse_share : share0);
-    const Vec3f sp = c - d;
-    if (vertex == 0) {
-      groups->diffuse_direct += d;
-      groups->specular_direct += sp;
-    } else {
-      groups->diffuse_indirect += d;
-      groups->specular_indirect += sp;
-    }
-  }
+  bool env_lit;        // the environment emits
+  bool sample_lights;  // light sampling finds emitters and the environment
+  bool bsdf_lights;    // BSDF sampling finds them
 };
 
-// Per-channel d / (d + s), 0 where both vanish.
-Vec3f diffuse_share(Vec3f d, Vec3f s) {
-  Vec3f r;
-  for (int c = 0; c < 3; ++c) r[c] = d[c] + s[c] > 0 ? d[c] / (d[c] + s[c]) : 0.0f;
-  return r;
+// The ray about to be traced and what produced it.
+struct Segment {
+  Ray ray;
+  Vec3f beta{1, 1, 1};
+  float prev_pdf = 0;      // solid-angle density of the direction that produced `ray`
+  bool prev_delta = true;  // the camera ray or a delta lobe produced `ray`: no MIS
+  int layers = 0;          // Blend surfaces passed on this segment
+};
+
+// The BRDF at a hit and the choice between it and thin transmission (a delta lobe straight
+// through, chosen with probability p_t).
+struct Lobes {
+  GltfBrdf brdf;
+  Vec3f trans_weight;
+  float p_t = 0;
+  float p_r = 1;  // share of the BRDF's (non-delta) sampling
+};
+
+// Emitter hit: the environment seen by a ray that escaped, MIS-weighted against the
+// environment sample of the previous vertex.
+void add_escaped(const PathContext& ctx, const Segment& seg, int vertex, PathRadiance& path) {
+  if (!ctx.env_lit) return;
+  const Environment& env = *ctx.lights.environment;
+  float w = 1;
+  if (!seg.prev_delta)
+    w = !ctx.bsdf_lights ? 0.0f : (ctx.sample_lights ? power_heuristic(seg.prev_pdf, env_pdf(env, seg.ray.dir)) : 1.0f);
+  if (w > 0) path.add(seg.beta * env_eval(env, seg.ray.dir) * w, vertex - 1);
 }
 
-// The shadow ray from a surface point towards direction wi, up to `distance` (kInfinity
-// for lights at infinity).
-Ray shadow_ray(const SurfaceInteraction& si, Vec3f wi, float distance) {
-  Ray r;
-  r.org = offset_ray_origin(si.p, si.ng, wi);
-  r.dir = wi;
-  r.tnear = 0;
-  r.tfar = std::isfinite(distance) ? distance * (1 - 1e-4f) : kInfinity;
-  return r;
+// Emitter hit: emission of the surface hit, seen by the previous vertex (or the camera),
+// MIS-weighted against the area-light sample taken there.
+void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit,
+                  const SurfaceInteraction& si, const MaterialPoint& mp, int vertex, PathRadiance& path) {
+  if (!(max_component(mp.emissive) > 0) || mp.unlit) return;
+  float w = 1;
+  if (!seg.prev_delta) {
+    if (!ctx.bsdf_lights) {
+      w = 0;
+    } else if (ctx.sample_lights) {
+      const float cos_l = std::fabs(dot(si.ng, seg.ray.dir));
+      const float pdf_l = cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l : 0.0f;
+      w = power_heuristic(seg.prev_pdf, pdf_l);
+    }
+  }
+  if (w > 0) path.add(seg.beta * mp.emissive * w, vertex - 1);
+}
+
+// The BRDF and the transmission/reflection choice by estimated energy: transmitted vs
+// reflected (Fresnel-weighted specular plus the remaining diffuse) at this view angle.
+Lobes choose_lobes(const MaterialPoint& mp, Vec3f wo) {
+  Lobes l;
+  l.brdf.base_color = mp.base_color;
+  l.brdf.metallic = mp.metallic;
+  l.brdf.roughness = mp.roughness;
+  l.brdf.n = mp.ns;
+  l.brdf.f0 = mp.f0;
+  l.brdf.specular = mp.specular;
+  l.brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
+  const float cos_o = std::fabs(dot(mp.ns, wo));
+  l.trans_weight = mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - dielectric_fresnel(l.brdf, cos_o)));
+  if (l.brdf.transmission > 0) {
+    const float t = luminance(l.trans_weight);
+    const float fd = dielectric_fresnel(l.brdf, cos_o);
+    const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
+                    mp.metallic * luminance(mp.base_color);
+    l.p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
+  }
+  l.p_r = 1 - l.p_t;
+  return l;
+}
+
+// BSDF sampling: the next direction (transmission or the BRDF), updating the throughput and
+// the MIS state. False when the path ends here.
+bool sample_bsdf(const Lobes& lobes, const SurfaceInteraction& si, Vec3f wo, int vertex,
+                 SampleStream& samples, Segment& seg, PathRadiance& path, Vec3f& wi) {
+  const float u_lobe = samples.get1d();
+  const Vec2f u_dir = samples.get2d();
+  if (u_lobe < lobes.p_t) {
+    wi = seg.ray.dir;
+    if (vertex == 0) path.share0 = {0, 0, 0};  // transmission counts as specular
+    seg.beta *= lobes.trans_weight / lobes.p_t;
+    seg.prev_delta = true;
+    seg.prev_pdf = 0;
+  } else {
+    BrdfSample bs;
+    if (!brdf_sample(lobes.brdf, wo, (u_lobe - lobes.p_t) / lobes.p_r, u_dir, bs)) return false;
+    if (dot(bs.wi, si.ng) <= 0) return false;  // below the geometric surface
+    wi = bs.wi;
+    if (vertex == 0 && path.groups) path.share0 = diffuse_share(lobes.brdf, wo, wi);
+    seg.beta *= bs.weight / lobes.p_r;
+    seg.prev_delta = false;
+    seg.prev_pdf = lobes.p_r * bs.pdf;
+  }
+  return max_component(seg.beta) > 0 && is_finite(seg.beta);
+}
+
+// Russian roulette (Arvo & Kirk 1990): survive with probability min(1, max beta), reweighted.
+bool survives_roulette(SampleStream& samples, Vec3f& beta) {
+  const float q = std::min(1.0f, max_component(beta));
+  if (samples.get1d() >= q) return false;
+  beta = beta / q;
+  return true;
 }
 
 }  // namespace
@@ -66,196 +133,60 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
                     LightGroups* groups) {
   ++counts.camera;
   coverage = 0;
-  PathState path{{0, 0, 0}, cfg, groups};
-  const AreaLights& area = *lights.area;
-  const Environment& env = *lights.environment;
-  const bool env_lit = !is_black(env);
-  const bool sample_lights = cfg.strategy != LightStrategy::Bsdf;
-  const bool bsdf_lights = cfg.strategy != LightStrategy::Light;
-
-  Ray ray = camera_ray;
-  ray.dir = normalize(ray.dir);
-  Vec3f beta{1, 1, 1};
-  float prev_pdf = 0;      // solid-angle density of the direction that produced `ray`
-  bool prev_delta = true;  // the camera ray or a delta lobe produced `ray`: no MIS
-  int layers = 0;          // Blend surfaces passed on this segment
+  PathRadiance path;
+  path.clamp_indirect = cfg.clamp_indirect;
+  path.groups = groups;
+  const PathContext ctx{scene, accel, lights, cfg, !is_black(*lights.environment),
+                        cfg.strategy != LightStrategy::Bsdf, cfg.strategy != LightStrategy::Light};
+  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter};
+  Segment seg;
+  seg.ray = camera_ray;
+  seg.ray.dir = normalize(seg.ray.dir);
 
   for (int vertex = 0;;) {
     Hit hit;
-    if (!intersect_visible(scene, accel, ray, hit, cfg.hit_filter)) {
-      if (env_lit) {
-        float w = 1;
-        if (!prev_delta) w = !bsdf_lights ? 0.0f : (sample_lights ? power_heuristic(prev_pdf, env_pdf(env, ray.dir)) : 1.0f);
-        if (w > 0) path.add(beta * env_eval(env, ray.dir) * w, vertex - 1);
-      }
+    if (!intersect_visible(scene, accel, seg.ray, hit, cfg.hit_filter)) {
+      add_escaped(ctx, seg, vertex, path);
       break;
     }
-    SurfaceInteraction si = make_interaction(scene, ray, hit);
-    if (vertex == 0 && layers == 0) compute_differentials(scene, si, rd);
+    SurfaceInteraction si = make_interaction(scene, seg.ray, hit);
+    if (vertex == 0 && seg.layers == 0) compute_differentials(scene, si, rd);
     const MaterialPoint mp = eval_material(scene, si);
 
     // Blend: hit with probability alpha, else continue along the same ray.
-    const float a = layers < cfg.max_blend_layers ? mp.alpha : 1.0f;
+    const float a = seg.layers < cfg.max_blend_layers ? mp.alpha : 1.0f;
     if (a < 1 && samples.get1d() >= a) {
-      ray.tnear = std::nextafter(std::max(hit.t, ray.tnear), kInfinity);
-      ++layers;
+      seg.ray.tnear = std::nextafter(std::max(hit.t, seg.ray.tnear), kInfinity);
+      ++seg.layers;
       continue;
     }
-    layers = 0;
+    seg.layers = 0;
     if (vertex == 0) coverage = 1;
 
-    // Emission seen by the previous vertex (or the camera).
-    if (max_component(mp.emissive) > 0 && !mp.unlit) {
-      float w = 1;
-      if (!prev_delta) {
-        if (!bsdf_lights) {
-          w = 0;
-        } else if (sample_lights) {
-          const float cos_l = std::fabs(dot(si.ng, ray.dir));
-          const float pdf_l = cos_l > 0 ? area_light_pdf(area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l : 0.0f;
-          w = power_heuristic(prev_pdf, pdf_l);
-        }
-      }
-      if (w > 0) path.add(beta * mp.emissive * w, vertex - 1);
-    }
+    // Emitter hit.
+    add_emission(ctx, seg, hit, si, mp, vertex, path);
     if (mp.unlit) {  // KHR_materials_unlit: radiance = base colour, no lighting, no bounce
-      path.add(beta * mp.base_color, vertex - 1);
+      path.add(seg.beta * mp.base_color, vertex - 1);
       break;
     }
     if (vertex > cfg.max_depth) break;
 
-    GltfBrdf brdf;
-    brdf.base_color = mp.base_color;
-    brdf.metallic = mp.metallic;
-    brdf.roughness = mp.roughness;
-    brdf.n = mp.ns;
-    brdf.f0 = mp.f0;
-    brdf.specular = mp.specular;
-    brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
-    const Vec3f wo = -ray.dir;
-    auto share_at = [&](Vec3f wi) {  // diffuse share of the BRDF towards wi (light groups)
-      Vec3f d, sp;
-      brdf_eval_parts(brdf, wo, wi, d, sp);
-      return diffuse_share(d, sp);
-    };
-    // Thin transmission: a delta lobe straight through, chosen with probability p_t.
-    const float cos_o = std::fabs(dot(mp.ns, wo));
-    const Vec3f trans_weight = mp.base_color * ((1 - mp.metallic) * brdf.transmission * (1 - dielectric_fresnel(brdf, cos_o)));
-    // Lobe choice by estimated energy: transmitted vs reflected (Fresnel-weighted specular plus
-    // the remaining diffuse) at this view angle.
-    float p_t = 0;
-    if (brdf.transmission > 0) {
-      const float t = luminance(trans_weight);
-      const float fd = dielectric_fresnel(brdf, cos_o);
-      const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - brdf.transmission) * luminance(mp.base_color)) +
-                      mp.metallic * luminance(mp.base_color);
-      p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
-    }
-    const float p_r = 1 - p_t;  // share of the BRDF's (non-delta) sampling
-
     // Next-event estimation.
-    for (const Light& light : scene.lights) {  // punctual lights: delta, always sampled
-      LightSample ls;
-      if (!sample_light(light, si.p, ls) || dot(ls.wi, si.ng) <= 0) continue;
-      const Vec3f f = brdf_eval(brdf, wo, ls.wi);
-      if (!(max_component(f) > 0)) continue;
-      ++counts.shadow;
-      const float t = shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
-      if (t > 0) {
-        const Vec3f share = groups && vertex == 0 ? share_at(ls.wi) : Vec3f{};
-        path.add(beta * f * ls.irradiance * (std::max(0.0f, dot(mp.ns, ls.wi)) * t), vertex, groups && vertex == 0 ? &share : nullptr);
-      }
-    }
-    if (sample_lights && !area.pmf.empty()) {
-      const float u1 = samples.get1d();
-      const Vec2f u2 = samples.get2d();
-      AreaLightSample ls;
-      if (sample_area_light(area, scene, u1, u2, ls)) {
-        const Vec3f d = ls.p - si.p;
-        const float dist2 = dot(d, d), dist = std::sqrt(dist2);
-        const Vec3f wi = d / dist;
-        const float cos_l = dot(ls.ng, wi);  // > 0: the point sees the light's back side
-        const Material& lm = material_of(scene, scene.meshes[size_t(scene.instances[ls.instance].mesh)].material);
-        const bool visible_side = lm.double_sided || cos_l < 0;
-        if (dist2 > 0 && std::isfinite(dist) && visible_side && std::fabs(cos_l) > 0 && dot(wi, si.ng) > 0) {
-          float pdf_b = 0;
-          const Vec3f f = brdf_eval_pdf(brdf, wo, wi, pdf_b);
-          if (max_component(f) > 0) {
-            Ray to_light;
-            to_light.org = si.p;
-            to_light.dir = wi;
-            Hit lh;
-            lh.t = dist;
-            lh.u = ls.u;
-            lh.v = ls.v;
-            lh.geom_id = ls.instance;
-            lh.prim_id = ls.prim;
-            // The emission there, times the light's own coverage: a Blend emitter is hit by
-            // BSDF-sampled rays with probability alpha, a Mask hole not at all.
-            const MaterialPoint lp = eval_material(scene, make_interaction(scene, to_light, lh));
-            const Vec3f le = lp.emissive * lp.alpha;
-            if (max_component(le) > 0) {
-              ++counts.shadow;
-              const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, dist), cfg.hit_filter);
-              const float pdf_l = ls.pdf_area * dist2 / std::fabs(cos_l);
-              const float w = bsdf_lights ? power_heuristic(pdf_l, p_r * pdf_b) : 1.0f;
-              if (t > 0 && w > 0) {
-                const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
-                path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_l), vertex, groups && vertex == 0 ? &share : nullptr);
-              }
-            }
-          }
-        }
-      }
-    }
-    if (sample_lights && env_lit) {
-      Vec3f wi, le;
-      float pdf_e = 0;
-      if (env_sample(env, samples.get2d(), wi, le, pdf_e) && dot(wi, si.ng) > 0) {
-        float pdf_b = 0;
-        const Vec3f f = brdf_eval_pdf(brdf, wo, wi, pdf_b);
-        if (max_component(f) > 0 && max_component(le) > 0) {
-          ++counts.shadow;
-          const float t = shadow_transmittance(scene, accel, shadow_ray(si, wi, kInfinity), cfg.hit_filter);
-          const float w = bsdf_lights ? power_heuristic(pdf_e, p_r * pdf_b) : 1.0f;
-          if (t > 0 && w > 0) {
-            const Vec3f share = groups && vertex == 0 ? share_at(wi) : Vec3f{};
-            path.add(beta * f * le * (std::max(0.0f, dot(mp.ns, wi)) * t * w / pdf_e), vertex, groups && vertex == 0 ? &share : nullptr);
-          }
-        }
-      }
-    }
+    const Vec3f wo = -seg.ray.dir;
+    const Lobes lobes = choose_lobes(mp, wo);
+    sample_direct_lighting(scene, accel, lights, {si, lobes.brdf, wo, seg.beta, vertex, lobes.p_r}, mode,
+                           samples, counts, path);
 
-    // Continue the path.
-    const float u_lobe = samples.get1d();
-    const Vec2f u_dir = samples.get2d();
+    // BSDF sampling.
     Vec3f wi;
-    if (u_lobe < p_t) {
-      wi = ray.dir;
-      if (vertex == 0) path.share0 = {0, 0, 0};  // transmission counts as specular
-      beta *= trans_weight / p_t;
-      prev_delta = true;
-      prev_pdf = 0;
-    } else {
-      BrdfSample bs;
-      if (!brdf_sample(brdf, wo, (u_lobe - p_t) / p_r, u_dir, bs)) break;
-      if (dot(bs.wi, si.ng) <= 0) break;  // below the geometric surface
-      wi = bs.wi;
-      if (vertex == 0 && groups) path.share0 = share_at(wi);
-      beta *= bs.weight / p_r;
-      prev_delta = false;
-      prev_pdf = p_r * bs.pdf;
-    }
-    if (!(max_component(beta) > 0) || !is_finite(beta)) break;
+    if (!sample_bsdf(lobes, si, wo, vertex, samples, seg, path, wi)) break;
     ++vertex;
-    if (vertex >= cfg.rr_depth) {  // Russian roulette
-      const float q = std::min(1.0f, max_component(beta));
-      if (samples.get1d() >= q) break;
-      beta = beta / q;
-    }
-    ray = Ray{};
-    ray.org = offset_ray_origin(si.p, si.ng, wi);
-    ray.dir = wi;
+
+    // Russian roulette.
+    if (vertex >= cfg.rr_depth && !survives_roulette(samples, seg.beta)) break;
+    seg.ray = Ray{};
+    seg.ray.org = offset_ray_origin(si.p, si.ng, wi);
+    seg.ray.dir = wi;
     ++counts.reflection;
   }
   return path.radiance;

@@ -1,25 +1,29 @@
 // The physically based path tracer: unidirectional paths with next-event estimation and
+// MIS between light and BSDF sampling, Russian roulette, thin transmission and stochastic
+// Blend alpha, over the glTF BRDF of materials/bsdf.h.
+#pragma once
+
+// The physically based path tracer: unidirectional paths with next-event estimation and
 // multiple importance sampling (Veach & Guibas, "Optimally Combining Sampling Techniques for
 // Monte Carlo Rendering", SIGGRAPH 1995; power heuristic, beta = 2) between light sampling
 // and BSDF sampling, for emissive triangles and the environment; punctual lights are delta
 // lights and are always sampled directly. Russian roulette (Arvo & Kirk 1990) after a few
-// bounces, optional clamping of indirect light (biased), and the glTF BRDF of bsdf.h.
+// bounces, optional clamping of indirect light (biased), and the glTF BRDF of materials/bsdf.h.
 //
 // Transmission (KHR_materials_transmission) is thin-walled: light passes straight through
 // the surface (no refraction, roughness ignored for the transmitted part) with weight
 // (1 - metallic) x transmission x (1 - F) x base colour, as a delta lobe. Blend alpha is
 // stochastic: a Blend surface of coverage a is hit with probability a, else the ray
 // continues straight on. Shadow rays see the same visibility as the Whitted integrator
-// (material.h): Blend surfaces attenuate, Mask holes pass, transmissive surfaces block.
-#pragma once
+// (integrators/visibility.h): Blend surfaces attenuate, Mask holes pass, transmissive surfaces block.
 
 #include "renderer/accel/accelerator.h"
-#include "renderer/lights/area.h"
-#include "renderer/lights/environment.h"
-#include "renderer/scene/interaction.h"
-#include "renderer/materials/material.h"
 #include "renderer/core/sampler.h"
-#include "renderer/integrators/whitted.h"
+#include "renderer/integrators/direct_lighting.h"
+#include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/ray_counts.h"
+#include "renderer/materials/material.h"
+#include "renderer/scene/interaction.h"
 
 namespace penumbra {
 
@@ -42,23 +46,6 @@ struct PathConfig {
   bool hit_filter = true;     ///< as WhittedConfig::hit_filter
 };
 
-/// What a path tracer needs besides the scene: its lights (built once per render).
-struct PathLights {
-  const AreaLights* area = nullptr;       ///< may be empty; never null in path_radiance
-  const Environment* environment = nullptr;  ///< never null in path_radiance
-};
-
-/// The beauty split for compositing (light-group AOVs); the five sum to path_radiance's value.
-/// emission: what the camera sees directly (emitters, the environment, unlit surfaces);
-/// direct: light arriving at the first hit straight from a light; indirect: light arriving at
-/// the first hit after further bounces; diffuse and specular split by the first hit's BRDF
-/// terms (thin transmission counts as specular).
-struct LightGroups {
-  Vec3f emission{0, 0, 0};
-  Vec3f diffuse_direct{0, 0, 0}, diffuse_indirect{0, 0, 0};
-  Vec3f specular_direct{0, 0, 0}, specular_indirect{0, 0, 0};
-};
-
 /// Radiance along a camera ray (counted as one camera ray; bounce rays are counted as
 /// `reflection`, shadow rays as `shadow`). `rd` gives texture footprints at the first hit
 /// (may be invalid). `coverage` is 1 if the path hit a surface, 0 if the camera ray escaped
@@ -69,13 +56,5 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
                     SampleStream& samples, float& coverage, RayCounts& counts,
                     LightGroups* groups = nullptr);
-
-/// Power heuristic weight of a technique with density `a` against one with density `b`.
-inline float power_heuristic(float a, float b) {
-  if (!(a > 0)) return 0;
-  if (!std::isfinite(a)) return 1;
-  const float r = b / a;
-  return 1 / (1 + r * r);
-}
 
 }  // namespace penumbra

@@ -1,14 +1,11 @@
-// Tile renderer: Whitted (one pass) and path tracer (progressive passes).
+// Image renderer: Whitted (one pass) and path tracer (progressive passes).
 #include "renderer/integrators/render.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <atomic>
 #include <chrono>
 
 #include "renderer/core/rng.h"
+#include "renderer/integrators/visibility.h"
 
 namespace penumbra {
 
@@ -25,7 +22,7 @@ Vec2f filtered_position(const RenderConfig& config, int x, int y, Vec2f u) {
 }
 
 // Whitted's sample s of pixel (x, y): stratified jitter, through the filter unless it is the
-// plain 1-pixel box (then the jittered position itself, as before filters existed).
+// plain 1-pixel box (then the jittered position itself).
 Vec2f whitted_position(const RenderConfig& config, int x, int y, uint32_t s) {
   Rng rng = make_pixel_rng(uint32_t(x), uint32_t(y), s, config.seed);
   const Vec2f j = stratified_sample(s, uint32_t(config.spp), rng);
@@ -56,28 +53,6 @@ struct RayCounters {
   RayCounts load() const { return {camera.load(), shadow.load(), reflection.load()}; }
 };
 
-// Runs fn(x0, y0, x1, y1) (frame coordinates) over every tile of the render window on `arena`.
-template <class Fn>
-void for_each_tile(tbb::task_arena& arena, const RenderConfig& config, Fn&& fn) {
-  const PixelWindow w = render_window(config);
-  const int ts = config.tile_size;
-  const int tiles_x = (w.width() + ts - 1) / ts, tiles_y = (w.height() + ts - 1) / ts;
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        const int x0 = w.x0 + (tile % tiles_x) * ts, y0 = w.y0 + (tile / tiles_x) * ts;
-        fn(x0, y0, std::min(x0 + ts, w.x1), std::min(y0 + ts, w.y1));
-      }
-    });
-  });
-}
-
-int tile_count(const RenderConfig& config) {
-  const PixelWindow w = render_window(config);
-  const int ts = config.tile_size;
-  return ((w.width() + ts - 1) / ts) * ((w.height() + ts - 1) / ts);
-}
-
 // A film covering the render window.
 Film window_film(const RenderConfig& config) {
   const PixelWindow w = render_window(config);
@@ -89,8 +64,8 @@ Film window_film(const RenderConfig& config) {
   return f;
 }
 
-int thread_count(const RenderConfig& config) {
-  return config.threads > 0 ? config.threads : tbb::this_task_arena::max_concurrency();
+TileScheduler make_scheduler(const RenderConfig& config) {
+  return TileScheduler(render_window(config), config.tile_size, config.threads);
 }
 
 }  // namespace
@@ -100,16 +75,6 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
   if (integrator == IntegratorType::Whitted) return whitted_position(config, x, y, s);
   SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
   return filtered_position(config, x, y, st.get2d());  // the stream's first request (path_samples)
-}
-
-PixelWindow render_window(const RenderConfig& config) {
-  PixelWindow w = config.window;
-  if (w.empty()) return {0, 0, config.width, config.height};
-  w.x0 = std::clamp(w.x0, 0, config.width);
-  w.x1 = std::clamp(w.x1, 0, config.width);
-  w.y0 = std::clamp(w.y0, 0, config.height);
-  w.y1 = std::clamp(w.y1, 0, config.height);
-  return w.empty() ? PixelWindow{0, 0, 0, 0} : w;
 }
 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
@@ -141,15 +106,14 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
   config.whitted.hit_filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
   const auto t0 = Clock::now();
   Film film = window_film(config);
-  const int tiles = tile_count(config);
-  const int threads = thread_count(config);
+  TileScheduler scheduler = make_scheduler(config);
+  const int tiles = scheduler.tile_count();
   RayCounters rays;
   std::atomic<int> done{0};
-  tbb::task_arena arena(threads);
-  for_each_tile(arena, config, [&](int x0, int y0, int x1, int y1) {
+  scheduler.for_each_tile([&](const PixelWindow& tile) {
     RayCounts counts;
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x)
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x)
         render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x - film.origin_x, y - film.origin_y), counts);
     rays.add(counts);
     const int d = ++done;
@@ -158,7 +122,7 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
   if (stats) {
     stats->rays = rays.load();
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    stats->threads = threads;
+    stats->threads = scheduler.threads();
     stats->passes = 1;
     stats->samples = uint64_t(film.width) * uint64_t(film.height) * uint64_t(config.spp);
   }
@@ -188,8 +152,8 @@ namespace {
 // Per-pixel accumulators of the path tracer.
 using PixelAccum = PathAccumulators::Pixel;
 
-// Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`, 15
-// sums, if not null).
+// Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`,
+// kLightGroupChannels sums, if not null).
 void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                   const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x,
                   int y, uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts,
@@ -203,11 +167,7 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
     float coverage = 0;
     LightGroups lg;
     const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);
-    if (groups) {
-      const Vec3f parts[5] = {lg.emission, lg.diffuse_direct, lg.diffuse_indirect, lg.specular_direct, lg.specular_indirect};
-      for (int g = 0; g < 5; ++g)
-        for (int c = 0; c < 3; ++c) groups[g * 3 + c] += parts[g][c];
-    }
+    if (groups) add_light_groups(lg, groups);
     acc.rgba[0] += l.x;
     acc.rgba[1] += l.y;
     acc.rgba[2] += l.z;
@@ -247,8 +207,9 @@ PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& 
     resolve(acc, &image.film.rgba[i * 4]);
     image.samples[i] = acc.n;
     if (!state.groups.empty()) {
-      if (image.groups.empty()) image.groups.assign(npix * 15, 0.0f);
-      for (size_t k = 0; k < 15; ++k) image.groups[i * 15 + k] = acc.n ? float(state.groups[i * 15 + k] / acc.n) : 0.0f;
+      constexpr size_t kG = kLightGroupChannels;
+      if (image.groups.empty()) image.groups.assign(npix * kG, 0.0f);
+      for (size_t k = 0; k < kG; ++k) image.groups[i * kG + k] = acc.n ? float(state.groups[i * kG + k] / acc.n) : 0.0f;
     }
     if (acc.n >= 2) {
       const double mean = acc.sum_y / acc.n;
@@ -262,7 +223,7 @@ bool matches(const PathAccumulators& state, const RenderConfig& config) {
   const PixelWindow w = render_window(config);
   return state.window.x0 == w.x0 && state.window.y0 == w.y0 && state.window.x1 == w.x1 && state.window.y1 == w.y1 &&
          state.pixels.size() == size_t(w.width()) * size_t(w.height()) &&
-         state.groups.size() == (config.light_groups ? state.pixels.size() * 15 : 0);
+         state.groups.size() == (config.light_groups ? state.pixels.size() * kLightGroupChannels : 0);
 }
 
 PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
@@ -279,41 +240,39 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
     state = PathAccumulators{};
     state.window = win;
     state.pixels.assign(npix, PixelAccum{});
-    state.groups.assign(config.light_groups ? npix * 15 : 0, 0.0);
+    state.groups.assign(config.light_groups ? npix * kLightGroupChannels : 0, 0.0);
   }
   std::vector<PixelAccum>& accum = state.pixels;
   std::vector<double>& group_sums = state.groups;
   const std::vector<int> ends = path_pass_ends(config.spp);
-  const int tiles = tile_count(config);
-  const int total_units = tiles * int(ends.size());
-  const int threads = thread_count(config);
+  TileScheduler scheduler = make_scheduler(config);
+  const int total_units = scheduler.tile_count() * int(ends.size());
   const bool adaptive = config.adaptive_threshold > 0;
   const uint32_t min_spp = uint32_t(std::max(2, std::min(config.adaptive_min_spp, config.spp)));
   RayCounters rays;
   std::atomic<int> done{0};
   std::atomic<uint64_t> active_pixels{0};
-  tbb::task_arena arena(threads);
   int passes = 0;
   bool time_limited = false;
   uint32_t begin = state.reached;  // every pixel still sampling has taken exactly this many
   size_t first = 0;
   while (first < ends.size() && uint32_t(ends[first]) <= begin) ++first;
-  done = int(first) * tiles;
+  done = int(first) * scheduler.tile_count();
   for (size_t pass = first; pass < ends.size(); ++pass) {
     const auto pass_start = Clock::now();
     const uint32_t pass_begin = begin;
     const uint32_t end = uint32_t(ends[pass]);
     active_pixels = 0;
-    for_each_tile(arena, config, [&](int x0, int y0, int x1, int y1) {
+    scheduler.for_each_tile([&](const PixelWindow& tile) {
       RayCounts counts;
       uint64_t active = 0;
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
           const size_t pi = size_t(y - win.y0) * size_t(win.width()) + size_t(x - win.x0);
           PixelAccum& acc = accum[pi];
           if (!acc.active) continue;
           path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts,
-                       group_sums.empty() ? nullptr : &group_sums[pi * 15]);
+                       group_sums.empty() ? nullptr : &group_sums[pi * kLightGroupChannels]);
           if (adaptive && acc.n >= min_spp && pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
             acc.active = false;
           active += acc.active;
@@ -353,7 +312,7 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
     for (uint32_t n : image.samples) total_samples += n;
     stats->rays = rays.load();
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    stats->threads = threads;
+    stats->threads = scheduler.threads();
     stats->passes = passes;
     stats->samples = total_samples;
     stats->time_limited = time_limited;

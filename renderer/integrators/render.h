@@ -1,63 +1,28 @@
-// The multi-threaded tile renderer: square tiles scheduled with TBB, one sample stream per
-// (pixel, sample) so the image is bit-identical for any thread count.
-//
+// The image renderer of both integrators: Whitted in one pass, the path tracer in progressive
+// passes with checkpointable per-pixel sums, over the tiles of core/parallel.h with one sample
+// stream per (pixel, sample), so the image is bit-identical for any thread count.
+#pragma once
+
 // Whitted: stratified jittered supersampling of each pixel, box filtered (or any pixel filter,
 // applied by filter importance sampling). Path: progressive passes over the image (1, 2, 4, 8,
 // 16 samples, then 16 per pass), each pixel the mean of its samples, with an optional time limit
 // (checked after each whole pass) and optional adaptive sampling that stops pixels whose
 // estimated error falls below a threshold. Each pixel's value depends only on its own
 // samples, so neither threads, tiles nor the pass schedule change it.
-#pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
-#include "renderer/scene/camera.h"
 #include "renderer/film/film.h"
-#include "renderer/film/filter.h"
 #include "renderer/integrators/path.h"
+#include "renderer/integrators/ray_counts.h"
+#include "renderer/integrators/render_config.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/whitted.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra {
-
-enum class IntegratorType : uint8_t { Whitted, Path };
-
-/// A rectangle of pixels [x0, x1) x [y0, y1) of the full frame.
-struct PixelWindow {
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  bool empty() const { return x1 <= x0 || y1 <= y0; }
-  int width() const { return x1 - x0; }
-  int height() const { return y1 - y0; }
-};
-
-/// Render settings with their defaults (the CLI validates user values before use).
-struct RenderConfig {
-  int width = 960;
-  int height = 540;
-  int spp = 4;            ///< samples per pixel, >= 1 (path: the maximum with --adaptive)
-  int threads = 0;        ///< worker threads; 0 = all hardware threads
-  int tile_size = 32;     ///< square tile edge in pixels
-  uint64_t seed = 0;      ///< decorrelates whole renders; same seed => same image
-  PixelFilter filter;     ///< box, 1 pixel wide by default
-  WhittedConfig whitted;
-  // Path tracer only.
-  PathConfig path;
-  SamplerType sampler = SamplerType::Sobol;
-  double time_limit = 0;          ///< seconds; > 0: stop after the pass that reaches it
-  float adaptive_threshold = 0;   ///< > 0: stop a pixel once its error estimate is below this
-  int adaptive_min_spp = 16;      ///< samples every pixel takes before it may stop
-  bool light_groups = false;      ///< also accumulate the LightGroups split (PathImage::groups)
-  /// Only these pixels of the width x height frame (crops, farm tiles); empty = the whole
-  /// frame. Every pixel is computed exactly as in the whole frame, so parts merge bit for bit.
-  PixelWindow window;
-  /// Set (e.g. by a signal handler): stop after the current pass. May be null.
-  const std::atomic<bool>* stop = nullptr;
-};
-
-/// config.window clamped to the frame, or the whole frame if it is empty.
-PixelWindow render_window(const RenderConfig& config);
 
 struct RenderStats {
   RayCounts rays;
@@ -72,8 +37,8 @@ struct RenderStats {
 /// the callee must be thread-safe. May be empty.
 using ProgressFn = std::function<void(int done, int total)>;
 
-/// Renders the scene with the Whitted integrator. Requires a valid config (width, height,
-/// spp, tile_size >= 1) and an accelerator built over mesh_views(scene) and instance_views(scene).
+/// Renders the scene with the Whitted integrator. Requires a config that passes validate()
+/// and an accelerator from make_scene_accelerator(name, scene).
 Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& camera,
                     const RenderConfig& config, RenderStats* stats = nullptr,
                     const ProgressFn& progress = {});
@@ -90,14 +55,10 @@ struct PathImage {
                                    ///< all per-pixel vectors cover render_window(config)
   std::vector<uint32_t> samples;   ///< samples taken per pixel
   std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
-  /// With RenderConfig::light_groups: 15 floats per pixel, the means of LightGroups' emission,
-  /// diffuse_direct, diffuse_indirect, specular_direct, specular_indirect (RGB each).
+  /// With RenderConfig::light_groups: kLightGroupChannels floats per pixel, the means of the
+  /// light groups in kLightGroupNames order (RGB each).
   std::vector<float> groups;
 };
-
-/// Names of the five light groups in PathImage::groups order.
-inline constexpr const char* kLightGroupNames[5] = {"emission", "diffuse_direct", "diffuse_indirect",
-                                                     "specular_direct", "specular_indirect"};
 
 /// The path tracer's per-pixel running sums, accumulated in each pixel's sample order: what a
 /// checkpoint saves and a resumed render continues from (plain data, written as raw bytes).
@@ -110,11 +71,15 @@ struct PathAccumulators {
   };
   PixelWindow window;              ///< the render window the pixels cover
   std::vector<Pixel> pixels;
-  std::vector<double> groups;      ///< 15 light-group sums per pixel, or empty
+  std::vector<double> groups;      ///< kLightGroupChannels light-group sums per pixel, or empty
   uint32_t reached = 0;            ///< samples every still-active pixel has taken
   int passes = 0;                  ///< passes completed
   bool complete = false;           ///< the requested spp (or adaptive convergence) was reached
 };
+
+/// Bytes of one pixel's accumulators as a checkpoint stores them (raw, native byte order).
+inline constexpr size_t kPathPixelBytes = sizeof(PathAccumulators::Pixel);
+static_assert(kPathPixelBytes == 56, "checkpoints store PathAccumulators::Pixel as 56 raw bytes");
 
 /// Called after every completed pass with the accumulators (for checkpoints).
 using PassFn = std::function<void(const PathAccumulators& state)>;

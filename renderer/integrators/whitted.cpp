@@ -2,6 +2,7 @@
 // with Blinn-Phong highlights (Blinn 1977) and front-to-back alpha compositing.
 #include "renderer/integrators/whitted.h"
 
+#include "renderer/integrators/visibility.h"
 #include "renderer/lights/punctual.h"
 
 namespace penumbra {
@@ -79,13 +80,8 @@ struct Tracer {
       if (dot(ls.wi, si.ng) <= 0) continue;  // light below the geometric surface
       const float ndotl = dot(mp.ns, ls.wi);
       if (ndotl <= 0) continue;
-      Ray shadow;
-      shadow.org = offset_ray_origin(si.p, si.ng, ls.wi);
-      shadow.dir = ls.wi;
-      shadow.tnear = 0;
-      shadow.tfar = std::isfinite(ls.distance) ? ls.distance * (1 - 1e-4f) : kInfinity;
       ++counts.shadow;
-      const float transmittance = shadow_transmittance(scene, accel, shadow, cfg.hit_filter);
+      const float transmittance = shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
       if (!(transmittance > 0)) continue;
       const Vec3f h = normalize(v + ls.wi);
       const float ndoth = std::max(0.0f, dot(mp.ns, h));

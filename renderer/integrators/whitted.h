@@ -1,9 +1,10 @@
-// The Whitted integrator of the course: ambient once, per light Lambert diffuse plus
-// Blinn-Phong specular with shadow rays, and ideal mirror reflection up to a maximum depth.
-// glTF metallic-roughness factors map to Whitted coefficients by whitted_params().
+// The Whitted integrator: ambient once, per punctual light Lambert diffuse plus Blinn-Phong
+// specular behind a shadow ray, and ideal mirror reflection up to a maximum depth. glTF
+// metallic-roughness factors map to Whitted coefficients by whitted_params().
 #pragma once
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/integrators/ray_counts.h"
 #include "renderer/scene/interaction.h"
 #include "renderer/materials/material.h"
 
@@ -46,24 +47,14 @@ struct WhittedConfig {
                                    ///< valid only when scene_needs_hit_filter() is false
 };
 
-struct RayCounts {
-  uint64_t camera = 0, shadow = 0, reflection = 0;
-  uint64_t total() const { return camera + shadow + reflection; }
-  RayCounts& operator+=(const RayCounts& o) {
-    camera += o.camera;
-    shadow += o.shadow;
-    reflection += o.reflection;
-    return *this;
-  }
-};
-
 /// Radiance along a camera ray (counted as one camera ray) with its differentials (for texture
 /// filtering; may be invalid), and its coverage (1 if it hit opaque geometry, 0 if it
 /// escaped, alpha-composited over Blend layers). The outgoing radiance at a hit is
 ///   L = emission + ka Ia occlusion + sum_lights V E [ kd/pi max(0, n.l)
 ///                                           + ks (p+8)/(8 pi) max(0, n.h)^p max(0, n.l) ]
 ///       + kr L(reflected ray)
-/// with E the light's irradiance (lights.h), V its shadow-ray transmittance (material.h) and
+/// with E the light's irradiance (lights/punctual.h), V its shadow-ray transmittance
+/// (integrators/visibility.h) and
 /// h = (v + l)/|v + l|; n is the normal-mapped shading normal. A Blend surface of coverage a
 /// contributes a L + (1 - a) L(behind), front to back. The 1/pi and (p+8)/(8 pi) factors normalise the lobes so that kd and
 /// ks are albedos under glTF's physical light units.

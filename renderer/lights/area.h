@@ -2,14 +2,14 @@
 // instance whose material emits, picked with probability proportional to an estimate of its
 // power and then sampled uniformly by area (pbrt-v4 12.2 "DiffuseAreaLight", with a power
 // light sampler, 12.6.2).
-//
+#pragma once
+
 // Power estimate: luminance(emissive factor x the emissive texture filtered over the
 // triangle's UV footprint) x world area x (2 if double-sided), floored at 1% of the factor's
 // so that no emitting triangle is unreachable by light sampling. The estimate only steers
 // sampling: the integrator evaluates the true emission at the sampled point.
 // One-sided emission: a single-sided (glTF doubleSided = false) material emits only from its
 // front (counter-clockwise) side; double-sided materials emit from both.
-#pragma once
 
 #include <cstdint>
 #include <vector>

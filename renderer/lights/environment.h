@@ -2,12 +2,12 @@
 // (latitude-longitude) HDR map with a rotation about +Y and an intensity multiplier,
 // importance sampled by a piecewise-constant 2D distribution proportional to
 // luminance x sin(theta) (pbrt-v3 14.2.4, "Infinite Area Lights").
-//
+#pragma once
+
 // Map convention (glTF is +Y up, cameras look down -Z): the image centre (u = 0.5) is the -Z
 // direction, u increases towards +X (so the map is not mirrored when seen from inside), the
 // top row is +Y. A rotation of R degrees turns the map counter-clockwise seen from above
 // (about +Y).
-#pragma once
 
 #include <vector>
 

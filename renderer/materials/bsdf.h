@@ -1,3 +1,7 @@
+// The glTF 2.0 metallic-roughness BRDF (glTF specification, Appendix B): evaluation, density
+// and sampling of its diffuse and GGX specular lobes in world-space directions.
+#pragma once
+
 // The glTF 2.0 metallic-roughness BRDF (glTF specification, Appendix B): Trowbridge-Reitz (GGX)
 // distribution with alpha = roughness^2, height-correlated Smith visibility, Schlick Fresnel,
 // Lambert diffuse under the dielectric's Fresnel layer, and the dielectric/metal mix by
@@ -10,7 +14,6 @@
 // visible normals (Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018);
 // pdf() is the combined density of both, so estimators may use any of the three functions.
 // Directions are unit vectors in world space; the shading frame comes from the normal.
-#pragma once
 
 #include "renderer/core/math.h"
 

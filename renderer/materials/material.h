@@ -1,11 +1,9 @@
 // Material evaluation at a surface point: glTF factors times textures (base colour, alpha,
-// metallic-roughness, normal map, occlusion, emission) and vertex colours, and the alpha-aware
-// visibility queries (cut-outs, blended layers, single-sided back faces) that every integrator
-// uses instead of calling the accelerator directly. Accelerators stay material-agnostic: the
-// filtering happens here, in an any-hit loop over closest hits.
+// metallic-roughness, normal map, occlusion, emission, transmission) and vertex colours, and
+// the coverage (alpha) of a hit for visibility filtering. Evaluation only: the ray queries
+// that use it are in integrators/visibility.h.
 #pragma once
 
-#include "renderer/accel/accelerator.h"
 #include "renderer/scene/interaction.h"
 
 namespace penumbra {
@@ -48,22 +46,5 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si);
 /// Coverage of the surface at barycentrics (u, v) of triangle `prim` of instance `instance`: alpha
 /// factor x base colour texture alpha (finest level) x COLOR_0 alpha. 1 for Opaque materials.
 float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v);
-
-/// Whether any material in the scene needs the filtered queries below (Mask, Blend or
-/// single-sided); when false they reduce to one accelerator call.
-bool scene_needs_hit_filter(const Scene& scene);
-
-/// Closest hit that a camera or mirror ray sees: skips Mask texels below the cut-off and the
-/// back faces of single-sided materials (glTF doubleSided = false), by re-shooting the same
-/// ray past each rejected hit (at most 1024 times; then the last hit counts as opaque).
-/// Blend surfaces are returned; the integrator composites them.
-bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit,
-                       bool filter);
-
-/// Fraction of light passing along a shadow ray: 0 if an opaque surface blocks it, else the
-/// product of (1 - alpha) over the Blend surfaces it crosses; Mask holes let light through.
-/// Back faces cast shadows whatever the material's sidedness.
-float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray,
-                           bool filter);
 
 }  // namespace penumbra

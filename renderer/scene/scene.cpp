@@ -1,8 +1,10 @@
-// Scene helpers.
+// Scene helpers: instances, bounds, counts, world triangles, normals and tangents.
 #include "renderer/scene/scene.h"
 
 #include <stdexcept>
 #include <string>
+
+#include "renderer/core/geometry.h"
 
 namespace penumbra {
 
@@ -74,25 +76,6 @@ uint64_t count_stored_triangles(const Scene& scene) {
   uint64_t n = 0;
   for (const auto& m : scene.meshes) n += m.indices.size() / 3;
   return n;
-}
-
-std::vector<TriangleMeshView> mesh_views(const Scene& scene) {
-  std::vector<TriangleMeshView> views;
-  views.reserve(scene.meshes.size());
-  for (const auto& m : scene.meshes) views.push_back({m.positions, m.indices});
-  return views;
-}
-
-std::vector<InstanceView> instance_views(const Scene& scene) {
-  std::vector<InstanceView> views;
-  views.reserve(scene.instances.size());
-  for (const Instance& inst : scene.instances) views.push_back({uint32_t(inst.mesh), inst.to_world});
-  return views;
-}
-
-std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
-                                                    const AccelConfig& config) {
-  return make_accelerator(name, mesh_views(scene), instance_views(scene), config);
 }
 
 WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim) {

@@ -1,16 +1,13 @@
-// The scene as plain data: world-space triangle meshes, materials, textures, punctual lights
-// and cameras, addressed by int handles. Built by io/ from glTF (or by tests directly); consumed by the
-// integrators. No behaviour here beyond small free functions.
+// The scene as plain data: triangle meshes and their instances, materials, textures, punctual
+// lights and cameras, addressed by int handles. Built by io/ from glTF (or by tests directly);
+// consumed by the integrators. No accelerators and no behaviour beyond small free functions
+// (integrators/scene_accel.h builds the accelerator over it).
 #pragma once
 
-#include <memory>
 #include <span>
 #include <string>
-#include <string_view>
 #include <vector>
 
-#include "renderer/accel/accelerator.h"
-#include "renderer/accel/factory.h"
 #include "renderer/core/math.h"
 #include "renderer/materials/texture.h"
 
@@ -142,16 +139,6 @@ uint64_t count_stored_triangles(const Scene& scene);
 /// Bytes held by the scene's arrays (mesh attributes, instances, texture pyramids), for
 /// memory budgets.
 uint64_t scene_memory_bytes(const Scene& scene);
-/// Views of every mesh and of every instance for make_accelerator(name, meshes, instances);
-/// geom_id in hits == instance index.
-std::vector<TriangleMeshView> mesh_views(const Scene& scene);
-std::vector<InstanceView> instance_views(const Scene& scene);
-
-/// make_accelerator(name, mesh_views(scene), instance_views(scene), config): the structure
-/// every integrator queries (geom_id = instance index). The scene must outlive it.
-std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
-                                                    const AccelConfig& config = {});
-
 /// Triangle `prim` of instance `inst` in world space: its vertex indices, its world positions
 /// and its unit front-facing geometric normal (counter-clockwise side in object space; zero if
 /// degenerate).

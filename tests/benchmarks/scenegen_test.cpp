@@ -7,6 +7,7 @@
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
 #include "support/cross_check.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

@@ -16,6 +16,7 @@
 #include "io/image_output.h"
 #include "io/render_settings.h"
 #include "renderer/integrators/render.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

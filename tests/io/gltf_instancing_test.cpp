@@ -12,6 +12,7 @@
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 

@@ -7,6 +7,7 @@
 
 #include "support/cross_check.h"
 #include "io/gltf_loader.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "support/test_util.h"
 

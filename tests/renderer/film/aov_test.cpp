@@ -2,6 +2,7 @@
 // depths, normals and positions on a known scene, background conventions, determinism, and
 // beauty = the sum of the light groups with physically known splits.
 #include "renderer/film/aov.h"
+#include "renderer/integrators/scene_accel.h"
 
 #include <catch2/catch.hpp>
 

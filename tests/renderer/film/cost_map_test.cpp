@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
 #include "renderer/core/rng.h"
 #include "support/scene_builder.h"

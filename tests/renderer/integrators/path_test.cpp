@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "io/gltf_loader.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/bsdf.h"
 #include "renderer/integrators/render.h"
 #include "support/scene_builder.h"

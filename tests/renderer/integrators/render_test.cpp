@@ -8,6 +8,7 @@
 
 #include "io/gltf_loader.h"
 #include "renderer/core/rng.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 

@@ -1,5 +1,6 @@
 // Tests for renderer/whitted: the material mapping and closed-form shading of simple scenes.
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/whitted.h"
 
 #include <catch2/catch.hpp>

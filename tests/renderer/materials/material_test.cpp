@@ -1,5 +1,7 @@
 // Tests for renderer/material: textures, texture transforms, UV sets, vertex colours, normal
 // maps, alpha cut-outs, blended shadows and single-sided culling, with analytic answers.
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"
 
 #include <catch2/catch.hpp>

@@ -1,6 +1,7 @@
 // Scene helpers (renderer/scene.h): instances and their inverses, the mirrored flag and the
 // front face it implies, world-space triangles and normals, bounds and triangle counts over
 // instances, and the views handed to the accelerator builders.
+#include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 
 #include <catch2/catch.hpp>
