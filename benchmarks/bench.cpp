@@ -31,10 +31,11 @@
 #include "io/ply_loader.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
-#include "renderer/camera.h"
-#include "renderer/cost_map.h"
-#include "renderer/sampling.h"
-#include "renderer/scene.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/camera.h"
+#include "renderer/film/cost_map.h"
+#include "renderer/core/rng.h"
+#include "renderer/scene/scene.h"
 
 using namespace penumbra;
 

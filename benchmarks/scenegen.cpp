@@ -6,8 +6,8 @@
 #include <functional>
 #include <stdexcept>
 
-#include "renderer/camera.h"
-#include "renderer/sampling.h"
+#include "renderer/scene/camera.h"
+#include "renderer/core/rng.h"
 
 namespace penumbra::bench {
 namespace {

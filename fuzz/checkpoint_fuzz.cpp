@@ -22,6 +22,7 @@
 #include "io/checkpoint.h"
 #include "io/error.h"
 #include "io/hash.h"
+#include "renderer/integrators/light_groups.h"
 
 namespace fs = std::filesystem;
 
@@ -56,7 +57,7 @@ penumbra::PathAccumulators seed_state(int w, int h, uint32_t reached, bool group
     p.sum_y = 0.5 * p.n;
     p.sum_y2 = 0.25 * p.n;
   }
-  if (groups) st.groups.assign(st.pixels.size() * 15, 0.125);
+  if (groups) st.groups.assign(st.pixels.size() * kLightGroupChannels, 0.125);
   st.reached = reached;
   st.passes = 3;
   return st;

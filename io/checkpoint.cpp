@@ -13,6 +13,7 @@
 #include "io/atomic_file.h"
 #include "io/error.h"
 #include "io/file_checks.h"
+#include "renderer/integrators/light_groups.h"
 #include "io/hash.h"
 
 namespace penumbra {
@@ -24,10 +25,10 @@ static_assert(std::endian::native == std::endian::little, "resume state files ar
 constexpr char kMagic[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '2'};
 constexpr char kOldMagic[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '1'};
 constexpr size_t kDigestBytes = 32;
-constexpr uint64_t kGroupsPerPixel = 15;
+constexpr uint64_t kGroupsPerPixel = kLightGroupChannels;
 
 using Pixel = PathAccumulators::Pixel;
-static_assert(sizeof(Pixel) == 56, "Pixel: rgba, sum_y, sum_y2 (6 doubles), n, active (2 uint32)");
+static_assert(sizeof(Pixel) == kPathPixelBytes, "Pixel: rgba, sum_y, sum_y2 (6 doubles), n, active (2 uint32)");
 
 // 56 bytes after the magic, no padding.
 struct Header {

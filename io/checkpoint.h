@@ -8,7 +8,7 @@
 #include <filesystem>
 
 #include "io/render_settings.h"
-#include "renderer/render.h"
+#include "renderer/integrators/render.h"
 
 namespace penumbra {
 
@@ -35,7 +35,7 @@ void write_checkpoint(const std::filesystem::path& path, const PathAccumulators&
 ///  - was written for settings other than `expected` (the message lists each differing key
 ///    with both values, as describe_differences);
 ///  - is inconsistent: an empty window or one that does not match the pixel count, light-group
-///    sums neither absent nor 15 per pixel, a negative or non-finite sum, coverage above the
+///    sums neither absent nor kLightGroupChannels per pixel, a negative or non-finite sum, coverage above the
 ///    sample count, a pixel with more samples than `reached` (or an active pixel with fewer),
 ///    passes < 0 or above `reached`, no passes but samples, or complete without a pass.
 PathAccumulators read_checkpoint(const std::filesystem::path& path, const RenderSettings& expected);

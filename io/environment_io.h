@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "renderer/environment.h"
+#include "renderer/lights/environment.h"
 
 namespace penumbra {
 

@@ -19,7 +19,7 @@
 #include "io/file_checks.h"
 #include "io/gltf_container.h"
 #include "io/gltf_json_checks.h"
-#include "renderer/animation.h"
+#include "renderer/scene/animation.h"
 
 namespace penumbra {
 

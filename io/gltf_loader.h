@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "renderer/scene.h"
+#include "renderer/scene/scene.h"
 
 namespace penumbra {
 

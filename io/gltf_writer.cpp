@@ -10,7 +10,7 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
-#include "renderer/camera.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra {
 namespace {

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "renderer/film.h"
+#include "renderer/film/film.h"
 
 namespace penumbra {
 

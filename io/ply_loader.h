@@ -6,7 +6,7 @@
 
 #include <filesystem>
 
-#include "renderer/scene.h"
+#include "renderer/scene/scene.h"
 
 namespace penumbra {
 

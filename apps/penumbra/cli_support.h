@@ -10,7 +10,7 @@
 #include <string_view>
 #include <utility>
 
-#include "renderer/math.h"
+#include "renderer/core/math.h"
 
 namespace penumbra::cli {
 

@@ -10,6 +10,7 @@
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/render_job.h"
 #include "io/exr_merge.h"
+#include "renderer/integrators/light_groups.h"
 
 namespace penumbra::cli {
 
@@ -116,10 +117,10 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
   }
   if (aovs.count("variance")) exr.extra.push_back({"variance", &image.variance, ChannelType::Float});
   if (aovs.count("light"))
-    for (int g = 0; g < 5; ++g)
+    for (int g = 0; g < kLightGroupCount; ++g)
       for (int c = 0; c < 3; ++c)
         exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &image.groups,
-                             job.args.use_float ? ChannelType::Float : ChannelType::Half, 15, g * 3 + c});
+                             job.args.use_float ? ChannelType::Float : ChannelType::Half, kLightGroupChannels, g * 3 + c});
   if (job.request.cost_aov) {
     if (buffers.cost.counted) {
       exr.extra.push_back({"cost.nodes", &buffers.cost.nodes});

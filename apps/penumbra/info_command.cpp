@@ -6,6 +6,7 @@
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
+#include "renderer/integrators/scene_accel.h"
 
 namespace penumbra::cli {
 

@@ -14,6 +14,8 @@
 #include "io/environment_io.h"
 #include "io/file_checks.h"
 #include "io/hash.h"
+#include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/scene_accel.h"
 
 namespace penumbra::cli {
 
@@ -32,11 +34,11 @@ constexpr uint64_t kAccelBytesPerTriangle = 96;
 uint64_t image_bytes_per_pixel(const RenderRequest& q) {
   const bool light_groups = q.aovs.count("light") > 0;
   uint64_t b = 16;
-  if (q.path) b += sizeof(PathAccumulators::Pixel) + 4 + 4;
-  if (light_groups) b += 15 * 8 + 15 * 4;
+  if (q.path) b += kPathPixelBytes + 4 + 4;
+  if (light_groups) b += kLightGroupChannels * (8 + 4);
   if (q.data_aovs) b += 14 * 4;
   if (q.cost_aov) b += 3 * 4 + 3;
-  b += (4 + (q.data_aovs ? 14 : 0) + (light_groups ? 15 : 0) + (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2)) * 4;
+  b += (4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) + (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2)) * 4;
   if (q.png) b += 12 + 3;
   return b;
 }
@@ -78,6 +80,7 @@ void setup_phase(RenderJob& job) {
       cam >= 0 && scene.cameras[size_t(cam)].aspect > 0 ? scene.cameras[size_t(cam)].aspect : 16.0f / 9.0f;
   job.cfg = make_render_config(a, q, hint);
   RenderConfig& cfg = job.cfg;
+  validate(cfg);  // the library's own range checks, after the command line's named ones
   const uint64_t committed = charge_image_budget(job);
   if (!cfg.window.empty() && q.cost_aov)
     throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");

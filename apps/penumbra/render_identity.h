@@ -7,7 +7,7 @@
 
 #include "apps/penumbra/render_options.h"
 #include "io/render_settings.h"
-#include "renderer/camera.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra::cli {
 

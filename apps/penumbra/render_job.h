@@ -9,9 +9,9 @@
 #include "apps/penumbra/render_options.h"
 #include "io/gltf_loader.h"
 #include "io/render_settings.h"
-#include "renderer/area_lights.h"
-#include "renderer/environment.h"
-#include "renderer/render.h"
+#include "renderer/lights/area.h"
+#include "renderer/lights/environment.h"
+#include "renderer/integrators/render.h"
 
 namespace penumbra::cli {
 

@@ -15,7 +15,7 @@
 
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
-#include "renderer/render.h"
+#include "renderer/integrators/render.h"
 
 namespace penumbra::cli {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "renderer/geometry.h"
+#include "renderer/core/geometry.h"
 
 namespace penumbra {
 

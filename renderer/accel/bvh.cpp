@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "renderer/accel/common.h"
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 namespace {
@@ -205,7 +206,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
  public:
   BvhAccelerator(std::span<const TriangleMeshView> meshes, const BvhConfig& config) : m_config(config) {
     validate(config);
-    const auto t0 = std::chrono::steady_clock::now();
+    const BuildTimer timer;
     std::vector<TriangleRecord> tris = gather_triangles(meshes);
     m_input_triangles = count_input_triangles(meshes);
     if (!tris.empty()) {
@@ -228,24 +229,21 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       }
       m_tally.fill(m_stats);
     }
-    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_build_seconds = timer.seconds();
   }
 
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = m_stats;
-    s.name = "bvh";
-    s.config = "width " + std::to_string(m_config.width) + ", max_leaf_size " +
-               std::to_string(m_config.max_leaf_size) + ", bin_count " + std::to_string(m_config.bin_count) +
-               ", traversal_cost " +
-               format_number(m_config.traversal_cost) + ", intersection_cost " +
-               format_number(m_config.intersection_cost);
-    s.triangles = m_input_triangles;
+    AccelStats s = make_stats(
+        m_stats, "bvh",
+        "width " + std::to_string(m_config.width) + ", max_leaf_size " + std::to_string(m_config.max_leaf_size) +
+            ", bin_count " + std::to_string(m_config.bin_count) + ", traversal_cost " +
+            format_number(m_config.traversal_cost) + ", intersection_cost " + format_number(m_config.intersection_cost),
+        m_input_triangles,
+        m_nodes.size() * sizeof(BvhNode) + m_nodes4.size() * sizeof(Bvh4Node) + m_tris.size() * sizeof(TriangleRecord),
+        m_build_seconds);
     s.nodes = m_config.width == 2 ? m_nodes.size() : m_nodes4.size() + m_tally.leaves;
-    s.bytes = m_nodes.size() * sizeof(BvhNode) + m_nodes4.size() * sizeof(Bvh4Node) +
-              m_tris.size() * sizeof(TriangleRecord);
-    s.build_seconds = m_build_seconds;
     return s;
   }
 

@@ -1,9 +1,10 @@
-// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007) of a binary tree,
-// then either flattened into 32-byte binary nodes (width 2) or collapsed into 4-wide nodes whose
-// four boxes are tested at once with SSE (width 4, the default), traversed front to back with a
-// fixed stack. It builds from triangle bounds only and calls the shared watertight triangle test
-// in its leaves.
+// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007), binary or
+// 4-wide SSE nodes, front-to-back traversal with a fixed stack.
 #pragma once
+
+// The binary build tree is either flattened into 32-byte binary nodes (width 2) or collapsed
+// into 4-wide nodes whose four boxes are tested at once with SSE (width 4, the default). It
+// builds from triangle bounds only and calls the shared watertight triangle test in its leaves.
 
 #include <cstddef>
 #include <memory>

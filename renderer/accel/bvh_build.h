@@ -9,7 +9,7 @@
 
 #include "renderer/accel/bvh.h"
 #include "renderer/accel/common.h"
-#include "renderer/math.h"
+#include "renderer/core/math.h"
 
 namespace penumbra {
 

@@ -175,29 +175,4 @@ class TraversalAccelerator : public Accelerator {
   }
 };
 
-/// A number as printf's %g would print it (for the human-readable AccelStats::config).
-inline std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-/// Summary of a leaf-size histogram, filled by each structure's statistics pass.
-struct LeafTally {
-  uint64_t leaves = 0, empty_leaves = 0, references = 0, max_prims = 0;
-  void add(uint64_t n) {
-    ++leaves;
-    empty_leaves += n == 0;
-    references += n;
-    max_prims = std::max(max_prims, n);
-  }
-  void fill(AccelStats& s) const {
-    s.leaves = leaves;
-    s.empty_leaves = empty_leaves;
-    s.references = references;
-    s.max_leaf_prims = max_prims;
-    s.avg_leaf_prims = leaves > empty_leaves ? double(references) / double(leaves - empty_leaves) : 0;
-  }
-};
-
 }  // namespace penumbra

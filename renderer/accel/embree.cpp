@@ -1,6 +1,7 @@
 // Embree 3 back end. Embree reports errors through a C callback, which only records them;
 // the build function converts a recorded error into an exception at this one boundary.
 #include "renderer/accel/embree.h"
+#include "renderer/accel/stats.h"
 
 #include <embree3/rtcore.h>
 
@@ -104,7 +105,7 @@ class EmbreeAccelerator final : public Accelerator {
                     const EmbreeConfig& config)
       : m_config(config) {
     validate(config);
-    const auto t0 = std::chrono::steady_clock::now();
+    const BuildTimer timer;
     const int64_t bytes_before = device_bytes();
     take_error();
     m_scene = new_scene();
@@ -148,7 +149,7 @@ class EmbreeAccelerator final : public Accelerator {
     RTCBounds b;
     rtcGetSceneBounds(m_scene, &b);
     if (m_triangles > 0) m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
-    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_build_seconds = timer.seconds();
   }
 
   ~EmbreeAccelerator() override {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "renderer/accel/common.h"
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 
@@ -70,28 +71,24 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
  public:
   GridAccelerator(std::span<const TriangleMeshView> meshes, const GridConfig& config) : m_config(config) {
     validate(config);
-    const auto t0 = std::chrono::steady_clock::now();
+    const BuildTimer timer;
     m_tris = gather_triangles(meshes);
     m_input_triangles = count_input_triangles(meshes);
     for (const auto& t : m_tris) m_bounds = merge(m_bounds, triangle_bounds(t));
     if (!m_tris.empty()) build();
-    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_build_seconds = timer.seconds();
   }
 
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = m_stats;
-    s.name = "grid";
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "lambda %g, resolution %ux%ux%u", double(m_config.lambda), m_res[0],
+    char config[160];
+    std::snprintf(config, sizeof config, "lambda %g, resolution %ux%ux%u", double(m_config.lambda), m_res[0],
                   m_res[1], m_res[2]);
-    s.config = buf;
-    s.triangles = m_input_triangles;
-    s.bytes = m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
-              m_tris.size() * sizeof(TriangleRecord);
-    s.build_seconds = m_build_seconds;
-    return s;
+    return make_stats(
+        m_stats, "grid", config, m_input_triangles,
+        m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) + m_tris.size() * sizeof(TriangleRecord),
+        m_build_seconds);
   }
 
  private:

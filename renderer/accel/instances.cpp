@@ -9,6 +9,7 @@
 
 #include "renderer/accel/bvh_build.h"
 #include "renderer/accel/common.h"
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 namespace {
@@ -18,7 +19,7 @@ class TwoLevelAccelerator final : public Accelerator {
   TwoLevelAccelerator(const AcceleratorBuilder& build, std::span<const TriangleMeshView> meshes,
                       std::span<const InstanceView> instances) {
     validate_instances(instances, meshes.size());
-    const auto t0 = std::chrono::steady_clock::now();
+    const BuildTimer timer;
     std::vector<TriangleMeshView> world;
     std::vector<int> object_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
@@ -45,7 +46,7 @@ class TwoLevelAccelerator final : public Accelerator {
     }
     for (const auto& level : m_levels) m_stats_bottom.push_back(level->stats());
     build_top();
-    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_build_seconds = timer.seconds();
   }
 
   bool intersect(const Ray& ray, Hit& hit) const override { return closest(ray, hit, nullptr); }

@@ -1,9 +1,11 @@
 // Two-level instancing for the back ends that have none of their own (bvh, kdtree, grid,
-// brute): one structure per instanced mesh in object space, one over everything placed by the
+// brute): object-space structures per mesh under a top-level BVH over the instances.
+#pragma once
+
+// One structure per instanced mesh in object space, one over everything placed by the
 // identity in world space, and a top-level BVH over the instances' world bounds whose leaves
 // carry the ray into object space (pbrt-v4's TransformedPrimitive; Wald et al., "Distributed
 // Interactive Ray Tracing of Dynamic Scenes", IEEE PVG 2003, for the two-level scheme).
-#pragma once
 
 #include <functional>
 #include <memory>

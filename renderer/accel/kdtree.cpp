@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "renderer/accel/common.h"
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 namespace {
@@ -279,7 +280,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
  public:
   KdTreeAccelerator(std::span<const TriangleMeshView> meshes, const KdTreeConfig& config) : m_config(config) {
     validate(config);
-    const auto t0 = std::chrono::steady_clock::now();
+    const BuildTimer timer;
     m_tris = gather_triangles(meshes);
     m_input_triangles = count_input_triangles(meshes);
     if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many triangles (max 2^30 - 1)");
@@ -305,22 +306,21 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
         throw std::runtime_error("kdtree: tree too large (more than 2^30 nodes or references)");
       m_tally.fill(m_stats);
     }
-    m_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_build_seconds = timer.seconds();
   }
 
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = m_stats;
-    s.name = "kdtree";
-    s.config = "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
-               format_number(m_config.intersection_cost) + ", empty_bonus " +
-               format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth);
-    s.triangles = m_input_triangles;
+    AccelStats s = make_stats(
+        m_stats, "kdtree",
+        "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
+            format_number(m_config.intersection_cost) + ", empty_bonus " + format_number(m_config.empty_bonus) +
+            ", max_depth " + std::to_string(m_max_depth),
+        m_input_triangles,
+        m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) + m_tris.size() * sizeof(TriangleRecord),
+        m_build_seconds);
     s.nodes = m_nodes.size();
-    s.bytes = m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) +
-              m_tris.size() * sizeof(TriangleRecord);
-    s.build_seconds = m_build_seconds;
     return s;
   }
 

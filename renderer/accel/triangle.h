@@ -1,17 +1,18 @@
 // The watertight ray-triangle test shared by Penumbra's own acceleration structures, so that a
 // disagreement between two structures is structural, never numerical.
 // Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013.
+#pragma once
+
 // The hit/miss decision is Woop's, in float (watertight). Once a ray is known to pass through
 // the triangle, t, u and v are recomputed with the same formulas in double: in float they lose
-// up to 1e-3 relative on long thin triangles far from the hit (the edge functions cancel), which
-// the benchmark's "slivers" scene exposed against Embree and a double-precision reference.
-#pragma once
+// up to 1e-3 relative on long thin triangles far from the hit (the edge functions cancel), as
+// in the benchmark's "slivers" scene checked against Embree and a double-precision reference.
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
-#include "renderer/geometry.h"
+#include "renderer/core/geometry.h"
 
 namespace penumbra {
 

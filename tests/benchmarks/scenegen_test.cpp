@@ -6,8 +6,9 @@
 #include "benchmarks/scenegen.h"
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
-#include "renderer/accel/cross_check.h"
-#include "test_util.h"
+#include "support/cross_check.h"
+#include "renderer/integrators/scene_accel.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;

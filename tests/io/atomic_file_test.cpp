@@ -11,7 +11,7 @@
 
 #include "io/error.h"
 #include "io/hash.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

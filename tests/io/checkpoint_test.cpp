@@ -10,9 +10,9 @@
 #include <iterator>
 #include <limits>
 
-#include "fifo_test_util.h"
+#include "support/fifo_test_util.h"
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

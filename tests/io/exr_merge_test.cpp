@@ -10,13 +10,14 @@
 #include <cstring>
 #include <fstream>
 
-#include "fifo_test_util.h"
+#include "support/fifo_test_util.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
 #include "io/render_settings.h"
-#include "renderer/render.h"
-#include "test_util.h"
+#include "renderer/integrators/render.h"
+#include "renderer/integrators/scene_accel.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

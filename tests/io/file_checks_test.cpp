@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

@@ -4,11 +4,11 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "gltf_writer.h"
+#include "support/gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
-#include "scene_builder.h"
-#include "test_util.h"
+#include "support/scene_builder.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using nlohmann::json;

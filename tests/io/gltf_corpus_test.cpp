@@ -5,7 +5,7 @@
 
 #include "io/error.h"
 #include "io/gltf_loader.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 namespace fs = std::filesystem;

@@ -11,10 +11,10 @@
 #include <fstream>
 #include <functional>
 
-#include "gltf_writer.h"
+#include "support/gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;

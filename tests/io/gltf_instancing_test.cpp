@@ -7,13 +7,14 @@
 
 #include <cmath>
 
-#include "gltf_writer.h"
+#include "support/gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
-#include "renderer/render.h"
-#include "scene_builder.h"
-#include "test_util.h"
+#include "renderer/integrators/render.h"
+#include "renderer/integrators/scene_accel.h"
+#include "support/scene_builder.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using penumbra::test::GltfWriter;

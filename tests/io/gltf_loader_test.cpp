@@ -6,9 +6,9 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 
-#include "gltf_writer.h"
+#include "support/gltf_writer.h"
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using penumbra::test::GltfWriter;

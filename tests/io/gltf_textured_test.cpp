@@ -9,9 +9,10 @@
 #include "io/gltf_loader.h"
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
-#include "renderer/material.h"
-#include "renderer/render.h"
-#include "test_util.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/materials/material.h"
+#include "renderer/integrators/render.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 

@@ -6,9 +6,9 @@
 #include "io/error.h"
 #include "io/gltf_loader.h"
 #include "io/gltf_writer.h"
-#include "renderer/camera.h"
-#include "scene_builder.h"
-#include "test_util.h"
+#include "renderer/scene/camera.h"
+#include "support/scene_builder.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using penumbra::test::check_vec;

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 

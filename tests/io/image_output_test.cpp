@@ -10,7 +10,7 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 

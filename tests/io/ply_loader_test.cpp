@@ -6,7 +6,7 @@
 
 #include "io/error.h"
 #include "io/ply_loader.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;

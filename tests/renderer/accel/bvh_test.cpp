@@ -5,10 +5,11 @@
 #include <catch2/catch.hpp>
 #include <tbb/task_arena.h>
 
-#include "cross_check.h"
+#include "support/cross_check.h"
 #include "io/gltf_loader.h"
-#include "renderer/scene.h"
-#include "test_util.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/scene.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;

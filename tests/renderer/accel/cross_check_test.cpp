@@ -1,4 +1,4 @@
-// The accelerator cross-check (issue 3): every back end against the brute-force oracle and
+// The accelerator cross-check: every back end against the brute-force oracle and
 // against Embree, per ray, on synthetic edge cases, the project's default scene and every valid
 // corpus model; watertightness from inside a closed sphere; and the default scene rendered with
 // every back end. The [.slow] variants run many more rays outside CI:
@@ -8,11 +8,12 @@
 #include <filesystem>
 #include <map>
 
-#include "cross_check.h"
+#include "support/cross_check.h"
 #include "io/gltf_loader.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
-#include "test_util.h"
+#include "renderer/integrators/render.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/scene.h"
+#include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "cross_check.h"
+#include "support/cross_check.h"
 #include "renderer/accel/factory.h"
 
 using namespace penumbra;

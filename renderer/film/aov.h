@@ -1,0 +1,39 @@
+// First-hit data AOVs for compositing: albedo, shading normal, camera-space depth, world
+// position, UV and object/material ids, taken from the same camera sample positions as the
+// beauty of either integrator (whitted: the stratified, filtered positions; path: the first
+// dimension of each sample's stream), so every layer lines up with the beauty exactly.
+#pragma once
+
+// Per pixel, over the pixel's samples:
+//   albedo  mean of the first visible surface's base colour (factor x texture x COLOR_0), 0 for
+//           samples that miss: premultiplied by coverage like the beauty;
+//   N, P, UV  mean over the samples that hit (unpremultiplied data; N renormalised); 0 if none;
+//   Z       the nearest camera-space depth (distance along the view axis, as Nuke's ZDefocus
+//           reads it) among the samples that hit; +inf where every sample misses;
+//   ids     the id hit by most samples (ties: the smaller id); 0 = background. Object id = glTF
+//           node index + 1, material id = material index + 1 (0 = the default material).
+
+#include <cstdint>
+#include <vector>
+
+#include "renderer/integrators/render.h"
+
+namespace penumbra {
+
+struct DataAovs {
+  int width = 0, height = 0;  ///< of render_window(config); every vector covers that window
+  std::vector<float> albedo;    ///< 3 per pixel
+  std::vector<float> normal;    ///< 3 per pixel, world space
+  std::vector<float> position;  ///< 3 per pixel, world space
+  std::vector<float> uv;        ///< 2 per pixel (TEXCOORD_0)
+  std::vector<float> depth;     ///< 1 per pixel
+  std::vector<float> object_id;    ///< 1 per pixel (integer values)
+  std::vector<float> material_id;  ///< 1 per pixel (integer values)
+};
+
+/// Traces the camera samples of `integrator` under `config` (threads, tiles, spp, seed,
+/// filter, sampler) and reduces them per pixel as above. Deterministic for any thread count.
+DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                          const RenderConfig& config, IntegratorType integrator);
+
+}  // namespace penumbra

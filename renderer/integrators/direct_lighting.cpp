@@ -1,0 +1,91 @@
+// Next-event estimation for punctual, area and environment lights.
+#include "renderer/integrators/direct_lighting.h"
+
+#include "renderer/integrators/visibility.h"
+#include "renderer/lights/punctual.h"
+#include "renderer/materials/material.h"
+
+namespace penumbra {
+
+bool sample_incident(const Light& light, Vec3f p, IncidentLight& out) {
+  LightSample ls;
+  if (!sample_light(light, p, ls)) return false;
+  out = IncidentLight{ls.wi, ls.distance, ls.irradiance, 1.0f, true};
+  return true;
+}
+
+bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float u1, Vec2f u2,
+                     IncidentLight& out) {
+  AreaLightSample ls;
+  if (!sample_area_light(area, scene, u1, u2, ls)) return false;
+  const Vec3f d = ls.p - p;
+  const float dist2 = dot(d, d), dist = std::sqrt(dist2);
+  const Vec3f wi = d / dist;
+  const float cos_l = dot(ls.ng, wi);  // > 0: the point sees the light's back side
+  const Material& lm = material_of(scene, scene.meshes[size_t(scene.instances[ls.instance].mesh)].material);
+  const bool visible_side = lm.double_sided || cos_l < 0;
+  if (!(dist2 > 0 && std::isfinite(dist) && visible_side && std::fabs(cos_l) > 0)) return false;
+  Ray to_light;
+  to_light.org = p;
+  to_light.dir = wi;
+  Hit lh;
+  lh.t = dist;
+  lh.u = ls.u;
+  lh.v = ls.v;
+  lh.geom_id = ls.instance;
+  lh.prim_id = ls.prim;
+  const MaterialPoint lp = eval_material(scene, make_interaction(scene, to_light, lh));
+  const Vec3f le = lp.emissive * lp.alpha;
+  if (!(max_component(le) > 0)) return false;
+  out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};
+  return true;
+}
+
+bool sample_incident(const Environment& env, Vec2f u, IncidentLight& out) {
+  Vec3f wi, le;
+  float pdf = 0;
+  if (!env_sample(env, u, wi, le, pdf) || !(max_component(le) > 0)) return false;
+  out = IncidentLight{wi, kInfinity, le, pdf, false};
+  return true;
+}
+
+namespace {
+
+// One light sample's contribution: BRDF, shadow ray, MIS weight.
+void estimate(const Scene& scene, const Accelerator& accel, const DirectLightingVertex& v,
+              const DirectLightingMode& mode, const IncidentLight& l, RayCounts& counts,
+              PathRadiance& out) {
+  if (!(dot(l.wi, v.si.ng) > 0)) return;  // light below the geometric surface
+  float pdf_b = 0;
+  const Vec3f f = brdf_eval_pdf(v.brdf, v.wo, l.wi, pdf_b);
+  if (!(max_component(f) > 0)) return;
+  ++counts.shadow;
+  const float t = shadow_transmittance(scene, accel, shadow_ray(v.si, l.wi, l.distance), mode.hit_filter);
+  const float w = l.delta || !mode.bsdf_mis ? 1.0f : power_heuristic(l.pdf, v.bsdf_share * pdf_b);
+  if (!(t > 0 && w > 0)) return;
+  const bool split = out.groups && v.vertex == 0;
+  const Vec3f share = split ? diffuse_share(v.brdf, v.wo, l.wi) : Vec3f{};
+  out.add(v.beta * f * l.li * (std::max(0.0f, dot(v.brdf.n, l.wi)) * t * w / l.pdf), v.vertex,
+          split ? &share : nullptr);
+}
+
+}  // namespace
+
+void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                            const DirectLightingVertex& v, const DirectLightingMode& mode,
+                            SampleStream& samples, RayCounts& counts, PathRadiance& out) {
+  IncidentLight l;
+  for (const Light& light : scene.lights)
+    if (sample_incident(light, v.si.p, l)) estimate(scene, accel, v, mode, l, counts, out);
+  if (!mode.sample_lights) return;
+  if (!lights.area->pmf.empty()) {
+    const float u1 = samples.get1d();
+    const Vec2f u2 = samples.get2d();
+    if (sample_incident(*lights.area, scene, v.si.p, u1, u2, l)) estimate(scene, accel, v, mode, l, counts, out);
+  }
+  if (!is_black(*lights.environment)) {
+    if (sample_incident(*lights.environment, samples.get2d(), l)) estimate(scene, accel, v, mode, l, counts, out);
+  }
+}
+
+}  // namespace penumbra

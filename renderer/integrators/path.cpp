@@ -1,0 +1,195 @@
+// Path tracer with next-event estimation and MIS (see path.h for the model and references),
+// in the phases of pbrt-v4's PathIntegrator::Li and Mitsuba 3's path integrator: emitter hit,
+// next-event estimation (direct_lighting.h), BSDF sampling, Russian roulette.
+#include "renderer/integrators/path.h"
+
+#include "renderer/integrators/direct_lighting.h"
+#include "renderer/integrators/visibility.h"
+
+namespace penumbra {
+
+namespace {
+
+// What stays fixed along a path.
+struct PathContext {
+  const Scene& scene;
+  const Accelerator& accel;
+  const PathLights& lights;
+  const PathConfig& cfg;
+  bool env_lit;        // the environment emits
+  bool sample_lights;  // light sampling finds emitters and the environment
+  bool bsdf_lights;    // BSDF sampling finds them
+};
+
+// The ray about to be traced and what produced it.
+struct Segment {
+  Ray ray;
+  Vec3f beta{1, 1, 1};
+  float prev_pdf = 0;      // solid-angle density of the direction that produced `ray`
+  bool prev_delta = true;  // the camera ray or a delta lobe produced `ray`: no MIS
+  int layers = 0;          // Blend surfaces passed on this segment
+};
+
+// The BRDF at a hit and the choice between it and thin transmission (a delta lobe straight
+// through, chosen with probability p_t).
+struct Lobes {
+  GltfBrdf brdf;
+  Vec3f trans_weight;
+  float p_t = 0;
+  float p_r = 1;  // share of the BRDF's (non-delta) sampling
+};
+
+// Emitter hit: the environment seen by a ray that escaped, MIS-weighted against the
+// environment sample of the previous vertex.
+void add_escaped(const PathContext& ctx, const Segment& seg, int vertex, PathRadiance& path) {
+  if (!ctx.env_lit) return;
+  const Environment& env = *ctx.lights.environment;
+  float w = 1;
+  if (!seg.prev_delta)
+    w = !ctx.bsdf_lights ? 0.0f : (ctx.sample_lights ? power_heuristic(seg.prev_pdf, env_pdf(env, seg.ray.dir)) : 1.0f);
+  if (w > 0) path.add(seg.beta * env_eval(env, seg.ray.dir) * w, vertex - 1);
+}
+
+// Emitter hit: emission of the surface hit, seen by the previous vertex (or the camera),
+// MIS-weighted against the area-light sample taken there.
+void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit,
+                  const SurfaceInteraction& si, const MaterialPoint& mp, int vertex, PathRadiance& path) {
+  if (!(max_component(mp.emissive) > 0) || mp.unlit) return;
+  float w = 1;
+  if (!seg.prev_delta) {
+    if (!ctx.bsdf_lights) {
+      w = 0;
+    } else if (ctx.sample_lights) {
+      const float cos_l = std::fabs(dot(si.ng, seg.ray.dir));
+      const float pdf_l = cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l : 0.0f;
+      w = power_heuristic(seg.prev_pdf, pdf_l);
+    }
+  }
+  if (w > 0) path.add(seg.beta * mp.emissive * w, vertex - 1);
+}
+
+// The BRDF and the transmission/reflection choice by estimated energy: transmitted vs
+// reflected (Fresnel-weighted specular plus the remaining diffuse) at this view angle.
+Lobes choose_lobes(const MaterialPoint& mp, Vec3f wo) {
+  Lobes l;
+  l.brdf.base_color = mp.base_color;
+  l.brdf.metallic = mp.metallic;
+  l.brdf.roughness = mp.roughness;
+  l.brdf.n = mp.ns;
+  l.brdf.f0 = mp.f0;
+  l.brdf.specular = mp.specular;
+  l.brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
+  const float cos_o = std::fabs(dot(mp.ns, wo));
+  l.trans_weight = mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - dielectric_fresnel(l.brdf, cos_o)));
+  if (l.brdf.transmission > 0) {
+    const float t = luminance(l.trans_weight);
+    const float fd = dielectric_fresnel(l.brdf, cos_o);
+    const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
+                    mp.metallic * luminance(mp.base_color);
+    l.p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
+  }
+  l.p_r = 1 - l.p_t;
+  return l;
+}
+
+// BSDF sampling: the next direction (transmission or the BRDF), updating the throughput and
+// the MIS state. False when the path ends here.
+bool sample_bsdf(const Lobes& lobes, const SurfaceInteraction& si, Vec3f wo, int vertex,
+                 SampleStream& samples, Segment& seg, PathRadiance& path, Vec3f& wi) {
+  const float u_lobe = samples.get1d();
+  const Vec2f u_dir = samples.get2d();
+  if (u_lobe < lobes.p_t) {
+    wi = seg.ray.dir;
+    if (vertex == 0) path.share0 = {0, 0, 0};  // transmission counts as specular
+    seg.beta *= lobes.trans_weight / lobes.p_t;
+    seg.prev_delta = true;
+    seg.prev_pdf = 0;
+  } else {
+    BrdfSample bs;
+    if (!brdf_sample(lobes.brdf, wo, (u_lobe - lobes.p_t) / lobes.p_r, u_dir, bs)) return false;
+    if (dot(bs.wi, si.ng) <= 0) return false;  // below the geometric surface
+    wi = bs.wi;
+    if (vertex == 0 && path.groups) path.share0 = diffuse_share(lobes.brdf, wo, wi);
+    seg.beta *= bs.weight / lobes.p_r;
+    seg.prev_delta = false;
+    seg.prev_pdf = lobes.p_r * bs.pdf;
+  }
+  return max_component(seg.beta) > 0 && is_finite(seg.beta);
+}
+
+// Russian roulette (Arvo & Kirk 1990): survive with probability min(1, max beta), reweighted.
+bool survives_roulette(SampleStream& samples, Vec3f& beta) {
+  const float q = std::min(1.0f, max_component(beta));
+  if (samples.get1d() >= q) return false;
+  beta = beta / q;
+  return true;
+}
+
+}  // namespace
+
+Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                    const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
+                    SampleStream& samples, float& coverage, RayCounts& counts,
+                    LightGroups* groups) {
+  ++counts.camera;
+  coverage = 0;
+  PathRadiance path;
+  path.clamp_indirect = cfg.clamp_indirect;
+  path.groups = groups;
+  const PathContext ctx{scene, accel, lights, cfg, !is_black(*lights.environment),
+                        cfg.strategy != LightStrategy::Bsdf, cfg.strategy != LightStrategy::Light};
+  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter};
+  Segment seg;
+  seg.ray = camera_ray;
+  seg.ray.dir = normalize(seg.ray.dir);
+
+  for (int vertex = 0;;) {
+    Hit hit;
+    if (!intersect_visible(scene, accel, seg.ray, hit, cfg.hit_filter)) {
+      add_escaped(ctx, seg, vertex, path);
+      break;
+    }
+    SurfaceInteraction si = make_interaction(scene, seg.ray, hit);
+    if (vertex == 0 && seg.layers == 0) compute_differentials(scene, si, rd);
+    const MaterialPoint mp = eval_material(scene, si);
+
+    // Blend: hit with probability alpha, else continue along the same ray.
+    const float a = seg.layers < cfg.max_blend_layers ? mp.alpha : 1.0f;
+    if (a < 1 && samples.get1d() >= a) {
+      seg.ray.tnear = std::nextafter(std::max(hit.t, seg.ray.tnear), kInfinity);
+      ++seg.layers;
+      continue;
+    }
+    seg.layers = 0;
+    if (vertex == 0) coverage = 1;
+
+    // Emitter hit.
+    add_emission(ctx, seg, hit, si, mp, vertex, path);
+    if (mp.unlit) {  // KHR_materials_unlit: radiance = base colour, no lighting, no bounce
+      path.add(seg.beta * mp.base_color, vertex - 1);
+      break;
+    }
+    if (vertex > cfg.max_depth) break;
+
+    // Next-event estimation.
+    const Vec3f wo = -seg.ray.dir;
+    const Lobes lobes = choose_lobes(mp, wo);
+    sample_direct_lighting(scene, accel, lights, {si, lobes.brdf, wo, seg.beta, vertex, lobes.p_r}, mode,
+                           samples, counts, path);
+
+    // BSDF sampling.
+    Vec3f wi;
+    if (!sample_bsdf(lobes, si, wo, vertex, samples, seg, path, wi)) break;
+    ++vertex;
+
+    // Russian roulette.
+    if (vertex >= cfg.rr_depth && !survives_roulette(samples, seg.beta)) break;
+    seg.ray = Ray{};
+    seg.ray.org = offset_ray_origin(si.p, si.ng, wi);
+    seg.ray.dir = wi;
+    ++counts.reflection;
+  }
+  return path.radiance;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,122 @@
+// The image renderer of both integrators: Whitted in one pass, the path tracer in progressive
+// passes with checkpointable per-pixel sums, over the tiles of core/parallel.h with one sample
+// stream per (pixel, sample), so the image is bit-identical for any thread count.
+#pragma once
+
+// Whitted: stratified jittered supersampling of each pixel, box filtered (or any pixel filter,
+// applied by filter importance sampling). Path: progressive passes over the image (1, 2, 4, 8,
+// 16 samples, then 16 per pass), each pixel the mean of its samples, with an optional time limit
+// (checked after each whole pass) and optional adaptive sampling that stops pixels whose
+// estimated error falls below a threshold. Each pixel's value depends only on its own
+// samples, so neither threads, tiles nor the pass schedule change it.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "renderer/film/film.h"
+#include "renderer/integrators/path.h"
+#include "renderer/integrators/ray_counts.h"
+#include "renderer/integrators/render_config.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/whitted.h"
+#include "renderer/scene/camera.h"
+
+namespace penumbra {
+
+struct RenderStats {
+  RayCounts rays;
+  double seconds = 0;
+  int threads = 0;
+  int passes = 0;           ///< path: passes rendered
+  uint64_t samples = 0;     ///< camera samples taken in all
+  bool time_limited = false;  ///< path: the time limit ended the render early
+};
+
+/// Called after each finished tile with (tiles done, tiles total), from worker threads;
+/// the callee must be thread-safe. May be empty.
+using ProgressFn = std::function<void(int done, int total)>;
+
+/// Renders the scene with the Whitted integrator. Requires a config that passes validate()
+/// and an accelerator from make_scene_accelerator(name, scene).
+Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                    const RenderConfig& config, RenderStats* stats = nullptr,
+                    const ProgressFn& progress = {});
+
+/// One pixel's value (RGBA, premultiplied) exactly as render_whitted computes it: the
+/// replay behind `penumbra render --debug-pixel x,y`.
+void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                          const RenderConfig& config, int x, int y, float rgba[4],
+                          RayCounts& counts);
+
+/// A path-traced image with its per-pixel statistics.
+struct PathImage {
+  Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied);
+                                   ///< all per-pixel vectors cover render_window(config)
+  std::vector<uint32_t> samples;   ///< samples taken per pixel
+  std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
+  /// With RenderConfig::light_groups: kLightGroupChannels floats per pixel, the means of the
+  /// light groups in kLightGroupNames order (RGB each).
+  std::vector<float> groups;
+};
+
+/// The path tracer's per-pixel running sums, accumulated in each pixel's sample order: what a
+/// checkpoint saves and a resumed render continues from (plain data, written as raw bytes).
+struct PathAccumulators {
+  struct Pixel {
+    double rgba[4] = {0, 0, 0, 0};
+    double sum_y = 0, sum_y2 = 0;  ///< luminance sums for the error estimate
+    uint32_t n = 0;                ///< samples taken
+    uint32_t active = 1;           ///< 0 once adaptive sampling stopped the pixel
+  };
+  PixelWindow window;              ///< the render window the pixels cover
+  std::vector<Pixel> pixels;
+  std::vector<double> groups;      ///< kLightGroupChannels light-group sums per pixel, or empty
+  uint32_t reached = 0;            ///< samples every still-active pixel has taken
+  int passes = 0;                  ///< passes completed
+  bool complete = false;           ///< the requested spp (or adaptive convergence) was reached
+};
+
+/// Bytes of one pixel's accumulators as a checkpoint stores them (raw, native byte order).
+inline constexpr size_t kPathPixelBytes = sizeof(PathAccumulators::Pixel);
+static_assert(kPathPixelBytes == 56, "checkpoints store PathAccumulators::Pixel as 56 raw bytes");
+
+/// Called after every completed pass with the accumulators (for checkpoints).
+using PassFn = std::function<void(const PathAccumulators& state)>;
+
+/// Renders with the path tracer. Same requirements as render_whitted; `lights` must be built
+/// from the same scene (build_area_lights) with a non-null environment.
+/// `state`, if given, is continued from when it matches the config's window and light groups
+/// (a resumed render: passes already done are skipped, so the result is bit-identical to an
+/// uninterrupted render with the same settings), and holds the final sums afterwards.
+/// Between passes the render stops early when config.stop is set or the time limit is near.
+PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                      const Camera& camera, const RenderConfig& config,
+                      RenderStats* stats = nullptr, const ProgressFn& progress = {},
+                      PathAccumulators* state = nullptr, const PassFn& after_pass = {});
+
+/// The image (means, counts, variances, light groups) of a set of accumulators.
+PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& config);
+
+/// One pixel exactly as render_path computes it with all `config.spp` samples (no adaptive
+/// stop): the replay behind --debug-pixel.
+void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                       const Camera& camera, const RenderConfig& config, int x, int y,
+                       float rgba[4], RayCounts& counts);
+
+/// Raster position (pixel corner at integer coordinates) of camera sample `s` of pixel (x, y)
+/// exactly as `integrator` places it: the one definition the integrators, the data AOVs and
+/// the cost map share.
+Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
+                             uint32_t s);
+
+/// The pass schedule of render_path: sample index where pass k ends (1, 2, 4, 8, 16, 32, 48,
+/// ... capped at spp).
+std::vector<int> path_pass_ends(int spp);
+
+/// Error estimate of a pixel for adaptive sampling (as Cycles weighs it): the standard error
+/// of its mean luminance divided by sqrt(mean luminance), so that dark pixels, where the
+/// display transform stretches noise, need a proportionally smaller absolute error.
+float pixel_error(double sum_y, double sum_y2, uint32_t n);
+
+}  // namespace penumbra

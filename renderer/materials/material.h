@@ -1,0 +1,50 @@
+// Material evaluation at a surface point: glTF factors times textures (base colour, alpha,
+// metallic-roughness, normal map, occlusion, emission, transmission) and vertex colours, and
+// the coverage (alpha) of a hit for visibility filtering. Evaluation only: the ray queries
+// that use it are in integrators/visibility.h.
+#pragma once
+
+#include "renderer/scene/interaction.h"
+
+namespace penumbra {
+
+/// A material's values at one surface point.
+struct MaterialPoint {
+  Vec3f base_color{1, 1, 1};  ///< linear RGB: factor x texture x COLOR_0
+  float alpha = 1;            ///< coverage: factor x texture.a x COLOR_0.a (1 for Opaque)
+  float metallic = 1, roughness = 1;  ///< factor x texture (B, G)
+  Vec3f emissive{0, 0, 0};    ///< emitted radiance: factor x strength x texture
+  float occlusion = 1;        ///< 1 + strength (texture.r - 1); ambient-only (not path traced)
+  Vec3f ns;                   ///< unit shading normal after normal mapping, facing the viewer
+  bool unlit = false;
+  float f0 = 0.04f;           ///< dielectric reflectance at normal incidence, from the ior
+  float specular = 1;         ///< KHR_materials_specular factor
+  float transmission = 0;     ///< factor x texture (R)
+};
+
+/// Dielectric reflectance at normal incidence for an index of refraction (glTF's 1.5 gives
+/// 0.04): ((ior - 1) / (ior + 1))^2.
+inline float ior_to_f0(float ior) {
+  const float r = (ior - 1) / (ior + 1);
+  return r * r;
+}
+
+/// The material used by meshes without one (glTF's default: white, metallic 1, roughness 1).
+const Material& default_material();
+inline const Material& material_of(const Scene& scene, int material) {
+  return material >= 0 ? scene.materials[size_t(material)] : default_material();
+}
+
+/// Value of a texture reference at si (uv set, KHR_texture_transform, filtered at the level
+/// si's UV derivatives select). {1,1,1,1} for ref.texture < 0.
+Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInteraction& si);
+
+/// Evaluates every material input at si (si must come from make_interaction; derivatives
+/// from compute_differentials are optional). Never allocates.
+MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si);
+
+/// Coverage of the surface at barycentrics (u, v) of triangle `prim` of instance `instance`: alpha
+/// factor x base colour texture alpha (finest level) x COLOR_0 alpha. 1 for Opaque materials.
+float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v);
+
+}  // namespace penumbra

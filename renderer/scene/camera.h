@@ -1,0 +1,31 @@
+// Camera ray generation (orthographic and perspective) and automatic framing.
+// The image aspect always defines the horizontal extent, so pixels are square and the image
+// is never distorted, whatever aspect-ratio hint the file carries.
+#pragma once
+
+#include "renderer/core/geometry.h"
+#include "renderer/scene/scene.h"
+
+namespace penumbra {
+
+/// Ray through raster position (x, y) of a width x height image; x to the right, y down,
+/// pixel (i, j) covers [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5).
+/// Perspective: origin at the eye, unit direction through the image plane; tnear/tfar are
+/// set so that clipping happens at the planes z = znear / zfar (not spheres).
+/// Orthographic: origin on the image plane (ymag half-height, xmag' = ymag * aspect), dir = -w.
+Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y);
+
+/// A camera at `eye` looking at `target` with approximate up vector `up` (right-handed frame).
+Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov);
+
+/// Default framing used when a scene has no camera: a perspective camera with a 39.6 degree
+/// vertical FOV looking at the bounds' centre from the front-right-above direction
+/// (0.5, 0.4, 1) so that the bounding sphere fits the image of the given aspect.
+Camera frame_bounds(const Bounds3f& bounds, float aspect);
+
+/// The documented default key light added when a scene has no light: a white directional
+/// light with illuminance pi lux (a white Lambertian surface facing it has radiance 1),
+/// arriving from above, left and behind the camera (direction 0.5 u - 0.8 v - 1.0 w).
+Light default_key_light(const Camera& cam);
+
+}  // namespace penumbra

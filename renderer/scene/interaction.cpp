@@ -1,0 +1,119 @@
+// Hit -> surface reconstruction and ray-differential footprints.
+#include "renderer/scene/interaction.h"
+
+namespace penumbra {
+
+SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {
+  const Instance& inst = scene.instances[hit.geom_id];
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const WorldTriangle tri = world_triangle(scene, inst, hit.prim_id);
+  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
+  const float w = 1.0f - hit.u - hit.v;
+  SurfaceInteraction si;
+  si.instance = hit.geom_id;
+  si.mesh = uint32_t(inst.mesh);
+  si.prim = hit.prim_id;
+  si.p = tri.p[0] * w + tri.p[1] * hit.u + tri.p[2] * hit.v;
+  si.material = mesh.material;
+  si.ng = tri.ng;
+  if (!(dot(si.ng, si.ng) > 0)) si.ng = normalize(-ray.dir);
+  Vec3f ns = si.ng;
+  if (!mesh.normals.empty()) {
+    ns = normalize(world_normal(inst, mesh.normals[i0]) * w + world_normal(inst, mesh.normals[i1]) * hit.u +
+                   world_normal(inst, mesh.normals[i2]) * hit.v);
+    if (!(dot(ns, ns) > 0)) ns = si.ng;
+  }
+  auto lerp2 = [&](const std::vector<Vec2f>& t) -> Vec2f {
+    return {t[i0].x * w + t[i1].x * hit.u + t[i2].x * hit.v, t[i0].y * w + t[i1].y * hit.u + t[i2].y * hit.v};
+  };
+  auto lerp4 = [&](const std::vector<Vec4f>& t) -> Vec4f {
+    return {t[i0].x * w + t[i1].x * hit.u + t[i2].x * hit.v, t[i0].y * w + t[i1].y * hit.u + t[i2].y * hit.v,
+            t[i0].z * w + t[i1].z * hit.u + t[i2].z * hit.v, t[i0].w * w + t[i1].w * hit.u + t[i2].w * hit.v};
+  };
+  if (!mesh.uvs.empty()) si.uv[0] = lerp2(mesh.uvs);
+  if (!mesh.uvs1.empty()) si.uv[1] = lerp2(mesh.uvs1);
+  if (!mesh.colors.empty()) si.color = lerp4(mesh.colors);
+  if (!mesh.tangents.empty()) {
+    si.tangent = lerp4(mesh.tangents);
+    // The bitangent sign is a sign, not an interpolant; a mirroring placement flips it.
+    si.tangent.w = (mesh.tangents[i0].w < 0) != inst.mirrored ? -1.0f : 1.0f;
+    if (!inst.identity) {
+      const Vec3f t = normalize(apply_vector(inst.to_world, {si.tangent.x, si.tangent.y, si.tangent.z}));
+      si.tangent = {t.x, t.y, t.z, si.tangent.w};
+    }
+  }
+  // Face-forward: both normals towards the viewer, so back faces shade like front faces.
+  si.back_face = dot(si.ng, ray.dir) > 0;
+  if (si.back_face) {
+    si.ng = -si.ng;
+    ns = -ns;
+  }
+  if (dot(ns, si.ng) < 0) ns = si.ng;  // interpolated normal flipped by the geometry
+  si.ns = ns;
+  return si;
+}
+
+void compute_differentials(const Scene& scene, SurfaceInteraction& si, const RayDifferential& rd) {
+  if (!rd.valid) return;
+  // Offsets of the auxiliary rays' hits on the tangent plane through si.p.
+  const float d = dot(si.ng, si.p);
+  const float nx = dot(si.ng, rd.rx_dir), ny = dot(si.ng, rd.ry_dir);
+  if (!(std::fabs(nx) > 1e-12f) || !(std::fabs(ny) > 1e-12f)) return;
+  const float tx = (d - dot(si.ng, rd.rx_org)) / nx, ty = (d - dot(si.ng, rd.ry_org)) / ny;
+  const Vec3f dpdx = rd.rx_org + rd.rx_dir * tx - si.p, dpdy = rd.ry_org + rd.ry_dir * ty - si.p;
+  if (!is_finite(dpdx) || !is_finite(dpdy)) return;
+  si.dpdx = dpdx;
+  si.dpdy = dpdy;
+  // Barycentric derivatives: least-squares solve of dp = e1 db1 + e2 db2.
+  const Instance& inst = scene.instances[si.instance];
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const WorldTriangle tri = world_triangle(scene, inst, si.prim);
+  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
+  const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
+  const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);
+  const float det = a11 * a22 - a12 * a12;
+  if (!(det > 0) || !std::isfinite(det)) return;
+  auto solve = [&](Vec3f dp) -> Vec2f {
+    const float r1 = dot(e1, dp), r2 = dot(e2, dp);
+    return {(a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det};
+  };
+  const Vec2f bx = solve(dpdx), by = solve(dpdy);
+  auto deriv2 = [&](const std::vector<Vec2f>& t, Vec2f db) -> Vec2f {
+    const Vec2f d1{t[i1].x - t[i0].x, t[i1].y - t[i0].y}, d2{t[i2].x - t[i0].x, t[i2].y - t[i0].y};
+    return {d1.x * db.x + d2.x * db.y, d1.y * db.x + d2.y * db.y};
+  };
+  if (!mesh.uvs.empty()) {
+    si.duvdx[0] = deriv2(mesh.uvs, bx);
+    si.duvdy[0] = deriv2(mesh.uvs, by);
+  }
+  if (!mesh.uvs1.empty()) {
+    si.duvdx[1] = deriv2(mesh.uvs1, bx);
+    si.duvdy[1] = deriv2(mesh.uvs1, by);
+  }
+  if (!mesh.normals.empty()) {
+    const Vec3f n0 = world_normal(inst, mesh.normals[i0]);
+    const Vec3f n1 = world_normal(inst, mesh.normals[i1]) - n0, n2 = world_normal(inst, mesh.normals[i2]) - n0;
+    const float s = si.back_face ? -1.0f : 1.0f;  // si.ns was face-forwarded
+    si.dndx = (n1 * bx.x + n2 * bx.y) * s;
+    si.dndy = (n1 * by.x + n2 * by.y) * s;
+  }
+}
+
+RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd,
+                                     Vec3f wo, Vec3f n, Vec3f wi) {
+  RayDifferential out;
+  if (!rd.valid) return out;
+  out.valid = true;
+  out.rx_org = si.p + si.dpdx;
+  out.ry_org = si.p + si.dpdy;
+  const Vec3f dwodx = -normalize(rd.rx_dir) - wo, dwody = -normalize(rd.ry_dir) - wo;
+  const float ddndx = dot(dwodx, n) + dot(wo, si.dndx);
+  const float ddndy = dot(dwody, n) + dot(wo, si.dndy);
+  out.rx_dir = wi - dwodx + 2.0f * (dot(wo, n) * si.dndx + ddndx * n);
+  out.ry_dir = wi - dwody + 2.0f * (dot(wo, n) * si.dndy + ddndy * n);
+  if (!is_finite(out.rx_dir) || !is_finite(out.ry_dir) || !is_finite(out.rx_org) || !is_finite(out.ry_org))
+    out.valid = false;
+  return out;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,147 @@
+// Scene helpers: instances, bounds, counts, world triangles, normals and tangents.
+#include "renderer/scene/scene.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "renderer/core/geometry.h"
+
+namespace penumbra {
+
+Instance make_instance(int mesh, const Affine3f& to_world, int node) {
+  Instance inst;
+  inst.mesh = mesh;
+  inst.node = node;
+  inst.to_world = to_world;
+  inst.identity = is_identity(to_world);
+  if (!inverse(to_world, inst.to_object))
+    throw std::invalid_argument("instance of mesh " + std::to_string(mesh) + ": transform is singular or not finite");
+  inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
+  return inst;
+}
+
+int add_world_mesh(Scene& scene, Mesh mesh) {
+  const int index = int(scene.meshes.size());
+  Instance inst;
+  inst.mesh = index;
+  inst.node = mesh.node;
+  scene.meshes.push_back(std::move(mesh));
+  scene.instances.push_back(inst);
+  return index;
+}
+
+Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
+  std::vector<Bounds3f> mesh_bounds(scene.meshes.size());
+  for (size_t i = 0; i < scene.meshes.size(); ++i)
+    for (Vec3f p : scene.meshes[i].positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
+  // Placed meshes: every vertex mapped (exact) while that stays cheap, else the mapped corners
+  // of the mesh's box (conservative), so a million placements of a big mesh cost no more
+  // than a million boxes.
+  uint64_t placed_vertices = 0;
+  for (const Instance& inst : scene.instances)
+    if (!inst.identity) placed_vertices += scene.meshes[size_t(inst.mesh)].positions.size();
+  const bool exact = placed_vertices <= exact_vertex_limit;
+  Bounds3f b;
+  for (const Instance& inst : scene.instances) {
+    const Mesh& m = scene.meshes[size_t(inst.mesh)];
+    if (inst.identity) {
+      b = merge(b, mesh_bounds[size_t(inst.mesh)]);
+    } else if (exact) {
+      for (Vec3f p : m.positions) b = merge(b, apply_point(inst.to_world, p));
+    } else {
+      b = merge(b, transform_bounds(inst.to_world, mesh_bounds[size_t(inst.mesh)]));
+    }
+  }
+  return b;
+}
+
+uint64_t count_triangles(const Scene& scene) {
+  uint64_t n = 0;
+  for (const Instance& inst : scene.instances) n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  return n;
+}
+
+uint64_t scene_memory_bytes(const Scene& scene) {
+  auto bytes = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+  uint64_t total = bytes(scene.instances) + bytes(scene.materials) + bytes(scene.lights);
+  for (const Mesh& m : scene.meshes)
+    total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
+             bytes(m.colors) + bytes(m.indices);
+  for (const Texture& t : scene.textures)
+    for (const MipLevel& level : t.levels) total += bytes(level.texels);
+  return total;
+}
+
+uint64_t count_stored_triangles(const Scene& scene) {
+  uint64_t n = 0;
+  for (const auto& m : scene.meshes) n += m.indices.size() / 3;
+  return n;
+}
+
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim) {
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const size_t base = size_t(prim) * 3;
+  WorldTriangle t;
+  for (int k = 0; k < 3; ++k) {
+    t.index[k] = mesh.indices[base + size_t(k)];
+    const Vec3f p = mesh.positions[t.index[k]];
+    t.p[k] = inst.identity ? p : apply_point(inst.to_world, p);
+  }
+  t.ng = triangle_normal(t.p[0], t.p[1], t.p[2]);
+  if (inst.mirrored) t.ng = -t.ng;
+  return t;
+}
+
+std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
+                                          std::span<const uint32_t> indices) {
+  std::vector<Vec3f> n(positions.size());
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+    // |cross| = 2 x area, so summing unnormalised cross products weights by area.
+    const Vec3f face = cross(positions[b] - positions[a], positions[c] - positions[a]);
+    n[a] += face;
+    n[b] += face;
+    n[c] += face;
+  }
+  for (auto& v : n) {
+    v = normalize(v);
+    if (!(dot(v, v) > 0)) v = {0, 0, 1};
+  }
+  return n;
+}
+
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
+                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
+                                    std::span<const uint32_t> indices) {
+  std::vector<Vec3f> tu(positions.size()), tv(positions.size());
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+    const Vec3f e1 = positions[b] - positions[a], e2 = positions[c] - positions[a];
+    const float du1 = uvs[b].x - uvs[a].x, dv1 = uvs[b].y - uvs[a].y;
+    const float du2 = uvs[c].x - uvs[a].x, dv2 = uvs[c].y - uvs[a].y;
+    const float r = du1 * dv2 - du2 * dv1;
+    if (!(std::fabs(r) > 0) || !std::isfinite(r)) continue;
+    // dp/du and dp/dv of the triangle, weighted by its area.
+    const float area = length(cross(e1, e2));
+    const Vec3f dpdu = normalize((e1 * dv2 - e2 * dv1) / r) * area;
+    const Vec3f dpdv = normalize((e2 * du1 - e1 * du2) / r) * area;
+    for (uint32_t v : {a, b, c}) {
+      tu[v] += dpdu;
+      tv[v] += dpdv;
+    }
+  }
+  std::vector<Vec4f> out(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const Vec3f n = normals[v];
+    Vec3f t = normalize(tu[v] - n * dot(n, tu[v]));
+    if (!(dot(t, t) > 0)) {  // no UV gradient here: any tangent orthogonal to n
+      const Vec3f axis = std::fabs(n.x) < 0.9f ? Vec3f{1, 0, 0} : Vec3f{0, 1, 0};
+      t = normalize(cross(axis, n));
+    }
+    const float w = dot(cross(n, t), tv[v]) > 0 ? -1.0f : 1.0f;
+    out[v] = {t.x, t.y, t.z, w};
+  }
+  return out;
+}
+
+}  // namespace penumbra

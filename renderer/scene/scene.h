@@ -1,0 +1,169 @@
+// The scene as plain data: triangle meshes and their instances, materials, textures, punctual
+// lights and cameras, addressed by int handles. Built by io/ from glTF (or by tests directly);
+// consumed by the integrators. No accelerators and no behaviour beyond small free functions
+// (integrators/scene_accel.h builds the accelerator over it).
+#pragma once
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "renderer/core/math.h"
+#include "renderer/materials/texture.h"
+
+namespace penumbra {
+
+/// A material's reference to a texture: which UV set, and KHR_texture_transform's affine map
+/// uv' = [m00 m01 m02; m10 m11 m12] (u, v, 1), the identity by default.
+struct TextureRef {
+  int texture = -1;   ///< index into Scene::textures; -1 = none
+  int texcoord = 0;   ///< 0 = TEXCOORD_0, 1 = TEXCOORD_1
+  float m[2][3] = {{1, 0, 0}, {0, 1, 0}};
+};
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+/// glTF metallic-roughness material: factors times textures (glTF 2.0 spec 3.9).
+/// Colour textures are stored linear (io/ decodes sRGB).
+struct Material {
+  std::string name;
+  Vec3f base_color{1, 1, 1};  ///< linear RGB factor
+  float alpha = 1;            ///< baseColorFactor.a
+  float metallic = 1;   ///< glTF default
+  float roughness = 1;  ///< glTF default
+  Vec3f emissive{0, 0, 0};  ///< emissiveFactor x KHR_materials_emissive_strength
+  bool unlit = false;       ///< KHR_materials_unlit: radiance = base_color, no lighting
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;  ///< Mask: coverage < cutoff is a hole
+  bool double_sided = true;   ///< false: back faces are invisible to camera and mirror rays
+                              ///< (glTF's default is false; io/ sets it from the file)
+  TextureRef base_color_tex;          ///< RGBA, multiplies base_color and alpha
+  TextureRef metallic_roughness_tex;  ///< B = metallic, G = roughness (linear)
+  TextureRef normal_tex;              ///< tangent-space normal map (linear)
+  float normal_scale = 1;             ///< scales the map's X and Y
+  TextureRef occlusion_tex;           ///< R = ambient occlusion (linear)
+  float occlusion_strength = 1;       ///< 1 + strength (R - 1)
+  TextureRef emissive_tex;            ///< RGB, multiplies emissive
+  float ior = 1.5f;                   ///< KHR_materials_ior: dielectric f0 = ((ior-1)/(ior+1))^2
+  float specular = 1;                 ///< KHR_materials_specular specularFactor
+  float transmission = 0;             ///< KHR_materials_transmission factor (thin-walled)
+  TextureRef transmission_tex;        ///< R multiplies transmission (linear)
+};
+
+/// A triangle mesh (one glTF primitive): in world space when its only instance is the identity
+/// (a flattened node), else in the object space its instances place.
+struct Mesh {
+  std::string name;                ///< "meshName[prim]" for messages
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> normals;      ///< unit, one per position (computed if the file has none)
+  std::vector<Vec4f> tangents;     ///< xyz unit tangent along +u, w = +-1 bitangent sign
+                                   ///< (bitangent = w cross(n, t)); empty if not needed
+  std::vector<Vec2f> uvs;          ///< TEXCOORD_0, empty if absent
+  std::vector<Vec2f> uvs1;         ///< TEXCOORD_1, empty if absent
+  std::vector<Vec4f> colors;       ///< COLOR_0 as linear RGBA, empty if absent
+  std::vector<uint32_t> indices;   ///< 3 per triangle, counter-clockwise = front
+  int material = -1;               ///< index into Scene::materials, -1 = default material
+  int node = -1;                   ///< glTF node of a flattened mesh, -1 if shared or not from glTF
+};
+
+/// One placement of a mesh in the world. A Hit's geom_id is an index into Scene::instances.
+/// Make them with make_instance() so the inverse and `mirrored` agree with `to_world`.
+struct Instance {
+  int mesh = 0;        ///< index into Scene::meshes
+  Affine3f to_world;   ///< object to world
+  Affine3f to_object;  ///< its inverse
+  bool identity = true;   ///< to_world is the identity (the mesh is in world space)
+  bool mirrored = false;  ///< det(to_world) < 0: the front face is clockwise in world space
+                          ///< (glTF 3.7.4), i.e. counter-clockwise in object space
+  int node = -1;          ///< glTF node, -1 if not from glTF
+  int copy = -1;          ///< EXT_mesh_gpu_instancing instance index within the node, else -1
+};
+
+enum class LightType { Point, Spot, Directional };
+
+/// KHR_lights_punctual light in world space. Units as in the glTF spec: point and spot
+/// intensity in candela (treated as W/sr in scene-linear units), directional in lux.
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  Vec3f color{1, 1, 1};
+  float intensity = 1;
+  Vec3f position;           ///< point / spot
+  Vec3f direction{0, 0, -1};  ///< spot / directional: unit direction the light travels
+  float range = kInfinity;  ///< point / spot cut-off distance (spec's smooth window)
+  float inner_cone = 0;     ///< spot, radians
+  float outer_cone = kPi / 4;  ///< spot, radians
+};
+
+enum class Projection { Perspective, Orthographic };
+
+/// A camera in world space: eye and a right-handed orthonormal frame (u right, v up, w back;
+/// the camera looks along -w), as glTF places cameras looking down their local -Z.
+struct Camera {
+  std::string name;
+  Projection projection = Projection::Perspective;
+  Vec3f eye;
+  Vec3f u{1, 0, 0}, v{0, 1, 0}, w{0, 0, 1};
+  float yfov = 0.6911f;   ///< perspective: vertical field of view, radians (0.6911 ~ 39.6 deg)
+  float aspect = 0;       ///< the file's aspect-ratio hint (width/height); 0 = none
+  float xmag = 1, ymag = 1;  ///< orthographic half-extents
+  float znear = 0;        ///< clip distances along -w
+  float zfar = kInfinity;
+};
+
+struct Scene {
+  std::vector<Mesh> meshes;
+  std::vector<Instance> instances;  ///< what is rendered: a mesh without an instance is not
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<Camera> cameras;
+};
+
+/// An instance of `mesh` placed by `to_world`. Throws std::invalid_argument if the map is
+/// singular or not finite.
+Instance make_instance(int mesh, const Affine3f& to_world, int node = -1);
+/// Appends a world-space mesh with its identity instance; returns the mesh index.
+int add_world_mesh(Scene& scene, Mesh mesh);
+
+/// World-space bounds of every instance's positions (empty box for an empty scene); exact
+/// unless the meshes placed by non-identity instances hold more than `exact_vertex_limit`
+/// vertices in all, then each such placement contributes the mapped box of its mesh
+/// (conservative, and as cheap for a million placements as for one).
+Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64_t(1) << 24);
+/// Triangles rendered: each mesh counted once per instance.
+uint64_t count_triangles(const Scene& scene);
+/// Triangles stored: each mesh once.
+uint64_t count_stored_triangles(const Scene& scene);
+
+/// Bytes held by the scene's arrays (mesh attributes, instances, texture pyramids), for
+/// memory budgets.
+uint64_t scene_memory_bytes(const Scene& scene);
+/// Triangle `prim` of instance `inst` in world space: its vertex indices, its world positions
+/// and its unit front-facing geometric normal (counter-clockwise side in object space; zero if
+/// degenerate).
+struct WorldTriangle {
+  uint32_t index[3];
+  Vec3f p[3];
+  Vec3f ng;
+};
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim);
+/// World-space vertex normal: L^-T n, normalised (n itself for identity instances).
+inline Vec3f world_normal(const Instance& inst, Vec3f n) {
+  return inst.identity ? n : normalize(apply_normal(inst.to_object, n));
+}
+/// Area-weighted smooth vertex normals of an indexed triangle list (unit; a vertex used by no
+/// non-degenerate triangle gets +Z).
+std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
+                                          std::span<const uint32_t> indices);
+/// Per-vertex tangents for normal mapping from positions, unit normals and the UV set the
+/// normal map uses: per-triangle dp/du and dp/dv accumulated (area-weighted) per vertex,
+/// Gram-Schmidt orthogonalised against the normal; w = +1 when cross(n, t) points along
+/// -dp/dv (glTF's V axis points down the image, so +Y of the map is -v), else -1, which is
+/// the MikkTSpace convention for glTF. Vertices without usable UVs get any unit tangent
+/// orthogonal to n.
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
+                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
+                                    std::span<const uint32_t> indices);
+
+}  // namespace penumbra
