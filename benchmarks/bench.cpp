@@ -1,4 +1,4 @@
-// penumbra-bench (issue 4): measures acceleration structures on the same scenes (glTF, PLY or
+// penumbra-bench: measures acceleration structures on the same scenes (glTF, PLY or
 // seeded generated scenes) and the same pre-generated ray sets (primary, shadow, diffuse,
 // random), verifies every structure's answers against Embree (disagreements settled by the exact
 // brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
@@ -67,7 +67,7 @@ Camera bench_camera(const Scene& scene, int w, int h) {
   return scene.cameras.empty() ? frame_bounds(compute_bounds(scene), float(w) / float(h)) : scene.cameras[0];
 }
 
-/// The four ray kinds of issue 4, generated once per scene from a fixed seed. Primary rays come
+/// The four ray kinds of the benchmark (primary, shadow, diffuse, random), generated once per scene from a fixed seed. Primary rays come
 /// from the scene's first camera (or one framing the bounds) on a w x h grid; shadow and diffuse
 /// rays start at the primary hits (found with Embree), offset along the geometric normal.
 std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,

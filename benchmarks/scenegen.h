@@ -1,4 +1,4 @@
-// Seeded generators of the benchmark's stress scenes (issue 4). Each scene stresses acceleration
+// Seeded generators of the benchmark's stress scenes. Each scene stresses acceleration
 // structures differently; the same (name, seed, triangles) always gives bit-identical geometry
 // on every platform (own integer RNG, no std distributions). Scenes are plain renderer Scenes
 // with a camera and lights, so they can be benchmarked in memory or written as glTF and rendered.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Penumbra's path tracer against Blender Cycles (CPU) on the same scenes, camera, resolution,
-# spp, threads and constant world, in the same run on the same machine (issue 6's benchmark).
+# spp, threads and constant world, in the same run on the same machine (the path tracer's benchmark).
 # For each scene and renderer: a REF_SPP reference, then renders at each of SPPS, timed by the
 # renderer itself (render only, no loading), with the RMSE of R, G, B against its own
 # reference (oiiotool --diff). Writes benchmarks/results/cycles-<date>.txt.

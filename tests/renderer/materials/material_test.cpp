@@ -1,5 +1,5 @@
-// Tests for renderer/material: textures, texture transforms, UV sets, vertex colours, normal
-// maps, alpha cut-outs, blended shadows and single-sided culling, with analytic answers.
+// Tests for renderer/materials/material: textures, texture transforms, UV sets, vertex colours,
+// normal maps and Whitted's blended layers, with analytic answers.
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"
@@ -8,54 +8,12 @@
 
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/whitted.h"
+#include "support/material_scenes.h"
 #include "support/scene_builder.h"
 
 using namespace penumbra;
 using namespace penumbra::test;
 
-namespace {
-constexpr float kEps = 2e-4f;
-
-// 2x2 nearest-filtered texture: top-left red, top-right green, bottom-left blue, bottom-right
-// white with alpha 0.25.
-int add_quadrant_texture(Scene& s) {
-  const std::vector<float> px = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 0.25f};
-  TextureSampler smp;
-  smp.mag = TextureFilter::Nearest;
-  smp.min = TextureFilter::Nearest;
-  smp.mipmaps = false;
-  s.textures.push_back(make_texture("quadrants", 2, 2, px, smp));
-  return int(s.textures.size()) - 1;
-}
-
-// A 2x2 quad at height z facing +z with uv = ((x+1)/2, (1-y)/2) on both UV sets, the second
-// mirrored in u.
-int add_uv_quad(Scene& s, float z, int material, bool flip = false) {
-  const int id = add_quad_z(s, -1, 1, -1, 1, z, material, flip);
-  Mesh& m = s.meshes[size_t(id)];
-  for (Vec3f p : m.positions) {
-    m.uvs.push_back({(p.x + 1) / 2, (1 - p.y) / 2});
-    m.uvs1.push_back({1 - (p.x + 1) / 2, (1 - p.y) / 2});
-  }
-  return id;
-}
-
-struct Probe {
-  Scene scene;
-  std::unique_ptr<Accelerator> accel;
-  void build() { accel = make_scene_accelerator("embree", scene); }
-  // Material at the first visible surface straight down at (x, y).
-  MaterialPoint at(float x, float y, Hit* out = nullptr) {
-    Ray r;
-    r.org = {x, y, 10};
-    r.dir = {0, 0, -1};
-    Hit h;
-    REQUIRE(intersect_visible(scene, *accel, r, h, true));
-    if (out) *out = h;
-    return eval_material(scene, make_interaction(scene, r, h));
-  }
-};
-}  // namespace
 
 TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEXCOORD_1 pick texels", "[material][quick]") {
   Probe p;
@@ -140,64 +98,6 @@ TEST_CASE("material: a normal map tilts the shading normal in the tangent frame"
   CHECK(p.at(0.3f, 0.3f).ns.y == Approx(std::sin(theta)).margin(1e-3));  // map +Y still +y
 }
 
-TEST_CASE("material: Mask cut-outs let camera and shadow rays through; cutoff decides", "[material][quick]") {
-  Probe p;
-  const int back = add_material(p.scene, {0, 1, 0}, 0, 1);
-  const int front = add_material(p.scene, {1, 0, 0}, 0, 1);
-  p.scene.materials[size_t(front)].alpha = 0.3f;
-  p.scene.materials[size_t(front)].alpha_mode = AlphaMode::Mask;
-  add_uv_quad(p.scene, 0, back);
-  add_uv_quad(p.scene, 1, front);
-  p.build();
-  Hit h;
-  CHECK(p.at(0, 0, &h).base_color.y == 1);  // alpha 0.3 < cutoff 0.5: the hole shows the back quad
-  CHECK(h.t == Approx(10));
-  Ray shadow;
-  shadow.org = {0, 0, 0.5f};
-  shadow.dir = {0, 0, 1};
-  CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == 1);
-  p.scene.materials[size_t(front)].alpha_cutoff = 0.2f;
-  CHECK(p.at(0, 0, &h).base_color.x == 1);  // now 0.3 >= 0.2: the front quad is solid
-  CHECK(h.t == Approx(9));
-  CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == 0);
-}
-
-TEST_CASE("material: Blend layers attenuate shadows by (1 - alpha) each", "[material][quick]") {
-  Probe p;
-  const int blend = add_material(p.scene, {1, 1, 1}, 0, 1);
-  p.scene.materials[size_t(blend)].alpha = 0.5f;
-  p.scene.materials[size_t(blend)].alpha_mode = AlphaMode::Blend;
-  add_uv_quad(p.scene, 1, blend);
-  add_uv_quad(p.scene, 2, blend);
-  add_uv_quad(p.scene, 3, blend, true);  // back face towards the ray: still casts
-  p.build();
-  Ray shadow;
-  shadow.org = {0, 0, 0};
-  shadow.dir = {0, 0, 1};
-  CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == Approx(0.125));
-  shadow.tfar = 2.5f;
-  CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == Approx(0.25));
-}
-
-TEST_CASE("material: single-sided back faces are invisible to camera rays but cast shadows", "[material][quick]") {
-  Probe p;
-  const int single = add_material(p.scene, {1, 0, 0}, 0, 1);
-  p.scene.materials[size_t(single)].double_sided = false;
-  const int floor = add_material(p.scene, {0, 0, 1}, 0, 1);
-  add_uv_quad(p.scene, 0, floor);
-  add_uv_quad(p.scene, 1, single, true);  // faces -z: the downward camera ray sees its back
-  p.build();
-  Hit h;
-  CHECK(p.at(0, 0, &h).base_color.z == 1);
-  CHECK(h.geom_id == 0);
-  Ray shadow;
-  shadow.org = {0, 0, 0.1f};
-  shadow.dir = {0, 0, 1};
-  CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == 0);
-  p.scene.materials[size_t(single)].double_sided = true;
-  CHECK(p.at(0, 0, &h).base_color.x == 1);
-  CHECK(scene_needs_hit_filter(p.scene) == false);
-}
 
 TEST_CASE("material: Whitted composites Blend layers front to back (a c + (1 - a) behind)", "[material][whitted][quick]") {
   Scene s;
