@@ -10,7 +10,7 @@ PACKAGES=(
   libopencolorio-dev opencolorio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
   catch2 libcli11-dev libbenchmark-dev
-  python3
+  python3 clang-format
 )
 
 missing=()
