@@ -48,27 +48,15 @@ json frame_matrix(Vec3f u, Vec3f v, Vec3f w, Vec3f origin) {
   return json::array({u.x, u.y, u.z, 0, v.x, v.y, v.z, 0, w.x, w.y, w.z, 0, origin.x, origin.y, origin.z, 1});
 }
 
+/// Appends `node` to the nodes and to the scene's roots.
+void add_root(Writer& wr, json node) {
+  wr.j["nodes"].push_back(std::move(node));
+  wr.j["scenes"][0]["nodes"].push_back(wr.j["nodes"].size() - 1);
+}
 
-}  // namespace
-
-void write_gltf(const Scene& scene, const std::filesystem::path& file) {
-  Writer wr;
-  wr.file = file.string();
-  const std::string bin_name = file.stem().string() + ".bin";
-  wr.j = {{"asset", {{"version", "2.0"}, {"generator", "Penumbra write_gltf"}}},
-          {"accessors", json::array()},
-          {"bufferViews", json::array()},
-          {"meshes", json::array()},
-          {"nodes", json::array()},
-          {"scenes", {{{"nodes", json::array()}}}},
-          {"scene", 0}};
-  auto add_root = [&](json node) {
-    wr.j["nodes"].push_back(std::move(node));
-    wr.j["scenes"][0]["nodes"].push_back(wr.j["nodes"].size() - 1);
-  };
-
+/// The materials; sets which material extensions they use.
+void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bool& unlit) {
   if (!scene.materials.empty()) wr.j["materials"] = json::array();
-  bool emissive_strength = false, unlit = false;
   for (const Material& m : scene.materials) {
     json mat = {{"pbrMetallicRoughness",
                  {{"baseColorFactor", {m.base_color.x, m.base_color.y, m.base_color.z, m.alpha}},
@@ -93,6 +81,11 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
     wr.j["materials"].push_back(mat);
   }
 
+}
+
+/// One glTF mesh per non-empty scene mesh (positions checked first); returns scene mesh -> glTF
+/// mesh, -1 for an empty one.
+std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
   std::vector<int> gltf_mesh(scene.meshes.size(), -1);  // scene mesh -> glTF mesh (-1: empty)
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
@@ -126,7 +119,11 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
     wr.j["meshes"].push_back(mesh);
     gltf_mesh[mi] = int(wr.j["meshes"].size()) - 1;
   }
-  // One node per instance; shared meshes stay shared, placements become node matrices.
+  return gltf_mesh;
+}
+
+/// One node per instance; shared meshes stay shared, placements become node matrices.
+void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& gltf_mesh) {
   for (size_t ii = 0; ii < scene.instances.size(); ++ii) {
     const Instance& inst = scene.instances[ii];
     if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())
@@ -141,9 +138,13 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
         for (int r = 0; r < 4; ++r) matrix.push_back(r < 3 ? inst.to_world.m[r][c] : (c == 3 ? 1.0f : 0.0f));
       node["matrix"] = matrix;
     }
-    add_root(node);
+    add_root(wr, node);
   }
 
+}
+
+/// Cameras, each on a root node holding its frame.
+void write_cameras(Writer& wr, const Scene& scene) {
   if (!scene.cameras.empty()) wr.j["cameras"] = json::array();
   for (size_t ci = 0; ci < scene.cameras.size(); ++ci) {
     const Camera& c = scene.cameras[ci];
@@ -160,10 +161,14 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
     }
     if (!c.name.empty()) cam["name"] = c.name;
     wr.j["cameras"].push_back(cam);
-    add_root({{"camera", ci}, {"matrix", frame_matrix(c.u, c.v, c.w, c.eye)},
+    add_root(wr, {{"camera", ci}, {"matrix", frame_matrix(c.u, c.v, c.w, c.eye)},
               {"name", c.name.empty() ? "camera" + std::to_string(ci) : c.name}});
   }
 
+}
+
+/// KHR_lights_punctual lights, each on a root node holding its frame.
+void write_lights(Writer& wr, const Scene& scene) {
   if (!scene.lights.empty()) {
     json lights = json::array();
     for (size_t li = 0; li < scene.lights.size(); ++li) {
@@ -177,12 +182,32 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
       // The light shines down its local -Z: the frame of a camera looking along its direction.
       Camera frame;
       if (l.type != LightType::Point) frame = look_at({0, 0, 0}, l.direction, {0, 1, 0}, 0);
-      add_root({{"matrix", frame_matrix(frame.u, frame.v, frame.w, l.type == LightType::Directional ? Vec3f{} : l.position)},
+      add_root(wr, {{"matrix", frame_matrix(frame.u, frame.v, frame.w, l.type == LightType::Directional ? Vec3f{} : l.position)},
                 {"extensions", {{"KHR_lights_punctual", {{"light", li}}}}},
                 {"name", l.name.empty() ? "light" + std::to_string(li) : l.name}});
     }
     wr.j["extensions"]["KHR_lights_punctual"]["lights"] = lights;
   }
+}
+
+}  // namespace
+
+void write_gltf(const Scene& scene, const std::filesystem::path& file) {
+  Writer wr;
+  wr.file = file.string();
+  const std::string bin_name = file.stem().string() + ".bin";
+  wr.j = {{"asset", {{"version", "2.0"}, {"generator", "Penumbra write_gltf"}}},
+          {"accessors", json::array()},
+          {"bufferViews", json::array()},
+          {"meshes", json::array()},
+          {"nodes", json::array()},
+          {"scenes", {{{"nodes", json::array()}}}},
+          {"scene", 0}};
+  bool emissive_strength = false, unlit = false;
+  write_materials(wr, scene, emissive_strength, unlit);
+  write_instances(wr, scene, write_meshes(wr, scene));
+  write_cameras(wr, scene);
+  write_lights(wr, scene);
   json used = json::array();
   if (!scene.lights.empty()) used.push_back("KHR_lights_punctual");
   if (emissive_strength) used.push_back("KHR_materials_emissive_strength");
@@ -190,21 +215,15 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
   if (!used.empty()) wr.j["extensionsUsed"] = used;
   if (!wr.bin.empty()) wr.j["buffers"] = {{{"byteLength", wr.bin.size()}, {"uri", bin_name}}};
 
-  auto write_bytes = [&](const std::filesystem::path& tmp, const char* data, size_t n, const std::string& name) {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(data, std::streamsize(n));
-    f.close();
-    if (!f) throw InputError(name, "", "cannot write");
-  };
   try {
     if (!wr.bin.empty()) {
       const auto bin_path = file.parent_path() / bin_name;
       write_atomically(bin_path, [&](const std::filesystem::path& tmp) {
-        write_bytes(tmp, reinterpret_cast<const char*>(wr.bin.data()), wr.bin.size(), bin_path.string());
+        write_file_checked(tmp, wr.bin.data(), wr.bin.size(), bin_path);
       });
     }
     const std::string text = wr.j.dump(1);
-    write_atomically(file, [&](const std::filesystem::path& tmp) { write_bytes(tmp, text.data(), text.size(), wr.file); });
+    write_atomically(file, [&](const std::filesystem::path& tmp) { write_file_checked(tmp, text.data(), text.size(), file); });
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io/error.h"
+#include "io/file_checks.h"
 
 namespace penumbra {
 namespace {
@@ -82,12 +83,14 @@ std::string format_index(double v) {
   return s.str();
 }
 
-}  // namespace
+/// The header after "ply": format and elements with their properties. Throws InputError naming
+/// the header line.
+struct Header {
+  Format format = Format::Ascii;
+  std::vector<Element> elements;
+};
 
-Scene load_ply(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(file, "", std::filesystem::exists(path) ? "cannot open" : "file not found");
+Header read_header(std::ifstream& in, const std::string& file) {
   std::string line;
   int line_no = 0;
   auto header_error = [&](const std::string& msg) {
@@ -98,11 +101,10 @@ Scene load_ply(const std::filesystem::path& path) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
   };
+  Header h;
   next_line();
   if (line != "ply") header_error("not a PLY file (first line must be 'ply')");
-  Format format = Format::Ascii;
   bool have_format = false;
-  std::vector<Element> elements;
   for (;;) {
     next_line();
     if (line_no > 10000) header_error("header longer than 10000 lines");
@@ -114,9 +116,9 @@ Scene load_ply(const std::filesystem::path& path) {
     if (kw == "format") {
       std::string f, v;
       ls >> f >> v;
-      if (f == "ascii") format = Format::Ascii;
-      else if (f == "binary_little_endian") format = Format::BinaryLE;
-      else if (f == "binary_big_endian") format = Format::BinaryBE;
+      if (f == "ascii") h.format = Format::Ascii;
+      else if (f == "binary_little_endian") h.format = Format::BinaryLE;
+      else if (f == "binary_big_endian") h.format = Format::BinaryBE;
       else header_error("unknown format '" + f + "'");
       if (v != "1.0") header_error("unsupported version '" + v + "'");
       have_format = true;
@@ -126,9 +128,9 @@ Scene load_ply(const std::filesystem::path& path) {
       if (!(ls >> e.name >> count) || count < 0 || count > (1ll << 31))
         header_error("element needs a name and a count in [0, 2^31]");
       e.count = uint64_t(count);
-      elements.push_back(e);
+      h.elements.push_back(e);
     } else if (kw == "property") {
-      if (elements.empty()) header_error("property before any element");
+      if (h.elements.empty()) header_error("property before any element");
       Property p;
       std::string t;
       ls >> t;
@@ -143,21 +145,23 @@ Scene load_ply(const std::filesystem::path& path) {
       }
       if (type_size(p.type) == 0) header_error("unknown property type '" + p.type + "'");
       if (p.name.empty()) header_error("property without a name");
-      elements.back().props.push_back(p);
+      h.elements.back().props.push_back(p);
     } else {
       header_error("unknown keyword '" + kw + "'");
     }
   }
   if (!have_format) header_error("no format line");
 
-  std::error_code size_error;
-  const uint64_t file_bytes = std::filesystem::file_size(path, size_error);
-  Scene scene;
-  Mesh mesh;
-  mesh.name = path.stem().string();
+  return h;
+}
+
+/// Reads every element after the header: vertex positions and polygon faces (fanned into
+/// triangles) into `mesh`. Throws InputError naming the element and index.
+void read_elements(std::ifstream& in, const Header& h, const std::string& file, uint64_t file_bytes, Mesh& mesh) {
+  const Format format = h.format;
   Reader r(in, format, file);
   bool have_vertices = false;
-  for (const Element& e : elements) {
+  for (const Element& e : h.elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
     int ix = -1, iy = -1, iz = -1, iface = -1;
     for (size_t k = 0; k < e.props.size(); ++k) {
@@ -214,8 +218,22 @@ Scene load_ply(const std::filesystem::path& path) {
       }
     }
   }
+}
+
+}  // namespace
+
+Scene load_ply(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  const uint64_t file_bytes = check_input_file(path, "", kMaxPlyBytes);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, "", "cannot open");
+  const Header header = read_header(in, file);
+  Mesh mesh;
+  mesh.name = path.stem().string();
+  read_elements(in, header, file, file_bytes, mesh);
   if (mesh.indices.empty()) throw InputError(file, "element face", "no triangles");
   mesh.normals = compute_smooth_normals(mesh.positions, mesh.indices);
+  Scene scene;
   add_world_mesh(scene, std::move(mesh));
   return scene;
 }

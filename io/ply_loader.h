@@ -4,11 +4,15 @@
 // skipped. Used to bring the Stanford models into the benchmark; writes nothing.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
+
+/// Largest PLY file read (the Stanford dragon in binary is 20 MiB; a billion triangles fits).
+inline constexpr uint64_t kMaxPlyBytes = uint64_t(32) << 30;
 
 /// Loads `file` as one mesh (no materials, lights or cameras). Throws InputError naming the
 /// file and the element ("face[812]: index 9312 >= vertex count 4000", "header line 3: ...")
