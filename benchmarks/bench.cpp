@@ -457,6 +457,7 @@ int main(int argc, char** argv) {
           rc.width = width;
           rc.height = height;
           rc.spp = 1;
+          validate(rc);
           const CostImage cost = render_cost(*accel, bench_camera(scene, width, height), rc);
           write_heatmap(total_cost(cost), width, height, std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
                         name + " " + cost_caption(cost, accel_name));
