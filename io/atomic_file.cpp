@@ -26,12 +26,15 @@ constexpr int kMaxSymlinks = 40;  // as the kernel's own limit on a path's links
 char g_paths[kSlots][kPathMax];
 std::atomic<bool> g_used[kSlots];
 
+std::atomic<bool> g_ready[kSlots];  // the slot's path is complete: the handler may unlink it
+
 int claim_slot(const std::string& path) {
   if (path.size() >= kPathMax) return -1;
   for (int i = 0; i < kSlots; ++i) {
     bool expected = false;
     if (g_used[i].compare_exchange_strong(expected, true)) {
       std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
+      g_ready[i].store(true, std::memory_order_release);
       return i;
     }
   }
@@ -39,7 +42,9 @@ int claim_slot(const std::string& path) {
 }
 
 void release_slot(int i) {
-  if (i >= 0) g_used[i].store(false);
+  if (i < 0) return;
+  g_ready[i].store(false, std::memory_order_release);
+  g_used[i].store(false);
 }
 
 std::string errno_text(int err) { return std::strerror(err); }
@@ -119,7 +124,7 @@ void stream_to(const OutputTarget& t, const fs::path& source, std::string* sha25
 
 void remove_pending_temporaries() noexcept {
   for (int i = 0; i < kSlots; ++i)
-    if (g_used[i].load()) ::unlink(g_paths[i]);
+    if (g_ready[i].load(std::memory_order_acquire)) ::unlink(g_paths[i]);
 }
 
 OutputTarget resolve_output(const fs::path& destination, const std::string& element) {
@@ -141,7 +146,8 @@ OutputTarget resolve_output(const fs::path& destination, const std::string& elem
   for (int links = 0;; ++links) {
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) {
-      if (errno != ENOENT) throw InputError("", where, "cannot access '" + p.string() + "': " + errno_text(errno));
+      const int err = errno;
+      if (err != ENOENT) throw InputError("", where, "cannot access '" + p.string() + "': " + errno_text(err));
       const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
       std::error_code ec;
       if (!fs::is_directory(dir, ec))
@@ -219,11 +225,16 @@ void write_atomically(const fs::path& destination, const std::function<void(cons
                            ? fs::temp_directory_path()
                            : (final_path.has_parent_path() ? final_path.parent_path() : fs::path("."));
   const fs::path temp = dir / ("." + final_path.stem().string() + ".tmp-" + unique + final_path.extension().string());
-  // Creating the temporary ourselves reports the real reason (permissions, full disk, ...).
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) fail(destination, "cannot create a temporary file in '" + dir.string() + "'", errno);
-  ::close(fd);
+  // Registered before it exists, so a signal never leaves it behind; created by us, so that a
+  // failure reports the real reason (permissions, full disk, ...).
   const int slot = claim_slot(temp.string());
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    const int err = errno;
+    release_slot(slot);
+    fail(destination, "cannot create a temporary file in '" + dir.string() + "'", err);
+  }
+  ::close(fd);
   auto discard = [&] {
     ::unlink(temp.c_str());
     release_slot(slot);
@@ -236,7 +247,13 @@ void write_atomically(const fs::path& destination, const std::function<void(cons
       discard();
       return;
     }
-    if (sha256) *sha256 = sha256_file(temp);
+    if (sha256) {
+      try {
+        *sha256 = sha256_file(temp);
+      } catch (const InputError& e) {  // our own temporary: an I/O failure, not bad input
+        throw std::runtime_error(e.what());
+      }
+    }
     struct stat old {};
     if ((t.device != 0 || t.inode != 0) && ::stat(final_path.c_str(), &old) == 0) ::chmod(temp.c_str(), old.st_mode & 07777);
   } catch (...) {

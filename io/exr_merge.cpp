@@ -13,6 +13,7 @@
 #include <string>
 
 #include "io/atomic_file.h"
+#include "io/checked_file.h"
 #include "io/error.h"
 #include "io/file_checks.h"
 #include "io/render_settings.h"
@@ -303,6 +304,7 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
     auto o = OIIO::ImageOutput::create(out.string());
     if (!o) throw std::runtime_error(out.string() + ": no image writer (" + OIIO::geterror() + ")");
     const bool multi = specs.size() > 1;
+    write_through_checked_file(o, temp, out, [&] {
     if (!(multi ? o->open(temp.string(), int(specs.size()), specs.data()) : o->open(temp.string(), specs[0])))
       throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
     for (size_t sub = 0; sub < specs.size(); ++sub) {
@@ -313,6 +315,7 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
         throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
     }
     if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
+    });
   });
 }
 
@@ -336,6 +339,12 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     const std::vector<OIIO::ImageSpec> specs = read_specs(*in, name);
     if (!options.force) {
       PartIdentity id = part_identity(name, specs[0]);
+      const auto complete = id.settings.entries.find("complete");
+      if (complete != id.settings.entries.end() && complete->second != "1")
+        throw InputError(name, "",
+                         "is incomplete: its render was interrupted or stopped by --time-limit before the "
+                         "requested samples; " +
+                             std::string(kForceHint));
       if (k == 0) {
         first_id = std::move(id);
       } else {
@@ -347,9 +356,11 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     for (const auto& sp : specs) part_bytes = std::max(part_bytes, image_bytes(sp, false));
     if (k == 0) {
       for (const auto& sp : specs) frame_bytes += image_bytes(sp, true);
+      frame_bytes += 4.0 * double(specs[0].full_width) * double(specs[0].full_height);  // pixel owners
       if (frame_bytes + part_bytes > double(options.max_memory_bytes))
         throw InputError(name, "",
-                         "the full frame would need " + format_bytes(uint64_t(frame_bytes)) + ", over the " +
+                         "the full frame and one decoded part would need " +
+                             format_bytes(uint64_t(frame_bytes + part_bytes)) + ", over the " +
                              format_bytes(options.max_memory_bytes) + " limit");
       for (const auto& sp : specs) pixels.emplace_back(size_t(image_bytes(sp, true)), 0);
       owner.assign(size_t(specs[0].full_width) * size_t(specs[0].full_height), -1);

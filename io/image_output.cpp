@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
+#include "io/checked_file.h"
 #include "io/error.h"
 #include "io/file_checks.h"
 
@@ -30,18 +31,13 @@ void write_with_oiio(const std::filesystem::path& final_path, const std::filesys
   if (!out)
     throw std::runtime_error(final_path.string() + ": no image writer for this extension (" +
                              OIIO::geterror() + ")");
-  // Display images are encoded into memory and written with checked system calls: OIIO's PNG
-  // writer does not report a full disk. EXR's writer checks every write itself.
-  const bool in_memory = std::string(out->format_name()) != "openexr" && out->supports("ioproxy");
-  OIIO::Filesystem::IOVecOutput memory;
-  if (in_memory && !out->set_ioproxy(&memory))
-    throw std::runtime_error(final_path.string() + ": cannot encode in memory: " + out->geterror());
-  if (!out->open(temp.string(), spec))
-    throw std::runtime_error(final_path.string() + ": cannot open for writing: " + out->geterror());
-  if (!out->write_image(pixel_type, pixels))
-    throw std::runtime_error(final_path.string() + ": write failed: " + out->geterror());
-  if (!out->close()) throw std::runtime_error(final_path.string() + ": close failed: " + out->geterror());
-  if (in_memory) write_file_checked(temp, memory.buffer().data(), memory.buffer().size(), final_path);
+  write_through_checked_file(out, temp, final_path, [&] {
+    if (!out->open(temp.string(), spec))
+      throw std::runtime_error(final_path.string() + ": cannot open for writing: " + out->geterror());
+    if (!out->write_image(pixel_type, pixels))
+      throw std::runtime_error(final_path.string() + ": write failed: " + out->geterror());
+    if (!out->close()) throw std::runtime_error(final_path.string() + ": close failed: " + out->geterror());
+  });
 }
 
 }  // namespace
@@ -173,6 +169,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out || !out->supports("multiimage"))
       throw std::runtime_error(path.string() + ": no multi-part image writer for this extension");
+    write_through_checked_file(out, temp, path, [&] {
     if (!out->open(temp.string(), int(specs.size()), specs.data()))
       throw std::runtime_error(path.string() + ": cannot open for writing: " + out->geterror());
     for (size_t part = 0; part < specs.size(); ++part) {
@@ -182,6 +179,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
         throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
     }
     if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
+    });
   }, sha256);
 }
 

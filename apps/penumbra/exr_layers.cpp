@@ -78,6 +78,7 @@ void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int heig
 void add_part_identity(ExrOptions& exr, const RenderJob& job) {
   RenderSettings part = job.settings;
   part.entries["spp"] = std::to_string(job.cfg.spp);
+  part.entries["complete"] = job.frame_complete ? "1" : "0";  // all requested samples taken
   std::string layers;
   for (const auto& name : job.request.aovs) layers += (layers.empty() ? "" : ",") + name;
   part.entries["aovs"] = layers;

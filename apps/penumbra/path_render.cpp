@@ -10,6 +10,7 @@
 #include "apps/penumbra/render_job.h"
 #include "io/atomic_file.h"
 #include "io/checkpoint.h"
+#include "io/error.h"
 #include "io/image_output.h"
 
 namespace penumbra::cli {
@@ -49,6 +50,11 @@ RenderSettings state_settings(const RenderJob& job) {
 void install_signal_handlers() {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  std::signal(SIGHUP, on_signal);
+  std::signal(SIGQUIT, on_signal);
+  // A reader that goes away (a closed pipe) is a checked write error (EPIPE), not a death that
+  // would leave temporaries behind.
+  std::signal(SIGPIPE, SIG_IGN);
 }
 
 void run_path_render(RenderJob& job, ProgressReporter& progress) {
@@ -60,6 +66,10 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
   if (a.resume) {
     if (fs::exists(state_file)) {
       state = read_checkpoint(state_file, fingerprint);
+      const PixelWindow win = render_window(job.cfg);
+      if (state.window.x0 != win.x0 || state.window.y0 != win.y0 || state.window.x1 != win.x1 ||
+          state.window.y1 != win.y1)
+        throw InputError(state_file.string(), "", "its pixels cover another window than this render's");
       if (!a.quiet)
         std::fprintf(stderr, "resuming %s: %d passes done, %u spp reached\n", state_file.string().c_str(),
                      state.passes, state.reached);
@@ -87,12 +97,13 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
   // A signal during the last pass still ends the run with 128 + signal, the image complete.
   if (g_stop.load()) job.interrupted = g_signal.load();
   job.frame_complete = state.complete;
-  if (job.request.out_streams) return;  // no resume state beside a stream
+  if (!job.request.state_beside_output) return;  // no resume state beside a stream or device
   if (job.interrupted && !state.complete) {
     write_checkpoint(state_file, state, fingerprint);
-  } else if (state.complete && fs::exists(state_file)) {
-    fs::remove(state_file);
-  } else if (!state.complete && (a.checkpoint > 0 || a.resume)) {
+  } else if (state.complete) {
+    // Removed only after the outputs are written, so that a failed write can still resume.
+    job.remove_state = (a.checkpoint > 0 || a.resume) && fs::exists(state_file);
+  } else if (a.checkpoint > 0 || a.resume) {
     write_checkpoint(state_file, state, fingerprint);  // stopped by --time-limit: resumable too
   }
 }

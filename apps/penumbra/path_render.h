@@ -9,7 +9,8 @@ namespace penumbra::cli {
 struct RenderJob;
 class ProgressReporter;
 
-/// Installs the SIGINT and SIGTERM handlers. Call once before loading.
+/// Installs the handlers: SIGINT, SIGTERM, SIGHUP and SIGQUIT as above; SIGPIPE ignored (a
+/// closed pipe becomes a write error). Call once before loading.
 void install_signal_handlers();
 
 /// Renders job.cfg with the path tracer into job.film / job.path_image / job.stats, resuming from

@@ -11,6 +11,7 @@
 #include "apps/penumbra/render_job.h"
 #include "apps/penumbra/scene_setup.h"
 #include "apps/penumbra/stats_json.h"
+#include "io/atomic_file.h"
 #include "io/environment_io.h"
 #include "io/file_checks.h"
 #include "io/hash.h"
@@ -30,15 +31,18 @@ constexpr uint64_t kAccelBytesPerTriangle = 96;
 /// Bytes per rendered pixel of every buffer a render keeps until its outputs are written: the
 /// film (RGBA float), the path tracer's accumulators and statistics, light groups (double sums
 /// and float means), data AOVs (14 floats), cost AOVs (3 floats), the EXR's packed channels
-/// (4 bytes each) and the display image (float RGB and its encoding).
-uint64_t image_bytes_per_pixel(const RenderRequest& q) {
+/// (4 bytes each, twice with --multipart) and the display image (float RGB and its encoding).
+uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   const bool light_groups = q.aovs.count("light") > 0;
   uint64_t b = 16;
   if (q.path) b += kPathPixelBytes + 4 + 4;
   if (light_groups) b += kLightGroupChannels * (8 + 4);
   if (q.data_aovs) b += 14 * 4;
   if (q.cost_aov) b += 3 * 4 + 3;
-  b += (4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) + (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2)) * 4;
+  if (q.aovs.count("samples")) b += 4;  // the counts as floats for the EXR
+  const uint64_t channels =
+      4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) + (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2);
+  b += channels * 4 * (multipart ? 2 : 1);  // packed channels; --multipart also repacks them per part
   if (q.png) b += 12 + 3;
   return b;
 }
@@ -49,7 +53,7 @@ uint64_t charge_image_budget(const RenderJob& job) {
   const RenderConfig& cfg = job.cfg;
   const uint64_t budget = job.request.budget;
   const PixelWindow w = render_window(cfg);
-  const uint64_t image = uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request);
+  const uint64_t image = uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
   const Scene& scene = job.loaded.scene;
   const uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle;
   if (image > budget || scene_bytes > budget - image)
@@ -67,6 +71,10 @@ void load_phase(RenderJob& job) {
   job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
                           job.request.time);
   job.load_s = seconds_since(t0);
+  // No output may replace a buffer or image the scene was loaded from.
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& f : job.loaded.info.source_files) inputs.push_back({"the scene's file", f});
+  check_distinct_files(job.request.outputs, inputs);
 }
 
 /// Camera and resolution (the image aspect follows the camera's hint unless both are given),
@@ -174,6 +182,7 @@ int run_render(const RenderArgs& a) {
   if (!a.debug_pixel.empty()) return render_debug_pixel(job);
   render_phase(job);
   write_phase(job);
+  if (job.remove_state) fs::remove(fs::path(job.request.out).concat(".resume"));
   if (!a.quiet) print_render_summary(job);
   const RenderRequest& q = job.request;
   if (q.paths_to_stdout) {

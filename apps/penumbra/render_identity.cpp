@@ -10,6 +10,7 @@ namespace penumbra::cli {
 RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, const Camera& camera,
                               const std::string& scene_sha256, const std::string& env_sha256) {
   std::map<std::string, std::string> e;
+  e["version"] = PENUMBRA_VERSION;  // another renderer version may sample differently
   e["scene.sha256"] = scene_sha256;
   e["scene.index"] = std::to_string(a.scene);
   e["scene.flatten"] = a.flatten ? "1" : "0";

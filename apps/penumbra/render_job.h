@@ -39,6 +39,7 @@ struct RenderJob {
   PathImage path_image;   ///< path tracer only; its film is moved into `film`
   int interrupted = 0;    ///< the signal that ended a path render early, or 0
   bool frame_complete = true;
+  bool remove_state = false;  ///< a completed --checkpoint/--resume render: drop OUT.exr.resume once written
   double mean_spp = 0;
   WrittenHashes hashes;
 

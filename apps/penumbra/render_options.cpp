@@ -140,7 +140,15 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   if (q.out_streams && (a.checkpoint > 0 || a.resume))
     throw UsageError("--checkpoint and --resume keep their state beside -o, which must then be a regular file");
   std::vector<std::pair<std::string, fs::path>> outputs = {{"-o", q.out}};
-  if (q.path && !q.out_streams) outputs.push_back({"the resume state", fs::path(q.out).concat(".resume")});
+  if (q.path && !q.out_streams) {
+    // The resume state is written beside a regular-file output only; a FIFO or device at its
+    // path is never written or removed.
+    const fs::path state = fs::path(q.out).concat(".resume");
+    q.state_beside_output = resolve_output(state, "the resume state").kind == OutputKind::Replace;
+    if (!q.state_beside_output && (a.checkpoint > 0 || a.resume))
+      throw UsageError("the resume state " + state.string() + " is not a regular file; --checkpoint and --resume need one");
+    if (q.state_beside_output) outputs.push_back({"the resume state", state});
+  }
   if (q.png) outputs.push_back({"--png", *q.png});
   if (q.cost_png) outputs.push_back({"--cost-png", *q.cost_png});
   if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
@@ -149,6 +157,7 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   if (!a.ocio_config.empty()) inputs.push_back({"--ocio-config", a.ocio_config});
   else if (const char* ocio = std::getenv("OCIO"); ocio && *ocio) inputs.push_back({"$OCIO", ocio});
   check_distinct_files(outputs, inputs);
+  q.outputs = outputs;
   struct stat stdout_stat {};
   if (::fstat(STDOUT_FILENO, &stdout_stat) == 0)
     for (const auto& [option, file] : outputs) {

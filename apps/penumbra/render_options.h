@@ -72,6 +72,10 @@ struct RenderRequest {
   std::set<std::string> aovs;
   bool cost_aov = false, data_aovs = false;
   std::optional<double> time;  ///< animation time from --time or --frame / --fps
+  /// Every file the run writes, named by its option, for the collision checks (also against
+  /// the files the scene loads, once they are known).
+  std::vector<std::pair<std::string, std::filesystem::path>> outputs;
+  bool state_beside_output = false;  ///< the resume state path can hold a regular file
 };
 
 /// Validates every flag in the order README lists the checks. Throws UsageError or InputError

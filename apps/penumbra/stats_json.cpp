@@ -43,7 +43,7 @@ std::string stats_json_text(const RenderJob& job) {
   j["triangles"] = count_triangles(scene);
   j["instances"] = scene.instances.size();
   j["lights"] = scene.lights.size();
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 void write_stats_json(const RenderJob& job) {

@@ -58,6 +58,14 @@ expect 0 "t3.exr" -- "$bin" render "$scene" -o "$work/t3.exr" "${small[@]}" --st
 wait $reader
 [ -p "$work/fifo" ] && pass || fail "the FIFO was replaced"
 json_ok "$work/fifo.out"
+# A reader that goes away mid-stream: the write fails with EPIPE (exit 1), no temporary stays.
+mkfifo "$work/pipe-out.exr"
+export TMPDIR="$work/tmp"; mkdir -p "$TMPDIR"
+(head -c 100 "$work/pipe-out.exr" >/dev/null) &
+expect 1 "pipe-out.exr: write failed: Broken pipe" -- "$bin" render "$scene" -o "$work/pipe-out.exr" --width 400 --spp 1 -q --no-png --float
+wait
+[ -z "$(ls -A "$TMPDIR")" ] && pass || fail "a broken stream left $(ls -A "$TMPDIR") in \$TMPDIR"
+unset TMPDIR
 # /dev/stdout: the JSON goes to stdout, and stdout then carries no paths.
 timeout 60 "$bin" render "$scene" -o "$work/t4.exr" "${small[@]}" --stats-json /dev/stdout >"$work/stdout.json" 2>"$work/err" \
   && pass || fail "--stats-json /dev/stdout: exit $?"
@@ -194,8 +202,9 @@ expect 0 "t.exr" -- "$bin" render "$work/tri/tri.gltf" -o "$work/tri/t.exr" "${o
 flip "$work/tri/tri.bin" 2
 expect 2 "t.exr.resume: was written for other settings" -- "$bin" render "$work/tri/tri.gltf" -o "$work/tri/t.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
 grep -q "scene.sha256: stored" "$work/err" && pass || fail "an edited buffer does not change scene.sha256"
+expect 2 "--stats-json .*tri.bin would overwrite the scene's file" -- "$bin" render "$work/tri/tri.gltf" -o "$work/tri/u.exr" "${small[@]}" --stats-json "$work/tri/tri.bin"
 rm -f "$work/res.exr.resume"; mkfifo "$work/res.exr.resume"
-expect 2 "res.exr.resume: .*is a FIFO, not a regular file" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
+expect 2 "the resume state .*res.exr.resume is not a regular file; --checkpoint and --resume need one" -- "$bin" render "$work/scene.gltf" -o "$work/res.exr" --integrator path --width 24 --spp 64 --no-png -q --resume
 rm -f "$work/res.exr.resume"
 
 # --- merge refuses parts of different renders (unless --force) and non-regular parts.
@@ -220,6 +229,9 @@ if command -v oiiotool >/dev/null; then  # crops cut by another tool carry no Pe
   expect 0 "cut.exr" -- "$bin" merge "$work/c0.exr" "$work/c1.exr" -o "$work/cut.exr" --force
   expect 0 "PASS" -- oiiotool "$work/full.exr" "$work/cut.exr" --fail 0 --diff
 fi
+"$bin" render "$scene" -o "$work/i0.exr" --width 48 --spp 64 --no-png -q --tile 0/2 --integrator path --time-limit 1e-9 >/dev/null \
+  || fail "time-limited tile"
+expect 2 "i0.exr: is incomplete" -- "$bin" merge "$work/i0.exr" "$work/m1.exr" -o "$work/inc.exr"
 expect 2 "/dev/zero: .*is a character device, not a regular file" -- "$bin" merge /dev/zero "$work/m1.exr" -o "$work/z.exr"
 expect 2 "in.fifo: .*is a FIFO, not a regular file" -- "$bin" merge "$work/m0.exr" "$work/in.fifo" -o "$work/z.exr"
 expect 2 "would overwrite part 1" -- "$bin" merge "$work/m0.exr" "$work/m1.exr" -o "$work/m0.exr"
