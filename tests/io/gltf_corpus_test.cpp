@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

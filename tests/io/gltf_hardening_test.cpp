@@ -13,7 +13,7 @@
 
 #include "support/gltf_writer.h"
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

@@ -9,7 +9,7 @@
 
 #include "support/gltf_writer.h"
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"

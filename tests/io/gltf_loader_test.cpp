@@ -1,7 +1,7 @@
 // Tests for io/gltf_loader on files generated here: index types, topologies, hierarchy,
 // normals, cameras, lights, and hostile input (each must end in an InputError naming the
 // element, or a warning).
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 
 #include <catch2/catch.hpp>
 #include <fstream>

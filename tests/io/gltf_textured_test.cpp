@@ -6,7 +6,7 @@
 // model's README says a correct viewer shows.
 #include <catch2/catch.hpp>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/scene_accel.h"

@@ -1,8 +1,8 @@
-// glTF 2.0 loader in phases: the scene file and the GLB container (gltf_container), the JSON
-// depth guard, checks on the raw JSON (gltf_json_checks) with the memory budget charged for what
+// glTF 2.0 loader in phases: the scene file and the GLB container (file_access), the JSON
+// depth guard, checks on the raw JSON (json_checks) with the memory budget charged for what
 // parsing will hold, URI resolution, tinygltf with sandboxed file callbacks, then validation and
 // flattening of the node hierarchy into world-space meshes.
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -17,8 +17,8 @@
 
 #include "io/error.h"
 #include "io/file_checks.h"
-#include "io/gltf_container.h"
-#include "io/gltf_json_checks.h"
+#include "io/gltf/file_access.h"
+#include "io/gltf/json_checks.h"
 #include "renderer/scene/animation.h"
 
 namespace penumbra {

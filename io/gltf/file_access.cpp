@@ -1,5 +1,5 @@
 // glTF file access: bounded non-blocking reads, the GLB chunk walk and URI resolution.
-#include "io/gltf_container.h"
+#include "io/gltf/file_access.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,5 +1,5 @@
 // Raw-JSON checks of a glTF document: index ranges, offsets and strides, enums and array types.
-#include "io/gltf_json_checks.h"
+#include "io/gltf/json_checks.h"
 
 #include <algorithm>
 #include <climits>
