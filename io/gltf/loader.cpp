@@ -14,6 +14,7 @@
 #include <new>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <span>
 
 #include "io/error.h"
 #include "io/file_checks.h"
@@ -205,6 +206,9 @@ class Converter {
     m_budget.charge(bytes, element, subject);
   }
 
+  /// The bytes of bufferViews[view] after checking that the view and its buffer exist and that
+  /// byteOffset + byteLength lies within the buffer; a bad view index names `user`.
+  std::span<const unsigned char> buffer_view_bytes(int view, const std::string& user) const;
   AccessorLayout layout(int accessor, const std::string& user);
   double component(const AccessorLayout& l, uint64_t element, int c) const;
   std::vector<double> read(int accessor, const std::string& user, std::initializer_list<int> types,
@@ -284,6 +288,24 @@ class Converter {
   std::map<std::pair<int, bool>, int> m_textures;      // (glTF texture, sRGB) -> Scene::textures
 };
 
+std::span<const unsigned char> Converter::buffer_view_bytes(int view, const std::string& user) const {
+  if (view < 0 || size_t(view) >= m_model.bufferViews.size())
+    fail(user, "bufferView " + std::to_string(view) + " out of range (" +
+                   std::to_string(m_model.bufferViews.size()) + " bufferViews)");
+  const std::string bv_where = idx("bufferViews", size_t(view));
+  const tinygltf::BufferView& bv = m_model.bufferViews[size_t(view)];
+  if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
+    fail(bv_where, "buffer " + std::to_string(bv.buffer) + " out of range (" +
+                       std::to_string(m_model.buffers.size()) + " buffers)");
+  const auto& buffer = m_model.buffers[size_t(bv.buffer)].data;
+  uint64_t bv_end = 0;
+  if (!add_ok(bv.byteOffset, bv.byteLength, bv_end) || bv_end > buffer.size())
+    fail(bv_where, "byteOffset " + std::to_string(bv.byteOffset) + " + byteLength " +
+                       std::to_string(bv.byteLength) + " exceeds buffer " + std::to_string(bv.buffer) +
+                       " of " + std::to_string(buffer.size()) + " bytes");
+  return {buffer.data() + bv.byteOffset, size_t(bv.byteLength)};
+}
+
 AccessorLayout Converter::layout(int accessor, const std::string& user) {
   const std::string where = idx("accessors", size_t(accessor));
   if (accessor < 0 || size_t(accessor) >= m_model.accessors.size())
@@ -307,21 +329,9 @@ AccessorLayout Converter::layout(int accessor, const std::string& user) {
   charge_memory(decoded, where, "decoding its " + std::to_string(l.count) + " elements needs");
 
   if (a.bufferView >= 0) {
-    if (size_t(a.bufferView) >= m_model.bufferViews.size())
-      fail(where, "bufferView " + std::to_string(a.bufferView) + " out of range (" +
-                      std::to_string(m_model.bufferViews.size()) + " bufferViews)");
+    const std::span<const unsigned char> view = buffer_view_bytes(a.bufferView, where);
     const std::string bv_where = idx("bufferViews", size_t(a.bufferView));
     const tinygltf::BufferView& bv = m_model.bufferViews[size_t(a.bufferView)];
-    if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
-      fail(bv_where, "buffer " + std::to_string(bv.buffer) + " out of range (" +
-                         std::to_string(m_model.buffers.size()) + " buffers)");
-    const auto& buffer = m_model.buffers[size_t(bv.buffer)].data;
-    uint64_t bv_end = 0;
-    if (!add_ok(bv.byteOffset, bv.byteLength, bv_end) || bv_end > buffer.size())
-      fail(bv_where, "byteOffset " + std::to_string(bv.byteOffset) + " + byteLength " +
-                         std::to_string(bv.byteLength) + " exceeds buffer " +
-                         std::to_string(bv.buffer) + " of " + std::to_string(buffer.size()) +
-                         " bytes");
     l.stride = bv.byteStride ? uint64_t(bv.byteStride) : elem;
     if (bv.byteStride != 0 && (bv.byteStride < elem || bv.byteStride > 252 || bv.byteStride % 4))
       fail(bv_where, "byteStride " + std::to_string(bv.byteStride) + " invalid for " +
@@ -335,7 +345,7 @@ AccessorLayout Converter::layout(int accessor, const std::string& user) {
     if (a.byteOffset % uint64_t(comp_size) != 0)
       warn(where, "byteOffset " + std::to_string(a.byteOffset) +
                       " is not a multiple of the component size");
-    l.data = buffer.data() + bv.byteOffset + a.byteOffset;
+    l.data = view.data() + a.byteOffset;
   } else if (!a.sparse.isSparse) {
     warn(where, "no bufferView: values are all zero");
   }
@@ -348,17 +358,10 @@ AccessorLayout Converter::layout(int accessor, const std::string& user) {
     charge_memory(n * (sizeof(std::pair<uint64_t, std::vector<double>>) + uint64_t(l.components) * 8 + 16),
                   sw, "its " + std::to_string(n) + " sparse values need");
     auto view_span = [&](int view, uint64_t offset, uint64_t bytes, const std::string& what) {
-      if (view < 0 || size_t(view) >= m_model.bufferViews.size())
-        fail(what, "bufferView " + std::to_string(view) + " out of range");
-      const auto& bv = m_model.bufferViews[size_t(view)];
-      if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
-        fail(idx("bufferViews", size_t(view)), "buffer out of range");
-      const auto& buf = m_model.buffers[size_t(bv.buffer)].data;
-      uint64_t e1 = 0, e2 = 0;
-      if (!add_ok(bv.byteOffset, bv.byteLength, e1) || e1 > buf.size() ||
-          !add_ok(offset, bytes, e2) || e2 > bv.byteLength)
-        fail(what, "reads past the end of its bufferView");
-      return buf.data() + bv.byteOffset + offset;
+      const std::span<const unsigned char> span = buffer_view_bytes(view, what);
+      uint64_t end = 0;
+      if (!add_ok(offset, bytes, end) || end > span.size()) fail(what, "reads past the end of its bufferView");
+      return span.data() + offset;
     };
     const int ict = a.sparse.indices.componentType;
     const int isz = tinygltf::GetComponentSizeInBytes(uint32_t(ict));
@@ -468,19 +471,9 @@ const DecodedImage& Converter::decoded_image(int image_index, const std::string&
   const unsigned char* data = nullptr;
   uint64_t size = 0;
   if (img.bufferView >= 0) {
-    if (size_t(img.bufferView) >= m_model.bufferViews.size())
-      fail(where + ".bufferView", "bufferView " + std::to_string(img.bufferView) + " out of range (" +
-                                      std::to_string(m_model.bufferViews.size()) + " bufferViews)");
-    const auto& bv = m_model.bufferViews[size_t(img.bufferView)];
-    if (bv.buffer < 0 || size_t(bv.buffer) >= m_model.buffers.size())
-      fail(idx("bufferViews", size_t(img.bufferView)), "buffer " + std::to_string(bv.buffer) + " out of range");
-    const auto& buf = m_model.buffers[size_t(bv.buffer)].data;
-    uint64_t end = 0;
-    if (!add_ok(bv.byteOffset, bv.byteLength, end) || end > buf.size())
-      fail(idx("bufferViews", size_t(img.bufferView)), "byteOffset + byteLength exceeds buffer " +
-                                                          std::to_string(bv.buffer) + " of " + std::to_string(buf.size()) + " bytes");
-    data = buf.data() + bv.byteOffset;
-    size = bv.byteLength;
+    const std::span<const unsigned char> view = buffer_view_bytes(img.bufferView, where + ".bufferView");
+    data = view.data();
+    size = view.size();
   } else {
     data = img.image.data();
     size = img.image.size();
@@ -930,33 +923,30 @@ void Converter::traverse(const std::vector<int>& roots) {
   m_parent = parent;
   m_world.assign(n, Transform{});
   m_has_world.assign(n, 0);
-  // Phase 2: depth-first traversal accumulating parent * local, with an explicit stack.
+  // Phase 2: depth-first traversal with an explicit stack; each node's world transform is
+  // parent * local (world_of), computed once.
   std::set<int> seen_roots;
-  struct Item { int node; Transform parent_world; };
-  std::vector<Item> stack;
+  std::vector<int> stack;
   for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
     const int r = *it;
     if (r < 0 || size_t(r) >= n) fail("scenes.nodes", "node index " + std::to_string(r) + " out of range (" + std::to_string(n) + " nodes)");
     if (parent[size_t(r)] >= 0) fail(idx("nodes", size_t(r)), "is listed as a scene root but is a child of nodes[" + std::to_string(parent[size_t(r)]) + "]");
     if (!seen_roots.insert(r).second) fail(idx("nodes", size_t(r)), "listed twice as a scene root");
-    stack.push_back({r, Transform{}});
+    stack.push_back(r);
   }
   while (!stack.empty()) {
-    const Item item = stack.back();
+    const int index = stack.back();
     stack.pop_back();
-    const auto& node = m_model.nodes[size_t(item.node)];
-    const Transform world = item.parent_world * local_transform(item.node);
-    if (!is_finite(world)) fail(idx("nodes", size_t(item.node)), "world transform overflows to non-finite values");
-    m_world[size_t(item.node)] = world;
-    m_has_world[size_t(item.node)] = 1;
-    if (node.mesh >= 0 || node.mesh < -1) m_mesh_uses.push_back({node.mesh, item.node});
-    if (node.camera >= 0 || node.camera < -1) add_camera(node.camera, item.node, world);
+    const auto& node = m_model.nodes[size_t(index)];
+    const Transform world = world_of(index);  // the parent's is known: pre-order
+    if (node.mesh >= 0 || node.mesh < -1) m_mesh_uses.push_back({node.mesh, index});
+    if (node.camera >= 0 || node.camera < -1) add_camera(node.camera, index, world);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
       const auto& li = it->second.Get("light");
-      if (!li.IsNumber()) fail(idx("nodes", size_t(item.node)) + ".extensions.KHR_lights_punctual.light", "must be an integer");
-      add_light(int(li.GetNumberAsInt()), item.node, world);
+      if (!li.IsNumber()) fail(idx("nodes", size_t(index)) + ".extensions.KHR_lights_punctual.light", "must be an integer");
+      add_light(int(li.GetNumberAsInt()), index, world);
     }
-    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);
   }
   // Meshes placed more than once are stored once and instanced (unless flattening is asked
   // for); a mesh placed once is put in world space, as Cycles applies the transform of a mesh
