@@ -1,4 +1,4 @@
-// io/gltf_loader on the shared corpus of third-party files: valid models load with the
+// The glTF loader on the shared corpus of third-party files: valid models load with the
 // triangle, camera and light counts the files hold (corpus README and the files' JSON);
 // every invalid file ends in an InputError or loads with warnings, never anything else.
 #include <catch2/catch.hpp>
