@@ -26,7 +26,7 @@
 #include "io/atomic_file.h"
 #include "io/error.h"
 #include "benchmarks/scenegen.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "io/ply_loader.h"
 #include "renderer/accel/embree.h"

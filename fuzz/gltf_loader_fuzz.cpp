@@ -1,4 +1,4 @@
-// libFuzzer entry point for io/gltf_loader: each input is written as a .glb (if it starts with
+// libFuzzer entry point for the glTF loader (io/gltf/): each input is written as a .glb (if it starts with
 // the GLB magic) or .gltf file in a private folder and loaded. An InputError is the expected
 // outcome for garbage; anything else (crash, sanitizer report, other exception, leak) is a
 // finding.
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 
 namespace fs = std::filesystem;
 

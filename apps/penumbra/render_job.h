@@ -7,7 +7,7 @@
 #include <string>
 
 #include "apps/penumbra/render_options.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/render_settings.h"
 #include "renderer/lights/area.h"
 #include "renderer/lights/environment.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/accel/factory.h"
 
 namespace penumbra::cli {

@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "benchmarks/scenegen.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
 #include "support/cross_check.h"
 #include "renderer/integrators/scene_accel.h"

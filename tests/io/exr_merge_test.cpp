@@ -12,7 +12,7 @@
 
 #include "support/fifo_test_util.h"
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "io/render_settings.h"
 #include "renderer/integrators/render.h"

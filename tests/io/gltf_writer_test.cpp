@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/scene/camera.h"
 #include "support/scene_builder.h"

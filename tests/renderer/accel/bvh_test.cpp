@@ -6,7 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include "support/cross_check.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "support/test_util.h"

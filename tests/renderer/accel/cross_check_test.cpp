@@ -9,7 +9,7 @@
 #include <map>
 
 #include "support/cross_check.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"

@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/cross_check.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "support/test_util.h"

@@ -6,7 +6,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 

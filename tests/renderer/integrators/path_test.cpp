@@ -10,7 +10,7 @@
 #include <atomic>
 #include <cstring>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/bsdf.h"
 #include "renderer/integrators/render.h"

@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 #include <cstring>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "renderer/core/rng.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"

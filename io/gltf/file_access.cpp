@@ -1,5 +1,8 @@
-// glTF file access: bounded non-blocking reads, the GLB chunk walk and URI resolution.
-#include "io/gltf_container.h"
+// glTF file access: bounded non-blocking reads, the GLB chunk walk, URI resolution and the
+// sandboxed file callbacks tinygltf parses with.
+#include "io/gltf/file_access.h"
+
+#include <tiny_gltf.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,7 +16,7 @@
 #include "io/error.h"
 #include "io/file_checks.h"
 
-namespace penumbra {
+namespace penumbra::gltf {
 
 namespace fs = std::filesystem;
 
@@ -151,4 +154,45 @@ ResolvedUri resolve_uri(const std::string& uri, const fs::path& root, bool allow
   return out;
 }
 
-}  // namespace penumbra
+namespace {
+
+bool sandbox_file_exists(const std::string& path, void* user) {
+  return static_cast<FileSandbox*>(user)->served.count(path) > 0;
+}
+
+std::string sandbox_expand(const std::string& path, void*) { return path; }  // no ~ or $VAR
+
+bool sandbox_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  auto& box = *static_cast<FileSandbox*>(user);
+  const auto it = box.served.find(path);
+  if (it == box.served.end()) {
+    if (err) *err = "not a file the loader checked";
+    return false;
+  }
+  try {
+    *out = read_input_file(it->second, "", box.max_bytes);
+  } catch (const InputError& e) {
+    if (err) *err = e.what();
+    return false;
+  }
+  if (std::find(box.read->begin(), box.read->end(), it->second) == box.read->end()) box.read->push_back(it->second);
+  return true;
+}
+
+bool sandbox_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not allowed";
+  return false;
+}
+
+}  // namespace
+
+std::string sandbox_name(const std::string& base, const std::string& decoded_uri) {
+  if (base.empty()) return decoded_uri;
+  return base.back() == '/' ? base + decoded_uri : base + "/" + decoded_uri;
+}
+
+void install_sandbox(tinygltf::TinyGLTF& parser, FileSandbox& box) {
+  parser.SetFsCallbacks({sandbox_file_exists, sandbox_expand, sandbox_read, sandbox_write, &box});
+}
+
+}  // namespace penumbra::gltf

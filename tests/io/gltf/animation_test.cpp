@@ -1,4 +1,4 @@
-// io/gltf_loader animation at a time: node TRS channels (LINEAR, slerp, STEP, CUBICSPLINE),
+// Animation at a time (io/gltf/animation.cpp): node TRS channels (LINEAR, slerp, STEP, CUBICSPLINE),
 // morph-target weights and skinning, on small generated files with hand-computed answers; the
 // corpus InterpolationTest against its own keyframes.
 #include <catch2/catch.hpp>
@@ -6,7 +6,7 @@
 
 #include "support/gltf_writer.h"
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 

@@ -1,13 +1,13 @@
 // Checks on the raw glTF JSON for what tinygltf's parse would lose or accept silently: it
 // truncates integer indices to int, reads a negative byteOffset or byteStride as absent, and
 // keeps strings where arrays belong. Run on the nlohmann DOM before tinygltf parses the text;
-// each violation is an InputError naming the JSON path. Internal to io/.
+// each violation is an InputError naming the JSON path. Internal to io/gltf/.
 #pragma once
 
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace penumbra {
+namespace penumbra::gltf {
 
 /// Validates, per the glTF 2.0 schema and spec:
 /// - every index property (scene, scenes[].nodes, nodes[].camera/mesh/skin/children, the
@@ -28,4 +28,4 @@ namespace penumbra {
 /// Throws InputError(file, JSON path, reason).
 void check_gltf_json(const nlohmann::json& doc, const std::string& file);
 
-}  // namespace penumbra
+}  // namespace penumbra::gltf

@@ -1,10 +1,10 @@
-// io/gltf_loader on the shared corpus of third-party files: valid models load with the
+// The glTF loader on the shared corpus of third-party files: valid models load with the
 // triangle, camera and light counts the files hold (corpus README and the files' JSON);
 // every invalid file ends in an InputError or loads with warnings, never anything else.
 #include <catch2/catch.hpp>
 
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

@@ -1,4 +1,4 @@
-// Instancing in the glTF loader: a mesh placed by several nodes is stored once (object space)
+// Mesh placement and instancing (io/gltf/meshes.cpp): a mesh placed by several nodes is stored once (object space)
 // and instanced, EXT_mesh_gpu_instancing places one instance per TRS element after the node's
 // transform, --flatten (GltfLoadOptions::flatten) gives world-space copies instead, malformed
 // instancing data is an error naming the element, and instanced and flattened scenes render
@@ -9,7 +9,7 @@
 
 #include "support/gltf_writer.h"
 #include "io/error.h"
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"

@@ -1,5 +1,5 @@
 // Raw-JSON checks of a glTF document: index ranges, offsets and strides, enums and array types.
-#include "io/gltf_json_checks.h"
+#include "io/gltf/json_checks.h"
 
 #include <algorithm>
 #include <climits>
@@ -8,7 +8,7 @@
 
 #include "io/error.h"
 
-namespace penumbra {
+namespace penumbra::gltf {
 
 namespace {
 
@@ -358,4 +358,4 @@ void check_gltf_json(const json& doc, const std::string& file) {
   JsonChecks(doc, file).run();
 }
 
-}  // namespace penumbra
+}  // namespace penumbra::gltf

@@ -1,4 +1,5 @@
-// Textured corpus models rendered from the front and sampled at known places: texture
+// Materials (io/gltf/materials.cpp): the KHR material extensions on a generated file, and
+// textured corpus models rendered from the front and sampled at known places: texture
 // orientation (TextureCoordinateTest), KHR_texture_transform (TextureTransformTest),
 // TEXCOORD_1 (MultiUVTest) and COLOR_0 (VertexColorTest). The renders are "albedo" renders:
 // no lights, ambient 1, metallic forced to 0, so a pixel's value is the base colour the
@@ -6,17 +7,26 @@
 // model's README says a correct viewer shows.
 #include <catch2/catch.hpp>
 
-#include "io/gltf_loader.h"
+#include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/material.h"
 #include "renderer/integrators/render.h"
+#include "support/gltf_writer.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
+using Catch::Matchers::Contains;
+using penumbra::test::GltfWriter;
 
 namespace {
+
+LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptions opt = {}) {
+  const auto dir = test::temp_dir(name);
+  w.write_embedded(dir / "scene.gltf");
+  return load_gltf(dir / "scene.gltf", opt);
+}
 
 struct FrontView {
   LoadedScene loaded;
@@ -201,4 +211,33 @@ TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCO
   }
   CHECK(samples > 30);
   CHECK(differs > 0);
+}
+
+TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field", "[io][gltf][quick]") {
+  GltfWriter w;
+  const int m = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
+  w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
+  w.node({{"mesh", m}});
+  w.j["materials"] = {{{"extensions",
+                        {{"KHR_materials_ior", {{"ior", 2.0}}},
+                         {"KHR_materials_specular", {{"specularFactor", 0.5}}},
+                         {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}}}}}};
+  w.j["extensionsUsed"] = {"KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission"};
+  w.j["extensionsRequired"] = {"KHR_materials_transmission"};
+  const LoadedScene loaded = write_and_load(w, "extmat");
+  const Material& mat = loaded.scene.materials.at(0);
+  CHECK(mat.ior == 2);
+  CHECK(mat.specular == 0.5f);
+  CHECK(mat.transmission == 0.75f);
+  // ior 0 is the extension's special case (f0 = 1); between 0 and 1 it is an error.
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.0;
+  CHECK(write_and_load(w, "ior0").scene.materials.at(0).ior == 0);
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.5;
+  REQUIRE_THROWS_WITH(write_and_load(w, "iorbad"), Contains("materials[0].extensions.KHR_materials_ior.ior"));
+  w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 1.5;
+  w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 1.5;
+  REQUIRE_THROWS_WITH(write_and_load(w, "trbad"), Contains("KHR_materials_transmission.transmissionFactor") && Contains("[0, 1]"));
+  w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 0.5;
+  w.j["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"] = "shiny";
+  REQUIRE_THROWS_WITH(write_and_load(w, "spbad"), Contains("KHR_materials_specular.specularFactor") && Contains("number"));
 }

@@ -1,17 +1,22 @@
 // The glTF loader's file-access phase: reading input files (regular files of bounded size
 // only), the GLB container (glTF 2.0 spec, "GLB File Format Specification") and resolving
-// buffer and image URIs against the scene folder under the URI policy. Internal to io/; it
-// neither parses JSON nor knows the glTF schema.
+// buffer and image URIs against the scene folder under the URI policy, and the file sandbox
+// tinygltf reads through. Internal to io/gltf/; it neither parses JSON nor knows the glTF schema.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
-namespace penumbra {
+namespace tinygltf {
+class TinyGLTF;
+}
+
+namespace penumbra::gltf {
 
 /// The bytes of `path` (at most its first `prefix_bytes`) after check_input_file(path, element,
 /// max_bytes). The file is opened without blocking and checked again on the open descriptor, so
@@ -59,4 +64,19 @@ struct ResolvedUri {
 ResolvedUri resolve_uri(const std::string& uri, const std::filesystem::path& root, bool allow_external,
                         uint64_t max_bytes);
 
-}  // namespace penumbra
+/// The files tinygltf may read: only those resolved and checked before parsing (resolve_uri),
+/// each under the name tinygltf will ask for (sandbox_name()).
+struct FileSandbox {
+  std::map<std::string, std::filesystem::path> served;  ///< tinygltf's path -> the checked file
+  uint64_t max_bytes = 0;                               ///< per file, as in read_input_file()
+  std::vector<std::filesystem::path>* read = nullptr;   ///< every file read, in order, once each
+};
+
+/// The path tinygltf asks for when it reads `decoded_uri` against `base` (its JoinPath).
+std::string sandbox_name(const std::string& base, const std::string& decoded_uri);
+
+/// Points tinygltf's file callbacks at `box` (which must outlive the parse): existence and reads
+/// only for served files, no ~ or $VAR expansion, no writes.
+void install_sandbox(tinygltf::TinyGLTF& parser, FileSandbox& box);
+
+}  // namespace penumbra::gltf

@@ -1,0 +1,132 @@
+// glTF 2.0 loading: the public entry points and the order of the phases. parse.h reads and
+// parses the file; then the model is described (GltfInfo), validated and converted by
+// accessors, images, materials, meshes, animation and nodes, each in its own file.
+#include "io/gltf/loader.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <new>
+
+#include "io/gltf/accessors.h"
+#include "io/gltf/animation.h"
+#include "io/gltf/context.h"
+#include "io/gltf/images.h"
+#include "io/gltf/materials.h"
+#include "io/gltf/meshes.h"
+#include "io/gltf/nodes.h"
+#include "io/gltf/parse.h"
+
+namespace penumbra {
+
+std::vector<std::string> supported_gltf_extensions() {
+  std::vector<std::string> out = {"KHR_lights_punctual"};
+  for (auto& e : gltf::material_extensions()) out.push_back(std::move(e));
+  out.push_back("EXT_mesh_gpu_instancing");
+  return out;
+}
+
+int json_nesting_depth(std::string_view json, int limit) {
+  int depth = 0, max_depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (c == '\\') ++i;  // skip the escaped character
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '{' || c == '[') {
+      max_depth = std::max(max_depth, ++depth);
+      if (max_depth > limit) return limit + 1;
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return max_depth;
+}
+
+namespace gltf {
+namespace {
+
+// The descriptive facts of GltfInfo that come straight from the model.
+void describe(const tinygltf::Model& model, GltfInfo& info) {
+  info.generator = model.asset.generator;
+  info.version = model.asset.version;
+  info.scene_count = int(model.scenes.size());
+  for (size_t i = 0; i < model.scenes.size(); ++i)
+    info.scene_names.push_back(model.scenes[i].name.empty() ? idx("scenes", i) : model.scenes[i].name);
+  info.node_count = int(model.nodes.size());
+  for (size_t i = 0; i < model.nodes.size(); ++i)
+    info.node_names.push_back(model.nodes[i].name.empty() ? idx("nodes", i) : model.nodes[i].name);
+  info.mesh_count = int(model.meshes.size());
+  for (const auto& m : model.meshes) info.primitive_count += int(m.primitives.size());
+  info.gltf_camera_count = int(model.cameras.size());
+  info.gltf_light_count = int(model.lights.size());
+  info.image_count = int(model.images.size());
+  info.animation_count = int(model.animations.size());
+  info.extensions_used = model.extensionsUsed;
+  info.extensions_required = model.extensionsRequired;
+}
+
+// The asset version and the extensions: a required one outside supported_gltf_extensions() is
+// an error, a used one a warning.
+void check_version_and_extensions(const GltfContext& ctx) {
+  const tinygltf::Model& model = ctx.model;
+  if (!model.asset.version.empty() && model.asset.version.rfind("2.", 0) != 0)
+    ctx.fail("asset.version", "version '" + model.asset.version + "' is not glTF 2.x");
+  const auto supported = supported_gltf_extensions();
+  for (const auto& e : model.extensionsRequired)
+    if (std::find(supported.begin(), supported.end(), e) == supported.end())
+      ctx.fail("extensionsRequired", "extension " + e + " is required by the file but not supported");
+  for (const auto& e : model.extensionsUsed)
+    if (std::find(supported.begin(), supported.end(), e) == supported.end())
+      ctx.warn("extensionsUsed", "extension " + e + " is not supported and will be ignored");
+}
+
+// The conversion phases, in order: whole-model validation, materials (with their textures),
+// meshes in local space, the animated pose, then the node walk that places cameras, lights
+// and meshes.
+void convert(const GltfContext& ctx) {
+  describe(ctx.model, ctx.out.info);
+  check_version_and_extensions(ctx);
+  validate_accessors(ctx);
+  validate_textures(ctx);
+  validate_material_textures(ctx);
+  TextureCache textures;
+  convert_materials(ctx, textures);
+  validate_cameras(ctx);
+  validate_lights(ctx);
+  const std::vector<std::vector<LocalPrimitive>> meshes = decode_meshes(ctx);
+  std::vector<NodePose> poses;
+  if (ctx.options.time) poses = evaluate_animations(ctx, *ctx.options.time);
+  const std::vector<int> roots = scene_roots(ctx);
+  NodeTransforms nodes = link_nodes(ctx, poses);
+  const std::vector<MeshUse> uses = place_nodes(ctx, nodes, roots);
+  place_meshes(ctx, meshes, nodes, uses);
+  const int scene = ctx.out.info.scene_index;
+  if (ctx.out.scene.meshes.empty())
+    ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
+             "no renderable triangles; the image shows only the background");
+}
+
+}  // namespace
+}  // namespace gltf
+
+LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options) {
+  const std::string name = file.string();
+  gltf::MemoryBudget budget(name, options.max_memory_bytes);
+  LoadedScene out;
+  tinygltf::Model model;
+  gltf::parse_gltf(file, options, budget, out, model);
+  try {
+    gltf::convert(gltf::GltfContext{model, name, options, budget, out});
+  } catch (const std::bad_alloc&) {
+    throw InputError(name, "", "out of memory while converting the scene");
+  }
+  return out;
+}
+
+}  // namespace penumbra

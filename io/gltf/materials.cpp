@@ -1,0 +1,199 @@
+// Materials: factors, alpha modes, texture infos (KHR_texture_transform) and the KHR material
+// extensions, each converted into the renderer's Material.
+#include "io/gltf/materials.h"
+
+#include <tiny_gltf.h>
+
+#include <cmath>
+
+namespace penumbra::gltf {
+
+std::vector<std::string> material_extensions() {
+  return {"KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_materials_ior",
+          "KHR_materials_specular", "KHR_materials_transmission", "KHR_texture_transform"};
+}
+
+namespace {
+
+double finite_or_fail(const GltfContext& ctx, double v, const std::string& where) {
+  if (!std::isfinite(v)) ctx.fail(where, "value is not finite");
+  return v;
+}
+
+// KHR_texture_transform: uv' = T R S uv (spec: offset, rotation counter-clockwise, scale) into
+// ref.m; its texCoord, if present, replaces `texcoord`.
+void read_texture_transform(const GltfContext& ctx, const tinygltf::Value& x, const std::string& where,
+                            TextureRef& ref, int& texcoord) {
+  const std::string xw = where + ".extensions.KHR_texture_transform";
+  double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+  auto read_pair = [&](const char* key, double* v) {
+    const auto& a = x.Get(key);
+    if (!a.IsArray()) return;
+    if (a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) ctx.fail(xw + "." + key, "must be 2 numbers");
+    v[0] = a.Get(0).GetNumberAsDouble();
+    v[1] = a.Get(1).GetNumberAsDouble();
+  };
+  read_pair("offset", off);
+  read_pair("scale", sc);
+  if (x.Get("rotation").IsNumber()) rot = x.Get("rotation").GetNumberAsDouble();
+  if (!std::isfinite(off[0] + off[1] + sc[0] + sc[1] + rot)) ctx.fail(xw, "values must be finite");
+  if (x.Get("texCoord").IsNumber()) texcoord = x.Get("texCoord").GetNumberAsInt();
+  const double c = std::cos(rot), sn = std::sin(rot);
+  ref.m[0][0] = float(sc[0] * c);
+  ref.m[0][1] = float(sc[1] * sn);
+  ref.m[0][2] = float(off[0]);
+  ref.m[1][0] = float(-sc[0] * sn);
+  ref.m[1][1] = float(sc[1] * c);
+  ref.m[1][2] = float(off[1]);
+}
+
+// A texture info (index, texCoord, extensions) at `where` as a TextureRef; texture -1 if it is
+// absent or unusable (with a warning where the file is at fault).
+TextureRef texture_ref(const GltfContext& ctx, TextureCache& cache, int texture, int texcoord,
+                       const tinygltf::ExtensionMap& extensions, bool srgb, const std::string& where) {
+  TextureRef ref;
+  const tinygltf::Model& model = ctx.model;
+  if (texture < 0 || size_t(texture) >= model.textures.size()) return ref;  // warned by validate_material_textures
+  const auto& t = model.textures[size_t(texture)];
+  if (t.source < 0 || size_t(t.source) >= model.images.size()) {
+    if (t.source < 0) ctx.warn(idx("textures", size_t(texture)), "has no image source; ignored");
+    return ref;
+  }
+  if (auto it = extensions.find("KHR_texture_transform"); it != extensions.end())
+    read_texture_transform(ctx, it->second, where, ref, texcoord);
+  if (texcoord < 0 || texcoord > 1) {
+    ctx.warn(where + ".texCoord",
+             "TEXCOORD_" + std::to_string(texcoord) + " is not supported (only 0 and 1); texture ignored");
+    return ref;
+  }
+  ref.texcoord = texcoord;
+  ref.texture = scene_texture(ctx, cache, texture, srgb, where);
+  return ref;
+}
+
+// Factors and alpha of the core material (pbrMetallicRoughness, emissiveFactor, alphaMode).
+void read_core_factors(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where, Material& m) {
+  const auto& pbr = src.pbrMetallicRoughness;
+  const std::string pw = where + ".pbrMetallicRoughness";
+  if (pbr.baseColorFactor.size() != 4) ctx.fail(pw + ".baseColorFactor", "must have 4 values");
+  for (int c = 0; c < 3; ++c)
+    m.base_color[c] =
+        float(std::clamp(finite_or_fail(ctx, pbr.baseColorFactor[size_t(c)], pw + ".baseColorFactor"), 0.0, 1.0));
+  m.alpha = float(std::clamp(finite_or_fail(ctx, pbr.baseColorFactor[3], pw + ".baseColorFactor"), 0.0, 1.0));
+  m.metallic = float(std::clamp(finite_or_fail(ctx, pbr.metallicFactor, pw + ".metallicFactor"), 0.0, 1.0));
+  m.roughness = float(std::clamp(finite_or_fail(ctx, pbr.roughnessFactor, pw + ".roughnessFactor"), 0.0, 1.0));
+  if (!src.emissiveFactor.empty()) {
+    if (src.emissiveFactor.size() != 3) ctx.fail(where + ".emissiveFactor", "must have 3 values");
+    for (int c = 0; c < 3; ++c)
+      m.emissive[c] =
+          float(std::clamp(finite_or_fail(ctx, src.emissiveFactor[size_t(c)], where + ".emissiveFactor"), 0.0, 1.0));
+  }
+}
+
+// A number in [lo, hi] at extensions.<ext>.<key> (absent: `out` keeps its default).
+void extension_number(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where,
+                      const char* ext, const char* key, float& out, double lo, double hi, const char* range) {
+  auto it = src.extensions.find(ext);
+  if (it == src.extensions.end()) return;
+  const auto& v = it->second.Get(key);
+  if (v.Type() == tinygltf::NULL_TYPE) return;
+  const std::string w = where + ".extensions." + ext + "." + key;
+  if (!v.IsNumber()) ctx.fail(w, "must be a number");
+  const double x = finite_or_fail(ctx, v.GetNumberAsDouble(), w);
+  if (x < lo || x > hi) ctx.fail(w, std::string("must be ") + range);
+  out = float(x);
+}
+
+// KHR_materials_emissive_strength, _unlit, _ior, _specular and _transmission.
+void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
+                         const std::string& where, Material& m) {
+  if (auto it = src.extensions.find("KHR_materials_emissive_strength"); it != src.extensions.end()) {
+    const auto& s = it->second.Get("emissiveStrength");
+    if (s.IsNumber()) {
+      const std::string sw = where + ".extensions.KHR_materials_emissive_strength";
+      const double strength = finite_or_fail(ctx, s.GetNumberAsDouble(), sw);
+      if (strength < 0) ctx.fail(sw, "emissiveStrength must be >= 0");
+      m.emissive *= float(strength);
+    }
+  }
+  m.unlit = src.extensions.count("KHR_materials_unlit") > 0;
+  // ior: >= 1, or 0 (the extension's special case: f0 = 1).
+  extension_number(ctx, src, where, "KHR_materials_ior", "ior", m.ior, 0.0, 1e6, "0 or in [1, 1e6]");
+  if (m.ior > 0 && m.ior < 1) ctx.fail(where + ".extensions.KHR_materials_ior.ior", "must be 0 or in [1, 1e6]");
+  extension_number(ctx, src, where, "KHR_materials_specular", "specularFactor", m.specular, 0.0, 1.0, "in [0, 1]");
+  extension_number(ctx, src, where, "KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0, 1.0,
+                   "in [0, 1]");
+  if (auto it = src.extensions.find("KHR_materials_transmission"); it != src.extensions.end() && m.transmission > 0) {
+    const auto& info = it->second.Get("transmissionTexture");
+    if (info.IsObject() && info.Get("index").IsInt()) {
+      tinygltf::ExtensionMap texture_extensions;
+      const auto& e = info.Get("extensions");
+      if (e.IsObject())
+        for (const auto& key : e.Keys()) texture_extensions[key] = e.Get(key);
+      const int tc = info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
+      m.transmission_tex = texture_ref(ctx, cache, info.Get("index").GetNumberAsInt(), tc, texture_extensions, false,
+                                       where + ".extensions.KHR_materials_transmission.transmissionTexture");
+    }
+  }
+}
+
+// Alpha mode and cutoff, sidedness, and the core textures (baseColor and emissive in sRGB).
+void read_alpha_and_textures(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
+                             const std::string& where, Material& m) {
+  if (src.alphaMode == "OPAQUE" || src.alphaMode.empty()) m.alpha_mode = AlphaMode::Opaque;
+  else if (src.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
+  else if (src.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
+  else ctx.fail(where + ".alphaMode", "'" + src.alphaMode + "' is not OPAQUE, MASK or BLEND");
+  m.alpha_cutoff = float(finite_or_fail(ctx, src.alphaCutoff, where + ".alphaCutoff"));
+  if (m.alpha_cutoff < 0) ctx.fail(where + ".alphaCutoff", "must be >= 0");
+  m.double_sided = src.doubleSided;
+  const auto& pbr = src.pbrMetallicRoughness;
+  m.base_color_tex = texture_ref(ctx, cache, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                 pbr.baseColorTexture.extensions, true, where + ".pbrMetallicRoughness.baseColorTexture");
+  m.metallic_roughness_tex =
+      texture_ref(ctx, cache, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                  pbr.metallicRoughnessTexture.extensions, false, where + ".pbrMetallicRoughness.metallicRoughnessTexture");
+  m.normal_tex = texture_ref(ctx, cache, src.normalTexture.index, src.normalTexture.texCoord,
+                             src.normalTexture.extensions, false, where + ".normalTexture");
+  m.normal_scale = float(finite_or_fail(ctx, src.normalTexture.scale, where + ".normalTexture.scale"));
+  m.occlusion_tex = texture_ref(ctx, cache, src.occlusionTexture.index, src.occlusionTexture.texCoord,
+                                src.occlusionTexture.extensions, false, where + ".occlusionTexture");
+  m.occlusion_strength = float(
+      std::clamp(finite_or_fail(ctx, src.occlusionTexture.strength, where + ".occlusionTexture.strength"), 0.0, 1.0));
+  if (max_component(m.emissive) > 0)
+    m.emissive_tex = texture_ref(ctx, cache, src.emissiveTexture.index, src.emissiveTexture.texCoord,
+                                 src.emissiveTexture.extensions, true, where + ".emissiveTexture");
+}
+
+}  // namespace
+
+void validate_material_textures(const GltfContext& ctx) {
+  const int n = int(ctx.model.textures.size());
+  for (size_t i = 0; i < ctx.model.materials.size(); ++i) {
+    const auto& m = ctx.model.materials[i];
+    const std::pair<const char*, int> refs[] = {
+        {"pbrMetallicRoughness.baseColorTexture", m.pbrMetallicRoughness.baseColorTexture.index},
+        {"pbrMetallicRoughness.metallicRoughnessTexture", m.pbrMetallicRoughness.metallicRoughnessTexture.index},
+        {"normalTexture", m.normalTexture.index}, {"occlusionTexture", m.occlusionTexture.index},
+        {"emissiveTexture", m.emissiveTexture.index}};
+    for (const auto& [field, index] : refs)
+      if (index < -1 || index >= n)
+        ctx.warn(idx("materials", i) + "." + field, "texture index " + std::to_string(index) + " out of range (" +
+                                                       std::to_string(n) + " textures); ignored");
+  }
+}
+
+void convert_materials(const GltfContext& ctx, TextureCache& cache) {
+  for (size_t i = 0; i < ctx.model.materials.size(); ++i) {
+    const auto& src = ctx.model.materials[i];
+    const std::string where = idx("materials", i);
+    Material m;
+    m.name = src.name.empty() ? where : src.name;
+    read_core_factors(ctx, src, where, m);
+    read_khr_extensions(ctx, cache, src, where, m);
+    read_alpha_and_textures(ctx, cache, src, where, m);
+    ctx.out.scene.materials.push_back(m);
+  }
+}
+
+}  // namespace penumbra::gltf
