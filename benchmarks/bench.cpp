@@ -13,28 +13,28 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <ctime>
 #include <random>
 #include <sstream>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "benchmarks/scenegen.h"
 #include "io/accel_params.h"
 #include "io/atomic_file.h"
 #include "io/error.h"
-#include "benchmarks/scenegen.h"
 #include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "io/ply_loader.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
+#include "renderer/core/rng.h"
+#include "renderer/film/cost_map.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
-#include "renderer/film/cost_map.h"
-#include "renderer/core/rng.h"
 #include "renderer/scene/scene.h"
 
 using namespace penumbra;
@@ -43,7 +43,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -67,9 +69,9 @@ Camera bench_camera(const Scene& scene, int w, int h) {
   return scene.cameras.empty() ? frame_bounds(compute_bounds(scene), float(w) / float(h)) : scene.cameras[0];
 }
 
-/// The four ray kinds of the benchmark (primary, shadow, diffuse, random), generated once per scene from a fixed seed. Primary rays come
-/// from the scene's first camera (or one framing the bounds) on a w x h grid; shadow and diffuse
-/// rays start at the primary hits (found with Embree), offset along the geometric normal.
+/// The four ray kinds of the benchmark (primary, shadow, diffuse, random), generated once per scene from a
+/// fixed seed. Primary rays come from the scene's first camera (or one framing the bounds) on a w x h grid;
+/// shadow and diffuse rays start at the primary hits (found with Embree), offset along the geometric normal.
 std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
                                   std::span<const TriangleMeshView> views, int w, int h,
                                   const std::vector<std::string>& kinds) {
@@ -129,7 +131,8 @@ std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
         s.rays.push_back({o, 0, random_direction(rng), kInfinity});
       }
     } else {
-      throw std::invalid_argument("--rays: unknown ray kind '" + kind + "' (known: primary, shadow, diffuse, random)");
+      throw std::invalid_argument("--rays: unknown ray kind '" + kind +
+                                  "' (known: primary, shadow, diffuse, random)");
     }
     sets.push_back(std::move(s));
   }
@@ -141,16 +144,17 @@ double trace_seconds(const Accelerator& a, const RaySet& set, int threads, uint6
   std::vector<uint8_t> result(set.rays.size());
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(std::max(threads, 1)));
   const auto t0 = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (set.any_hit) {
-        result[i] = a.occluded(set.rays[i]);
-      } else {
-        Hit h;
-        result[i] = a.intersect(set.rays[i], h);
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i < r.end(); ++i) {
+                        if (set.any_hit) {
+                          result[i] = a.occluded(set.rays[i]);
+                        } else {
+                          Hit h;
+                          result[i] = a.intersect(set.rays[i], h);
+                        }
+                      }
+                    });
   const double s = seconds_since(t0);
   hits = 0;
   for (uint8_t v : result) hits += v;
@@ -181,8 +185,10 @@ Agreement check_against_embree(const Accelerator& a, const Accelerator& embree, 
   Agreement g;
   for (const Ray& r : set.rays) {
     if (same_answer(a, embree, r, set.any_hit, scale)) continue;
-    if (same_answer(a, exact, r, set.any_hit, scale)) ++g.ties;
-    else ++g.wrong;
+    if (same_answer(a, exact, r, set.any_hit, scale))
+      ++g.ties;
+    else
+      ++g.wrong;
   }
   return g;
 }
@@ -198,7 +204,8 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
       const std::string count = rest.substr(colon + 1);
       char* end = nullptr;
       n = std::strtoull(count.c_str(), &end, 10);
-      if (count.empty() || *end != 0) throw std::invalid_argument(spec + ": triangle count '" + count + "' is not a number");
+      if (count.empty() || *end != 0)
+        throw std::invalid_argument(spec + ": triangle count '" + count + "' is not a number");
     }
     Scene scene = bench::generate_scene(rest.substr(0, colon), seed, n);
     name = rest.substr(0, colon) + "-" + std::to_string(count_triangles(scene) / 1000) + "k";
@@ -234,10 +241,14 @@ std::string json_escape(const std::string& s) {
 std::string xml_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else
+      o += c;
   }
   return o;
 }
@@ -301,15 +312,18 @@ std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thre
   const int width = charts * (chart_w + 30) + 40, height = int(scenes.size()) * panel_h + 70;
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-    << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  o << "<text x=\"20\" y=\"22\" font-size=\"15\" font-weight=\"bold\">penumbra-bench: throughput (Mrays/s, higher is better) "
+    << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" "
+       "fill=\"white\"/>\n";
+  o << "<text x=\"20\" y=\"22\" font-size=\"15\" font-weight=\"bold\">penumbra-bench: throughput (Mrays/s, "
+       "higher is better) "
        "and build time (ms, lower is better)</text>\n";
   for (size_t a = 0; a < accels.size(); ++a)  // legend
-    o << "<rect x=\"" << 20 + a * 90 << "\" y=\"34\" width=\"12\" height=\"12\" fill=\"" << colors[a % 6] << "\"/><text x=\""
-      << 36 + a * 90 << "\" y=\"44\">" << xml_escape(accels[a]) << "</text>\n";
+    o << "<rect x=\"" << 20 + a * 90 << "\" y=\"34\" width=\"12\" height=\"12\" fill=\"" << colors[a % 6]
+      << "\"/><text x=\"" << 36 + a * 90 << "\" y=\"44\">" << xml_escape(accels[a]) << "</text>\n";
   for (size_t si = 0; si < scenes.size(); ++si) {
     const int y0 = 70 + int(si) * panel_h;
-    o << "<text x=\"20\" y=\"" << y0 + 14 << "\" font-size=\"13\" font-weight=\"bold\">" << xml_escape(scenes[si]) << "</text>\n";
+    o << "<text x=\"20\" y=\"" << y0 + 14 << "\" font-size=\"13\" font-weight=\"bold\">"
+      << xml_escape(scenes[si]) << "</text>\n";
     for (int c = 0; c < charts; ++c) {
       const bool build = c == int(thread_counts.size());
       const int x0 = 40 + c * (chart_w + 30), top = y0 + 40, base = top + chart_h;
@@ -325,10 +339,12 @@ std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thre
       for (size_t g = 0; g < groups; ++g)
         for (size_t a = 0; a < accels.size(); ++a) vmax = std::max(vmax, value(g, a));
       if (!(vmax > 0)) vmax = 1;
-      const std::string title = build ? "build time (ms)" : std::to_string(thread_counts[size_t(c)]) + " thread" +
-                                                                (thread_counts[size_t(c)] == 1 ? "" : "s") + ", Mrays/s";
+      const std::string title = build ? "build time (ms)"
+                                      : std::to_string(thread_counts[size_t(c)]) + " thread" +
+                                            (thread_counts[size_t(c)] == 1 ? "" : "s") + ", Mrays/s";
       o << "<text x=\"" << x0 << "\" y=\"" << top - 8 << "\" font-weight=\"bold\">" << title << "</text>\n";
-      o << "<line x1=\"" << x0 << "\" y1=\"" << base << "\" x2=\"" << x0 + chart_w << "\" y2=\"" << base << "\" stroke=\"black\"/>\n";
+      o << "<line x1=\"" << x0 << "\" y1=\"" << base << "\" x2=\"" << x0 + chart_w << "\" y2=\"" << base
+        << "\" stroke=\"black\"/>\n";
       const double gw = double(chart_w) / double(groups), bw = gw * 0.8 / double(accels.size());
       for (size_t g = 0; g < groups; ++g) {
         for (size_t a = 0; a < accels.size(); ++a) {
@@ -336,15 +352,16 @@ std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thre
           const double x = x0 + double(g) * gw + gw * 0.1 + double(a) * bw;
           char buf[64];
           std::snprintf(buf, sizeof buf, v >= 100 ? "%.0f" : (v >= 10 ? "%.1f" : "%.2f"), v);
-          o << "<rect x=\"" << x << "\" y=\"" << base - h << "\" width=\"" << bw * 0.92 << "\" height=\"" << h << "\" fill=\""
-            << colors[a % 6] << "\"><title>" << xml_escape(scenes[si] + " " + accels[a] + (build ? "" : " " + kinds[g])) << ": "
-            << buf << "</title></rect>\n";
+          o << "<rect x=\"" << x << "\" y=\"" << base - h << "\" width=\"" << bw * 0.92 << "\" height=\"" << h
+            << "\" fill=\"" << colors[a % 6] << "\"><title>"
+            << xml_escape(scenes[si] + " " + accels[a] + (build ? "" : " " + kinds[g])) << ": " << buf
+            << "</title></rect>\n";
           if (bw >= 14)
-            o << "<text x=\"" << x + bw * 0.46 << "\" y=\"" << base - h - 3 << "\" font-size=\"8\" text-anchor=\"middle\">" << buf
-              << "</text>\n";
+            o << "<text x=\"" << x + bw * 0.46 << "\" y=\"" << base - h - 3
+              << "\" font-size=\"8\" text-anchor=\"middle\">" << buf << "</text>\n";
         }
-        o << "<text x=\"" << x0 + double(g) * gw + gw / 2 << "\" y=\"" << base + 14 << "\" text-anchor=\"middle\">"
-          << (build ? "build" : xml_escape(kinds[g])) << "</text>\n";
+        o << "<text x=\"" << x0 + double(g) * gw + gw / 2 << "\" y=\"" << base + 14
+          << "\" text-anchor=\"middle\">" << (build ? "build" : xml_escape(kinds[g])) << "</text>\n";
       }
     }
   }
@@ -355,9 +372,10 @@ std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thre
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"penumbra-bench: acceleration structures on the same scenes and rays, verified against Embree"};
-  std::vector<std::string> scenes, accels{"embree", "bvh", "kdtree", "grid"}, kinds{"primary", "shadow", "diffuse", "random"},
-      params;
+  CLI::App app{
+      "penumbra-bench: acceleration structures on the same scenes and rays, verified against Embree"};
+  std::vector<std::string> scenes, accels{"embree", "bvh", "kdtree", "grid"},
+      kinds{"primary", "shadow", "diffuse", "random"}, params;
   std::vector<int> threads{1, 0};
   int width = 512, height = 288, builds = 5, repeats = 3;
   std::string csv, json, svg, heatmaps;
@@ -366,22 +384,29 @@ int main(int argc, char** argv) {
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
   app.add_option("--seed", seed, "seed of the generated scenes (default 1)");
-  app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")->delimiter(',');
+  app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")
+      ->delimiter(',');
   app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
   app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
       ->delimiter(',')
       ->check(CLI::Range(0, 1024));
   app.add_option("--width", width, "primary rays per row (default 512)")->check(CLI::Range(1, 8192));
   app.add_option("--height", height, "primary rays per column (default 288)")->check(CLI::Range(1, 8192));
-  app.add_option("--builds", builds, "builds per structure; the median is reported (default 5)")->check(CLI::Range(1, 100));
-  app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")->check(CLI::Range(1, 100));
+  app.add_option("--builds", builds, "builds per structure; the median is reported (default 5)")
+      ->check(CLI::Range(1, 100));
+  app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")
+      ->check(CLI::Range(1, 100));
   app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
   app.add_option("--csv", csv, "also write the table as CSV (written atomically)");
-  app.add_option("--json", json, "also write the results, machine, build, versions and command line as JSON (written atomically)");
-  app.add_option("--heatmaps", heatmaps,
-                 "also write a traversal-cost heat map (nodes + triangles per primary ray) per scene and structure "
-                 "into this folder: SCENE.ACCEL.cost.png (for embree, which keeps no counts: nanoseconds per ray)");
-  app.add_option("--svg", svg, "also write a bar chart of throughput and build time as SVG (written atomically)");
+  app.add_option(
+      "--json", json,
+      "also write the results, machine, build, versions and command line as JSON (written atomically)");
+  app.add_option(
+      "--heatmaps", heatmaps,
+      "also write a traversal-cost heat map (nodes + triangles per primary ray) per scene and structure "
+      "into this folder: SCENE.ACCEL.cost.png (for embree, which keeps no counts: nanoseconds per ray)");
+  app.add_option("--svg", svg,
+                 "also write a bar chart of throughput and build time as SVG (written atomically)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -395,7 +420,8 @@ int main(int argc, char** argv) {
     // Check the output folders before measuring for minutes.
     for (const std::string* out : {&csv, &json, &svg}) {
       if (out->empty()) continue;
-      const std::filesystem::path dir = std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
+      const std::filesystem::path dir =
+          std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
       if (!std::filesystem::is_directory(dir))
         throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
     }
@@ -403,7 +429,8 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--heatmaps: directory '" + heatmaps + "' does not exist");
     for (const auto& k : kinds)
       if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
-        throw std::invalid_argument("--rays: unknown ray kind '" + k + "' (known: primary, shadow, diffuse, random)");
+        throw std::invalid_argument("--rays: unknown ray kind '" + k +
+                                    "' (known: primary, shadow, diffuse, random)");
     AccelConfig config;
     for (const auto& p : params) apply_accel_param(config, p);
     for (const auto& a : accels) {
@@ -412,20 +439,23 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
     }
     // Embree first, so every later row can show its ratio as soon as it is measured.
-    if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end()) std::rotate(accels.begin(), it, it + 1);
+    if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end())
+      std::rotate(accels.begin(), it, it + 1);
     // The table, one row as soon as it is measured (long runs show progress).
-    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s", "scene", "accel", "rays", "build ms", "MiB", "B/tri",
-                "SAH", "count", "wrong", "ties");
-    for (int t : threads) std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
+    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s", "scene", "accel", "rays", "build ms", "MiB",
+                "B/tri", "SAH", "count", "wrong", "ties");
+    for (int t : threads)
+      std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
     std::printf("\n");
     auto print_row = [](const Row& r) {
-      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu %5llu", r.scene.c_str(), r.accel.c_str(),
-                  r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
+      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu %5llu", r.scene.c_str(),
+                  r.accel.c_str(), r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
                   r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
                   static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches),
                   static_cast<unsigned long long>(r.ties));
       for (size_t i = 0; i < r.mrays.size(); ++i)
-        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second, i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
+        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second,
+                    i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
       std::printf("\n");
       std::fflush(stdout);
     };
@@ -459,7 +489,8 @@ int main(int argc, char** argv) {
           rc.spp = 1;
           validate(rc);
           const CostImage cost = render_cost(*accel, bench_camera(scene, width, height), rc);
-          write_heatmap(total_cost(cost), width, height, std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
+          write_heatmap(total_cost(cost), width, height,
+                        std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
                         name + " " + cost_caption(cost, accel_name));
         }
         for (const auto& set : sets) {
@@ -482,7 +513,8 @@ int main(int argc, char** argv) {
           // Ratio to Embree on the same rays (Embree is measured first, see above).
           for (const auto& e : rows)
             if (e.scene == name && e.accel == "embree" && e.kind == row.kind)
-              for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(row.mrays[i].second / e.mrays[i].second);
+              for (size_t i = 0; i < row.mrays.size(); ++i)
+                row.vs_embree.push_back(row.mrays[i].second / e.mrays[i].second);
           if (accel_name == "embree")
             for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(1.0);
           print_row(row);
@@ -493,45 +525,52 @@ int main(int argc, char** argv) {
 
     uint64_t wrong = 0;
     for (const auto& r : rows) wrong += r.mismatches;
-    if (!csv.empty()) write_atomically(csv, [&](const std::filesystem::path& tmp) {
-      std::ofstream f(tmp);
-      f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties";
-      for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
-        f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
-      f << "\n";
-      for (const auto& r : rows) {
-        f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.build_s << ',' << r.bytes << ','
-          << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ',' << r.ties;
-        for (size_t i = 0; i < r.mrays.size(); ++i) f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+    if (!csv.empty())
+      write_atomically(csv, [&](const std::filesystem::path& tmp) {
+        std::ofstream f(tmp);
+        f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties";
+        for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
+          f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
         f << "\n";
-      }
-      if (!f) throw std::runtime_error(csv + ": cannot write");
-    });
-    if (!json.empty()) write_atomically(json, [&](const std::filesystem::path& tmp) {
-      std::ofstream f(tmp);
-      f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"machine\": {\n" << machine_json() << "  },\n"
-        << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n  \"results\": [\n";
-      for (size_t i = 0; i < rows.size(); ++i) {
-        const auto& r = rows[i];
-        f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel << "\", \"config\": \""
-          << json_escape(r.config) << "\", \"rays\": \"" << r.kind
-          << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes
-          << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties
-          << ", \"mrays\": {";
-        for (size_t k = 0; k < r.mrays.size(); ++k)
-          f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;
-        f << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
-      }
-      f << "  ]\n}\n";
-      if (!f) throw std::runtime_error(json + ": cannot write");
-    });
-    if (!svg.empty()) write_atomically(svg, [&](const std::filesystem::path& tmp) {
-      std::vector<int> counts;
-      for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays) counts.push_back(m.first);
-      std::ofstream f(tmp);
-      f << svg_chart(rows, counts);
-      if (!f) throw std::runtime_error(svg + ": cannot write");
-    });
+        for (const auto& r : rows) {
+          f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.build_s << ','
+            << r.bytes << ',' << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ','
+            << r.ties;
+          for (size_t i = 0; i < r.mrays.size(); ++i)
+            f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+          f << "\n";
+        }
+        if (!f) throw std::runtime_error(csv + ": cannot write");
+      });
+    if (!json.empty())
+      write_atomically(json, [&](const std::filesystem::path& tmp) {
+        std::ofstream f(tmp);
+        f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"machine\": {\n"
+          << machine_json() << "  },\n"
+          << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n  \"results\": [\n";
+        for (size_t i = 0; i < rows.size(); ++i) {
+          const auto& r = rows[i];
+          f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel
+            << "\", \"config\": \"" << json_escape(r.config) << "\", \"rays\": \"" << r.kind
+            << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s
+            << ", \"bytes\": " << r.bytes << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays
+            << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties << ", \"mrays\": {";
+          for (size_t k = 0; k < r.mrays.size(); ++k)
+            f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;
+          f << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
+        }
+        f << "  ]\n}\n";
+        if (!f) throw std::runtime_error(json + ": cannot write");
+      });
+    if (!svg.empty())
+      write_atomically(svg, [&](const std::filesystem::path& tmp) {
+        std::vector<int> counts;
+        for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
+          counts.push_back(m.first);
+        std::ofstream f(tmp);
+        f << svg_chart(rows, counts);
+        if (!f) throw std::runtime_error(svg + ": cannot write");
+      });
     if (wrong > 0) {
       std::fprintf(stderr, "penumbra-bench: %llu rays disagree with Embree: these results do not count\n",
                    static_cast<unsigned long long>(wrong));

@@ -6,8 +6,8 @@
 #include <functional>
 #include <stdexcept>
 
-#include "renderer/scene/camera.h"
 #include "renderer/core/rng.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra::bench {
 namespace {
@@ -44,7 +44,8 @@ struct MeshBuilder {
   /// Axis-aligned box, faces outward (counter-clockwise seen from outside).
   void box(Vec3f lo, Vec3f hi) {
     uint32_t v[8];
-    for (int i = 0; i < 8; ++i) v[i] = vertex({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+    for (int i = 0; i < 8; ++i)
+      v[i] = vertex({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
     quad(v[0], v[2], v[3], v[1]);  // -z
     quad(v[4], v[5], v[7], v[6]);  // +z
     quad(v[0], v[4], v[6], v[2]);  // -x
@@ -145,7 +146,9 @@ Scene atrium(uint64_t seed, float s) {
 
   MeshBuilder shell{new_mesh(sc, "shell", stone)};
   const float X = 16, Y = 14, Z = 9, T = 0.4f;
-  shell.surface(n(64), n(36), false, [&](float u, float v) { return Vec3f{-X + 2 * X * u, 0, Z - 2 * Z * v}; });  // floor
+  shell.surface(n(64), n(36), false, [&](float u, float v) {
+    return Vec3f{-X + 2 * X * u, 0, Z - 2 * Z * v};
+  });  // floor
   shell.box({-X - T, 0, -Z - T}, {-X, Y, Z + T});
   shell.box({X, 0, -Z - T}, {X + T, Y, Z + T});
   shell.box({-X, 0, -Z - T}, {X, Y, -Z});
@@ -175,7 +178,8 @@ Scene atrium(uint64_t seed, float s) {
         const float x = -12 + 3.0f * float(i);
         cols.box({x - 0.6f, y0, side * 5 - 0.6f}, {x + 0.6f, y0 + 0.3f, side * 5 + 0.6f});  // base
         cols.column({x, y0 + 0.3f, side * 5}, r, h, n(48), n(24));
-        cols.box({x - 0.55f, y0 + 0.3f + h, side * 5 - 0.55f}, {x + 0.55f, y0 + 0.6f + h, side * 5 + 0.55f});  // capital
+        cols.box({x - 0.55f, y0 + 0.3f + h, side * 5 - 0.55f},
+                 {x + 0.55f, y0 + 0.6f + h, side * 5 + 0.55f});  // capital
         if (i < 8) {
           // Semicircular arch from this column's capital to the next one's.
           const Vec3f c{x + 1.5f, y0 + 0.6f + h, side * 5};
@@ -189,7 +193,8 @@ Scene atrium(uint64_t seed, float s) {
   MeshBuilder drapes{new_mesh(sc, "drapes", cloth)};
   for (float side : {-1.0f, 1.0f}) {
     for (int i = 0; i < 8; ++i) {
-      const float x0 = -12 + 3.0f * float(i) + 0.45f, phase = rng.uniform(0, kTwoPi), depth = rng.uniform(0.05f, 0.2f);
+      const float x0 = -12 + 3.0f * float(i) + 0.45f, phase = rng.uniform(0, kTwoPi),
+                  depth = rng.uniform(0.05f, 0.2f);
       drapes.surface(n(30), n(40), false, [&](float u, float v) {
         const float sag = 0.4f * std::sin(kPi * u) * v;
         return Vec3f{x0 + 2.1f * u, 10.2f - 3.2f * v + sag,
@@ -202,8 +207,10 @@ Scene atrium(uint64_t seed, float s) {
   MeshBuilder crates{new_mesh(sc, "crates", wood)};
   for (int i = 0; i < 60; ++i) {
     const float x = rng.uniform(-14, 14), z = rng.uniform(-3.8f, 3.8f), a = rng.uniform(0.2f, 0.7f);
-    if (rng.uniform() < 0.5f) crates.box({x - a, 0, z - a}, {x + a, 2 * a, z + a});
-    else crates.column({x, 0, z}, a * 0.7f, 2.2f * a, n(20), n(6));
+    if (rng.uniform() < 0.5f)
+      crates.box({x - a, 0, z - a}, {x + a, 2 * a, z + a});
+    else
+      crates.column({x, 0, z}, a * 0.7f, 2.2f * a, n(20), n(6));
   }
 
   sc.lights.push_back(point_light("skylight", {0, 12, 0}, 900, {1.0f, 0.95f, 0.85f}));
@@ -227,7 +234,9 @@ Scene soup(uint64_t seed, uint64_t triangles) {
   for (uint64_t i = 0; i < triangles; ++i) {
     const Vec3f c{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
     uint32_t v[3];
-    for (auto& k : v) k = b.vertex(c + Vec3f{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)} * 0.5f);
+    for (auto& k : v)
+      k = b.vertex(c + Vec3f{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)} *
+                           0.5f);
     b.tri(v[0], v[1], v[2]);
   }
   sc.lights.push_back(point_light("key", {3, 4, 3}, 40));
@@ -246,7 +255,8 @@ Vec2f catmull_rom(const std::vector<Vec2f>& pts, float t) {
   auto p = [&](int k) { return pts[size_t(std::clamp(k, 0, n))]; };
   const Vec2f p0 = p(i - 1), p1 = p(i), p2 = p(i + 1), p3 = p(i + 2);
   auto cr = [&](float a, float b, float c, float d) {
-    return 0.5f * (2 * b + (-a + c) * x + (2 * a - 5 * b + 4 * c - d) * x * x + (-a + 3 * b - 3 * c + d) * x * x * x);
+    return 0.5f * (2 * b + (-a + c) * x + (2 * a - 5 * b + 4 * c - d) * x * x +
+                   (-a + 3 * b - 3 * c + d) * x * x * x);
   };
   return {cr(p0.x, p1.x, p2.x, p3.x), cr(p0.y, p1.y, p2.y, p3.y)};
 }
@@ -255,9 +265,10 @@ Vec2f catmull_rom(const std::vector<Vec2f>& pts, float t) {
 /// origin; `s` scales its tessellation.
 void teapot(MeshBuilder& b, float s) {
   const auto n = [&](float k) { return std::max(4, int(std::lround(k * s))); };
-  const std::vector<Vec2f> body = {{0.0f, 0.0f},  {0.55f, 0.0f}, {0.68f, 0.06f}, {0.75f, 0.3f},
+  const std::vector<Vec2f> body = {{0.0f, 0.0f},   {0.55f, 0.0f},  {0.68f, 0.06f}, {0.75f, 0.3f},
                                    {0.72f, 0.55f}, {0.58f, 0.72f}, {0.45f, 0.78f}};
-  const std::vector<Vec2f> lid = {{0.45f, 0.78f}, {0.32f, 0.84f}, {0.1f, 0.9f}, {0.08f, 0.96f}, {0.12f, 1.0f}, {0.0f, 1.04f}};
+  const std::vector<Vec2f> lid = {{0.45f, 0.78f}, {0.32f, 0.84f}, {0.1f, 0.9f},
+                                  {0.08f, 0.96f}, {0.12f, 1.0f},  {0.0f, 1.04f}};
   for (const auto* profile : {&body, &lid}) {
     const int rings = n(profile == &body ? 120 : 50);
     b.surface(n(160), rings, true, [&](float u, float v) {
@@ -367,7 +378,8 @@ Scene terrain(uint64_t seed, uint64_t triangles) {
   b.surface(k, k, false, [&](float u, float v) {
     const float x = (u - 0.5f) * size, z = (v - 0.5f) * size;
     float h = 0, amp = 80, freq = 1.0f / 250;
-    for (int o = 0; o < 7; ++o, amp *= 0.5f, freq *= 2) h += amp * (value_noise(x * freq, z * freq, seed + uint64_t(o)) - 0.5f);
+    for (int o = 0; o < 7; ++o, amp *= 0.5f, freq *= 2)
+      h += amp * (value_noise(x * freq, z * freq, seed + uint64_t(o)) - 0.5f);
     return Vec3f{x, h, z};
   });
   sc.lights.push_back(sun({0.4f, -0.6f, 0.3f}, 3));
@@ -397,7 +409,8 @@ std::vector<GeneratorInfo> generators() {
 
 Scene generate_scene(const std::string& name, uint64_t seed, uint64_t triangles) {
   const auto all = generators();
-  const auto it = std::find_if(all.begin(), all.end(), [&](const GeneratorInfo& g) { return g.name == name; });
+  const auto it =
+      std::find_if(all.begin(), all.end(), [&](const GeneratorInfo& g) { return g.name == name; });
   if (it == all.end()) {
     std::string known;
     for (const auto& g : all) known += (known.empty() ? "" : ", ") + g.name;
@@ -405,7 +418,8 @@ Scene generate_scene(const std::string& name, uint64_t seed, uint64_t triangles)
   }
   if (triangles == 0) triangles = it->default_triangles;
   if (triangles < 1000 || triangles > 100000000)
-    throw std::invalid_argument(name + ": triangle count " + std::to_string(triangles) + " outside [1000, 100000000]");
+    throw std::invalid_argument(name + ": triangle count " + std::to_string(triangles) +
+                                " outside [1000, 100000000]");
   if (name == "atrium") return fit(triangles, [&](float s) { return atrium(seed, s); });
   if (name == "soup") return soup(seed, triangles);
   if (name == "stadium") return fit(triangles, [&](float s) { return stadium(seed, s); });

@@ -31,8 +31,8 @@ int main(int argc, char** argv) {
   }
   if (list) {
     for (const auto& g : bench::generators())
-      std::printf("%-8s %9llu triangles  %s\n", g.name.c_str(), static_cast<unsigned long long>(g.default_triangles),
-                  g.description.c_str());
+      std::printf("%-8s %9llu triangles  %s\n", g.name.c_str(),
+                  static_cast<unsigned long long>(g.default_triangles), g.description.c_str());
     return 0;
   }
   if (!ply.empty()) {  // --ply IN OUT: the single positional is the output
@@ -46,9 +46,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "penumbra-scenegen: error: an output file ending in .gltf is required\n");
     return 2;
   }
-  const auto dir = std::filesystem::path(out).has_parent_path() ? std::filesystem::path(out).parent_path() : ".";
+  const auto dir =
+      std::filesystem::path(out).has_parent_path() ? std::filesystem::path(out).parent_path() : ".";
   if (!std::filesystem::is_directory(dir)) {
-    std::fprintf(stderr, "penumbra-scenegen: error: %s: directory '%s' does not exist\n", out.c_str(), dir.string().c_str());
+    std::fprintf(stderr, "penumbra-scenegen: error: %s: directory '%s' does not exist\n", out.c_str(),
+                 dir.string().c_str());
     return 2;
   }
   try {

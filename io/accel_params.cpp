@@ -20,7 +20,8 @@ T parse_value(std::string_view key, std::string_view text) {
     r = std::from_chars(text.data(), end, v);
   }
   if (text.empty() || r.ec != std::errc() || r.ptr != end)
-    throw std::invalid_argument("--accel-param " + std::string(key) + ": '" + std::string(text) + "' is not a valid " +
+    throw std::invalid_argument("--accel-param " + std::string(key) + ": '" + std::string(text) +
+                                "' is not a valid " +
                                 (std::is_floating_point_v<T> ? "number" : "non-negative integer"));
   return v;
 }
@@ -59,25 +60,41 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
   const std::string_view key = kv.substr(0, eq), value = kv.substr(eq + 1);
   if (key == "embree.robust") {
     const int v = parse_value<int>(key, value);
-    if (v != 0 && v != 1) throw std::invalid_argument("--accel-param embree.robust: must be 0 or 1, got '" + std::string(value) + "'");
+    if (v != 0 && v != 1)
+      throw std::invalid_argument("--accel-param embree.robust: must be 0 or 1, got '" + std::string(value) +
+                                  "'");
     c.embree.robust = v == 1;
-  } else if (key == "embree.quality") c.embree.quality = parse_value<int>(key, value);
-  else if (key == "bvh.width") c.bvh.width = parse_value<int>(key, value);
-  else if (key == "bvh.max_leaf_size") c.bvh.max_leaf_size = parse_value<int>(key, value);
-  else if (key == "bvh.bin_count") c.bvh.bin_count = parse_value<int>(key, value);
-  else if (key == "bvh.traversal_cost") c.bvh.traversal_cost = parse_value<float>(key, value);
-  else if (key == "bvh.intersection_cost") c.bvh.intersection_cost = parse_value<float>(key, value);
-  else if (key == "kdtree.traversal_cost") c.kdtree.traversal_cost = parse_value<float>(key, value);
-  else if (key == "kdtree.intersection_cost") c.kdtree.intersection_cost = parse_value<float>(key, value);
-  else if (key == "kdtree.empty_bonus") c.kdtree.empty_bonus = parse_value<float>(key, value);
-  else if (key == "kdtree.max_depth") c.kdtree.max_depth = parse_value<int>(key, value);
-  else if (key == "grid.lambda") c.grid.lambda = parse_value<float>(key, value);
-  else if (key == "grid.max_resolution") c.grid.max_resolution = parse_value<uint32_t>(key, value);
-  else if (key == "grid.max_cells") c.grid.max_cells = parse_value<uint64_t>(key, value);
+  } else if (key == "embree.quality")
+    c.embree.quality = parse_value<int>(key, value);
+  else if (key == "bvh.width")
+    c.bvh.width = parse_value<int>(key, value);
+  else if (key == "bvh.max_leaf_size")
+    c.bvh.max_leaf_size = parse_value<int>(key, value);
+  else if (key == "bvh.bin_count")
+    c.bvh.bin_count = parse_value<int>(key, value);
+  else if (key == "bvh.traversal_cost")
+    c.bvh.traversal_cost = parse_value<float>(key, value);
+  else if (key == "bvh.intersection_cost")
+    c.bvh.intersection_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.traversal_cost")
+    c.kdtree.traversal_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.intersection_cost")
+    c.kdtree.intersection_cost = parse_value<float>(key, value);
+  else if (key == "kdtree.empty_bonus")
+    c.kdtree.empty_bonus = parse_value<float>(key, value);
+  else if (key == "kdtree.max_depth")
+    c.kdtree.max_depth = parse_value<int>(key, value);
+  else if (key == "grid.lambda")
+    c.grid.lambda = parse_value<float>(key, value);
+  else if (key == "grid.max_resolution")
+    c.grid.max_resolution = parse_value<uint32_t>(key, value);
+  else if (key == "grid.max_cells")
+    c.grid.max_cells = parse_value<uint64_t>(key, value);
   else {
     std::string known;
     for (const auto& k : accel_param_keys()) known += (known.empty() ? "" : ", ") + k.key;
-    throw std::invalid_argument("--accel-param: unknown key '" + std::string(key) + "' (known: " + known + ")");
+    throw std::invalid_argument("--accel-param: unknown key '" + std::string(key) + "' (known: " + known +
+                                ")");
   }
 }
 

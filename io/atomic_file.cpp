@@ -47,7 +47,9 @@ void release_slot(int i) {
   g_used[i].store(false);
 }
 
-std::string errno_text(int err) { return std::strerror(err); }
+std::string errno_text(int err) {
+  return std::strerror(err);
+}
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what, int err) {
   throw std::runtime_error(path.string() + ": " + what + ": " + errno_text(err));
@@ -134,7 +136,8 @@ OutputTarget resolve_output(const fs::path& destination, const std::string& elem
   if (given.empty()) throw InputError("", element, "empty output path");
   if (const int fd = descriptor_path(given); fd >= 0) {
     struct stat st {};
-    if (::fstat(fd, &st) != 0) throw InputError("", where, "descriptor " + std::to_string(fd) + " is not open");
+    if (::fstat(fd, &st) != 0)
+      throw InputError("", where, "descriptor " + std::to_string(fd) + " is not open");
     t.kind = OutputKind::Stream;
     t.target = destination;
     t.fd = fd;
@@ -147,7 +150,8 @@ OutputTarget resolve_output(const fs::path& destination, const std::string& elem
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) {
       const int err = errno;
-      if (err != ENOENT) throw InputError("", where, "cannot access '" + p.string() + "': " + errno_text(err));
+      if (err != ENOENT)
+        throw InputError("", where, "cannot access '" + p.string() + "': " + errno_text(err));
       const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
       std::error_code ec;
       if (!fs::is_directory(dir, ec))
@@ -159,9 +163,11 @@ OutputTarget resolve_output(const fs::path& destination, const std::string& elem
       if (links >= kMaxSymlinks) throw InputError("", where, "too many levels of symbolic links");
       std::error_code ec;
       const fs::path link = fs::read_symlink(p, ec);
-      if (ec) throw InputError("", where, "cannot read the symbolic link '" + p.string() + "': " + ec.message());
+      if (ec)
+        throw InputError("", where, "cannot read the symbolic link '" + p.string() + "': " + ec.message());
       p = link.is_absolute() ? link : (p.has_parent_path() ? p.parent_path() : fs::path(".")) / link;
-      if (const int fd = descriptor_path(p.lexically_normal().string()); fd >= 0) return resolve_output(p, element);
+      if (const int fd = descriptor_path(p.lexically_normal().string()); fd >= 0)
+        return resolve_output(p, element);
       continue;
     }
     t.target = p;
@@ -172,10 +178,12 @@ OutputTarget resolve_output(const fs::path& destination, const std::string& elem
       t.kind = OutputKind::Stream;
       return t;
     }
-    const char* what = S_ISDIR(st.st_mode) ? "a directory" : (S_ISSOCK(st.st_mode) ? "a socket" : "a block device");
+    const char* what =
+        S_ISDIR(st.st_mode) ? "a directory" : (S_ISSOCK(st.st_mode) ? "a socket" : "a block device");
     throw InputError("", where,
-                     std::string("is ") + what + "; an output replaces only a regular file (or streams to a "
-                                                 "character device or FIFO)");
+                     std::string("is ") + what +
+                         "; an output replaces only a regular file (or streams to a "
+                         "character device or FIFO)");
   }
 }
 
@@ -183,7 +191,8 @@ void check_distinct_files(const std::vector<std::pair<std::string, fs::path>>& o
                           const std::vector<std::pair<std::string, fs::path>>& inputs) {
   // Existing files are identified by device and inode, new ones by their resolved path.
   auto identity = [](const OutputTarget& t) {
-    if (t.device != 0 || t.inode != 0) return "inode " + std::to_string(t.device) + ":" + std::to_string(t.inode);
+    if (t.device != 0 || t.inode != 0)
+      return "inode " + std::to_string(t.device) + ":" + std::to_string(t.inode);
     std::error_code ec;
     const fs::path dir = fs::weakly_canonical(t.target.has_parent_path() ? t.target.parent_path() : ".", ec);
     return "path " + (dir / t.target.filename()).string();
@@ -194,14 +203,16 @@ void check_distinct_files(const std::vector<std::pair<std::string, fs::path>>& o
     const std::string name = option + " " + path.string();
     const auto [it, fresh] = seen.emplace(id, name);
     if (!fresh)
-      throw InputError("", "", it->second + " and " + name + " are the same file; every output needs its own path");
+      throw InputError("", "",
+                       it->second + " and " + name + " are the same file; every output needs its own path");
   }
   for (const auto& [option, path] : inputs) {
     struct stat st {};
     if (path.empty() || ::stat(path.c_str(), &st) != 0) continue;
     const auto it = seen.find("inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino));
     if (it != seen.end())
-      throw InputError("", "", it->second + " would overwrite " + option + " " + path.string() + ", which this run reads");
+      throw InputError(
+          "", "", it->second + " would overwrite " + option + " " + path.string() + ", which this run reads");
   }
 }
 
@@ -224,7 +235,8 @@ void write_atomically(const fs::path& destination, const std::function<void(cons
   const fs::path dir = t.kind == OutputKind::Stream
                            ? fs::temp_directory_path()
                            : (final_path.has_parent_path() ? final_path.parent_path() : fs::path("."));
-  const fs::path temp = dir / ("." + final_path.stem().string() + ".tmp-" + unique + final_path.extension().string());
+  const fs::path temp =
+      dir / ("." + final_path.stem().string() + ".tmp-" + unique + final_path.extension().string());
   // Registered before it exists, so a signal never leaves it behind; created by us, so that a
   // failure reports the real reason (permissions, full disk, ...).
   const int slot = claim_slot(temp.string());
@@ -255,7 +267,8 @@ void write_atomically(const fs::path& destination, const std::function<void(cons
       }
     }
     struct stat old {};
-    if ((t.device != 0 || t.inode != 0) && ::stat(final_path.c_str(), &old) == 0) ::chmod(temp.c_str(), old.st_mode & 07777);
+    if ((t.device != 0 || t.inode != 0) && ::stat(final_path.c_str(), &old) == 0)
+      ::chmod(temp.c_str(), old.st_mode & 07777);
   } catch (...) {
     discard();
     throw;

@@ -63,8 +63,7 @@ void CheckedFileProxy::finish(const std::filesystem::path& shown_as) {
     if (r != 0 && m_errno == 0) m_errno = close_errno;
   }
   m_mode = Closed;
-  if (m_errno != 0)
-    throw std::runtime_error(shown_as.string() + ": write failed: " + std::strerror(m_errno));
+  if (m_errno != 0) throw std::runtime_error(shown_as.string() + ": write failed: " + std::strerror(m_errno));
 }
 
 void write_through_checked_file(std::unique_ptr<OIIO::ImageOutput>& out, const std::filesystem::path& temp,

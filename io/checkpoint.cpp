@@ -13,8 +13,8 @@
 #include "io/atomic_file.h"
 #include "io/error.h"
 #include "io/file_checks.h"
-#include "renderer/integrators/light_groups.h"
 #include "io/hash.h"
+#include "renderer/integrators/light_groups.h"
 
 namespace penumbra {
 
@@ -28,7 +28,8 @@ constexpr size_t kDigestBytes = 32;
 constexpr uint64_t kGroupsPerPixel = kLightGroupChannels;
 
 using Pixel = PathAccumulators::Pixel;
-static_assert(sizeof(Pixel) == kPathPixelBytes, "Pixel: rgba, sum_y, sum_y2 (6 doubles), n, active (2 uint32)");
+static_assert(sizeof(Pixel) == kPathPixelBytes,
+              "Pixel: rgba, sum_y, sum_y2 (6 doubles), n, active (2 uint32)");
 
 // 56 bytes after the magic, no padding.
 struct Header {

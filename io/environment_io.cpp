@@ -16,8 +16,8 @@ uint64_t environment_bytes(int width, int height, int channels) {
   return uint64_t(width) * uint64_t(height) * (uint64_t(std::max(channels, 1)) * 4 + 12 + 4 + 4);
 }
 
-Environment load_environment(const std::filesystem::path& path, float intensity,
-                             float rotation_degrees, uint64_t max_bytes) {
+Environment load_environment(const std::filesystem::path& path, float intensity, float rotation_degrees,
+                             uint64_t max_bytes) {
   const std::string file = path.string();
   if (!std::isfinite(intensity) || intensity < 0)
     throw InputError(file, "--env-intensity", "must be finite and >= 0");
@@ -29,12 +29,15 @@ Environment load_environment(const std::filesystem::path& path, float intensity,
   const int w = spec.width, h = spec.height, nc = spec.nchannels;
   if (w < 1 || h < 1 || nc < 1) throw InputError(file, "", "environment map has no pixels");
   if (w > kMaxEnvironmentSide || h > kMaxEnvironmentSide)
-    throw InputError(file, "", "environment map " + std::to_string(w) + "x" + std::to_string(h) + " exceeds " +
-                                   std::to_string(kMaxEnvironmentSide) + " per side");
+    throw InputError(file, "",
+                     "environment map " + std::to_string(w) + "x" + std::to_string(h) + " exceeds " +
+                         std::to_string(kMaxEnvironmentSide) + " per side");
   if (environment_bytes(w, h, nc) > max_bytes)
-    throw InputError(file, "", "environment map " + std::to_string(w) + "x" + std::to_string(h) + " needs " +
-                                   std::to_string(environment_bytes(w, h, nc) >> 20) + " MiB, over the memory budget of " +
-                                   std::to_string(max_bytes >> 20) + " MiB (--max-memory)");
+    throw InputError(file, "",
+                     "environment map " + std::to_string(w) + "x" + std::to_string(h) + " needs " +
+                         std::to_string(environment_bytes(w, h, nc) >> 20) +
+                         " MiB, over the memory budget of " + std::to_string(max_bytes >> 20) +
+                         " MiB (--max-memory)");
   std::vector<float> pixels(size_t(w) * size_t(h) * size_t(nc));
   if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data()))
     throw InputError(file, "", "cannot decode environment map: " + in->geterror());

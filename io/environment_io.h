@@ -23,7 +23,7 @@ uint64_t environment_bytes(int width, int height, int channels);
 /// naming the file for a missing or unreadable file, a size beyond kMaxEnvironmentSide or
 /// one needing more than `max_bytes` (environment_bytes), or a NaN, infinite or negative
 /// texel (naming its pixel).
-Environment load_environment(const std::filesystem::path& path, float intensity,
-                             float rotation_degrees, uint64_t max_bytes = uint64_t(8) << 30);
+Environment load_environment(const std::filesystem::path& path, float intensity, float rotation_degrees,
+                             uint64_t max_bytes = uint64_t(8) << 30);
 
 }  // namespace penumbra

@@ -305,16 +305,17 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
     if (!o) throw std::runtime_error(out.string() + ": no image writer (" + OIIO::geterror() + ")");
     const bool multi = specs.size() > 1;
     write_through_checked_file(o, temp, out, [&] {
-    if (!(multi ? o->open(temp.string(), int(specs.size()), specs.data()) : o->open(temp.string(), specs[0])))
-      throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
-    for (size_t sub = 0; sub < specs.size(); ++sub) {
-      if (sub > 0 && !o->open(temp.string(), specs[sub], OIIO::ImageOutput::AppendSubimage))
-        throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " +
-                                 o->geterror());
-      if (!o->write_image(OIIO::TypeDesc::UNKNOWN, pixels[sub].data()))
-        throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
-    }
-    if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
+      if (!(multi ? o->open(temp.string(), int(specs.size()), specs.data())
+                  : o->open(temp.string(), specs[0])))
+        throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
+      for (size_t sub = 0; sub < specs.size(); ++sub) {
+        if (sub > 0 && !o->open(temp.string(), specs[sub], OIIO::ImageOutput::AppendSubimage))
+          throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " +
+                                   o->geterror());
+        if (!o->write_image(OIIO::TypeDesc::UNKNOWN, pixels[sub].data()))
+          throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
+      }
+      if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
     });
   });
 }

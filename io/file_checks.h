@@ -13,8 +13,7 @@ namespace penumbra {
 /// unless it is a regular file of at most `max_bytes` bytes; the reason says what the path is
 /// instead ("does not exist", "is a FIFO, not a regular file", "is 3.0 GiB, over the 2.0 GiB
 /// limit"). `element` names the reference in the scene or the option ("buffers[2]", "--env").
-uint64_t check_input_file(const std::filesystem::path& path, const std::string& element,
-                          uint64_t max_bytes);
+uint64_t check_input_file(const std::filesystem::path& path, const std::string& element, uint64_t max_bytes);
 
 /// What kind of file system object `path` is, for messages: "a regular file", "a directory",
 /// "a FIFO", "a character device", "a block device", "a socket", "a symbolic link" (only when

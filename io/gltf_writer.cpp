@@ -29,11 +29,16 @@ struct Writer {
                const json& minmax = nullptr) {
     while (bin.size() % 4) bin.push_back(0);
     const size_t offset = bin.size();
-    if (offset + bytes > (size_t(1) << 32) - 1) throw InputError(file, "buffers[0]", "geometry exceeds 4 GiB");
+    if (offset + bytes > (size_t(1) << 32) - 1)
+      throw InputError(file, "buffers[0]", "geometry exceeds 4 GiB");
     bin.resize(offset + bytes);
     if (bytes) std::memcpy(bin.data() + offset, data, bytes);
-    j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
-    json a = {{"bufferView", j["bufferViews"].size() - 1}, {"componentType", component_type}, {"count", count}, {"type", type}};
+    j["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
+    json a = {{"bufferView", j["bufferViews"].size() - 1},
+              {"componentType", component_type},
+              {"count", count},
+              {"type", type}};
     if (!minmax.is_null()) {
       a["min"] = minmax[0];
       a["max"] = minmax[1];
@@ -80,7 +85,6 @@ void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bo
     }
     wr.j["materials"].push_back(mat);
   }
-
 }
 
 /// One glTF mesh per non-empty scene mesh (positions checked first); returns scene mesh -> glTF
@@ -97,21 +101,26 @@ std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
       b = merge(b, p);
     }
     if (m.indices.size() % 3 != 0)
-      throw InputError(wr.file, where, "index count " + std::to_string(m.indices.size()) + " is not a multiple of 3");
+      throw InputError(wr.file, where,
+                       "index count " + std::to_string(m.indices.size()) + " is not a multiple of 3");
     for (uint32_t i : m.indices)
       if (i >= m.positions.size())
-        throw InputError(wr.file, where, "index " + std::to_string(i) + " >= vertex count " + std::to_string(m.positions.size()));
+        throw InputError(
+            wr.file, where,
+            "index " + std::to_string(i) + " >= vertex count " + std::to_string(m.positions.size()));
     if (m.positions.empty() || m.indices.size() < 3) continue;  // glTF has no empty primitives
     const json minmax = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
-    json attributes = {{"POSITION", wr.accessor(m.positions.data(), m.positions.size() * 12, kFloat, m.positions.size(),
-                                                "VEC3", kArrayBuffer, minmax)}};
+    json attributes = {{"POSITION", wr.accessor(m.positions.data(), m.positions.size() * 12, kFloat,
+                                                m.positions.size(), "VEC3", kArrayBuffer, minmax)}};
     if (m.normals.size() == m.positions.size())
-      attributes["NORMAL"] = wr.accessor(m.normals.data(), m.normals.size() * 12, kFloat, m.normals.size(), "VEC3", kArrayBuffer);
+      attributes["NORMAL"] = wr.accessor(m.normals.data(), m.normals.size() * 12, kFloat, m.normals.size(),
+                                         "VEC3", kArrayBuffer);
     if (m.uvs.size() == m.positions.size())
-      attributes["TEXCOORD_0"] = wr.accessor(m.uvs.data(), m.uvs.size() * 8, kFloat, m.uvs.size(), "VEC2", kArrayBuffer);
+      attributes["TEXCOORD_0"] =
+          wr.accessor(m.uvs.data(), m.uvs.size() * 8, kFloat, m.uvs.size(), "VEC2", kArrayBuffer);
     json prim = {{"attributes", attributes},
-                 {"indices", wr.accessor(m.indices.data(), m.indices.size() * 4, kUint32, m.indices.size(), "SCALAR",
-                                         kElementArrayBuffer)},
+                 {"indices", wr.accessor(m.indices.data(), m.indices.size() * 4, kUint32, m.indices.size(),
+                                         "SCALAR", kElementArrayBuffer)},
                  {"mode", 4}};
     if (m.material >= 0 && size_t(m.material) < scene.materials.size()) prim["material"] = m.material;
     json mesh = {{"primitives", {prim}}};
@@ -127,7 +136,8 @@ void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& glt
   for (size_t ii = 0; ii < scene.instances.size(); ++ii) {
     const Instance& inst = scene.instances[ii];
     if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())
-      throw InputError(wr.file, "instances[" + std::to_string(ii) + "]", "mesh " + std::to_string(inst.mesh) + " out of range");
+      throw InputError(wr.file, "instances[" + std::to_string(ii) + "]",
+                       "mesh " + std::to_string(inst.mesh) + " out of range");
     if (gltf_mesh[size_t(inst.mesh)] < 0) continue;
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     json node = {{"mesh", gltf_mesh[size_t(inst.mesh)]},
@@ -140,7 +150,6 @@ void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& glt
     }
     add_root(wr, node);
   }
-
 }
 
 /// Cameras, each on a root node holding its frame.
@@ -155,16 +164,18 @@ void write_cameras(Writer& wr, const Scene& scene) {
       if (std::isfinite(c.zfar)) p["zfar"] = c.zfar;
       cam = {{"type", "perspective"}, {"perspective", p}};
     } else {
-      json o = {{"xmag", c.xmag}, {"ymag", c.ymag}, {"znear", c.znear},
+      json o = {{"xmag", c.xmag},
+                {"ymag", c.ymag},
+                {"znear", c.znear},
                 {"zfar", std::isfinite(c.zfar) ? c.zfar : 1e30f}};
       cam = {{"type", "orthographic"}, {"orthographic", o}};
     }
     if (!c.name.empty()) cam["name"] = c.name;
     wr.j["cameras"].push_back(cam);
-    add_root(wr, {{"camera", ci}, {"matrix", frame_matrix(c.u, c.v, c.w, c.eye)},
-              {"name", c.name.empty() ? "camera" + std::to_string(ci) : c.name}});
+    add_root(wr, {{"camera", ci},
+                  {"matrix", frame_matrix(c.u, c.v, c.w, c.eye)},
+                  {"name", c.name.empty() ? "camera" + std::to_string(ci) : c.name}});
   }
-
 }
 
 /// KHR_lights_punctual lights, each on a root node holding its frame.
@@ -174,17 +185,20 @@ void write_lights(Writer& wr, const Scene& scene) {
     for (size_t li = 0; li < scene.lights.size(); ++li) {
       const Light& l = scene.lights[li];
       json light = {{"color", {l.color.x, l.color.y, l.color.z}}, {"intensity", l.intensity}};
-      light["type"] = l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
+      light["type"] =
+          l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
       if (l.type != LightType::Directional && std::isfinite(l.range)) light["range"] = l.range;
-      if (l.type == LightType::Spot) light["spot"] = {{"innerConeAngle", l.inner_cone}, {"outerConeAngle", l.outer_cone}};
+      if (l.type == LightType::Spot)
+        light["spot"] = {{"innerConeAngle", l.inner_cone}, {"outerConeAngle", l.outer_cone}};
       if (!l.name.empty()) light["name"] = l.name;
       lights.push_back(light);
       // The light shines down its local -Z: the frame of a camera looking along its direction.
       Camera frame;
       if (l.type != LightType::Point) frame = look_at({0, 0, 0}, l.direction, {0, 1, 0}, 0);
-      add_root(wr, {{"matrix", frame_matrix(frame.u, frame.v, frame.w, l.type == LightType::Directional ? Vec3f{} : l.position)},
-                {"extensions", {{"KHR_lights_punctual", {{"light", li}}}}},
-                {"name", l.name.empty() ? "light" + std::to_string(li) : l.name}});
+      add_root(wr, {{"matrix", frame_matrix(frame.u, frame.v, frame.w,
+                                            l.type == LightType::Directional ? Vec3f{} : l.position)},
+                    {"extensions", {{"KHR_lights_punctual", {{"light", li}}}}},
+                    {"name", l.name.empty() ? "light" + std::to_string(li) : l.name}});
     }
     wr.j["extensions"]["KHR_lights_punctual"]["lights"] = lights;
   }
@@ -223,7 +237,9 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
       });
     }
     const std::string text = wr.j.dump(1);
-    write_atomically(file, [&](const std::filesystem::path& tmp) { write_file_checked(tmp, text.data(), text.size(), file); });
+    write_atomically(file, [&](const std::filesystem::path& tmp) {
+      write_file_checked(tmp, text.data(), text.size(), file);
+    });
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

@@ -50,7 +50,8 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   spec.channelnames = {"R", "G", "B", "A"};
   const size_t pixels = size_t(film.width) * size_t(film.height);
   for (const auto& c : options.extra) {
-    if (!c.data || c.stride < 1 || c.offset < 0 || c.offset >= c.stride || c.data->size() != pixels * size_t(c.stride))
+    if (!c.data || c.stride < 1 || c.offset < 0 || c.offset >= c.stride ||
+        c.data->size() != pixels * size_t(c.stride))
       throw std::invalid_argument(path.string() + ": channel " + c.name + " does not match the image size");
     spec.channelnames.push_back(c.name);
   }
@@ -58,7 +59,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     spec.channelformats.assign(size_t(nc), colour);
     for (size_t i = 0; i < options.extra.size(); ++i) {
       const ChannelType t = options.extra[i].type;
-      spec.channelformats[4 + i] = t == ChannelType::Half ? OIIO::TypeDesc::HALF
+      spec.channelformats[4 + i] = t == ChannelType::Half   ? OIIO::TypeDesc::HALF
                                    : t == ChannelType::Uint ? OIIO::TypeDesc::UINT
                                                             : OIIO::TypeDesc::FLOAT;
     }
@@ -76,11 +77,15 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
   for (const auto& [k, v] : options.metadata) spec.attribute(k, v);
   for (const auto& [k, v] : options.float_metadata) spec.attribute(k, v);
-  for (const auto& [k, m] : options.matrix_metadata) spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
+  for (const auto& [k, m] : options.matrix_metadata)
+    spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
   if (options.extra.empty()) {
-    write_atomically(path, [&](const std::filesystem::path& temp) {
-      write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
-    }, sha256);
+    write_atomically(
+        path,
+        [&](const std::filesystem::path& temp) {
+          write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
+        },
+        sha256);
     return;
   }
   // Pixels in each channel's own file format (OIIO's float -> uint conversion would normalise,
@@ -108,13 +113,17 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     for (size_t k = 0; k < 4; ++k) put(px + offsets[k], spec.channelformat(int(k)), film.rgba[i * 4 + k]);
     for (size_t k = 0; k < options.extra.size(); ++k) {
       const ExrChannel& c = options.extra[k];
-      put(px + offsets[4 + k], spec.channelformat(int(4 + k)), (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
+      put(px + offsets[4 + k], spec.channelformat(int(4 + k)),
+          (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
     }
   }
   if (!options.multipart) {
-    write_atomically(path, [&](const std::filesystem::path& temp) {
-      write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
-    }, sha256);
+    write_atomically(
+        path,
+        [&](const std::filesystem::path& temp) {
+          write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
+        },
+        sha256);
     return;
   }
   // Multi-part: "rgba" (R, G, B, A and the metadata), then one part per layer (the channel
@@ -165,22 +174,26 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     specs.push_back(ps);
     buffers.push_back(std::move(buf));
   }
-  write_atomically(path, [&](const std::filesystem::path& temp) {
-    auto out = OIIO::ImageOutput::create(path.string());
-    if (!out || !out->supports("multiimage"))
-      throw std::runtime_error(path.string() + ": no multi-part image writer for this extension");
-    write_through_checked_file(out, temp, path, [&] {
-    if (!out->open(temp.string(), int(specs.size()), specs.data()))
-      throw std::runtime_error(path.string() + ": cannot open for writing: " + out->geterror());
-    for (size_t part = 0; part < specs.size(); ++part) {
-      if (part > 0 && !out->open(temp.string(), specs[part], OIIO::ImageOutput::AppendSubimage))
-        throw std::runtime_error(path.string() + ": cannot start part " + keys[part] + ": " + out->geterror());
-      if (!out->write_image(OIIO::TypeDesc::UNKNOWN, buffers[part].data()))
-        throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
-    }
-    if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
-    });
-  }, sha256);
+  write_atomically(
+      path,
+      [&](const std::filesystem::path& temp) {
+        auto out = OIIO::ImageOutput::create(path.string());
+        if (!out || !out->supports("multiimage"))
+          throw std::runtime_error(path.string() + ": no multi-part image writer for this extension");
+        write_through_checked_file(out, temp, path, [&] {
+          if (!out->open(temp.string(), int(specs.size()), specs.data()))
+            throw std::runtime_error(path.string() + ": cannot open for writing: " + out->geterror());
+          for (size_t part = 0; part < specs.size(); ++part) {
+            if (part > 0 && !out->open(temp.string(), specs[part], OIIO::ImageOutput::AppendSubimage))
+              throw std::runtime_error(path.string() + ": cannot start part " + keys[part] + ": " +
+                                       out->geterror());
+            if (!out->write_image(OIIO::TypeDesc::UNKNOWN, buffers[part].data()))
+              throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
+          }
+          if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
+        });
+      },
+      sha256);
 }
 
 namespace {
@@ -246,11 +259,13 @@ struct Canvas {
 
 /// The viridis colour map (van der Walt & Smith, matplotlib 2015), five sRGB stops.
 void viridis(float t, uint8_t out[3]) {
-  static const float stops[5][3] = {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  static const float stops[5][3] = {
+      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
   t = std::clamp(std::isfinite(t) ? t : 0.0f, 0.0f, 1.0f) * 4;
   const int i = std::min(int(t), 3);
   const float f = t - float(i);
-  for (int k = 0; k < 3; ++k) out[k] = uint8_t(std::lround(stops[i][k] + (stops[i + 1][k] - stops[i][k]) * f));
+  for (int k = 0; k < 3; ++k)
+    out[k] = uint8_t(std::lround(stops[i][k] + (stops[i + 1][k] - stops[i][k]) * f));
 }
 
 std::string legend_number(double v) {
@@ -280,7 +295,8 @@ void write_heatmap(const std::vector<float>& values, int width, int height, cons
     }
   const uint8_t black[3] = {0, 0, 0};
   const int margin = 4 * s, y_title = height + 3, y_bar = y_title + 7 * s + 3, bar_h = 8 * s;
-  const int ts = c.text(0, 0, title, s, black, false) <= width - 2 * margin ? s : 1;  // a long title: small font
+  const int ts =
+      c.text(0, 0, title, s, black, false) <= width - 2 * margin ? s : 1;  // a long title: small font
   c.text(margin, y_title + (s - ts) * 7, title, ts, black);
   const int x0 = margin, x1 = std::max(x0 + 1, width - margin);
   for (int x = x0; x < x1; ++x) {
@@ -303,9 +319,12 @@ void write_heatmap(const std::vector<float>& values, int width, int height, cons
   OIIO::ImageSpec spec(width, height + legend, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
-  write_atomically(path, [&](const std::filesystem::path& temp) {
-    write_with_oiio(path, temp, spec, c.rgb.data(), OIIO::TypeDesc::UINT8);
-  }, sha256);
+  write_atomically(
+      path,
+      [&](const std::filesystem::path& temp) {
+        write_with_oiio(path, temp, spec, c.rgb.data(), OIIO::TypeDesc::UINT8);
+      },
+      sha256);
 }
 
 namespace {
@@ -325,8 +344,10 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
                              : (env && *env)              ? std::string(env)
                                                           : std::string("<shipped config>");
   // A config is a small text file; a FIFO or device named here must not block the run.
-  if (!options.ocio_config.empty()) check_input_file(options.ocio_config, "--ocio-config", kMaxOcioConfigBytes);
-  else if (env && *env) check_input_file(env, "$OCIO", kMaxOcioConfigBytes);
+  if (!options.ocio_config.empty())
+    check_input_file(options.ocio_config, "--ocio-config", kMaxOcioConfigBytes);
+  else if (env && *env)
+    check_input_file(env, "$OCIO", kMaxOcioConfigBytes);
   OCIO::ConstConfigRcPtr config;
   try {
     if (!options.ocio_config.empty()) {
@@ -357,15 +378,19 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
     view_found |= view == config->getView(display.c_str(), i);
   }
   if (!view_found)
-    throw InputError(source, "--view", "display '" + display + "' has no view '" + view + "' (available: " + views + ")");
+    throw InputError(source, "--view",
+                     "display '" + display + "' has no view '" + view + "' (available: " + views + ")");
   if (!options.look.empty() && !config->getLook(options.look.c_str())) {
     std::string looks;
-    for (int i = 0; i < config->getNumLooks(); ++i) looks += std::string(looks.empty() ? "" : ", ") + config->getLookNameByIndex(i);
-    throw InputError(source, "--look", "no look '" + options.look + "' (available: " + (looks.empty() ? "none" : looks) + ")");
+    for (int i = 0; i < config->getNumLooks(); ++i)
+      looks += std::string(looks.empty() ? "" : ", ") + config->getLookNameByIndex(i);
+    throw InputError(source, "--look",
+                     "no look '" + options.look + "' (available: " + (looks.empty() ? "none" : looks) + ")");
   }
   try {
     if (options.look.empty())
-      return config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
+      return config
+          ->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
           ->getDefaultCPUProcessor();
     // The look in scene-linear, then the display/view transform.
     auto look = OCIO::LookTransform::Create();
@@ -390,19 +415,19 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
 void check_display_output(const std::filesystem::path& path, const DisplayOptions& options) {
   const std::string ext = lower_extension(path);
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".tif" && ext != ".tiff")
-    throw InputError(path.string(), "", "unsupported display image format '" + ext + "' (use .png, .jpg, .jpeg, .tif or .tiff)");
+    throw InputError(path.string(), "",
+                     "unsupported display image format '" + ext + "' (use .png, .jpg, .jpeg, .tif or .tiff)");
   display_processor(options);
 }
 
-void apply_display_transform(std::vector<float>& rgb, int width, int height,
-                             const DisplayOptions& options) {
+void apply_display_transform(std::vector<float>& rgb, int width, int height, const DisplayOptions& options) {
   const auto cpu = display_processor(options);
   OCIO::PackedImageDesc desc(rgb.data(), width, height, 3);
   cpu->apply(desc);
 }
 
-void write_display_image(const Film& film, const std::filesystem::path& path,
-                         const DisplayOptions& options, std::string* sha256) {
+void write_display_image(const Film& film, const std::filesystem::path& path, const DisplayOptions& options,
+                         std::string* sha256) {
   const size_t n = size_t(film.width) * size_t(film.height);
   std::vector<float> rgb(n * 3);
   const float gain = std::exp2(options.exposure);
@@ -415,9 +440,12 @@ void write_display_image(const Film& film, const std::filesystem::path& path,
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
   for (float& v : rgb) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
-  write_atomically(path, [&](const std::filesystem::path& temp) {
-    write_with_oiio(path, temp, spec, rgb.data(), OIIO::TypeDesc::FLOAT);
-  }, sha256);
+  write_atomically(
+      path,
+      [&](const std::filesystem::path& temp) {
+        write_with_oiio(path, temp, spec, rgb.data(), OIIO::TypeDesc::FLOAT);
+      },
+      sha256);
 }
 
 }  // namespace penumbra

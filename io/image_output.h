@@ -29,13 +29,13 @@ struct ExrChannel {
 };
 
 struct ExrOptions {
-  bool half = true;                  ///< 16-bit half R, G, B, A; false = 32-bit float
-  std::vector<ExrChannel> extra;     ///< AOV channels after R, G, B, A
-  std::string compression = "zip";   ///< any OpenEXR compression OIIO accepts; with multipart,
-                                     ///< lossy codecs apply to colour parts only (data: zip)
-  bool multipart = false;            ///< one part per layer ("rgba", "albedo", "N", "Z", ...)
+  bool half = true;                 ///< 16-bit half R, G, B, A; false = 32-bit float
+  std::vector<ExrChannel> extra;    ///< AOV channels after R, G, B, A
+  std::string compression = "zip";  ///< any OpenEXR compression OIIO accepts; with multipart,
+                                    ///< lossy codecs apply to colour parts only (data: zip)
+  bool multipart = false;           ///< one part per layer ("rgba", "albedo", "N", "Z", ...)
   std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
-  std::vector<std::pair<std::string, float>> float_metadata;   ///< extra float attributes
+  std::vector<std::pair<std::string, float>> float_metadata;  ///< extra float attributes
   /// 4x4 matrix attributes (M44f, row-major, row vectors: p' = p M, as OpenEXR's
   /// worldToCamera and worldToNDC).
   std::vector<std::pair<std::string, std::array<float, 16>>> matrix_metadata;
@@ -60,8 +60,8 @@ struct DisplayOptions {
 /// TIFF). The format follows the extension (.png, .jpg/.jpeg, .tif/.tiff). Throws InputError
 /// for a bad config/display/view and std::runtime_error for write failures.
 /// If `sha256` is not null it receives the SHA-256 of the file's bytes.
-void write_display_image(const Film& film, const std::filesystem::path& path,
-                         const DisplayOptions& options, std::string* sha256 = nullptr);
+void write_display_image(const Film& film, const std::filesystem::path& path, const DisplayOptions& options,
+                         std::string* sha256 = nullptr);
 
 /// Checks, before any rendering, that `path` has a display-image extension (.png, .jpg,
 /// .jpeg, .tif, .tiff) and that the config, display and view resolve. Throws InputError
@@ -72,15 +72,13 @@ void check_display_output(const std::filesystem::path& path, const DisplayOption
 /// linear from 0 (dark blue) to the image's maximum (yellow) on the viridis ramp, with a legend
 /// strip below it: `title`, the colour bar and its scale (0, quarters, maximum). Written
 /// atomically. Throws std::runtime_error naming the file if OpenImageIO fails.
-void write_heatmap(const std::vector<float>& values, int width, int height,
-                   const std::filesystem::path& path, const std::string& title,
-                   std::string* sha256 = nullptr);
+void write_heatmap(const std::vector<float>& values, int width, int height, const std::filesystem::path& path,
+                   const std::string& title, std::string* sha256 = nullptr);
 
 /// Penumbra's shipped OCIO config text (io/ocio/config.ocio, embedded at build time).
 const char* shipped_ocio_config();
 
 /// Applies the display transform to `rgb` (width*height*3 floats, in place).
-void apply_display_transform(std::vector<float>& rgb, int width, int height,
-                             const DisplayOptions& options);
+void apply_display_transform(std::vector<float>& rgb, int width, int height, const DisplayOptions& options);
 
 }  // namespace penumbra

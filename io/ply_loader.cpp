@@ -1,9 +1,9 @@
 // PLY loader: see ply_loader.h. Format: G. Turk, "The PLY Polygon File Format" (1994).
 #include "io/ply_loader.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
-#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -116,10 +116,14 @@ Header read_header(std::ifstream& in, const std::string& file) {
     if (kw == "format") {
       std::string f, v;
       ls >> f >> v;
-      if (f == "ascii") h.format = Format::Ascii;
-      else if (f == "binary_little_endian") h.format = Format::BinaryLE;
-      else if (f == "binary_big_endian") h.format = Format::BinaryBE;
-      else header_error("unknown format '" + f + "'");
+      if (f == "ascii")
+        h.format = Format::Ascii;
+      else if (f == "binary_little_endian")
+        h.format = Format::BinaryLE;
+      else if (f == "binary_big_endian")
+        h.format = Format::BinaryBE;
+      else
+        header_error("unknown format '" + f + "'");
       if (v != "1.0") header_error("unsupported version '" + v + "'");
       have_format = true;
     } else if (kw == "element") {
@@ -157,7 +161,8 @@ Header read_header(std::ifstream& in, const std::string& file) {
 
 /// Reads every element after the header: vertex positions and polygon faces (fanned into
 /// triangles) into `mesh`. Throws InputError naming the element and index.
-void read_elements(std::ifstream& in, const Header& h, const std::string& file, uint64_t file_bytes, Mesh& mesh) {
+void read_elements(std::ifstream& in, const Header& h, const std::string& file, uint64_t file_bytes,
+                   Mesh& mesh) {
   const Format format = h.format;
   Reader r(in, format, file);
   bool have_vertices = false;
@@ -171,9 +176,11 @@ void read_elements(std::ifstream& in, const Header& h, const std::string& file, 
         if (p.name == "y") iy = int(k);
         if (p.name == "z") iz = int(k);
       }
-      if (is_face && !p.count_type.empty() && (p.name == "vertex_indices" || p.name == "vertex_index")) iface = int(k);
+      if (is_face && !p.count_type.empty() && (p.name == "vertex_indices" || p.name == "vertex_index"))
+        iface = int(k);
     }
-    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) throw InputError(file, "element vertex", "needs x, y and z properties");
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0))
+      throw InputError(file, "element vertex", "needs x, y and z properties");
     if (is_face && iface < 0) throw InputError(file, "element face", "needs a vertex_indices list");
     if (is_face && !have_vertices) throw InputError(file, "element face", "comes before element vertex");
     if (is_vertex) {
@@ -197,18 +204,22 @@ void read_elements(std::ifstream& in, const Header& h, const std::string& file, 
           continue;
         }
         const double n = r.read(prop.count_type, where);
-        if (!(n >= 0 && n <= 1024 && n == std::floor(n))) throw InputError(file, where, "list length must be in [0, 1024]");
+        if (!(n >= 0 && n <= 1024 && n == std::floor(n)))
+          throw InputError(file, where, "list length must be in [0, 1024]");
         poly.clear();
         for (int j = 0; j < int(n); ++j) {
           const double v = r.read(prop.type, where);
           if (int(k) != iface) continue;
           if (!(v >= 0 && v < double(mesh.positions.size()) && v == std::floor(v)))
-            throw InputError(file, where, "index " + format_index(v) + " >= vertex count " + std::to_string(mesh.positions.size()));
+            throw InputError(
+                file, where,
+                "index " + format_index(v) + " >= vertex count " + std::to_string(mesh.positions.size()));
           poly.push_back(uint32_t(v));
         }
         if (int(k) == iface) {
           if (poly.size() < 3) throw InputError(file, where, "a face needs at least 3 vertices");
-          for (size_t j = 1; j + 1 < poly.size(); ++j) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
+          for (size_t j = 1; j + 1 < poly.size(); ++j)
+            mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
         }
       }
       if (is_vertex) {

@@ -17,10 +17,16 @@ namespace {
 const char* g_phase = "parsing the command line";
 }  // namespace
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
-void set_phase(const char* phase) { g_phase = phase; }
-const char* current_phase() { return g_phase; }
+void set_phase(const char* phase) {
+  g_phase = phase;
+}
+const char* current_phase() {
+  return g_phase;
+}
 
 long long parse_integer(std::string_view text, long long lo, long long hi, const std::string& option) {
   long long v = 0;
@@ -53,11 +59,16 @@ uint64_t parse_bytes(const std::string& s) {
   }
   const std::string unit = s.substr(pos);
   double mul = 1;
-  if (unit == "K" || unit == "k") mul = 1024.0;
-  else if (unit == "M" || unit == "m") mul = 1024.0 * 1024;
-  else if (unit == "G" || unit == "g") mul = 1024.0 * 1024 * 1024;
-  else if (!unit.empty()) throw UsageError("--max-memory: unknown unit '" + unit + "' (use K, M or G)");
-  if (!(v > 0) || !std::isfinite(v * mul) || v * mul > 1e15) throw UsageError("--max-memory: out of range: " + s);
+  if (unit == "K" || unit == "k")
+    mul = 1024.0;
+  else if (unit == "M" || unit == "m")
+    mul = 1024.0 * 1024;
+  else if (unit == "G" || unit == "g")
+    mul = 1024.0 * 1024 * 1024;
+  else if (!unit.empty())
+    throw UsageError("--max-memory: unknown unit '" + unit + "' (use K, M or G)");
+  if (!(v > 0) || !std::isfinite(v * mul) || v * mul > 1e15)
+    throw UsageError("--max-memory: out of range: " + s);
   return uint64_t(v * mul);
 }
 
@@ -67,7 +78,9 @@ uint64_t default_memory_budget() {
   return uint64_t(pages) * uint64_t(page) / 2;
 }
 
-uint64_t memory_budget(const std::string& text) { return text.empty() ? default_memory_budget() : parse_bytes(text); }
+uint64_t memory_budget(const std::string& text) {
+  return text.empty() ? default_memory_budget() : parse_bytes(text);
+}
 
 Vec3f parse_colour(const std::string& s, const char* option) {
   std::vector<float> v;
@@ -85,7 +98,8 @@ Vec3f parse_colour(const std::string& s, const char* option) {
   if (v.size() == 1) v = {v[0], v[0], v[0]};
   if (v.size() != 3) throw UsageError(std::string(option) + ": expected r,g,b or one value, got '" + s + "'");
   for (float x : v)
-    if (!std::isfinite(x) || x < 0) throw UsageError(std::string(option) + ": values must be finite and >= 0");
+    if (!std::isfinite(x) || x < 0)
+      throw UsageError(std::string(option) + ": values must be finite and >= 0");
   return {v[0], v[1], v[2]};
 }
 
@@ -108,7 +122,9 @@ std::string human_count(uint64_t n) {
   return std::to_string(n);
 }
 
-std::string exact(double v) { return format("%.17g", v); }
+std::string exact(double v) {
+  return format("%.17g", v);
+}
 
 double peak_memory_mib() {
   rusage ru{};

@@ -19,9 +19,12 @@ namespace {
 std::string json_string(const std::string& v) {
   std::string r = "\"";
   for (unsigned char c : v) {
-    if (c == '"' || c == '\\') r += '\\', r += char(c);
-    else if (c < 0x20) r += format("\\u%04x", c);
-    else r += char(c);
+    if (c == '"' || c == '\\')
+      r += '\\', r += char(c);
+    else if (c < 0x20)
+      r += format("\\u%04x", c);
+    else
+      r += char(c);
   }
   return r + "\"";
 }
@@ -35,7 +38,8 @@ std::string id_manifest(const Scene& scene, const GltfInfo& info) {
   std::string j = "{\"object\": {";
   bool first = true;
   for (int n : nodes) {
-    const std::string name = size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
+    const std::string name =
+        size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
     j += (first ? "" : ", ") + json_string(std::to_string(n + 1)) + ": " + json_string(name);
     first = false;
   }
@@ -50,8 +54,8 @@ std::string id_manifest(const Scene& scene, const GltfInfo& info) {
 /// homogeneous divide, as Nuke reads them; plus the field of view and clip distances.
 void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int height) {
   const Vec3f u = cam.u, v = cam.v, w = cam.w, e = cam.eye;
-  const std::array<float, 16> w2c = {u.x, v.x, w.x, 0, u.y, v.y, w.y, 0, u.z, v.z, w.z, 0,
-                                     -dot(e, u), -dot(e, v), -dot(e, w), 1};
+  const std::array<float, 16> w2c = {u.x, v.x, w.x, 0, u.y,        v.y,        w.y,        0,
+                                     u.z, v.z, w.z, 0, -dot(e, u), -dot(e, v), -dot(e, w), 1};
   const float aspect = float(width) / float(height);
   std::array<float, 16> proj{};  // camera space -> clip space (row vectors)
   if (cam.projection == Projection::Perspective) {
@@ -63,15 +67,18 @@ void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int heig
   std::array<float, 16> w2ndc{};
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c)
-      for (int k = 0; k < 4; ++k) w2ndc[size_t(r * 4 + c)] += w2c[size_t(r * 4 + k)] * proj[size_t(k * 4 + c)];
+      for (int k = 0; k < 4; ++k)
+        w2ndc[size_t(r * 4 + c)] += w2c[size_t(r * 4 + k)] * proj[size_t(k * 4 + c)];
   exr.matrix_metadata.push_back({"worldToCamera", w2c});
   exr.matrix_metadata.push_back({"worldToNDC", w2ndc});
   if (cam.projection == Projection::Perspective) {
     exr.float_metadata.push_back({"penumbra:yfov_degrees", cam.yfov * 180 / kPi});
-    exr.float_metadata.push_back({"penumbra:xfov_degrees", 2 * std::atan(std::tan(0.5f * cam.yfov) * aspect) * 180 / kPi});
+    exr.float_metadata.push_back(
+        {"penumbra:xfov_degrees", 2 * std::atan(std::tan(0.5f * cam.yfov) * aspect) * 180 / kPi});
   }
   exr.float_metadata.push_back({"penumbra:near", cam.znear});
-  exr.float_metadata.push_back({"penumbra:far", std::isfinite(cam.zfar) ? cam.zfar : std::numeric_limits<float>::max()});
+  exr.float_metadata.push_back(
+      {"penumbra:far", std::isfinite(cam.zfar) ? cam.zfar : std::numeric_limits<float>::max()});
 }
 
 /// Crops and tiles carry their render's identity: merge accepts only parts of one render.
@@ -91,7 +98,8 @@ void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
   const auto& aovs = job.request.aovs;
   const ChannelType colour = job.args.use_float ? ChannelType::Float : ChannelType::Half;
   if (aovs.count("albedo"))
-    for (int c = 0; c < 3; ++c) exr.extra.push_back({std::string("albedo.") + "RGB"[c], &data.albedo, colour, 3, c});
+    for (int c = 0; c < 3; ++c)
+      exr.extra.push_back({std::string("albedo.") + "RGB"[c], &data.albedo, colour, 3, c});
   if (aovs.count("N"))
     for (int c = 0; c < 3; ++c)
       exr.extra.push_back({std::string("N.") + "XYZ"[c], &data.normal, ChannelType::Float, 3, c});
@@ -100,7 +108,8 @@ void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
       exr.extra.push_back({std::string("P.") + "XYZ"[c], &data.position, ChannelType::Float, 3, c});
   if (aovs.count("Z")) exr.extra.push_back({"Z", &data.depth, ChannelType::Float});
   if (aovs.count("UV"))
-    for (int c = 0; c < 2; ++c) exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
+    for (int c = 0; c < 2; ++c)
+      exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
   if (aovs.count("id")) {
     exr.extra.push_back({"id.object", &data.object_id, ChannelType::Uint});
     exr.extra.push_back({"id.material", &data.material_id, ChannelType::Uint});
@@ -121,7 +130,8 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
     for (int g = 0; g < kLightGroupCount; ++g)
       for (int c = 0; c < 3; ++c)
         exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &image.groups,
-                             job.args.use_float ? ChannelType::Float : ChannelType::Half, kLightGroupChannels, g * 3 + c});
+                             job.args.use_float ? ChannelType::Float : ChannelType::Half, kLightGroupChannels,
+                             g * 3 + c});
   if (job.request.cost_aov) {
     if (buffers.cost.counted) {
       exr.extra.push_back({"cost.nodes", &buffers.cost.nodes});
@@ -151,7 +161,8 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
                   {"penumbra:camera", job.camera.name},
                   {"penumbra:spp", std::to_string(cfg.spp)},
                   {"penumbra:integrator", a.integrator},
-                  {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
+                  {"penumbra:filter",
+                   std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
   if (job.request.path) {
     exr.metadata.push_back({"penumbra:mean_spp", format("%.3f", job.mean_spp)});
     exr.metadata.push_back({"penumbra:passes", std::to_string(job.stats.passes)});

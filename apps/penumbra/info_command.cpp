@@ -10,37 +10,44 @@
 
 namespace penumbra::cli {
 
-int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten, const std::string& accel_name,
-             const std::vector<std::string>& accel_params) {
+int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
+             const std::string& accel_name, const std::vector<std::string>& accel_params) {
   const AccelConfig accel_config = parse_accel(accel_name, accel_params);
   LoadedScene loaded = load_scene(file, scene_index, allow_external, flatten, default_memory_budget(), false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
   std::printf("file         %s\n", file.c_str());
-  std::printf("asset        glTF %s%s%s\n", i.version.c_str(), i.generator.empty() ? "" : ", generator: ", i.generator.c_str());
+  std::printf("asset        glTF %s%s%s\n", i.version.c_str(),
+              i.generator.empty() ? "" : ", generator: ", i.generator.c_str());
   std::printf("scenes       %d", i.scene_count);
   for (int k = 0; k < i.scene_count; ++k)
-    std::printf("%s%d: %s%s", k ? ", " : " (", k, i.scene_names[size_t(k)].c_str(), k == i.scene_index ? " [rendered]" : "");
+    std::printf("%s%d: %s%s", k ? ", " : " (", k, i.scene_names[size_t(k)].c_str(),
+                k == i.scene_index ? " [rendered]" : "");
   std::printf("%s\n", i.scene_count ? ")" : "");
   std::printf("nodes        %d\n", i.node_count);
   std::printf("meshes       %d (%d primitives); stored: %zu triangle meshes, %llu triangles\n", i.mesh_count,
               i.primitive_count, s.meshes.size(), static_cast<unsigned long long>(count_stored_triangles(s)));
-  const size_t placed = size_t(std::count_if(s.instances.begin(), s.instances.end(), [](const Instance& x) { return !x.identity; }));
+  const size_t placed = size_t(
+      std::count_if(s.instances.begin(), s.instances.end(), [](const Instance& x) { return !x.identity; }));
   std::printf("instances    %zu (%zu in world space, %zu placed by a transform), %llu triangles rendered\n",
-              s.instances.size(), s.instances.size() - placed, placed, static_cast<unsigned long long>(count_triangles(s)));
+              s.instances.size(), s.instances.size() - placed, placed,
+              static_cast<unsigned long long>(count_triangles(s)));
   std::printf("materials    %zu\n", s.materials.size());
   for (size_t k = 0; k < s.materials.size(); ++k) {
     const auto& m = s.materials[k];
-    std::printf("  [%zu] %s: base (%.3g %.3g %.3g) metallic %.3g roughness %.3g emissive (%.3g %.3g %.3g)\n", k,
-                m.name.c_str(), m.base_color.x, m.base_color.y, m.base_color.z, m.metallic, m.roughness,
+    std::printf("  [%zu] %s: base (%.3g %.3g %.3g) metallic %.3g roughness %.3g emissive (%.3g %.3g %.3g)\n",
+                k, m.name.c_str(), m.base_color.x, m.base_color.y, m.base_color.z, m.metallic, m.roughness,
                 m.emissive.x, m.emissive.y, m.emissive.z);
   }
-  std::printf("cameras      %d defined, %zu in the scene (use --camera N or NAME)\n", i.gltf_camera_count, i.camera_instances.size());
-  for (size_t k = 0; k < i.camera_instances.size(); ++k) std::printf("  [%zu] %s\n", k, i.camera_instances[k].c_str());
+  std::printf("cameras      %d defined, %zu in the scene (use --camera N or NAME)\n", i.gltf_camera_count,
+              i.camera_instances.size());
+  for (size_t k = 0; k < i.camera_instances.size(); ++k)
+    std::printf("  [%zu] %s\n", k, i.camera_instances[k].c_str());
   std::printf("lights       %d defined, %zu in the scene\n", i.gltf_light_count, s.lights.size());
   for (size_t k = 0; k < s.lights.size(); ++k) {
     const auto& l = s.lights[k];
-    const char* type = l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
+    const char* type =
+        l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
     std::printf("  [%zu] %s: %s, intensity %.4g %s\n", k, l.name.c_str(), type, l.intensity,
                 l.type == LightType::Directional ? "lux" : "cd");
   }
@@ -51,10 +58,12 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
     for (const auto& x : v) r += (r.empty() ? "" : ", ") + x;
     return r.empty() ? std::string("none") : r;
   };
-  std::printf("extensions   used: %s; required: %s\n", join(i.extensions_used).c_str(), join(i.extensions_required).c_str());
+  std::printf("extensions   used: %s; required: %s\n", join(i.extensions_used).c_str(),
+              join(i.extensions_required).c_str());
   const Bounds3f b = compute_bounds(s);
   if (!b.empty())
-    std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+    std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
+                b.hi.y, b.hi.z);
   else
     std::printf("bounds       empty\n");
   auto accel = make_scene_accelerator(accel_name, s, accel_config);
@@ -62,7 +71,8 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
   std::printf("accelerator  %s%s%s%s\n", st.name.c_str(), st.config.empty() ? "" : " (", st.config.c_str(),
               st.config.empty() ? "" : ")");
   std::printf("  triangles  %llu\n", static_cast<unsigned long long>(st.triangles));
-  if (st.instances > 0) std::printf("  instances  %llu (two levels)\n", static_cast<unsigned long long>(st.instances));
+  if (st.instances > 0)
+    std::printf("  instances  %llu (two levels)\n", static_cast<unsigned long long>(st.instances));
   std::printf("  build      %.3f s\n", st.build_seconds);
   std::printf("  memory     %.2f MiB\n", double(st.bytes) / (1 << 20));
   if (st.nodes > 0) {
@@ -70,11 +80,12 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
     std::printf("  %s      %llu%s\n", grid ? "cells" : "nodes", static_cast<unsigned long long>(st.nodes),
                 grid ? "" : (" (" + std::to_string(st.nodes - st.leaves) + " interior)").c_str());
     if (!grid) std::printf("  leaves     %llu\n", static_cast<unsigned long long>(st.leaves));
-    std::printf("  empty      %llu %s\n", static_cast<unsigned long long>(st.empty_leaves), grid ? "cells" : "leaves");
+    std::printf("  empty      %llu %s\n", static_cast<unsigned long long>(st.empty_leaves),
+                grid ? "cells" : "leaves");
     std::printf("  references %llu (%.2f per triangle)\n", static_cast<unsigned long long>(st.references),
                 st.triangles ? double(st.references) / double(st.triangles) : 0.0);
-    std::printf("  per %s   avg %.2f, max %llu triangles (non-empty)\n", grid ? "cell" : "leaf", st.avg_leaf_prims,
-                static_cast<unsigned long long>(st.max_leaf_prims));
+    std::printf("  per %s   avg %.2f, max %llu triangles (non-empty)\n", grid ? "cell" : "leaf",
+                st.avg_leaf_prims, static_cast<unsigned long long>(st.max_leaf_prims));
     if (!grid) std::printf("  max depth  %llu\n", static_cast<unsigned long long>(st.max_depth));
     if (st.sah_cost > 0) std::printf("  SAH cost   %.2f\n", st.sah_cost);
   } else if (st.name == "embree") {

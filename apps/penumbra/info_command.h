@@ -9,7 +9,7 @@
 namespace penumbra::cli {
 
 /// Prints the description on stdout. Returns the exit code; throws for bad input like render.
-int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten, const std::string& accel_name,
-             const std::vector<std::string>& accel_params);
+int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
+             const std::string& accel_name, const std::vector<std::string>& accel_params);
 
 }  // namespace penumbra::cli

@@ -3,7 +3,6 @@
 // maps errors to exit codes: 0 success, 2 bad input or usage, 1 a failure outside the input
 // (I/O, memory); a render ended by a signal returns 128 + signal. Only main() exits.
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <new>
 
@@ -32,17 +31,20 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
   info.add_option("--accel", a.accel,
                   "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, brute");
   info.add_option("--accel-param", a.accel_params, accel_param_help())->type_name("KEY=VALUE");
-  info.add_flag("--allow-external-uris", a.allow_external, "let buffer URIs reach files outside the scene's folder");
+  info.add_flag("--allow-external-uris", a.allow_external,
+                "let buffer URIs reach files outside the scene's folder");
   info.add_flag("--flatten", a.flatten, "as for render: no instancing");
 }
 
 void add_merge_options(CLI::App& merge, MergeArgs& a) {
   merge.add_option("parts", a.parts, "part EXRs (together covering the frame once)")->required();
   merge.add_option("-o,--output", a.output, "full-frame EXR (written atomically)")->required();
-  merge.add_option("--max-memory", a.max_memory, "budget for the decoded full frame, e.g. 4G (default: half the RAM)");
-  merge.add_flag("--force", a.force,
-                 "merge parts without Penumbra's scene and settings metadata, or with differing metadata (parts "
-                 "cut by other tools); the windows and channels are still checked");
+  merge.add_option("--max-memory", a.max_memory,
+                   "budget for the decoded full frame, e.g. 4G (default: half the RAM)");
+  merge.add_flag(
+      "--force", a.force,
+      "merge parts without Penumbra's scene and settings metadata, or with differing metadata (parts "
+      "cut by other tools); the windows and channels are still checked");
 }
 
 int report(const char* kind, const char* what, int code) {
@@ -57,14 +59,16 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("penumbra " PENUMBRA_VERSION));
   RenderArgs render_args;
-  auto* render = app.add_subcommand("render", "Render a glTF scene to a scene-linear EXR and a display image");
+  auto* render =
+      app.add_subcommand("render", "Render a glTF scene to a scene-linear EXR and a display image");
   add_render_options(*render, render_args);
   InfoArgs info_args;
-  auto* info = app.add_subcommand("info", "Describe a glTF scene: scenes, meshes, materials, cameras, lights, bounds");
+  auto* info =
+      app.add_subcommand("info", "Describe a glTF scene: scenes, meshes, materials, cameras, lights, bounds");
   add_info_options(*info, info_args);
   MergeArgs merge_args;
-  auto* merge =
-      app.add_subcommand("merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
+  auto* merge = app.add_subcommand(
+      "merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   add_merge_options(*merge, merge_args);
 
   try {
@@ -78,8 +82,8 @@ int main(int argc, char** argv) {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
     if (*info)
-      return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten, info_args.accel,
-                      info_args.accel_params);
+      return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,
+                      info_args.accel, info_args.accel_params);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {
@@ -88,10 +92,11 @@ int main(int argc, char** argv) {
     return report("error", e.what(), kExitInput);
   } catch (const std::bad_alloc&) {
     // Outputs are written atomically: nothing half-written is left behind.
-    std::fprintf(stderr,
-                 "penumbra: error: out of memory while %s; no file is left half-written (a lower --max-memory refuses "
-                 "oversized inputs up front)\n",
-                 current_phase());
+    std::fprintf(
+        stderr,
+        "penumbra: error: out of memory while %s; no file is left half-written (a lower --max-memory refuses "
+        "oversized inputs up front)\n",
+        current_phase());
     return kExitInternal;
   } catch (const std::runtime_error& e) {
     // A failed write, sync or rename (full disk, permissions): the message names the file.

@@ -40,8 +40,8 @@ extern "C" void on_signal(int sig) {
 RenderSettings state_settings(const RenderJob& job) {
   RenderSettings s = job.settings;
   const PixelWindow win = render_window(job.cfg);
-  s.entries["window"] = std::to_string(win.x0) + "," + std::to_string(win.y0) + "-" + std::to_string(win.x1) + "," +
-                        std::to_string(win.y1);
+  s.entries["window"] = std::to_string(win.x0) + "," + std::to_string(win.y0) + "-" + std::to_string(win.x1) +
+                        "," + std::to_string(win.y1);
   return s;
 }
 
@@ -83,15 +83,17 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
     ExrOptions cp;
     cp.half = !a.use_float;
     cp.compression = a.compression;
-    cp.metadata = {{"penumbra:scene", a.scene_file}, {"penumbra:checkpoint", "passes " + std::to_string(st.passes)}};
+    cp.metadata = {{"penumbra:scene", a.scene_file},
+                   {"penumbra:checkpoint", "passes " + std::to_string(st.passes)}};
     write_exr(resolve_path_image(st, job.cfg).film, out, cp);
     write_checkpoint(state_file, st, fingerprint);
     last_checkpoint = Clock::now();
   };
   job.cfg.stop = &g_stop;
   g_graceful = true;
-  job.path_image = render_path(job.loaded.scene, *job.accel, job.path_lights(), job.camera, job.cfg, &job.stats,
-                               [&](int d, int t) { progress(d, t); }, &state, after_pass);
+  job.path_image = render_path(
+      job.loaded.scene, *job.accel, job.path_lights(), job.camera, job.cfg, &job.stats,
+      [&](int d, int t) { progress(d, t); }, &state, after_pass);
   g_graceful = false;
   job.film = std::move(job.path_image.film);
   // A signal during the last pass still ends the run with 128 + signal, the image complete.

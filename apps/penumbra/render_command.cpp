@@ -40,8 +40,8 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   if (q.data_aovs) b += 14 * 4;
   if (q.cost_aov) b += 3 * 4 + 3;
   if (q.aovs.count("samples")) b += 4;  // the counts as floats for the EXR
-  const uint64_t channels =
-      4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) + (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2);
+  const uint64_t channels = 4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) +
+                            (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2);
   b += channels * 4 * (multipart ? 2 : 1);  // packed channels; --multipart also repacks them per part
   if (q.png) b += 12 + 3;
   return b;
@@ -53,14 +53,17 @@ uint64_t charge_image_budget(const RenderJob& job) {
   const RenderConfig& cfg = job.cfg;
   const uint64_t budget = job.request.budget;
   const PixelWindow w = render_window(cfg);
-  const uint64_t image = uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
+  const uint64_t image =
+      uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
   const Scene& scene = job.loaded.scene;
-  const uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle;
+  const uint64_t scene_bytes =
+      scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle;
   if (image > budget || scene_bytes > budget - image)
     throw UsageError("image " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " (" +
                      job.args.integrator + (job.request.aovs.empty() ? "" : ", with AOVs") + ") needs " +
-                     format_bytes(image) + " for the film and output buffers, over the " + format_bytes(budget) +
-                     " budget with the rest of the scene (" + format_bytes(scene_bytes) + ") (--max-memory)");
+                     format_bytes(image) + " for the film and output buffers, over the " +
+                     format_bytes(budget) + " budget with the rest of the scene (" +
+                     format_bytes(scene_bytes) + ") (--max-memory)");
   return image + scene_bytes;
 }
 
@@ -83,7 +86,8 @@ void setup_phase(RenderJob& job) {
   const RenderArgs& a = job.args;
   const RenderRequest& q = job.request;
   Scene& scene = job.loaded.scene;
-  const int cam = a.camera.empty() ? (scene.cameras.empty() ? -1 : 0) : find_camera(scene, a.camera, a.scene_file);
+  const int cam =
+      a.camera.empty() ? (scene.cameras.empty() ? -1 : 0) : find_camera(scene, a.camera, a.scene_file);
   const float hint =
       cam >= 0 && scene.cameras[size_t(cam)].aspect > 0 ? scene.cameras[size_t(cam)].aspect : 16.0f / 9.0f;
   job.cfg = make_render_config(a, q, hint);
@@ -95,7 +99,8 @@ void setup_phase(RenderJob& job) {
   job.camera = cam >= 0 ? scene.cameras[size_t(cam)]
                         : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
   // The path tracer's lights: emissive triangles and the environment.
-  if (q.env_colour) job.environment = make_constant_environment(*q.env_colour * a.env_intensity);
+  if (q.env_colour)
+    job.environment = make_constant_environment(*q.env_colour * a.env_intensity);
   else if (!a.env.empty())
     job.environment = load_environment(a.env, a.env_intensity, a.env_rotation, q.budget - committed);
   if (q.path) job.area_lights = build_area_lights(scene);
@@ -124,26 +129,27 @@ int render_debug_pixel(RenderJob& job) {
   const RenderRequest& q = job.request;
   const RenderConfig& cfg = job.cfg;
   if (q.debug_x < 0 || q.debug_y < 0 || q.debug_x >= cfg.width || q.debug_y >= cfg.height)
-    throw UsageError("--debug-pixel " + job.args.debug_pixel + " is outside the " + std::to_string(cfg.width) + "x" +
-                     std::to_string(cfg.height) + " image");
+    throw UsageError("--debug-pixel " + job.args.debug_pixel + " is outside the " +
+                     std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
   float rgba[4];
   RayCounts counts;
   if (q.path)
-    render_path_pixel(job.loaded.scene, *job.accel, job.path_lights(), job.camera, cfg, q.debug_x, q.debug_y, rgba,
-                      counts);
+    render_path_pixel(job.loaded.scene, *job.accel, job.path_lights(), job.camera, cfg, q.debug_x, q.debug_y,
+                      rgba, counts);
   else
     render_whitted_pixel(job.loaded.scene, *job.accel, job.camera, cfg, q.debug_x, q.debug_y, rgba, counts);
-  std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, %s %llu)\n", q.debug_x,
-              q.debug_y, rgba[0], rgba[1], rgba[2], rgba[3], static_cast<unsigned long long>(counts.camera),
-              static_cast<unsigned long long>(counts.shadow), q.path ? "bounce" : "reflection",
-              static_cast<unsigned long long>(counts.reflection));
+  std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, %s %llu)\n",
+              q.debug_x, q.debug_y, rgba[0], rgba[1], rgba[2], rgba[3],
+              static_cast<unsigned long long>(counts.camera), static_cast<unsigned long long>(counts.shadow),
+              q.path ? "bounce" : "reflection", static_cast<unsigned long long>(counts.reflection));
   return kExitOk;
 }
 
 void render_phase(RenderJob& job) {
   set_phase("rendering");
   ProgressReporter reporter(!job.args.quiet);
-  if (job.request.path) run_path_render(job, reporter);
+  if (job.request.path)
+    run_path_render(job, reporter);
   else
     job.film = render_whitted(job.loaded.scene, *job.accel, job.camera, job.cfg, &job.stats,
                               [&](int d, int t) { reporter(d, t); });
@@ -195,10 +201,11 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "penumbra: interrupted by signal %d during the last pass: the image is complete\n",
                  job.interrupted);
   else
-    std::fprintf(stderr,
-                 "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
-                 "continue with the same command and --resume\n",
-                 job.interrupted, job.stats.passes, job.mean_spp);
+    std::fprintf(
+        stderr,
+        "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
+        "continue with the same command and --resume\n",
+        job.interrupted, job.stats.passes, job.mean_spp);
   return 128 + job.interrupted;
 }
 

@@ -14,7 +14,8 @@ RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, cons
   e["scene.sha256"] = scene_sha256;
   e["scene.index"] = std::to_string(a.scene);
   e["scene.flatten"] = a.flatten ? "1" : "0";
-  e["scene.time"] = a.time ? exact(*a.time) : (a.frame ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
+  e["scene.time"] =
+      a.time ? exact(*a.time) : (a.frame ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
   e["camera"] = a.camera.empty() ? "default '" + camera.name + "'" : a.camera;
   e["image"] = std::to_string(cfg.width) + "x" + std::to_string(cfg.height);
   e["integrator"] = a.integrator;
@@ -38,7 +39,8 @@ RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, cons
   } else {
     const auto& w = cfg.whitted;
     e["whitted.max_depth"] = std::to_string(w.max_depth);
-    e["whitted.background"] = exact(w.background.x) + "," + exact(w.background.y) + "," + exact(w.background.z);
+    e["whitted.background"] =
+        exact(w.background.x) + "," + exact(w.background.y) + "," + exact(w.background.z);
     e["whitted.ambient"] = exact(w.ambient.x) + "," + exact(w.ambient.y) + "," + exact(w.ambient.z);
   }
   return {e};

@@ -9,9 +9,9 @@
 #include "apps/penumbra/render_options.h"
 #include "io/gltf/loader.h"
 #include "io/render_settings.h"
+#include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"
 #include "renderer/lights/environment.h"
-#include "renderer/integrators/render.h"
 
 namespace penumbra::cli {
 
@@ -29,15 +29,15 @@ struct RenderJob {
   Camera camera;
   Environment environment;
   AreaLights area_lights;
-  bool default_light = false;   ///< the scene had no light: the default key light was added
-  RenderSettings settings;      ///< what decides the pixels (path renders and windows only)
-  std::string scene_sha256;     ///< over every file the scene loaded (path renders and windows)
+  bool default_light = false;  ///< the scene had no light: the default key light was added
+  RenderSettings settings;     ///< what decides the pixels (path renders and windows only)
+  std::string scene_sha256;    ///< over every file the scene loaded (path renders and windows)
   std::unique_ptr<Accelerator> accel;
   double load_s = 0, build_s = 0, write_s = 0;
   RenderStats stats;
   Film film;
-  PathImage path_image;   ///< path tracer only; its film is moved into `film`
-  int interrupted = 0;    ///< the signal that ended a path render early, or 0
+  PathImage path_image;  ///< path tracer only; its film is moved into `film`
+  int interrupted = 0;   ///< the signal that ended a path render early, or 0
   bool frame_complete = true;
   bool remove_state = false;  ///< a completed --checkpoint/--resume render: drop OUT.exr.resume once written
   double mean_spp = 0;

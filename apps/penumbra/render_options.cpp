@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The AOV names --aov accepts (besides "all").
-constexpr const char* kAovNames[] = {"albedo", "N", "P", "Z", "UV", "id", "samples", "variance", "light", "cost"};
+constexpr const char* kAovNames[] = {"albedo", "N",       "P",        "Z",     "UV",
+                                     "id",     "samples", "variance", "light", "cost"};
 
 /// -o, --png, --cost-png and --stats-json: extensions, folders and the display transform.
 void check_output_paths(const RenderArgs& a, RenderRequest& q) {
@@ -53,18 +54,24 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
   q.ambient = parse_colour(a.ambient, "--ambient");
   q.path = a.integrator == "path";
   if (q.path && (a.background_given || a.ambient_given))
-    throw UsageError(std::string(a.background_given ? "--background" : "--ambient") +
-                     " applies to --integrator whitted; the path tracer is lit by the scene's lights and --env");
+    throw UsageError(
+        std::string(a.background_given ? "--background" : "--ambient") +
+        " applies to --integrator whitted; the path tracer is lit by the scene's lights and --env");
   if (!q.path) {
-    for (const auto& [given, name] :
-         {std::pair{!a.env.empty(), "--env"}, {a.time_limit > 0, "--time-limit"}, {a.adaptive > 0, "--adaptive"},
-          {a.clamp_indirect > 0, "--clamp-indirect"}, {a.light_sampling != "mis", "--light-sampling"},
-          {a.sampler != "sobol", "--sampler"}, {a.checkpoint > 0, "--checkpoint"}, {a.resume, "--resume"}})
+    for (const auto& [given, name] : {std::pair{!a.env.empty(), "--env"},
+                                      {a.time_limit > 0, "--time-limit"},
+                                      {a.adaptive > 0, "--adaptive"},
+                                      {a.clamp_indirect > 0, "--clamp-indirect"},
+                                      {a.light_sampling != "mis", "--light-sampling"},
+                                      {a.sampler != "sobol", "--sampler"},
+                                      {a.checkpoint > 0, "--checkpoint"},
+                                      {a.resume, "--resume"}})
       if (given) throw UsageError(std::string(name) + " needs --integrator path");
   }
   if (!std::isfinite(a.clamp_indirect) || a.clamp_indirect < 0)
     throw UsageError("--clamp-indirect must be finite and >= 0 (0 = off)");
-  if (!std::isfinite(a.adaptive) || a.adaptive < 0) throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
+  if (!std::isfinite(a.adaptive) || a.adaptive < 0)
+    throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
   if (!std::isfinite(a.time_limit) || a.time_limit < 0)
     throw UsageError("--time-limit must be a finite number of seconds >= 0");
   if (!std::isfinite(a.checkpoint) || a.checkpoint < 0)
@@ -74,7 +81,8 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
   if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation must be finite");
   q.filter_type = q.path ? FilterType::BlackmanHarris : FilterType::Box;
   if (!a.filter.empty() && !parse_filter_type(a.filter, q.filter_type))
-    throw UsageError("--filter: unknown filter '" + a.filter + "' (known: box, tent, gaussian, blackman-harris)");
+    throw UsageError("--filter: unknown filter '" + a.filter +
+                     "' (known: box, tent, gaussian, blackman-harris)");
   q.filter_width = a.filter_width > 0 ? a.filter_width : default_filter_width(q.filter_type);
   if (!std::isfinite(a.filter_width) || a.filter_width < 0 || q.filter_width > 16)
     throw UsageError("--filter-width must be in (0, 16] pixels");
@@ -138,7 +146,8 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
 void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   q.out_streams = resolve_output(q.out, "-o").kind == OutputKind::Stream;
   if (q.out_streams && (a.checkpoint > 0 || a.resume))
-    throw UsageError("--checkpoint and --resume keep their state beside -o, which must then be a regular file");
+    throw UsageError(
+        "--checkpoint and --resume keep their state beside -o, which must then be a regular file");
   std::vector<std::pair<std::string, fs::path>> outputs = {{"-o", q.out}};
   if (q.path && !q.out_streams) {
     // The resume state is written beside a regular-file output only; a FIFO or device at its
@@ -146,7 +155,8 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
     const fs::path state = fs::path(q.out).concat(".resume");
     q.state_beside_output = resolve_output(state, "the resume state").kind == OutputKind::Replace;
     if (!q.state_beside_output && (a.checkpoint > 0 || a.resume))
-      throw UsageError("the resume state " + state.string() + " is not a regular file; --checkpoint and --resume need one");
+      throw UsageError("the resume state " + state.string() +
+                       " is not a regular file; --checkpoint and --resume need one");
     if (q.state_beside_output) outputs.push_back({"the resume state", state});
   }
   if (q.png) outputs.push_back({"--png", *q.png});
@@ -154,8 +164,10 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
   std::vector<std::pair<std::string, fs::path>> inputs = {{"the scene file", a.scene_file}};
   if (!a.env.empty() && !q.env_colour) inputs.push_back({"--env", a.env});
-  if (!a.ocio_config.empty()) inputs.push_back({"--ocio-config", a.ocio_config});
-  else if (const char* ocio = std::getenv("OCIO"); ocio && *ocio) inputs.push_back({"$OCIO", ocio});
+  if (!a.ocio_config.empty())
+    inputs.push_back({"--ocio-config", a.ocio_config});
+  else if (const char* ocio = std::getenv("OCIO"); ocio && *ocio)
+    inputs.push_back({"$OCIO", ocio});
   check_distinct_files(outputs, inputs);
   q.outputs = outputs;
   struct stat stdout_stat {};
@@ -172,64 +184,135 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
 void add_render_options(CLI::App& render, RenderArgs& args) {
   render.add_option("scene", args.scene_file, "glTF scene (.gltf or .glb)")->required();
   render.add_option("-o,--output", args.output, "output EXR path (written atomically)")->required();
-  render.add_option("--png", args.png, "display image path (.png/.jpg/.tif); default: the EXR path with .png");
+  render.add_option("--png", args.png,
+                    "display image path (.png/.jpg/.tif); default: the EXR path with .png");
   render.add_flag("--no-png", args.no_png, "write only the EXR");
-  render.add_option("--width", args.width, "image width in pixels (default 960, or from --height and the camera aspect)")->check(CLI::Range(1, 16384));
-  render.add_option("--height", args.height, "image height in pixels (default: width / camera aspect)")->check(CLI::Range(1, 16384));
-  render.add_option("--integrator", args.integrator, "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast) or path (physically based path tracer)")
+  render
+      .add_option("--width", args.width,
+                  "image width in pixels (default 960, or from --height and the camera aspect)")
+      ->check(CLI::Range(1, 16384));
+  render.add_option("--height", args.height, "image height in pixels (default: width / camera aspect)")
+      ->check(CLI::Range(1, 16384));
+  render
+      .add_option("--integrator", args.integrator,
+                  "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast) or path "
+                  "(physically based path tracer)")
       ->check(CLI::IsMember({"whitted", "path"}));
-  render.add_option("--spp", args.spp, "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")->check(CLI::Range(1, 65536));
-  render.add_option("--max-depth", args.max_depth, "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only (default 12)")->check(CLI::Range(0, 64));
-  render.add_option("--rr-depth", args.rr_depth, "path: Russian roulette from this bounce on (default 3)")->check(CLI::Range(1, 64));
-  render.add_option("--clamp-indirect", args.clamp_indirect, "path: clamp each indirect sample's largest channel to this radiance; biased, trades fireflies for energy (default 0 = off)");
-  render.add_option("--light-sampling", args.light_sampling, "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single techniques are for validation")
+  render
+      .add_option("--spp", args.spp,
+                  "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")
+      ->check(CLI::Range(1, 65536));
+  render
+      .add_option("--max-depth", args.max_depth,
+                  "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only "
+                  "(default 12)")
+      ->check(CLI::Range(0, 64));
+  render.add_option("--rr-depth", args.rr_depth, "path: Russian roulette from this bounce on (default 3)")
+      ->check(CLI::Range(1, 64));
+  render.add_option("--clamp-indirect", args.clamp_indirect,
+                    "path: clamp each indirect sample's largest channel to this radiance; biased, trades "
+                    "fireflies for energy (default 0 = off)");
+  render
+      .add_option("--light-sampling", args.light_sampling,
+                  "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single "
+                  "techniques are for validation")
       ->check(CLI::IsMember({"mis", "bsdf", "light"}));
-  render.add_option("--sampler", args.sampler, "path: sobol (Owen-scrambled, default) or independent (PCG32)")->check(CLI::IsMember({"sobol", "independent"}));
-  render.add_option("--env", args.env, "path: environment light: a radiance r,g,b or grey, or an equirectangular map (.exr, .hdr, any float image OpenImageIO reads)");
+  render
+      .add_option("--sampler", args.sampler, "path: sobol (Owen-scrambled, default) or independent (PCG32)")
+      ->check(CLI::IsMember({"sobol", "independent"}));
+  render.add_option("--env", args.env,
+                    "path: environment light: a radiance r,g,b or grey, or an equirectangular map (.exr, "
+                    ".hdr, any float image OpenImageIO reads)");
   render.add_option("--env-intensity", args.env_intensity, "path: multiplies --env (default 1)");
-  render.add_option("--env-rotation", args.env_rotation, "path: turns the --env map about +Y, degrees (default 0)");
-  render.add_option("--time-limit", args.time_limit, "path: stop after the pass that would run past this many seconds (default 0 = none)");
-  render.add_option("--adaptive", args.adaptive, "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is below it (default 0 = off)");
-  render.add_option("--adaptive-min-spp", args.adaptive_min_spp, "path: samples every pixel takes before --adaptive may stop it (default 16)")->check(CLI::Range(2, 65536));
-  render.add_option("--filter", args.filter, "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, blackman-harris for path)");
-  render.add_option("--filter-width", args.filter_width, "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
-  render.add_option("--threads", args.threads, "worker threads (default 0 = all cores)")->check(CLI::Range(0, 1024));
-  render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")->check(CLI::Range(0, 1 << 30));
-  render.add_option("--camera", args.camera, "camera instance: index as listed by `penumbra info`, or name (default 0; none in the file: frame the bounds)");
-  render.add_option("--accel", args.accel, "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
+  render.add_option("--env-rotation", args.env_rotation,
+                    "path: turns the --env map about +Y, degrees (default 0)");
+  render.add_option("--time-limit", args.time_limit,
+                    "path: stop after the pass that would run past this many seconds (default 0 = none)");
+  render.add_option("--adaptive", args.adaptive,
+                    "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is "
+                    "below it (default 0 = off)");
+  render
+      .add_option("--adaptive-min-spp", args.adaptive_min_spp,
+                  "path: samples every pixel takes before --adaptive may stop it (default 16)")
+      ->check(CLI::Range(2, 65536));
+  render.add_option("--filter", args.filter,
+                    "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, "
+                    "blackman-harris for path)");
+  render.add_option("--filter-width", args.filter_width,
+                    "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
+  render.add_option("--threads", args.threads, "worker threads (default 0 = all cores)")
+      ->check(CLI::Range(0, 1024));
+  render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")
+      ->check(CLI::Range(0, 1 << 30));
+  render.add_option("--camera", args.camera,
+                    "camera instance: index as listed by `penumbra info`, or name (default 0; none in the "
+                    "file: frame the bounds)");
+  render.add_option(
+      "--accel", args.accel,
+      "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
   render.add_option("--accel-param", args.accel_params, accel_param_help())->type_name("KEY=VALUE");
-  render.add_flag("--multipart", args.multipart, "write one EXR part per layer (rgba, albedo, N, Z, ...); lossy --compression then applies to colour parts only");
+  render.add_flag("--multipart", args.multipart,
+                  "write one EXR part per layer (rgba, albedo, N, Z, ...); lossy --compression then applies "
+                  "to colour parts only");
   render.add_flag("--float", args.use_float, "write 32-bit float EXR channels (default half)");
   render.add_option("--compression", args.compression, "EXR compression (default zip)")
       ->check(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}));
   render.add_option("--exposure", args.exposure, "exposure in stops for the display image (default 0)");
-  render.add_option("--ocio-config", args.ocio_config, "OpenColorIO config (default: $OCIO, else the shipped config)");
+  render.add_option("--ocio-config", args.ocio_config,
+                    "OpenColorIO config (default: $OCIO, else the shipped config)");
   render.add_option("--display", args.display, "OCIO display (default: the config's default)");
-  render.add_option("--view", args.view, "OCIO view: Standard (default), Filmic (ACES 1.0 SDR tone mapping) or Raw with the shipped config");
-  render.add_option("--look", args.look, "OCIO look applied before the view: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV with the shipped config");
-  render.add_option("--background", args.background, "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
+  render.add_option(
+      "--view", args.view,
+      "OCIO view: Standard (default), Filmic (ACES 1.0 SDR tone mapping) or Raw with the shipped config");
+  render.add_option("--look", args.look,
+                    "OCIO look applied before the view: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV "
+                    "with the shipped config");
+  render.add_option(
+      "--background", args.background,
+      "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
   render.add_option("--ambient", args.ambient, "whitted: ambient intensity Ia, r,g,b or grey (default 0.05)");
   render.add_option("--seed", args.seed, "sampler seed, an integer in [0, 2^64 - 1] (default 0)");
-  auto* time_opt = render.add_option("--time", args.time, "animation time in seconds: animations (node TRS, skins, morph weights) are evaluated there (default: the file's static pose)");
+  auto* time_opt = render.add_option("--time", args.time,
+                                     "animation time in seconds: animations (node TRS, skins, morph weights) "
+                                     "are evaluated there (default: the file's static pose)");
   render.add_option("--frame", args.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
   render.add_option("--fps", args.fps, "frames per second for --frame (default 24)");
-  render.add_option("--max-memory", args.max_memory, "one memory budget for the scene, the acceleration structure, --env and the image buffers, e.g. 4G; what does not fit is refused before it is allocated (default: half the RAM)");
-  render.add_flag("--allow-external-uris", args.allow_external, "let buffer URIs reach files outside the scene's folder");
-  render.add_flag("--flatten", args.flatten, "give every placement of a mesh its own world-space copy instead of instancing it");
-  render.add_option("--checkpoint", args.checkpoint, "path: every this many seconds (after a whole pass) write the image so far and the resume state OUT.exr.resume, atomically (default 0 = never)");
-  render.add_flag("--resume", args.resume, "path: continue from OUT.exr.resume (written by --checkpoint, --time-limit or an interrupt) to the requested spp; the result equals an uninterrupted render");
-  render.add_option("--stats-json", args.stats_json, "also write the run's statistics (times per phase, rays, spp, memory) as JSON to this file");
-  render.add_option("--crop", args.crop, "render only x0 x1 y0 y1 (pixels, or fractions with a '.'; x1, y1 exclusive): an EXR data window inside the full frame")
-      ->expected(4)->type_name("X0 X1 Y0 Y1");
-  render.add_option("--tile", args.tile, "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");
+  render.add_option(
+      "--max-memory", args.max_memory,
+      "one memory budget for the scene, the acceleration structure, --env and the image buffers, e.g. 4G; "
+      "what does not fit is refused before it is allocated (default: half the RAM)");
+  render.add_flag("--allow-external-uris", args.allow_external,
+                  "let buffer URIs reach files outside the scene's folder");
+  render.add_flag("--flatten", args.flatten,
+                  "give every placement of a mesh its own world-space copy instead of instancing it");
+  render.add_option("--checkpoint", args.checkpoint,
+                    "path: every this many seconds (after a whole pass) write the image so far and the "
+                    "resume state OUT.exr.resume, atomically (default 0 = never)");
+  render.add_flag("--resume", args.resume,
+                  "path: continue from OUT.exr.resume (written by --checkpoint, --time-limit or an "
+                  "interrupt) to the requested spp; the result equals an uninterrupted render");
+  render.add_option(
+      "--stats-json", args.stats_json,
+      "also write the run's statistics (times per phase, rays, spp, memory) as JSON to this file");
+  render
+      .add_option("--crop", args.crop,
+                  "render only x0 x1 y0 y1 (pixels, or fractions with a '.'; x1, y1 exclusive): an EXR data "
+                  "window inside the full frame")
+      ->expected(4)
+      ->type_name("X0 X1 Y0 Y1");
+  render.add_option(
+      "--tile", args.tile,
+      "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");
   render.add_option("--debug-pixel", args.debug_pixel, "render only pixel x,y and print its value");
   render.add_flag("-q,--quiet", args.quiet, "no progress, warnings or summary on stderr");
-  render.add_option("--aov", args.aovs,
-                     "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
-                     "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
-                     "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
-                     "(cost.nodes, cost.triangles, cost.ns) and a heat map");
-  render.add_option("--cost-png", args.cost_png, "heat map path for --aov cost (default: the EXR path with .cost.png)");
+  render.add_option(
+      "--aov", args.aovs,
+      "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
+      "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
+      "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
+      "(cost.nodes, cost.triangles, cost.ns) and a heat map");
+  render.add_option("--cost-png", args.cost_png,
+                    "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }
 
 void note_given_options(const CLI::App& render, int argc, char** argv, RenderArgs& args) {
@@ -319,7 +402,8 @@ PixelWindow parse_window(const RenderArgs& a, int width, int height) {
     const auto [index, count] = split_pair(a.tile, '/', "--tile", "i/N with 0 <= i < N");
     const long long n = parse_integer(count, 1, 1ll << 40, "--tile N");
     if (n > height)
-      throw UsageError("--tile: " + std::to_string(n) + " stripes exceed the " + std::to_string(height) + " rows");
+      throw UsageError("--tile: " + std::to_string(n) + " stripes exceed the " + std::to_string(height) +
+                       " rows");
     long long i = -1;
     try {
       i = parse_integer(index, 0, n - 1, "--tile i");

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <filesystem>
 #include <optional>
 #include <set>
@@ -58,8 +57,8 @@ struct RenderRequest {
   bool path = false;  ///< --integrator path
   std::filesystem::path out;
   std::optional<std::filesystem::path> png, cost_png;
-  bool out_streams = false;      ///< -o is a device or FIFO (no resume state beside it)
-  bool paths_to_stdout = true;   ///< false when an output streams to stdout
+  bool out_streams = false;     ///< -o is a device or FIFO (no resume state beside it)
+  bool paths_to_stdout = true;  ///< false when an output streams to stdout
   DisplayOptions display;
   Vec3f background, ambient;
   FilterType filter_type = FilterType::Box;

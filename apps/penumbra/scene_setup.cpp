@@ -11,8 +11,8 @@
 
 namespace penumbra::cli {
 
-LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten, uint64_t max_memory,
-                       bool quiet, std::optional<double> time) {
+LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
+                       uint64_t max_memory, bool quiet, std::optional<double> time) {
   GltfLoadOptions opt;
   opt.time = time;
   opt.flatten = flatten;
@@ -25,7 +25,8 @@ LoadedScene load_scene(const std::string& file, int scene, bool allow_external, 
     for (size_t i = 0; i < shown; ++i)
       std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), loaded.warnings[i].c_str());
     if (loaded.warnings.size() > shown)
-      std::fprintf(stderr, "warning: %s: ... and %zu more warnings\n", file.c_str(), loaded.warnings.size() - shown);
+      std::fprintf(stderr, "warning: %s: ... and %zu more warnings\n", file.c_str(),
+                   loaded.warnings.size() - shown);
   }
   return loaded;
 }
@@ -45,7 +46,8 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     if (scene.cameras[i].name != spec) continue;
     if (found >= 0)
-      throw InputError(file, "--camera", "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
+      throw InputError(file, "--camera",
+                       "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
     found = int(i);
   }
   if (found < 0) throw InputError(file, "--camera", "no camera named '" + spec + "' (" + listing + ")");
@@ -65,7 +67,8 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
     apply_accel_param(config, p);
     const std::string prefix = p.substr(0, p.find('.'));
     if (prefix != name)
-      throw UsageError("--accel-param " + p + ": a parameter of '" + prefix + "', but --accel is '" + name + "'");
+      throw UsageError("--accel-param " + p + ": a parameter of '" + prefix + "', but --accel is '" + name +
+                       "'");
   }
   validate(config.embree);
   validate(config.bvh);

@@ -20,7 +20,8 @@ std::string stats_json_text(const RenderJob& job) {
   j["output"] = q.out.string();
   j["outputs"]["exr"] = {{"path", q.out.string()}, {"sha256", job.hashes.exr}};
   if (q.png) j["outputs"]["png"] = {{"path", q.png->string()}, {"sha256", job.hashes.png}};
-  if (q.cost_png) j["outputs"]["cost_png"] = {{"path", q.cost_png->string()}, {"sha256", job.hashes.cost_png}};
+  if (q.cost_png)
+    j["outputs"]["cost_png"] = {{"path", q.cost_png->string()}, {"sha256", job.hashes.cost_png}};
   j["integrator"] = a.integrator;
   j["width"] = job.cfg.width;
   j["height"] = job.cfg.height;
@@ -33,7 +34,8 @@ std::string stats_json_text(const RenderJob& job) {
   j["interrupted"] = job.interrupted != 0;
   j["threads"] = stats.threads;
   j["accelerator"] = a.accel;
-  j["seconds"] = {{"load", job.load_s}, {"build", job.build_s}, {"render", stats.seconds}, {"write", job.write_s}};
+  j["seconds"] = {
+      {"load", job.load_s}, {"build", job.build_s}, {"render", stats.seconds}, {"write", job.write_s}};
   j["rays"] = {{"camera", stats.rays.camera},
                {"shadow", stats.rays.shadow},
                {q.path ? "bounce" : "reflection", stats.rays.reflection},

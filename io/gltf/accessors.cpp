@@ -36,7 +36,8 @@ const unsigned char* sparse_span(const GltfContext& ctx, int view, uint64_t offs
                                  const std::string& what) {
   const std::span<const unsigned char> span = buffer_view_bytes(ctx, view, what);
   uint64_t end = 0;
-  if (!add_ok(offset, bytes, end) || end > span.size()) ctx.fail(what, "reads past the end of its bufferView");
+  if (!add_ok(offset, bytes, end) || end > span.size())
+    ctx.fail(what, "reads past the end of its bufferView");
   return span.data() + offset;
 }
 
@@ -54,10 +55,11 @@ void read_sparse(const GltfContext& ctx, const tinygltf::Accessor& a, const std:
   if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
       ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
     ctx.fail(sw + ".indices", "componentType must be an unsigned integer type");
-  const unsigned char* ip = sparse_span(ctx, a.sparse.indices.bufferView, uint64_t(a.sparse.indices.byteOffset),
-                                        n * uint64_t(isz), sw + ".indices");
-  const unsigned char* vp =
-      sparse_span(ctx, a.sparse.values.bufferView, uint64_t(a.sparse.values.byteOffset), n * elem, sw + ".values");
+  const unsigned char* ip =
+      sparse_span(ctx, a.sparse.indices.bufferView, uint64_t(a.sparse.indices.byteOffset), n * uint64_t(isz),
+                  sw + ".indices");
+  const unsigned char* vp = sparse_span(ctx, a.sparse.values.bufferView, uint64_t(a.sparse.values.byteOffset),
+                                        n * elem, sw + ".values");
   AccessorLayout values;
   values.data = vp;
   values.stride = elem;
@@ -68,13 +70,23 @@ void read_sparse(const GltfContext& ctx, const tinygltf::Accessor& a, const std:
   for (uint64_t i = 0; i < n; ++i) {
     uint64_t target = 0;
     if (isz == 1) target = ip[i];
-    if (isz == 2) { uint16_t v; std::memcpy(&v, ip + i * 2, 2); target = v; }
-    if (isz == 4) { uint32_t v; std::memcpy(&v, ip + i * 4, 4); target = v; }
+    if (isz == 2) {
+      uint16_t v;
+      std::memcpy(&v, ip + i * 2, 2);
+      target = v;
+    }
+    if (isz == 4) {
+      uint32_t v;
+      std::memcpy(&v, ip + i * 4, 4);
+      target = v;
+    }
     if (target >= l.count)
-      ctx.fail(sw + ".indices", "index " + std::to_string(target) + " >= accessor count " + std::to_string(l.count));
+      ctx.fail(sw + ".indices",
+               "index " + std::to_string(target) + " >= accessor count " + std::to_string(l.count));
     if (i > 0 && target <= l.sparse.back().first)  // the spec: sparse indices MUST strictly increase
       ctx.fail(sw + ".indices", "indices must strictly increase (index " + std::to_string(i) + " is " +
-                                    std::to_string(target) + " after " + std::to_string(l.sparse.back().first) + ")");
+                                    std::to_string(target) + " after " +
+                                    std::to_string(l.sparse.back().first) + ")");
     std::vector<double> vals(size_t(l.components));
     for (int c = 0; c < l.components; ++c) vals[size_t(c)] = accessor_component(values, i, c);
     l.sparse.emplace_back(target, std::move(vals));
@@ -112,16 +124,17 @@ AccessorLayout accessor_layout(const GltfContext& ctx, int accessor, const std::
     const tinygltf::BufferView& bv = model.bufferViews[size_t(a.bufferView)];
     l.stride = bv.byteStride ? uint64_t(bv.byteStride) : elem;
     if (bv.byteStride != 0 && (bv.byteStride < elem || bv.byteStride > 252 || bv.byteStride % 4))
-      ctx.fail(bv_where, "byteStride " + std::to_string(bv.byteStride) + " invalid for " + std::to_string(elem) +
-                             "-byte elements of " + where);
+      ctx.fail(bv_where, "byteStride " + std::to_string(bv.byteStride) + " invalid for " +
+                             std::to_string(elem) + "-byte elements of " + where);
     uint64_t last = 0, end = 0;
     if (!mul_ok(l.count - 1, l.stride, last) || !add_ok(last, a.byteOffset, end) || !add_ok(end, elem, end) ||
         end > bv.byteLength)
       ctx.fail(where, "byteOffset " + std::to_string(a.byteOffset) + " + " + std::to_string(l.count) +
-                          " elements (stride " + std::to_string(l.stride) + ") read past the end of " + bv_where +
-                          " (" + std::to_string(bv.byteLength) + " bytes)");
+                          " elements (stride " + std::to_string(l.stride) + ") read past the end of " +
+                          bv_where + " (" + std::to_string(bv.byteLength) + " bytes)");
     if (a.byteOffset % uint64_t(comp_size) != 0)
-      ctx.warn(where, "byteOffset " + std::to_string(a.byteOffset) + " is not a multiple of the component size");
+      ctx.warn(where,
+               "byteOffset " + std::to_string(a.byteOffset) + " is not a multiple of the component size");
     l.data = view.data() + a.byteOffset;
   } else if (!a.sparse.isSparse) {
     ctx.warn(where, "no bufferView: values are all zero");
@@ -135,27 +148,54 @@ double accessor_component(const AccessorLayout& l, uint64_t element, int c) {
   const int size = tinygltf::GetComponentSizeInBytes(uint32_t(l.component_type));
   const unsigned char* p = l.data + element * l.stride + uint64_t(c) * uint64_t(size);
   switch (l.component_type) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { const uint8_t v = *p; return l.normalized ? v / 255.0 : v; }
-    case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return l.normalized ? std::max(v / 127.0, -1.0) : v; }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return l.normalized ? v / 65535.0 : v; }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return l.normalized ? std::max(v / 32767.0, -1.0) : v; }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return v; }
-    default: return 0.0;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      const uint8_t v = *p;
+      return l.normalized ? v / 255.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return l.normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return l.normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return l.normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default:
+      return 0.0;
   }
 }
 
 std::vector<double> read_accessor(const GltfContext& ctx, int accessor, const std::string& user,
-                                  std::initializer_list<int> types, std::initializer_list<int> component_types,
-                                  bool allow_normalized, bool allow_integer) {
+                                  std::initializer_list<int> types,
+                                  std::initializer_list<int> component_types, bool allow_normalized,
+                                  bool allow_integer) {
   AccessorLayout l = accessor_layout(ctx, accessor, user);
   const auto& a = ctx.model.accessors[size_t(accessor)];
   const std::string where = user + " (" + idx("accessors", size_t(accessor)) + ")";
-  if (std::find(types.begin(), types.end(), a.type) == types.end()) ctx.fail(where, "unexpected accessor type");
+  if (std::find(types.begin(), types.end(), a.type) == types.end())
+    ctx.fail(where, "unexpected accessor type");
   const bool ok_component =
       std::find(component_types.begin(), component_types.end(), a.componentType) != component_types.end();
   const bool is_float = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-  if (!ok_component || (!is_float && !(allow_normalized && a.normalized) && !(allow_integer && !a.normalized)))
+  if (!ok_component ||
+      (!is_float && !(allow_normalized && a.normalized) && !(allow_integer && !a.normalized)))
     ctx.fail(where, "unsupported componentType " + std::to_string(a.componentType) +
                         (a.normalized ? " (normalized)" : ""));
   std::vector<double> out(size_t(l.count) * size_t(l.components));
@@ -163,7 +203,8 @@ std::vector<double> read_accessor(const GltfContext& ctx, int accessor, const st
     for (int c = 0; c < l.components; ++c)
       out[size_t(i) * size_t(l.components) + size_t(c)] = accessor_component(l, i, c);
   for (const auto& [target, vals] : l.sparse)
-    for (int c = 0; c < l.components; ++c) out[size_t(target) * size_t(l.components) + size_t(c)] = vals[size_t(c)];
+    for (int c = 0; c < l.components; ++c)
+      out[size_t(target) * size_t(l.components) + size_t(c)] = vals[size_t(c)];
   return out;
 }
 

@@ -43,8 +43,9 @@ double accessor_component(const AccessorLayout& l, uint64_t element, int c);
 /// type must be one of `types` and its componentType one of `component_types`; integer types
 /// need `allow_normalized` (and normalized: true) or `allow_integer` (and normalized: false).
 std::vector<double> read_accessor(const GltfContext& ctx, int accessor, const std::string& user,
-                                  std::initializer_list<int> types, std::initializer_list<int> component_types,
-                                  bool allow_normalized, bool allow_integer = false);
+                                  std::initializer_list<int> types,
+                                  std::initializer_list<int> component_types, bool allow_normalized,
+                                  bool allow_integer = false);
 
 /// A SCALAR unsigned byte/short/int, non-normalized index accessor.
 std::vector<uint32_t> read_indices(const GltfContext& ctx, int accessor, const std::string& user);

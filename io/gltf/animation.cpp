@@ -31,25 +31,32 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
   const auto& smp = anim.samplers[size_t(ch.sampler)];
   const std::string sw = aw + "." + idx("samplers", size_t(ch.sampler));
   Interpolation interp = Interpolation::Linear;
-  if (smp.interpolation == "STEP") interp = Interpolation::Step;
-  else if (smp.interpolation == "CUBICSPLINE") interp = Interpolation::CubicSpline;
+  if (smp.interpolation == "STEP")
+    interp = Interpolation::Step;
+  else if (smp.interpolation == "CUBICSPLINE")
+    interp = Interpolation::CubicSpline;
   else if (smp.interpolation != "LINEAR" && !smp.interpolation.empty())
     ctx.fail(sw + ".interpolation", "'" + smp.interpolation + "' is not STEP, LINEAR or CUBICSPLINE");
   const std::string& path = ch.target_path;
   size_t width = 0;
-  if (path == "translation" || path == "scale") width = 3;
-  else if (path == "rotation") width = 4;
-  else if (path == "weights") width = 0;  // from the counts below
+  if (path == "translation" || path == "scale")
+    width = 3;
+  else if (path == "rotation")
+    width = 4;
+  else if (path == "weights")
+    width = 0;  // from the counts below
   else {
     ctx.warn(cw + ".target.path", "path '" + path + "' is not supported; channel ignored");
     return;
   }
-  const auto in = read_accessor(ctx, smp.input, sw + ".input", {TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-  const auto outv = read_accessor(ctx, smp.output, sw + ".output",
-                                  {width == 3 ? TINYGLTF_TYPE_VEC3 : (width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_SCALAR)},
-                                  {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                   TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-                                  true);
+  const auto in = read_accessor(ctx, smp.input, sw + ".input", {TINYGLTF_TYPE_SCALAR},
+                                {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+  const auto outv = read_accessor(
+      ctx, smp.output, sw + ".output",
+      {width == 3 ? TINYGLTF_TYPE_VEC3 : (width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_SCALAR)},
+      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+       TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+      true);
   std::vector<float> times(in.begin(), in.end()), values(outv.begin(), outv.end());
   for (size_t k = 0; k < times.size(); ++k)
     if (!std::isfinite(times[k]) || (k > 0 && times[k] < times[k - 1]))
@@ -70,10 +77,19 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
   std::vector<double> v(width);
   sample_track(times, values, width, interp, path == "rotation", time, v.data());
   NodePose& pose = poses[size_t(ch.target_node)];
-  if (path == "translation") { pose.has_t = true; pose.t = {v[0], v[1], v[2]}; }
-  else if (path == "scale") { pose.has_s = true; pose.s = {v[0], v[1], v[2]}; }
-  else if (path == "rotation") { pose.has_r = true; pose.r = {v[0], v[1], v[2], v[3]}; }
-  else { pose.has_w = true; pose.weights = v; }
+  if (path == "translation") {
+    pose.has_t = true;
+    pose.t = {v[0], v[1], v[2]};
+  } else if (path == "scale") {
+    pose.has_s = true;
+    pose.s = {v[0], v[1], v[2]};
+  } else if (path == "rotation") {
+    pose.has_r = true;
+    pose.r = {v[0], v[1], v[2], v[3]};
+  } else {
+    pose.has_w = true;
+    pose.weights = v;
+  }
 }
 
 }  // namespace
@@ -81,11 +97,13 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
 std::vector<NodePose> evaluate_animations(const GltfContext& ctx, double time) {
   std::vector<NodePose> poses(ctx.model.nodes.size());
   for (size_t ai = 0; ai < ctx.model.animations.size(); ++ai)
-    for (size_t ci = 0; ci < ctx.model.animations[ai].channels.size(); ++ci) sample_channel(ctx, ai, ci, time, poses);
+    for (size_t ci = 0; ci < ctx.model.animations[ai].channels.size(); ++ci)
+      sample_channel(ctx, ai, ci, time, poses);
   return poses;
 }
 
-std::vector<double> morph_weights(const GltfContext& ctx, const std::vector<NodePose>& poses, int mesh, int node) {
+std::vector<double> morph_weights(const GltfContext& ctx, const std::vector<NodePose>& poses, int mesh,
+                                  int node) {
   const auto& gnode = ctx.model.nodes[size_t(node)];
   std::vector<double> morph = ctx.model.meshes[size_t(mesh)].weights;
   if (!gnode.weights.empty()) morph = gnode.weights;
@@ -115,7 +133,8 @@ std::vector<Transform> joint_matrices(const GltfContext& ctx, NodeTransforms& no
   std::vector<Transform> joint_mats;
   for (size_t k = 0; k < skin.joints.size(); ++k) {
     const int j = skin.joints[k];
-    if (j < 0 || size_t(j) >= ctx.model.nodes.size()) ctx.fail(sw + ".joints", "node index " + std::to_string(j) + " out of range");
+    if (j < 0 || size_t(j) >= ctx.model.nodes.size())
+      ctx.fail(sw + ".joints", "node index " + std::to_string(j) + " out of range");
     Transform inv_bind;
     if (!ibm.empty()) inv_bind = from_column_major(&ibm[k * 16]);
     joint_mats.push_back(world_transform(ctx, nodes, j) * inv_bind);

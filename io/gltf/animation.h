@@ -27,7 +27,8 @@ std::vector<NodePose> evaluate_animations(const GltfContext& ctx, double time);
 
 /// The morph weights of mesh `mesh` placed by `node`: animated, else the node's, else the mesh's
 /// defaults; non-finite weights are 0. `poses` is empty when no time is asked for.
-std::vector<double> morph_weights(const GltfContext& ctx, const std::vector<NodePose>& poses, int mesh, int node);
+std::vector<double> morph_weights(const GltfContext& ctx, const std::vector<NodePose>& poses, int mesh,
+                                  int node);
 
 /// Joint matrices J_k = world(joint k) x inverseBindMatrix k of skins[skin], for `node_where`.
 /// Throws InputError naming the skin.

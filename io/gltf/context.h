@@ -18,11 +18,17 @@ class Model;
 namespace penumbra::gltf {
 
 /// Overflow-safe arithmetic for sizes read from the file: false if the result wraps.
-inline bool add_ok(uint64_t a, uint64_t b, uint64_t& r) { return !__builtin_add_overflow(a, b, &r); }
-inline bool mul_ok(uint64_t a, uint64_t b, uint64_t& r) { return !__builtin_mul_overflow(a, b, &r); }
+inline bool add_ok(uint64_t a, uint64_t b, uint64_t& r) {
+  return !__builtin_add_overflow(a, b, &r);
+}
+inline bool mul_ok(uint64_t a, uint64_t b, uint64_t& r) {
+  return !__builtin_mul_overflow(a, b, &r);
+}
 
 /// "array[i]", the JSON path of an array element.
-inline std::string idx(const char* array, size_t i) { return std::string(array) + "[" + std::to_string(i) + "]"; }
+inline std::string idx(const char* array, size_t i) {
+  return std::string(array) + "[" + std::to_string(i) + "]";
+}
 
 /// The memory budget (GltfLoadOptions::max_memory_bytes): everything that grows with the file is
 /// charged here before it is allocated.
@@ -53,10 +59,10 @@ class MemoryBudget {
 /// One conversion of a parsed model into `out`. The references outlive every phase.
 struct GltfContext {
   const tinygltf::Model& model;
-  const std::string& file;          ///< the scene file, as named in every InputError
+  const std::string& file;  ///< the scene file, as named in every InputError
   const GltfLoadOptions& options;
   MemoryBudget& budget;
-  LoadedScene& out;                 ///< the scene, info and warnings being filled
+  LoadedScene& out;  ///< the scene, info and warnings being filled
 
   /// Throws InputError(file, element, message).
   [[noreturn]] void fail(const std::string& element, const std::string& message) const {

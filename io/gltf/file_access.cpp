@@ -2,10 +2,9 @@
 // sandboxed file callbacks tinygltf parses with.
 #include "io/gltf/file_access.h"
 
-#include <tiny_gltf.h>
-
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <tiny_gltf.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -160,7 +159,9 @@ bool sandbox_file_exists(const std::string& path, void* user) {
   return static_cast<FileSandbox*>(user)->served.count(path) > 0;
 }
 
-std::string sandbox_expand(const std::string& path, void*) { return path; }  // no ~ or $VAR
+std::string sandbox_expand(const std::string& path, void*) {
+  return path;
+}  // no ~ or $VAR
 
 bool sandbox_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   auto& box = *static_cast<FileSandbox*>(user);
@@ -175,7 +176,8 @@ bool sandbox_read(std::vector<unsigned char>* out, std::string* err, const std::
     if (err) *err = e.what();
     return false;
   }
-  if (std::find(box.read->begin(), box.read->end(), it->second) == box.read->end()) box.read->push_back(it->second);
+  if (std::find(box.read->begin(), box.read->end(), it->second) == box.read->end())
+    box.read->push_back(it->second);
   return true;
 }
 

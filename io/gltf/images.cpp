@@ -66,20 +66,22 @@ void decode_into(const GltfContext& ctx, std::span<const unsigned char> data, co
   config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   auto in = OIIO::ImageInput::open("image." + ext, &config, &reader);
   if (!in) {
-    ctx.warn(where, "cannot decode " + ext + " image: " + OIIO::geterror() + "; textures using it are ignored");
+    ctx.warn(where,
+             "cannot decode " + ext + " image: " + OIIO::geterror() + "; textures using it are ignored");
     return;
   }
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width < 1 || spec.height < 1 || spec.width > kMaxTextureSize || spec.height > kMaxTextureSize ||
       spec.nchannels < 1 || spec.nchannels > 64) {
     ctx.warn(where, "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " with " +
-                        std::to_string(spec.nchannels) + " channels (limit " + std::to_string(kMaxTextureSize) +
-                        " per side); textures using it are ignored");
+                        std::to_string(spec.nchannels) + " channels (limit " +
+                        std::to_string(kMaxTextureSize) + " per side); textures using it are ignored");
     return;
   }
   const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
-  ctx.charge(texels * uint64_t(spec.nchannels) * 4 + texels * 16, where,
-             "decoding the " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " image needs");
+  ctx.charge(
+      texels * uint64_t(spec.nchannels) * 4 + texels * 16, where,
+      "decoding the " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " image needs");
   std::vector<float> pixels(size_t(texels) * size_t(spec.nchannels));
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
     ctx.warn(where, "cannot decode " + ext + " image: " + in->geterror() + "; textures using it are ignored");
@@ -101,9 +103,12 @@ TextureSampler texture_sampler(const GltfContext& ctx, int sampler) {
   const std::string sw = idx("samplers", size_t(sampler));
   auto wrap = [&](int mode, const char* field) {
     switch (mode) {
-      case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
-      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
-      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+      case TINYGLTF_TEXTURE_WRAP_REPEAT:
+        return TextureWrap::Repeat;
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+        return TextureWrap::ClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+        return TextureWrap::MirroredRepeat;
       default:
         ctx.warn(sw + "." + field, "unknown wrap mode " + std::to_string(mode) + "; REPEAT used");
         return TextureWrap::Repeat;
@@ -113,29 +118,46 @@ TextureSampler texture_sampler(const GltfContext& ctx, int sampler) {
   smp.wrap_t = wrap(s.wrapT, "wrapT");
   if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) smp.mag = TextureFilter::Nearest;
   switch (s.minFilter) {
-    case TINYGLTF_TEXTURE_FILTER_NEAREST: smp.min = TextureFilter::Nearest; smp.mipmaps = false; break;
-    case TINYGLTF_TEXTURE_FILTER_LINEAR: smp.mipmaps = false; break;
-    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST: smp.min = TextureFilter::Nearest; smp.mip = TextureFilter::Nearest; break;
-    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST: smp.mip = TextureFilter::Nearest; break;
-    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR: smp.min = TextureFilter::Nearest; break;
-    default: break;  // LINEAR_MIPMAP_LINEAR or unspecified: trilinear
+    case TINYGLTF_TEXTURE_FILTER_NEAREST:
+      smp.min = TextureFilter::Nearest;
+      smp.mipmaps = false;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR:
+      smp.mipmaps = false;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+      smp.min = TextureFilter::Nearest;
+      smp.mip = TextureFilter::Nearest;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+      smp.mip = TextureFilter::Nearest;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+      smp.min = TextureFilter::Nearest;
+      break;
+    default:
+      break;  // LINEAR_MIPMAP_LINEAR or unspecified: trilinear
   }
   return smp;
 }
 
 }  // namespace
 
-void keep_encoded_images(tinygltf::TinyGLTF& parser) { parser.SetImageLoader(capture_image, nullptr); }
+void keep_encoded_images(tinygltf::TinyGLTF& parser) {
+  parser.SetImageLoader(capture_image, nullptr);
+}
 
 const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, int image_index,
                                   const std::string& user) {
   if (auto it = cache.images.find(image_index); it != cache.images.end()) return it->second;
   DecodedImage& out = cache.images[image_index];
   const auto& img = ctx.model.images[size_t(image_index)];
-  const std::string where = idx("images", size_t(image_index)) + (img.name.empty() ? "" : " '" + img.name + "'");
+  const std::string where =
+      idx("images", size_t(image_index)) + (img.name.empty() ? "" : " '" + img.name + "'");
   const std::span<const unsigned char> data = encoded_bytes(ctx, img, where);
   if (data.empty()) {
-    ctx.warn(where, "image data could not be read" + (img.uri.empty() ? std::string() : " from '" + img.uri + "'") +
+    ctx.warn(where, "image data could not be read" +
+                        (img.uri.empty() ? std::string() : " from '" + img.uri + "'") +
                         "; textures using it (" + user + ") are ignored");
     return out;
   }
@@ -148,7 +170,8 @@ const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, i
   return out;
 }
 
-int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb, const std::string& where) {
+int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb,
+                  const std::string& where) {
   if (auto it = cache.textures.find({texture, srgb}); it != cache.textures.end()) return it->second;
   const auto& t = ctx.model.textures[size_t(texture)];
   const DecodedImage& img = decoded_image(ctx, cache, t.source, where);
@@ -168,7 +191,8 @@ int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool
   const int index = int(ctx.out.scene.textures.size());
   ctx.out.scene.textures.push_back(make_texture(
       idx("textures", size_t(texture)) + " (" + idx("images", size_t(t.source)) +
-          (image.name.empty() ? (image.uri.empty() ? "" : " '" + image.uri + "'") : " '" + image.name + "'") + ")",
+          (image.name.empty() ? (image.uri.empty() ? "" : " '" + image.uri + "'") : " '" + image.name + "'") +
+          ")",
       img.width, img.height, rgba, smp));
   ctx.budget.release(copy_bytes);  // rgba is freed on return
   cache.textures[{texture, srgb}] = index;
@@ -179,7 +203,8 @@ void validate_textures(const GltfContext& ctx) {
   for (size_t i = 0; i < ctx.model.textures.size(); ++i) {
     const auto& t = ctx.model.textures[i];
     if (t.source < -1 || t.source >= int(ctx.model.images.size()))
-      ctx.warn(idx("textures", i) + ".source", "image index " + std::to_string(t.source) + " out of range; texture ignored");
+      ctx.warn(idx("textures", i) + ".source",
+               "image index " + std::to_string(t.source) + " out of range; texture ignored");
     if (t.sampler < -1 || t.sampler >= int(ctx.model.samplers.size()))
       ctx.warn(idx("textures", i) + ".sampler",
                "sampler index " + std::to_string(t.sampler) + " out of range; default sampler used");

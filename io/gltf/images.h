@@ -33,17 +33,19 @@ struct DecodedImage {
 
 /// Images decoded so far and the scene textures made from them.
 struct TextureCache {
-  std::map<int, DecodedImage> images;           ///< glTF image -> decoded, on first use
+  std::map<int, DecodedImage> images;            ///< glTF image -> decoded, on first use
   std::map<std::pair<int, bool>, int> textures;  ///< (glTF texture, sRGB) -> Scene::textures, -1 unusable
 };
 
 /// images[image] decoded (once; later calls return the cached result). `user` names the texture
 /// info asking, for warnings. Charges the decoded texels.
-const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, int image, const std::string& user);
+const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, int image,
+                                  const std::string& user);
 
 /// The Scene::textures index of textures[texture] with its sampler, sRGB-decoded if `srgb`, made
 /// on first use; -1 if its image is unusable. `texture` and its source are valid indices.
-int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb, const std::string& where);
+int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb,
+                  const std::string& where);
 
 /// Warns about textures whose source or sampler index is out of range (they are ignored or use
 /// the default sampler).

@@ -18,11 +18,11 @@ namespace penumbra {
 
 /// Loader limits and choices, with their defaults.
 struct GltfLoadOptions {
-  int scene = -1;                     ///< glTF scene index; -1 = the file's default (or 0)
-  bool allow_external_uris = false;   ///< allow URIs that resolve outside the file's folder
-  uint64_t max_file_bytes = 2ull << 30;   ///< per file read (glTF, GLB, .bin)
-  uint64_t max_memory_bytes = 8ull << 30; ///< budget for decoded geometry
-  int max_json_depth = 64;            ///< deeper JSON nesting is rejected before parsing
+  int scene = -1;                          ///< glTF scene index; -1 = the file's default (or 0)
+  bool allow_external_uris = false;        ///< allow URIs that resolve outside the file's folder
+  uint64_t max_file_bytes = 2ull << 30;    ///< per file read (glTF, GLB, .bin)
+  uint64_t max_memory_bytes = 8ull << 30;  ///< budget for decoded geometry
+  int max_json_depth = 64;                 ///< deeper JSON nesting is rejected before parsing
   /// Animation time in seconds: every animation's channels (node TRS, morph weights; skins
   /// follow their joints) are evaluated at this time before the scene is built. Unset: the
   /// file's static pose (no channel applied).
@@ -41,8 +41,8 @@ struct GltfInfo {
   int node_count = 0, mesh_count = 0, primitive_count = 0;
   int gltf_camera_count = 0, gltf_light_count = 0, image_count = 0, animation_count = 0;
   std::vector<std::string> extensions_used, extensions_required;
-  std::vector<std::string> camera_instances;  ///< "name (perspective, node 3)" in scene order
-  std::vector<std::string> node_names;        ///< each node's name, or "nodes[i]" if unnamed
+  std::vector<std::string> camera_instances;        ///< "name (perspective, node 3)" in scene order
+  std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
                                                     ///< external buffer and image file, in load order
 };

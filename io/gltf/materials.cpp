@@ -9,8 +9,8 @@
 namespace penumbra::gltf {
 
 std::vector<std::string> material_extensions() {
-  return {"KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_materials_ior",
-          "KHR_materials_specular", "KHR_materials_transmission", "KHR_texture_transform"};
+  return {"KHR_materials_emissive_strength", "KHR_materials_unlit",        "KHR_materials_ior",
+          "KHR_materials_specular",          "KHR_materials_transmission", "KHR_texture_transform"};
 }
 
 namespace {
@@ -29,7 +29,8 @@ void read_texture_transform(const GltfContext& ctx, const tinygltf::Value& x, co
   auto read_pair = [&](const char* key, double* v) {
     const auto& a = x.Get(key);
     if (!a.IsArray()) return;
-    if (a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) ctx.fail(xw + "." + key, "must be 2 numbers");
+    if (a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
+      ctx.fail(xw + "." + key, "must be 2 numbers");
     v[0] = a.Get(0).GetNumberAsDouble();
     v[1] = a.Get(1).GetNumberAsDouble();
   };
@@ -53,7 +54,8 @@ TextureRef texture_ref(const GltfContext& ctx, TextureCache& cache, int texture,
                        const tinygltf::ExtensionMap& extensions, bool srgb, const std::string& where) {
   TextureRef ref;
   const tinygltf::Model& model = ctx.model;
-  if (texture < 0 || size_t(texture) >= model.textures.size()) return ref;  // warned by validate_material_textures
+  if (texture < 0 || size_t(texture) >= model.textures.size())
+    return ref;  // warned by validate_material_textures
   const auto& t = model.textures[size_t(texture)];
   if (t.source < 0 || size_t(t.source) >= model.images.size()) {
     if (t.source < 0) ctx.warn(idx("textures", size_t(texture)), "has no image source; ignored");
@@ -72,21 +74,23 @@ TextureRef texture_ref(const GltfContext& ctx, TextureCache& cache, int texture,
 }
 
 // Factors and alpha of the core material (pbrMetallicRoughness, emissiveFactor, alphaMode).
-void read_core_factors(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where, Material& m) {
+void read_core_factors(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where,
+                       Material& m) {
   const auto& pbr = src.pbrMetallicRoughness;
   const std::string pw = where + ".pbrMetallicRoughness";
   if (pbr.baseColorFactor.size() != 4) ctx.fail(pw + ".baseColorFactor", "must have 4 values");
   for (int c = 0; c < 3; ++c)
-    m.base_color[c] =
-        float(std::clamp(finite_or_fail(ctx, pbr.baseColorFactor[size_t(c)], pw + ".baseColorFactor"), 0.0, 1.0));
+    m.base_color[c] = float(
+        std::clamp(finite_or_fail(ctx, pbr.baseColorFactor[size_t(c)], pw + ".baseColorFactor"), 0.0, 1.0));
   m.alpha = float(std::clamp(finite_or_fail(ctx, pbr.baseColorFactor[3], pw + ".baseColorFactor"), 0.0, 1.0));
   m.metallic = float(std::clamp(finite_or_fail(ctx, pbr.metallicFactor, pw + ".metallicFactor"), 0.0, 1.0));
-  m.roughness = float(std::clamp(finite_or_fail(ctx, pbr.roughnessFactor, pw + ".roughnessFactor"), 0.0, 1.0));
+  m.roughness =
+      float(std::clamp(finite_or_fail(ctx, pbr.roughnessFactor, pw + ".roughnessFactor"), 0.0, 1.0));
   if (!src.emissiveFactor.empty()) {
     if (src.emissiveFactor.size() != 3) ctx.fail(where + ".emissiveFactor", "must have 3 values");
     for (int c = 0; c < 3; ++c)
-      m.emissive[c] =
-          float(std::clamp(finite_or_fail(ctx, src.emissiveFactor[size_t(c)], where + ".emissiveFactor"), 0.0, 1.0));
+      m.emissive[c] = float(std::clamp(
+          finite_or_fail(ctx, src.emissiveFactor[size_t(c)], where + ".emissiveFactor"), 0.0, 1.0));
   }
 }
 
@@ -119,11 +123,14 @@ void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tiny
   m.unlit = src.extensions.count("KHR_materials_unlit") > 0;
   // ior: >= 1, or 0 (the extension's special case: f0 = 1).
   extension_number(ctx, src, where, "KHR_materials_ior", "ior", m.ior, 0.0, 1e6, "0 or in [1, 1e6]");
-  if (m.ior > 0 && m.ior < 1) ctx.fail(where + ".extensions.KHR_materials_ior.ior", "must be 0 or in [1, 1e6]");
-  extension_number(ctx, src, where, "KHR_materials_specular", "specularFactor", m.specular, 0.0, 1.0, "in [0, 1]");
-  extension_number(ctx, src, where, "KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0, 1.0,
+  if (m.ior > 0 && m.ior < 1)
+    ctx.fail(where + ".extensions.KHR_materials_ior.ior", "must be 0 or in [1, 1e6]");
+  extension_number(ctx, src, where, "KHR_materials_specular", "specularFactor", m.specular, 0.0, 1.0,
                    "in [0, 1]");
-  if (auto it = src.extensions.find("KHR_materials_transmission"); it != src.extensions.end() && m.transmission > 0) {
+  extension_number(ctx, src, where, "KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0,
+                   1.0, "in [0, 1]");
+  if (auto it = src.extensions.find("KHR_materials_transmission");
+      it != src.extensions.end() && m.transmission > 0) {
     const auto& info = it->second.Get("transmissionTexture");
     if (info.IsObject() && info.Get("index").IsInt()) {
       tinygltf::ExtensionMap texture_extensions;
@@ -131,8 +138,9 @@ void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tiny
       if (e.IsObject())
         for (const auto& key : e.Keys()) texture_extensions[key] = e.Get(key);
       const int tc = info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
-      m.transmission_tex = texture_ref(ctx, cache, info.Get("index").GetNumberAsInt(), tc, texture_extensions, false,
-                                       where + ".extensions.KHR_materials_transmission.transmissionTexture");
+      m.transmission_tex =
+          texture_ref(ctx, cache, info.Get("index").GetNumberAsInt(), tc, texture_extensions, false,
+                      where + ".extensions.KHR_materials_transmission.transmissionTexture");
     }
   }
 }
@@ -140,26 +148,32 @@ void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tiny
 // Alpha mode and cutoff, sidedness, and the core textures (baseColor and emissive in sRGB).
 void read_alpha_and_textures(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
                              const std::string& where, Material& m) {
-  if (src.alphaMode == "OPAQUE" || src.alphaMode.empty()) m.alpha_mode = AlphaMode::Opaque;
-  else if (src.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
-  else if (src.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
-  else ctx.fail(where + ".alphaMode", "'" + src.alphaMode + "' is not OPAQUE, MASK or BLEND");
+  if (src.alphaMode == "OPAQUE" || src.alphaMode.empty())
+    m.alpha_mode = AlphaMode::Opaque;
+  else if (src.alphaMode == "MASK")
+    m.alpha_mode = AlphaMode::Mask;
+  else if (src.alphaMode == "BLEND")
+    m.alpha_mode = AlphaMode::Blend;
+  else
+    ctx.fail(where + ".alphaMode", "'" + src.alphaMode + "' is not OPAQUE, MASK or BLEND");
   m.alpha_cutoff = float(finite_or_fail(ctx, src.alphaCutoff, where + ".alphaCutoff"));
   if (m.alpha_cutoff < 0) ctx.fail(where + ".alphaCutoff", "must be >= 0");
   m.double_sided = src.doubleSided;
   const auto& pbr = src.pbrMetallicRoughness;
-  m.base_color_tex = texture_ref(ctx, cache, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                 pbr.baseColorTexture.extensions, true, where + ".pbrMetallicRoughness.baseColorTexture");
+  m.base_color_tex =
+      texture_ref(ctx, cache, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                  pbr.baseColorTexture.extensions, true, where + ".pbrMetallicRoughness.baseColorTexture");
   m.metallic_roughness_tex =
       texture_ref(ctx, cache, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                  pbr.metallicRoughnessTexture.extensions, false, where + ".pbrMetallicRoughness.metallicRoughnessTexture");
+                  pbr.metallicRoughnessTexture.extensions, false,
+                  where + ".pbrMetallicRoughness.metallicRoughnessTexture");
   m.normal_tex = texture_ref(ctx, cache, src.normalTexture.index, src.normalTexture.texCoord,
                              src.normalTexture.extensions, false, where + ".normalTexture");
   m.normal_scale = float(finite_or_fail(ctx, src.normalTexture.scale, where + ".normalTexture.scale"));
   m.occlusion_tex = texture_ref(ctx, cache, src.occlusionTexture.index, src.occlusionTexture.texCoord,
                                 src.occlusionTexture.extensions, false, where + ".occlusionTexture");
-  m.occlusion_strength = float(
-      std::clamp(finite_or_fail(ctx, src.occlusionTexture.strength, where + ".occlusionTexture.strength"), 0.0, 1.0));
+  m.occlusion_strength = float(std::clamp(
+      finite_or_fail(ctx, src.occlusionTexture.strength, where + ".occlusionTexture.strength"), 0.0, 1.0));
   if (max_component(m.emissive) > 0)
     m.emissive_tex = texture_ref(ctx, cache, src.emissiveTexture.index, src.emissiveTexture.texCoord,
                                  src.emissiveTexture.extensions, true, where + ".emissiveTexture");
@@ -173,13 +187,16 @@ void validate_material_textures(const GltfContext& ctx) {
     const auto& m = ctx.model.materials[i];
     const std::pair<const char*, int> refs[] = {
         {"pbrMetallicRoughness.baseColorTexture", m.pbrMetallicRoughness.baseColorTexture.index},
-        {"pbrMetallicRoughness.metallicRoughnessTexture", m.pbrMetallicRoughness.metallicRoughnessTexture.index},
-        {"normalTexture", m.normalTexture.index}, {"occlusionTexture", m.occlusionTexture.index},
+        {"pbrMetallicRoughness.metallicRoughnessTexture",
+         m.pbrMetallicRoughness.metallicRoughnessTexture.index},
+        {"normalTexture", m.normalTexture.index},
+        {"occlusionTexture", m.occlusionTexture.index},
         {"emissiveTexture", m.emissiveTexture.index}};
     for (const auto& [field, index] : refs)
       if (index < -1 || index >= n)
-        ctx.warn(idx("materials", i) + "." + field, "texture index " + std::to_string(index) + " out of range (" +
-                                                       std::to_string(n) + " textures); ignored");
+        ctx.warn(idx("materials", i) + "." + field, "texture index " + std::to_string(index) +
+                                                        " out of range (" + std::to_string(n) +
+                                                        " textures); ignored");
   }
 }
 

@@ -15,7 +15,9 @@ namespace penumbra::gltf {
 
 namespace {
 
-float finite_or_zero(double v) { return std::isfinite(v) ? float(v) : 0.0f; }
+float finite_or_zero(double v) {
+  return std::isfinite(v) ? float(v) : 0.0f;
+}
 
 // The vertex attributes of a primitive as read, before conversion.
 struct RawAttributes {
@@ -25,8 +27,8 @@ struct RawAttributes {
 
 // The triangle list of a primitive (glTF spec 3.7.2.1, "Topology Types") from its indices, or
 // 0..nv-1 without, each index checked against the vertex count.
-std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where,
-                                    size_t nv) {
+std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Primitive& prim,
+                                    const std::string& where, size_t nv) {
   std::vector<uint32_t> raw;
   if (prim.indices >= 0 || prim.indices < -1) {
     raw = read_indices(ctx, prim.indices, where + ".indices");
@@ -39,7 +41,8 @@ std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Prim
   std::vector<uint32_t> tris;
   if (prim.mode == 4) {
     if (raw.size() % 3)
-      ctx.warn(where, "index count " + std::to_string(raw.size()) + " not a multiple of 3; extra indices ignored");
+      ctx.warn(where,
+               "index count " + std::to_string(raw.size()) + " not a multiple of 3; extra indices ignored");
     tris.assign(raw.begin(), raw.begin() + ptrdiff_t(raw.size() / 3 * 3));
   } else if (prim.mode == 5) {
     for (size_t i = 0; i + 2 < raw.size(); ++i) {
@@ -59,7 +62,8 @@ void read_vertex_attributes(const GltfContext& ctx, const tinygltf::Primitive& p
   if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
     raw.nrm = read_accessor(ctx, it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
                             {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-    if (raw.nrm.size() != raw.pos.size()) ctx.fail(where + ".attributes.NORMAL", "count differs from POSITION count");
+    if (raw.nrm.size() != raw.pos.size())
+      ctx.fail(where + ".attributes.NORMAL", "count differs from POSITION count");
   }
   for (const char* name : {"TEXCOORD_0", "TEXCOORD_1"}) {
     auto it = prim.attributes.find(name);
@@ -74,10 +78,12 @@ void read_vertex_attributes(const GltfContext& ctx, const tinygltf::Primitive& p
   if (auto it = prim.attributes.find("TANGENT"); it != prim.attributes.end()) {
     raw.tan = read_accessor(ctx, it->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4},
                             {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-    if (raw.tan.size() / 4 != nv) ctx.fail(where + ".attributes.TANGENT", "count differs from POSITION count");
+    if (raw.tan.size() / 4 != nv)
+      ctx.fail(where + ".attributes.TANGENT", "count differs from POSITION count");
   }
   if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
-    raw.col = read_accessor(ctx, it->second, where + ".attributes.COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4},
+    raw.col = read_accessor(ctx, it->second, where + ".attributes.COLOR_0",
+                            {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4},
                             {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
                             true);
@@ -104,7 +110,8 @@ bool convert_positions_and_normals(const GltfContext& ctx, const RawAttributes& 
   for (size_t i = 0; i < nv; ++i) {
     out.normals[i] = {float(raw.nrm[i * 3]), float(raw.nrm[i * 3 + 1]), float(raw.nrm[i * 3 + 2])};
     if (!is_finite(out.normals[i]) || !(dot(out.normals[i], out.normals[i]) > 0)) {
-      ctx.warn(where + ".attributes.NORMAL", "zero, NaN or infinite normals; computing smooth normals instead");
+      ctx.warn(where + ".attributes.NORMAL",
+               "zero, NaN or infinite normals; computing smooth normals instead");
       out.normals.clear();
       break;
     }
@@ -113,20 +120,21 @@ bool convert_positions_and_normals(const GltfContext& ctx, const RawAttributes& 
 }
 
 // Morph targets: POSITION and NORMAL displacements (glTF 3.7.2.2); non-finite deltas are 0.
-void read_morph_targets(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where, size_t nv,
-                        LocalPrimitive& out) {
+void read_morph_targets(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where,
+                        size_t nv, LocalPrimitive& out) {
   for (size_t ti = 0; ti < prim.targets.size(); ++ti) {
     const std::string tw = where + "." + idx("targets", ti);
     std::vector<Vec3f> dp(nv), dn;
     for (const auto& [name, accessor] : prim.targets[ti]) {
       if (name != "POSITION" && name != "NORMAL") continue;
-      const auto d = read_accessor(ctx, accessor, tw + "." + name, {TINYGLTF_TYPE_VEC3},
-                                   {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT},
-                                   true);
+      const auto d = read_accessor(
+          ctx, accessor, tw + "." + name, {TINYGLTF_TYPE_VEC3},
+          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
       if (d.size() != nv * 3) ctx.fail(tw + "." + name, "count differs from POSITION count");
       auto& dst = name == "POSITION" ? dp : dn;
       dst.resize(nv);
-      for (size_t i = 0; i < nv; ++i) dst[i] = {finite_or_zero(d[i * 3]), finite_or_zero(d[i * 3 + 1]), finite_or_zero(d[i * 3 + 2])};
+      for (size_t i = 0; i < nv; ++i)
+        dst[i] = {finite_or_zero(d[i * 3]), finite_or_zero(d[i * 3 + 1]), finite_or_zero(d[i * 3 + 2])};
     }
     out.target_positions.push_back(std::move(dp));
     out.target_normals.push_back(std::move(dn));
@@ -134,12 +142,13 @@ void read_morph_targets(const GltfContext& ctx, const tinygltf::Primitive& prim,
 }
 
 // Skinning attributes (glTF 3.7.3): JOINTS_0 with WEIGHTS_0, both or neither.
-void read_skin_attributes(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where, size_t nv,
-                          LocalPrimitive& out) {
+void read_skin_attributes(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where,
+                          size_t nv, LocalPrimitive& out) {
   const auto jt = prim.attributes.find("JOINTS_0"), wt = prim.attributes.find("WEIGHTS_0");
   if (jt == prim.attributes.end() || wt == prim.attributes.end()) return;
-  const auto j = read_accessor(ctx, jt->second, where + ".attributes.JOINTS_0", {TINYGLTF_TYPE_VEC4},
-                               {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, false, true);
+  const auto j = read_accessor(
+      ctx, jt->second, where + ".attributes.JOINTS_0", {TINYGLTF_TYPE_VEC4},
+      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, false, true);
   const auto w = read_accessor(ctx, wt->second, where + ".attributes.WEIGHTS_0", {TINYGLTF_TYPE_VEC4},
                                {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
@@ -156,22 +165,25 @@ void read_skin_attributes(const GltfContext& ctx, const tinygltf::Primitive& pri
 }
 
 // Texture coordinates, tangents (cleared with a warning if any is unusable) and colours in [0,1].
-void convert_surface_attributes(const GltfContext& ctx, const RawAttributes& raw, const std::string& where, size_t nv,
-                                LocalPrimitive& out) {
+void convert_surface_attributes(const GltfContext& ctx, const RawAttributes& raw, const std::string& where,
+                                size_t nv, LocalPrimitive& out) {
   if (!raw.uv.empty()) {
     out.uvs.resize(nv);
-    for (size_t i = 0; i < nv; ++i) out.uvs[i] = {finite_or_zero(raw.uv[i * 2]), finite_or_zero(raw.uv[i * 2 + 1])};
+    for (size_t i = 0; i < nv; ++i)
+      out.uvs[i] = {finite_or_zero(raw.uv[i * 2]), finite_or_zero(raw.uv[i * 2 + 1])};
   }
   if (!raw.uv1.empty()) {
     out.uvs1.resize(nv);
-    for (size_t i = 0; i < nv; ++i) out.uvs1[i] = {finite_or_zero(raw.uv1[i * 2]), finite_or_zero(raw.uv1[i * 2 + 1])};
+    for (size_t i = 0; i < nv; ++i)
+      out.uvs1[i] = {finite_or_zero(raw.uv1[i * 2]), finite_or_zero(raw.uv1[i * 2 + 1])};
   }
   if (!raw.tan.empty()) {
     out.tangents.resize(nv);
     for (size_t i = 0; i < nv; ++i) {
       const Vec3f t{float(raw.tan[i * 4]), float(raw.tan[i * 4 + 1]), float(raw.tan[i * 4 + 2])};
       if (!is_finite(t) || !(dot(t, t) > 0) || !std::isfinite(raw.tan[i * 4 + 3])) {
-        ctx.warn(where + ".attributes.TANGENT", "zero, NaN or infinite tangents; generating tangents instead");
+        ctx.warn(where + ".attributes.TANGENT",
+                 "zero, NaN or infinite tangents; generating tangents instead");
         out.tangents.clear();
         break;
       }
@@ -197,7 +209,8 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
     ctx.warn(where, "points/lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
     return out;
   }
-  if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6) ctx.fail(where, "invalid mode " + std::to_string(prim.mode));
+  if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6)
+    ctx.fail(where, "invalid mode " + std::to_string(prim.mode));
   if (prim.material < -1 || prim.material >= int(ctx.model.materials.size()))
     ctx.fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
                                       std::to_string(ctx.model.materials.size()) + " materials)");
@@ -273,7 +286,8 @@ std::vector<Transform> skin_transforms(const GltfContext& ctx, const LocalPrimit
                  "joint " + std::to_string(j) + " >= skin joint count " + std::to_string(joint_mats.size()));
       for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c)
-          b.m[size_t(r)][size_t(c)] += double(wk[k] / (wsum > 0 ? wsum : 1)) * joint_mats[j].m[size_t(r)][size_t(c)];
+          b.m[size_t(r)][size_t(c)] +=
+              double(wk[k] / (wsum > 0 ? wsum : 1)) * joint_mats[j].m[size_t(r)][size_t(c)];
     }
     vertex_xf[i] = wsum > 0 ? b : world;
   }
@@ -297,7 +311,8 @@ void add_tangents(const GltfContext& ctx, const LocalPrimitive& local, const Tra
   } else if (nt.texture >= 0 && !nuv.empty()) {
     out.tangents = compute_tangents(out.positions, out.normals, nuv, out.indices);
   } else if (nt.texture >= 0) {
-    ctx.warn(where, "normal texture without TEXCOORD_" + std::to_string(nt.texcoord) + "; normal map ignored");
+    ctx.warn(where,
+             "normal texture without TEXCOORD_" + std::to_string(nt.texcoord) + "; normal map ignored");
   }
 }
 
@@ -308,7 +323,8 @@ bool place_primitive(const GltfContext& ctx, const LocalPrimitive& local, const 
   const auto& mesh = ctx.model.meshes[size_t(e.mesh)];
   const std::string where = idx("meshes", size_t(e.mesh)) + "." + idx("primitives", pi);
   const std::string node_where = e.node >= 0 ? idx("nodes", size_t(e.node)) : "object space (instanced mesh)";
-  ctx.charge(uint64_t(local.indices.size()) * 4 + uint64_t(local.positions.size()) * 96, where, "a placed copy needs");
+  ctx.charge(uint64_t(local.indices.size()) * 4 + uint64_t(local.positions.size()) * 96, where,
+             "a placed copy needs");
   out.name = (mesh.name.empty() ? idx("meshes", size_t(e.mesh)) : mesh.name) + "[" + std::to_string(pi) + "]";
   out.node = e.node;
   out.material = local.material;
@@ -350,8 +366,9 @@ void emit_primitives(const GltfContext& ctx, const std::vector<LocalPrimitive>& 
                      const Transform& world) {
   Transform inv;
   if (!inverse(world, inv)) return;  // callers skip singular placements
-  const bool flip = !e.joint_mats->empty() ? determinant3x3((*e.joint_mats)[0]) < 0
-                                           : determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
+  const bool flip = !e.joint_mats->empty()
+                        ? determinant3x3((*e.joint_mats)[0]) < 0
+                        : determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
   for (size_t pi = 0; pi < primitives.size(); ++pi) {
     if (!primitives[pi].usable) continue;
     Mesh out;
@@ -415,10 +432,12 @@ std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Tra
     const tinygltf::Value& a = attributes.Get(names[k]);
     if (!a.IsInt()) ctx.fail(aw, "must be an accessor index");
     if (k == 1)
-      values[k] = read_accessor(ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC4},
-                                {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
+      values[k] = read_accessor(
+          ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC4},
+          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
     else
-      values[k] = read_accessor(ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+      values[k] =
+          read_accessor(ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
     const uint64_t n = values[k].size() / (k == 1 ? 4 : 3);
     if (!first.empty() && n != count)
       ctx.fail(aw, "has " + std::to_string(n) + " elements but " + first + " has " + std::to_string(count) +
@@ -439,7 +458,8 @@ std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Tra
     std::array<double, 3> t{0, 0, 0}, sc{1, 1, 1};
     Quat q;
     if (!values[0].empty()) t = {values[0][3 * i], values[0][3 * i + 1], values[0][3 * i + 2]};
-    if (!values[1].empty()) q = {values[1][4 * i], values[1][4 * i + 1], values[1][4 * i + 2], values[1][4 * i + 3]};
+    if (!values[1].empty())
+      q = {values[1][4 * i], values[1][4 * i + 1], values[1][4 * i + 2], values[1][4 * i + 3]};
     if (!values[2].empty()) sc = {values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]};
     out.push_back(world * compose_trs(t, q, sc));  // NodeWorldXform x InstanceXform
   }
@@ -479,8 +499,9 @@ uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>
     bool usable = true;  // world-space corners finite and not huge, as for flattened meshes
     for (const Bounds3f& b : object_bounds) {
       const Bounds3f w = transform_bounds(inst.to_world, b);
-      usable = usable && (b.empty() || (is_finite(w.lo) && is_finite(w.hi) &&
-                                        std::max(max_component(abs(w.lo)), max_component(abs(w.hi))) <= 1e18f));
+      usable =
+          usable && (b.empty() || (is_finite(w.lo) && is_finite(w.hi) &&
+                                   std::max(max_component(abs(w.lo)), max_component(abs(w.hi))) <= 1e18f));
     }
     if (!usable) {
       ++singular;
@@ -497,8 +518,9 @@ uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>
 // A node's mesh placed by `placements` (the node's world transform, or one per
 // EXT_mesh_gpu_instancing instance). shared: stored once in object space and instanced; else
 // one world-space copy per placement (skinned meshes always).
-void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimitive>>& decoded, NodeTransforms& nodes,
-              const MeshUse& use, const std::vector<Transform>& placements, bool shared, ObjectMeshes& objects) {
+void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimitive>>& decoded,
+              NodeTransforms& nodes, const MeshUse& use, const std::vector<Transform>& placements,
+              bool shared, ObjectMeshes& objects) {
   const std::string node_where = idx("nodes", size_t(use.node));
   if (use.mesh < 0 || size_t(use.mesh) >= ctx.model.meshes.size())
     ctx.fail(node_where + ".mesh", "mesh index " + std::to_string(use.mesh) + " out of range (" +
@@ -530,7 +552,8 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
     }
   }
   if (singular == 1 && placements.size() == 1)
-    ctx.warn(node_where, "singular, non-finite or huge transform; mesh " + std::to_string(use.mesh) + " skipped");
+    ctx.warn(node_where,
+             "singular, non-finite or huge transform; mesh " + std::to_string(use.mesh) + " skipped");
   else if (singular > 0)
     ctx.warn(node_where + ".extensions.EXT_mesh_gpu_instancing",
              std::to_string(singular) + " of " + std::to_string(placements.size()) +
@@ -542,7 +565,8 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
 std::vector<std::vector<LocalPrimitive>> decode_meshes(const GltfContext& ctx) {
   std::vector<std::vector<LocalPrimitive>> meshes(ctx.model.meshes.size());
   for (size_t m = 0; m < ctx.model.meshes.size(); ++m)
-    for (size_t p = 0; p < ctx.model.meshes[m].primitives.size(); ++p) meshes[m].push_back(decode_primitive(ctx, m, p));
+    for (size_t p = 0; p < ctx.model.meshes[m].primitives.size(); ++p)
+      meshes[m].push_back(decode_primitive(ctx, m, p));
   return meshes;
 }
 
@@ -560,7 +584,8 @@ void place_meshes(const GltfContext& ctx, const std::vector<std::vector<LocalPri
   }
   ObjectMeshes objects;
   for (size_t k = 0; k < uses.size(); ++k)
-    add_mesh(ctx, decoded, nodes, uses[k], placements[k], !ctx.options.flatten && counts[uses[k].mesh] > 1, objects);
+    add_mesh(ctx, decoded, nodes, uses[k], placements[k], !ctx.options.flatten && counts[uses[k].mesh] > 1,
+             objects);
 }
 
 }  // namespace penumbra::gltf

@@ -26,12 +26,12 @@ struct LocalPrimitive {
   std::vector<Vec3f> positions, normals;  ///< normals empty if absent or unusable
   std::vector<Vec4f> tangents, colors;    ///< empty if absent
   std::vector<Vec2f> uvs, uvs1;
-  std::vector<uint32_t> indices;          ///< triangle list
+  std::vector<uint32_t> indices;                                     ///< triangle list
   std::vector<std::vector<Vec3f>> target_positions, target_normals;  ///< morph target deltas
-  std::vector<std::array<uint16_t, 4>> joints;  ///< JOINTS_0 (skinning), empty if absent
-  std::vector<Vec4f> weights;                   ///< WEIGHTS_0
+  std::vector<std::array<uint16_t, 4>> joints;                       ///< JOINTS_0 (skinning), empty if absent
+  std::vector<Vec4f> weights;                                        ///< WEIGHTS_0
   int material = -1;
-  bool usable = false;                    ///< false: skipped with a warning
+  bool usable = false;  ///< false: skipped with a warning
 };
 
 /// Every primitive of every mesh, [mesh][primitive]. Points and lines, primitives without

@@ -38,7 +38,8 @@ Transform local_transform(const GltfContext& ctx, const NodeTransforms& nodes, i
     if (!std::isfinite(len) || len < 1e-6)
       ctx.fail(where + ".rotation", "is not a unit quaternion (length " + std::to_string(len) + ")");
     if (std::fabs(len - 1) > 1e-3)
-      ctx.warn(where + ".rotation", "quaternion not normalised (length " + std::to_string(len) + "); normalising");
+      ctx.warn(where + ".rotation",
+               "quaternion not normalised (length " + std::to_string(len) + "); normalising");
   }
   if (size_t(node) < nodes.poses->size()) {
     const NodePose& pose = (*nodes.poses)[size_t(node)];
@@ -66,7 +67,8 @@ void add_camera(const GltfContext& ctx, int camera_index, int node, const Transf
   const Vec3f w = normalize(transform_vector(world, {0, 0, 1}));
   Vec3f u = transform_vector(world, {1, 0, 0});
   u = normalize(u - w * dot(u, w));
-  if (!(dot(w, w) > 0) || !(dot(u, u) > 0) || !is_finite(cam.eye)) ctx.fail(node_where, "camera transform is singular");
+  if (!(dot(w, w) > 0) || !(dot(u, u) > 0) || !is_finite(cam.eye))
+    ctx.fail(node_where, "camera transform is singular");
   cam.w = w;
   cam.u = u;
   cam.v = cross(w, u);
@@ -99,7 +101,8 @@ void add_light(const GltfContext& ctx, int light_index, int node, const Transfor
   const auto& src = ctx.model.lights[size_t(light_index)];
   Light l;
   l.name = src.name.empty() ? "lights[" + std::to_string(light_index) + "]" : src.name;
-  l.type = src.type == "point" ? LightType::Point : (src.type == "spot" ? LightType::Spot : LightType::Directional);
+  l.type = src.type == "point" ? LightType::Point
+                               : (src.type == "spot" ? LightType::Spot : LightType::Directional);
   if (src.color.size() == 3) l.color = {float(src.color[0]), float(src.color[1]), float(src.color[2])};
   l.intensity = float(src.intensity);
   l.range = src.range > 0 ? float(src.range) : kInfinity;
@@ -107,7 +110,8 @@ void add_light(const GltfContext& ctx, int light_index, int node, const Transfor
   l.outer_cone = float(src.spot.outerConeAngle);
   l.position = transform_point(world, {0, 0, 0});
   l.direction = normalize(transform_vector(world, {0, 0, -1}));
-  if (l.type != LightType::Point && !(dot(l.direction, l.direction) > 0)) ctx.fail(node_where, "light transform is singular");
+  if (l.type != LightType::Point && !(dot(l.direction, l.direction) > 0))
+    ctx.fail(node_where, "light transform is singular");
   ctx.out.scene.lights.push_back(l);
 }
 
@@ -124,7 +128,8 @@ void validate_cameras(const GltfContext& ctx) {
     if (c.type == "perspective") {
       const auto& p = c.perspective;
       positive(p.yfov, "perspective.yfov");
-      if (p.yfov >= kPi) ctx.fail(where, "perspective.yfov must be < pi (got " + std::to_string(p.yfov) + ")");
+      if (p.yfov >= kPi)
+        ctx.fail(where, "perspective.yfov must be < pi (got " + std::to_string(p.yfov) + ")");
       positive(p.znear, "perspective.znear");
       if (p.aspectRatio != 0) positive(p.aspectRatio, "perspective.aspectRatio");
       if (p.zfar != 0) {
@@ -155,7 +160,8 @@ void validate_lights(const GltfContext& ctx) {
       for (double v : l.color)
         if (!(std::isfinite(v) && v >= 0)) ctx.fail(where + ".color", "values must be finite and >= 0");
     }
-    if (!(std::isfinite(l.intensity) && l.intensity >= 0)) ctx.fail(where + ".intensity", "must be finite and >= 0");
+    if (!(std::isfinite(l.intensity) && l.intensity >= 0))
+      ctx.fail(where + ".intensity", "must be finite and >= 0");
     if (!(std::isfinite(l.range) && l.range >= 0)) ctx.fail(where + ".range", "must be finite and > 0");
     if (l.type == "spot") {
       const double in = l.spot.innerConeAngle, out = l.spot.outerConeAngle;
@@ -170,8 +176,9 @@ std::vector<int> scene_roots(const GltfContext& ctx) {
   const int asked = ctx.options.scene;
   int scene = asked >= 0 ? asked : model.defaultScene;
   if (asked >= 0 && size_t(asked) >= model.scenes.size())
-    throw InputError(ctx.file, "--scene", "scene " + std::to_string(asked) + " does not exist (" +
-                                              std::to_string(model.scenes.size()) + " scenes)");
+    throw InputError(ctx.file, "--scene",
+                     "scene " + std::to_string(asked) + " does not exist (" +
+                         std::to_string(model.scenes.size()) + " scenes)");
   if (scene >= int(model.scenes.size()) || scene < -1)
     ctx.fail("scene", "default scene " + std::to_string(scene) + " out of range (" +
                           std::to_string(model.scenes.size()) + " scenes)");
@@ -199,8 +206,9 @@ NodeTransforms link_nodes(const GltfContext& ctx, const std::vector<NodePose>& p
                  "node index " + std::to_string(c) + " out of range (" + std::to_string(n) + " nodes)");
       if (size_t(c) == i) ctx.fail(idx("nodes", i) + ".children", "node is its own child");
       if (parent[size_t(c)] >= 0)
-        ctx.fail(idx("nodes", size_t(c)), "has more than one parent (nodes[" + std::to_string(parent[size_t(c)]) +
-                                              "] and nodes[" + std::to_string(i) + "])");
+        ctx.fail(idx("nodes", size_t(c)), "has more than one parent (nodes[" +
+                                              std::to_string(parent[size_t(c)]) + "] and nodes[" +
+                                              std::to_string(i) + "])");
       parent[size_t(c)] = int(i);
     }
   }
@@ -235,25 +243,30 @@ NodeTransforms link_nodes(const GltfContext& ctx, const std::vector<NodePose>& p
 const Transform& world_transform(const GltfContext& ctx, NodeTransforms& nodes, int node) {
   // Walk up to the first ancestor with a known world transform (or a root), then down.
   std::vector<int> chain;
-  for (int cur = node; cur >= 0 && !nodes.known[size_t(cur)]; cur = nodes.parent[size_t(cur)]) chain.push_back(cur);
+  for (int cur = node; cur >= 0 && !nodes.known[size_t(cur)]; cur = nodes.parent[size_t(cur)])
+    chain.push_back(cur);
   for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
     const int p = nodes.parent[size_t(*it)];
-    const Transform world = (p >= 0 ? nodes.world[size_t(p)] : Transform{}) * local_transform(ctx, nodes, *it);
-    if (!is_finite(world)) ctx.fail(idx("nodes", size_t(*it)), "world transform overflows to non-finite values");
+    const Transform world =
+        (p >= 0 ? nodes.world[size_t(p)] : Transform{}) * local_transform(ctx, nodes, *it);
+    if (!is_finite(world))
+      ctx.fail(idx("nodes", size_t(*it)), "world transform overflows to non-finite values");
     nodes.world[size_t(*it)] = world;
     nodes.known[size_t(*it)] = 1;
   }
   return nodes.world[size_t(node)];
 }
 
-std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes, const std::vector<int>& roots) {
+std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes,
+                                 const std::vector<int>& roots) {
   const size_t n = ctx.model.nodes.size();
   std::set<int> seen_roots;
   std::vector<int> stack;
   for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
     const int r = *it;
     if (r < 0 || size_t(r) >= n)
-      ctx.fail("scenes.nodes", "node index " + std::to_string(r) + " out of range (" + std::to_string(n) + " nodes)");
+      ctx.fail("scenes.nodes",
+               "node index " + std::to_string(r) + " out of range (" + std::to_string(n) + " nodes)");
     if (nodes.parent[size_t(r)] >= 0)
       ctx.fail(idx("nodes", size_t(r)), "is listed as a scene root but is a child of nodes[" +
                                             std::to_string(nodes.parent[size_t(r)]) + "]");

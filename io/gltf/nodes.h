@@ -13,8 +13,8 @@ namespace penumbra::gltf {
 
 /// Parent links and the world transforms computed so far.
 struct NodeTransforms {
-  std::vector<int> parent;          ///< per node, -1 for a root
-  std::vector<Transform> world;     ///< per node, valid where `known`
+  std::vector<int> parent;       ///< per node, -1 for a root
+  std::vector<Transform> world;  ///< per node, valid where `known`
   std::vector<uint8_t> known;
   const std::vector<NodePose>* poses = nullptr;  ///< animated TRS overrides (may be empty)
 };
@@ -41,6 +41,7 @@ const Transform& world_transform(const GltfContext& ctx, NodeTransforms& nodes, 
 
 /// Walks the scene depth-first from `roots` (checked: in range, parentless, listed once),
 /// placing cameras and lights into ctx.out.scene; returns the nodes with meshes in visit order.
-std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes, const std::vector<int>& roots);
+std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes,
+                                 const std::vector<int>& roots);
 
 }  // namespace penumbra::gltf

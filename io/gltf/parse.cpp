@@ -83,7 +83,8 @@ void charge_elements(const nlohmann::json& doc, MemoryBudget& budget) {
 
 // Reads the scene file. Before the whole file is read, the JSON text's parsed size is charged
 // (from the file size, or a GLB's JSON chunk length), and a GLB's binary rest.
-std::vector<unsigned char> read_scene_file(const fs::path& file, uint64_t max_file_bytes, MemoryBudget& budget) {
+std::vector<unsigned char> read_scene_file(const fs::path& file, uint64_t max_file_bytes,
+                                           MemoryBudget& budget) {
   const std::string name = file.string();
   const uint64_t size = check_input_file(file, "", max_file_bytes);
   const std::vector<unsigned char> head = read_input_file(file, "", max_file_bytes, 20);
@@ -126,7 +127,8 @@ void resolve_external_files(const nlohmann::json& doc, const std::string& file, 
       const ResolvedUri r = resolve_uri(uri, root, options.allow_external_uris, options.max_file_bytes);
       std::string problem;
       if (!r.refusal.empty()) problem = r.by_policy ? r.refusal : "cannot be read: " + r.refusal;
-      const uint64_t declared = is_buffer && element.contains("byteLength") ? element["byteLength"].get<uint64_t>() : 0;
+      const uint64_t declared =
+          is_buffer && element.contains("byteLength") ? element["byteLength"].get<uint64_t>() : 0;
       if (problem.empty() && is_buffer && r.size != declared)
         problem = "names '" + r.path.string() + "', a file of " + std::to_string(r.size) +
                   " bytes, but the buffer's byteLength is " + std::to_string(declared);
@@ -194,8 +196,9 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
     for (auto& w : glb.warnings) out.warnings.push_back(std::move(w));
   }
   if (json_nesting_depth(json, options.max_json_depth) > options.max_json_depth)
-    throw InputError(name, "JSON", "nesting deeper than " + std::to_string(options.max_json_depth) +
-                                       " levels (refused before parsing)");
+    throw InputError(
+        name, "JSON",
+        "nesting deeper than " + std::to_string(options.max_json_depth) + " levels (refused before parsing)");
 
   std::error_code ec;
   const fs::path root = fs::weakly_canonical(fs::absolute(file).parent_path(), ec);
@@ -211,9 +214,11 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   std::string terr, twarn;
   bool ok = false;
   try {
-    ok = is_glb ? parser.LoadBinaryFromMemory(&model, &terr, &twarn, bytes.data(), unsigned(parse_bytes), root.string())
-                : parser.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(bytes.data()),
-                                             unsigned(bytes.size()), root.string());
+    ok = is_glb
+             ? parser.LoadBinaryFromMemory(&model, &terr, &twarn, bytes.data(), unsigned(parse_bytes),
+                                           root.string())
+             : parser.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(bytes.data()),
+                                          unsigned(bytes.size()), root.string());
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while parsing (file too large or malformed)");
   } catch (const std::exception& e) {

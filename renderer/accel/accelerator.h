@@ -35,20 +35,20 @@ struct InstanceView {
 /// does not expose its node counts). For the grid, "nodes" and "leaves" are cells.
 struct AccelStats {
   std::string name;
-  std::string config;            ///< the build parameters, human readable
-  uint64_t triangles = 0;        ///< triangles given to the builder (each stored mesh once)
-  uint64_t instances = 0;        ///< placements under a top level (0: single level)
-  uint64_t nodes = 0;            ///< all nodes (interior + leaves), or grid cells
-  uint64_t leaves = 0;           ///< leaves, or grid cells
-  uint64_t empty_leaves = 0;     ///< leaves or cells with no triangle
-  uint64_t references = 0;       ///< triangle references summed over leaves/cells
-  uint64_t max_leaf_prims = 0;   ///< largest leaf or cell
-  double avg_leaf_prims = 0;     ///< references / non-empty leaves
-  uint64_t max_depth = 0;        ///< deepest leaf (root = depth 0)
-  double sah_cost = 0;           ///< SAH cost of the tree with the builder's constants (0: n/a);
-                                 ///< two levels: top nodes at 1 plus each instance's bottom cost
-                                 ///< weighted by the area of its world box
-  uint64_t bytes = 0;            ///< memory held by the structure
+  std::string config;           ///< the build parameters, human readable
+  uint64_t triangles = 0;       ///< triangles given to the builder (each stored mesh once)
+  uint64_t instances = 0;       ///< placements under a top level (0: single level)
+  uint64_t nodes = 0;           ///< all nodes (interior + leaves), or grid cells
+  uint64_t leaves = 0;          ///< leaves, or grid cells
+  uint64_t empty_leaves = 0;    ///< leaves or cells with no triangle
+  uint64_t references = 0;      ///< triangle references summed over leaves/cells
+  uint64_t max_leaf_prims = 0;  ///< largest leaf or cell
+  double avg_leaf_prims = 0;    ///< references / non-empty leaves
+  uint64_t max_depth = 0;       ///< deepest leaf (root = depth 0)
+  double sah_cost = 0;          ///< SAH cost of the tree with the builder's constants (0: n/a);
+                                ///< two levels: top nodes at 1 plus each instance's bottom cost
+                                ///< weighted by the area of its world box
+  uint64_t bytes = 0;           ///< memory held by the structure
   double build_seconds = 0;
 };
 

@@ -33,8 +33,7 @@ class BruteAccelerator final : public Accelerator {
       const auto& m = m_meshes[g];
       for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
         float t, u, v;
-        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]],
-                                          m.positions[m.indices[i + 1]],
+        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
                                           m.positions[m.indices[i + 2]], tfar, t, u, v)) {
           tfar = t;
           hit = {t, u, v, g, uint32_t(i / 3)};
@@ -50,8 +49,7 @@ class BruteAccelerator final : public Accelerator {
     for (const auto& m : m_meshes)
       for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
         float t, u, v;
-        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]],
-                                          m.positions[m.indices[i + 1]],
+        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
                                           m.positions[m.indices[i + 2]], ray.tfar, t, u, v))
           return true;
       }

@@ -6,7 +6,6 @@
 // Dammertz, Hanika & Keller, "Shallow Bounding Volume Hierarchies for Fast SIMD Ray Tracing of
 // Incoherent Rays", EGSR 2008.
 #include "renderer/accel/bvh.h"
-#include "renderer/accel/bvh_build.h"
 
 #include <tbb/parallel_invoke.h>
 #include <xmmintrin.h>
@@ -18,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/accel/bvh_build.h"
 #include "renderer/accel/common.h"
 #include "renderer/accel/stats.h"
 
@@ -28,11 +28,11 @@ namespace {
 /// register holds the same bound of all four children. Unused slots have an empty box
 /// (lo = +inf, hi = -inf), which no ray meets.
 struct alignas(64) Bvh4Node {
-  float lo[3][4];      // 48 bytes: lo[axis][child]
-  float hi[3][4];      // 48 bytes: hi[axis][child]
-  uint32_t child[4];   // 16 bytes: interior child: node index; leaf: first triangle
-  uint8_t count[4];    //  4 bytes: 0 = interior child (or unused slot), else triangles in the leaf
-  uint32_t pad[3];     // 12 bytes: unused
+  float lo[3][4];     // 48 bytes: lo[axis][child]
+  float hi[3][4];     // 48 bytes: hi[axis][child]
+  uint32_t child[4];  // 16 bytes: interior child: node index; leaf: first triangle
+  uint8_t count[4];   //  4 bytes: 0 = interior child (or unused slot), else triangles in the leaf
+  uint32_t pad[3];    // 12 bytes: unused
 };
 static_assert(sizeof(Bvh4Node) == 128, "Bvh4Node must stay 128 bytes");
 
@@ -94,7 +94,7 @@ class Builder {
 
  private:
   static std::unique_ptr<BvhBuildNode> make_leaf(std::unique_ptr<BvhBuildNode> node, uint32_t begin,
-                                              uint32_t n) {
+                                                 uint32_t n) {
     node->first = begin;
     node->count = n;
     return node;
@@ -153,8 +153,8 @@ class Builder {
     if (best_axis < 0) return false;
     // Phase 3: compare with a leaf, C = Ct + Ci (A_L N_L + A_R N_R) / A.
     const float area = surface_area(box);
-    const float split_cost = m_config.traversal_cost +
-                             m_config.intersection_cost * (area > 0 ? best_cost / area : float(n));
+    const float split_cost =
+        m_config.traversal_cost + m_config.intersection_cost * (area > 0 ? best_cost / area : float(n));
     const float leaf_cost = m_config.intersection_cost * float(n);
     if (n <= uint32_t(m_config.max_leaf_size) && leaf_cost <= split_cost) return false;
     // Phase 4: partition the references by bin.
@@ -235,14 +235,16 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = make_stats(
-        m_stats, "bvh",
-        "width " + std::to_string(m_config.width) + ", max_leaf_size " + std::to_string(m_config.max_leaf_size) +
-            ", bin_count " + std::to_string(m_config.bin_count) + ", traversal_cost " +
-            format_number(m_config.traversal_cost) + ", intersection_cost " + format_number(m_config.intersection_cost),
-        m_input_triangles,
-        m_nodes.size() * sizeof(BvhNode) + m_nodes4.size() * sizeof(Bvh4Node) + m_tris.size() * sizeof(TriangleRecord),
-        m_build_seconds);
+    AccelStats s = make_stats(m_stats, "bvh",
+                              "width " + std::to_string(m_config.width) + ", max_leaf_size " +
+                                  std::to_string(m_config.max_leaf_size) + ", bin_count " +
+                                  std::to_string(m_config.bin_count) + ", traversal_cost " +
+                                  format_number(m_config.traversal_cost) + ", intersection_cost " +
+                                  format_number(m_config.intersection_cost),
+                              m_input_triangles,
+                              m_nodes.size() * sizeof(BvhNode) + m_nodes4.size() * sizeof(Bvh4Node) +
+                                  m_tris.size() * sizeof(TriangleRecord),
+                              m_build_seconds);
     s.nodes = m_config.width == 2 ? m_nodes.size() : m_nodes4.size() + m_tally.leaves;
     return s;
   }
@@ -253,7 +255,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
-    return m_config.width == 2 ? traverse2(ray, best, visit, counter) : traverse4<AnyHit>(ray, best, visit, counter);
+    return m_config.width == 2 ? traverse2(ray, best, visit, counter)
+                               : traverse4<AnyHit>(ray, best, visit, counter);
   }
 
   /// 4-wide traversal: the four child boxes are slab-tested at once; the children met are
@@ -373,12 +376,13 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   bool traverse2(const Ray& ray, const float& best, Visit& visit, const Counter& counter) const {
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid) return false;
-    return walk_bvh(m_nodes, prepare_box_query(ray), w.tnear, best, [&] { counter.node(); },
-                    [&](uint32_t first, uint32_t count) {
-                      for (uint32_t i = first, e = first + count; i < e; ++i)
-                        if (visit(w, m_tris[i])) return true;
-                      return false;
-                    });
+    return walk_bvh(
+        m_nodes, prepare_box_query(ray), w.tnear, best, [&] { counter.node(); },
+        [&](uint32_t first, uint32_t count) {
+          for (uint32_t i = first, e = first + count; i < e; ++i)
+            if (visit(w, m_tris[i])) return true;
+          return false;
+        });
   }
 
   /// Emits the 4-wide node for interior binary node `b`: its children, with the interior child
@@ -472,7 +476,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
 
 void validate(const BvhConfig& c) {
   if (c.max_leaf_size < 1 || c.max_leaf_size > 255)
-    throw std::invalid_argument("bvh: max_leaf_size must be in [1, 255], got " + std::to_string(c.max_leaf_size));
+    throw std::invalid_argument("bvh: max_leaf_size must be in [1, 255], got " +
+                                std::to_string(c.max_leaf_size));
   if (c.bin_count < 2 || c.bin_count > 256)
     throw std::invalid_argument("bvh: bin_count must be in [2, 256], got " + std::to_string(c.bin_count));
   if (c.width != 2 && c.width != 4)

@@ -16,12 +16,12 @@ namespace penumbra {
 
 /// BVH build parameters. Costs are relative; only their ratio matters.
 struct BvhConfig {
-  int max_leaf_size = 8;          ///< [1, 255]: nodes with more triangles are always split
-  int bin_count = 16;             ///< [2, 256]: SAH bins per axis (Wald 2007 uses 16-32)
-  float traversal_cost = 1.0f;    ///< > 0: cost of visiting one node (3 suits big dense meshes, see RESULTS.md)
-  float intersection_cost = 1.0f; ///< > 0: cost of one triangle test
+  int max_leaf_size = 8;        ///< [1, 255]: nodes with more triangles are always split
+  int bin_count = 16;           ///< [2, 256]: SAH bins per axis (Wald 2007 uses 16-32)
+  float traversal_cost = 1.0f;  ///< > 0: cost of visiting one node (3 suits big dense meshes, see RESULTS.md)
+  float intersection_cost = 1.0f;    ///< > 0: cost of one triangle test
   size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks
-  int width = 4;                  ///< 2 (binary nodes) or 4 (4-wide nodes, SSE box tests)
+  int width = 4;                     ///< 2 (binary nodes) or 4 (4-wide nodes, SSE box tests)
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.

@@ -5,9 +5,9 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <type_traits>
-#include <span>
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
@@ -85,8 +85,7 @@ inline constexpr float kSlabPad = 1.0f + 4 * 3 * 0.5f * 1.1920929e-7f;
 /// narrows t0/t1 to the entry and exit distances and returns true. A ray parallel to a slab
 /// (direction component 0, so 1/d is infinite) overlaps it iff its origin lies within it, faces
 /// included: the IEEE arithmetic alone would give NaN there (0 * inf).
-inline bool intersect_box(const Vec3f& lo, const Vec3f& hi, const RayBoxQuery& q, float& t0,
-                          float& t1) {
+inline bool intersect_box(const Vec3f& lo, const Vec3f& hi, const RayBoxQuery& q, float& t0, float& t1) {
   for (int k = 0; k < 3; ++k) {
     if (std::isinf(q.inv_dir[k])) {
       if (q.org[k] < lo[k] || q.org[k] > hi[k]) return false;
@@ -106,11 +105,13 @@ inline bool intersect_box(const Vec3f& lo, const Vec3f& hi, const RayBoxQuery& q
 
 /// Pads a positive distance upward by the slab margin (used when a traversal compares a hit
 /// distance with a cell or node exit distance).
-inline float pad_up(float t) { return t * kSlabPad; }
+inline float pad_up(float t) {
+  return t * kSlabPad;
+}
 
 /// Closest-hit leaf loop: tests `tris[refs[i]]` and narrows `tfar`. Returns true on any hit.
-inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri,
-                           float& tfar, Hit& hit) {
+inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri, float& tfar,
+                           Hit& hit) {
   float t, u, v;
   if (!intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, tfar, t, u, v)) return false;
   tfar = t;
@@ -154,7 +155,8 @@ class TraversalAccelerator : public Accelerator {
   bool occluded(const Ray& ray) const final {
     const float tfar = ray.tfar;
     return static_cast<const Derived*>(this)->traverse(
-        ray, tfar, [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); },
+        ray, tfar,
+        [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); },
         NoCount{}, std::true_type{});
   }
 

@@ -1,7 +1,6 @@
 // Embree 3 back end. Embree reports errors through a C callback, which only records them;
 // the build function converts a recorded error into an exception at this one boundary.
 #include "renderer/accel/embree.h"
-#include "renderer/accel/stats.h"
 
 #include <embree3/rtcore.h>
 
@@ -13,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 namespace {
@@ -75,10 +76,10 @@ void throw_if_error(const char* what) {
 void attach_triangles(RTCScene scene, const TriangleMeshView& mesh, unsigned id) {
   RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_TRIANGLE);
   const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, nv ? nv : 1));
-  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, nt ? nt : 1));
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        sizeof(float) * 3, nv ? nv : 1));
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             sizeof(uint32_t) * 3, nt ? nt : 1));
   if (!v || !idx) {
     rtcReleaseGeometry(geom);
     throw_if_error("allocating geometry buffers");
@@ -194,7 +195,9 @@ class EmbreeAccelerator final : public Accelerator {
     AccelStats s;
     s.name = "embree";
     s.config = std::string("robust ") + (m_config.robust ? "1" : "0") + ", quality " +
-               (m_config.quality == 0 ? "low" : m_config.quality == 1 ? "medium" : "high");
+               (m_config.quality == 0   ? "low"
+                : m_config.quality == 1 ? "medium"
+                                        : "high");
     s.triangles = m_triangles;
     s.instances = m_instances;
     s.bytes = m_bytes;
@@ -223,7 +226,8 @@ class EmbreeAccelerator final : public Accelerator {
     RTCScene scene = rtcNewScene(device());
     throw_if_error("rtcNewScene");
     if (m_config.robust) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH};
+    const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM,
+                                       RTC_BUILD_QUALITY_HIGH};
     rtcSetSceneBuildQuality(scene, quality[m_config.quality]);
     return scene;
   }
@@ -242,7 +246,8 @@ class EmbreeAccelerator final : public Accelerator {
 
 void validate(const EmbreeConfig& c) {
   if (c.quality < 0 || c.quality > 2)
-    throw std::invalid_argument("embree: quality must be 0 (low), 1 (medium) or 2 (high), got " + std::to_string(c.quality));
+    throw std::invalid_argument("embree: quality must be 0 (low), 1 (medium) or 2 (high), got " +
+                                std::to_string(c.quality));
 }
 
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
@@ -260,8 +265,7 @@ std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMes
 
 std::string embree_version() {
   const auto v = rtcGetDeviceProperty(device(), RTC_DEVICE_PROPERTY_VERSION);
-  return std::to_string(v / 10000) + "." + std::to_string((v / 100) % 100) + "." +
-         std::to_string(v % 100);
+  return std::to_string(v / 10000) + "." + std::to_string((v / 100) % 100) + "." + std::to_string(v % 100);
 }
 
 }  // namespace penumbra

@@ -10,7 +10,9 @@
 
 namespace penumbra {
 
-std::vector<std::string> accelerator_names() { return {"embree", "bvh", "kdtree", "grid", "brute"}; }
+std::vector<std::string> accelerator_names() {
+  return {"embree", "bvh", "kdtree", "grid", "brute"};
+}
 
 namespace {
 
@@ -22,8 +24,7 @@ namespace {
 
 }  // namespace
 
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
-                                              std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
                                               const AccelConfig& config) {
   if (name == "embree") return make_embree_accelerator(meshes, config.embree);
   if (name == "bvh") return make_bvh_accelerator(meshes, config.bvh);
@@ -33,14 +34,14 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
   throw_unknown(name);
 }
 
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name,
-                                              std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
                                               std::span<const InstanceView> instances,
                                               const AccelConfig& config) {
   validate_instances(instances, meshes.size());
   if (name == "embree") return make_embree_accelerator(meshes, instances, config.embree);
   // A flattened scene (every placement the identity) is one level: geom_id = instance index.
-  if (std::all_of(instances.begin(), instances.end(), [](const InstanceView& i) { return is_identity(i.to_world); })) {
+  if (std::all_of(instances.begin(), instances.end(),
+                  [](const InstanceView& i) { return is_identity(i.to_world); })) {
     std::vector<TriangleMeshView> views;
     views.reserve(instances.size());
     for (const auto& i : instances) views.push_back(meshes[i.mesh]);

@@ -85,10 +85,10 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     char config[160];
     std::snprintf(config, sizeof config, "lambda %g, resolution %ux%ux%u", double(m_config.lambda), m_res[0],
                   m_res[1], m_res[2]);
-    return make_stats(
-        m_stats, "grid", config, m_input_triangles,
-        m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) + m_tris.size() * sizeof(TriangleRecord),
-        m_build_seconds);
+    return make_stats(m_stats, "grid", config, m_input_triangles,
+                      m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
+                          m_tris.size() * sizeof(TriangleRecord),
+                      m_build_seconds);
   }
 
  private:
@@ -111,9 +111,9 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     for (int k = 0; k < 3; ++k) {
       const double o = ray.org[k], d = ray.dir[k];
       const double p = o + d * double(std::max(t0, 0.0f));
-      cell[k] = m_cell_size[k] > 0 ? int(std::clamp(std::floor((p - m_lo[k]) / m_cell_size[k]), 0.0,
-                                                    double(m_res[k] - 1)))
-                                   : 0;
+      cell[k] = m_cell_size[k] > 0
+                    ? int(std::clamp(std::floor((p - m_lo[k]) / m_cell_size[k]), 0.0, double(m_res[k] - 1)))
+                    : 0;
       if (d > 0) {
         step[k] = 1;
         out[k] = int(m_res[k]);
@@ -170,7 +170,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
       uint64_t cells = 1;
       for (int k = 0; k < 3; ++k) {
         const bool flat = !(ext[k] > 1e-7 * max_ext);
-        m_res[k] = flat ? 1u : uint32_t(std::clamp(std::ceil(ext[k] / s), 1.0, double(m_config.max_resolution)));
+        m_res[k] =
+            flat ? 1u : uint32_t(std::clamp(std::ceil(ext[k] / s), 1.0, double(m_config.max_resolution)));
         cells *= m_res[k];
       }
       // Too many cells, or (for scenes of large overlapping triangles) too many candidate
@@ -200,8 +201,10 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
           continue;
         }
         const int last = int(m_res[k]) - 1;
-        lo[k] = int(std::clamp(std::floor((b.lo[k] - margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
-        hi[k] = int(std::clamp(std::floor((b.hi[k] + margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
+        lo[k] =
+            int(std::clamp(std::floor((b.lo[k] - margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
+        hi[k] =
+            int(std::clamp(std::floor((b.hi[k] + margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
       }
     };
     auto for_each_cell = [&](const TriangleRecord& t, auto&& f) {
@@ -274,8 +277,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   std::vector<TriangleRecord> m_tris;
   std::vector<uint32_t> m_offsets;  // per cell (x fastest): first reference; ncells + 1 entries
   std::vector<uint32_t> m_refs;     // triangle indices, grouped by cell
-  Bounds3f m_bounds;  // exact bounds of the triangles
-  Bounds3f m_grid;    // the grid's box: m_bounds widened by the rounding band
+  Bounds3f m_bounds;                // exact bounds of the triangles
+  Bounds3f m_grid;                  // the grid's box: m_bounds widened by the rounding band
   double m_lo[3] = {0, 0, 0}, m_cell_size[3] = {0, 0, 0};
   uint32_t m_res[3] = {0, 0, 0};
   uint64_t m_input_triangles = 0;

@@ -58,9 +58,8 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
   bool occluded(const Ray& ray) const override {
-    return walk(ray, ray.tfar, nullptr, [&](const Item& item, const Ray& local) {
-      return m_levels[item.level]->occluded(local);
-    });
+    return walk(ray, ray.tfar, nullptr,
+                [&](const Item& item, const Ray& local) { return m_levels[item.level]->occluded(local); });
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -83,7 +82,8 @@ class TwoLevelAccelerator final : public Accelerator {
       bottom_depth = std::max(bottom_depth, b.max_depth);
       s.bytes += b.bytes;
     }
-    s.avg_leaf_prims = s.leaves > s.empty_leaves ? double(s.references) / double(s.leaves - s.empty_leaves) : 0;
+    s.avg_leaf_prims =
+        s.leaves > s.empty_leaves ? double(s.references) / double(s.leaves - s.empty_leaves) : 0;
     s.nodes += m_nodes.size();
     s.max_depth = m_top_depth + bottom_depth;
     s.sah_cost = m_sah_cost;
@@ -99,7 +99,7 @@ class TwoLevelAccelerator final : public Accelerator {
     uint32_t level;     // index into m_levels
     uint32_t instance;  // the instance index reported in hits, or kWorld
     Affine3f to_object;
-    Bounds3f box;       // world bounds
+    Bounds3f box;  // world bounds
   };
 
   void build_top() {
@@ -142,23 +142,24 @@ class TwoLevelAccelerator final : public Accelerator {
   template <typename Query>
   bool walk(const Ray& ray, const float& best, TraversalCost* cost, Query&& query) const {
     if (!is_valid_query(ray)) return false;
-    return walk_bvh(m_nodes, prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
-                    [&] {
-                      if (cost) ++cost->nodes;
-                    },
-                    [&](uint32_t first, uint32_t count) {
-                      for (uint32_t i = first, e = first + count; i < e; ++i) {
-                        const Item& item = m_items[i];
-                        Ray local = ray;
-                        local.tfar = best;
-                        if (item.instance != kWorld) {
-                          local.org = apply_point(item.to_object, ray.org);
-                          local.dir = apply_vector(item.to_object, ray.dir);
-                        }
-                        if (query(item, local)) return true;
-                      }
-                      return false;
-                    });
+    return walk_bvh(
+        m_nodes, prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
+        [&] {
+          if (cost) ++cost->nodes;
+        },
+        [&](uint32_t first, uint32_t count) {
+          for (uint32_t i = first, e = first + count; i < e; ++i) {
+            const Item& item = m_items[i];
+            Ray local = ray;
+            local.tfar = best;
+            if (item.instance != kWorld) {
+              local.org = apply_point(item.to_object, ray.org);
+              local.dir = apply_vector(item.to_object, ray.dir);
+            }
+            if (query(item, local)) return true;
+          }
+          return false;
+        });
   }
 
   bool closest(const Ray& ray, Hit& hit, TraversalCost* cost) const {
@@ -177,9 +178,9 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
   std::vector<std::unique_ptr<Accelerator>> m_levels;  // bottom levels: per mesh, then world
-  std::vector<uint32_t> m_world_ids;  // world level's geom_id -> instance index
-  std::vector<Item> m_items;          // in top-level leaf order
-  std::vector<BvhNode> m_nodes;       // top level, depth first
+  std::vector<uint32_t> m_world_ids;                   // world level's geom_id -> instance index
+  std::vector<Item> m_items;                           // in top-level leaf order
+  std::vector<BvhNode> m_nodes;                        // top level, depth first
   std::vector<AccelStats> m_stats_bottom;
   Bounds3f m_bounds;
   uint64_t m_instances = 0;
@@ -193,8 +194,9 @@ class TwoLevelAccelerator final : public Accelerator {
 void validate_instances(std::span<const InstanceView> instances, size_t mesh_count) {
   for (size_t i = 0; i < instances.size(); ++i)
     if (instances[i].mesh >= mesh_count)
-      throw std::invalid_argument("instance " + std::to_string(i) + ": mesh " + std::to_string(instances[i].mesh) +
-                                  " out of range (" + std::to_string(mesh_count) + " meshes)");
+      throw std::invalid_argument("instance " + std::to_string(i) + ": mesh " +
+                                  std::to_string(instances[i].mesh) + " out of range (" +
+                                  std::to_string(mesh_count) + " meshes)");
 }
 
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,

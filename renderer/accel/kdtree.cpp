@@ -24,9 +24,9 @@ namespace {
 /// Flattened node, 8 bytes. The child below the split is the next node in the array.
 struct KdNode {
   union {
-    float split;          // 4 bytes: interior: split position along `axis`
-    uint32_t one_prim;    //          leaf with one triangle: its index
-    uint32_t prim_offset; //          leaf with several: first entry in the reference array
+    float split;           // 4 bytes: interior: split position along `axis`
+    uint32_t one_prim;     //          leaf with one triangle: its index
+    uint32_t prim_offset;  //          leaf with several: first entry in the reference array
   };
   uint32_t flags;  // 4 bytes: low 2 bits: 0/1/2 = split axis, 3 = leaf;
                    //          high 30 bits: interior: index of the above child; leaf: count
@@ -154,8 +154,10 @@ class Builder {
     for (const Event& e : events) cls[e.tri] = kBoth;
     for (const Event& e : events) {
       if (e.axis != best.axis) continue;
-      if (e.type == kEnd && e.pos <= best.pos) cls[e.tri] = kLeftOnly;
-      else if (e.type == kStart && e.pos >= best.pos) cls[e.tri] = kRightOnly;
+      if (e.type == kEnd && e.pos <= best.pos)
+        cls[e.tri] = kLeftOnly;
+      else if (e.type == kStart && e.pos >= best.pos)
+        cls[e.tri] = kRightOnly;
       else if (e.type == kPlanar) {
         if (e.pos < best.pos || (e.pos == best.pos && best.planar_left)) cls[e.tri] = kLeftOnly;
         if (e.pos > best.pos || (e.pos == best.pos && !best.planar_left)) cls[e.tri] = kRightOnly;
@@ -219,7 +221,8 @@ class Builder {
 
   float sah(float pl, float pr, uint32_t nl, uint32_t nr) const {
     const float lambda = (nl == 0 || nr == 0) ? 1.0f - m_config.empty_bonus : 1.0f;
-    return lambda * (m_config.traversal_cost + m_config.intersection_cost * (pl * float(nl) + pr * float(nr)));
+    return lambda *
+           (m_config.traversal_cost + m_config.intersection_cost * (pl * float(nl) + pr * float(nr)));
   }
 
   Split find_plane(const std::vector<Event>& ev, uint32_t n, const Bounds3f& box) const {
@@ -284,9 +287,10 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     m_tris = gather_triangles(meshes);
     m_input_triangles = count_input_triangles(meshes);
     if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many triangles (max 2^30 - 1)");
-    m_max_depth = config.max_depth > 0
-                      ? config.max_depth
-                      : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(m_tris.size(), 1)))));
+    m_max_depth =
+        config.max_depth > 0
+            ? config.max_depth
+            : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(m_tris.size(), 1)))));
     if (!m_tris.empty()) {
       std::vector<Event> events;
       events.reserve(m_tris.size() * 6);
@@ -312,14 +316,15 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = make_stats(
-        m_stats, "kdtree",
-        "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
-            format_number(m_config.intersection_cost) + ", empty_bonus " + format_number(m_config.empty_bonus) +
-            ", max_depth " + std::to_string(m_max_depth),
-        m_input_triangles,
-        m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) + m_tris.size() * sizeof(TriangleRecord),
-        m_build_seconds);
+    AccelStats s =
+        make_stats(m_stats, "kdtree",
+                   "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
+                       format_number(m_config.intersection_cost) + ", empty_bonus " +
+                       format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth),
+                   m_input_triangles,
+                   m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) +
+                       m_tris.size() * sizeof(TriangleRecord),
+                   m_build_seconds);
     s.nodes = m_nodes.size();
     return s;
   }
@@ -430,9 +435,9 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   std::vector<KdNode> m_nodes;  // depth-first; node 0 is the root
   std::vector<uint32_t> m_refs;
   std::vector<TriangleRecord> m_tris;
-  Bounds3f m_bounds;     // exact bounds of the triangles
-  Bounds3f m_clip;       // m_bounds widened by m_band, for clipping rays
-  float m_band = 0;      // origins this close to a split plane count as on it
+  Bounds3f m_bounds;  // exact bounds of the triangles
+  Bounds3f m_clip;    // m_bounds widened by m_band, for clipping rays
+  float m_band = 0;   // origins this close to a split plane count as on it
   uint64_t m_input_triangles = 0;
   double m_root_area = 0;
   LeafTally m_tally;

@@ -14,11 +14,11 @@ namespace penumbra {
 
 /// kD-tree build parameters; defaults are the constants of Wald & Havran (2006).
 struct KdTreeConfig {
-  float traversal_cost = 15.0f;     ///< > 0: K_T, cost of one traversal step
-  float intersection_cost = 20.0f;  ///< > 0: K_I, cost of one triangle test
-  float empty_bonus = 0.2f;         ///< [0, 1): a split with an empty side costs (1 - bonus) x
-  int max_depth = 0;                ///< [0, 64]; 0 = automatic, 8 + 1.3 log2(N) capped at 64
-  size_t parallel_threshold = 8192; ///< nodes with more triangles build children in parallel
+  float traversal_cost = 15.0f;      ///< > 0: K_T, cost of one traversal step
+  float intersection_cost = 20.0f;   ///< > 0: K_I, cost of one triangle test
+  float empty_bonus = 0.2f;          ///< [0, 1): a split with an empty side costs (1 - bonus) x
+  int max_depth = 0;                 ///< [0, 64]; 0 = automatic, 8 + 1.3 log2(N) capped at 64
+  size_t parallel_threshold = 8192;  ///< nodes with more triangles build children in parallel
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.

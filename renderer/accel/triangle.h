@@ -21,15 +21,14 @@ struct WatertightRay {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
   double dsx = 0, dsy = 0, dsz = 1;  ///< the shear in double, for the hit's t, u, v
-  float tnear = 0;     ///< max(ray.tnear, 0): every back end treats t < 0 as behind the origin
-  bool valid = false;  ///< false for NaN/Inf/zero directions or tnear > tfar: such rays miss
+  float tnear = 0;                   ///< max(ray.tnear, 0): every back end treats t < 0 as behind the origin
+  bool valid = false;                ///< false for NaN/Inf/zero directions or tnear > tfar: such rays miss
 };
 
 inline WatertightRay prepare_watertight(const Ray& ray) {
   WatertightRay w;
   const Vec3f d = ray.dir;
-  if (!is_finite(d) || !is_finite(ray.org) || std::isnan(ray.tnear) || std::isnan(ray.tfar))
-    return w;
+  if (!is_finite(d) || !is_finite(ray.org) || std::isnan(ray.tnear) || std::isnan(ray.tfar)) return w;
   w.tnear = std::max(ray.tnear, 0.0f);
   if (w.tnear > ray.tfar) return w;
   const Vec3f ad = abs(d);
@@ -58,9 +57,8 @@ inline float component(const Vec3f& v, int i) {
 
 /// Tests triangle (a, b, c) against the ray; on a hit with t in [tnear, tfar] writes t, u, v
 /// (p = (1-u-v) a + u b + v c) and returns true. Degenerate triangles never hit.
-inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, Vec3f a,
-                                          Vec3f b, Vec3f c, float tfar, float& t_out,
-                                          float& u_out, float& v_out) {
+inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, Vec3f a, Vec3f b, Vec3f c,
+                                          float tfar, float& t_out, float& u_out, float& v_out) {
   // Translate to the ray origin, then shear so the ray is the +z axis.
   const Vec3f A = a - ray.org, B = b - ray.org, C = c - ray.org;
   const float Az0 = component(A, w.kz), Bz0 = component(B, w.kz), Cz0 = component(C, w.kz);
@@ -118,8 +116,8 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   if (!(t >= w.tnear && t <= tfar)) return false;
   t_out = float(t);
   if (!(t_out >= w.tnear && t_out <= tfar)) return false;  // rounding to float at the ends
-  u_out = float(dV / det);  // weight of b
-  v_out = float(dW / det);  // weight of c
+  u_out = float(dV / det);                                 // weight of b
+  v_out = float(dW / det);                                 // weight of c
   return true;
 }
 

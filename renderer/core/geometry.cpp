@@ -29,8 +29,7 @@ bool intersect_sphere(const Ray& ray, Vec3f center, float radius, float& t_out) 
   return false;
 }
 
-bool intersect_triangle_cramer(const Ray& ray, Vec3f a, Vec3f b, Vec3f c, float& t, float& u,
-                               float& v) {
+bool intersect_triangle_cramer(const Ray& ray, Vec3f a, Vec3f b, Vec3f c, float& t, float& u, float& v) {
   // Columns of the system [b-a, c-a, -d] (u, v, t)^T = e - a.
   const Vec3f e1 = b - a, e2 = c - a, rhs = ray.org - a, nd = -ray.dir;
   const float det = dot(e1, cross(e2, nd));

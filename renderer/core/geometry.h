@@ -32,11 +32,12 @@ bool intersect_sphere(const Ray& ray, Vec3f center, float radius, float& t_out);
 
 /// Ray-triangle by Cramer's rule on e + t d = a + u (b - a) + v (c - a).
 /// Hit iff t in [tnear, tfar], u >= 0, v >= 0, u + v <= 1. Not watertight: reference only.
-bool intersect_triangle_cramer(const Ray& ray, Vec3f a, Vec3f b, Vec3f c, float& t, float& u,
-                               float& v);
+bool intersect_triangle_cramer(const Ray& ray, Vec3f a, Vec3f b, Vec3f c, float& t, float& u, float& v);
 
 /// Unit geometric normal (b - a) x (c - a) / |(b - a) x (c - a)|; zero for degenerate triangles.
-inline Vec3f triangle_normal(Vec3f a, Vec3f b, Vec3f c) { return normalize(cross(b - a, c - a)); }
+inline Vec3f triangle_normal(Vec3f a, Vec3f b, Vec3f c) {
+  return normalize(cross(b - a, c - a));
+}
 
 /// Offsets a surface point along its geometric normal so a ray leaving it in direction `dir`
 /// does not re-hit the same surface, scaled to the float precision of p.

@@ -5,10 +5,8 @@ namespace penumbra {
 
 Quat operator*(const Quat& a, const Quat& b) {
   // [w1 w2 - v1.v2, w1 v2 + w2 v1 + v1 x v2]
-  return {a.w * b.x + b.w * a.x + (a.y * b.z - a.z * b.y),
-          a.w * b.y + b.w * a.y + (a.z * b.x - a.x * b.z),
-          a.w * b.z + b.w * a.z + (a.x * b.y - a.y * b.x),
-          a.w * b.w - (a.x * b.x + a.y * b.y + a.z * b.z)};
+  return {a.w * b.x + b.w * a.x + (a.y * b.z - a.z * b.y), a.w * b.y + b.w * a.y + (a.z * b.x - a.x * b.z),
+          a.w * b.z + b.w * a.z + (a.x * b.y - a.y * b.x), a.w * b.w - (a.x * b.x + a.y * b.y + a.z * b.z)};
 }
 
 Transform operator*(const Transform& a, const Transform& b) {
@@ -183,7 +181,8 @@ Bounds3f transform_bounds(const Affine3f& a, const Bounds3f& b) {
   if (b.empty()) return b;
   Bounds3f out;
   for (int k = 0; k < 8; ++k)
-    out = merge(out, apply_point(a, {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}));
+    out = merge(out,
+                apply_point(a, {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}));
   return out;
 }
 

@@ -28,23 +28,49 @@ struct Vec3f {
   constexpr float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
 };
 
-constexpr Vec3f operator+(Vec3f a, Vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-constexpr Vec3f operator-(Vec3f a, Vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-constexpr Vec3f operator-(Vec3f a) { return {-a.x, -a.y, -a.z}; }
-constexpr Vec3f operator*(Vec3f a, Vec3f b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-constexpr Vec3f operator*(Vec3f a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-constexpr Vec3f operator*(float s, Vec3f a) { return {a.x * s, a.y * s, a.z * s}; }
-constexpr Vec3f operator/(Vec3f a, float s) { return {a.x / s, a.y / s, a.z / s}; }
-constexpr Vec3f& operator+=(Vec3f& a, Vec3f b) { return a = a + b; }
-constexpr Vec3f& operator*=(Vec3f& a, Vec3f b) { return a = a * b; }
-constexpr Vec3f& operator*=(Vec3f& a, float s) { return a = a * s; }
-constexpr bool operator==(Vec3f a, Vec3f b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+constexpr Vec3f operator+(Vec3f a, Vec3f b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+constexpr Vec3f operator-(Vec3f a, Vec3f b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+constexpr Vec3f operator-(Vec3f a) {
+  return {-a.x, -a.y, -a.z};
+}
+constexpr Vec3f operator*(Vec3f a, Vec3f b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+constexpr Vec3f operator*(Vec3f a, float s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+constexpr Vec3f operator*(float s, Vec3f a) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+constexpr Vec3f operator/(Vec3f a, float s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+constexpr Vec3f& operator+=(Vec3f& a, Vec3f b) {
+  return a = a + b;
+}
+constexpr Vec3f& operator*=(Vec3f& a, Vec3f b) {
+  return a = a * b;
+}
+constexpr Vec3f& operator*=(Vec3f& a, float s) {
+  return a = a * s;
+}
+constexpr bool operator==(Vec3f a, Vec3f b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
 
-constexpr float dot(Vec3f a, Vec3f b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr float dot(Vec3f a, Vec3f b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 constexpr Vec3f cross(Vec3f a, Vec3f b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline float length(Vec3f a) { return std::sqrt(dot(a, a)); }
+inline float length(Vec3f a) {
+  return std::sqrt(dot(a, a));
+}
 /// Unit vector along a; a zero vector stays zero (never NaN).
 inline Vec3f normalize(Vec3f a) {
   const float l = length(a);
@@ -56,14 +82,22 @@ constexpr Vec3f min(Vec3f a, Vec3f b) {
 constexpr Vec3f max(Vec3f a, Vec3f b) {
   return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-inline Vec3f abs(Vec3f a) { return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}; }
-constexpr float max_component(Vec3f a) { return std::max(a.x, std::max(a.y, a.z)); }
+inline Vec3f abs(Vec3f a) {
+  return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)};
+}
+constexpr float max_component(Vec3f a) {
+  return std::max(a.x, std::max(a.y, a.z));
+}
 inline bool is_finite(Vec3f a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 /// Ideal mirror direction of d about unit normal n: r = d - 2 (d.n) n.
-constexpr Vec3f reflect(Vec3f d, Vec3f n) { return d - 2.0f * dot(d, n) * n; }
-constexpr float luminance(Vec3f c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+constexpr Vec3f reflect(Vec3f d, Vec3f n) {
+  return d - 2.0f * dot(d, n) * n;
+}
+constexpr float luminance(Vec3f c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 /// Axis-aligned box; the default box is empty (min > max) and absorbs any point.
 struct Bounds3f {
@@ -73,8 +107,12 @@ struct Bounds3f {
   Vec3f center() const { return (lo + hi) * 0.5f; }
   Vec3f extent() const { return hi - lo; }
 };
-inline Bounds3f merge(Bounds3f b, Vec3f p) { return {min(b.lo, p), max(b.hi, p)}; }
-inline Bounds3f merge(Bounds3f a, Bounds3f b) { return {min(a.lo, b.lo), max(a.hi, b.hi)}; }
+inline Bounds3f merge(Bounds3f b, Vec3f p) {
+  return {min(b.lo, p), max(b.hi, p)};
+}
+inline Bounds3f merge(Bounds3f a, Bounds3f b) {
+  return {min(a.lo, b.lo), max(a.hi, b.hi)};
+}
 
 /// Unit quaternion (x, y, z, w) in glTF order.
 struct Quat {

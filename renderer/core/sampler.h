@@ -44,7 +44,9 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 }
 
 /// Sobol dimension 0 (van der Corput) and 1 (primitive polynomial x + 1), as 32-bit fractions.
-inline uint32_t sobol_dim0(uint32_t i) { return reverse_bits(i); }
+inline uint32_t sobol_dim0(uint32_t i) {
+  return reverse_bits(i);
+}
 inline uint32_t sobol_dim1(uint32_t i) {
   uint32_t r = 0;
   for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
@@ -52,10 +54,14 @@ inline uint32_t sobol_dim1(uint32_t i) {
   return r;
 }
 
-inline uint32_t hash32(uint64_t a, uint64_t b) { return uint32_t(splitmix64(splitmix64(a) ^ b) >> 32); }
+inline uint32_t hash32(uint64_t a, uint64_t b) {
+  return uint32_t(splitmix64(splitmix64(a) ^ b) >> 32);
+}
 
 /// 32-bit fraction -> float in [0, 1).
-inline float fraction_to_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
+inline float fraction_to_float(uint32_t x) {
+  return float(x >> 8) * 0x1p-24f;
+}
 
 /// The sample stream of sample `index` of one pixel. Cheap to construct; not thread-shared.
 struct SampleStream {

@@ -26,70 +26,70 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
   const bool filter = scene_needs_hit_filter(scene);
   TileScheduler scheduler(win, config.tile_size, config.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) {
-      std::vector<uint32_t> objects, materials;
-      for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x = tile.x0; x < tile.x1; ++x) {
-          const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
-          Vec3f albedo{0, 0, 0}, normal{0, 0, 0}, position{0, 0, 0};
-          Vec2f uv{0, 0};
-          int hits = 0;
-          objects.clear();
-          materials.clear();
-          for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
-            const Vec2f p = camera_sample_position(config, integrator, x, y, s);
-            const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
-            Hit hit;
-            if (!intersect_visible(scene, accel, ray, hit, filter)) {
-              objects.push_back(0);
-              materials.push_back(0);
-              continue;
-            }
-            const SurfaceInteraction si = make_interaction(scene, ray, hit);
-            const MaterialPoint mp = eval_material(scene, si);
-            albedo += mp.base_color;
-            normal += mp.ns;
-            position += si.p;
-            uv = {uv.x + si.uv[0].x, uv.y + si.uv[0].y};
-            ++hits;
-            const float z = dot(si.p - camera.eye, -camera.w);
-            a.depth[i] = std::min(a.depth[i], z);
-            const Instance& inst = scene.instances[hit.geom_id];
-            objects.push_back(inst.node >= 0 ? uint32_t(inst.node) + 1 : 0);
-            const int m = scene.meshes[size_t(inst.mesh)].material;
-            materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
+    std::vector<uint32_t> objects, materials;
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
+        Vec3f albedo{0, 0, 0}, normal{0, 0, 0}, position{0, 0, 0};
+        Vec2f uv{0, 0};
+        int hits = 0;
+        objects.clear();
+        materials.clear();
+        for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
+          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
+          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          Hit hit;
+          if (!intersect_visible(scene, accel, ray, hit, filter)) {
+            objects.push_back(0);
+            materials.push_back(0);
+            continue;
           }
-          // The most frequent id (ties: the smaller one).
-          auto majority = [](std::vector<uint32_t>& ids) {
-            std::sort(ids.begin(), ids.end());
-            uint32_t best = 0;
-            size_t best_count = 0;
-            for (size_t k = 0; k < ids.size();) {
-              size_t e = k;
-              while (e < ids.size() && ids[e] == ids[k]) ++e;
-              if (e - k > best_count) {
-                best = ids[k];
-                best_count = e - k;
-              }
-              k = e;
-            }
-            return float(best);
-          };
-          a.object_id[i] = majority(objects);
-          a.material_id[i] = majority(materials);
-          const float inv_spp = 1.0f / float(config.spp);
-          for (int c = 0; c < 3; ++c) a.albedo[i * 3 + size_t(c)] = albedo[c] * inv_spp;
-          if (hits > 0) {
-            const float inv = 1.0f / float(hits);
-            const Vec3f nn = normalize(normal);
-            const Vec3f pp = position * inv;
-            for (int c = 0; c < 3; ++c) {
-              a.normal[i * 3 + size_t(c)] = nn[c];
-              a.position[i * 3 + size_t(c)] = pp[c];
-            }
-            a.uv[i * 2] = uv.x * inv;
-            a.uv[i * 2 + 1] = uv.y * inv;
-          }
+          const SurfaceInteraction si = make_interaction(scene, ray, hit);
+          const MaterialPoint mp = eval_material(scene, si);
+          albedo += mp.base_color;
+          normal += mp.ns;
+          position += si.p;
+          uv = {uv.x + si.uv[0].x, uv.y + si.uv[0].y};
+          ++hits;
+          const float z = dot(si.p - camera.eye, -camera.w);
+          a.depth[i] = std::min(a.depth[i], z);
+          const Instance& inst = scene.instances[hit.geom_id];
+          objects.push_back(inst.node >= 0 ? uint32_t(inst.node) + 1 : 0);
+          const int m = scene.meshes[size_t(inst.mesh)].material;
+          materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
         }
+        // The most frequent id (ties: the smaller one).
+        auto majority = [](std::vector<uint32_t>& ids) {
+          std::sort(ids.begin(), ids.end());
+          uint32_t best = 0;
+          size_t best_count = 0;
+          for (size_t k = 0; k < ids.size();) {
+            size_t e = k;
+            while (e < ids.size() && ids[e] == ids[k]) ++e;
+            if (e - k > best_count) {
+              best = ids[k];
+              best_count = e - k;
+            }
+            k = e;
+          }
+          return float(best);
+        };
+        a.object_id[i] = majority(objects);
+        a.material_id[i] = majority(materials);
+        const float inv_spp = 1.0f / float(config.spp);
+        for (int c = 0; c < 3; ++c) a.albedo[i * 3 + size_t(c)] = albedo[c] * inv_spp;
+        if (hits > 0) {
+          const float inv = 1.0f / float(hits);
+          const Vec3f nn = normalize(normal);
+          const Vec3f pp = position * inv;
+          for (int c = 0; c < 3; ++c) {
+            a.normal[i * 3 + size_t(c)] = nn[c];
+            a.position[i * 3 + size_t(c)] = pp[c];
+          }
+          a.uv[i * 2] = uv.x * inv;
+          a.uv[i * 2 + 1] = uv.y * inv;
+        }
+      }
   });
   return a;
 }

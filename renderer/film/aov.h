@@ -21,12 +21,12 @@
 namespace penumbra {
 
 struct DataAovs {
-  int width = 0, height = 0;  ///< of render_window(config); every vector covers that window
-  std::vector<float> albedo;    ///< 3 per pixel
-  std::vector<float> normal;    ///< 3 per pixel, world space
-  std::vector<float> position;  ///< 3 per pixel, world space
-  std::vector<float> uv;        ///< 2 per pixel (TEXCOORD_0)
-  std::vector<float> depth;     ///< 1 per pixel
+  int width = 0, height = 0;       ///< of render_window(config); every vector covers that window
+  std::vector<float> albedo;       ///< 3 per pixel
+  std::vector<float> normal;       ///< 3 per pixel, world space
+  std::vector<float> position;     ///< 3 per pixel, world space
+  std::vector<float> uv;           ///< 2 per pixel (TEXCOORD_0)
+  std::vector<float> depth;        ///< 1 per pixel
   std::vector<float> object_id;    ///< 1 per pixel (integer values)
   std::vector<float> material_id;  ///< 1 per pixel (integer values)
 };

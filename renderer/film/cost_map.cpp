@@ -18,23 +18,23 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
   const uint32_t spp = uint32_t(config.spp);
   TileScheduler scheduler(PixelWindow{0, 0, config.width, config.height}, config.tile_size, config.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) {
-      for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x = tile.x0; x < tile.x1; ++x) {
-          TraversalCost cost;
-          double seconds = 0;
-          for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
-            const Vec2f p = camera_sample_position(config, integrator, x, y, s);
-            const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
-            Hit hit;
-            const auto t0 = std::chrono::steady_clock::now();
-            accel.intersect_counted(ray, hit, cost);
-            seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          }
-          const size_t i = size_t(y) * size_t(config.width) + size_t(x);
-          img.nanoseconds[i] = float(seconds * 1e9 / spp);
-          img.nodes[i] = float(double(cost.nodes) / spp);
-          img.triangles[i] = float(double(cost.triangles) / spp);
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        TraversalCost cost;
+        double seconds = 0;
+        for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
+          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
+          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          Hit hit;
+          const auto t0 = std::chrono::steady_clock::now();
+          accel.intersect_counted(ray, hit, cost);
+          seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
+        const size_t i = size_t(y) * size_t(config.width) + size_t(x);
+        img.nanoseconds[i] = float(seconds * 1e9 / spp);
+        img.nodes[i] = float(double(cost.nodes) / spp);
+        img.triangles[i] = float(double(cost.triangles) / spp);
+      }
   });
   return img;
 }
@@ -47,7 +47,8 @@ std::vector<float> total_cost(const CostImage& cost) {
 }
 
 std::string cost_caption(const CostImage& cost, const std::string& accel_name) {
-  return accel_name + (cost.counted ? ": nodes + triangles per camera ray" : ": nanoseconds per camera ray (wall clock)");
+  return accel_name +
+         (cost.counted ? ": nodes + triangles per camera ray" : ": nanoseconds per camera ray (wall clock)");
 }
 
 }  // namespace penumbra

@@ -15,10 +15,10 @@ namespace penumbra {
 /// Per-pixel means over the pixel's camera samples, row-major, top row first.
 struct CostImage {
   int width = 0, height = 0;
-  std::vector<float> nodes;      ///< nodes (BVH, kD-tree) or cells (grid) visited per camera ray
-  std::vector<float> triangles;  ///< ray-triangle tests per camera ray
+  std::vector<float> nodes;        ///< nodes (BVH, kD-tree) or cells (grid) visited per camera ray
+  std::vector<float> triangles;    ///< ray-triangle tests per camera ray
   std::vector<float> nanoseconds;  ///< wall-clock time per camera ray (varies from run to run)
-  bool counted = false;          ///< nodes and triangles are filled (accel.counts_traversal())
+  bool counted = false;            ///< nodes and triangles are filled (accel.counts_traversal())
 };
 
 /// Traces the camera rays of `config` (width, height, spp, seed, threads, filter, sampler) at

@@ -15,13 +15,12 @@ struct Film {
   int full_width = 0, full_height = 0;
 
   float* pixel(int x, int y) { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
-  const float* pixel(int x, int y) const {
-    return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4];
-  }
+  const float* pixel(int x, int y) const { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
 };
 
 inline Film make_film(int width, int height) {
-  return Film{width, height, std::vector<float>(size_t(width) * size_t(height) * 4, 0.0f), 0, 0, width, height};
+  return Film{width, height, std::vector<float>(size_t(width) * size_t(height) * 4, 0.0f), 0, 0,
+              width, height};
 }
 
 }  // namespace penumbra

@@ -8,10 +8,14 @@ namespace penumbra {
 
 float default_filter_width(FilterType type) {
   switch (type) {
-    case FilterType::Box: return 1;
-    case FilterType::Tent: return 2;
-    case FilterType::Gaussian: return 3;
-    case FilterType::BlackmanHarris: return 1.5f;
+    case FilterType::Box:
+      return 1;
+    case FilterType::Tent:
+      return 2;
+    case FilterType::Gaussian:
+      return 3;
+    case FilterType::BlackmanHarris:
+      return 1.5f;
   }
   return 1;
 }
@@ -27,10 +31,14 @@ bool parse_filter_type(std::string_view name, FilterType& out) {
 
 const char* filter_name(FilterType type) {
   switch (type) {
-    case FilterType::Box: return "box";
-    case FilterType::Tent: return "tent";
-    case FilterType::Gaussian: return "gaussian";
-    case FilterType::BlackmanHarris: return "blackman-harris";
+    case FilterType::Box:
+      return "box";
+    case FilterType::Tent:
+      return "tent";
+    case FilterType::Gaussian:
+      return "gaussian";
+    case FilterType::BlackmanHarris:
+      return "blackman-harris";
   }
   return "box";
 }
@@ -39,8 +47,10 @@ float filter_profile(const PixelFilter& f, float x) {
   const float r = f.width / 2;
   if (!(std::fabs(x) <= r)) return 0;
   switch (f.type) {
-    case FilterType::Box: return 1;
-    case FilterType::Tent: return 1 - std::fabs(x) / r;
+    case FilterType::Box:
+      return 1;
+    case FilterType::Tent:
+      return 1 - std::fabs(x) / r;
     case FilterType::Gaussian: {
       // pbrt-v4's Gaussian: shifted so it reaches zero at the radius.
       const float sigma = f.width / 6;
@@ -50,8 +60,8 @@ float filter_profile(const PixelFilter& f, float x) {
     case FilterType::BlackmanHarris: {
       // 4-term Blackman-Harris window over [-r, r] (Harris 1978), as Cycles uses.
       const float t = 2 * kPi * (x + r) / f.width;
-      return std::max(0.0f, 0.35875f - 0.48829f * std::cos(t) + 0.14128f * std::cos(2 * t) -
-                                0.01168f * std::cos(3 * t));
+      return std::max(
+          0.0f, 0.35875f - 0.48829f * std::cos(t) + 0.14128f * std::cos(2 * t) - 0.01168f * std::cos(3 * t));
     }
   }
   return 0;
@@ -79,7 +89,8 @@ namespace {
 float sample_1d(const PixelFilter& f, float u) {
   const float r = f.width / 2;
   switch (f.type) {
-    case FilterType::Box: return (u - 0.5f) * f.width;
+    case FilterType::Box:
+      return (u - 0.5f) * f.width;
     case FilterType::Tent:  // inverse CDF of the triangle on [-r, r]
       return u < 0.5f ? r * (std::sqrt(2 * u) - 1) : r * (1 - std::sqrt(2 * (1 - u)));
     default: {
@@ -94,6 +105,8 @@ float sample_1d(const PixelFilter& f, float u) {
 }
 }  // namespace
 
-Vec2f sample_filter(const PixelFilter& f, Vec2f u) { return {sample_1d(f, u.x), sample_1d(f, u.y)}; }
+Vec2f sample_filter(const PixelFilter& f, Vec2f u) {
+  return {sample_1d(f, u.x), sample_1d(f, u.y)};
+}
 
 }  // namespace penumbra

@@ -53,8 +53,7 @@ namespace {
 
 // One light sample's contribution: BRDF, shadow ray, MIS weight.
 void estimate(const Scene& scene, const Accelerator& accel, const DirectLightingVertex& v,
-              const DirectLightingMode& mode, const IncidentLight& l, RayCounts& counts,
-              PathRadiance& out) {
+              const DirectLightingMode& mode, const IncidentLight& l, RayCounts& counts, PathRadiance& out) {
   if (!(dot(l.wi, v.si.ng) > 0)) return;  // light below the geometric surface
   float pdf_b = 0;
   const Vec3f f = brdf_eval_pdf(v.brdf, v.wo, l.wi, pdf_b);
@@ -81,10 +80,12 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
   if (!lights.area->pmf.empty()) {
     const float u1 = samples.get1d();
     const Vec2f u2 = samples.get2d();
-    if (sample_incident(*lights.area, scene, v.si.p, u1, u2, l)) estimate(scene, accel, v, mode, l, counts, out);
+    if (sample_incident(*lights.area, scene, v.si.p, u1, u2, l))
+      estimate(scene, accel, v, mode, l, counts, out);
   }
   if (!is_black(*lights.environment)) {
-    if (sample_incident(*lights.environment, samples.get2d(), l)) estimate(scene, accel, v, mode, l, counts, out);
+    if (sample_incident(*lights.environment, samples.get2d(), l))
+      estimate(scene, accel, v, mode, l, counts, out);
   }
 }
 

@@ -26,11 +26,11 @@ struct PathLights {
 
 /// One light sample seen from a surface point, whatever the light's kind.
 struct IncidentLight {
-  Vec3f wi;                 ///< unit direction towards the light
-  float distance = 0;       ///< to the sampled point (kInfinity: at infinity)
-  Vec3f li;                 ///< radiance arriving along -wi (irradiance for delta lights)
-  float pdf = 1;            ///< solid-angle density of wi (1 for delta lights)
-  bool delta = true;        ///< a punctual light: no MIS
+  Vec3f wi;            ///< unit direction towards the light
+  float distance = 0;  ///< to the sampled point (kInfinity: at infinity)
+  Vec3f li;            ///< radiance arriving along -wi (irradiance for delta lights)
+  float pdf = 1;       ///< solid-angle density of wi (1 for delta lights)
+  bool delta = true;   ///< a punctual light: no MIS
 };
 
 /// Samples of each light kind towards point p; false when the light sends nothing there.

@@ -54,7 +54,7 @@ inline Vec3f diffuse_share(const GltfBrdf& brdf, Vec3f wo, Vec3f wi) {
 /// A path's radiance and, optionally, its light groups. Every contribution goes through add().
 struct PathRadiance {
   Vec3f radiance{0, 0, 0};
-  float clamp_indirect = 0;      ///< PathConfig::clamp_indirect
+  float clamp_indirect = 0;       ///< PathConfig::clamp_indirect
   LightGroups* groups = nullptr;  ///< null: no split
   Vec3f share0{0, 0, 0};          ///< diffuse share of the direction sampled at hit 0
 

@@ -46,14 +46,16 @@ void add_escaped(const PathContext& ctx, const Segment& seg, int vertex, PathRad
   const Environment& env = *ctx.lights.environment;
   float w = 1;
   if (!seg.prev_delta)
-    w = !ctx.bsdf_lights ? 0.0f : (ctx.sample_lights ? power_heuristic(seg.prev_pdf, env_pdf(env, seg.ray.dir)) : 1.0f);
+    w = !ctx.bsdf_lights
+            ? 0.0f
+            : (ctx.sample_lights ? power_heuristic(seg.prev_pdf, env_pdf(env, seg.ray.dir)) : 1.0f);
   if (w > 0) path.add(seg.beta * env_eval(env, seg.ray.dir) * w, vertex - 1);
 }
 
 // Emitter hit: emission of the surface hit, seen by the previous vertex (or the camera),
 // MIS-weighted against the area-light sample taken there.
-void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit,
-                  const SurfaceInteraction& si, const MaterialPoint& mp, int vertex, PathRadiance& path) {
+void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, const SurfaceInteraction& si,
+                  const MaterialPoint& mp, int vertex, PathRadiance& path) {
   if (!(max_component(mp.emissive) > 0) || mp.unlit) return;
   float w = 1;
   if (!seg.prev_delta) {
@@ -61,7 +63,9 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit,
       w = 0;
     } else if (ctx.sample_lights) {
       const float cos_l = std::fabs(dot(si.ng, seg.ray.dir));
-      const float pdf_l = cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l : 0.0f;
+      const float pdf_l =
+          cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l
+                    : 0.0f;
       w = power_heuristic(seg.prev_pdf, pdf_l);
     }
   }
@@ -80,12 +84,14 @@ Lobes choose_lobes(const MaterialPoint& mp, Vec3f wo) {
   l.brdf.specular = mp.specular;
   l.brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
   const float cos_o = std::fabs(dot(mp.ns, wo));
-  l.trans_weight = mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - dielectric_fresnel(l.brdf, cos_o)));
+  l.trans_weight =
+      mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - dielectric_fresnel(l.brdf, cos_o)));
   if (l.brdf.transmission > 0) {
     const float t = luminance(l.trans_weight);
     const float fd = dielectric_fresnel(l.brdf, cos_o);
-    const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
-                    mp.metallic * luminance(mp.base_color);
+    const float r =
+        (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
+        mp.metallic * luminance(mp.base_color);
     l.p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
   }
   l.p_r = 1 - l.p_t;
@@ -129,15 +135,19 @@ bool survives_roulette(SampleStream& samples, Vec3f& beta) {
 
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts,
-                    LightGroups* groups) {
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups) {
   ++counts.camera;
   coverage = 0;
   PathRadiance path;
   path.clamp_indirect = cfg.clamp_indirect;
   path.groups = groups;
-  const PathContext ctx{scene, accel, lights, cfg, !is_black(*lights.environment),
-                        cfg.strategy != LightStrategy::Bsdf, cfg.strategy != LightStrategy::Light};
+  const PathContext ctx{scene,
+                        accel,
+                        lights,
+                        cfg,
+                        !is_black(*lights.environment),
+                        cfg.strategy != LightStrategy::Bsdf,
+                        cfg.strategy != LightStrategy::Light};
   const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter};
   Segment seg;
   seg.ray = camera_ray;

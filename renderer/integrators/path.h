@@ -54,7 +54,6 @@ struct PathConfig {
 /// light group. Thread-safe; never allocates, throws or logs.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts,
-                    LightGroups* groups = nullptr);
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);
 
 }  // namespace penumbra

@@ -13,7 +13,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool is_plain_box(const PixelFilter& f) { return f.type == FilterType::Box && f.width == 1; }
+bool is_plain_box(const PixelFilter& f) {
+  return f.type == FilterType::Box && f.width == 1;
+}
 
 // Raster position of a camera sample from u in [0,1)^2 by filter importance sampling.
 Vec2f filtered_position(const RenderConfig& config, int x, int y, Vec2f u) {
@@ -41,7 +43,9 @@ Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float
 }
 
 // Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
-float differential_step(int spp) { return std::max(0.125f, 1.0f / std::sqrt(float(spp))); }
+float differential_step(int spp) {
+  return std::max(0.125f, 1.0f / std::sqrt(float(spp)));
+}
 
 struct RayCounters {
   std::atomic<uint64_t> camera{0}, shadow{0}, reflection{0};
@@ -78,8 +82,7 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
 }
 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
-                          const RenderConfig& config, int x, int y, float rgba[4],
-                          RayCounts& counts) {
+                          const RenderConfig& config, int x, int y, float rgba[4], RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
   const float step = differential_step(config.spp);
   Vec3f sum{0, 0, 0};
@@ -114,7 +117,8 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
     RayCounts counts;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x)
-        render_whitted_pixel(scene, accel, camera, config, x, y, film.pixel(x - film.origin_x, y - film.origin_y), counts);
+        render_whitted_pixel(scene, accel, camera, config, x, y,
+                             film.pixel(x - film.origin_x, y - film.origin_y), counts);
     rays.add(counts);
     const int d = ++done;
     if (progress) progress(d, tiles);
@@ -155,9 +159,8 @@ using PixelAccum = PathAccumulators::Pixel;
 // Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`,
 // kLightGroupChannels sums, if not null).
 void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
-                  const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x,
-                  int y, uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts,
-                  double* groups = nullptr) {
+                  const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
+                  uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr) {
   const float step = differential_step(config.spp);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
@@ -166,7 +169,8 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
     const Ray ray = camera_ray(camera, config, p.x, p.y, step, rd);
     float coverage = 0;
     LightGroups lg;
-    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);
+    const Vec3f l =
+        path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);
     if (groups) add_light_groups(lg, groups);
     acc.rgba[0] += l.x;
     acc.rgba[1] += l.y;
@@ -187,8 +191,8 @@ void resolve(const PixelAccum& acc, float rgba[4]) {
 }  // namespace
 
 void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathLights& lights,
-                       const Camera& camera, const RenderConfig& config, int x, int y,
-                       float rgba[4], RayCounts& counts) {
+                       const Camera& camera, const RenderConfig& config, int x, int y, float rgba[4],
+                       RayCounts& counts) {
   PathConfig pc = config.path;
   pc.hit_filter = pc.hit_filter && scene_needs_hit_filter(scene);
   PixelAccum acc;
@@ -209,7 +213,8 @@ PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& 
     if (!state.groups.empty()) {
       constexpr size_t kG = kLightGroupChannels;
       if (image.groups.empty()) image.groups.assign(npix * kG, 0.0f);
-      for (size_t k = 0; k < kG; ++k) image.groups[i * kG + k] = acc.n ? float(state.groups[i * kG + k] / acc.n) : 0.0f;
+      for (size_t k = 0; k < kG; ++k)
+        image.groups[i * kG + k] = acc.n ? float(state.groups[i * kG + k] / acc.n) : 0.0f;
     }
     if (acc.n >= 2) {
       const double mean = acc.sum_y / acc.n;
@@ -221,8 +226,8 @@ PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& 
 
 bool matches(const PathAccumulators& state, const RenderConfig& config) {
   const PixelWindow w = render_window(config);
-  return state.window.x0 == w.x0 && state.window.y0 == w.y0 && state.window.x1 == w.x1 && state.window.y1 == w.y1 &&
-         state.pixels.size() == size_t(w.width()) * size_t(w.height()) &&
+  return state.window.x0 == w.x0 && state.window.y0 == w.y0 && state.window.x1 == w.x1 &&
+         state.window.y1 == w.y1 && state.pixels.size() == size_t(w.width()) * size_t(w.height()) &&
          state.groups.size() == (config.light_groups ? state.pixels.size() * kLightGroupChannels : 0);
 }
 
@@ -273,7 +278,8 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
           if (!acc.active) continue;
           path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts,
                        group_sums.empty() ? nullptr : &group_sums[pi * kLightGroupChannels]);
-          if (adaptive && acc.n >= min_spp && pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
+          if (adaptive && acc.n >= min_spp &&
+              pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
             acc.active = false;
           active += acc.active;
         }
@@ -297,7 +303,8 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
       const double last = std::chrono::duration<double>(Clock::now() - pass_start).count();
       // Stop unless the next pass (at most as long as this one, scaled by its sample count)
       // still fits in the limit.
-      const double next = last * double(uint32_t(ends[pass + 1]) - end) / double(std::max(1u, end - pass_begin));
+      const double next =
+          last * double(uint32_t(ends[pass + 1]) - end) / double(std::max(1u, end - pass_begin));
       if (elapsed + next > config.time_limit) {
         time_limited = true;
         break;

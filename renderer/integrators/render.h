@@ -28,8 +28,8 @@ struct RenderStats {
   RayCounts rays;
   double seconds = 0;
   int threads = 0;
-  int passes = 0;           ///< path: passes rendered
-  uint64_t samples = 0;     ///< camera samples taken in all
+  int passes = 0;             ///< path: passes rendered
+  uint64_t samples = 0;       ///< camera samples taken in all
   bool time_limited = false;  ///< path: the time limit ended the render early
 };
 
@@ -46,15 +46,14 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
 /// One pixel's value (RGBA, premultiplied) exactly as render_whitted computes it: the
 /// replay behind `penumbra render --debug-pixel x,y`.
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
-                          const RenderConfig& config, int x, int y, float rgba[4],
-                          RayCounts& counts);
+                          const RenderConfig& config, int x, int y, float rgba[4], RayCounts& counts);
 
 /// A path-traced image with its per-pixel statistics.
 struct PathImage {
-  Film film;                       ///< mean of each pixel's samples (RGBA, premultiplied);
-                                   ///< all per-pixel vectors cover render_window(config)
-  std::vector<uint32_t> samples;   ///< samples taken per pixel
-  std::vector<float> variance;     ///< variance of each pixel's mean luminance (0 if n < 2)
+  Film film;                      ///< mean of each pixel's samples (RGBA, premultiplied);
+                                  ///< all per-pixel vectors cover render_window(config)
+  std::vector<uint32_t> samples;  ///< samples taken per pixel
+  std::vector<float> variance;    ///< variance of each pixel's mean luminance (0 if n < 2)
   /// With RenderConfig::light_groups: kLightGroupChannels floats per pixel, the means of the
   /// light groups in kLightGroupNames order (RGB each).
   std::vector<float> groups;
@@ -69,12 +68,12 @@ struct PathAccumulators {
     uint32_t n = 0;                ///< samples taken
     uint32_t active = 1;           ///< 0 once adaptive sampling stopped the pixel
   };
-  PixelWindow window;              ///< the render window the pixels cover
+  PixelWindow window;  ///< the render window the pixels cover
   std::vector<Pixel> pixels;
-  std::vector<double> groups;      ///< kLightGroupChannels light-group sums per pixel, or empty
-  uint32_t reached = 0;            ///< samples every still-active pixel has taken
-  int passes = 0;                  ///< passes completed
-  bool complete = false;           ///< the requested spp (or adaptive convergence) was reached
+  std::vector<double> groups;  ///< kLightGroupChannels light-group sums per pixel, or empty
+  uint32_t reached = 0;        ///< samples every still-active pixel has taken
+  int passes = 0;              ///< passes completed
+  bool complete = false;       ///< the requested spp (or adaptive convergence) was reached
 };
 
 /// Bytes of one pixel's accumulators as a checkpoint stores them (raw, native byte order).
@@ -91,9 +90,9 @@ using PassFn = std::function<void(const PathAccumulators& state)>;
 /// uninterrupted render with the same settings), and holds the final sums afterwards.
 /// Between passes the render stops early when config.stop is set or the time limit is near.
 PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
-                      const Camera& camera, const RenderConfig& config,
-                      RenderStats* stats = nullptr, const ProgressFn& progress = {},
-                      PathAccumulators* state = nullptr, const PassFn& after_pass = {});
+                      const Camera& camera, const RenderConfig& config, RenderStats* stats = nullptr,
+                      const ProgressFn& progress = {}, PathAccumulators* state = nullptr,
+                      const PassFn& after_pass = {});
 
 /// The image (means, counts, variances, light groups) of a set of accumulators.
 PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& config);
@@ -101,14 +100,13 @@ PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& 
 /// One pixel exactly as render_path computes it with all `config.spp` samples (no adaptive
 /// stop): the replay behind --debug-pixel.
 void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathLights& lights,
-                       const Camera& camera, const RenderConfig& config, int x, int y,
-                       float rgba[4], RayCounts& counts);
+                       const Camera& camera, const RenderConfig& config, int x, int y, float rgba[4],
+                       RayCounts& counts);
 
 /// Raster position (pixel corner at integer coordinates) of camera sample `s` of pixel (x, y)
 /// exactly as `integrator` places it: the one definition the integrators, the data AOVs and
 /// the cost map share.
-Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
-                             uint32_t s);
+Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y, uint32_t s);
 
 /// The pass schedule of render_path: sample index where pass k ends (1, 2, 4, 8, 16, 32, 48,
 /// ... capped at spp).

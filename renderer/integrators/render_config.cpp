@@ -17,7 +17,8 @@ void check_range(const char* name, long long value, long long lo, long long hi) 
 
 void check_non_negative(const char* name, double value) {
   if (!std::isfinite(value) || value < 0)
-    throw std::invalid_argument(std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) + ")");
+    throw std::invalid_argument(std::string(name) + " must be finite and >= 0 (got " + std::to_string(value) +
+                                ")");
 }
 
 void check_non_negative(const char* name, Vec3f v) {

@@ -27,12 +27,12 @@ struct RenderConfig {
   PixelFilter filter;     ///< box, 1 pixel wide by default; width in (0, kMaxFilterWidth]
   WhittedConfig whitted;  ///< max_depth [0, kMaxDepth]
   // Path tracer only.
-  PathConfig path;        ///< max_depth [0, kMaxDepth], rr_depth [1, kMaxDepth]
+  PathConfig path;  ///< max_depth [0, kMaxDepth], rr_depth [1, kMaxDepth]
   SamplerType sampler = SamplerType::Sobol;
-  double time_limit = 0;          ///< seconds, finite >= 0; > 0: stop after the pass that reaches it
-  float adaptive_threshold = 0;   ///< finite >= 0; > 0: stop a pixel once its error estimate is below this
-  int adaptive_min_spp = 16;      ///< [2, kMaxSpp]: samples every pixel takes before it may stop
-  bool light_groups = false;      ///< also accumulate the LightGroups split (PathImage::groups)
+  double time_limit = 0;         ///< seconds, finite >= 0; > 0: stop after the pass that reaches it
+  float adaptive_threshold = 0;  ///< finite >= 0; > 0: stop a pixel once its error estimate is below this
+  int adaptive_min_spp = 16;     ///< [2, kMaxSpp]: samples every pixel takes before it may stop
+  bool light_groups = false;     ///< also accumulate the LightGroups split (PathImage::groups)
   /// Only these pixels of the width x height frame (crops, farm tiles); all zero = the whole
   /// frame, else non-empty and inside the frame. Every pixel is computed exactly as in the
   /// whole frame, so parts merge bit for bit.

@@ -25,8 +25,7 @@ bool scene_needs_hit_filter(const Scene& scene) {
   return false;
 }
 
-bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit,
-                       bool filter) {
+bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter) {
   if (!filter) return accel.intersect(ray, hit);
   Ray r = ray;
   for (int layer = 0; layer < kMaxLayers; ++layer) {
@@ -44,8 +43,7 @@ bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& 
   return true;
 }
 
-float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray,
-                           bool filter) {
+float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray, bool filter) {
   if (!filter) return accel.occluded(ray) ? 0.0f : 1.0f;
   if (!accel.occluded(ray)) return 1;  // nothing at all in the way
   float transmittance = 1;

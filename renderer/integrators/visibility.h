@@ -19,14 +19,12 @@ bool scene_needs_hit_filter(const Scene& scene);
 /// ray past each rejected hit (at most 1024 times; then the last hit counts as opaque).
 /// Blend surfaces are returned; the integrator composites them. `filter` false: one plain
 /// accelerator query.
-bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit,
-                       bool filter);
+bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter);
 
 /// Fraction of light passing along a shadow ray: 0 if an opaque surface blocks it, else the
 /// product of (1 - alpha) over the Blend surfaces it crosses; Mask holes let light through.
 /// Back faces cast shadows whatever the material's sidedness.
-float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray,
-                           bool filter);
+float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray, bool filter);
 
 /// The shadow ray from surface point si towards unit direction wi, offset off the surface
 /// along the geometric normal, ending just short of `distance` (kInfinity for lights at

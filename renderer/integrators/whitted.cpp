@@ -81,7 +81,8 @@ struct Tracer {
       const float ndotl = dot(mp.ns, ls.wi);
       if (ndotl <= 0) continue;
       ++counts.shadow;
-      const float transmittance = shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
+      const float transmittance =
+          shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
       if (!(transmittance > 0)) continue;
       const Vec3f h = normalize(v + ls.wi);
       const float ndoth = std::max(0.0f, dot(mp.ns, h));
@@ -111,8 +112,7 @@ struct Tracer {
 }  // namespace
 
 Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const WhittedConfig& cfg,
-                       const Ray& camera_ray, const RayDifferential& rd, float& coverage,
-                       RayCounts& counts) {
+                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts) {
   ++counts.camera;
   Tracer tracer{scene, accel, cfg, counts};
   return tracer.trace(camera_ray, rd, 0, 0, {1, 1, 1}, &coverage);

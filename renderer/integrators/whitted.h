@@ -5,8 +5,8 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/integrators/ray_counts.h"
-#include "renderer/scene/interaction.h"
 #include "renderer/materials/material.h"
+#include "renderer/scene/interaction.h"
 
 namespace penumbra {
 
@@ -37,14 +37,14 @@ WhittedParams whitted_params(const Material& m);
 
 /// Integrator settings, validated by the CLI.
 struct WhittedConfig {
-  int max_depth = 5;               ///< maximum number of mirror bounces (0 = none)
+  int max_depth = 5;                   ///< maximum number of mirror bounces (0 = none)
   Vec3f ambient{0.05f, 0.05f, 0.05f};  ///< ambient intensity Ia (radiance units)
-  Vec3f background{0, 0, 0};       ///< radiance of rays that escape (alpha stays 0)
-  float min_reflectance = 1e-3f;   ///< mirror rays with path weight below this are not traced
-  int max_blend_layers = 16;       ///< alpha-blended surfaces composited along one ray; deeper
-                                   ///< layers count as opaque
-  bool hit_filter = true;          ///< false skips alpha/back-face filtering of hits: a speed-up,
-                                   ///< valid only when scene_needs_hit_filter() is false
+  Vec3f background{0, 0, 0};           ///< radiance of rays that escape (alpha stays 0)
+  float min_reflectance = 1e-3f;       ///< mirror rays with path weight below this are not traced
+  int max_blend_layers = 16;           ///< alpha-blended surfaces composited along one ray; deeper
+                                       ///< layers count as opaque
+  bool hit_filter = true;              ///< false skips alpha/back-face filtering of hits: a speed-up,
+                                       ///< valid only when scene_needs_hit_filter() is false
 };
 
 /// Radiance along a camera ray (counted as one camera ray) with its differentials (for texture
@@ -56,11 +56,10 @@ struct WhittedConfig {
 /// with E the light's irradiance (lights/punctual.h), V its shadow-ray transmittance
 /// (integrators/visibility.h) and
 /// h = (v + l)/|v + l|; n is the normal-mapped shading normal. A Blend surface of coverage a
-/// contributes a L + (1 - a) L(behind), front to back. The 1/pi and (p+8)/(8 pi) factors normalise the lobes so that kd and
-/// ks are albedos under glTF's physical light units.
-/// Thread-safe; never allocates, throws or logs.
+/// contributes a L + (1 - a) L(behind), front to back. The 1/pi and (p+8)/(8 pi) factors normalise the lobes
+/// so that kd and ks are albedos under glTF's physical light units. Thread-safe; never allocates, throws or
+/// logs.
 Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const WhittedConfig& cfg,
-                       const Ray& camera_ray, const RayDifferential& rd, float& coverage,
-                       RayCounts& counts);
+                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts);
 
 }  // namespace penumbra

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "renderer/scene/interaction.h"
 #include "renderer/materials/material.h"
+#include "renderer/scene/interaction.h"
 
 namespace penumbra {
 
@@ -56,7 +56,9 @@ AreaLights build_area_lights(const Scene& scene) {
       const float area = 0.5f * length(cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
       EmissiveTriangle t{uint32_t(i), prim, std::isfinite(area) ? area : 0.0f};
       double p = 0;
-      if (t.area > 0) p = double(emission_estimate(scene, t.instance, prim, tri, mat)) * t.area * (mat.double_sided ? 2 : 1);
+      if (t.area > 0)
+        p = double(emission_estimate(scene, t.instance, prim, tri, mat)) * t.area *
+            (mat.double_sided ? 2 : 1);
       lights.triangles.push_back(t);
       power.push_back(std::isfinite(p) ? p : 0.0);
     }

@@ -25,10 +25,10 @@ struct EmissiveTriangle {
 
 struct AreaLights {
   std::vector<EmissiveTriangle> triangles;
-  std::vector<float> cdf;         ///< triangles.size() + 1 entries, cdf[0] = 0, back() = 1
-  std::vector<float> pmf;         ///< selection probability of each triangle
-  std::vector<int64_t> first;     ///< per instance: index of its triangle 0, or -1 if it emits
-                                  ///< nothing (an emitting instance lists all its triangles)
+  std::vector<float> cdf;      ///< triangles.size() + 1 entries, cdf[0] = 0, back() = 1
+  std::vector<float> pmf;      ///< selection probability of each triangle
+  std::vector<int64_t> first;  ///< per instance: index of its triangle 0, or -1 if it emits
+                               ///< nothing (an emitting instance lists all its triangles)
 };
 
 /// Collects the scene's emissive triangles. Allocates; call once per render.
@@ -48,7 +48,6 @@ struct AreaLightSample {
 
 /// Picks a triangle by power with u1 and a uniform point on it with u. False if there are
 /// no lights (or the chosen triangle is degenerate). Never allocates.
-bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, Vec2f u,
-                       AreaLightSample& out);
+bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, Vec2f u, AreaLightSample& out);
 
 }  // namespace penumbra

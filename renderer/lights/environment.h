@@ -16,7 +16,7 @@
 namespace penumbra {
 
 struct Environment {
-  Vec3f color{0, 0, 0};     ///< constant radiance (used when the map is empty)
+  Vec3f color{0, 0, 0};  ///< constant radiance (used when the map is empty)
   int width = 0, height = 0;
   std::vector<Vec3f> texels;  ///< linear RGB, row-major, row 0 = +Y; empty = constant
   float intensity = 1;        ///< multiplies the map

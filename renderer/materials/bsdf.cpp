@@ -20,14 +20,18 @@ Local frame_of(const GltfBrdf& b) {
   return f;
 }
 
-float alpha_of(const GltfBrdf& b) { return std::max(kMinGgxAlpha, b.roughness * b.roughness); }
+float alpha_of(const GltfBrdf& b) {
+  return std::max(kMinGgxAlpha, b.roughness * b.roughness);
+}
 
 Vec3f schlick(Vec3f f0, float cos_theta) {
   const float k = std::pow(std::clamp(1 - cos_theta, 0.0f, 1.0f), 5.0f);
   return f0 + (Vec3f{1, 1, 1} - f0) * k;
 }
 
-Vec3f mix(Vec3f a, Vec3f b, float t) { return a * (1 - t) + b * t; }
+Vec3f mix(Vec3f a, Vec3f b, float t) {
+  return a * (1 - t) + b * t;
+}
 
 /// Density of the specular lobe's wi (local): D_v(h) / (4 v.h) = G1(v) D(h) / (4 n.v).
 float specular_pdf(Vec3f v, Vec3f h, float alpha) {

@@ -21,9 +21,9 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
   if (ref.texture < 0) return {1, 1, 1, 1};
   const Texture& tex = scene.textures[size_t(ref.texture)];
   const int set = ref.texcoord == 1 ? 1 : 0;
-  return sample_texture(tex, transform_uv(ref, si.uv[set], true),
-                        texture_lod(tex, transform_uv(ref, si.duvdx[set], false),
-                                    transform_uv(ref, si.duvdy[set], false)));
+  return sample_texture(
+      tex, transform_uv(ref, si.uv[set], true),
+      texture_lod(tex, transform_uv(ref, si.duvdx[set], false), transform_uv(ref, si.duvdy[set], false)));
 }
 
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {

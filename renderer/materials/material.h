@@ -10,16 +10,16 @@ namespace penumbra {
 
 /// A material's values at one surface point.
 struct MaterialPoint {
-  Vec3f base_color{1, 1, 1};  ///< linear RGB: factor x texture x COLOR_0
-  float alpha = 1;            ///< coverage: factor x texture.a x COLOR_0.a (1 for Opaque)
+  Vec3f base_color{1, 1, 1};          ///< linear RGB: factor x texture x COLOR_0
+  float alpha = 1;                    ///< coverage: factor x texture.a x COLOR_0.a (1 for Opaque)
   float metallic = 1, roughness = 1;  ///< factor x texture (B, G)
-  Vec3f emissive{0, 0, 0};    ///< emitted radiance: factor x strength x texture
-  float occlusion = 1;        ///< 1 + strength (texture.r - 1); ambient-only (not path traced)
-  Vec3f ns;                   ///< unit shading normal after normal mapping, facing the viewer
+  Vec3f emissive{0, 0, 0};            ///< emitted radiance: factor x strength x texture
+  float occlusion = 1;                ///< 1 + strength (texture.r - 1); ambient-only (not path traced)
+  Vec3f ns;                           ///< unit shading normal after normal mapping, facing the viewer
   bool unlit = false;
-  float f0 = 0.04f;           ///< dielectric reflectance at normal incidence, from the ior
-  float specular = 1;         ///< KHR_materials_specular factor
-  float transmission = 0;     ///< factor x texture (R)
+  float f0 = 0.04f;        ///< dielectric reflectance at normal incidence, from the ior
+  float specular = 1;      ///< KHR_materials_specular factor
+  float transmission = 0;  ///< factor x texture (R)
 };
 
 /// Dielectric reflectance at normal incidence for an index of refraction (glTF's 1.5 gives

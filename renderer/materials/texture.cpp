@@ -62,8 +62,8 @@ Vec4f sample_level(const MipLevel& l, const TextureSampler& s, Vec2f uv, Texture
   if (!(fy >= 0 && fy <= 1)) fy = 0;
   const int xa = wrap_index(x0, l.width, s.wrap_s), xb = wrap_index(x0 + 1, l.width, s.wrap_s);
   const int ya = wrap_index(y0, l.height, s.wrap_t), yb = wrap_index(y0 + 1, l.height, s.wrap_t);
-  return lerp4(lerp4(fetch(l, xa, ya), fetch(l, xb, ya), fx),
-               lerp4(fetch(l, xa, yb), fetch(l, xb, yb), fx), fy);
+  return lerp4(lerp4(fetch(l, xa, ya), fetch(l, xb, ya), fx), lerp4(fetch(l, xa, yb), fetch(l, xb, yb), fx),
+               fy);
 }
 
 }  // namespace
@@ -96,7 +96,8 @@ Texture make_texture(std::string name, int width, int height, const std::vector<
   tex.name = std::move(name);
   tex.sampler = sampler;
   std::vector<float> cur(rgba.size());
-  for (size_t i = 0; i < rgba.size(); ++i) cur[i] = std::isfinite(rgba[i]) ? std::clamp(rgba[i], 0.0f, 1.0f) : 0.0f;
+  for (size_t i = 0; i < rgba.size(); ++i)
+    cur[i] = std::isfinite(rgba[i]) ? std::clamp(rgba[i], 0.0f, 1.0f) : 0.0f;
   int w = width, h = height;
   for (;;) {
     MipLevel level;
@@ -116,7 +117,8 @@ Texture make_texture(std::string name, int width, int height, const std::vector<
         for (int c = 0; c < 4; ++c) {
           float sum = 0;
           for (int j = 0; j < 2; ++j)
-            for (int i = 0; i < 2; ++i) sum += cur[(size_t(ys[j]) * size_t(w) + size_t(xs[i])) * 4 + size_t(c)];
+            for (int i = 0; i < 2; ++i)
+              sum += cur[(size_t(ys[j]) * size_t(w) + size_t(xs[i])) * 4 + size_t(c)];
           next[(size_t(y) * size_t(nw) + size_t(x)) * 4 + size_t(c)] = sum * 0.25f;
         }
       }
@@ -143,8 +145,7 @@ Vec4f sample_texture(const Texture& tex, Vec2f uv, float lod) {
   const int last = int(tex.levels.size()) - 1;
   if (!s.mipmaps || last == 0) return sample_level(tex.levels[0], s, uv, s.min);
   const float l = std::min(lod, float(last));
-  if (s.mip == TextureFilter::Nearest)
-    return sample_level(tex.levels[size_t(std::lround(l))], s, uv, s.min);
+  if (s.mip == TextureFilter::Nearest) return sample_level(tex.levels[size_t(std::lround(l))], s, uv, s.min);
   const int l0 = std::min(int(l), last), l1 = std::min(l0 + 1, last);
   const float t = l - float(l0);
   const Vec4f a = sample_level(tex.levels[size_t(l0)], s, uv, s.min);

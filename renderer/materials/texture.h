@@ -31,7 +31,7 @@ struct MipLevel {
 };
 
 struct Texture {
-  std::string name;  ///< for messages: "textures[3] (images[1] 'wood.png')"
+  std::string name;              ///< for messages: "textures[3] (images[1] 'wood.png')"
   std::vector<MipLevel> levels;  ///< level 0 = full resolution, each next halves (ceil) down to 1x1
   TextureSampler sampler;
 };

@@ -62,10 +62,10 @@ void sample_track(std::span<const float> times, std::span<const float> values, s
       for (size_t c = 0; c < width; ++c) out[c] = (1 - s) * key_value(i)[c] + s * key_value(j)[c];
       return;
     case Interpolation::CubicSpline: {
-      const float* vi = values.data() + i * stride + width;         // value k
-      const float* bi = values.data() + i * stride + 2 * width;     // out-tangent k
-      const float* aj = values.data() + j * stride;                 // in-tangent k+1
-      const float* vj = values.data() + j * stride + width;         // value k+1
+      const float* vi = values.data() + i * stride + width;      // value k
+      const float* bi = values.data() + i * stride + 2 * width;  // out-tangent k
+      const float* aj = values.data() + j * stride;              // in-tangent k+1
+      const float* vj = values.data() + j * stride + width;      // value k+1
       const double s2 = s * s, s3 = s2 * s;
       const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
       for (size_t c = 0; c < width; ++c)

@@ -92,15 +92,16 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
   }
   if (!mesh.normals.empty()) {
     const Vec3f n0 = world_normal(inst, mesh.normals[i0]);
-    const Vec3f n1 = world_normal(inst, mesh.normals[i1]) - n0, n2 = world_normal(inst, mesh.normals[i2]) - n0;
+    const Vec3f n1 = world_normal(inst, mesh.normals[i1]) - n0,
+                n2 = world_normal(inst, mesh.normals[i2]) - n0;
     const float s = si.back_face ? -1.0f : 1.0f;  // si.ns was face-forwarded
     si.dndx = (n1 * bx.x + n2 * bx.y) * s;
     si.dndy = (n1 * by.x + n2 * by.y) * s;
   }
 }
 
-RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd,
-                                     Vec3f wo, Vec3f n, Vec3f wi) {
+RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd, Vec3f wo,
+                                     Vec3f n, Vec3f wi) {
   RayDifferential out;
   if (!rd.valid) return out;
   out.valid = true;

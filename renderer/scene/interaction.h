@@ -16,20 +16,20 @@ struct RayDifferential {
 };
 
 struct SurfaceInteraction {
-  Vec3f p;        ///< hit point, interpolated from the triangle's vertices
-  Vec3f ng;       ///< unit geometric normal, facing the incoming ray (dot(ng, -dir) >= 0)
-  Vec3f ns;       ///< unit interpolated vertex normal, in the same hemisphere as ng
-  Vec2f uv[2];    ///< TEXCOORD_0 and TEXCOORD_1 ((0,0) if absent)
+  Vec3f p;                  ///< hit point, interpolated from the triangle's vertices
+  Vec3f ng;                 ///< unit geometric normal, facing the incoming ray (dot(ng, -dir) >= 0)
+  Vec3f ns;                 ///< unit interpolated vertex normal, in the same hemisphere as ng
+  Vec2f uv[2];              ///< TEXCOORD_0 and TEXCOORD_1 ((0,0) if absent)
   Vec4f color{1, 1, 1, 1};  ///< COLOR_0 (white if absent)
-  Vec4f tangent;  ///< world tangent (xyz) and bitangent sign (w); w == 0 if the mesh has none
+  Vec4f tangent;            ///< world tangent (xyz) and bitangent sign (w); w == 0 if the mesh has none
   int material = -1;
   uint32_t instance = 0;  ///< index into Scene::instances (the Hit's geom_id)
   uint32_t mesh = 0, prim = 0;
   bool back_face = false;  ///< true if the ray hit the triangle's back (clockwise) side
   // Screen-space derivatives, zero unless compute_differentials() found a footprint.
-  Vec3f dpdx, dpdy;             ///< of the hit point
-  Vec3f dndx, dndy;             ///< of the (unnormalised) interpolated normal
-  Vec2f duvdx[2], duvdy[2];     ///< of each UV set
+  Vec3f dpdx, dpdy;          ///< of the hit point
+  Vec3f dndx, dndy;          ///< of the (unnormalised) interpolated normal
+  Vec2f duvdx[2], duvdy[2];  ///< of each UV set
 };
 
 /// Requires hit.valid() and hit ids inside the scene (as any accelerator over mesh_views()
@@ -45,7 +45,7 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
 /// dp/dx, dp/dy; directions by the change of the view vector and of the normal. `wo` is the
 /// unit direction towards the viewer, `n` the unit normal used for reflection, `wi` the
 /// reflected direction. Returns an invalid differential if rd is invalid.
-RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd,
-                                     Vec3f wo, Vec3f n, Vec3f wi);
+RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd, Vec3f wo,
+                                     Vec3f n, Vec3f wi);
 
 }  // namespace penumbra

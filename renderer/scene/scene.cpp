@@ -15,7 +15,8 @@ Instance make_instance(int mesh, const Affine3f& to_world, int node) {
   inst.to_world = to_world;
   inst.identity = is_identity(to_world);
   if (!inverse(to_world, inst.to_object))
-    throw std::invalid_argument("instance of mesh " + std::to_string(mesh) + ": transform is singular or not finite");
+    throw std::invalid_argument("instance of mesh " + std::to_string(mesh) +
+                                ": transform is singular or not finite");
   inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
   return inst;
 }
@@ -110,9 +111,8 @@ std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
   return n;
 }
 
-std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
-                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
-                                    std::span<const uint32_t> indices) {
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                                    std::span<const Vec2f> uvs, std::span<const uint32_t> indices) {
   std::vector<Vec3f> tu(positions.size()), tv(positions.size());
   for (size_t i = 0; i + 2 < indices.size(); i += 3) {
     const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];

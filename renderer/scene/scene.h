@@ -16,8 +16,8 @@ namespace penumbra {
 /// A material's reference to a texture: which UV set, and KHR_texture_transform's affine map
 /// uv' = [m00 m01 m02; m10 m11 m12] (u, v, 1), the identity by default.
 struct TextureRef {
-  int texture = -1;   ///< index into Scene::textures; -1 = none
-  int texcoord = 0;   ///< 0 = TEXCOORD_0, 1 = TEXCOORD_1
+  int texture = -1;  ///< index into Scene::textures; -1 = none
+  int texcoord = 0;  ///< 0 = TEXCOORD_0, 1 = TEXCOORD_1
   float m[2][3] = {{1, 0, 0}, {0, 1, 0}};
 };
 
@@ -29,14 +29,14 @@ struct Material {
   std::string name;
   Vec3f base_color{1, 1, 1};  ///< linear RGB factor
   float alpha = 1;            ///< baseColorFactor.a
-  float metallic = 1;   ///< glTF default
-  float roughness = 1;  ///< glTF default
-  Vec3f emissive{0, 0, 0};  ///< emissiveFactor x KHR_materials_emissive_strength
-  bool unlit = false;       ///< KHR_materials_unlit: radiance = base_color, no lighting
+  float metallic = 1;         ///< glTF default
+  float roughness = 1;        ///< glTF default
+  Vec3f emissive{0, 0, 0};    ///< emissiveFactor x KHR_materials_emissive_strength
+  bool unlit = false;         ///< KHR_materials_unlit: radiance = base_color, no lighting
   AlphaMode alpha_mode = AlphaMode::Opaque;
-  float alpha_cutoff = 0.5f;  ///< Mask: coverage < cutoff is a hole
-  bool double_sided = true;   ///< false: back faces are invisible to camera and mirror rays
-                              ///< (glTF's default is false; io/ sets it from the file)
+  float alpha_cutoff = 0.5f;          ///< Mask: coverage < cutoff is a hole
+  bool double_sided = true;           ///< false: back faces are invisible to camera and mirror rays
+                                      ///< (glTF's default is false; io/ sets it from the file)
   TextureRef base_color_tex;          ///< RGBA, multiplies base_color and alpha
   TextureRef metallic_roughness_tex;  ///< B = metallic, G = roughness (linear)
   TextureRef normal_tex;              ///< tangent-space normal map (linear)
@@ -53,25 +53,25 @@ struct Material {
 /// A triangle mesh (one glTF primitive): in world space when its only instance is the identity
 /// (a flattened node), else in the object space its instances place.
 struct Mesh {
-  std::string name;                ///< "meshName[prim]" for messages
+  std::string name;  ///< "meshName[prim]" for messages
   std::vector<Vec3f> positions;
-  std::vector<Vec3f> normals;      ///< unit, one per position (computed if the file has none)
-  std::vector<Vec4f> tangents;     ///< xyz unit tangent along +u, w = +-1 bitangent sign
-                                   ///< (bitangent = w cross(n, t)); empty if not needed
-  std::vector<Vec2f> uvs;          ///< TEXCOORD_0, empty if absent
-  std::vector<Vec2f> uvs1;         ///< TEXCOORD_1, empty if absent
-  std::vector<Vec4f> colors;       ///< COLOR_0 as linear RGBA, empty if absent
-  std::vector<uint32_t> indices;   ///< 3 per triangle, counter-clockwise = front
-  int material = -1;               ///< index into Scene::materials, -1 = default material
-  int node = -1;                   ///< glTF node of a flattened mesh, -1 if shared or not from glTF
+  std::vector<Vec3f> normals;     ///< unit, one per position (computed if the file has none)
+  std::vector<Vec4f> tangents;    ///< xyz unit tangent along +u, w = +-1 bitangent sign
+                                  ///< (bitangent = w cross(n, t)); empty if not needed
+  std::vector<Vec2f> uvs;         ///< TEXCOORD_0, empty if absent
+  std::vector<Vec2f> uvs1;        ///< TEXCOORD_1, empty if absent
+  std::vector<Vec4f> colors;      ///< COLOR_0 as linear RGBA, empty if absent
+  std::vector<uint32_t> indices;  ///< 3 per triangle, counter-clockwise = front
+  int material = -1;              ///< index into Scene::materials, -1 = default material
+  int node = -1;                  ///< glTF node of a flattened mesh, -1 if shared or not from glTF
 };
 
 /// One placement of a mesh in the world. A Hit's geom_id is an index into Scene::instances.
 /// Make them with make_instance() so the inverse and `mirrored` agree with `to_world`.
 struct Instance {
-  int mesh = 0;        ///< index into Scene::meshes
-  Affine3f to_world;   ///< object to world
-  Affine3f to_object;  ///< its inverse
+  int mesh = 0;           ///< index into Scene::meshes
+  Affine3f to_world;      ///< object to world
+  Affine3f to_object;     ///< its inverse
   bool identity = true;   ///< to_world is the identity (the mesh is in world space)
   bool mirrored = false;  ///< det(to_world) < 0: the front face is clockwise in world space
                           ///< (glTF 3.7.4), i.e. counter-clockwise in object space
@@ -88,10 +88,10 @@ struct Light {
   LightType type = LightType::Point;
   Vec3f color{1, 1, 1};
   float intensity = 1;
-  Vec3f position;           ///< point / spot
-  Vec3f direction{0, 0, -1};  ///< spot / directional: unit direction the light travels
-  float range = kInfinity;  ///< point / spot cut-off distance (spec's smooth window)
-  float inner_cone = 0;     ///< spot, radians
+  Vec3f position;              ///< point / spot
+  Vec3f direction{0, 0, -1};   ///< spot / directional: unit direction the light travels
+  float range = kInfinity;     ///< point / spot cut-off distance (spec's smooth window)
+  float inner_cone = 0;        ///< spot, radians
   float outer_cone = kPi / 4;  ///< spot, radians
 };
 
@@ -104,10 +104,10 @@ struct Camera {
   Projection projection = Projection::Perspective;
   Vec3f eye;
   Vec3f u{1, 0, 0}, v{0, 1, 0}, w{0, 0, 1};
-  float yfov = 0.6911f;   ///< perspective: vertical field of view, radians (0.6911 ~ 39.6 deg)
-  float aspect = 0;       ///< the file's aspect-ratio hint (width/height); 0 = none
+  float yfov = 0.6911f;      ///< perspective: vertical field of view, radians (0.6911 ~ 39.6 deg)
+  float aspect = 0;          ///< the file's aspect-ratio hint (width/height); 0 = none
   float xmag = 1, ymag = 1;  ///< orthographic half-extents
-  float znear = 0;        ///< clip distances along -w
+  float znear = 0;           ///< clip distances along -w
   float zfar = kInfinity;
 };
 
@@ -162,8 +162,7 @@ std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,
 /// -dp/dv (glTF's V axis points down the image, so +Y of the map is -v), else -1, which is
 /// the MikkTSpace convention for glTF. Vertices without usable UVs get any unit tangent
 /// orthogonal to n.
-std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions,
-                                    std::span<const Vec3f> normals, std::span<const Vec2f> uvs,
-                                    std::span<const uint32_t> indices);
+std::vector<Vec4f> compute_tangents(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                                    std::span<const Vec2f> uvs, std::span<const uint32_t> indices);
 
 }  // namespace penumbra

@@ -1,13 +1,14 @@
 // The seeded benchmark scene generators: sizes, determinism, the property each scene is meant
 // to stress, and every acceleration structure cross-checked on small versions of each.
+#include "benchmarks/scenegen.h"
+
 #include <catch2/catch.hpp>
 #include <cstring>
 
-#include "benchmarks/scenegen.h"
 #include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
-#include "support/cross_check.h"
 #include "renderer/integrators/scene_accel.h"
+#include "support/cross_check.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -20,7 +21,8 @@ bool same_geometry(const Scene& a, const Scene& b) {
   for (size_t i = 0; i < a.meshes.size(); ++i) {
     const Mesh &x = a.meshes[i], &y = b.meshes[i];
     if (x.indices != y.indices || x.positions.size() != y.positions.size()) return false;
-    if (std::memcmp(x.positions.data(), y.positions.data(), x.positions.size() * sizeof(Vec3f)) != 0) return false;
+    if (std::memcmp(x.positions.data(), y.positions.data(), x.positions.size() * sizeof(Vec3f)) != 0)
+      return false;
   }
   return true;
 }
@@ -90,7 +92,8 @@ TEST_CASE("scenegen: each scene has the shape it is meant to stress", "[scenegen
     const Mesh& m = s.meshes[0];
     int octant[8] = {};
     for (size_t t = 0; t < m.indices.size(); t += 3) {
-      const Vec3f c = (m.positions[m.indices[t]] + m.positions[m.indices[t + 1]] + m.positions[m.indices[t + 2]]) / 3.0f;
+      const Vec3f c =
+          (m.positions[m.indices[t]] + m.positions[m.indices[t + 1]] + m.positions[m.indices[t + 2]]) / 3.0f;
       ++octant[(c.x > 0) + 2 * (c.y > 0) + 4 * (c.z > 0)];
     }
     for (int o : octant) CHECK(std::abs(o - 5000) < 250);
@@ -103,7 +106,8 @@ TEST_CASE("scenegen: each scene has the shape it is meant to stress", "[scenegen
     int hits = 0;
     for (int i = 0; i < 50; ++i)
       for (int j = 0; j < 50; ++j) {
-        const float x = b.lo.x + (b.hi.x - b.lo.x) * (i + 0.5f) / 50, z = b.lo.z + (b.hi.z - b.lo.z) * (j + 0.5f) / 50;
+        const float x = b.lo.x + (b.hi.x - b.lo.x) * (i + 0.5f) / 50,
+                    z = b.lo.z + (b.hi.z - b.lo.z) * (j + 0.5f) / 50;
         Hit h;
         hits += a->intersect({{x, b.hi.y + 1, z}, 0, {0, -1, 0}, kInfinity}, h);
       }

@@ -8,9 +8,11 @@ using namespace penumbra;
 
 TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   AccelConfig c;
-  for (const char* kv : {"embree.robust=0", "embree.quality=2", "bvh.width=2", "bvh.max_leaf_size=3", "bvh.bin_count=32", "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5",
-                         "kdtree.traversal_cost=1", "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5",
-                         "kdtree.max_depth=30", "grid.lambda=8", "grid.max_resolution=64", "grid.max_cells=4096"})
+  for (const char* kv :
+       {"embree.robust=0", "embree.quality=2", "bvh.width=2", "bvh.max_leaf_size=3", "bvh.bin_count=32",
+        "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5", "kdtree.traversal_cost=1",
+        "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5", "kdtree.max_depth=30", "grid.lambda=8",
+        "grid.max_resolution=64", "grid.max_cells=4096"})
     apply_accel_param(c, kv);
   CHECK_FALSE(c.embree.robust);
   CHECK(c.embree.quality == 2);
@@ -31,13 +33,15 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {
   AccelConfig c;
-  CHECK_THROWS_WITH(apply_accel_param(c, "bvh.leaf=3"), Catch::Contains("unknown key 'bvh.leaf'") && Catch::Contains("bvh.max_leaf_size"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "bvh.leaf=3"),
+                    Catch::Contains("unknown key 'bvh.leaf'") && Catch::Contains("bvh.max_leaf_size"));
   CHECK_THROWS_WITH(apply_accel_param(c, "bvh.max_leaf_size"), Catch::Contains("expected key=value"));
   CHECK_THROWS_WITH(apply_accel_param(c, "bvh.max_leaf_size=3.5"), Catch::Contains("bvh.max_leaf_size"));
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.max_cells=-1"), Catch::Contains("grid.max_cells"));
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda=nan"), Catch::Contains("grid.lambda"));
   CHECK_THROWS_WITH(apply_accel_param(c, "grid.lambda="), Catch::Contains("grid.lambda"));
-  CHECK_THROWS_WITH(apply_accel_param(c, "embree.robust=2"), Catch::Contains("embree.robust: must be 0 or 1"));
+  CHECK_THROWS_WITH(apply_accel_param(c, "embree.robust=2"),
+                    Catch::Contains("embree.robust: must be 0 or 1"));
   CHECK(c.bvh.max_leaf_size == BvhConfig{}.max_leaf_size);  // failed assignments leave it alone
 }
 

@@ -24,8 +24,12 @@ std::string read_text(const fs::path& p) {
   ss << in.rdbuf();
   return ss.str();
 }
-void write_text(const fs::path& temp, const std::string& text) { write_file_checked(temp, text.data(), text.size()); }
-size_t entries(const fs::path& dir) { return size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator())); }
+void write_text(const fs::path& temp, const std::string& text) {
+  write_file_checked(temp, text.data(), text.size());
+}
+size_t entries(const fs::path& dir) {
+  return size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
 }  // namespace
 
 TEST_CASE("resolve_output: each kind of target", "[io][atomic][quick]") {
@@ -65,21 +69,26 @@ TEST_CASE("check_distinct_files: one file under any name is refused", "[io][atom
   CHECK_THROWS_WITH(check_distinct_files({{"-o", dir / "a.exr"}, {"--stats-json", dir / "hard.json"}}),
                     Contains("-o " + (dir / "a.exr").string() + " and --stats-json"));
   fs::create_symlink(dir / "new.exr", dir / "dangling.json");  // neither exists yet
-  CHECK_THROWS_AS(check_distinct_files({{"-o", dir / "new.exr"}, {"--stats-json", dir / "dangling.json"}}), InputError);
-  CHECK_THROWS_WITH(check_distinct_files({{"--stats-json", dir / "a.exr"}}, {{"the scene file", dir / "hard.json"}}),
-                    Contains("would overwrite the scene file"));
+  CHECK_THROWS_AS(check_distinct_files({{"-o", dir / "new.exr"}, {"--stats-json", dir / "dangling.json"}}),
+                  InputError);
+  CHECK_THROWS_WITH(
+      check_distinct_files({{"--stats-json", dir / "a.exr"}}, {{"the scene file", dir / "hard.json"}}),
+      Contains("would overwrite the scene file"));
 }
 
-TEST_CASE("write_atomically: replaces, streams, records and keeps the old file on failure", "[io][atomic][quick]") {
+TEST_CASE("write_atomically: replaces, streams, records and keeps the old file on failure",
+          "[io][atomic][quick]") {
   const auto dir = test::temp_dir("atomic_write");
   const fs::path dest = dir / "out.json";
   write_text(dest, "previous");
   ::chmod(dest.c_str(), 0640);
   std::string sha;
-  write_atomically(dest, [](const fs::path& temp) { write_text(temp, "new contents"); }, &sha);
+  write_atomically(
+      dest, [](const fs::path& temp) { write_text(temp, "new contents"); }, &sha);
   CHECK(read_text(dest) == "new contents");
   CHECK(sha == sha256_hex("new contents"));
-  CHECK((fs::status(dest).permissions() & fs::perms::all) == (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+  CHECK((fs::status(dest).permissions() & fs::perms::all) ==
+        (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
   // Through a symlink: the target is replaced, the link stays a link.
   fs::create_symlink("out.json", dir / "link.json");
   write_atomically(dir / "link.json", [](const fs::path& temp) { write_text(temp, "via link"); });
@@ -93,7 +102,8 @@ TEST_CASE("write_atomically: replaces, streams, records and keeps the old file o
   CHECK(read_text(dest) == "via link");
   CHECK(entries(dir) == 2);
   // Streams: /dev/null takes the bytes and stays a device; /dev/full reports its errno.
-  write_atomically("/dev/null", [](const fs::path& temp) { write_text(temp, "discarded"); }, &sha);
+  write_atomically(
+      "/dev/null", [](const fs::path& temp) { write_text(temp, "discarded"); }, &sha);
   CHECK(sha == sha256_hex("discarded"));
   CHECK(fs::is_character_file("/dev/null"));
   CHECK_THROWS_WITH(write_atomically("/dev/full", [](const fs::path& temp) { write_text(temp, "x"); }),

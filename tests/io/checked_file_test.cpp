@@ -49,7 +49,8 @@ std::string bytes_of(const std::filesystem::path& p) {
 
 }  // namespace
 
-TEST_CASE("checked file: a write that cannot complete is an error and the old file stays", "[io][checked][quick]") {
+TEST_CASE("checked file: a write that cannot complete is an error and the old file stays",
+          "[io][checked][quick]") {
   const auto dir = test::temp_dir("checked_file");
   for (const char* name : {"big.exr", "big.png", "big.tif"}) {
     const auto path = dir / name;

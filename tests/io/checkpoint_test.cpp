@@ -10,8 +10,8 @@
 #include <iterator>
 #include <limits>
 
-#include "support/fifo_test_util.h"
 #include "io/error.h"
+#include "support/fifo_test_util.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

@@ -52,10 +52,9 @@ TEST_CASE("environment maps load from EXR and HDR with intensity and rotation", 
 
 TEST_CASE("bad environment maps are errors naming the file", "[io][environment][hostile][quick]") {
   const auto dir = test::temp_dir("envbad");
-  REQUIRE_THROWS_WITH(load_environment(dir / "none.exr", 1, 0), Contains("none.exr") && Contains("not found"));
-  {
-    std::ofstream(dir / "junk.exr") << "not an image";
-  }
+  REQUIRE_THROWS_WITH(load_environment(dir / "none.exr", 1, 0),
+                      Contains("none.exr") && Contains("not found"));
+  { std::ofstream(dir / "junk.exr") << "not an image"; }
   REQUIRE_THROWS_AS(load_environment(dir / "junk.exr", 1, 0), InputError);
   std::vector<float> v = ramp();
   v[3 * 9] = std::numeric_limits<float>::quiet_NaN();  // texel (1, 1)
@@ -68,6 +67,7 @@ TEST_CASE("bad environment maps are errors naming the file", "[io][environment][
   REQUIRE_THROWS_WITH(load_environment(dir / "ok.exr", -1, 0), Contains("env-intensity"));
   // A map beyond the memory budget is refused before its pixels are decoded.
   CHECK(environment_bytes(8, 4, 3) == 8 * 4 * (12 + 20));
-  REQUIRE_THROWS_WITH(load_environment(dir / "ok.exr", 1, 0, 512), Contains("ok.exr") && Contains("memory budget"));
+  REQUIRE_THROWS_WITH(load_environment(dir / "ok.exr", 1, 0, 512),
+                      Contains("ok.exr") && Contains("memory budget"));
   CHECK(load_environment(dir / "ok.exr", 1, 0, 8 * 4 * 32).width == 8);
 }

@@ -10,13 +10,13 @@
 #include <cstring>
 #include <fstream>
 
-#include "support/fifo_test_util.h"
 #include "io/error.h"
 #include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "io/render_settings.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
+#include "support/fifo_test_util.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

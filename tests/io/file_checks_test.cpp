@@ -28,7 +28,8 @@ TEST_CASE("check_input_file: only bounded regular files", "[io][files][quick]") 
   const auto dir = test::temp_dir("file_checks");
   { std::ofstream(dir / "ten.bin") << "0123456789"; }
   CHECK(check_input_file(dir / "ten.bin", "x", 10) == 10);
-  CHECK_THAT(message_of(dir / "ten.bin", 9), Contains("ten.bin: --thing: is 10 bytes, over the 9 bytes limit"));
+  CHECK_THAT(message_of(dir / "ten.bin", 9),
+             Contains("ten.bin: --thing: is 10 bytes, over the 9 bytes limit"));
   CHECK_THAT(message_of(dir / "missing"), Contains("--thing: file not found"));
   CHECK_THAT(message_of(dir), Contains("is a directory, not a regular file"));
   REQUIRE(::mkfifo((dir / "fifo").c_str(), 0600) == 0);

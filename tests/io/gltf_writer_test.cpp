@@ -1,11 +1,12 @@
 // write_gltf: everything it writes comes back through load_gltf (geometry bit for bit,
 // materials, lights and cameras), and bad scenes or folders fail without leaving files.
+#include "io/gltf_writer.h"
+
 #include <catch2/catch.hpp>
 #include <cstring>
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
-#include "io/gltf_writer.h"
 #include "renderer/scene/camera.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
@@ -76,7 +77,6 @@ Scene sample_scene() {
   return s;
 }
 
-
 }  // namespace
 
 TEST_CASE("write_gltf: a scene comes back through load_gltf", "[gltf][writer]") {
@@ -91,10 +91,12 @@ TEST_CASE("write_gltf: a scene comes back through load_gltf", "[gltf][writer]") 
   for (size_t i = 0; i < 3; ++i) {
     CHECK(r.meshes[i].indices == s.meshes[i].indices);
     REQUIRE(r.meshes[i].positions.size() == s.meshes[i].positions.size());
-    CHECK(std::memcmp(r.meshes[i].positions.data(), s.meshes[i].positions.data(), s.meshes[i].positions.size() * 12) == 0);
+    CHECK(std::memcmp(r.meshes[i].positions.data(), s.meshes[i].positions.data(),
+                      s.meshes[i].positions.size() * 12) == 0);
     CHECK(r.meshes[i].material == s.meshes[i].material);
   }
-  for (int k = 0; k < 3; ++k) check_vec(r.meshes[0].normals[size_t(k)], s.meshes[0].normals[size_t(k)], 1e-6f);
+  for (int k = 0; k < 3; ++k)
+    check_vec(r.meshes[0].normals[size_t(k)], s.meshes[0].normals[size_t(k)], 1e-6f);
   REQUIRE(r.meshes[0].uvs.size() == 3);
   CHECK(r.meshes[0].uvs[2].y == 1.0f);
   REQUIRE(r.materials.size() == 3);
@@ -127,7 +129,8 @@ TEST_CASE("write_gltf: a scene comes back through load_gltf", "[gltf][writer]") 
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("write_gltf: bad scenes and folders fail with the element named and leave no file", "[gltf][writer]") {
+TEST_CASE("write_gltf: bad scenes and folders fail with the element named and leave no file",
+          "[gltf][writer]") {
   const auto dir = temp_dir("gltf-writer-bad");
   Scene s = sample_scene();
   s.meshes[1].positions[2].y = std::nanf("");
@@ -137,7 +140,8 @@ TEST_CASE("write_gltf: bad scenes and folders fail with the element named and le
   CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[2]: index 9 >= vertex count 4"));
   s = sample_scene();
   s.meshes[0].indices.push_back(0);
-  CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"), Catch::Contains("meshes[0]: index count 4 is not a multiple of 3"));
+  CHECK_THROWS_WITH(write_gltf(s, dir / "bad.gltf"),
+                    Catch::Contains("meshes[0]: index count 4 is not a multiple of 3"));
   CHECK(std::filesystem::is_empty(dir));
   CHECK_THROWS_AS(write_gltf(sample_scene(), dir / "missing" / "x.gltf"), InputError);
   std::filesystem::remove_all(dir);

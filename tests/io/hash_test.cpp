@@ -49,8 +49,10 @@ TEST_CASE("sha256: files agree with sha256sum; non-regular files are refused", "
   char buf[65] = {};
   const size_t n = std::fread(buf, 1, 64, p);
   ::pclose(p);
-  if (n == 64) CHECK(ours == std::string(buf, 64));
-  else test::skip("sha256sum is not available");
+  if (n == 64)
+    CHECK(ours == std::string(buf, 64));
+  else
+    test::skip("sha256sum is not available");
   CHECK_THROWS_AS(sha256_file(dir), InputError);
   CHECK_THROWS_AS(sha256_file(dir / "missing"), InputError);
 }
@@ -74,7 +76,7 @@ TEST_CASE("sha256_of_files: content and relative names, not the folder", "[io][h
     return sha256_of_files({d / "scene.gltf", std::filesystem::canonical(d / "tex" / "wood.png")});
   };
   const std::string original = set(a);
-  CHECK(set(b) == original);  // the same files elsewhere
+  CHECK(set(b) == original);                          // the same files elsewhere
   std::ofstream(b / "tex" / "wood.png") << "pixelz";  // same size, other bytes
   CHECK(set(b) != original);
   std::filesystem::rename(a / "tex" / "wood.png", a / "tex" / "pine.png");  // same bytes, other name

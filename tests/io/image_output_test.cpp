@@ -4,8 +4,8 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include <catch2/catch.hpp>
 #include <array>
+#include <catch2/catch.hpp>
 #include <fstream>
 
 #include "io/atomic_file.h"
@@ -38,7 +38,8 @@ std::vector<float> read_all(const std::filesystem::path& p, OIIO::ImageSpec& spe
 }
 
 size_t files_in(const std::filesystem::path& dir) {
-  return size_t(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+  return size_t(
+      std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
 }
 }  // namespace
 
@@ -61,8 +62,10 @@ TEST_CASE("EXR round trip: RGBA channels, size, half and float precision", "[io]
     CHECK(spec.format == (half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT));
     CHECK(spec.get_string_attribute("penumbra:test") == "yes");
     for (size_t i = 0; i < px.size(); ++i) {
-      if (half) REQUIRE(px[i] == Approx(f.rgba[i]).epsilon(1e-3).margin(1e-4));
-      else REQUIRE(px[i] == f.rgba[i]);
+      if (half)
+        REQUIRE(px[i] == Approx(f.rgba[i]).epsilon(1e-3).margin(1e-4));
+      else
+        REQUIRE(px[i] == f.rgba[i]);
     }
   }
   CHECK(files_in(dir) == 2);  // no temporaries left behind
@@ -81,7 +84,8 @@ TEST_CASE("display PNG: 8-bit RGB through the shipped config's sRGB view", "[io]
   CHECK(spec.nchannels == 3);
   CHECK(spec.format == OIIO::TypeDesc::UINT8);
   auto srgb = [](double l) { return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1 / 2.4) - 0.055; };
-  for (int x = 0; x < 4; ++x) CHECK(px[size_t(x) * 3] == Approx(std::round(srgb(values[x]) * 255) / 255).margin(1.0 / 255));
+  for (int x = 0; x < 4; ++x)
+    CHECK(px[size_t(x) * 3] == Approx(std::round(srgb(values[x]) * 255) / 255).margin(1.0 / 255));
   // +1 stop of exposure makes 0.25 display like 0.5.
   opt.exposure = 1;
   write_display_image(f, dir / "b.png", opt);
@@ -89,7 +93,8 @@ TEST_CASE("display PNG: 8-bit RGB through the shipped config's sRGB view", "[io]
   CHECK(px2[9] == Approx(px[3]).margin(1.0 / 255));
 }
 
-TEST_CASE("a missing OCIO config or view is an input error and nothing is written", "[io][image][ocio][quick]") {
+TEST_CASE("a missing OCIO config or view is an input error and nothing is written",
+          "[io][image][ocio][quick]") {
   const auto dir = test::temp_dir("ocio-bad");
   const Film f = ramp(4, 4);
   DisplayOptions opt;
@@ -101,13 +106,16 @@ TEST_CASE("a missing OCIO config or view is an input error and nothing is writte
   CHECK(files_in(dir) == 0);
   // The up-front check: same failures, with the valid choices listed, and a bad extension.
   using Catch::Matchers::Contains;
-  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no view 'No Such View'") && Contains("Standard, Filmic, Raw"));
+  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt),
+                    Contains("no view 'No Such View'") && Contains("Standard, Filmic, Raw"));
   opt.view.clear();
   CHECK_NOTHROW(check_display_output(dir / "x.PNG", opt));
   CHECK_NOTHROW(check_display_output(dir / "x.tiff", opt));
-  CHECK_THROWS_WITH(check_display_output(dir / "x.bmp", opt), Contains("x.bmp") && Contains("unsupported display image format"));
+  CHECK_THROWS_WITH(check_display_output(dir / "x.bmp", opt),
+                    Contains("x.bmp") && Contains("unsupported display image format"));
   opt.display = "P3";
-  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt), Contains("no display 'P3'") && Contains("sRGB"));
+  CHECK_THROWS_WITH(check_display_output(dir / "x.png", opt),
+                    Contains("no display 'P3'") && Contains("sRGB"));
   CHECK(files_in(dir) == 0);
 }
 
@@ -159,7 +167,8 @@ TEST_CASE("EXR AOV channels are written as exact 32-bit floats after R, G, B, A"
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a legend below", "[io][heatmap]") {
+TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a legend below",
+          "[io][heatmap]") {
   const auto dir = penumbra::test::temp_dir("heatmap");
   const int w = 100, h = 40;
   std::vector<float> v(size_t(w) * h, 0.0f);
@@ -171,7 +180,9 @@ TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a
   CHECK(spec.width == w);
   CHECK(spec.height > h);  // legend strip
   CHECK(spec.nchannels == 3);
-  auto at = [&](int x, int y, int c) { return std::lround(px[(size_t(y) * size_t(spec.width) + size_t(x)) * 3 + size_t(c)] * 255); };
+  auto at = [&](int x, int y, int c) {
+    return std::lround(px[(size_t(y) * size_t(spec.width) + size_t(x)) * 3 + size_t(c)] * 255);
+  };
   CHECK(at(10, 10, 0) == 68);  // viridis at 0
   CHECK(at(10, 10, 2) == 84);
   CHECK(at(0, 0, 0) == 68);
@@ -186,7 +197,8 @@ TEST_CASE("heat maps: zero is the ramp's dark end, the maximum its yellow end, a
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadata round-trip", "[io][exr][aov][quick]") {
+TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadata round-trip",
+          "[io][exr][aov][quick]") {
   const auto dir = penumbra::test::temp_dir("exr-layers");
   const Film f = ramp(8, 4);
   std::vector<float> normal(8 * 4 * 3), ids(8 * 4), albedo(8 * 4 * 3);
@@ -198,8 +210,10 @@ TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadat
     ids[i] = float(100000 + i * 7);  // beyond half's integers
   }
   ExrOptions opt;
-  for (int c = 0; c < 3; ++c) opt.extra.push_back({std::string("N.") + "XYZ"[c], &normal, ChannelType::Float, 3, c});
-  for (int c = 0; c < 3; ++c) opt.extra.push_back({std::string("albedo.") + "RGB"[c], &albedo, ChannelType::Half, 3, c});
+  for (int c = 0; c < 3; ++c)
+    opt.extra.push_back({std::string("N.") + "XYZ"[c], &normal, ChannelType::Float, 3, c});
+  for (int c = 0; c < 3; ++c)
+    opt.extra.push_back({std::string("albedo.") + "RGB"[c], &albedo, ChannelType::Half, 3, c});
   opt.extra.push_back({"id.object", &ids, ChannelType::Uint});
   const std::array<float, 16> m = {1, 2, 3, 0, 4, 5, 6, 0, 7, 8, 9, 0, 10, 11, 12, 1};
   opt.matrix_metadata.push_back({"worldToCamera", m});
@@ -238,7 +252,8 @@ TEST_CASE("EXR layers: strided vectors, uint ids, half colour and matrix metadat
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("display: the shipped Filmic view rolls highlights off; looks act in scene-linear", "[io][image][ocio][quick]") {
+TEST_CASE("display: the shipped Filmic view rolls highlights off; looks act in scene-linear",
+          "[io][image][ocio][quick]") {
   const std::vector<float> values = {0.0f, 0.01f, 0.05f, 0.18f, 0.5f, 1.0f, 2.0f, 4.0f, 16.0f, 64.0f};
   auto through = [&](const std::string& view, const std::string& look) {
     std::vector<float> rgb;
@@ -269,5 +284,6 @@ TEST_CASE("display: the shipped Filmic view rolls highlights off; looks act in s
   CHECK(through("Standard", "Plus 1 EV")[3] == Approx(grey[1]).margin(1e-4));
   DisplayOptions bad;
   bad.look = "Bleach";
-  CHECK_THROWS_WITH(check_display_output("x.png", bad), Catch::Contains("no look 'Bleach' (available: High Contrast"));
+  CHECK_THROWS_WITH(check_display_output("x.png", bad),
+                    Catch::Contains("no look 'Bleach' (available: High Contrast"));
 }

@@ -1,11 +1,12 @@
 // load_ply: ASCII and binary (both byte orders) files give the same triangles; malformed files
 // fail with the file and the element named.
+#include "io/ply_loader.h"
+
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <fstream>
 
 #include "io/error.h"
-#include "io/ply_loader.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -24,7 +25,9 @@ std::string header(const char* format) {
   return buf;
 }
 
-void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+void write(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
 
 void check_square(const Scene& s) {
   REQUIRE(s.meshes.size() == 1);
@@ -43,7 +46,8 @@ void check_square(const Scene& s) {
 TEST_CASE("load_ply: ASCII, binary little- and big-endian give the same mesh", "[ply]") {
   const auto dir = temp_dir("ply");
   const float v[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0.5f}};
-  write(dir / "a.ply", header("ascii") + "0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n2 0 0.5 5\n4 0 1 2 3\n3 1 4 2\n");
+  write(dir / "a.ply",
+        header("ascii") + "0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n2 0 0.5 5\n4 0 1 2 3\n3 1 4 2\n");
   check_square(load_ply(dir / "a.ply"));
   for (bool big : {false, true}) {
     std::string body;
@@ -87,11 +91,14 @@ TEST_CASE("load_ply: malformed files name the file and the element", "[ply]") {
   fails_with(header("binary_middle_endian"), "header line 2: unknown format 'binary_middle_endian'");
   fails_with("ply\nformat ascii 1.0\nelement vertex 99999999999\n", "count in [0, 2^31]");
   // A header claiming 2^31 vertices in a tiny file: a clean error, not a 24 GiB allocation.
-  fails_with("ply\nformat binary_little_endian 1.0\nelement vertex 2147483648\nproperty float x\nproperty float y\n"
-             "property float z\nend_header\n",
-             "vertex[0]: unexpected end of file");
-  fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "unexpected end of file in the header");
-  fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n", "needs x, y and z");
+  fails_with(
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2147483648\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n",
+      "vertex[0]: unexpected end of file");
+  fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
+             "unexpected end of file in the header");
+  fails_with("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
+             "needs x, y and z");
   CHECK_THROWS_WITH(load_ply(dir / "missing.ply"), Catch::Contains("missing.ply: file not found"));
   std::filesystem::remove_all(dir);
 }

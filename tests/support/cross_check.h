@@ -5,21 +5,20 @@
 #pragma once
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <map>
+#include <memory>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
 
-#include <catch2/catch.hpp>
-
 #include "renderer/accel/factory.h"
-#include "renderer/scene/camera.h"
 #include "renderer/core/geometry.h"
 #include "renderer/core/rng.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra::test {
 
@@ -31,7 +30,8 @@ struct NamedAccel {
 };
 
 /// Every back end over `views` ("brute" keeps references: views must outlive the result).
-inline std::vector<NamedAccel> build_all(std::span<const TriangleMeshView> views, const AccelConfig& config = {}) {
+inline std::vector<NamedAccel> build_all(std::span<const TriangleMeshView> views,
+                                         const AccelConfig& config = {}) {
   std::vector<NamedAccel> out;
   for (const auto& n : accelerator_names()) out.push_back({n, make_accelerator(n, views, config)});
   return out;
@@ -53,7 +53,8 @@ inline std::string describe(const Ray& r) {
 inline std::string describe(const Hit& h) {
   if (!h.valid()) return "miss";
   char buf[160];
-  std::snprintf(buf, sizeof buf, "t %.9g geom %u prim %u uv (%.6g, %.6g)", h.t, h.geom_id, h.prim_id, h.u, h.v);
+  std::snprintf(buf, sizeof buf, "t %.9g geom %u prim %u uv (%.6g, %.6g)", h.t, h.geom_id, h.prim_id, h.u,
+                h.v);
   return buf;
 }
 
@@ -73,7 +74,8 @@ inline bool meets_at(std::span<const TriangleMeshView> views, const Ray& r, uint
     e2[k] = double(c[k]) - a[k];
     ap[k] = p[k] - a[k];
   }
-  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
   const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
   if (nn == 0) return false;
   // Distance of p from the plane, in units of t.
@@ -145,11 +147,12 @@ struct CrossCheckResult {
 
 inline std::string summary(const std::string& what, const CrossCheckResult& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "%s: %zu rays (%zu hits, tolerated: %zu boundary, %zu edge): hit/miss %zu, t %zu, prim %zu, uv %zu, "
-                "occluded %zu%s%s",
-                what.c_str(), r.rays, r.hits, r.boundary, r.edge, r.hit_miss, r.t, r.prim, r.uv, r.occlusion,
-                r.first.empty() ? "" : "\n  first: ", r.first.c_str());
+  std::snprintf(
+      buf, sizeof buf,
+      "%s: %zu rays (%zu hits, tolerated: %zu boundary, %zu edge): hit/miss %zu, t %zu, prim %zu, uv %zu, "
+      "occluded %zu%s%s",
+      what.c_str(), r.rays, r.hits, r.boundary, r.edge, r.hit_miss, r.t, r.prim, r.uv, r.occlusion,
+      r.first.empty() ? "" : "\n  first: ", r.first.c_str());
   return buf;
 }
 
@@ -168,10 +171,10 @@ inline Reference reference(const Accelerator& ref, std::vector<Ray> rays) {
 
 /// Compares `a` with a reference on every ray. `scale` is the scene's size (bounds diagonal):
 /// t agrees if |ta - tb| <= 1e-5 max(ta, tb, 0.1 scale) / max(|cos theta|, 1e-3), theta the angle
-/// between the ray and the reference triangle's normal (t is ill-conditioned at grazing angles). `exact` (back ends sharing the
-/// watertight test) demands identical hit/miss on every ray. Otherwise (against Embree, whose
-/// triangle test rounds differently and treats triangle boundaries by its own rule) two kinds of
-/// hit/miss difference are rounding or convention questions, counted but not failures:
+/// between the ray and the reference triangle's normal (t is ill-conditioned at grazing angles). `exact`
+/// (back ends sharing the watertight test) demands identical hit/miss on every ray. Otherwise (against
+/// Embree, whose triangle test rounds differently and treats triangle boundaries by its own rule) two kinds
+/// of hit/miss difference are rounding or convention questions, counted but not failures:
 ///  - boundary: the one hit lies within 1e-4 scale of the ray's tnear or tfar (a ray starting
 ///    exactly on a surface, or a shadow ray ending exactly on one); likewise a t difference where
 ///    one side saw the surface at the origin and the other the next one;
@@ -185,14 +188,17 @@ inline CrossCheckResult cross_check(const Accelerator& a, const Reference& ref,
                                     float uv_tol) {
   CrossCheckResult res;
   auto note = [&](const char* what, const Ray& r, const Hit& ha, const Hit& hb) {
-    if (res.first.empty()) res.first = std::string(what) + ": " + describe(r) + " -> " + describe(ha) + " vs ref " + describe(hb);
+    if (res.first.empty())
+      res.first = std::string(what) + ": " + describe(r) + " -> " + describe(ha) + " vs ref " + describe(hb);
   };
   auto tol = [&](float t1, float t2) {
     return kTimeEps * std::max({std::fabs(t1), std::fabs(t2), 0.1f * scale});
   };
   // Near the ends of the ray's interval, t is rounding noise in units of the scene's size.
   // (A ray leaving a surface at a grazing angle can re-meet it at t ~ 1e-5 scale.)
-  auto near_end = [&](float t, float end) { return std::fabs(t - end) <= 1e-4f * std::max(scale, std::fabs(t)); };
+  auto near_end = [&](float t, float end) {
+    return std::fabs(t - end) <= 1e-4f * std::max(scale, std::fabs(t));
+  };
   auto on_edge = [](const Hit& h) {
     const float w = 1 - h.u - h.v, e = 1e-6f;
     return std::fabs(h.u) <= e || std::fabs(h.v) <= e || std::fabs(w) <= e;
@@ -241,10 +247,11 @@ inline CrossCheckResult cross_check(const Accelerator& a, const Reference& ref,
         ++res.prim;
         note("primitive", r, ha, hb);
       }
-    } else if (uv_tol == 0 ? (ha.u != hb.u || ha.v != hb.v)
-                           : !(point_distance(views, ha, hb) <=
-                                   4 * tol(ha.t, hb.t) * grazing * length(r.dir) + barycentric_slack(views, hb)) &&
-                                 !near_end(std::min(ha.t, hb.t), std::max(r.tnear, 0.0f))) {
+    } else if (uv_tol == 0
+                   ? (ha.u != hb.u || ha.v != hb.v)
+                   : !(point_distance(views, ha, hb) <=
+                       4 * tol(ha.t, hb.t) * grazing * length(r.dir) + barycentric_slack(views, hb)) &&
+                         !near_end(std::min(ha.t, hb.t), std::max(r.tnear, 0.0f))) {
       ++res.uv;
       note("barycentrics", r, ha, hb);
     }
@@ -307,8 +314,9 @@ inline std::vector<SurfacePoint> surface_points(const Accelerator& ref, std::spa
     Hit h;
     if (!ref.intersect(r, h)) continue;
     const auto& m = views[h.geom_id];
-    Vec3f ng = triangle_normal(m.positions[m.indices[h.prim_id * 3]], m.positions[m.indices[h.prim_id * 3 + 1]],
-                               m.positions[m.indices[h.prim_id * 3 + 2]]);
+    Vec3f ng =
+        triangle_normal(m.positions[m.indices[h.prim_id * 3]], m.positions[m.indices[h.prim_id * 3 + 1]],
+                        m.positions[m.indices[h.prim_id * 3 + 2]]);
     if (dot(ng, ng) == 0) continue;
     if (dot(ng, r.dir) > 0) ng = -ng;
     pts.push_back({point_at(views, h), ng});
@@ -353,9 +361,15 @@ inline std::vector<Vec3f> lights_around(const Bounds3f& b) {
 inline std::vector<Ray> bad_rays(const Bounds3f& b) {
   const float nan = std::nanf(""), inf = kInfinity;
   const Vec3f c = b.center();
-  return {{{nan, c.y, c.z}, 0, {0, 0, 1}, inf}, {c, 0, {nan, 0, 1}, inf}, {c, 0, {0, 0, 0}, inf},
-          {c, 0, {inf, 1, 0}, inf},             {{inf, 0, 0}, 0, {-1, 0, 0}, inf}, {c, nan, {0, 1, 0}, inf},
-          {c, 0, {0, 1, 0}, nan},               {c, 2, {0, 1, 0}, 1},  {c, 0, {-inf, -inf, -inf}, inf}};
+  return {{{nan, c.y, c.z}, 0, {0, 0, 1}, inf},
+          {c, 0, {nan, 0, 1}, inf},
+          {c, 0, {0, 0, 0}, inf},
+          {c, 0, {inf, 1, 0}, inf},
+          {{inf, 0, 0}, 0, {-1, 0, 0}, inf},
+          {c, nan, {0, 1, 0}, inf},
+          {c, 0, {0, 1, 0}, nan},
+          {c, 2, {0, 1, 0}, 1},
+          {c, 0, {-inf, -inf, -inf}, inf}};
 }
 
 /// The whole ray collection for a scene: camera, random, bounce, on-surface and shadow rays.
@@ -391,8 +405,8 @@ inline Bounds3f bounds_of(std::span<const TriangleMeshView> views) {
 /// Back ends sharing the watertight test must match brute force exactly (u, v bit for bit).
 /// Brute force costs rays x triangles, so on big models it answers every k-th ray only
 /// (at most ~2e8 triangle tests); Embree answers all of them.
-inline void check_all(const std::string& scene, std::span<const TriangleMeshView> views, const std::vector<Ray>& rays,
-               const AccelConfig& config = {}) {
+inline void check_all(const std::string& scene, std::span<const TriangleMeshView> views,
+                      const std::vector<Ray>& rays, const AccelConfig& config = {}) {
   const auto all = build_all(views, config);
   const Accelerator& brute = find(all, "brute");
   const Accelerator& embree = find(all, "embree");
@@ -412,7 +426,8 @@ inline void check_all(const std::string& scene, std::span<const TriangleMeshView
       CHECK(rb.failures() == 0);
     }
     const bool slow = a.name == "brute";  // brute force answers the subset only
-    const auto re = cross_check(*a.accel, slow ? by_embree_subset : by_embree, views, scale, a.name == "embree", 1e-4f);
+    const auto re =
+        cross_check(*a.accel, slow ? by_embree_subset : by_embree, views, scale, a.name == "embree", 1e-4f);
     INFO(summary(scene + ": " + a.name + " vs embree", re));
     CHECK(re.failures() == 0);
     CHECK(a.accel->stats().triangles == brute.stats().triangles);
@@ -420,8 +435,8 @@ inline void check_all(const std::string& scene, std::span<const TriangleMeshView
 }
 
 /// The standard ray collection (camera, random, bounces, on-surface, shadow, bad) for a scene.
-inline void check_scene(const std::string& scene, std::span<const TriangleMeshView> views, std::vector<Vec3f> lights,
-                 int scale = 1, std::vector<Ray> extra = {}) {
+inline void check_scene(const std::string& scene, std::span<const TriangleMeshView> views,
+                        std::vector<Vec3f> lights, int scale = 1, std::vector<Ray> extra = {}) {
   const Bounds3f b = bounds_of(views);
   if (lights.empty()) lights = lights_around(b);
   const auto embree = make_accelerator("embree", views);
@@ -469,12 +484,12 @@ struct Soup {
 /// A closed icosphere (shared vertices) of radius r around c, subdivided `level` times.
 inline Soup icosphere(int level, float r, Vec3f c) {
   const float t = (1 + std::sqrt(5.0f)) / 2;
-  std::vector<Vec3f> v{{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Vec3f> v{{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : v) p = normalize(p);
-  std::vector<uint32_t> f{0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,
-                          11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8,
-                          3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  std::vector<uint32_t> f{0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+                          4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+                          6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
   for (int l = 0; l < level; ++l) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {
@@ -513,10 +528,12 @@ inline Flattened flatten(std::span<const TriangleMeshView> meshes, std::span<con
   for (size_t i = 0; i < instances.size(); ++i) {
     Affine3f inv;
     if (!inverse(instances[i].to_world, inv)) continue;
-    for (Vec3f p : meshes[instances[i].mesh].positions) f.positions[i].push_back(apply_point(instances[i].to_world, p));
+    for (Vec3f p : meshes[instances[i].mesh].positions)
+      f.positions[i].push_back(apply_point(instances[i].to_world, p));
   }
   for (size_t i = 0; i < instances.size(); ++i)
-    f.views.push_back({f.positions[i], f.positions[i].empty() ? std::span<const uint32_t>{} : meshes[instances[i].mesh].indices});
+    f.views.push_back({f.positions[i], f.positions[i].empty() ? std::span<const uint32_t>{}
+                                                              : meshes[instances[i].mesh].indices});
   return f;
 }
 
@@ -525,7 +542,8 @@ inline Flattened flatten(std::span<const TriangleMeshView> meshes, std::span<con
 /// world space), and Penumbra's own back ends against the two-level brute force exactly (the same
 /// object-space rays meet the same watertight test).
 inline void check_instanced(const std::string& scene, std::span<const TriangleMeshView> meshes,
-                            std::span<const InstanceView> instances, std::vector<Vec3f> lights, uint32_t seed = 7) {
+                            std::span<const InstanceView> instances, std::vector<Vec3f> lights,
+                            uint32_t seed = 7) {
   const Flattened flat = flatten(meshes, instances);
   const Bounds3f b = bounds_of(flat.views);
   if (lights.empty()) lights = lights_around(b);

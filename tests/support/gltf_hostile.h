@@ -53,7 +53,8 @@ inline std::vector<uint8_t> read_bytes(const std::filesystem::path& path) {
 }
 
 // Appends a chunk to a GLB file and fixes the header's total length.
-inline void append_glb_chunk(const std::filesystem::path& path, uint32_t type, const std::vector<uint8_t>& data) {
+inline void append_glb_chunk(const std::filesystem::path& path, uint32_t type,
+                             const std::vector<uint8_t>& data) {
   std::vector<uint8_t> b = read_bytes(path);
   const uint32_t length = uint32_t(data.size());
   b.insert(b.end(), reinterpret_cast<const uint8_t*>(&length), reinterpret_cast<const uint8_t*>(&length) + 4);

@@ -13,9 +13,12 @@ namespace penumbra::test {
 
 class GltfWriter {
  public:
-  nlohmann::json j = {{"asset", {{"version", "2.0"}}}, {"accessors", nlohmann::json::array()},
-                      {"bufferViews", nlohmann::json::array()}, {"meshes", nlohmann::json::array()},
-                      {"nodes", nlohmann::json::array()}, {"scenes", {{{"nodes", nlohmann::json::array()}}}},
+  nlohmann::json j = {{"asset", {{"version", "2.0"}}},
+                      {"accessors", nlohmann::json::array()},
+                      {"bufferViews", nlohmann::json::array()},
+                      {"meshes", nlohmann::json::array()},
+                      {"nodes", nlohmann::json::array()},
+                      {"scenes", {{{"nodes", nlohmann::json::array()}}}},
                       {"scene", 0}};
   std::vector<uint8_t> bin;
 
@@ -26,11 +29,15 @@ class GltfWriter {
     bin.resize(offset + bytes);
     std::memcpy(bin.data() + offset, data, bytes);
     j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}});
-    j["accessors"].push_back({{"bufferView", int(j["bufferViews"].size()) - 1}, {"componentType", component_type},
-                              {"count", count}, {"type", type}});
+    j["accessors"].push_back({{"bufferView", int(j["bufferViews"].size()) - 1},
+                              {"componentType", component_type},
+                              {"count", count},
+                              {"type", type}});
     return int(j["accessors"].size()) - 1;
   }
-  int positions(const std::vector<float>& xyz) { return accessor(xyz.data(), xyz.size() * 4, 5126, xyz.size() / 3, "VEC3"); }
+  int positions(const std::vector<float>& xyz) {
+    return accessor(xyz.data(), xyz.size() * 4, 5126, xyz.size() / 3, "VEC3");
+  }
   template <class T>
   int indices(const std::vector<T>& idx) {
     const int ct = sizeof(T) == 1 ? 5121 : (sizeof(T) == 2 ? 5123 : 5125);
@@ -69,7 +76,8 @@ class GltfWriter {
   void write_embedded(const std::filesystem::path& path) {
     nlohmann::json out = j;
     if (!bin.empty())
-      out["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
+      out["buffers"] = {
+          {{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
     std::ofstream(path) << out.dump();
   }
   /// .gltf next to an external buffer file `uri` (relative to the .gltf's folder).
@@ -77,7 +85,8 @@ class GltfWriter {
     nlohmann::json out = j;
     out["buffers"] = {{{"byteLength", bin.size()}, {"uri", uri}}};
     std::ofstream(path) << out.dump();
-    std::ofstream(path.parent_path() / uri, std::ios::binary).write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
+    std::ofstream(path.parent_path() / uri, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
   }
   /// Binary glTF (GLB) with JSON and BIN chunks.
   void write_glb(const std::filesystem::path& path) {
@@ -103,6 +112,8 @@ class GltfWriter {
 };
 
 /// A unit quad in the z = 0 plane (4 vertices, counter-clockwise seen from +z).
-inline std::vector<float> quad_positions() { return {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}; }
+inline std::vector<float> quad_positions() {
+  return {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+}
 
 }  // namespace penumbra::test

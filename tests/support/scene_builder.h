@@ -9,8 +9,10 @@
 namespace penumbra::test {
 
 /// Adds an axis-aligned rectangle with normal +z (or -z if `flip`) at height z, spanning
-/// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index (== its instance index when every mesh is added this way).
-inline int add_quad_z(Scene& s, float x0, float x1, float y0, float y1, float z, int material, bool flip = false) {
+/// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index (== its instance index when every mesh
+/// is added this way).
+inline int add_quad_z(Scene& s, float x0, float x1, float y0, float y1, float z, int material,
+                      bool flip = false) {
   Mesh m;
   m.name = "quad";
   m.positions = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};

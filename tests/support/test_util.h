@@ -1,33 +1,39 @@
 // Test helpers: locating the shared corpus and the project's scenes, temporary folders.
 #pragma once
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 namespace penumbra::test {
 
 /// ../shared/corpus beside the checkout, or $PENUMBRA_CORPUS; nullopt if neither exists.
 inline std::optional<std::filesystem::path> corpus_dir() {
   const char* env = std::getenv("PENUMBRA_CORPUS");
-  std::filesystem::path p = env && *env ? std::filesystem::path(env) : std::filesystem::path(PENUMBRA_CORPUS_DEFAULT);
+  std::filesystem::path p =
+      env && *env ? std::filesystem::path(env) : std::filesystem::path(PENUMBRA_CORPUS_DEFAULT);
   if (std::filesystem::is_directory(p / "valid")) return p;
   return std::nullopt;
 }
 
 /// Prints the marker ctest turns into "skipped" (see tests/CMakeLists.txt).
-inline void skip(const std::string& why) { std::cout << "PENUMBRA_SKIP: " << why << std::endl; }
+inline void skip(const std::string& why) {
+  std::cout << "PENUMBRA_SKIP: " << why << std::endl;
+}
 
-inline std::filesystem::path source_dir() { return PENUMBRA_SOURCE_DIR; }
+inline std::filesystem::path source_dir() {
+  return PENUMBRA_SOURCE_DIR;
+}
 
 /// A fresh, empty temporary folder unique to this process and name.
 inline std::filesystem::path temp_dir(const std::string& name) {
-  auto p = std::filesystem::temp_directory_path() /
-           ("penumbra-test-" + std::to_string(::getpid()) + "-" + name);
+  auto p =
+      std::filesystem::temp_directory_path() / ("penumbra-test-" + std::to_string(::getpid()) + "-" + name);
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
   return p;

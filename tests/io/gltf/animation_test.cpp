@@ -4,9 +4,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "support/gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf/loader.h"
+#include "support/gltf_writer.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -22,12 +22,15 @@ int floats(test::GltfWriter& w, const std::vector<float>& v, const char* type, s
 
 // Adds animation channel (node, path) with the given keys and interpolation.
 void channel(test::GltfWriter& w, int node, const char* path, const std::vector<float>& times,
-             const std::vector<float>& values, const char* type, size_t width, const char* interp = "LINEAR") {
+             const std::vector<float>& values, const char* type, size_t width,
+             const char* interp = "LINEAR") {
   const int in = floats(w, times, "SCALAR", 1), out = floats(w, values, type, width);
-  if (!w.j.contains("animations")) w.j["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
+  if (!w.j.contains("animations"))
+    w.j["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
   auto& a = w.j["animations"][0];
   a["samplers"].push_back({{"input", in}, {"output", out}, {"interpolation", interp}});
-  a["channels"].push_back({{"sampler", int(a["samplers"].size()) - 1}, {"target", {{"node", node}, {"path", path}}}});
+  a["channels"].push_back(
+      {{"sampler", int(a["samplers"].size()) - 1}, {"target", {{"node", node}, {"path", path}}}});
 }
 
 /// The world-space mesh a node places (its first instance).
@@ -55,13 +58,13 @@ std::filesystem::path animated_file() {
   w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["JOINTS_0"] = ja;
   w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["WEIGHTS_0"] = wa;
 
-  const int a = w.node({{"mesh", mesh}});                                        // 0: translation
-  const int b = w.node({{"mesh", mesh}});                                        // 1: rotation
-  const int c = w.node({{"mesh", mesh}});                                        // 2: cubic scale
-  const int d = w.node({{"mesh", mesh}, {"translation", {0, 0, 5}}});            // 3: morph weights
-  const int e = w.node({{"mesh", mesh}});                                        // 4: step translation
-  const int j0 = w.node({{"name", "j0"}});                                       // 5
-  const int j1 = w.node({{"name", "j1"}});                                       // 6
+  const int a = w.node({{"mesh", mesh}});                              // 0: translation
+  const int b = w.node({{"mesh", mesh}});                              // 1: rotation
+  const int c = w.node({{"mesh", mesh}});                              // 2: cubic scale
+  const int d = w.node({{"mesh", mesh}, {"translation", {0, 0, 5}}});  // 3: morph weights
+  const int e = w.node({{"mesh", mesh}});                              // 4: step translation
+  const int j0 = w.node({{"name", "j0"}});                             // 5
+  const int j1 = w.node({{"name", "j1"}});                             // 6
   const int sk = w.node({{"mesh", skinned}, {"skin", 0}, {"translation", {10, 0, 0}}});  // 7
   w.j["skins"] = json::array({{{"joints", {j0, j1}}}});
   channel(w, a, "translation", {0, 2}, {0, 0, 0, 4, 0, 0}, "VEC3", 3);
@@ -69,7 +72,8 @@ std::filesystem::path animated_file() {
   channel(w, b, "rotation", {0, 1}, {0, 0, 0, 1, 0, 0, s45, s45}, "VEC4", 4);
   // Cubic scale: keys t = 0, 1 with values 1 and 3, out-tangent 0 at the first, in-tangent 0
   // at the second: p(0.5) = 0.5 x 1 + 0.5 x 3 = 2.
-  channel(w, c, "scale", {0, 1}, {0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 3, 3, 3, 0, 0, 0}, "VEC3", 3, "CUBICSPLINE");
+  channel(w, c, "scale", {0, 1}, {0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 3, 3, 3, 0, 0, 0}, "VEC3", 3,
+          "CUBICSPLINE");
   channel(w, d, "weights", {0, 2}, {0, 1}, "SCALAR", 1);
   channel(w, e, "translation", {0, 1}, {0, 0, 0, 0, 7, 0}, "VEC3", 3, "STEP");
   channel(w, j1, "translation", {0, 1}, {0, 0, 0, 0, 0, 2}, "VEC3", 3);
@@ -124,7 +128,8 @@ TEST_CASE("animation: node channels are evaluated at --time", "[io][animation][q
 
 TEST_CASE("animation: malformed channels are errors naming the animation element", "[io][animation][quick]") {
   const auto dir = test::temp_dir("anim-bad");
-  auto expect_error = [&](const std::function<void(test::GltfWriter&, int)>& damage, const std::string& needle) {
+  auto expect_error = [&](const std::function<void(test::GltfWriter&, int)>& damage,
+                          const std::string& needle) {
     test::GltfWriter w;
     const int n = w.node({{"mesh", w.mesh(w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0}))}});
     damage(w, n);
@@ -136,20 +141,31 @@ TEST_CASE("animation: malformed channels are errors naming the animation element
       CHECK_THAT(e.what(), Catch::Contains(needle));
     }
   };
-  expect_error([](test::GltfWriter& w, int n) { channel(w, n, "translation", {0, 1}, {0, 0, 0}, "VEC3", 3); },
-               "animations[0].samplers[0].output");
-  expect_error([](test::GltfWriter& w, int n) { channel(w, n, "translation", {1, 0}, {0, 0, 0, 1, 1, 1}, "VEC3", 3); },
-               "non-decreasing");
-  expect_error([](test::GltfWriter& w, int n) { channel(w, n + 5, "translation", {0, 1}, {0, 0, 0, 1, 1, 1}, "VEC3", 3); },
-               "animations[0].channels[0].target.node");
-  expect_error([](test::GltfWriter& w, int n) { channel(w, n, "scale", {0, 1}, {1, 1, 1, 2, 2, 2}, "VEC3", 3, "QUADRATIC"); },
-               "interpolation");
-  expect_error([](test::GltfWriter& w, int n) {
-    w.j["nodes"][size_t(n)]["skin"] = 3;
-  }, "nodes[0].skin");
+  expect_error(
+      [](test::GltfWriter& w, int n) {
+        channel(w, n, "translation", {0, 1}, {0, 0, 0}, "VEC3", 3);
+      },
+      "animations[0].samplers[0].output");
+  expect_error(
+      [](test::GltfWriter& w, int n) {
+        channel(w, n, "translation", {1, 0}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
+      },
+      "non-decreasing");
+  expect_error(
+      [](test::GltfWriter& w, int n) {
+        channel(w, n + 5, "translation", {0, 1}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
+      },
+      "animations[0].channels[0].target.node");
+  expect_error(
+      [](test::GltfWriter& w, int n) {
+        channel(w, n, "scale", {0, 1}, {1, 1, 1, 2, 2, 2}, "VEC3", 3, "QUADRATIC");
+      },
+      "interpolation");
+  expect_error([](test::GltfWriter& w, int n) { w.j["nodes"][size_t(n)]["skin"] = 3; }, "nodes[0].skin");
 }
 
-TEST_CASE("animation: corpus InterpolationTest matches its keyframes and midpoints", "[io][corpus][animation]") {
+TEST_CASE("animation: corpus InterpolationTest matches its keyframes and midpoints",
+          "[io][corpus][animation]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   const auto file = *corpus / "valid/InterpolationTest/glTF-Binary/InterpolationTest.glb";

@@ -14,7 +14,8 @@ namespace {
 std::vector<fs::path> gltf_files(const fs::path& root) {
   std::vector<fs::path> out;
   for (const auto& e : fs::recursive_directory_iterator(root))
-    if (e.is_regular_file() && (e.path().extension() == ".gltf" || e.path().extension() == ".glb")) out.push_back(e.path());
+    if (e.is_regular_file() && (e.path().extension() == ".gltf" || e.path().extension() == ".glb"))
+      out.push_back(e.path());
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -71,7 +72,8 @@ TEST_CASE("corpus: every valid file loads", "[io][corpus]") {
   }
 }
 
-TEST_CASE("corpus: every invalid file ends in a clear error or warnings, never a crash", "[io][corpus][hostile]") {
+TEST_CASE("corpus: every invalid file ends in a clear error or warnings, never a crash",
+          "[io][corpus][hostile]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   int errors = 0, loaded = 0;
@@ -132,7 +134,8 @@ TEST_CASE("corpus: materials, alpha modes and textures load as the files say", "
   {
     const LoadedScene ls = load_gltf(*corpus / "valid/DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
     const Material& m = ls.scene.materials.at(0);
-    for (const TextureRef* r : {&m.base_color_tex, &m.metallic_roughness_tex, &m.normal_tex, &m.occlusion_tex, &m.emissive_tex})
+    for (const TextureRef* r :
+         {&m.base_color_tex, &m.metallic_roughness_tex, &m.normal_tex, &m.occlusion_tex, &m.emissive_tex})
       CHECK(r->texture >= 0);
     CHECK(ls.scene.textures.size() == 5);
     CHECK(ls.scene.textures[0].levels[0].width == 2048);
@@ -141,7 +144,8 @@ TEST_CASE("corpus: materials, alpha modes and textures load as the files say", "
     CHECK(ls.scene.meshes[0].tangents.size() == ls.scene.meshes[0].positions.size());  // generated
   }
   {
-    const LoadedScene ls = load_gltf(*corpus / "valid/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb");
+    const LoadedScene ls =
+        load_gltf(*corpus / "valid/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb");
     float strongest = 0;
     for (const auto& m : ls.scene.materials) strongest = std::max(strongest, max_component(m.emissive));
     CHECK(strongest > 1);  // KHR_materials_emissive_strength scales beyond the [0,1] factor

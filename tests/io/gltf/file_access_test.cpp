@@ -4,8 +4,8 @@
 #include <OpenImageIO/imageio.h>
 #include <sys/stat.h>
 
-#include <chrono>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 
@@ -18,12 +18,12 @@
 using namespace penumbra;
 using Catch::Matchers::Contains;
 using nlohmann::json;
-using penumbra::test::GltfWriter;
-using penumbra::test::names;
-using penumbra::test::write_text;
-using penumbra::test::triangle_scene;
-using penumbra::test::has_warning;
 using penumbra::test::append_glb_chunk;
+using penumbra::test::GltfWriter;
+using penumbra::test::has_warning;
+using penumbra::test::names;
+using penumbra::test::triangle_scene;
+using penumbra::test::write_text;
 namespace fs = std::filesystem;
 
 TEST_CASE(
@@ -123,7 +123,6 @@ TEST_CASE("gltf hardening: URIs refused by policy and missing files name the buf
   allow.allow_external_uris = true;
   CHECK(load_gltf(dir / "sub" / "sub.gltf", allow).scene.meshes.size() == 1);
 }
-
 
 TEST_CASE("gltf hardening: a FIFO or a device as the scene or as a buffer is refused without blocking",
           "[io][gltf][hostile][quick]") {

@@ -15,13 +15,15 @@
 
 using namespace penumbra;
 using Catch::Matchers::Contains;
-using penumbra::test::GltfWriter;
 using penumbra::test::crc32;
+using penumbra::test::GltfWriter;
 using penumbra::test::names;
 using penumbra::test::read_bytes;
 namespace fs = std::filesystem;
 
-TEST_CASE("gltf: unreadable images are warnings naming the image; an image bufferView past its buffer is an error", "[io][texture][quick]") {
+TEST_CASE(
+    "gltf: unreadable images are warnings naming the image; an image bufferView past its buffer is an error",
+    "[io][texture][quick]") {
   const auto dir = test::temp_dir("badimages");
   auto file_with = [&](nlohmann::json images, int view_bytes) {
     test::GltfWriter w;
@@ -44,13 +46,15 @@ TEST_CASE("gltf: unreadable images are warnings naming the image; an image buffe
     return dir / "t.gltf";
   };
   const int view = 2;  // the bufferView added above (after POSITION's and TEXCOORD_0's)
-  const auto ok = file_with({{{"uri", "missing.png"}}, {{"uri", "../../etc/passwd"}},
+  const auto ok = file_with({{{"uri", "missing.png"}},
+                             {{"uri", "../../etc/passwd"}},
                              {{"bufferView", view}, {"mimeType", "image/png"}}},
                             24);
   const LoadedScene ls = load_gltf(ok);
   CHECK(ls.scene.textures.empty());
-  for (const char* needle : {"images[0]: image data could not be read from 'missing.png'",
-                             "images[1]: image data could not be read", "images[2]: not a PNG or JPEG image"}) {
+  for (const char* needle :
+       {"images[0]: image data could not be read from 'missing.png'",
+        "images[1]: image data could not be read", "images[2]: not a PNG or JPEG image"}) {
     bool found = false;
     for (const auto& w : ls.warnings) found = found || w.find(needle) != std::string::npos;
     CHECK(found);

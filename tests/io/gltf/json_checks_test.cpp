@@ -16,9 +16,9 @@ using namespace penumbra;
 using Catch::Matchers::Contains;
 using nlohmann::json;
 using penumbra::test::GltfWriter;
+using penumbra::test::has_warning;
 using penumbra::test::names;
 using penumbra::test::triangle_scene;
-using penumbra::test::has_warning;
 namespace fs = std::filesystem;
 
 TEST_CASE("gltf hardening: negative or huge byteOffset and byteStride are errors naming the element",

@@ -6,13 +6,13 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 
-#include "support/gltf_writer.h"
 #include "io/error.h"
+#include "support/gltf_writer.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
-using penumbra::test::GltfWriter;
 using Catch::Matchers::Contains;
+using penumbra::test::GltfWriter;
 
 namespace {
 LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptions opt = {}) {
@@ -48,7 +48,8 @@ TEST_CASE("u8, u16, u32 and implicit indices all load the same quad", "[io][gltf
 TEST_CASE("external .bin buffers and GLB load like data URIs", "[io][gltf][quick]") {
   const auto dir = test::temp_dir("containers");
   GltfWriter w;
-  w.node({{"mesh", w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}))}});
+  w.node({{"mesh",
+           w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}))}});
   w.write_external(dir / "ext.gltf", "ext.bin");
   w.write_glb(dir / "bin.glb");
   for (const char* f : {"ext.gltf", "bin.glb"}) {
@@ -71,7 +72,8 @@ TEST_CASE("triangle strips and fans become counter-clockwise triangle lists", "[
   for (const Mesh& m : l.scene.meshes) {
     REQUIRE(m.indices.size() == 6);
     for (size_t t = 0; t < 2; ++t) {
-      const Vec3f a = m.positions[m.indices[t * 3]], b = m.positions[m.indices[t * 3 + 1]], c = m.positions[m.indices[t * 3 + 2]];
+      const Vec3f a = m.positions[m.indices[t * 3]], b = m.positions[m.indices[t * 3 + 1]],
+                  c = m.positions[m.indices[t * 3 + 2]];
       CHECK(cross(b - a, c - a).z > 0);  // front faces +z
     }
   }
@@ -94,11 +96,13 @@ TEST_CASE("node TRS hierarchy accumulates parent * child", "[io][gltf][quick]") 
 
 TEST_CASE("mirroring transforms flip the winding so normals stay outward", "[io][gltf][quick]") {
   GltfWriter w;
-  const int m = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
+  const int m =
+      w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
   w.node({{"mesh", m}, {"scale", {-1, 1, 1}}});
   const LoadedScene l = write_and_load(w, "mirror");
   const Mesh& mesh = l.scene.meshes.at(0);
-  const Vec3f a = mesh.positions[mesh.indices[0]], b = mesh.positions[mesh.indices[1]], c = mesh.positions[mesh.indices[2]];
+  const Vec3f a = mesh.positions[mesh.indices[0]], b = mesh.positions[mesh.indices[1]],
+              c = mesh.positions[mesh.indices[2]];
   CHECK(cross(b - a, c - a).z > 0);
   CHECK(mesh.normals[0].z == Approx(1));
 }
@@ -120,16 +124,25 @@ TEST_CASE("explicit normals transform by the inverse transpose", "[io][gltf][qui
 TEST_CASE("cameras and punctual lights are placed by their nodes", "[io][gltf][quick]") {
   GltfWriter w;
   w.node({{"mesh", w.mesh(w.positions(test::quad_positions()))}});
-  w.j["cameras"] = {{{"type", "perspective"}, {"name", "persp"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}, {"aspectRatio", 2.0}}}},
-                    {{"type", "orthographic"}, {"orthographic", {{"xmag", 3}, {"ymag", 1.5}, {"znear", 0}, {"zfar", 50}}}}};
+  w.j["cameras"] = {
+      {{"type", "perspective"},
+       {"name", "persp"},
+       {"perspective", {{"yfov", 0.7}, {"znear", 0.1}, {"aspectRatio", 2.0}}}},
+      {{"type", "orthographic"}, {"orthographic", {{"xmag", 3}, {"ymag", 1.5}, {"znear", 0}, {"zfar", 50}}}}};
   w.node({{"camera", 0}, {"translation", {0, 0, 5}}});
   w.node({{"camera", 1}, {"translation", {1, 2, 3}}});
   w.j["extensionsUsed"] = {"KHR_lights_punctual"};
-  w.j["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "spot"}, {"intensity", 20}, {"range", 9},
-                                                               {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
-                                                              {{"type", "directional"}, {"color", {1, 0.5, 0.25}}}}}}}};
+  w.j["extensions"] = {{"KHR_lights_punctual",
+                        {{"lights",
+                          {{{"type", "spot"},
+                            {"intensity", 20},
+                            {"range", 9},
+                            {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
+                           {{"type", "directional"}, {"color", {1, 0.5, 0.25}}}}}}}};
   const double s = std::sqrt(0.5);
-  w.node({{"translation", {0, 4, 0}}, {"rotation", {-s, 0, 0, s}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  w.node({{"translation", {0, 4, 0}},
+          {"rotation", {-s, 0, 0, s}},
+          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   w.node({{"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
   const LoadedScene l = write_and_load(w, "camlights");
   REQUIRE(l.scene.cameras.size() == 2);
@@ -159,7 +172,8 @@ TEST_CASE("cameras and punctual lights are placed by their nodes", "[io][gltf][q
 TEST_CASE("an index beyond the vertex count is an error naming the primitive", "[io][gltf][hostile][quick]") {
   GltfWriter w;
   w.node({{"mesh", w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 7}))}});
-  REQUIRE_THROWS_WITH(write_and_load(w, "bad-index"), Contains("meshes[0].primitives[0]: index 7 >= vertex count 4"));
+  REQUIRE_THROWS_WITH(write_and_load(w, "bad-index"),
+                      Contains("meshes[0].primitives[0]: index 7 >= vertex count 4"));
 }
 
 TEST_CASE("accessors reading past their bufferView are errors", "[io][gltf][hostile][quick]") {
@@ -173,7 +187,8 @@ TEST_CASE("accessors reading past their bufferView are errors", "[io][gltf][host
   REQUIRE_THROWS_AS(write_and_load(w, "overflow"), InputError);
 }
 
-TEST_CASE("node cycles and shared children are errors and deep chains load iteratively", "[io][gltf][hostile]") {
+TEST_CASE("node cycles and shared children are errors and deep chains load iteratively",
+          "[io][gltf][hostile]") {
   {
     GltfWriter w;
     w.node({{"children", {1}}});
@@ -201,8 +216,10 @@ TEST_CASE("node cycles and shared children are errors and deep chains load itera
     w.j["nodes"] = nlohmann::json::array();
     for (int i = 0; i < n; ++i) {
       nlohmann::json node = {{"translation", {0, 0, 0.001}}};
-      if (i + 1 < n) node["children"] = {i + 1};
-      else node["mesh"] = m;
+      if (i + 1 < n)
+        node["children"] = {i + 1};
+      else
+        node["mesh"] = m;
       w.j["nodes"].push_back(node);
     }
     w.j["scenes"][0]["nodes"] = {0};
@@ -214,8 +231,8 @@ TEST_CASE("node cycles and shared children are errors and deep chains load itera
 
 TEST_CASE("deeply nested JSON is refused before parsing", "[io][gltf][hostile][quick]") {
   const auto dir = test::temp_dir("nesting");
-  std::ofstream(dir / "deep.gltf") << "{\"asset\":{\"version\":\"2.0\"},\"extras\":" << std::string(100000, '[')
-                                   << std::string(100000, ']') << "}";
+  std::ofstream(dir / "deep.gltf") << "{\"asset\":{\"version\":\"2.0\"},\"extras\":"
+                                   << std::string(100000, '[') << std::string(100000, ']') << "}";
   REQUIRE_THROWS_WITH(load_gltf(dir / "deep.gltf"), Contains("nesting deeper than"));
   CHECK(json_nesting_depth(R"({"a":"[[[[","b":[{}]})", 10) == 3);  // brackets in strings ignored
 }
@@ -252,14 +269,16 @@ TEST_CASE("bad camera and light parameters are errors naming them", "[io][gltf][
   GltfWriter w;
   w.j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.0}, {"znear", 0.1}}}}};
   REQUIRE_THROWS_WITH(write_and_load(w, "cam0"), Contains("cameras[0]") && Contains("yfov"));
-  w.j["cameras"] = {{{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", -1}, {"znear", 0}, {"zfar", 1}}}}};
+  w.j["cameras"] = {
+      {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", -1}, {"znear", 0}, {"zfar", 1}}}}};
   REQUIRE_THROWS_WITH(write_and_load(w, "cam1"), Contains("cameras[0]") && Contains("ymag"));
   w.j.erase("cameras");
   w.node({{"camera", 3}});
   REQUIRE_THROWS_WITH(write_and_load(w, "cam2"), Contains("nodes[0].camera"));
 }
 
-TEST_CASE("points and lines are skipped with a warning and unknown required extensions fail", "[io][gltf][quick]") {
+TEST_CASE("points and lines are skipped with a warning and unknown required extensions fail",
+          "[io][gltf][quick]") {
   GltfWriter w;
   w.node({{"mesh", w.mesh(w.positions(test::quad_positions()), -1, 1)}});
   const LoadedScene l = write_and_load(w, "lines");
@@ -267,11 +286,13 @@ TEST_CASE("points and lines are skipped with a warning and unknown required exte
   REQUIRE_FALSE(l.warnings.empty());
   w.j["extensionsRequired"] = {"KHR_draco_mesh_compression"};
   w.j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
-  REQUIRE_THROWS_WITH(write_and_load(w, "draco"), Contains("extensionsRequired") && Contains("KHR_draco_mesh_compression"));
+  REQUIRE_THROWS_WITH(write_and_load(w, "draco"),
+                      Contains("extensionsRequired") && Contains("KHR_draco_mesh_compression"));
 }
 
 TEST_CASE("missing and non-regular files are clear errors", "[io][gltf][hostile][quick]") {
-  REQUIRE_THROWS_WITH(load_gltf("/nonexistent/scene.gltf"), Contains("/nonexistent/scene.gltf") && Contains("not found"));
+  REQUIRE_THROWS_WITH(load_gltf("/nonexistent/scene.gltf"),
+                      Contains("/nonexistent/scene.gltf") && Contains("not found"));
   REQUIRE_THROWS_WITH(load_gltf(test::temp_dir("dir")), Contains("not a regular file"));
   const auto dir = test::temp_dir("garbage");
   std::ofstream(dir / "x.gltf") << "this is not json";

@@ -10,9 +10,9 @@
 #include "io/gltf/loader.h"
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/material.h"
-#include "renderer/integrators/render.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"
 
@@ -48,7 +48,8 @@ struct FrontView {
     Vec3f sum;
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
-        sum += at(x0 + (x1 - x0) * (float(i) + 0.5f) / float(n), y0 + (y1 - y0) * (float(j) + 0.5f) / float(n));
+        sum +=
+            at(x0 + (x1 - x0) * (float(i) + 0.5f) / float(n), y0 + (y1 - y0) * (float(j) + 0.5f) / float(n));
     return sum / float(n * n);
   }
 };
@@ -86,14 +87,18 @@ FrontView front_albedo(const std::filesystem::path& file, int width = 480) {
   return v;
 }
 
-float lum(Vec3f c) { return luminance(c); }
+float lum(Vec3f c) {
+  return luminance(c);
+}
 
 }  // namespace
 
-TEST_CASE("corpus textures: TextureCoordinateTest shows each quadrant of the image the right way up", "[io][corpus][texture]") {
+TEST_CASE("corpus textures: TextureCoordinateTest shows each quadrant of the image the right way up",
+          "[io][corpus][texture]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
-  const FrontView v = front_albedo(*corpus / "valid/TextureCoordinateTest/glTF-Binary/TextureCoordinateTest.glb");
+  const FrontView v =
+      front_albedo(*corpus / "valid/TextureCoordinateTest/glTF-Binary/TextureCoordinateTest.glb");
   // Quad colours are the materials' factors (yellow, orange, blue, green) over a white texture.
   const Vec3f tl = v.mean(-1.0f, -0.4f, 0.5f, 0.9f), tr = v.mean(0.4f, 1.0f, 0.5f, 0.9f);
   const Vec3f bl = v.mean(-1.0f, -0.4f, -0.9f, -0.5f), br = v.mean(0.4f, 1.0f, -0.9f, -0.5f);
@@ -110,9 +115,14 @@ TEST_CASE("corpus textures: TextureCoordinateTest shows each quadrant of the ima
   // left edges, so each quad is darkest at the corner of the image it shows (its outer
   // corner) and not at the two corners next to it; a flipped V axis would move the dark
   // patch to the neighbouring corner.
-  struct Quad { float x0, x1, y0, y1; bool outer_left, outer_top; };
-  const Quad quads[4] = {{-1.2f, -0.2f, 0.2f, 1.2f, true, true}, {0.2f, 1.2f, 0.2f, 1.2f, false, true},
-                         {-1.2f, -0.2f, -1.2f, -0.2f, true, false}, {0.2f, 1.2f, -1.2f, -0.2f, false, false}};
+  struct Quad {
+    float x0, x1, y0, y1;
+    bool outer_left, outer_top;
+  };
+  const Quad quads[4] = {{-1.2f, -0.2f, 0.2f, 1.2f, true, true},
+                         {0.2f, 1.2f, 0.2f, 1.2f, false, true},
+                         {-1.2f, -0.2f, -1.2f, -0.2f, true, false},
+                         {0.2f, 1.2f, -1.2f, -0.2f, false, false}};
   const float p = 0.3f;
   for (const Quad& q : quads) {
     // Mean of the p x p square inside the quad at its corner (left?, top?).
@@ -126,10 +136,12 @@ TEST_CASE("corpus textures: TextureCoordinateTest shows each quadrant of the ima
   }
 }
 
-TEST_CASE("corpus textures: TextureTransformTest offsets, rotation and scale read the texels the spec names", "[io][corpus][texture]") {
+TEST_CASE("corpus textures: TextureTransformTest offsets, rotation and scale read the texels the spec names",
+          "[io][corpus][texture]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
-  const FrontView v = front_albedo(*corpus / "valid/TextureTransformTest/glTF/TextureTransformTest.gltf", 640);
+  const FrontView v =
+      front_albedo(*corpus / "valid/TextureTransformTest/glTF/TextureTransformTest.gltf", 640);
   const Scene& s = v.loaded.scene;
   // Each quad spans 1 x 1 around its node's translation, uv (0,0) at its top-left corner;
   // the top row's UVs run 0..0.5, the bottom row's 0..1 (README).
@@ -158,7 +170,8 @@ TEST_CASE("corpus textures: TextureTransformTest offsets, rotation and scale rea
   CHECK(close(scaled, texel(4, {1.5f * uv.x, 1.5f * uv.y})));
 }
 
-TEST_CASE("corpus textures: VertexColorTest multiplies COLOR_0 so the hidden X marks stay hidden", "[io][corpus][texture]") {
+TEST_CASE("corpus textures: VertexColorTest multiplies COLOR_0 so the hidden X marks stay hidden",
+          "[io][corpus][texture]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   const FrontView v = front_albedo(*corpus / "valid/VertexColorTest/glTF-Binary/VertexColorTest.glb");
@@ -170,7 +183,8 @@ TEST_CASE("corpus textures: VertexColorTest multiplies COLOR_0 so the hidden X m
     const float x0[3] = {-0.72f, -0.18f, 0.38f};
     const Vec3f m = v.mean(x0[cell], x0[cell] + 0.36f, 0.2f, 0.5f);
     const float own = cell == 0 ? m.x : (cell == 1 ? m.y : m.z);
-    const float other = cell == 0 ? std::max(m.y, m.z) : (cell == 1 ? std::max(m.x, m.z) : std::max(m.x, m.y));
+    const float other =
+        cell == 0 ? std::max(m.y, m.z) : (cell == 1 ? std::max(m.x, m.z) : std::max(m.x, m.y));
     CHECK(own > 0.1f);
     CHECK(other < 0.02f);
     ++checked;
@@ -178,7 +192,8 @@ TEST_CASE("corpus textures: VertexColorTest multiplies COLOR_0 so the hidden X m
   CHECK(checked == 3);
 }
 
-TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCOORD_1", "[io][corpus][texture]") {
+TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCOORD_1",
+          "[io][corpus][texture]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   LoadedScene ls = load_gltf(*corpus / "valid/MultiUVTest/glTF-Binary/MultiUVTest.glb");
@@ -213,9 +228,11 @@ TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCO
   CHECK(differs > 0);
 }
 
-TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field", "[io][gltf][quick]") {
+TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field",
+          "[io][gltf][quick]") {
   GltfWriter w;
-  const int m = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
+  const int m =
+      w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
   w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
   w.node({{"mesh", m}});
   w.j["materials"] = {{{"extensions",
@@ -236,8 +253,10 @@ TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name 
   REQUIRE_THROWS_WITH(write_and_load(w, "iorbad"), Contains("materials[0].extensions.KHR_materials_ior.ior"));
   w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 1.5;
   w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 1.5;
-  REQUIRE_THROWS_WITH(write_and_load(w, "trbad"), Contains("KHR_materials_transmission.transmissionFactor") && Contains("[0, 1]"));
+  REQUIRE_THROWS_WITH(write_and_load(w, "trbad"),
+                      Contains("KHR_materials_transmission.transmissionFactor") && Contains("[0, 1]"));
   w.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 0.5;
   w.j["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"] = "shiny";
-  REQUIRE_THROWS_WITH(write_and_load(w, "spbad"), Contains("KHR_materials_specular.specularFactor") && Contains("number"));
+  REQUIRE_THROWS_WITH(write_and_load(w, "spbad"),
+                      Contains("KHR_materials_specular.specularFactor") && Contains("number"));
 }

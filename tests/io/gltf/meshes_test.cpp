@@ -1,24 +1,23 @@
-// Mesh placement and instancing (io/gltf/meshes.cpp): a mesh placed by several nodes is stored once (object space)
-// and instanced, EXT_mesh_gpu_instancing places one instance per TRS element after the node's
+// Mesh placement and instancing (io/gltf/meshes.cpp): a mesh placed by several nodes is stored once (object
+// space) and instanced, EXT_mesh_gpu_instancing places one instance per TRS element after the node's
 // transform, --flatten (GltfLoadOptions::flatten) gives world-space copies instead, malformed
 // instancing data is an error naming the element, and instanced and flattened scenes render
 // the same image with every accelerator.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
-#include "support/gltf_writer.h"
 #include "io/error.h"
 #include "io/gltf/loader.h"
 #include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
+#include "support/gltf_writer.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
-using penumbra::test::GltfWriter;
 using Catch::Matchers::Contains;
+using penumbra::test::GltfWriter;
 using json = nlohmann::json;
 
 namespace {
@@ -29,13 +28,16 @@ LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptio
   return load_gltf(dir / "scene.gltf", opt);
 }
 
-void check_vec(Vec3f a, Vec3f b, float eps = 1e-5f) { test::check_vec(a, b, eps); }
+void check_vec(Vec3f a, Vec3f b, float eps = 1e-5f) {
+  test::check_vec(a, b, eps);
+}
 
 /// A file whose unit quad mesh is placed by three nodes (moved, mirrored, rotated) and whose
 /// triangle mesh is placed by one node (moved).
 GltfWriter shared_mesh_file() {
   GltfWriter w;
-  const int quad = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
+  const int quad =
+      w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
   const int tri = w.mesh(w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0}));
   w.node({{"mesh", quad}, {"translation", {2, 0, 0}}});
   w.node({{"mesh", quad}, {"scale", {-1, 1, 1}}});
@@ -45,7 +47,9 @@ GltfWriter shared_mesh_file() {
 }
 
 /// The positions an instance puts in the world.
-std::vector<Vec3f> world_positions(const Scene& s, const Instance& inst) { return test::world_copy(s, inst).positions; }
+std::vector<Vec3f> world_positions(const Scene& s, const Instance& inst) {
+  return test::world_copy(s, inst).positions;
+}
 
 }  // namespace
 
@@ -101,11 +105,13 @@ TEST_CASE("gltf instancing: a mesh placed by several nodes is stored once", "[io
   check_vec(compute_bounds(f.scene).hi, b.hi);
 }
 
-TEST_CASE("gltf instancing: EXT_mesh_gpu_instancing places T R S per instance after the node", "[io][gltf][instances][quick]") {
+TEST_CASE("gltf instancing: EXT_mesh_gpu_instancing places T R S per instance after the node",
+          "[io][gltf][instances][quick]") {
   for (bool flatten : {false, true}) {
     INFO("flatten " << flatten);
     GltfWriter w;
-    const int quad = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
+    const int quad =
+        w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
     const std::vector<float> t = {0, 0, 0, 0, 5, 0};
     const int16_t h = 23170;  // sqrt(1/2) as a normalized short: 90 degrees about z
     const std::vector<int16_t> r = {0, 0, 0, 32767, 0, 0, h, h};
@@ -143,7 +149,8 @@ TEST_CASE("gltf instancing: malformed EXT_mesh_gpu_instancing is an error naming
           "[io][gltf][instances][quick]") {
   auto file = [](json attributes) {
     GltfWriter w;
-    const int quad = w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
+    const int quad =
+        w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
     const std::vector<float> three = {0, 0, 0, 1, 0, 0, 2, 0, 0}, two = {0, 0, 0, 1, 1, 1};
     const std::vector<float> zero_scale = {1, 1, 1, 0, 0, 0};
     const std::vector<float> vec2 = {0, 0, 1, 1};
@@ -162,15 +169,18 @@ TEST_CASE("gltf instancing: malformed EXT_mesh_gpu_instancing is an error naming
   const std::string ext = "nodes[0].extensions.EXT_mesh_gpu_instancing";
   {
     GltfWriter w = file({{"TRANSLATION", "three"}, {"SCALE", "two"}});
-    CHECK_THROWS_WITH(write_and_load(w, "inst-count"), Contains(ext + ".attributes.SCALE") && Contains("same count"));
+    CHECK_THROWS_WITH(write_and_load(w, "inst-count"),
+                      Contains(ext + ".attributes.SCALE") && Contains("same count"));
   }
   {
     GltfWriter w = file({{"TRANSLATION", "vec2"}});
-    CHECK_THROWS_WITH(write_and_load(w, "inst-type"), Contains(ext + ".attributes.TRANSLATION") && Contains("accessor type"));
+    CHECK_THROWS_WITH(write_and_load(w, "inst-type"),
+                      Contains(ext + ".attributes.TRANSLATION") && Contains("accessor type"));
   }
   {
     GltfWriter w = file({{"TRANSLATION", 1.5}});
-    CHECK_THROWS_WITH(write_and_load(w, "inst-index"), Contains(ext + ".attributes.TRANSLATION") && Contains("accessor index"));
+    CHECK_THROWS_WITH(write_and_load(w, "inst-index"),
+                      Contains(ext + ".attributes.TRANSLATION") && Contains("accessor index"));
   }
   {
     GltfWriter w = file({{"TRANSLATION", 99}});
@@ -280,7 +290,8 @@ void check_instanced_matches_flattened(const std::filesystem::path& file, const 
   for (const auto& name : accelerator_names()) {
     const Film f = render_whitted(inst.scene, *make_scene_accelerator(name, inst.scene), cam, cfg);
     const auto [differing, mean] = compare(f, reference);
-    INFO(file.filename().string() << ", " << name << ": " << differing << " pixels differ, mean |difference| " << mean);
+    INFO(file.filename().string() << ", " << name << ": " << differing << " pixels differ, mean |difference| "
+                                  << mean);
     CHECK(differing <= reference.rgba.size() / 4 / 200);
     CHECK(mean < 1e-3);
   }
@@ -304,7 +315,8 @@ TEST_CASE("gltf instancing: instanced and flattened scenes render the same image
   s.meshes.push_back(uv_sphere(12, mirror));
   test::add_quad_z(s, -6, 6, -6, 6, 0, floor);
   auto place = [&](int mesh, Vec3f t, Quat q, Vec3f sc) {
-    s.instances.push_back(make_instance(mesh, to_affine(compose_trs({t.x, t.y, t.z}, q, {sc.x, sc.y, sc.z}))));
+    s.instances.push_back(
+        make_instance(mesh, to_affine(compose_trs({t.x, t.y, t.z}, q, {sc.x, sc.y, sc.z}))));
   };
   const double h = std::sqrt(0.5);
   place(sphere, {0, 0, 1}, {}, {1, 1, 1});
@@ -326,5 +338,6 @@ TEST_CASE("gltf instancing: SimpleInstancing renders the same instanced and flat
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("no corpus (set PENUMBRA_CORPUS)");
   const Camera view = look_at({-8, 18, 26}, {5, 5, 5}, {0, 1, 0}, 0.9f);
-  check_instanced_matches_flattened(*corpus / "valid/SimpleInstancing/glTF-Binary/SimpleInstancing.glb", &view);
+  check_instanced_matches_flattened(*corpus / "valid/SimpleInstancing/glTF-Binary/SimpleInstancing.glb",
+                                    &view);
 }

@@ -15,8 +15,8 @@ using Catch::Matchers::Contains;
 using nlohmann::json;
 using penumbra::test::GltfWriter;
 using penumbra::test::names;
-using penumbra::test::write_text;
 using penumbra::test::triangle_scene;
+using penumbra::test::write_text;
 namespace fs = std::filesystem;
 
 TEST_CASE(

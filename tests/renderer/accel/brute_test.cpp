@@ -3,10 +3,9 @@
 // empty scenes and invalid (NaN, infinite, zero-direction) rays.
 #include "renderer/accel/brute.h"
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
-
-#include <catch2/catch.hpp>
 
 using namespace penumbra;
 
@@ -54,12 +53,12 @@ TEST_CASE("brute: tnear and tfar bound the hits, occluded() agrees with intersec
     uint32_t geom;
   };
   const Case cases[] = {
-      {{{0, 0, 1}, 0, {0, 0, -1}, 0.5f}, false, 0, 0},        // ends before the near layer
-      {{{0, 0, 1}, 0, {0, 0, -1}, 1.0f}, true, 1, 0},         // ends exactly on it
-      {{{0, 0, 1}, 1.5f, {0, 0, -1}, kInfinity}, true, 3, 1}, // starts past it
+      {{{0, 0, 1}, 0, {0, 0, -1}, 0.5f}, false, 0, 0},         // ends before the near layer
+      {{{0, 0, 1}, 0, {0, 0, -1}, 1.0f}, true, 1, 0},          // ends exactly on it
+      {{{0, 0, 1}, 1.5f, {0, 0, -1}, kInfinity}, true, 3, 1},  // starts past it
       {{{0, 0, 1}, 3.5f, {0, 0, -1}, kInfinity}, false, 0, 0},
-      {{{0, 0, 1}, 0, {0, 0, 1}, kInfinity}, false, 0, 0},    // away from both
-      {{{3, 3, 1}, 0, {0, 0, -1}, kInfinity}, false, 0, 0},   // beside both
+      {{{0, 0, 1}, 0, {0, 0, 1}, kInfinity}, false, 0, 0},   // away from both
+      {{{3, 3, 1}, 0, {0, 0, -1}, kInfinity}, false, 0, 0},  // beside both
       {{{5.25f, 5.25f, 1}, 0, {0, 0, -1}, kInfinity}, true, 3, 1},
   };
   for (const Case& c : cases) {
@@ -85,10 +84,11 @@ TEST_CASE("brute: empty scenes and invalid rays miss", "[accel][quick]") {
   TwoLayers s;
   const auto accel = make_brute_accelerator(s.views);
   const float nan = std::nanf("");
-  for (const Ray& r : {Ray{{nan, 0, 1}, 0, {0, 0, -1}, kInfinity}, Ray{{0, 0, 1}, 0, {0, nan, -1}, kInfinity},
-                       Ray{{0, 0, 1}, 0, {0, 0, 0}, kInfinity}, Ray{{0, 0, kInfinity}, 0, {0, 0, -1}, kInfinity},
-                       Ray{{0, 0, 1}, 0, {0, 0, -kInfinity}, kInfinity}, Ray{{0, 0, 1}, nan, {0, 0, -1}, kInfinity},
-                       Ray{{0, 0, 1}, 0, {0, 0, -1}, nan}, Ray{{0, 0, 1}, 2, {0, 0, -1}, 1}}) {
+  for (const Ray& r :
+       {Ray{{nan, 0, 1}, 0, {0, 0, -1}, kInfinity}, Ray{{0, 0, 1}, 0, {0, nan, -1}, kInfinity},
+        Ray{{0, 0, 1}, 0, {0, 0, 0}, kInfinity}, Ray{{0, 0, kInfinity}, 0, {0, 0, -1}, kInfinity},
+        Ray{{0, 0, 1}, 0, {0, 0, -kInfinity}, kInfinity}, Ray{{0, 0, 1}, nan, {0, 0, -1}, kInfinity},
+        Ray{{0, 0, 1}, 0, {0, 0, -1}, nan}, Ray{{0, 0, 1}, 2, {0, 0, -1}, 1}}) {
     Hit miss;
     CHECK_FALSE(accel->intersect(r, miss));
     CHECK_FALSE(accel->occluded(r));

@@ -2,26 +2,29 @@
 // configuration, and exact agreement with brute force under non-default settings.
 #include "renderer/accel/bvh.h"
 
-#include <catch2/catch.hpp>
 #include <tbb/task_arena.h>
 
-#include "support/cross_check.h"
+#include <catch2/catch.hpp>
+
 #include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
+#include "support/cross_check.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
 using namespace penumbra::test;
 
 namespace {
-std::vector<Ray> scene_rays(const LoadedScene& l, const Accelerator& ref, std::span<const TriangleMeshView> views) {
+std::vector<Ray> scene_rays(const LoadedScene& l, const Accelerator& ref,
+                            std::span<const TriangleMeshView> views) {
   const Bounds3f b = compute_bounds(l.scene);
   return all_rays(ref, views, b, lights_around(b), 1, 99);
 }
 }  // namespace
 
-TEST_CASE("bvh: leaves respect max_leaf_size, every triangle is referenced once, a binary tree", "[accel][bvh]") {
+TEST_CASE("bvh: leaves respect max_leaf_size, every triangle is referenced once, a binary tree",
+          "[accel][bvh]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   const auto views = mesh_views(l.scene);
   for (int leaf : {1, 4, 8}) {
@@ -50,7 +53,8 @@ TEST_CASE("bvh: width 4 collapses the same leaves into 4-wide nodes of 128 bytes
     BvhConfig c2, c4;
     c2.width = 2;
     c2.max_leaf_size = c4.max_leaf_size = leaf;
-    const AccelStats s2 = make_bvh_accelerator(views, c2)->stats(), s4 = make_bvh_accelerator(views, c4)->stats();
+    const AccelStats s2 = make_bvh_accelerator(views, c2)->stats(),
+                     s4 = make_bvh_accelerator(views, c4)->stats();
     INFO("max_leaf_size " << leaf);
     CHECK(s4.config.find("width 4") != std::string::npos);
     // The same binary build underneath: the same leaves.
@@ -80,7 +84,8 @@ TEST_CASE("bvh: axis-parallel rays through the faces and edges of 4-wide node bo
       for (int k = 0; k < 4; ++k) {
         const uint32_t base = uint32_t(pos.size());
         for (int c = 0; c < 8; ++c)
-          pos.push_back({float(2 * i + (c & 1)), float(2 * j + ((c >> 1) & 1)), float(2 * k + ((c >> 2) & 1))});
+          pos.push_back(
+              {float(2 * i + (c & 1)), float(2 * j + ((c >> 1) & 1)), float(2 * k + ((c >> 2) & 1))});
         const uint32_t f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 4, 6}, {0, 6, 2},
                                    {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3}};
         for (const auto& t : f) idx.insert(idx.end(), {base + t[0], base + t[1], base + t[2]});
@@ -127,7 +132,9 @@ TEST_CASE("bvh: any leaf size and bin count gives brute force's answers", "[acce
     c.parallel_threshold = 64;  // exercise the parallel build on a small scene
     const auto bvh = make_bvh_accelerator(views, c);
     const auto r = cross_check(*bvh, ref, views, scale, true, 0.0f);
-    INFO(summary("bvh width " + std::to_string(c.width) + " leaf " + std::to_string(leaf) + " bins " + std::to_string(bins), r));
+    INFO(summary("bvh width " + std::to_string(c.width) + " leaf " + std::to_string(leaf) + " bins " +
+                     std::to_string(bins),
+                 r));
     CHECK(r.failures() == 0);
   }
 }

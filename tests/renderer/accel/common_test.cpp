@@ -4,10 +4,9 @@
 // and the packed triangle array.
 #include "renderer/accel/common.h"
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
-
-#include <catch2/catch.hpp>
 
 using namespace penumbra;
 
@@ -37,15 +36,15 @@ TEST_CASE("slab test: entry and exit distances through faces, edges and corners"
   REQUIRE(slab({{-1, 0, 0}, 0, {1, 0, 0}, kInfinity}, t0, t1));  // along an edge
   CHECK(t0 == Approx(1));
   CHECK(t1 == Approx(2));
-  CHECK(slab({{0, -1, 0.5f}, 0, {1, 1, 0}, kInfinity}));   // touching only the edge x = 1, y = 0
-  CHECK(slab({{2, 2, 2}, 0, {-1, -1, -1}, kInfinity}));    // into the corner (1, 1, 1)
+  CHECK(slab({{0, -1, 0.5f}, 0, {1, 1, 0}, kInfinity}));               // touching only the edge x = 1, y = 0
+  CHECK(slab({{2, 2, 2}, 0, {-1, -1, -1}, kInfinity}));                // into the corner (1, 1, 1)
   CHECK(slab({{0.5f, 0.5f, 0.5f}, 0, {0, 0, 1}, kInfinity}, t0, t1));  // from inside
   CHECK(t0 == 0);
   CHECK(t1 == Approx(0.5f));
 }
 
 TEST_CASE("slab test: misses, parallel rays and signed zeros", "[accel][quick]") {
-  CHECK_FALSE(slab({{0.1f, -1, 0.5f}, 0, {1, 1, 0}, kInfinity}));  // passes that edge outside
+  CHECK_FALSE(slab({{0.1f, -1, 0.5f}, 0, {1, 1, 0}, kInfinity}));   // passes that edge outside
   CHECK_FALSE(slab({{-1, 0.5f, 0.5f}, 0, {-1, 0, 0}, kInfinity}));  // points away
   CHECK_FALSE(slab({{0.5f, 2, 0.5f}, 0, {1, 0, 0}, kInfinity}));    // parallel, outside in y
   CHECK(slab({{-1, 1, 0.5f}, 0, {1, 0, 0}, kInfinity}));            // parallel, on the face y = 1
@@ -55,15 +54,17 @@ TEST_CASE("slab test: misses, parallel rays and signed zeros", "[accel][quick]")
   CHECK(q.dir_neg[1] == 1);
   CHECK(q.dir_neg[2] == 1);
   float t0 = 0, t1 = 0.5f;  // the range ends before the box
-  CHECK_FALSE(intersect_box(kLo, kHi, prepare_box_query({{-1, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity}), t0, t1));
+  CHECK_FALSE(
+      intersect_box(kLo, kHi, prepare_box_query({{-1, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity}), t0, t1));
 }
 
 TEST_CASE("slab test: NaN and infinite components never give NaN distances", "[accel][quick]") {
   const float nan = std::nanf("");
-  for (const Ray& r : {Ray{{-1, 0.5f, 0.5f}, 0, {nan, 0, 0}, kInfinity}, Ray{{nan, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity},
-                       Ray{{-1, 0.5f, 0.5f}, 0, {kInfinity, 0, 0}, kInfinity},
-                       Ray{{-1, 0.5f, 0.5f}, 0, {1, -kInfinity, 0}, kInfinity},
-                       Ray{{-kInfinity, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity}}) {
+  for (const Ray& r :
+       {Ray{{-1, 0.5f, 0.5f}, 0, {nan, 0, 0}, kInfinity}, Ray{{nan, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity},
+        Ray{{-1, 0.5f, 0.5f}, 0, {kInfinity, 0, 0}, kInfinity},
+        Ray{{-1, 0.5f, 0.5f}, 0, {1, -kInfinity, 0}, kInfinity},
+        Ray{{-kInfinity, 0.5f, 0.5f}, 0, {1, 0, 0}, kInfinity}}) {
     float t0, t1;
     if (slab(r, t0, t1)) {
       CHECK_FALSE(std::isnan(t0));

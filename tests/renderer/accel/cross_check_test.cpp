@@ -3,12 +3,13 @@
 // corpus model; watertightness from inside a closed sphere; and the default scene rendered with
 // every back end. The [.slow] variants run many more rays outside CI:
 //   renderer_tests "[slow]"
+#include "support/cross_check.h"
+
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <filesystem>
 #include <map>
 
-#include "support/cross_check.h"
 #include "io/gltf/loader.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
@@ -72,7 +73,7 @@ TEST_CASE("cross-check: one triangle, hit in the middle, on edges and on vertice
     CHECK(h.t == Approx(1).epsilon(1e-6));
     CHECK(h.u == Approx(0.25f).epsilon(1e-5));
     CHECK(h.v == Approx(0.5f).epsilon(1e-5));
-    CHECK_FALSE(a.accel->intersect({{0.25f, 0.5f, 1}, 0, {0, 0, -1}, 0.999f}, h));  // segment stops short
+    CHECK_FALSE(a.accel->intersect({{0.25f, 0.5f, 1}, 0, {0, 0, -1}, 0.999f}, h));    // segment stops short
     CHECK_FALSE(a.accel->intersect({{0.25f, 0.5f, 1}, 0, {0, 0, 1}, kInfinity}, h));  // facing away
   }
 }
@@ -80,20 +81,20 @@ TEST_CASE("cross-check: one triangle, hit in the middle, on edges and on vertice
 TEST_CASE("cross-check: degenerate and zero-area triangles", "[accel][crosscheck]") {
   Soup s;
   s.add({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 2, 2}, {3, 3, 3}, {0.5f, 0.5f, 0.5f}, {0, 0, 1}, {1, 0, 1}},
-        {3, 3, 3,   // a point
-         3, 4, 4,   // two equal vertices
-         0, 3, 4,   // collinear (0,0,0)-(2,2,2)-(3,3,3)
-         0, 1, 2,   // a real triangle
-         5, 5, 3,   // another point-segment
-         6, 7, 6,   // a segment in z = 1
-         0, 1, 2}); // the real one again (a tie)
+        {3, 3, 3,    // a point
+         3, 4, 4,    // two equal vertices
+         0, 3, 4,    // collinear (0,0,0)-(2,2,2)-(3,3,3)
+         0, 1, 2,    // a real triangle
+         5, 5, 3,    // another point-segment
+         6, 7, 6,    // a segment in z = 1
+         0, 1, 2});  // the real one again (a tie)
   check_scene("degenerate", s.views(), {});
 }
 
 TEST_CASE("cross-check: coplanar, overlapping and interpenetrating triangles", "[accel][crosscheck]") {
   Soup s;
-  for (int i = 0; i < 4; ++i) s.add_plane(2, 0.0f, 0.0f, 1.0f, 3);        // identical stacked planes
-  s.add_plane(2, 0.0f, 0.5f, 1.5f, 4);                                    // overlapping, offset
+  for (int i = 0; i < 4; ++i) s.add_plane(2, 0.0f, 0.0f, 1.0f, 3);  // identical stacked planes
+  s.add_plane(2, 0.0f, 0.5f, 1.5f, 4);                              // overlapping, offset
   s.add({{0.2f, 0.2f, -0.5f}, {0.8f, 0.8f, 0.5f}, {0.2f, 0.8f, 0.5f}}, {0, 1, 2});  // through the plane
   s.add({{0.2f, 0.2f, 0.5f}, {0.8f, 0.8f, -0.5f}, {0.8f, 0.2f, -0.5f}}, {0, 1, 2});
   check_scene("coplanar", s.views(), {}, 1, lattice_rays(-0.5f, 1.5f, 0.25f));
@@ -121,10 +122,11 @@ TEST_CASE("cross-check: a tessellated plane, rays through vertices, along edges 
   std::vector<Ray> extra;
   for (float x = -4; x <= 4; x += 0.5f)
     for (float z = -4; z <= 4; z += 0.5f) {
-      extra.push_back({{x, 1, z}, 0, {0, -1, 0}, kInfinity});                       // vertices, edges
-      extra.push_back({{x, 0, z}, 0, {0, 1, 0}, kInfinity});                        // starts on the plane
+      extra.push_back({{x, 1, z}, 0, {0, -1, 0}, kInfinity});                        // vertices, edges
+      extra.push_back({{x, 0, z}, 0, {0, 1, 0}, kInfinity});                         // starts on the plane
       extra.push_back({{x, 0, z}, 0, normalize(Vec3f{0.3f, -1, 0.2f}), kInfinity});  // into it
-      extra.push_back({{x - 0.5f, 1, z - 0.5f}, 0, normalize(Vec3f{0.5f, -1, 0.5f}), kInfinity});  // diagonals
+      extra.push_back(
+          {{x - 0.5f, 1, z - 0.5f}, 0, normalize(Vec3f{0.5f, -1, 0.5f}), kInfinity});  // diagonals
     }
   for (float z = -4; z <= 4; z += 1) extra.push_back({{-5, 0, z}, 0, {1, 0, 0}, kInfinity});  // in the plane
   check_scene("plane", s.views(), {}, 1, extra);
@@ -135,9 +137,10 @@ TEST_CASE("cross-check: huge and tiny coordinates", "[accel][crosscheck]") {
     float scale;
     Vec3f offset;
   };
-  for (const Variant& v : {Variant{1e-6f, {0, 0, 0}}, Variant{1e-6f, {1e-6f, 2e-6f, 0}}, Variant{1, {1e-6f, 0, 0}},
-                           Variant{1, {1e3f, -1e3f, 1e3f}}, Variant{1, {1e6f, 0, 1e6f}}, Variant{1e6f, {0, 0, 0}},
-                           Variant{1e6f, {1e6f, 1e6f, 1e6f}}}) {
+  for (const Variant& v :
+       {Variant{1e-6f, {0, 0, 0}}, Variant{1e-6f, {1e-6f, 2e-6f, 0}}, Variant{1, {1e-6f, 0, 0}},
+        Variant{1, {1e3f, -1e3f, 1e3f}}, Variant{1, {1e6f, 0, 1e6f}}, Variant{1e6f, {0, 0, 0}},
+        Variant{1e6f, {1e6f, 1e6f, 1e6f}}}) {
     const Soup s = icosphere(2, v.scale, v.offset);
     char name[96];
     std::snprintf(name, sizeof name, "sphere scale %g offset (%g, %g, %g)", v.scale, v.offset.x, v.offset.y,
@@ -146,7 +149,8 @@ TEST_CASE("cross-check: huge and tiny coordinates", "[accel][crosscheck]") {
   }
 }
 
-TEST_CASE("cross-check: rays from inside a closed sphere always hit (watertightness)", "[accel][crosscheck]") {
+TEST_CASE("cross-check: rays from inside a closed sphere always hit (watertightness)",
+          "[accel][crosscheck]") {
   const Soup s = icosphere(4, 1.0f, {0.1f, -0.2f, 0.3f});  // 5120 triangles
   const auto views = s.views();
   const auto all = build_all(views);
@@ -225,16 +229,19 @@ TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus]"
     const auto instances = instance_views(l.scene);
     const std::string name = e.path().filename().string();
     check_scene(name, flatten(meshes, instances).views, light_positions(l.scene));
-    if (std::any_of(l.scene.instances.begin(), l.scene.instances.end(), [](const Instance& i) { return !i.identity; }))
+    if (std::any_of(l.scene.instances.begin(), l.scene.instances.end(),
+                    [](const Instance& i) { return !i.identity; }))
       check_instanced(name, meshes, instances, light_positions(l.scene));
     ++models;
   }
   CHECK(models >= 30);
 }
 
-TEST_CASE("cross-check, slow: the default scene and spheres with 16x the rays", "[.][slow][accel][crosscheck]") {
+TEST_CASE("cross-check, slow: the default scene and spheres with 16x the rays",
+          "[.][slow][accel][crosscheck]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
-  check_scene("default.gltf", flatten(mesh_views(l.scene), instance_views(l.scene)).views, light_positions(l.scene), 4);
+  check_scene("default.gltf", flatten(mesh_views(l.scene), instance_views(l.scene)).views,
+              light_positions(l.scene), 4);
   const Soup s = icosphere(3, 1.0f, {1e3f, 0, 0});
   check_scene("sphere", s.views(), {}, 4);
 }
@@ -265,10 +272,12 @@ TEST_CASE("the default scene renders the same image with every accelerator", "[a
     for (size_t p = 0; p < embree.rgba.size(); p += 4) {
       bool same = true;
       for (int c = 0; c < 4; ++c)
-        same &= std::fabs(films[i].rgba[p + c] - embree.rgba[p + c]) <= 1e-4f * std::max(1.0f, std::fabs(embree.rgba[p + c]));
+        same &= std::fabs(films[i].rgba[p + c] - embree.rgba[p + c]) <=
+                1e-4f * std::max(1.0f, std::fabs(embree.rgba[p + c]));
       differing += !same;
     }
-    INFO(all[i].name << ": " << differing << " of " << embree.rgba.size() / 4 << " pixels differ from embree by > 1e-4");
+    INFO(all[i].name << ": " << differing << " of " << embree.rgba.size() / 4
+                     << " pixels differ from embree by > 1e-4");
     CHECK(differing <= embree.rgba.size() / 4 / 1000);
   }
 }

@@ -3,11 +3,10 @@
 // checks and the version string.
 #include "renderer/accel/embree.h"
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
-
-#include <catch2/catch.hpp>
 
 #include "renderer/accel/brute.h"
 #include "renderer/accel/factory.h"
@@ -28,10 +27,10 @@ std::vector<Ray> analytic_rays() {
   std::vector<Ray> rays;
   for (float x : {-0.5f, 0.1f, 0.25f, 0.5f, 0.75f, 0.9f, 1.5f})
     for (float y : {-0.5f, 0.2f, 0.5f, 0.8f, 1.5f}) {
-      rays.push_back({{x, y, 1}, 0, {0, 0, -1}, kInfinity});    // straight down
+      rays.push_back({{x, y, 1}, 0, {0, 0, -1}, kInfinity});  // straight down
       rays.push_back({{x, y, 1}, 0, {0.1f, -0.05f, -1}, kInfinity});
-      rays.push_back({{x, y, -3}, 0, {0, 0, 1}, kInfinity});    // from below
-      rays.push_back({{x, y, 1}, 0, {0, 0, -1}, 0.5f});         // too short
+      rays.push_back({{x, y, -3}, 0, {0, 0, 1}, kInfinity});      // from below
+      rays.push_back({{x, y, 1}, 0, {0, 0, -1}, 0.5f});           // too short
       rays.push_back({{x, y, 1}, 1.25f, {0, 0, -1}, kInfinity});  // starts between the layers
     }
   return rays;
@@ -40,8 +39,8 @@ std::vector<Ray> analytic_rays() {
 void check_same(const Accelerator& embree, const Accelerator& brute, const Ray& r) {
   Hit he, hb;
   const bool e = embree.intersect(r, he), b = brute.intersect(r, hb);
-  INFO("ray org " << r.org.x << "," << r.org.y << "," << r.org.z << " dir " << r.dir.x << "," << r.dir.y << ","
-                  << r.dir.z << " tnear " << r.tnear << " tfar " << r.tfar);
+  INFO("ray org " << r.org.x << "," << r.org.y << "," << r.org.z << " dir " << r.dir.x << "," << r.dir.y
+                  << "," << r.dir.z << " tnear " << r.tnear << " tfar " << r.tfar);
   REQUIRE(e == b);
   CHECK(embree.occluded(r) == e);
   if (!e) return;
@@ -67,7 +66,8 @@ TEST_CASE("embree: the same hits as brute force on analytic cases", "[accel][emb
 
 TEST_CASE("embree: instanced placements hit as the brute-force two-level build", "[accel][embree][quick]") {
   Analytic s;
-  const std::vector<InstanceView> instances{{0, Affine3f{}}, {1, Affine3f{}}, {0, to_affine(translate(0, 0, -0.5))}};
+  const std::vector<InstanceView> instances{
+      {0, Affine3f{}}, {1, Affine3f{}}, {0, to_affine(translate(0, 0, -0.5))}};
   const auto embree = make_accelerator("embree", s.views, instances);
   const auto brute = make_accelerator("brute", s.views, instances);
   for (const Ray& r : analytic_rays()) check_same(*embree, *brute, r);

@@ -14,9 +14,10 @@ TEST_CASE("NaN, infinite and zero-direction rays miss in every back end", "[acce
   for (const auto& name : accelerator_names()) {
     const auto accel = make_accelerator(name, std::span(&view, 1));
     const float nan = std::nanf("");
-    for (const Ray& r : {Ray{{0, 0, 1}, 0, {nan, 0, -1}, kInfinity}, Ray{{nan, 0, 1}, 0, {0, 0, -1}, kInfinity},
-                         Ray{{0, 0, 1}, 0, {0, 0, 0}, kInfinity}, Ray{{0, 0, 1}, 0, {kInfinity, 0, -1}, kInfinity},
-                         Ray{{0, 0, 1}, nan, {0, 0, -1}, kInfinity}}) {
+    for (const Ray& r :
+         {Ray{{0, 0, 1}, 0, {nan, 0, -1}, kInfinity}, Ray{{nan, 0, 1}, 0, {0, 0, -1}, kInfinity},
+          Ray{{0, 0, 1}, 0, {0, 0, 0}, kInfinity}, Ray{{0, 0, 1}, 0, {kInfinity, 0, -1}, kInfinity},
+          Ray{{0, 0, 1}, nan, {0, 0, -1}, kInfinity}}) {
       Hit h;
       CHECK_FALSE(accel->intersect(r, h));
       CHECK_FALSE(accel->occluded(r));
@@ -40,7 +41,8 @@ TEST_CASE("empty scenes build and miss", "[accel][quick]") {
   CHECK_THROWS_AS(make_accelerator("octree-of-dreams", {}), std::invalid_argument);
 }
 
-TEST_CASE("the factory knows five back ends, embree first, and refuses bad configurations", "[accel][quick]") {
+TEST_CASE("the factory knows five back ends, embree first, and refuses bad configurations",
+          "[accel][quick]") {
   CHECK(accelerator_names() == std::vector<std::string>{"embree", "bvh", "kdtree", "grid", "brute"});
   AccelConfig bad_bvh;
   bad_bvh.bvh.max_leaf_size = 0;

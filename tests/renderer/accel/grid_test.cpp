@@ -5,10 +5,10 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/cross_check.h"
 #include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
+#include "support/cross_check.h"
 #include "support/test_util.h"
 
 using namespace penumbra;

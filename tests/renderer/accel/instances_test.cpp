@@ -3,12 +3,11 @@
 // every back end over instances agrees with brute force over the flattened scene, and
 // Penumbra's back ends agree exactly with the two-level brute force.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
-#include "support/cross_check.h"
 #include "renderer/accel/factory.h"
+#include "support/cross_check.h"
 
 using namespace penumbra;
 using namespace penumbra::test;
@@ -18,12 +17,14 @@ namespace {
 /// Translation x rotation about a unit axis x scale, as an Affine3f.
 Affine3f placement(Vec3f t, Vec3f axis, double angle, Vec3f s) {
   const double h = angle / 2, k = std::sin(h);
-  const Transform m = translate(t.x, t.y, t.z) * rotate(Quat{axis.x * k, axis.y * k, axis.z * k, std::cos(h)}) *
-                      scale(s.x, s.y, s.z);
+  const Transform m = translate(t.x, t.y, t.z) *
+                      rotate(Quat{axis.x * k, axis.y * k, axis.z * k, std::cos(h)}) * scale(s.x, s.y, s.z);
   return to_affine(m);
 }
 
-Affine3f translation(Vec3f t) { return placement(t, {0, 0, 1}, 0, {1, 1, 1}); }
+Affine3f translation(Vec3f t) {
+  return placement(t, {0, 0, 1}, 0, {1, 1, 1});
+}
 
 }  // namespace
 
@@ -92,15 +93,17 @@ TEST_CASE("instances: identity placements build one level; bad instances are ref
     CHECK(h.geom_id == 1);
     CHECK(h.t == Approx(4).epsilon(1e-6));  // the icosphere has a vertex at (0, 0, 1)
     // An instance of a mesh that does not exist.
-    CHECK_THROWS_AS(make_accelerator(name, meshes, std::vector<InstanceView>{{1, {}}}), std::invalid_argument);
+    CHECK_THROWS_AS(make_accelerator(name, meshes, std::vector<InstanceView>{{1, {}}}),
+                    std::invalid_argument);
   }
 }
 
-TEST_CASE("instances: every back end agrees with brute force over the flattened scene", "[accel][instances][crosscheck]") {
+TEST_CASE("instances: every back end agrees with brute force over the flattened scene",
+          "[accel][instances][crosscheck]") {
   Soup s;
   Soup sphere = icosphere(2, 1, {0, 0, 0});
-  s.add(sphere.positions[0], sphere.indices[0]);  // mesh 0: sphere (320 triangles)
-  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);           // mesh 1: a 2 x 2 plane in y = 0
+  s.add(sphere.positions[0], sphere.indices[0]);                 // mesh 0: sphere (320 triangles)
+  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);                          // mesh 1: a 2 x 2 plane in y = 0
   s.add({{0, 0, 0}, {0.3f, 0, 0}, {0, 0.3f, 0.1f}}, {0, 1, 2});  // mesh 2: one small triangle
   const auto meshes = s.views();
   std::vector<InstanceView> instances = {
@@ -115,8 +118,9 @@ TEST_CASE("instances: every back end agrees with brute force over the flattened 
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1, 1);
   for (int i = 0; i < 300; ++i)
-    instances.push_back({2, placement({u(rng) * 3, 2 + u(rng), u(rng) * 3}, normalize(Vec3f{u(rng), u(rng), u(rng) + 2}),
-                                      u(rng) * 3, {1 + u(rng) * 0.5f, 1, 1 + u(rng) * 0.5f})});
+    instances.push_back(
+        {2, placement({u(rng) * 3, 2 + u(rng), u(rng) * 3}, normalize(Vec3f{u(rng), u(rng), u(rng) + 2}),
+                      u(rng) * 3, {1 + u(rng) * 0.5f, 1, 1 + u(rng) * 0.5f})});
   instances.push_back({0, placement({9, 9, 9}, {0, 0, 1}, 0, {0, 0, 0})});  // singular: never hit
   check_instanced("instances", meshes, instances, {});
 }

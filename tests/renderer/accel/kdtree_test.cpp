@@ -2,13 +2,14 @@
 // configuration, and exact agreement with brute force under non-default settings.
 #include "renderer/accel/kdtree.h"
 
-#include <catch2/catch.hpp>
 #include <tbb/task_arena.h>
 
-#include "support/cross_check.h"
+#include <catch2/catch.hpp>
+
 #include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
+#include "support/cross_check.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -30,7 +31,8 @@ TEST_CASE("kdtree: splits off empty space and respects max_depth", "[accel][kdtr
   CHECK(s1.nodes <= 3);
 }
 
-TEST_CASE("kdtree: perfect splits keep a long diagonal triangle out of cells it only bounds", "[accel][kdtree]") {
+TEST_CASE("kdtree: perfect splits keep a long diagonal triangle out of cells it only bounds",
+          "[accel][kdtree]") {
   // A thin diagonal sliver across a cloud of small triangles: its bounding box covers the whole
   // scene, but with clipping it is referenced only in leaves along the diagonal.
   std::vector<Vec3f> pos{{0, 0, 0}, {10, 10, 0}, {10, 10.01f, 0}};
@@ -64,7 +66,8 @@ TEST_CASE("kdtree: other cost constants give brute force's answers, and the buil
   const auto brute = make_accelerator("brute", views);
   const Bounds3f b = compute_bounds(l.scene);
   const Reference ref = reference(*brute, all_rays(*brute, views, b, lights_around(b), 1, 3));
-  for (auto [kt, ki, bonus] : {std::tuple{1.0f, 1.0f, 0.0f}, std::tuple{15.0f, 20.0f, 0.5f}, std::tuple{80.0f, 1.0f, 0.2f}}) {
+  for (auto [kt, ki, bonus] :
+       {std::tuple{1.0f, 1.0f, 0.0f}, std::tuple{15.0f, 20.0f, 0.5f}, std::tuple{80.0f, 1.0f, 0.2f}}) {
     KdTreeConfig c;
     c.traversal_cost = kt;
     c.intersection_cost = ki;

@@ -55,7 +55,8 @@ TEST_CASE("ray-triangle (Cramer and watertight) agree with hand-computed hits", 
   REQUIRE_FALSE(intersect_triangle_watertight(out, prepare_watertight(out), a, b, c, kInfinity, t, u, v));
   const Ray behind{{0.25f, 0.25f, -1}, 0, {0, 0, -1}, kInfinity};
   REQUIRE_FALSE(intersect_triangle_cramer(behind, a, b, c, t, u, v));
-  REQUIRE_FALSE(intersect_triangle_watertight(behind, prepare_watertight(behind), a, b, c, kInfinity, t, u, v));
+  REQUIRE_FALSE(
+      intersect_triangle_watertight(behind, prepare_watertight(behind), a, b, c, kInfinity, t, u, v));
   REQUIRE_FALSE(intersect_triangle_watertight(r, w, a, b, c, 1.5f, t, u, v));
   // Oblique ray: from (0,0,1) towards (0.2, 0.2, 0): t = 1 with dir (0.2, 0.2, -1).
   const Ray ob{{0, 0, 1}, 0, {0.2f, 0.2f, -1}, kInfinity};
@@ -99,7 +100,8 @@ TEST_CASE("NaN and degenerate inputs never hit", "[geometry][quick]") {
 TEST_CASE("offset ray origins escape their own surface", "[geometry][quick]") {
   // A point on a large plane far from the origin: a ray leaving it must not re-hit the plane.
   for (float scale : {1e-3f, 1.0f, 1e3f, 1e5f}) {
-    const Vec3f a{-scale * 10, -scale * 10, scale}, b{scale * 10, -scale * 10, scale}, c{0, scale * 10, scale};
+    const Vec3f a{-scale * 10, -scale * 10, scale}, b{scale * 10, -scale * 10, scale},
+        c{0, scale * 10, scale};
     const Vec3f p{scale * 0.123f, scale * 0.456f, scale};
     const Vec3f ng{0, 0, 1};
     const Vec3f dir = normalize(Vec3f{0.3f, 0.2f, 1});

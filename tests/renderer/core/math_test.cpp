@@ -39,7 +39,8 @@ TEST_CASE("quaternion product composes rotations like Eigen", "[math][quick]") {
   for (int k = 0; k < 100; ++k) {
     const Quat a = random_quat(rng), b = random_quat(rng);
     const Quat p = a * b;
-    const Eigen::Quaterniond e = Eigen::Quaterniond(a.w, a.x, a.y, a.z) * Eigen::Quaterniond(b.w, b.x, b.y, b.z);
+    const Eigen::Quaterniond e =
+        Eigen::Quaterniond(a.w, a.x, a.y, a.z) * Eigen::Quaterniond(b.w, b.x, b.y, b.z);
     REQUIRE(p.x == Approx(e.x()).margin(1e-12));
     REQUIRE(p.y == Approx(e.y()).margin(1e-12));
     REQUIRE(p.z == Approx(e.z()).margin(1e-12));

@@ -3,13 +3,13 @@
 #include "renderer/core/parallel.h"
 
 #include <atomic>
-#include <vector>
-
 #include <catch2/catch.hpp>
+#include <vector>
 
 using namespace penumbra;
 
-TEST_CASE("tile scheduler: each pixel of the window exactly once, any tiles and threads", "[parallel][quick]") {
+TEST_CASE("tile scheduler: each pixel of the window exactly once, any tiles and threads",
+          "[parallel][quick]") {
   for (const PixelWindow w : {PixelWindow{0, 0, 1, 1}, PixelWindow{0, 0, 37, 23}, PixelWindow{5, 3, 70, 40},
                               PixelWindow{10, 7, 11, 64}})
     for (int tile_size : {1, 3, 8, 32, 100})

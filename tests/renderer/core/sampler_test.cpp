@@ -57,7 +57,8 @@ TEST_CASE("sampler: Owen scrambling keeps every elementary interval stratified",
 TEST_CASE("sampler: streams are deterministic and decorrelated across pixels and seeds", "[sampler][quick]") {
   for (SamplerType t : {SamplerType::Sobol, SamplerType::Independent}) {
     SampleStream a = make_sample_stream(t, 5, 9, 3, 0), b = make_sample_stream(t, 5, 9, 3, 0);
-    SampleStream other_pixel = make_sample_stream(t, 6, 9, 3, 0), other_seed = make_sample_stream(t, 5, 9, 3, 1);
+    SampleStream other_pixel = make_sample_stream(t, 6, 9, 3, 0),
+                 other_seed = make_sample_stream(t, 5, 9, 3, 1);
     int same_pixel = 0, same_seed = 0;
     for (int d = 0; d < 16; ++d) {
       const float x = a.get1d();

@@ -2,11 +2,11 @@
 // depths, normals and positions on a known scene, background conventions, determinism, and
 // beauty = the sum of the light groups with physically known splits.
 #include "renderer/film/aov.h"
-#include "renderer/integrators/scene_accel.h"
 
 #include <catch2/catch.hpp>
 
 #include "io/gltf/loader.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -14,7 +14,9 @@ using namespace penumbra;
 using namespace penumbra::test;
 
 namespace {
-RenderConfig config(int w, int h, int spp) { return small_render_config(w, h, spp, 4); }
+RenderConfig config(int w, int h, int spp) {
+  return small_render_config(w, h, spp, 4);
+}
 }  // namespace
 
 TEST_CASE("aov: ids, depth, normal, position and albedo are exact on a known scene", "[aov][quick]") {
@@ -83,7 +85,8 @@ TEST_CASE("light groups: the beauty is their sum, split as physics says", "[aov]
   const Environment env = make_constant_environment({0.2f, 0.2f, 0.25f});
   RenderConfig cfg = config(32, 18, 8);
   cfg.light_groups = true;
-  const PathImage img = render_path(loaded.scene, *accel, PathLights{&al, &env}, loaded.scene.cameras.at(0), cfg);
+  const PathImage img =
+      render_path(loaded.scene, *accel, PathLights{&al, &env}, loaded.scene.cameras.at(0), cfg);
   REQUIRE(img.groups.size() == size_t(32 * 18 * 15));
   double diffuse = 0, specular = 0, indirect = 0;
   for (size_t i = 0; i < size_t(32 * 18); ++i)
@@ -109,7 +112,8 @@ TEST_CASE("light groups: the beauty is their sum, split as physics says", "[aov]
   RenderConfig c2 = config(4, 4, 1024);
   c2.light_groups = true;
   c2.path.max_depth = 40;
-  const PathImage e = render_path(s, *accel2, PathLights{&al2, &black}, look_at({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1), c2);
+  const PathImage e =
+      render_path(s, *accel2, PathLights{&al2, &black}, look_at({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1), c2);
   auto mean = [&](int group) {
     double m = 0;
     for (size_t i = 0; i < 16; ++i) m += e.groups[i * 15 + size_t(group * 3)];

@@ -5,9 +5,9 @@
 #include <catch2/catch.hpp>
 
 #include "renderer/accel/factory.h"
+#include "renderer/core/rng.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
-#include "renderer/core/rng.h"
 #include "support/scene_builder.h"
 
 using namespace penumbra;
@@ -22,7 +22,8 @@ Scene two_quads() {
 }
 }  // namespace
 
-TEST_CASE("cost map: brute force tests every triangle on every camera ray and visits no node", "[cost][quick]") {
+TEST_CASE("cost map: brute force tests every triangle on every camera ray and visits no node",
+          "[cost][quick]") {
   const Scene s = two_quads();
   const auto views = mesh_views(s);
   const auto brute = make_accelerator("brute", views);
@@ -87,7 +88,8 @@ TEST_CASE("cost map: matches intersect_counted per ray, the same for 1 and 2 thr
       const Vec2f j = stratified_sample(0, 1, rng);
       Hit h;
       bvh->intersect_counted(generate_camera_ray(cam, cfg.width, cfg.height, x + j.x, y + j.y), h, direct);
-      image_total += c.nodes[size_t(y) * size_t(cfg.width) + size_t(x)] + c.triangles[size_t(y) * size_t(cfg.width) + size_t(x)];
+      image_total += c.nodes[size_t(y) * size_t(cfg.width) + size_t(x)] +
+                     c.triangles[size_t(y) * size_t(cfg.width) + size_t(x)];
     }
   CHECK(image_total == double(direct.nodes + direct.triangles));
 }

@@ -6,14 +6,14 @@
 // convergence rate, determinism across threads, and the time limit and adaptive sampling.
 #include "renderer/integrators/path.h"
 
-#include <catch2/catch.hpp>
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <cstring>
 
 #include "io/gltf/loader.h"
+#include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/bsdf.h"
-#include "renderer/integrators/render.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -35,7 +35,9 @@ Rendered render(const Scene& s, const Environment& env, const Camera& cam, const
   return r;
 }
 
-RenderConfig small_config(int w, int h, int spp) { return small_render_config(w, h, spp); }
+RenderConfig small_config(int w, int h, int spp) {
+  return small_render_config(w, h, spp);
+}
 
 double channel_mean(const Film& f, int c) {
   double sum = 0;
@@ -73,7 +75,8 @@ Vec3f ray_mean(const Scene& s, const Environment& env, const PathConfig& pc, con
 double corner_form_factor(double a, double b, double h) {
   const double x = a / h, y = b / h;
   return (x / std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) +
-          y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y))) / (2 * M_PI);
+          y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y))) /
+         (2 * M_PI);
 }
 
 }  // namespace
@@ -99,7 +102,8 @@ TEST_CASE("path: a closed emitting enclosure converges to the geometric series",
     CHECK(channel_mean(r.image.film, 0) == Approx(c.expected).epsilon(0.005));
     CHECK(channel_mean(r.image.film, 3) == 1.0);
     // Every pixel converges: within 1% at 4096 spp.
-    for (size_t i = 0; i < r.image.film.rgba.size(); i += 4) REQUIRE(r.image.film.rgba[i] == Approx(c.expected).epsilon(0.01));
+    for (size_t i = 0; i < r.image.film.rgba.size(); i += 4)
+      REQUIRE(r.image.film.rgba[i] == Approx(c.expected).epsilon(0.01));
   }
   // Russian roulette keeps the estimate unbiased.
   Scene s;
@@ -107,7 +111,8 @@ TEST_CASE("path: a closed emitting enclosure converges to the geometric series",
   RenderConfig cfg = small_config(8, 8, 256);
   cfg.path.max_depth = 40;
   cfg.path.rr_depth = 1;
-  CHECK(channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 1) == Approx(2.0).epsilon(0.01));
+  CHECK(channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 1) ==
+        Approx(2.0).epsilon(0.01));
 }
 
 TEST_CASE("path: white furnace: a convex white object in a uniform environment vanishes", "[path]") {
@@ -117,7 +122,8 @@ TEST_CASE("path: white furnace: a convex white object in a uniform environment v
   const Rendered r = render(s, make_constant_environment({1, 1, 1}), cam, small_config(6, 6, 4096));
   CHECK(channel_mean(r.image.film, 3) > 0.5);  // the sphere covers most of the image
   CHECK(channel_mean(r.image.film, 0) == Approx(1).epsilon(0.002));
-  for (size_t i = 0; i < r.image.film.rgba.size(); i += 4) REQUIRE(r.image.film.rgba[i + 1] == Approx(1).epsilon(0.01));
+  for (size_t i = 0; i < r.image.film.rgba.size(); i += 4)
+    REQUIRE(r.image.film.rgba[i + 1] == Approx(1).epsilon(0.01));
 }
 
 TEST_CASE("path: GGX furnace: a rough metal loses exactly its single-scattering energy", "[path]") {
@@ -136,7 +142,8 @@ TEST_CASE("path: GGX furnace: a rough metal loses exactly its single-scattering 
       const double mu = (i + 0.5) / nm;
       for (int j = 0; j < np; ++j) {
         const double phi = (j + 0.5) * 2 * M_PI / np, st = std::sqrt(1 - mu * mu);
-        albedo += brdf_eval(b, {0, 0, 1}, {float(st * std::cos(phi)), float(st * std::sin(phi)), float(mu)}).x * mu;
+        albedo +=
+            brdf_eval(b, {0, 0, 1}, {float(st * std::cos(phi)), float(st * std::sin(phi)), float(mu)}).x * mu;
       }
     }
     albedo *= (1.0 / nm) * (2 * M_PI / np);
@@ -177,7 +184,8 @@ TEST_CASE("path: MIS, BSDF sampling alone and light sampling alone agree in the 
               << ", light " << results[2].first << " +- " << results[2].second);
   CHECK(mis > 0.1);
   for (int k : {1, 2}) {
-    const double tolerance = 4 * std::sqrt(mis_err * mis_err + results[size_t(k)].second * results[size_t(k)].second);
+    const double tolerance =
+        4 * std::sqrt(mis_err * mis_err + results[size_t(k)].second * results[size_t(k)].second);
     CHECK(std::fabs(results[size_t(k)].first - mis) < tolerance);
     CHECK(tolerance < 0.05 * mis);  // and the comparison is tight enough to mean something
   }
@@ -217,12 +225,13 @@ TEST_CASE("path: a square area light gives its form factor; one-sided lights emi
     bool facing_down, double_sided;
     double expected;
   };
-  for (const Case& c : {Case{true, false, rho * le * f}, Case{false, false, 0.0}, Case{false, true, rho * le * f},
-                        Case{true, true, rho * le * f}}) {
+  for (const Case& c : {Case{true, false, rho * le * f}, Case{false, false, 0.0},
+                        Case{false, true, rho * le * f}, Case{true, true, rho * le * f}}) {
     INFO("facing down " << c.facing_down << ", double-sided " << c.double_sided);
     Scene s;
     add_quad_z(s, -10, 10, -10, 10, 0, add_lambert(s, {float(rho), float(rho), float(rho)}));
-    add_quad_z(s, -1, 1, -1, 1, 1, add_lambert(s, {0, 0, 0}, {float(le), float(le), float(le)}, c.double_sided),
+    add_quad_z(s, -1, 1, -1, 1, 1,
+               add_lambert(s, {0, 0, 0}, {float(le), float(le), float(le)}, c.double_sided),
                /*flip=*/c.facing_down);
     Ray r = ray;
     if (c.double_sided || !c.facing_down) r.org = {0, 0, 0.5f};  // start below a light that faces the view
@@ -297,8 +306,10 @@ TEST_CASE("path: the error falls as 1/sqrt(spp)", "[path]") {
     }
     const double slope = sxy / sxx;
     INFO((type == SamplerType::Sobol ? "sobol" : "independent") << " slope " << slope);
-    if (type == SamplerType::Independent) CHECK(slope == Approx(-0.5).margin(0.08));
-    else CHECK(slope < -0.45);
+    if (type == SamplerType::Independent)
+      CHECK(slope == Approx(-0.5).margin(0.08));
+    else
+      CHECK(slope < -0.45);
   }
 }
 
@@ -335,7 +346,8 @@ TEST_CASE("path: the image is bit-identical for any thread count, tile size and 
   cfg.time_limit = 0;
   cfg.spp = 1;
   const Rendered one = render(s, env, s.cameras.at(0), cfg);
-  CHECK(std::memcmp(limited.image.film.rgba.data(), one.image.film.rgba.data(), one.image.film.rgba.size() * sizeof(float)) == 0);
+  CHECK(std::memcmp(limited.image.film.rgba.data(), one.image.film.rgba.data(),
+                    one.image.film.rgba.size() * sizeof(float)) == 0);
   CHECK(path_pass_ends(40) == std::vector<int>{1, 2, 4, 8, 16, 32, 40});
 }
 
@@ -366,9 +378,11 @@ TEST_CASE("path: clamping indirect light bounds each indirect sample", "[path][q
   add_sphere(s, {0, 0, 0}, 3, 2, add_lambert(s, {0.9f, 0.9f, 0.9f}, {1, 1, 1}));
   const Camera cam = look_at({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1.0f);
   RenderConfig cfg = small_config(4, 4, 64);
-  const double unclamped = channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 0);
+  const double unclamped =
+      channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 0);
   cfg.path.clamp_indirect = 0.01f;
-  const double clamped = channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 0);
+  const double clamped =
+      channel_mean(render(s, make_constant_environment({0, 0, 0}), cam, cfg).image.film, 0);
   CHECK(unclamped == Approx((1 - std::pow(0.9, 14)) / 0.1).epsilon(0.03));  // max depth 12
   // Emission seen directly (1) and direct light at the first hit (0.9) are kept; each of at most
   // max_depth = 12 indirect contributions adds at most 0.01.
@@ -376,7 +390,8 @@ TEST_CASE("path: clamping indirect light bounds each indirect sample", "[path][q
   CHECK(clamped <= 1.9 + 12 * 0.01 + 0.02);
 }
 
-TEST_CASE("path: a render stopped between passes and resumed equals the uninterrupted render", "[path][resume]") {
+TEST_CASE("path: a render stopped between passes and resumed equals the uninterrupted render",
+          "[path][resume]") {
   LoadedScene loaded = load_gltf(test::source_dir() / "scenes/default.gltf");
   const Scene& s = loaded.scene;
   const auto accel = make_scene_accelerator("embree", s);
@@ -407,7 +422,8 @@ TEST_CASE("path: a render stopped between passes and resumed equals the uninterr
   const PathImage resumed = render_path(s, *accel, lights, s.cameras.at(0), cfg, &second, {}, &copy);
   CHECK(copy.complete);
   CHECK(second.passes == int(path_pass_ends(40).size()) - 3);
-  CHECK(std::memcmp(whole.film.rgba.data(), resumed.film.rgba.data(), whole.film.rgba.size() * sizeof(float)) == 0);
+  CHECK(std::memcmp(whole.film.rgba.data(), resumed.film.rgba.data(),
+                    whole.film.rgba.size() * sizeof(float)) == 0);
   CHECK(whole.samples == resumed.samples);
   CHECK(whole.groups == resumed.groups);
   CHECK(whole.variance == resumed.variance);

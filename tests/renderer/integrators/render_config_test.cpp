@@ -3,12 +3,11 @@
 // render_window() clamps.
 #include "renderer/integrators/render_config.h"
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <string>
-
-#include <catch2/catch.hpp>
 
 using namespace penumbra;
 
@@ -43,7 +42,10 @@ TEST_CASE("validate: defaults and the documented bounds pass", "[render][quick]"
           c.adaptive_min_spp = 2;
           c.window = {0, 0, kMaxImageSize, 1};
         })).empty());
-  CHECK(failure(with([](RenderConfig& c) { c.width = c.height = 1; c.window = {0, 0, 1, 1}; })).empty());
+  CHECK(failure(with([](RenderConfig& c) {
+          c.width = c.height = 1;
+          c.window = {0, 0, 1, 1};
+        })).empty());
 }
 
 TEST_CASE("validate: each setting outside its range is refused by name", "[render][quick]") {
@@ -71,10 +73,22 @@ TEST_CASE("validate: each setting outside its range is refused by name", "[rende
       {"time_limit", [](RenderConfig& c) { c.time_limit = -0.5; }},
       {"adaptive_threshold", [](RenderConfig& c) { c.adaptive_threshold = -1e-3f; }},
       {"adaptive_min_spp", [](RenderConfig& c) { c.adaptive_min_spp = 1; }},
-      {"window", [](RenderConfig& c) { c.window = {10, 10, 5, 20}; }},
-      {"window", [](RenderConfig& c) { c.window = {-1, 0, 10, 10}; }},
-      {"window", [](RenderConfig& c) { c.window = {0, 0, c.width + 1, 10}; }},
-      {"window", [](RenderConfig& c) { c.window = {0, 500, 10, c.height + 1}; }},
+      {"window",
+       [](RenderConfig& c) {
+         c.window = {10, 10, 5, 20};
+       }},
+      {"window",
+       [](RenderConfig& c) {
+         c.window = {-1, 0, 10, 10};
+       }},
+      {"window",
+       [](RenderConfig& c) {
+         c.window = {0, 0, c.width + 1, 10};
+       }},
+      {"window",
+       [](RenderConfig& c) {
+         c.window = {0, 500, 10, c.height + 1};
+       }},
   };
   for (const auto& [name, breaks] : cases) {
     const std::string message = failure(with(breaks));

@@ -1,12 +1,12 @@
 // Tests for renderer/render: bitwise determinism across thread counts, coverage alpha,
 // stratified sampling.
-#include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 
 #include <catch2/catch.hpp>
 #include <cstring>
 
 #include "io/gltf/loader.h"
+#include "renderer/accel/factory.h"
 #include "renderer/core/rng.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"

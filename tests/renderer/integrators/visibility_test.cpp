@@ -50,7 +50,8 @@ TEST_CASE("material: Blend layers attenuate shadows by (1 - alpha) each", "[mate
   CHECK(shadow_transmittance(p.scene, *p.accel, shadow, true) == Approx(0.25));
 }
 
-TEST_CASE("material: single-sided back faces are invisible to camera rays but cast shadows", "[material][quick]") {
+TEST_CASE("material: single-sided back faces are invisible to camera rays but cast shadows",
+          "[material][quick]") {
   Probe p;
   const int single = add_material(p.scene, {1, 0, 0}, 0, 1);
   p.scene.materials[size_t(single)].double_sided = false;

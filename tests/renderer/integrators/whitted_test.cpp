@@ -1,10 +1,10 @@
 // Tests for renderer/whitted: the material mapping and closed-form shading of simple scenes.
-#include "renderer/accel/factory.h"
-#include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/whitted.h"
 
 #include <catch2/catch.hpp>
 
+#include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 
 using namespace penumbra;
@@ -27,7 +27,7 @@ TEST_CASE("whitted_params follows the documented glTF mapping", "[whitted][quick
   CHECK(w.ka.y == Approx(0.6 * 0.75));
   const double f0x = 0.04 * 0.75 + 0.8 * 0.25;
   CHECK(w.ks.x == Approx(f0x));
-  CHECK(w.kr.x == Approx(f0x * 0.25));             // (1 - roughness)^2
+  CHECK(w.kr.x == Approx(f0x * 0.25));              // (1 - roughness)^2
   CHECK(w.exponent == Approx(2.0 / 0.0625 - 2.0));  // alpha = roughness^2 = 0.25
   // A perfect mirror: no diffuse, full reflectance, the maximum exponent.
   m = {};
@@ -55,7 +55,7 @@ TEST_CASE("a single lit quad matches the closed-form Blinn-Phong value", "[whitt
 
   // Closed form at p = 0, n = v = +z, light at (1, 0, 1): d^2 = 2, E = 2 / 2 = 1.
   const double ndotl = 1 / std::sqrt(2.0);
-  const double ndoth = std::cos(M_PI / 8);  // h halfway between v (0 deg) and l (45 deg)
+  const double ndoth = std::cos(M_PI / 8);     // h halfway between v (0 deg) and l (45 deg)
   const double p = 2 / std::pow(0.25, 2) - 2;  // 30
   const double spec = 0.04 * (p + 8) / (8 * M_PI) * std::pow(ndoth, p) * ndotl;
   for (int c = 0; c < 3; ++c) {

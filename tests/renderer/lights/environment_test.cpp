@@ -31,7 +31,8 @@ double sphere_integral(G&& g, int nt = 800, int np = 1600) {
     const double th = (i + 0.5) * M_PI / nt;
     for (int j = 0; j < np; ++j) {
       const double ph = (j + 0.5) * 2 * M_PI / np;
-      const Vec3f d{float(std::sin(th) * std::cos(ph)), float(std::cos(th)), float(std::sin(th) * std::sin(ph))};
+      const Vec3f d{float(std::sin(th) * std::cos(ph)), float(std::cos(th)),
+                    float(std::sin(th) * std::sin(ph))};
       sum += g(d) * std::sin(th);
     }
   }
@@ -39,7 +40,8 @@ double sphere_integral(G&& g, int nt = 800, int np = 1600) {
 }
 }  // namespace
 
-TEST_CASE("environment: the map's centre is -Z, +X is to its right, the top row is +Y", "[environment][quick]") {
+TEST_CASE("environment: the map's centre is -Z, +X is to its right, the top row is +Y",
+          "[environment][quick]") {
   const Environment e = test_sky();
   const Vec2f front = env_direction_to_uv(e, {0, 0, -1});
   CHECK(front.x == Approx(0.5));
@@ -55,7 +57,8 @@ TEST_CASE("environment: the map's centre is -Z, +X is to its right, the top row 
   CHECK(env_eval(r, {-1, 0, 0}) == env_eval(e, {0, 0, -1}));
 }
 
-TEST_CASE("environment: the sampling density integrates to 1 and matches the samples", "[environment][quick]") {
+TEST_CASE("environment: the sampling density integrates to 1 and matches the samples",
+          "[environment][quick]") {
   for (float rot : {0.0f, 1.0f}) {
     const Environment e = test_sky(rot);
     CHECK(sphere_integral([&](Vec3f d) { return env_pdf(e, d); }) == Approx(1).epsilon(0.01));
@@ -73,7 +76,8 @@ TEST_CASE("environment: the sampling density integrates to 1 and matches the sam
       REQUIRE(l == env_eval(e, d));
       est += luminance(l) * std::max(0.0f, d.y) / pdf;
     }
-    const double ref = sphere_integral([&](Vec3f d) { return luminance(env_eval(e, d)) * std::max(0.0f, d.y); }, 1600, 3200);
+    const double ref =
+        sphere_integral([&](Vec3f d) { return luminance(env_eval(e, d)) * std::max(0.0f, d.y); }, 1600, 3200);
     CHECK(est / n == Approx(ref).epsilon(0.01));
   }
   // A constant environment samples the sphere uniformly.

@@ -28,7 +28,9 @@ double hemisphere_integral(G&& g, int n_mu = 3000, int n_phi = 256) {
   return sum * (2 * M_PI) / (double(n_mu) * n_phi);
 }
 
-Vec3f view_at(float theta) { return {std::sin(theta), 0, std::cos(theta)}; }
+Vec3f view_at(float theta) {
+  return {std::sin(theta), 0, std::cos(theta)};
+}
 
 /// Mean sample weight (f cos / pdf) over n stratified samples: the directional albedo.
 Vec3f sampled_albedo(const GltfBrdf& b, Vec3f wo, int n, uint64_t seed) {
@@ -49,7 +51,8 @@ TEST_CASE("bsdf: GGX D is normalised and the visible normals integrate to 1", "[
     CHECK(hemisphere_integral([&](Vec3f h) { return ggx_d(h, alpha) * h.z; }) == Approx(1).epsilon(2e-3));
     for (float theta : {0.0f, 0.6f, 1.3f}) {
       const Vec3f v = view_at(theta);
-      const double dv = hemisphere_integral([&](Vec3f h) { return smith_g1(v, alpha) * std::max(0.0f, dot(v, h)) * ggx_d(h, alpha) / v.z; });
+      const double dv = hemisphere_integral(
+          [&](Vec3f h) { return smith_g1(v, alpha) * std::max(0.0f, dot(v, h)) * ggx_d(h, alpha) / v.z; });
       CHECK(dv == Approx(1).epsilon(3e-3));
     }
   }
@@ -60,7 +63,9 @@ TEST_CASE("bsdf: the VNDF sampler draws visible normals with their density", "[b
   for (float alpha : {0.2f, 0.6f}) {
     for (float theta : {0.3f, 1.2f}) {
       const Vec3f v = view_at(theta);
-      auto density = [&](Vec3f h) { return smith_g1(v, alpha) * std::max(0.0f, dot(v, h)) * ggx_d(h, alpha) / v.z; };
+      auto density = [&](Vec3f h) {
+        return smith_g1(v, alpha) * std::max(0.0f, dot(v, h)) * ggx_d(h, alpha) / v.z;
+      };
       // Moments of the sampled normals against quadrature of the density.
       const int n = 200000;
       double mz = 0, mx = 0, mz4 = 0;
@@ -75,7 +80,9 @@ TEST_CASE("bsdf: the VNDF sampler draws visible normals with their density", "[b
       INFO("alpha " << alpha << ", theta " << theta);
       CHECK(mz / n == Approx(hemisphere_integral([&](Vec3f h) { return density(h) * h.z; })).epsilon(5e-3));
       CHECK(mx / n == Approx(hemisphere_integral([&](Vec3f h) { return density(h) * h.x; })).margin(5e-3));
-      CHECK(mz4 / n == Approx(hemisphere_integral([&](Vec3f h) { return density(h) * std::pow(h.z, 4.0f); })).epsilon(1e-2));
+      CHECK(mz4 / n == Approx(hemisphere_integral([&](Vec3f h) {
+                         return density(h) * std::pow(h.z, 4.0f);
+                       })).epsilon(1e-2));
     }
   }
 }
@@ -143,7 +150,8 @@ TEST_CASE("bsdf: GGX furnace: sampled directional albedo equals quadrature; smoo
         b.metallic = metal;
         b.roughness = rough;
         const Vec3f wo = view_at(theta);
-        const double quad = hemisphere_integral([&](Vec3f wi) { return brdf_eval(b, wo, wi).x * wi.z; }, 6000, 256);
+        const double quad =
+            hemisphere_integral([&](Vec3f wi) { return brdf_eval(b, wo, wi).x * wi.z; }, 6000, 256);
         const Vec3f mc = sampled_albedo(b, wo, 400000, 3);
         INFO("roughness " << rough << ", metallic " << metal << ", theta " << theta << ": quadrature " << quad
                           << ", sampled " << mc.x);

@@ -1,12 +1,12 @@
 // Tests for renderer/materials/material: textures, texture transforms, UV sets, vertex colours,
 // normal maps and Whitted's blended layers, with analytic answers.
-#include "renderer/integrators/scene_accel.h"
-#include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"
 
 #include <catch2/catch.hpp>
 
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/visibility.h"
 #include "renderer/integrators/whitted.h"
 #include "support/material_scenes.h"
 #include "support/scene_builder.h"
@@ -14,8 +14,8 @@
 using namespace penumbra;
 using namespace penumbra::test;
 
-
-TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEXCOORD_1 pick texels", "[material][quick]") {
+TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEXCOORD_1 pick texels",
+          "[material][quick]") {
   Probe p;
   const int tex = add_quadrant_texture(p.scene);
   const int mat = add_material(p.scene, {0.5f, 1, 1}, 0, 1);
@@ -35,8 +35,12 @@ TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEX
   CHECK(p.at(-0.5f, 0.5f).base_color.y == Approx(1).margin(kEps));  // green
   // Rotation by 90 degrees (glTF: uv' = R uv with R = [c s; -s c]) maps (u, v) to (v, -u):
   // the point uv = (0.25, 0.75) (bottom-left) reads uv' = (0.75, -0.25) -> wraps to (0.75, 0.75).
-  ref.m[0][0] = 0; ref.m[0][1] = 1; ref.m[0][2] = 0;
-  ref.m[1][0] = -1; ref.m[1][1] = 0; ref.m[1][2] = 0;
+  ref.m[0][0] = 0;
+  ref.m[0][1] = 1;
+  ref.m[0][2] = 0;
+  ref.m[1][0] = -1;
+  ref.m[1][1] = 0;
+  ref.m[1][2] = 0;
   m = p.at(-0.5f, -0.5f);
   CHECK(m.base_color.x == Approx(0.5).margin(kEps));  // bottom-right texel: white x factor
   CHECK(m.base_color.y == Approx(1).margin(kEps));
@@ -45,11 +49,13 @@ TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEX
   CHECK(p.at(-0.5f, 0.5f).base_color.y == Approx(1).margin(kEps));
 }
 
-TEST_CASE("material: COLOR_0 multiplies base colour and alpha; metallic-roughness reads B and G", "[material][quick]") {
+TEST_CASE("material: COLOR_0 multiplies base colour and alpha; metallic-roughness reads B and G",
+          "[material][quick]") {
   Probe p;
   const int mat = add_material(p.scene, {0.5f, 0.5f, 0.5f}, 0.8f, 0.6f);
   const int id = add_uv_quad(p.scene, 0, mat);
-  for ([[maybe_unused]] auto& c : p.scene.meshes[size_t(id)].positions) p.scene.meshes[size_t(id)].colors.push_back({1, 0.5f, 0.25f, 0.5f});
+  for ([[maybe_unused]] auto& c : p.scene.meshes[size_t(id)].positions)
+    p.scene.meshes[size_t(id)].colors.push_back({1, 0.5f, 0.25f, 0.5f});
   std::vector<float> mr = {0, 0.5f, 0.25f, 1};  // 1x1: G = roughness 0.5, B = metallic 0.25
   p.scene.textures.push_back(make_texture("mr", 1, 1, mr, {}));
   p.scene.materials[size_t(mat)].metallic_roughness_tex.texture = 0;
@@ -77,7 +83,8 @@ TEST_CASE("material: a normal map tilts the shading normal in the tangent frame"
   for (float sx : {1.0f, 0.0f}) {
     // A map encoding (sin t, 0, cos t) tilts towards +x; (0, sin t, cos t) towards +y.
     const float nx = sx * std::sin(theta), ny = (1 - sx) * std::sin(theta), nz = std::cos(theta);
-    p.scene.textures = {make_texture("n", 1, 1, {nx * 0.5f + 0.5f, ny * 0.5f + 0.5f, nz * 0.5f + 0.5f, 1}, {})};
+    p.scene.textures = {
+        make_texture("n", 1, 1, {nx * 0.5f + 0.5f, ny * 0.5f + 0.5f, nz * 0.5f + 0.5f, 1}, {})};
     p.scene.materials[size_t(mat)].normal_tex.texture = 0;
     p.build();
     const MaterialPoint m = p.at(0.3f, 0.3f);
@@ -98,8 +105,8 @@ TEST_CASE("material: a normal map tilts the shading normal in the tangent frame"
   CHECK(p.at(0.3f, 0.3f).ns.y == Approx(std::sin(theta)).margin(1e-3));  // map +Y still +y
 }
 
-
-TEST_CASE("material: Whitted composites Blend layers front to back (a c + (1 - a) behind)", "[material][whitted][quick]") {
+TEST_CASE("material: Whitted composites Blend layers front to back (a c + (1 - a) behind)",
+          "[material][whitted][quick]") {
   Scene s;
   const int front = add_material(s, {1, 0, 0}, 0, 1, true);  // unlit: radiance = base colour
   s.materials[size_t(front)].alpha = 0.25f;

@@ -62,7 +62,7 @@ TEST_CASE("texture: repeat, clamp and mirrored repeat", "[texture][quick]") {
     if (wrap == TextureWrap::Repeat) CHECK(neg == Approx(1).margin(kEps));
     if (wrap == TextureWrap::ClampToEdge) CHECK(neg == Approx(0).margin(kEps));
     if (wrap == TextureWrap::MirroredRepeat) CHECK(neg == Approx(0).margin(kEps));
-    const float far = sample_texture(t, {1.6f, 0.5f}, -kInfinity).x;  // texel 6
+    const float far = sample_texture(t, {1.6f, 0.5f}, -kInfinity).x;                      // texel 6
     if (wrap == TextureWrap::MirroredRepeat) CHECK(far == Approx(1.0 / 3).margin(kEps));  // 6 -> 1
     if (wrap == TextureWrap::Repeat) CHECK(far == Approx(2.0 / 3).margin(kEps));          // 6 -> 2
   }

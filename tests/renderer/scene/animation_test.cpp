@@ -54,7 +54,8 @@ TEST_CASE("animation: LINEAR rotations slerp along the shorter arc", "[animation
   CHECK(std::fabs(v[2]) == Approx(std::sin(kPi_d / 16)));
 }
 
-TEST_CASE("animation: CUBICSPLINE is the Hermite spline of values and scaled tangents", "[animation][quick]") {
+TEST_CASE("animation: CUBICSPLINE is the Hermite spline of values and scaled tangents",
+          "[animation][quick]") {
   // Keys at t = 0 and 2 (td = 2): v0 = 1 with out-tangent b0 = 3; v1 = 5 with in-tangent a1 = -1.
   // p(s) = (2s^3 - 3s^2 + 1) v0 + (s^3 - 2s^2 + s) td b0 + (-2s^3 + 3s^2) v1 + (s^3 - s^2) td a1.
   const std::vector<float> times = {0, 2};

@@ -6,9 +6,9 @@
 using namespace penumbra;
 
 TEST_CASE("perspective: centre ray looks down -w, edges span the field of view", "[camera][quick]") {
-  Camera cam;  // at the origin looking down -z
+  Camera cam;                      // at the origin looking down -z
   cam.yfov = 2 * std::atan(0.5f);  // tan(yfov/2) = 0.5
-  const int w = 200, h = 100;  // aspect 2
+  const int w = 200, h = 100;      // aspect 2
   const Ray centre = generate_camera_ray(cam, w, h, 100, 50);
   CHECK(centre.dir.x == Approx(0).margin(1e-6));
   CHECK(centre.dir.y == Approx(0).margin(1e-6));

@@ -93,7 +93,8 @@ TEST_CASE("interaction: a flat mirror reflects the differential rays exactly", "
   const Scene s = uv_quad();
   const Camera cam = look_at({0.3f, 0.2f, 2}, {0, 0, 0}, {0, 1, 0}, 0.6f);
   const Ray r = generate_camera_ray(cam, 64, 64, 32.5f, 30.5f);
-  const Ray rx = generate_camera_ray(cam, 64, 64, 33.5f, 30.5f), ry = generate_camera_ray(cam, 64, 64, 32.5f, 31.5f);
+  const Ray rx = generate_camera_ray(cam, 64, 64, 33.5f, 30.5f),
+            ry = generate_camera_ray(cam, 64, 64, 32.5f, 31.5f);
   const RayDifferential rd{true, rx.org, rx.dir, ry.org, ry.dir};
   SurfaceInteraction si = make_interaction(s, r, hit_quad(s, r));
   compute_differentials(s, si, rd);

@@ -1,11 +1,11 @@
 // Scene helpers (renderer/scene.h): instances and their inverses, the mirrored flag and the
 // front face it implies, world-space triangles and normals, bounds and triangle counts over
 // instances, and the views handed to the accelerator builders.
-#include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 
 #include <catch2/catch.hpp>
 
+#include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 
 using namespace penumbra;
@@ -13,12 +13,14 @@ using penumbra::test::check_vec;
 
 namespace {
 
-Affine3f trs(Vec3f t, Quat q, Vec3f s) { return to_affine(compose_trs({t.x, t.y, t.z}, q, {s.x, s.y, s.z})); }
-
+Affine3f trs(Vec3f t, Quat q, Vec3f s) {
+  return to_affine(compose_trs({t.x, t.y, t.z}, q, {s.x, s.y, s.z}));
+}
 
 }  // namespace
 
-TEST_CASE("scene: make_instance inverts the placement and flags mirrors; singular maps are refused", "[scene][quick]") {
+TEST_CASE("scene: make_instance inverts the placement and flags mirrors; singular maps are refused",
+          "[scene][quick]") {
   const Instance moved = make_instance(0, trs({1, 2, 3}, {}, {2, 4, 8}), 5);
   CHECK_FALSE(moved.identity);
   CHECK_FALSE(moved.mirrored);
@@ -36,10 +38,11 @@ TEST_CASE("scene: make_instance inverts the placement and flags mirrors; singula
 TEST_CASE("scene: world triangles keep the object's front face under mirrors; normals follow L^-T",
           "[scene][quick]") {
   Scene s;
-  test::add_quad_z(s, 0, 1, 0, 1, 0, -1);  // front +z
+  test::add_quad_z(s, 0, 1, 0, 1, 0, -1);                                   // front +z
   s.instances.push_back(make_instance(0, trs({0, 0, 2}, {}, {-1, 1, 1})));  // mirrored in x
-  s.instances.push_back(make_instance(0, trs({}, {}, {1, 1, 4})));           // stretched along z
-  s.instances.push_back(make_instance(0, trs({}, {std::sqrt(0.5), 0, 0, std::sqrt(0.5)}, {1, 1, 1})));  // x 90 deg
+  s.instances.push_back(make_instance(0, trs({}, {}, {1, 1, 4})));          // stretched along z
+  s.instances.push_back(
+      make_instance(0, trs({}, {std::sqrt(0.5), 0, 0, std::sqrt(0.5)}, {1, 1, 1})));  // x 90 deg
   const WorldTriangle in_place = world_triangle(s, s.instances[0], 0);
   check_vec(in_place.ng, {0, 0, 1});
   const WorldTriangle mirrored = world_triangle(s, s.instances[1], 0);
@@ -51,10 +54,12 @@ TEST_CASE("scene: world triangles keep the object's front face under mirrors; no
   check_vec(world_normal(s.instances[0], {0, 0, 1}), {0, 0, 1});
 }
 
-TEST_CASE("scene: bounds and triangle counts run over instances; views list meshes and placements", "[scene][quick]") {
+TEST_CASE("scene: bounds and triangle counts run over instances; views list meshes and placements",
+          "[scene][quick]") {
   Scene s;
   test::add_quad_z(s, -1, 1, -1, 1, 0, -1);  // mesh 0, placed by the identity
-  s.instances.push_back(make_instance(0, trs({10, 0, 0}, {0, 0, std::sin(kPi / 8), std::cos(kPi / 8)}, {1, 1, 1})));
+  s.instances.push_back(
+      make_instance(0, trs({10, 0, 0}, {0, 0, std::sin(kPi / 8), std::cos(kPi / 8)}, {1, 1, 1})));
   CHECK(count_triangles(s) == 4);
   CHECK(count_stored_triangles(s) == 2);
   // Exact: the quad turned 45 degrees about z reaches sqrt 2 from its centre.
