@@ -181,7 +181,10 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
 
 }  // namespace
 
-void add_render_options(CLI::App& render, RenderArgs& args) {
+namespace {
+
+/// The scene file, the outputs' paths, the image size and every integrator and sampling flag.
+void add_sampling_options(CLI::App& render, RenderArgs& args) {
   render.add_option("scene", args.scene_file, "glTF scene (.gltf or .glb)")->required();
   render.add_option("-o,--output", args.output, "output EXR path (written atomically)")->required();
   render.add_option("--png", args.png,
@@ -240,6 +243,10 @@ void add_render_options(CLI::App& render, RenderArgs& args) {
                     "blackman-harris for path)");
   render.add_option("--filter-width", args.filter_width,
                     "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
+}
+
+/// Threads, scene and camera choice, and the acceleration structure.
+void add_scene_options(CLI::App& render, RenderArgs& args) {
   render.add_option("--threads", args.threads, "worker threads (default 0 = all cores)")
       ->check(CLI::Range(0, 1024));
   render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")
@@ -251,6 +258,11 @@ void add_render_options(CLI::App& render, RenderArgs& args) {
       "--accel", args.accel,
       "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
   render.add_option("--accel-param", args.accel_params, accel_param_help())->type_name("KEY=VALUE");
+}
+
+/// The EXR's layout and compression, the display transform, animation time, memory, resume,
+/// windows, debugging, quiet and AOVs.
+void add_output_options(CLI::App& render, RenderArgs& args) {
   render.add_flag("--multipart", args.multipart,
                   "write one EXR part per layer (rgba, albedo, N, Z, ...); lossy --compression then applies "
                   "to colour parts only");
@@ -313,6 +325,14 @@ void add_render_options(CLI::App& render, RenderArgs& args) {
       "(cost.nodes, cost.triangles, cost.ns) and a heat map");
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
+}
+
+}  // namespace
+
+void add_render_options(CLI::App& render, RenderArgs& args) {
+  add_sampling_options(render, args);
+  add_scene_options(render, args);
+  add_output_options(render, args);
 }
 
 void note_given_options(const CLI::App& render, int argc, char** argv, RenderArgs& args) {
