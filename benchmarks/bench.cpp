@@ -32,7 +32,7 @@
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 #include "renderer/core/rng.h"
-#include "renderer/film/cost_map.h"
+#include "renderer/integrators/cost_map.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
 #include "renderer/scene/scene.h"

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "io/image_output.h"
-#include "renderer/film/aov.h"
-#include "renderer/film/cost_map.h"
+#include "renderer/integrators/aov.h"
+#include "renderer/integrators/cost_map.h"
 
 namespace penumbra::cli {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "renderer/core/math.h"
-#include "renderer/materials/texture.h"
+#include "renderer/scene/texture.h"
 
 namespace penumbra {
 

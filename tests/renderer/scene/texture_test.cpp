@@ -1,6 +1,6 @@
 // Tests for renderer/texture: wrap modes, texel filters, the MIP pyramid and level selection
 // against analytic footprints.
-#include "renderer/materials/texture.h"
+#include "renderer/scene/texture.h"
 
 #include <catch2/catch.hpp>
 

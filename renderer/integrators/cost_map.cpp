@@ -1,5 +1,5 @@
 // Traversal-cost images: see cost_map.h.
-#include "renderer/film/cost_map.h"
+#include "renderer/integrators/cost_map.h"
 
 #include <chrono>
 

@@ -1,5 +1,5 @@
 // First-hit data AOVs.
-#include "renderer/film/aov.h"
+#include "renderer/integrators/aov.h"
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
 // Texture storage and filtering (isotropic MIP mapping after Williams, "Pyramidal
 // Parametrics", SIGGRAPH 1983; level selection as in pbrt-v4's MIPMap::Filter).
-#include "renderer/materials/texture.h"
+#include "renderer/scene/texture.h"
 
 #include <cmath>
 

@@ -1,6 +1,6 @@
 // Tests for renderer/cost_map: known counts with brute force, agreement with per-ray counting,
 // the same image for any thread count, and costs that follow the geometry.
-#include "renderer/film/cost_map.h"
+#include "renderer/integrators/cost_map.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,7 +1,7 @@
 // Tests for renderer/aov (first-hit data layers) and the path tracer's light groups: exact ids,
 // depths, normals and positions on a known scene, background conventions, determinism, and
 // beauty = the sum of the light groups with physically known splits.
-#include "renderer/film/aov.h"
+#include "renderer/integrators/aov.h"
 
 #include <catch2/catch.hpp>
 
