@@ -57,7 +57,7 @@ penumbra::PathAccumulators seed_state(int w, int h, uint32_t reached, bool group
     p.sum_y = 0.5 * p.n;
     p.sum_y2 = 0.25 * p.n;
   }
-  if (groups) st.groups.assign(st.pixels.size() * kLightGroupChannels, 0.125);
+  if (groups) st.groups.assign(st.pixels.size() * penumbra::kLightGroupChannels, 0.125);
   st.reached = reached;
   st.passes = 3;
   return st;

@@ -3,12 +3,14 @@
 // the settings, then every value.
 #include "io/checkpoint.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "io/error.h"
@@ -185,30 +187,34 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
   if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: the header is incomplete");
   check_sizes(file, h, size);
 
-  // Everything else is read into buffers sized by the validated counts, and hashed.
-  std::string text(h.settings_bytes, '\0');
-  PathAccumulators state;
-  state.pixels.resize(h.pixels);
-  state.groups.resize(h.groups);
-  std::array<uint8_t, kDigestBytes> stored{};
-  in.read(text.data(), std::streamsize(text.size()));
-  in.read(reinterpret_cast<char*>(state.pixels.data()), std::streamsize(h.pixels * sizeof(Pixel)));
-  in.read(reinterpret_cast<char*>(state.groups.data()), std::streamsize(h.groups * sizeof(double)));
-  in.read(reinterpret_cast<char*>(stored.data()), std::streamsize(stored.size()));
-  if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
+  // The seal, verified by streaming the file through SHA-256 in small chunks: nothing sized by
+  // the file is allocated before the checksum and the settings have been accepted.
+  const uint64_t sealed = size - kDigestBytes;
   Sha256 sha;
-  sha.update(magic, sizeof magic);
-  sha.update(&h, sizeof h);
-  sha.update(text);
-  sha.update(state.pixels.data(), state.pixels.size() * sizeof(Pixel));
-  sha.update(state.groups.data(), state.groups.size() * sizeof(double));
-  if (sha.finish() != stored)
-    throw InputError(
-        file, "",
-        "checksum mismatch: the checkpoint is damaged (its SHA-256 does not match its contents); "
-        "delete it to render from the beginning");
+  {
+    std::ifstream all(path, std::ios::binary);
+    std::vector<char> chunk(1 << 20);
+    for (uint64_t left = sealed; left > 0;) {
+      const size_t n = size_t(std::min<uint64_t>(left, chunk.size()));
+      if (!all.read(chunk.data(), std::streamsize(n)))
+        throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
+      sha.update(chunk.data(), n);
+      left -= n;
+    }
+    std::array<uint8_t, kDigestBytes> stored{};
+    if (!all.read(reinterpret_cast<char*>(stored.data()), std::streamsize(stored.size())))
+      throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
+    if (sha.finish() != stored)
+      throw InputError(
+          file, "",
+          "checksum mismatch: the checkpoint is damaged (its SHA-256 does not match its contents); "
+          "delete it to render from the beginning");
+  }
 
-  // The settings it was written for.
+  // The settings it was written for; the payload is read only for a state of this render.
+  std::string text(h.settings_bytes, '\0');
+  in.read(text.data(), std::streamsize(text.size()));
+  if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
   RenderSettings settings;
   try {
     settings = parse_canonical_text(text);
@@ -219,6 +225,12 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
     throw InputError(file, "",
                      "was written for other settings; delete it or render with the same settings:\n" +
                          describe_differences(settings, expected));
+  PathAccumulators state;
+  state.pixels.resize(h.pixels);
+  state.groups.resize(h.groups);
+  in.read(reinterpret_cast<char*>(state.pixels.data()), std::streamsize(h.pixels * sizeof(Pixel)));
+  in.read(reinterpret_cast<char*>(state.groups.data()), std::streamsize(h.groups * sizeof(double)));
+  if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
 
   // The values, checked against each other.
   state.window = {h.window[0], h.window[1], h.window[2], h.window[3]};
