@@ -1,0 +1,206 @@
+// SDF primitives (closed forms), CSG operators, Lipschitz bounds and sphere tracing.
+#include "renderer/shapes/sdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+
+namespace {
+
+float length2(float x, float y) {
+  return std::sqrt(x * x + y * y);
+}
+
+float box_distance(Vec3f p, Vec3f half) {
+  const Vec3f q = abs(p) - half;
+  return length(max(q, Vec3f{})) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0f);
+}
+
+// Capped cone with radius r1 at y = -h and r2 at y = +h, exact distance (the nearer of the
+// distances to the caps and to the slanted side in the (radial, y) half-plane).
+float capped_cone_distance(Vec3f p, float h, float r1, float r2) {
+  const float qx = length2(p.x, p.z), qy = p.y;
+  const float k2x = r2 - r1, k2y = 2 * h;
+  const float cax = qx - std::min(qx, qy < 0 ? r1 : r2), cay = std::abs(qy) - h;
+  const float t = std::clamp(((r2 - qx) * k2x + (h - qy) * k2y) / (k2x * k2x + k2y * k2y), 0.0f, 1.0f);
+  const float cbx = qx - r2 + k2x * t, cby = qy - h + k2y * t;
+  const float s = (cbx < 0 && cay < 0) ? -1.0f : 1.0f;
+  return s * std::sqrt(std::min(cax * cax + cay * cay, cbx * cbx + cby * cby));
+}
+
+// Polynomial smooth minimum with blend radius k > 0: equals min(a, b) where |a - b| >= k; its
+// gradient is h grad a + (1 - h) grad b, a convex combination.
+float smooth_min(float a, float b, float k) {
+  const float h = std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
+  return b + (a - b) * h - k * h * (1 - h);
+}
+
+float primitive(const SdfTree& tree, const SdfNode& n, Vec3f p) {
+  switch (n.kind) {
+    case SdfKind::Sphere:
+      return length(p) - n.size.x;
+    case SdfKind::Box:
+      return box_distance(p, n.size);
+    case SdfKind::RoundBox:
+      return box_distance(p, n.size - Vec3f{n.radius, n.radius, n.radius}) - n.radius;
+    case SdfKind::Capsule: {
+      const Vec3f q{p.x, p.y - std::clamp(p.y, -n.size.y, n.size.y), p.z};
+      return length(q) - n.radius;
+    }
+    case SdfKind::Cylinder: {
+      const float dx = length2(p.x, p.z) - n.radius, dy = std::abs(p.y) - n.size.y;
+      return std::min(std::max(dx, dy), 0.0f) + length2(std::max(dx, 0.0f), std::max(dy, 0.0f));
+    }
+    case SdfKind::Cone:
+      return capped_cone_distance(p, n.size.y, n.radius, 0);
+    case SdfKind::Torus:
+      return length2(length2(p.x, p.z) - n.size.x, p.y) - n.radius;
+    case SdfKind::HalfSpace:
+      return dot(n.normal, p) - n.offset;
+    case SdfKind::ConvexPolyhedron: {
+      float d = -kInfinity;
+      for (int i = n.first_plane; i < n.first_plane + n.plane_count; ++i) {
+        const Vec4f& pl = tree.planes[size_t(i)];
+        d = std::max(d, pl.x * p.x + pl.y * p.y + pl.z * p.z - pl.w);
+      }
+      return d;
+    }
+    default:
+      return kInfinity;
+  }
+}
+
+float eval(const SdfTree& tree, int index, Vec3f p_parent, int depth) {
+  const SdfNode& n = tree.nodes[size_t(index)];
+  const Vec3f p = apply_point(n.to_local, p_parent);
+  if (!is_operator(n.kind)) return primitive(tree, n, p);
+  if (depth >= kMaxSdfDepth) return kInfinity;
+  const float a = eval(tree, n.a, p, depth + 1);
+  if (n.kind == SdfKind::Complement) return -a;
+  const float b = eval(tree, n.b, p, depth + 1);
+  switch (n.kind) {
+    case SdfKind::Union:
+      return std::min(a, b);
+    case SdfKind::Intersection:
+      return std::max(a, b);
+    case SdfKind::Subtraction:
+      return std::max(a, -b);
+    case SdfKind::SmoothUnion:
+      return smooth_min(a, b, n.radius);
+    case SdfKind::SmoothIntersection:
+      return -smooth_min(-a, -b, n.radius);
+    case SdfKind::SmoothSubtraction:
+      return -smooth_min(-a, b, n.radius);
+    default:
+      return kInfinity;
+  }
+}
+
+float lipschitz(const SdfTree& tree, int index, int depth) {
+  const SdfNode& n = tree.nodes[size_t(index)];
+  float l = 1;
+  if (is_operator(n.kind) && depth < kMaxSdfDepth) {
+    l = lipschitz(tree, n.a, depth + 1);
+    if (n.kind != SdfKind::Complement) l = std::max(l, lipschitz(tree, n.b, depth + 1));
+  }
+  return l * max_singular_value(n.to_local);
+}
+
+}  // namespace
+
+bool is_operator(SdfKind kind) {
+  return kind >= SdfKind::Union;
+}
+
+float sdf_eval(const SdfTree& tree, int node, Vec3f p) {
+  return eval(tree, node, p, 0);
+}
+
+float sdf_eval(const SdfTree& tree, Vec3f p) {
+  return tree.root < 0 ? kInfinity : eval(tree, tree.root, p, 0);
+}
+
+float sdf_lipschitz(const SdfTree& tree) {
+  return tree.root < 0 ? 1.0f : lipschitz(tree, tree.root, 0);
+}
+
+Vec3f sdf_normal(const SdfTree& tree, Vec3f p, float h) {
+  const Vec3f dx{h, 0, 0}, dy{0, h, 0}, dz{0, 0, h};
+  const Vec3f g{sdf_eval(tree, p + dx) - sdf_eval(tree, p - dx),
+                sdf_eval(tree, p + dy) - sdf_eval(tree, p - dy),
+                sdf_eval(tree, p + dz) - sdf_eval(tree, p - dz)};
+  return normalize(g);
+}
+
+float max_singular_value(const Affine3f& a) {
+  // Gram matrix G = A^T A (symmetric); its largest eigenvalue is sigma_max^2. Cyclic Jacobi
+  // rotations in double converge to the eigenvalues on the diagonal.
+  double g[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      g[r][c] = 0;
+      for (int k = 0; k < 3; ++k) g[r][c] += double(a.m[k][r]) * double(a.m[k][c]);
+    }
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const double off = g[0][1] * g[0][1] + g[0][2] * g[0][2] + g[1][2] * g[1][2];
+    if (off < 1e-30) break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        if (std::abs(g[p][q]) < 1e-300) continue;
+        const double theta = (g[q][q] - g[p][p]) / (2 * g[p][q]);
+        const double t = (theta >= 0 ? 1 : -1) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        const double c = 1 / std::sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < 3; ++k) {  // G <- J^T G J
+          const double gkp = g[k][p], gkq = g[k][q];
+          g[k][p] = c * gkp - s * gkq;
+          g[k][q] = s * gkp + c * gkq;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const double gpk = g[p][k], gqk = g[q][k];
+          g[p][k] = c * gpk - s * gqk;
+          g[q][k] = s * gpk + c * gqk;
+        }
+      }
+  }
+  const double top = std::max(g[0][0], std::max(g[1][1], g[2][2]));
+  return float(std::sqrt(std::max(top, 0.0)) * (1 + 1e-6));  // rounded up: a bound stays a bound
+}
+
+bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, const SphereTraceConfig& config,
+                  float& t_hit, int& steps) {
+  steps = 0;
+  const float dir_len = length(ray.dir);
+  if (!(dir_len > 0) || !(lipschitz_bound > 0) || tree.root < 0) return false;
+  const float step_scale = 1.0f / (lipschitz_bound * dir_len);  // |f| * step_scale never passes the surface
+  float t = ray.tnear, prev_t = t, prev_f = 0;
+  while (steps < config.max_steps && t <= ray.tfar) {
+    const float f = sdf_eval(tree, ray.org + ray.dir * t);
+    ++steps;
+    const float eps = std::max(config.absolute_epsilon, config.relative_epsilon * t * dir_len);
+    if (steps > 1 && (f < 0) != (prev_f < 0)) {
+      // The minimum step crossed the surface: bisect between the last two samples.
+      float lo = prev_t, hi = t, flo = prev_f;
+      for (int i = 0; i < 40 && hi - lo > 1e-7f * std::max(1.0f, hi); ++i) {
+        const float mid = 0.5f * (lo + hi);
+        const float fm = sdf_eval(tree, ray.org + ray.dir * mid);
+        if ((fm < 0) == (flo < 0))
+          lo = mid, flo = fm;
+        else
+          hi = mid;
+      }
+      t_hit = hi;
+      return t_hit <= ray.tfar;
+    }
+    if (std::abs(f) / lipschitz_bound < eps) {
+      t_hit = t;
+      return true;
+    }
+    prev_t = t;
+    prev_f = f;
+    t += std::max(std::abs(f) * step_scale, eps / dir_len);
+  }
+  return false;
+}
+
+}  // namespace penumbra
