@@ -7,20 +7,14 @@
 #include <fstream>
 
 #include "io/error.h"
+#include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;
 using penumbra::test::GltfWriter;
-
-namespace {
-LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptions opt = {}) {
-  const auto dir = test::temp_dir(name);
-  w.write_embedded(dir / "scene.gltf");
-  return load_gltf(dir / "scene.gltf", opt);
-}
-}  // namespace
+using penumbra::test::write_and_load;
 
 TEST_CASE("u8, u16, u32 and implicit indices all load the same quad", "[io][gltf][quick]") {
   const auto dir = test::temp_dir("index-types");

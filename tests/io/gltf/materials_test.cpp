@@ -13,20 +13,16 @@
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/materials/material.h"
+#include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;
 using penumbra::test::GltfWriter;
+using penumbra::test::write_and_load;
 
 namespace {
-
-LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptions opt = {}) {
-  const auto dir = test::temp_dir(name);
-  w.write_embedded(dir / "scene.gltf");
-  return load_gltf(dir / "scene.gltf", opt);
-}
 
 struct FrontView {
   LoadedScene loaded;

@@ -11,6 +11,7 @@
 #include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
+#include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
@@ -18,15 +19,10 @@
 using namespace penumbra;
 using Catch::Matchers::Contains;
 using penumbra::test::GltfWriter;
+using penumbra::test::write_and_load;
 using json = nlohmann::json;
 
 namespace {
-
-LoadedScene write_and_load(GltfWriter& w, const std::string& name, GltfLoadOptions opt = {}) {
-  const auto dir = test::temp_dir(name);
-  w.write_embedded(dir / "scene.gltf");
-  return load_gltf(dir / "scene.gltf", opt);
-}
 
 void check_vec(Vec3f a, Vec3f b, float eps = 1e-5f) {
   test::check_vec(a, b, eps);
