@@ -3,6 +3,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <stdexcept>
 #include <vector>
 
 #include "io/error.h"
@@ -110,18 +111,24 @@ std::string sha256_file(const std::filesystem::path& path) {
   return h.finish_hex();
 }
 
-std::string sha256_of_files(const std::vector<std::filesystem::path>& files) {
-  Sha256 h;
+std::string sha256_of_set(const std::vector<std::filesystem::path>& files,
+                          const std::vector<std::string>& digests) {
   namespace fs = std::filesystem;
+  if (files.size() != digests.size()) throw std::invalid_argument("sha256_of_set: one digest per file");
+  Sha256 h;
   const fs::path base = files.empty() ? fs::path() : fs::absolute(files[0]).lexically_normal().parent_path();
-  for (const auto& f : files) {
-    const std::string name = fs::absolute(f).lexically_normal().lexically_relative(base).generic_string();
-    const std::string digest = sha256_file(f);
-    std::error_code ec;
-    const uint64_t size = std::filesystem::file_size(f, ec);
-    h.update(name + '\0' + std::to_string(ec ? 0 : size) + '\0' + digest + '\n');
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string name =
+        fs::absolute(files[i]).lexically_normal().lexically_relative(base).generic_string();
+    h.update(name + '\0' + digests[i] + '\n');
   }
   return h.finish_hex();
+}
+
+std::string sha256_of_files(const std::vector<std::filesystem::path>& files) {
+  std::vector<std::string> digests;
+  for (const auto& f : files) digests.push_back(sha256_file(f));
+  return sha256_of_set(files, digests);
 }
 
 }  // namespace penumbra

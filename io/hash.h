@@ -36,9 +36,14 @@ class Sha256 {
 std::string sha256_hex(std::string_view data);
 
 /// SHA-256 identifying a set of files by content (a scene: the glTF file and every buffer and
-/// image it loads): over each file's name relative to the first file's folder, its size and its
-/// SHA-256, in the given order. Moving the whole set elsewhere keeps the digest; editing,
-/// renaming or replacing any file changes it. Throws InputError as sha256_file does.
+/// image it loads): over each file's name relative to the first file's folder and its SHA-256
+/// (`digests[i]`, hex, of `files[i]`), in the given order. Moving the whole set elsewhere keeps
+/// the digest; editing, renaming or replacing any file changes it. Throws std::invalid_argument
+/// if the two lists differ in length.
+std::string sha256_of_set(const std::vector<std::filesystem::path>& files,
+                          const std::vector<std::string>& digests);
+
+/// sha256_of_set over the files' current bytes (read now). Throws InputError as sha256_file does.
 std::string sha256_of_files(const std::vector<std::filesystem::path>& files);
 
 /// SHA-256 of a regular file's bytes as hex. Throws InputError naming the file if it is not

@@ -111,7 +111,8 @@ void setup_phase(RenderJob& job) {
   // What this render is, for its resume state and the metadata of crops and tiles: the content
   // of every file it loaded and every setting that decides its pixels.
   if (q.path || !cfg.window.empty()) {
-    job.scene_sha256 = sha256_of_files(job.loaded.info.source_files);
+    // The bytes as the loader read them, not the files as they are now.
+    job.scene_sha256 = sha256_of_set(job.loaded.info.source_files, job.loaded.info.source_sha256);
     job.settings = pixel_settings(a, cfg, job.camera, job.scene_sha256,
                                   !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
   }

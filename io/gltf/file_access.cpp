@@ -14,6 +14,7 @@
 
 #include "io/error.h"
 #include "io/file_checks.h"
+#include "io/hash.h"
 
 namespace penumbra::gltf {
 
@@ -176,8 +177,11 @@ bool sandbox_read(std::vector<unsigned char>* out, std::string* err, const std::
     if (err) *err = e.what();
     return false;
   }
-  if (std::find(box.read->begin(), box.read->end(), it->second) == box.read->end())
+  if (std::find(box.read->begin(), box.read->end(), it->second) == box.read->end()) {
     box.read->push_back(it->second);
+    if (box.read_sha256)
+      box.read_sha256->push_back(sha256_hex({reinterpret_cast<const char*>(out->data()), out->size()}));
+  }
   return true;
 }
 

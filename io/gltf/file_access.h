@@ -69,7 +69,9 @@ ResolvedUri resolve_uri(const std::string& uri, const std::filesystem::path& roo
 struct FileSandbox {
   std::map<std::string, std::filesystem::path> served;  ///< tinygltf's path -> the checked file
   uint64_t max_bytes = 0;                               ///< per file, as in read_input_file()
-  std::vector<std::filesystem::path>* read = nullptr;   ///< every file read, in order, once each
+  std::vector<std::filesystem::path>* read = nullptr;
+  std::vector<std::string>* read_sha256 =
+      nullptr;  ///< SHA-256 of each `read` file's bytes   ///< every file read, in order, once each
 };
 
 /// The path tinygltf asks for when it reads `decoded_uri` against `base` (its JoinPath).

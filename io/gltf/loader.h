@@ -45,6 +45,8 @@ struct GltfInfo {
   std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
                                                     ///< external buffer and image file, in load order
+  /// The SHA-256 of each source_files entry's bytes as the loader read them (same order).
+  std::vector<std::string> source_sha256;
 };
 
 struct LoadedScene {

@@ -13,6 +13,7 @@
 #include "io/gltf/images.h"
 #include "io/gltf/json_checks.h"
 #include "io/gltf/meshes.h"
+#include "io/hash.h"
 
 namespace penumbra::gltf {
 
@@ -181,6 +182,7 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
                 tinygltf::Model& model) {
   const std::string name = file.string();
   std::vector<unsigned char> bytes = read_scene_file(file, options.max_file_bytes, budget);
+  const std::string scene_sha256 = sha256_hex({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
   if (bytes.size() >= 0xffffffffu) throw InputError(name, "", "file too large for glTF (>= 4 GiB)");
 
   // A GLB is handed to tinygltf without the chunks of unknown type (they follow JSON and BIN).
@@ -203,9 +205,11 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   std::error_code ec;
   const fs::path root = fs::weakly_canonical(fs::absolute(file).parent_path(), ec);
   out.info.source_files.push_back(file);
+  out.info.source_sha256.push_back(scene_sha256);
   FileSandbox box;
   box.max_bytes = options.max_file_bytes;
   box.read = &out.info.source_files;
+  box.read_sha256 = &out.info.source_sha256;
   check_document(json, name, root, options, box, budget, out.warnings);
 
   tinygltf::TinyGLTF parser;

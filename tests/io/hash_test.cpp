@@ -81,4 +81,5 @@ TEST_CASE("sha256_of_files: content and relative names, not the folder", "[io][h
   CHECK(set(b) != original);
   std::filesystem::rename(a / "tex" / "wood.png", a / "tex" / "pine.png");  // same bytes, other name
   CHECK(sha256_of_files({a / "scene.gltf", a / "tex" / "pine.png"}) != original);
+  CHECK_THROWS_AS(sha256_of_set({a / "scene.gltf"}, {}), std::invalid_argument);
 }

@@ -11,6 +11,7 @@
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
+#include "io/hash.h"
 #include "support/gltf_hostile.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"
@@ -169,6 +170,10 @@ TEST_CASE("gltf hardening: GltfInfo::source_files lists the scene file, then eac
   const std::vector<fs::path> expected = {dir / "scene.gltf", fs::canonical(dir / "scene.bin"),
                                           fs::canonical(dir / "tex.png")};
   CHECK(ext.info.source_files == expected);  // each file once, in load order; unread files absent
+  // The digest of each file's bytes as read, equal to hashing the file now.
+  REQUIRE(ext.info.source_sha256.size() == expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) CHECK(ext.info.source_sha256[i] == sha256_file(expected[i]));
+  CHECK(sha256_of_set(ext.info.source_files, ext.info.source_sha256) == sha256_of_files(expected));
 
   w.j.erase("images");
   w.write_embedded(dir / "embedded.gltf");
