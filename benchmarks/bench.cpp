@@ -73,7 +73,7 @@ Camera bench_camera(const Scene& scene, int w, int h) {
 /// fixed seed. Primary rays come from the scene's first camera (or one framing the bounds) on a w x h grid;
 /// shadow and diffuse rays start at the primary hits (found with Embree), offset along the geometric normal.
 std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
-                                  std::span<const TriangleMeshView> views, int w, int h,
+                                  std::span<const GeometryView> views, int w, int h,
                                   const std::vector<std::string>& kinds) {
   const Bounds3f b = compute_bounds(scene);
   const Camera cam = bench_camera(scene, w, h);

@@ -135,6 +135,7 @@ std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
 void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& gltf_mesh) {
   for (size_t ii = 0; ii < scene.instances.size(); ++ii) {
     const Instance& inst = scene.instances[ii];
+    if (inst.shape >= 0) continue;  // shapes have no glTF form of their own
     if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())
       throw InputError(wr.file, "instances[" + std::to_string(ii) + "]",
                        "mesh " + std::to_string(inst.mesh) + " out of range");

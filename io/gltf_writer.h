@@ -14,6 +14,7 @@ namespace penumbra {
 /// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices) and each instance one node
 /// using it (with a matrix unless the identity), so shared meshes stay shared; lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
+/// Shape instances are not written.
 /// Throws InputError naming the file if it cannot be written or the scene cannot be expressed
 /// (a buffer over 4 GiB, an index out of range, an index count not a multiple of 3, a non-finite
 /// position, an instance of a mesh that does not exist).

@@ -1,7 +1,7 @@
 // The one ray-query interface of Penumbra. Every back end (Embree, BVH, kD-tree, grid, brute
-// force) builds from triangle geometry only and answers closest-hit and occlusion queries with
-// the same Hit record. Accelerators know nothing of materials or film. Back ends are chosen by
-// name through accel/factory.h.
+// force) builds from geometry views (triangle meshes and shapes: analytic primitives and implicit
+// surfaces) and answers closest-hit and occlusion queries with the same Hit record. Accelerators
+// know nothing of materials or film. Back ends are chosen by name through accel/factory.h.
 #pragma once
 
 #include <cmath>
@@ -11,23 +11,28 @@
 #include <vector>
 
 #include "renderer/core/geometry.h"
+#include "renderer/shapes/shape.h"
 
 namespace penumbra {
 
-/// A read-only view of one triangle mesh in world space. geom_id in a Hit is the index of the
-/// mesh in the span given to the builder; prim_id is the triangle index within it.
-struct TriangleMeshView {
+/// A read-only view of one geometry: a triangle mesh, or (when `shape` is set) one shape, which
+/// is a single primitive. geom_id in a Hit is the index of the view in the span given to the
+/// builder; prim_id is the triangle index within a mesh and 0 for a shape (whose Hit u, v are 0).
+/// Builders copy the shape; the mesh arrays are copied by every back end but brute force.
+struct GeometryView {
   std::span<const Vec3f> positions;
   std::span<const uint32_t> indices;  ///< 3 per triangle, each < positions.size()
+  const Shape* shape = nullptr;       ///< a shape instead of triangles (positions, indices unused)
 };
 
-/// One placement of a mesh: the mesh's triangles mapped by `to_world` (object to world space).
+/// One placement of a geometry: the mesh's triangles (or the shape) mapped by `to_world` (object
+/// to world space).
 /// Builders given instances report the instance's index as a Hit's geom_id. Instances with the
 /// identity map are built in world space directly; the others share one object-space structure
 /// per mesh under a top level over their world bounds (two-level instancing). An instance whose
 /// map is singular or not finite is never hit.
 struct InstanceView {
-  uint32_t mesh = 0;  ///< index into the mesh span given to the builder
+  uint32_t mesh = 0;  ///< index into the geometry span given to the builder
   Affine3f to_world;
 };
 
@@ -37,6 +42,7 @@ struct AccelStats {
   std::string name;
   std::string config;           ///< the build parameters, human readable
   uint64_t triangles = 0;       ///< triangles given to the builder (each stored mesh once)
+  uint64_t shapes = 0;          ///< shapes given to the builder (each stored shape once)
   uint64_t instances = 0;       ///< placements under a top level (0: single level)
   uint64_t nodes = 0;           ///< all nodes (interior + leaves), or grid cells
   uint64_t leaves = 0;          ///< leaves, or grid cells
@@ -52,11 +58,14 @@ struct AccelStats {
   double build_seconds = 0;
 };
 
-/// Work done by queries: nodes (or grid cells) visited and triangles tested. Summed by
-/// intersect_counted(); the cost heat map (penumbra render --aov cost) shows it per pixel.
+/// Work done by queries: nodes (or grid cells) visited, triangles and shapes tested, and SDF
+/// evaluations of sphere tracing. Summed by intersect_counted(); the cost heat map (penumbra
+/// render --aov cost) shows it per pixel.
 struct TraversalCost {
-  uint64_t nodes = 0;      ///< interior and leaf nodes (BVH, kD-tree) or cells (grid) visited
-  uint64_t triangles = 0;  ///< ray-triangle tests
+  uint64_t nodes = 0;        ///< interior and leaf nodes (BVH, kD-tree) or cells (grid) visited
+  uint64_t triangles = 0;    ///< ray-triangle tests
+  uint64_t shapes = 0;       ///< ray-shape tests (analytic or implicit)
+  uint64_t evaluations = 0;  ///< SDF evaluations made by the implicit shapes' tests
 };
 
 /// The rays every back end answers: finite origin and direction, a non-zero direction and a
@@ -73,7 +82,7 @@ class Accelerator {
   /// NaN/Inf origin or direction, a zero direction or tnear > tfar miss.
   /// Thread-safe; never allocates, throws or logs.
   virtual bool intersect(const Ray& ray, Hit& hit) const = 0;
-  /// True iff some triangle is hit with t in [max(ray.tnear, 0), ray.tfar]. Thread-safe.
+  /// True iff some triangle or shape is hit with t in [max(ray.tnear, 0), ray.tfar]. Thread-safe.
   virtual bool occluded(const Ray& ray) const = 0;
   /// intersect(), also adding the work it did to `cost`. Back ends that cannot count (Embree
   /// keeps no statistics in release builds) answer without counting: see counts_traversal().

@@ -1,4 +1,5 @@
-// Brute-force back end: a linear scan over every triangle with the shared watertight test.
+// Brute-force back end: a linear scan over every triangle and shape with the shared tests
+// (the watertight triangle test, the per-kind shape test).
 // The oracle for accelerator tests; O(N) per ray, never use it for real renders.
 #pragma once
 
@@ -9,7 +10,8 @@
 
 namespace penumbra {
 
-/// The meshes' data is referenced, not copied: it must outlive the accelerator.
-std::unique_ptr<Accelerator> make_brute_accelerator(std::span<const TriangleMeshView> meshes);
+/// The views' data (mesh arrays and shapes) is referenced, not copied: it must outlive the
+/// accelerator.
+std::unique_ptr<Accelerator> make_brute_accelerator(std::span<const GeometryView> meshes);
 
 }  // namespace penumbra

@@ -204,15 +204,15 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   friend class TraversalAccelerator<BvhAccelerator>;
 
  public:
-  BvhAccelerator(std::span<const TriangleMeshView> meshes, const BvhConfig& config) : m_config(config) {
+  BvhAccelerator(std::span<const GeometryView> meshes, const BvhConfig& config) : m_config(config) {
     validate(config);
     const BuildTimer timer;
-    std::vector<TriangleRecord> tris = gather_triangles(meshes);
+    std::vector<PrimitiveRecord> tris = gather_primitives(meshes, m_shapes);
     m_input_triangles = count_input_triangles(meshes);
     if (!tris.empty()) {
       std::vector<BvhBuildRef> refs(tris.size());
       for (uint32_t i = 0; i < tris.size(); ++i) {
-        const Bounds3f b = triangle_bounds(tris[i]);
+        const Bounds3f b = primitive_bounds(tris[i]);
         refs[i] = {b, b.center(), i};
       }
       auto root = build_bvh_tree(refs, m_config);
@@ -243,9 +243,10 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
                                   format_number(m_config.intersection_cost),
                               m_input_triangles,
                               m_nodes.size() * sizeof(BvhNode) + m_nodes4.size() * sizeof(Bvh4Node) +
-                                  m_tris.size() * sizeof(TriangleRecord),
+                                  m_tris.size() * sizeof(PrimitiveRecord),
                               m_build_seconds);
     s.nodes = m_config.width == 2 ? m_nodes.size() : m_nodes4.size() + m_tally.leaves;
+    s.shapes = m_shapes.size();
     return s;
   }
 
@@ -362,7 +363,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
           _mm_prefetch(p + 64, _MM_HINT_T0);
         } else {
           const char* p = reinterpret_cast<const char*>(&m_tris[n.child[c]]);
-          const char* end = p + n.count[c] * sizeof(TriangleRecord);
+          const char* end = p + n.count[c] * sizeof(PrimitiveRecord);
           for (; p < end; p += 64) _mm_prefetch(p, _MM_HINT_T0);
         }
       }
@@ -461,10 +462,10 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   }
 
   BvhConfig m_config;
-  std::vector<BvhNode> m_nodes;        // width 2: depth-first; node 0 is the root; boxes widened
-  std::vector<Bvh4Node> m_nodes4;      // width 4: node 0 is the root; boxes widened
-  Bounds3f m_bounds;                   // exact bounds of the triangles
-  std::vector<TriangleRecord> m_tris;  // reordered so leaves are contiguous
+  std::vector<BvhNode> m_nodes;         // width 2: depth-first; node 0 is the root; boxes widened
+  std::vector<Bvh4Node> m_nodes4;       // width 4: node 0 is the root; boxes widened
+  Bounds3f m_bounds;                    // exact bounds of the triangles
+  std::vector<PrimitiveRecord> m_tris;  // reordered so leaves are contiguous
   uint64_t m_input_triangles = 0;
   double m_sah_root_area = 0;
   LeafTally m_tally;
@@ -486,7 +487,7 @@ void validate(const BvhConfig& c) {
     throw std::invalid_argument("bvh: traversal_cost and intersection_cost must be > 0");
 }
 
-std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const GeometryView> meshes,
                                                   const BvhConfig& config) {
   return std::make_unique<BvhAccelerator>(meshes, config);
 }

@@ -28,7 +28,7 @@ struct BvhConfig {
 void validate(const BvhConfig& config);
 
 /// Builds a BVH over copies of the triangles (`meshes` need not outlive it).
-std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const GeometryView> meshes,
                                                   const BvhConfig& config = {});
 
 }  // namespace penumbra

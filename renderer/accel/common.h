@@ -15,28 +15,48 @@
 
 namespace penumbra {
 
-/// One world-space triangle copied out of a TriangleMeshView, with the ids a Hit reports.
+/// One primitive copied out of the geometry views, with the ids a Hit reports: a world-space
+/// triangle (a, b, c), or, when prim_id has kShapeBit set, a shape whose bounds are [a, b] and
+/// whose index in the structure's shape table is prim_id & ~kShapeBit (c unused).
 /// 44 bytes: a, b, c (3 x 12) + geom_id (4) + prim_id (4).
-struct TriangleRecord {
+struct PrimitiveRecord {
   Vec3f a, b, c;
-  uint32_t geom_id = 0;  ///< index of the mesh in the span given to the builder
-  uint32_t prim_id = 0;  ///< triangle index within that mesh
+  uint32_t geom_id = 0;  ///< index of the view in the span given to the builder
+  uint32_t prim_id = 0;  ///< triangle index within that mesh, or kShapeBit | shape table index
 };
-static_assert(sizeof(TriangleRecord) == 44);
+static_assert(sizeof(PrimitiveRecord) == 44);
 
-/// Copies every triangle of `meshes` in (mesh, triangle) order. Triangles with a non-finite
-/// vertex are dropped (the watertight test can never hit them); degenerate ones are kept so
-/// every structure sees exactly what the brute-force oracle sees.
-std::vector<TriangleRecord> gather_triangles(std::span<const TriangleMeshView> meshes);
+inline constexpr uint32_t kShapeBit = 0x80000000u;
 
-/// Triangles in `meshes` as given (before dropping non-finite ones): what stats() reports.
-inline uint64_t count_input_triangles(std::span<const TriangleMeshView> meshes) {
+inline bool is_shape(const PrimitiveRecord& r) {
+  return (r.prim_id & kShapeBit) != 0;
+}
+
+/// The primitives of every view, in view order (triangles in index order; a shape is one record
+/// pointing at its copy in `shapes`, which this appends to). Triangles with a non-finite vertex
+/// and shapes without finite bounds are dropped (no test can hit them); degenerate triangles are
+/// kept so every structure sees exactly what the brute-force oracle sees.
+std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> views,
+                                               std::vector<Shape>& shapes);
+
+/// Triangles in `views` as given (before dropping non-finite ones): what stats() reports.
+inline uint64_t count_input_triangles(std::span<const GeometryView> views) {
   uint64_t n = 0;
-  for (const auto& m : meshes) n += m.indices.size() / 3;
+  for (const auto& m : views)
+    if (!m.shape) n += m.indices.size() / 3;
   return n;
 }
 
-inline Bounds3f triangle_bounds(const TriangleRecord& t) {
+/// Shapes in `views`.
+inline uint64_t count_input_shapes(std::span<const GeometryView> views) {
+  uint64_t n = 0;
+  for (const auto& m : views) n += m.shape != nullptr;
+  return n;
+}
+
+/// The box a builder sees for a primitive: the triangle's vertices, or the shape's bounds.
+inline Bounds3f primitive_bounds(const PrimitiveRecord& t) {
+  if (is_shape(t)) return {t.a, t.b};
   return merge(merge(Bounds3f{t.a, t.a}, t.b), t.c);
 }
 
@@ -109,19 +129,43 @@ inline float pad_up(float t) {
   return t * kSlabPad;
 }
 
-/// Closest-hit leaf loop: tests `tris[refs[i]]` and narrows `tfar`. Returns true on any hit.
-inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri, float& tfar,
-                           Hit& hit) {
+/// The shape test of a leaf: the ray against shapes[record's index], counting into `cost`.
+inline bool intersect_shape_record(const Ray& ray, const PrimitiveRecord& rec, const Shape* shapes,
+                                   float tfar, ShapeHit& sh, TraversalCost* cost) {
+  Ray r = ray;
+  r.tfar = tfar;
+  const bool found = intersect_shape(shapes[rec.prim_id & ~kShapeBit], r, sh);
+  if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
+  return found;
+}
+
+/// Closest-hit leaf test, dispatching on the primitive's kind to the one shared test per kind;
+/// narrows `tfar` and fills `hit` on a hit. `cost` (may be null) counts the tests.
+inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const PrimitiveRecord& rec,
+                           const Shape* shapes, float& tfar, Hit& hit, TraversalCost* cost) {
+  if (is_shape(rec)) {
+    ShapeHit sh;
+    if (!intersect_shape_record(ray, rec, shapes, tfar, sh, cost)) return false;
+    tfar = sh.t;
+    hit = {sh.t, 0, 0, rec.geom_id, 0};
+    return true;
+  }
+  if (cost) ++cost->triangles;
   float t, u, v;
-  if (!intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, tfar, t, u, v)) return false;
+  if (!intersect_triangle_watertight(ray, w, rec.a, rec.b, rec.c, tfar, t, u, v)) return false;
   tfar = t;
-  hit = {t, u, v, tri.geom_id, tri.prim_id};
+  hit = {t, u, v, rec.geom_id, rec.prim_id};
   return true;
 }
 
-inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const TriangleRecord& tri) {
+inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const PrimitiveRecord& rec,
+                          const Shape* shapes) {
+  if (is_shape(rec)) {
+    ShapeHit sh;
+    return intersect_shape_record(ray, rec, shapes, ray.tfar, sh, nullptr);
+  }
   float t, u, v;
-  return intersect_triangle_watertight(ray, w, tri.a, tri.b, tri.c, ray.tfar, t, u, v);
+  return intersect_triangle_watertight(ray, w, rec.a, rec.b, rec.c, ray.tfar, t, u, v);
 }
 
 /// Node counters for traversals: NoCount compiles away; CountNodes adds to a TraversalCost.
@@ -133,43 +177,51 @@ struct CountNodes {
   void node() const { ++cost.nodes; }
 };
 
-/// intersect(), intersect_counted() and occluded() of the reference structures, written once:
+/// intersect(), intersect_counted() and occluded() of the reference structures, written once
+/// over the structure's primitive records and its table of shapes (m_shapes, filled by
+/// gather_primitives):
 /// each structure provides
 ///   template <class Visit, class Counter, bool AnyHit>
 ///   bool traverse(const Ray&, const float& best, Visit&&, const Counter&,
 ///                 std::bool_constant<AnyHit>) const,
 /// which walks the cells or leaves the ray may meet (skipping those beyond `best`), calls
-/// counter.node() per node or cell visited, and calls visit(w, tri) on their triangles until it
+/// counter.node() per node or cell visited, and calls visit(w, record) on their primitives until it
 /// returns true (CRTP, so the visitors inline). AnyHit is true for occlusion queries, where any
-/// triangle hit ends the query and visiting order does not matter.
+/// hit ends the query and visiting order does not matter.
 template <typename Derived>
 class TraversalAccelerator : public Accelerator {
  public:
   bool intersect(const Ray& ray, Hit& hit) const final { return closest(ray, hit, NoCount{}, nullptr); }
 
   bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const final {
-    return closest(ray, hit, CountNodes{cost}, &cost.triangles);
+    return closest(ray, hit, CountNodes{cost}, &cost);
   }
   bool counts_traversal() const final { return true; }
 
   bool occluded(const Ray& ray) const final {
     const float tfar = ray.tfar;
+    const Shape* shapes = m_shapes.data();
     return static_cast<const Derived*>(this)->traverse(
         ray, tfar,
-        [&](const WatertightRay& w, const TriangleRecord& tri) { return occluded_leaf(ray, w, tri); },
+        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
+          return occluded_leaf(ray, w, rec, shapes);
+        },
         NoCount{}, std::true_type{});
   }
 
+ protected:
+  std::vector<Shape> m_shapes;  ///< the shapes the records point at (gather_primitives fills it)
+
  private:
   template <typename Counter>
-  bool closest(const Ray& ray, Hit& hit, const Counter& counter, uint64_t* tests) const {
+  bool closest(const Ray& ray, Hit& hit, const Counter& counter, TraversalCost* cost) const {
     hit = Hit{};
     float best = ray.tfar;
+    const Shape* shapes = m_shapes.data();
     static_cast<const Derived*>(this)->traverse(
         ray, best,
-        [&](const WatertightRay& w, const TriangleRecord& tri) {
-          if constexpr (!std::is_same_v<Counter, NoCount>) ++*tests;
-          intersect_leaf(ray, w, tri, best, hit);
+        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
+          intersect_leaf(ray, w, rec, shapes, best, hit, cost);
           return false;
         },
         counter, std::false_type{});

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -73,7 +74,7 @@ void throw_if_error(const char* what) {
 
 /// A new triangle geometry holding a copy of `mesh` (an empty mesh gets one degenerate triangle,
 /// which is never hit, so it still occupies its id), committed and attached to `scene` as `id`.
-void attach_triangles(RTCScene scene, const TriangleMeshView& mesh, unsigned id) {
+void attach_triangles(RTCScene scene, const GeometryView& mesh, unsigned id) {
   RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_TRIANGLE);
   const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -98,11 +99,63 @@ void attach_triangles(RTCScene scene, const TriangleMeshView& mesh, unsigned id)
   throw_if_error("attaching geometry");
 }
 
+/// Embree's user-geometry callbacks for one Shape (geometryUserPtr), called with one ray at a
+/// time (rtcIntersect1 / rtcOccluded1): bounds, closest hit, any hit, each through the shared
+/// per-kind shape test.
+void user_shape_bounds(const RTCBoundsFunctionArguments* args) {
+  const Bounds3f b = shape_bounds(*static_cast<const Shape*>(args->geometryUserPtr));
+  RTCBounds* o = args->bounds_o;
+  o->lower_x = b.lo.x, o->lower_y = b.lo.y, o->lower_z = b.lo.z;
+  o->upper_x = b.hi.x, o->upper_y = b.hi.y, o->upper_z = b.hi.z;
+}
+
+void user_shape_intersect(const RTCIntersectFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  const Ray r{{rh->ray.org_x, rh->ray.org_y, rh->ray.org_z},
+              rh->ray.tnear,
+              {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z},
+              rh->ray.tfar};
+  ShapeHit sh;
+  if (!intersect_shape(*static_cast<const Shape*>(args->geometryUserPtr), r, sh)) return;
+  rh->ray.tfar = sh.t;
+  rh->hit.u = rh->hit.v = 0;
+  rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0;
+  rh->hit.primID = args->primID;
+  rh->hit.geomID = args->geomID;
+  rh->hit.instID[0] = args->context->instID[0];
+}
+
+void user_shape_occluded(const RTCOccludedFunctionNArguments* args) {
+  if (args->N != 1 || !args->valid[0]) return;
+  auto* ray = reinterpret_cast<RTCRay*>(args->ray);
+  const Ray r{
+      {ray->org_x, ray->org_y, ray->org_z}, ray->tnear, {ray->dir_x, ray->dir_y, ray->dir_z}, ray->tfar};
+  ShapeHit sh;
+  if (intersect_shape(*static_cast<const Shape*>(args->geometryUserPtr), r, sh)) ray->tfar = -kInfinity;
+}
+
+/// A new user geometry of one primitive over `shape` (which must outlive it), committed and
+/// attached to `scene` as `id`.
+void attach_shape(RTCScene scene, const Shape* shape, unsigned id) {
+  RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, 1);
+  rtcSetGeometryUserData(geom, const_cast<Shape*>(shape));
+  rtcSetGeometryBoundsFunction(geom, user_shape_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, user_shape_intersect);
+  rtcSetGeometryOccludedFunction(geom, user_shape_occluded);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene, geom, id);
+  rtcReleaseGeometry(geom);
+  throw_if_error("attaching a shape");
+}
+
 class EmbreeAccelerator final : public Accelerator {
  public:
-  /// Identity instances become triangle geometries of the top scene; every other instance is an
-  /// Embree instance of a per-mesh scene. Geometry id in the top scene == instance index.
-  EmbreeAccelerator(std::span<const TriangleMeshView> meshes, std::span<const InstanceView> instances,
+  /// Identity instances become triangle (or user) geometries of the top scene; every other
+  /// instance is an Embree instance of a per-geometry scene. Geometry id in the top scene ==
+  /// instance index. Shapes with empty or non-finite bounds keep their id but are never hit.
+  EmbreeAccelerator(std::span<const GeometryView> meshes, std::span<const InstanceView> instances,
                     const EmbreeConfig& config)
       : m_config(config) {
     validate(config);
@@ -113,26 +166,24 @@ class EmbreeAccelerator final : public Accelerator {
     std::vector<RTCScene> objects(meshes.size(), nullptr);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
-      const TriangleMeshView& mesh = meshes[inst.mesh];
+      const GeometryView& mesh = meshes[inst.mesh];
       const unsigned id = unsigned(i);
       Affine3f inverse_map;
       if (is_identity(inst.to_world)) {
-        attach_triangles(m_scene, mesh, id);
-        m_triangles += mesh.indices.size() / 3;
+        attach_geometry(m_scene, mesh, id);
         continue;
       }
       if (!inverse(inst.to_world, inverse_map)) {  // singular: an empty mesh keeps the id
-        attach_triangles(m_scene, TriangleMeshView{}, id);
+        attach_triangles(m_scene, GeometryView{}, id);
         continue;
       }
       RTCScene& object = objects[inst.mesh];
       if (!object) {
         object = new_scene();
         m_objects.push_back(object);
-        attach_triangles(object, mesh, 0);
+        attach_geometry(object, mesh, 0);
         rtcCommitScene(object);
         throw_if_error("building an instanced mesh (rtcCommitScene)");
-        m_triangles += mesh.indices.size() / 3;
       }
       RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
       rtcSetGeometryInstancedScene(geom, object);
@@ -149,7 +200,8 @@ class EmbreeAccelerator final : public Accelerator {
     m_bytes = uint64_t(std::max<int64_t>(0, device_bytes() - bytes_before));
     RTCBounds b;
     rtcGetSceneBounds(m_scene, &b);
-    if (m_triangles > 0) m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+    if (m_triangles + m_shapes.size() > 0)
+      m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
     m_build_seconds = timer.seconds();
   }
 
@@ -199,6 +251,7 @@ class EmbreeAccelerator final : public Accelerator {
                 : m_config.quality == 1 ? "medium"
                                         : "high");
     s.triangles = m_triangles;
+    s.shapes = m_shapes.size();
     s.instances = m_instances;
     s.bytes = m_bytes;
     s.build_seconds = m_build_seconds;
@@ -206,6 +259,22 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
  private:
+  /// Attaches a view as triangles, or its shape (copied) as user geometry.
+  void attach_geometry(RTCScene scene, const GeometryView& view, unsigned id) {
+    if (!view.shape) {
+      attach_triangles(scene, view, id);
+      m_triangles += view.indices.size() / 3;
+      return;
+    }
+    m_shapes.push_back(std::make_unique<Shape>(*view.shape));
+    const Bounds3f b = shape_bounds(*m_shapes.back());
+    if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) {
+      attach_triangles(scene, GeometryView{}, id);
+      return;
+    }
+    attach_shape(scene, m_shapes.back().get(), id);
+  }
+
   static void fill_ray(const Ray& in, RTCRay& r) {
     r.org_x = in.org.x;
     r.org_y = in.org.y;
@@ -234,7 +303,8 @@ class EmbreeAccelerator final : public Accelerator {
 
   EmbreeConfig m_config;
   RTCScene m_scene = nullptr;
-  std::vector<RTCScene> m_objects;  // per-mesh scenes of the instances
+  std::vector<RTCScene> m_objects;               // per-geometry scenes of the instances
+  std::vector<std::unique_ptr<Shape>> m_shapes;  // the user geometries' shapes (stable addresses)
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
   uint64_t m_instances = 0;
@@ -250,14 +320,14 @@ void validate(const EmbreeConfig& c) {
                                 std::to_string(c.quality));
 }
 
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      const EmbreeConfig& config) {
   std::vector<InstanceView> instances(meshes.size());
   for (size_t i = 0; i < meshes.size(); ++i) instances[i].mesh = uint32_t(i);
   return std::make_unique<EmbreeAccelerator>(meshes, instances, config);
 }
 
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config) {
   return std::make_unique<EmbreeAccelerator>(meshes, instances, config);

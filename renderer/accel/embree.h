@@ -23,14 +23,14 @@ void validate(const EmbreeConfig& config);
 
 /// Builds an Embree scene over the meshes (data is copied into Embree-owned buffers).
 /// Throws std::runtime_error with Embree's message if the device or build fails.
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      const EmbreeConfig& config = {});
 
 /// Builds an Embree scene over placements of the meshes (geom_id in a Hit = instance index):
 /// identity placements as triangle geometries of the top scene, the others as Embree instances
 /// (RTC_GEOMETRY_TYPE_INSTANCE) of one scene per mesh. Instance mesh indices must be valid
 /// (the factory checks them).
-std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config = {});
 

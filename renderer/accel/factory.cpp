@@ -24,7 +24,7 @@ namespace {
 
 }  // namespace
 
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               const AccelConfig& config) {
   if (name == "embree") return make_embree_accelerator(meshes, config.embree);
   if (name == "bvh") return make_bvh_accelerator(meshes, config.bvh);
@@ -34,7 +34,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   throw_unknown(name);
 }
 
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               std::span<const InstanceView> instances,
                                               const AccelConfig& config) {
   validate_instances(instances, meshes.size());
@@ -42,7 +42,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   // A flattened scene (every placement the identity) is one level: geom_id = instance index.
   if (std::all_of(instances.begin(), instances.end(),
                   [](const InstanceView& i) { return is_identity(i.to_world); })) {
-    std::vector<TriangleMeshView> views;
+    std::vector<GeometryView> views;
     views.reserve(instances.size());
     for (const auto& i : instances) views.push_back(meshes[i.mesh]);
     return make_accelerator(name, views, config);
@@ -50,7 +50,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   const auto names = accelerator_names();
   if (std::find(names.begin(), names.end(), name) == names.end()) throw_unknown(name);
   return make_two_level_accelerator(
-      [&](std::span<const TriangleMeshView> level) { return make_accelerator(name, level, config); }, meshes,
+      [&](std::span<const GeometryView> level) { return make_accelerator(name, level, config); }, meshes,
       instances);
 }
 

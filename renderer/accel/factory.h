@@ -31,7 +31,7 @@ std::vector<std::string> accelerator_names();
 /// for "brute" the meshes must outlive the accelerator. Throws std::invalid_argument for an
 /// unknown name or an invalid configuration, std::runtime_error if the build fails (the message
 /// names the back end).
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               const AccelConfig& config = {});
 
 /// Builds the named back end over placements of `meshes`; a Hit's geom_id is the instance index.
@@ -40,7 +40,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
 /// identity (a flattened scene) this is exactly the single-level build over the instances'
 /// meshes. Throws as above, and std::invalid_argument if an instance names a mesh outside
 /// `meshes`.
-std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               std::span<const InstanceView> instances,
                                               const AccelConfig& config = {});
 

@@ -63,18 +63,25 @@ bool triangle_box_overlap(const double lo[3], const double hi[3], Vec3f a, Vec3f
 
 namespace {
 
+// True if the boxes [lo, hi] (double) and [a, b] overlap, faces included.
+bool box_overlap(const double lo[3], const double hi[3], Vec3f a, Vec3f b) {
+  for (int k = 0; k < 3; ++k)
+    if (double(b[k]) < lo[k] || double(a[k]) > hi[k]) return false;
+  return true;
+}
+
 constexpr int kMailboxSize = 64;  // power of two
 
 class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   friend class TraversalAccelerator<GridAccelerator>;
 
  public:
-  GridAccelerator(std::span<const TriangleMeshView> meshes, const GridConfig& config) : m_config(config) {
+  GridAccelerator(std::span<const GeometryView> meshes, const GridConfig& config) : m_config(config) {
     validate(config);
     const BuildTimer timer;
-    m_tris = gather_triangles(meshes);
+    m_tris = gather_primitives(meshes, m_shapes);
     m_input_triangles = count_input_triangles(meshes);
-    for (const auto& t : m_tris) m_bounds = merge(m_bounds, triangle_bounds(t));
+    for (const auto& t : m_tris) m_bounds = merge(m_bounds, primitive_bounds(t));
     if (!m_tris.empty()) build();
     m_build_seconds = timer.seconds();
   }
@@ -85,10 +92,12 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     char config[160];
     std::snprintf(config, sizeof config, "lambda %g, resolution %ux%ux%u", double(m_config.lambda), m_res[0],
                   m_res[1], m_res[2]);
-    return make_stats(m_stats, "grid", config, m_input_triangles,
-                      m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
-                          m_tris.size() * sizeof(TriangleRecord),
-                      m_build_seconds);
+    AccelStats s = make_stats(m_stats, "grid", config, m_input_triangles,
+                              m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
+                                  m_tris.size() * sizeof(PrimitiveRecord),
+                              m_build_seconds);
+    s.shapes = m_shapes.size();
+    return s;
   }
 
  private:
@@ -193,8 +202,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     const size_t ncells = size_t(m_res[0]) * m_res[1] * m_res[2];
 
     // Phase 2: per triangle, the cells it overlaps (counted, then written), in parallel.
-    auto cell_range = [&](const TriangleRecord& t, int lo[3], int hi[3]) {
-      const Bounds3f b = triangle_bounds(t);
+    auto cell_range = [&](const PrimitiveRecord& t, int lo[3], int hi[3]) {
+      const Bounds3f b = primitive_bounds(t);
       for (int k = 0; k < 3; ++k) {
         if (m_cell_size[k] <= 0) {
           lo[k] = hi[k] = 0;
@@ -207,7 +216,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
             int(std::clamp(std::floor((b.hi[k] + margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
       }
     };
-    auto for_each_cell = [&](const TriangleRecord& t, auto&& f) {
+    auto for_each_cell = [&](const PrimitiveRecord& t, auto&& f) {
       int lo[3], hi[3];
       cell_range(t, lo, hi);
       for (int z = lo[2]; z <= hi[2]; ++z)
@@ -219,7 +228,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
               blo[k] = m_lo[k] + idx[k] * m_cell_size[k] - margin[k];
               bhi[k] = m_lo[k] + (idx[k] + 1) * m_cell_size[k] + margin[k];
             }
-            if (triangle_box_overlap(blo, bhi, t.a, t.b, t.c))
+            if (is_shape(t) ? box_overlap(blo, bhi, t.a, t.b) : triangle_box_overlap(blo, bhi, t.a, t.b, t.c))
               f(uint32_t((size_t(z) * m_res[1] + size_t(y)) * m_res[0] + size_t(x)));
           }
     };
@@ -259,7 +268,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   uint64_t bbox_references(const Vec3f& ext, double s) const {
     uint64_t total = 0;
     for (const auto& t : m_tris) {
-      const Bounds3f b = triangle_bounds(t);
+      const Bounds3f b = primitive_bounds(t);
       uint64_t c = 1;
       for (int k = 0; k < 3; ++k) {
         const double res = std::ceil(ext[k] / s);
@@ -274,7 +283,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   static constexpr uint64_t kMaxCandidateRefs = 1ull << 26;  // 256 MiB of references at most
 
   GridConfig m_config;
-  std::vector<TriangleRecord> m_tris;
+  std::vector<PrimitiveRecord> m_tris;
   std::vector<uint32_t> m_offsets;  // per cell (x fastest): first reference; ncells + 1 entries
   std::vector<uint32_t> m_refs;     // triangle indices, grouped by cell
   Bounds3f m_bounds;                // exact bounds of the triangles
@@ -296,7 +305,7 @@ void validate(const GridConfig& c) {
     throw std::invalid_argument("grid: max_cells must be in [1, 2^30]");
 }
 
-std::unique_ptr<Accelerator> make_grid_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_grid_accelerator(std::span<const GeometryView> meshes,
                                                    const GridConfig& config) {
   return std::make_unique<GridAccelerator>(meshes, config);
 }

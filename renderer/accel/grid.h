@@ -22,7 +22,7 @@ struct GridConfig {
 void validate(const GridConfig& config);
 
 /// Builds a uniform grid over copies of the triangles (`meshes` need not outlive it).
-std::unique_ptr<Accelerator> make_grid_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_grid_accelerator(std::span<const GeometryView> meshes,
                                                    const GridConfig& config = {});
 
 /// Akenine-Moeller's separating-axis test ("Fast 3D Triangle-Box Overlap Testing", JGT 2001):

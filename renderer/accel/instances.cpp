@@ -16,11 +16,11 @@ namespace {
 
 class TwoLevelAccelerator final : public Accelerator {
  public:
-  TwoLevelAccelerator(const AcceleratorBuilder& build, std::span<const TriangleMeshView> meshes,
+  TwoLevelAccelerator(const AcceleratorBuilder& build, std::span<const GeometryView> meshes,
                       std::span<const InstanceView> instances) {
     validate_instances(instances, meshes.size());
     const BuildTimer timer;
-    std::vector<TriangleMeshView> world;
+    std::vector<GeometryView> world;
     std::vector<int> object_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
@@ -74,6 +74,7 @@ class TwoLevelAccelerator final : public Accelerator {
     uint64_t bottom_depth = 0;
     for (const AccelStats& b : m_stats_bottom) {
       s.triangles += b.triangles;
+      s.shapes += b.shapes;
       s.nodes += b.nodes;
       s.leaves += b.leaves;
       s.empty_leaves += b.empty_leaves;
@@ -200,7 +201,7 @@ void validate_instances(std::span<const InstanceView> instances, size_t mesh_cou
 }
 
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
-                                                        std::span<const TriangleMeshView> meshes,
+                                                        std::span<const GeometryView> meshes,
                                                         std::span<const InstanceView> instances) {
   return std::make_unique<TwoLevelAccelerator>(build, meshes, instances);
 }

@@ -16,7 +16,7 @@
 namespace penumbra {
 
 /// Builds one back end's structure over some meshes (geom_id = index in the span).
-using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<const TriangleMeshView>)>;
+using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<const GeometryView>)>;
 
 /// Two-level structure over `instances` of `meshes`; a Hit's geom_id is the instance index and
 /// its t is measured along the world ray (object-space rays keep the parameterisation: the
@@ -25,7 +25,7 @@ using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<
 /// or non-finite map are left out. Throws std::invalid_argument if an instance names a mesh
 /// outside `meshes`, and whatever `build` throws.
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
-                                                        std::span<const TriangleMeshView> meshes,
+                                                        std::span<const GeometryView> meshes,
                                                         std::span<const InstanceView> instances);
 
 /// Throws std::invalid_argument naming the instance if it refers to a mesh outside `mesh_count`.

@@ -79,8 +79,13 @@ struct BuildNode {
 };
 
 /// Bounds of the part of triangle t inside `box` (Sutherland-Hodgman clipping in double),
-/// rounded outward to float and intersected with `box`. Empty if nothing is inside.
-Bounds3f clip_triangle(const TriangleRecord& t, const Bounds3f& box) {
+/// rounded outward to float and intersected with `box`; for a shape, its bounds intersected
+/// with `box`. Empty if nothing is inside.
+Bounds3f clip_triangle(const PrimitiveRecord& t, const Bounds3f& box) {
+  if (is_shape(t)) {
+    const Bounds3f o{max(t.a, box.lo), min(t.b, box.hi)};
+    return o.empty() ? Bounds3f{} : o;
+  }
   struct P {
     double v[3];
   };
@@ -135,7 +140,7 @@ Bounds3f clip_triangle(const TriangleRecord& t, const Bounds3f& box) {
 
 class Builder {
  public:
-  Builder(const KdTreeConfig& c, const std::vector<TriangleRecord>& tris, int max_depth)
+  Builder(const KdTreeConfig& c, const std::vector<PrimitiveRecord>& tris, int max_depth)
       : m_config(c), m_tris(tris), m_max_depth(max_depth) {}
 
   std::unique_ptr<BuildNode> build(std::vector<Event> events, uint32_t n, const Bounds3f& box, int depth) {
@@ -270,7 +275,7 @@ class Builder {
   }
 
   const KdTreeConfig& m_config;
-  const std::vector<TriangleRecord>& m_tris;
+  const std::vector<PrimitiveRecord>& m_tris;
   int m_max_depth;
   tbb::enumerable_thread_specific<std::vector<uint8_t>> m_classes;
 };
@@ -281,12 +286,12 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   friend class TraversalAccelerator<KdTreeAccelerator>;
 
  public:
-  KdTreeAccelerator(std::span<const TriangleMeshView> meshes, const KdTreeConfig& config) : m_config(config) {
+  KdTreeAccelerator(std::span<const GeometryView> meshes, const KdTreeConfig& config) : m_config(config) {
     validate(config);
     const BuildTimer timer;
-    m_tris = gather_triangles(meshes);
+    m_tris = gather_primitives(meshes, m_shapes);
     m_input_triangles = count_input_triangles(meshes);
-    if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many triangles (max 2^30 - 1)");
+    if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many primitives (max 2^30 - 1)");
     m_max_depth =
         config.max_depth > 0
             ? config.max_depth
@@ -295,7 +300,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
       std::vector<Event> events;
       events.reserve(m_tris.size() * 6);
       for (uint32_t i = 0; i < m_tris.size(); ++i) {
-        const Bounds3f b = triangle_bounds(m_tris[i]);
+        const Bounds3f b = primitive_bounds(m_tris[i]);
         m_bounds = merge(m_bounds, b);
         add_events(events, i, b);
       }
@@ -323,9 +328,10 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
                        format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth),
                    m_input_triangles,
                    m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) +
-                       m_tris.size() * sizeof(TriangleRecord),
+                       m_tris.size() * sizeof(PrimitiveRecord),
                    m_build_seconds);
     s.nodes = m_nodes.size();
+    s.shapes = m_shapes.size();
     return s;
   }
 
@@ -434,7 +440,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   int m_max_depth = 0;
   std::vector<KdNode> m_nodes;  // depth-first; node 0 is the root
   std::vector<uint32_t> m_refs;
-  std::vector<TriangleRecord> m_tris;
+  std::vector<PrimitiveRecord> m_tris;
   Bounds3f m_bounds;  // exact bounds of the triangles
   Bounds3f m_clip;    // m_bounds widened by m_band, for clipping rays
   float m_band = 0;   // origins this close to a split plane count as on it
@@ -456,7 +462,7 @@ void validate(const KdTreeConfig& c) {
     throw std::invalid_argument("kdtree: max_depth must be in [0, 64], got " + std::to_string(c.max_depth));
 }
 
-std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const GeometryView> meshes,
                                                      const KdTreeConfig& config) {
   return std::make_unique<KdTreeAccelerator>(meshes, config);
 }

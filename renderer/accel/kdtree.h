@@ -25,7 +25,7 @@ struct KdTreeConfig {
 void validate(const KdTreeConfig& config);
 
 /// Builds a kD-tree over copies of the triangles (`meshes` need not outlive it).
-std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const TriangleMeshView> meshes,
+std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const GeometryView> meshes,
                                                      const KdTreeConfig& config = {});
 
 }  // namespace penumbra

@@ -55,7 +55,7 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
           a.depth[i] = std::min(a.depth[i], z);
           const Instance& inst = scene.instances[hit.geom_id];
           objects.push_back(inst.node >= 0 ? uint32_t(inst.node) + 1 : 0);
-          const int m = scene.meshes[size_t(inst.mesh)].material;
+          const int m = instance_material(scene, inst);
           materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
         }
         // The most frequent id (ties: the smaller one).

@@ -195,7 +195,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     // Russian roulette.
     if (vertex >= cfg.rr_depth && !survives_roulette(samples, seg.beta)) break;
     seg.ray = Ray{};
-    seg.ray.org = offset_ray_origin(si.p, si.ng, wi);
+    seg.ray.org = spawn_origin(si, wi);
     seg.ray.dir = wi;
     ++counts.reflection;
   }

@@ -3,17 +3,21 @@
 
 namespace penumbra {
 
-std::vector<TriangleMeshView> mesh_views(const Scene& scene) {
-  std::vector<TriangleMeshView> views;
-  views.reserve(scene.meshes.size());
+std::vector<GeometryView> mesh_views(const Scene& scene) {
+  std::vector<GeometryView> views;
+  views.reserve(scene.meshes.size() + scene.shapes.size());
   for (const auto& m : scene.meshes) views.push_back({m.positions, m.indices});
+  for (const auto& s : scene.shapes) views.push_back({{}, {}, &s.shape});
   return views;
 }
 
 std::vector<InstanceView> instance_views(const Scene& scene) {
   std::vector<InstanceView> views;
   views.reserve(scene.instances.size());
-  for (const Instance& inst : scene.instances) views.push_back({uint32_t(inst.mesh), inst.to_world});
+  for (const Instance& inst : scene.instances) {
+    const size_t geometry = inst.shape >= 0 ? scene.meshes.size() + size_t(inst.shape) : size_t(inst.mesh);
+    views.push_back({uint32_t(geometry), inst.to_world});
+  }
   return views;
 }
 

@@ -1,5 +1,5 @@
-// The accelerator the integrators query: the scene's meshes and instances handed to the
-// accelerator factory as plain triangle views (geom_id in hits == instance index). The scene
+// The accelerator the integrators query: the scene's meshes, shapes and instances handed to the
+// accelerator factory as plain geometry views (geom_id in hits == instance index). The scene
 // itself stays plain data; this is where it meets accel/.
 #pragma once
 
@@ -12,9 +12,10 @@
 
 namespace penumbra {
 
-/// Views of every mesh and of every instance for make_accelerator(name, meshes, instances);
-/// they point into the scene, which must outlive them.
-std::vector<TriangleMeshView> mesh_views(const Scene& scene);
+/// Views of every mesh, then every shape (view index = meshes.size() + shape index), and of every
+/// instance for make_accelerator(name, views, instances); they point into the scene, which must
+/// outlive them.
+std::vector<GeometryView> mesh_views(const Scene& scene);
 std::vector<InstanceView> instance_views(const Scene& scene);
 
 /// make_accelerator(name, mesh_views(scene), instance_views(scene), config): the structure

@@ -19,7 +19,7 @@ Ray past(const Ray& ray, float t) {
 
 bool scene_needs_hit_filter(const Scene& scene) {
   for (const auto& inst : scene.instances) {
-    const Material& m = material_of(scene, scene.meshes[size_t(inst.mesh)].material);
+    const Material& m = material_of(scene, instance_material(scene, inst));
     if (m.alpha_mode != AlphaMode::Opaque || !m.double_sided) return true;
   }
   return false;
@@ -32,9 +32,9 @@ bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& 
     hit = Hit{};
     if (!accel.intersect(r, hit)) return false;
     const Instance& inst = scene.instances[hit.geom_id];
-    const Material& m = material_of(scene, scene.meshes[size_t(inst.mesh)].material);
+    const Material& m = material_of(scene, instance_material(scene, inst));
     bool skip = false;
-    if (!m.double_sided) skip = dot(world_triangle(scene, inst, hit.prim_id).ng, r.dir) > 0;
+    if (!m.double_sided) skip = dot(hit_front_normal(scene, r, hit), r.dir) > 0;
     if (!skip && m.alpha_mode == AlphaMode::Mask)
       skip = eval_alpha(scene, hit.geom_id, hit.prim_id, hit.u, hit.v) < 1;
     if (!skip) return true;
@@ -60,7 +60,7 @@ float shadow_transmittance(const Scene& scene, const Accelerator& accel, const R
 
 Ray shadow_ray(const SurfaceInteraction& si, Vec3f wi, float distance) {
   Ray r;
-  r.org = offset_ray_origin(si.p, si.ng, wi);
+  r.org = spawn_origin(si, wi);
   r.dir = wi;
   r.tnear = 0;
   r.tfar = std::isfinite(distance) ? distance * (1 - 1e-4f) : kInfinity;

@@ -100,7 +100,7 @@ struct Tracer {
         r = reflect(normalize(ray.dir), n);
       }
       Ray refl;
-      refl.org = offset_ray_origin(si.p, si.ng, r);
+      refl.org = spawn_origin(si, r);
       refl.dir = r;
       ++counts.reflection;
       radiance += w.kr * trace(refl, reflect_differential(si, rd, v, n, r), depth + 1, 0, rweight, nullptr);

@@ -46,6 +46,7 @@ AreaLights build_area_lights(const Scene& scene) {
   std::vector<double> power;
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
+    if (inst.shape >= 0) continue;  // emissive shapes shine when hit but are not sampled
     const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
     const Material& mat = material_of(scene, mesh.material);
     if (!(max_component(mat.emissive) > 0) || mat.unlit) continue;

@@ -31,7 +31,8 @@ struct AreaLights {
                                ///< nothing (an emitting instance lists all its triangles)
 };
 
-/// Collects the scene's emissive triangles. Allocates; call once per render.
+/// Collects the scene's emissive triangles (emissive shapes are not sampled: they add their
+/// emission when a path hits them). Allocates; call once per render.
 AreaLights build_area_lights(const Scene& scene);
 
 /// Density (per unit world area) with which sample_area_light() picks a point on triangle

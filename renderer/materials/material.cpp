@@ -63,7 +63,12 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
 }
 
 float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v) {
-  const Mesh& mesh = scene.meshes[size_t(scene.instances[instance].mesh)];
+  const Instance& inst = scene.instances[instance];
+  if (inst.shape >= 0) {
+    const Material& mat = material_of(scene, scene.shapes[size_t(inst.shape)].material);
+    return mat.alpha_mode == AlphaMode::Opaque ? 1.0f : mat.alpha;
+  }
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const Material& mat = material_of(scene, mesh.material);
   if (mat.alpha_mode == AlphaMode::Opaque) return 1;
   const size_t base = size_t(prim) * 3;

@@ -44,7 +44,8 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si);
 
 /// Coverage of the surface at barycentrics (u, v) of triangle `prim` of instance `instance`: alpha
-/// factor x base colour texture alpha (finest level) x COLOR_0 alpha. 1 for Opaque materials.
+/// factor x base colour texture alpha (finest level) x COLOR_0 alpha; for a shape instance the
+/// alpha factor alone. 1 for Opaque materials.
 float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v);
 
 }  // namespace penumbra

@@ -1,10 +1,101 @@
 // Hit -> surface reconstruction and ray-differential footprints.
 #include "renderer/scene/interaction.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace penumbra {
+
+namespace {
+
+// The ray in the instance's object space (same parameterisation: the direction is mapped, not
+// normalised).
+Ray to_object_ray(const Instance& inst, const Ray& ray) {
+  if (inst.identity) return ray;
+  Ray r = ray;
+  r.org = apply_point(inst.to_object, ray.org);
+  r.dir = apply_vector(inst.to_object, ray.dir);
+  return r;
+}
+
+// Object-space hit point on the shape, and the world-space tolerance of where it lies.
+Vec3f shape_hit_point(const SceneShape& ss, const Instance& inst, const Ray& ray, float t, float& world_tol) {
+  const Ray r = to_object_ray(inst, ray);
+  const float obj_len = length(r.dir), world_len = length(ray.dir);
+  const float tol = shape_hit_tolerance(ss.shape, t, obj_len);
+  world_tol = obj_len > 0 ? tol * (world_len / obj_len) : 0;
+  return snap_to_shape(ss.shape, r.org + r.dir * t);
+}
+
+// Central-difference step for implicit normals: a few hit tolerances, at least 1e-5 of the size.
+float normal_step(const Shape& shape, float tol) {
+  const Bounds3f b = shape_bounds(shape);
+  const float size = b.empty() ? 1.0f : max_component(b.extent());
+  return std::max(4 * tol, 1e-5f * size);
+}
+
+SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& inst, const Ray& ray,
+                                          const Hit& hit) {
+  const SceneShape& ss = scene.shapes[size_t(inst.shape)];
+  SurfaceInteraction si;
+  si.instance = hit.geom_id;
+  si.shape = inst.shape;
+  si.material = ss.material;
+  float world_tol = 0;
+  const Vec3f p = shape_hit_point(ss, inst, ray, hit.t, world_tol);
+  const Ray obj = to_object_ray(inst, ray);
+  const ShapeSurface surf = shape_surface(
+      ss.shape, p, normal_step(ss.shape, shape_hit_tolerance(ss.shape, hit.t, length(obj.dir))));
+  si.p = inst.identity ? p : apply_point(inst.to_world, p);
+  Vec3f n = world_normal(inst, surf.n);
+  if (!(dot(n, n) > 0) || !is_finite(n)) n = normalize(-ray.dir);
+  si.uv[0] = si.uv[1] = surf.uv;
+  si.spawn_offset = 4 * world_tol;
+  si.back_face = dot(n, ray.dir) > 0;
+  if (si.back_face) n = -n;
+  si.ng = si.ns = n;
+  return si;
+}
+
+// Difference of two texture coordinates of a shape whose u wraps around (sphere, capsule).
+Vec2f uv_delta(const Shape& shape, Vec2f a, Vec2f b) {
+  Vec2f d{b.x - a.x, b.y - a.y};
+  if (shape.kind == ShapeKind::Sphere || shape.kind == ShapeKind::Capsule) d.x -= std::round(d.x);
+  return d;
+}
+
+void shape_differentials(const Scene& scene, SurfaceInteraction& si) {
+  const Instance& inst = scene.instances[si.instance];
+  const Shape& shape = scene.shapes[size_t(si.shape)].shape;
+  const auto to_obj = [&](Vec3f q) { return inst.identity ? q : apply_point(inst.to_object, q); };
+  const Vec3f p = to_obj(si.p);
+  const Vec2f uv = shape_surface(shape, p, 1e-4f).uv;
+  const Vec2f ux = shape_surface(shape, to_obj(si.p + si.dpdx), 1e-4f).uv;
+  const Vec2f uy = shape_surface(shape, to_obj(si.p + si.dpdy), 1e-4f).uv;
+  si.duvdx[0] = si.duvdx[1] = uv_delta(shape, uv, ux);
+  si.duvdy[0] = si.duvdy[1] = uv_delta(shape, uv, uy);
+}
+
+}  // namespace
+
+Vec3f spawn_origin(const SurfaceInteraction& si, Vec3f dir) {
+  const Vec3f o = offset_ray_origin(si.p, si.ng, dir);
+  if (si.spawn_offset == 0) return o;
+  return o + si.ng * (dot(si.ng, dir) >= 0 ? si.spawn_offset : -si.spawn_offset);
+}
+
+Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
+  const Instance& inst = scene.instances[hit.geom_id];
+  if (inst.shape < 0) return world_triangle(scene, inst, hit.prim_id).ng;
+  const SceneShape& ss = scene.shapes[size_t(inst.shape)];
+  float world_tol = 0;
+  const Vec3f p = shape_hit_point(ss, inst, ray, hit.t, world_tol);
+  return normalize(world_normal(inst, shape_surface(ss.shape, p, normal_step(ss.shape, world_tol)).n));
+}
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {
   const Instance& inst = scene.instances[hit.geom_id];
+  if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const WorldTriangle tri = world_triangle(scene, inst, hit.prim_id);
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
@@ -64,6 +155,10 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
   if (!is_finite(dpdx) || !is_finite(dpdy)) return;
   si.dpdx = dpdx;
   si.dpdy = dpdy;
+  if (si.shape >= 0) {
+    shape_differentials(scene, si);
+    return;
+  }
   // Barycentric derivatives: least-squares solve of dp = e1 db1 + e2 db2.
   const Instance& inst = scene.instances[si.instance];
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];

@@ -1,4 +1,4 @@
-// Surface data at a ray hit, reconstructed from the Hit record and the scene's meshes, plus
+// Surface data at a ray hit, reconstructed from the Hit record and the scene's meshes or shapes, plus
 // the screen-space derivatives (from ray differentials) that texture filtering needs; shared
 // by all integrators.
 #pragma once
@@ -16,7 +16,8 @@ struct RayDifferential {
 };
 
 struct SurfaceInteraction {
-  Vec3f p;                  ///< hit point, interpolated from the triangle's vertices
+  Vec3f p;                  ///< hit point, interpolated from the triangle's vertices (on a shape:
+                            ///< the object-space hit mapped to world space)
   Vec3f ng;                 ///< unit geometric normal, facing the incoming ray (dot(ng, -dir) >= 0)
   Vec3f ns;                 ///< unit interpolated vertex normal, in the same hemisphere as ng
   Vec2f uv[2];              ///< TEXCOORD_0 and TEXCOORD_1 ((0,0) if absent)
@@ -25,7 +26,11 @@ struct SurfaceInteraction {
   int material = -1;
   uint32_t instance = 0;  ///< index into Scene::instances (the Hit's geom_id)
   uint32_t mesh = 0, prim = 0;
-  bool back_face = false;  ///< true if the ray hit the triangle's back (clockwise) side
+  int shape = -1;          ///< index into Scene::shapes for a shape hit (mesh and prim are then 0)
+  bool back_face = false;  ///< true if the ray hit the triangle's back (clockwise) side, or a
+                           ///< shape from inside (flat shapes: from -Y)
+  float spawn_offset = 0;  ///< extra world distance along ng that spawned rays keep from the
+                           ///< surface: the implicit shapes' hit tolerance, 0 otherwise
   // Screen-space derivatives, zero unless compute_differentials() found a footprint.
   Vec3f dpdx, dpdy;          ///< of the hit point
   Vec3f dndx, dndy;          ///< of the (unnormalised) interpolated normal
@@ -36,8 +41,17 @@ struct SurfaceInteraction {
 /// and instance_views() returns). Everything is in world space.
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit);
 
+/// The origin of a ray leaving si.p in direction `dir`: offset_ray_origin() plus si.spawn_offset
+/// along the side of ng that `dir` points to, so the ray does not find the same surface again.
+Vec3f spawn_origin(const SurfaceInteraction& si, Vec3f dir);
+
+/// The unit world-space front normal of the hit surface: the triangle's counter-clockwise side
+/// (as world_triangle), or a shape's outward normal at the hit. Cheaper than make_interaction.
+Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit);
+
 /// Fills si's derivatives by intersecting the differential rays with the tangent plane at
-/// si.p and expressing the offsets in the triangle's barycentrics (pbrt-v3, 10.1.1). Leaves
+/// si.p and expressing the offsets in the triangle's barycentrics (pbrt-v3, 10.1.1), or for a
+/// shape as differences of its UV map at the offset points. Leaves
 /// them zero when rd is not valid or the plane is parallel to an auxiliary ray.
 void compute_differentials(const Scene& scene, SurfaceInteraction& si, const RayDifferential& rd);
 

@@ -21,6 +21,20 @@ Instance make_instance(int mesh, const Affine3f& to_world, int node) {
   return inst;
 }
 
+Instance make_shape_instance(int shape, const Affine3f& to_world, int node) {
+  Instance inst;
+  inst.mesh = -1;
+  inst.shape = shape;
+  inst.node = node;
+  inst.to_world = to_world;
+  inst.identity = is_identity(to_world);
+  if (!inverse(to_world, inst.to_object))
+    throw std::invalid_argument("instance of shape " + std::to_string(shape) +
+                                ": transform is singular or not finite");
+  inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
+  return inst;
+}
+
 int add_world_mesh(Scene& scene, Mesh mesh) {
   const int index = int(scene.meshes.size());
   Instance inst;
@@ -40,10 +54,15 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   // than a million boxes.
   uint64_t placed_vertices = 0;
   for (const Instance& inst : scene.instances)
-    if (!inst.identity) placed_vertices += scene.meshes[size_t(inst.mesh)].positions.size();
+    if (!inst.identity && inst.shape < 0) placed_vertices += scene.meshes[size_t(inst.mesh)].positions.size();
   const bool exact = placed_vertices <= exact_vertex_limit;
   Bounds3f b;
   for (const Instance& inst : scene.instances) {
+    if (inst.shape >= 0) {
+      const Bounds3f sb = shape_bounds(scene.shapes[size_t(inst.shape)].shape);
+      if (!sb.empty()) b = merge(b, transform_bounds(inst.to_world, sb));
+      continue;
+    }
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     if (inst.identity) {
       b = merge(b, mesh_bounds[size_t(inst.mesh)]);
@@ -58,7 +77,14 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
 
 uint64_t count_triangles(const Scene& scene) {
   uint64_t n = 0;
-  for (const Instance& inst : scene.instances) n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  for (const Instance& inst : scene.instances)
+    if (inst.shape < 0) n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  return n;
+}
+
+uint64_t count_shape_instances(const Scene& scene) {
+  uint64_t n = 0;
+  for (const Instance& inst : scene.instances) n += inst.shape >= 0;
   return n;
 }
 
@@ -68,6 +94,8 @@ uint64_t scene_memory_bytes(const Scene& scene) {
   for (const Mesh& m : scene.meshes)
     total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
              bytes(m.colors) + bytes(m.indices);
+  total += bytes(scene.shapes);
+  for (const SceneShape& s : scene.shapes) total += bytes(s.shape.sdf.nodes) + bytes(s.shape.sdf.planes);
   for (const Texture& t : scene.textures)
     for (const MipLevel& level : t.levels) total += bytes(level.texels);
   return total;

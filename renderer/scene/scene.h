@@ -1,7 +1,7 @@
-// The scene as plain data: triangle meshes and their instances, materials, textures, punctual
-// lights and cameras, addressed by int handles. Built by io/ from glTF (or by tests directly);
-// consumed by the integrators. No accelerators and no behaviour beyond small free functions
-// (integrators/scene_accel.h builds the accelerator over it).
+// The scene as plain data: triangle meshes, shapes (analytic primitives and implicit surfaces)
+// and their instances, materials, textures, punctual lights and cameras, addressed by int handles. Built by
+// io/ from glTF (or by tests directly); consumed by the integrators. No accelerators and no behaviour beyond
+// small free functions (integrators/scene_accel.h builds the accelerator over it).
 #pragma once
 
 #include <span>
@@ -10,6 +10,7 @@
 
 #include "renderer/core/math.h"
 #include "renderer/scene/texture.h"
+#include "renderer/shapes/shape.h"
 
 namespace penumbra {
 
@@ -66,10 +67,21 @@ struct Mesh {
   int node = -1;                  ///< glTF node of a flattened mesh, -1 if shared or not from glTF
 };
 
-/// One placement of a mesh in the world. A Hit's geom_id is an index into Scene::instances.
-/// Make them with make_instance() so the inverse and `mirrored` agree with `to_world`.
+/// An analytic primitive or an implicit surface in its object space with its material, placed
+/// by instances as meshes are.
+struct SceneShape {
+  std::string name;  ///< for messages: the glTF node's name, or "nodes[i]"
+  Shape shape;
+  int material = -1;  ///< index into Scene::materials, -1 = default material
+  int node = -1;      ///< glTF node that carries it, -1 if not from glTF
+};
+
+/// One placement of a mesh or a shape in the world. A Hit's geom_id is an index into
+/// Scene::instances. Make them with make_instance() or make_shape_instance() so the inverse and
+/// `mirrored` agree with `to_world`.
 struct Instance {
-  int mesh = 0;           ///< index into Scene::meshes
+  int mesh = 0;           ///< index into Scene::meshes; -1 when the instance places a shape
+  int shape = -1;         ///< index into Scene::shapes, or -1 for a mesh instance
   Affine3f to_world;      ///< object to world
   Affine3f to_object;     ///< its inverse
   bool identity = true;   ///< to_world is the identity (the mesh is in world space)
@@ -113,6 +125,7 @@ struct Camera {
 
 struct Scene {
   std::vector<Mesh> meshes;
+  std::vector<SceneShape> shapes;
   std::vector<Instance> instances;  ///< what is rendered: a mesh without an instance is not
   std::vector<Material> materials;
   std::vector<Texture> textures;
@@ -123,23 +136,32 @@ struct Scene {
 /// An instance of `mesh` placed by `to_world`. Throws std::invalid_argument if the map is
 /// singular or not finite.
 Instance make_instance(int mesh, const Affine3f& to_world, int node = -1);
+/// An instance of Scene::shapes[shape] placed by `to_world`; throws as make_instance().
+Instance make_shape_instance(int shape, const Affine3f& to_world, int node = -1);
+/// The material index (-1 = default) of what the instance places.
+inline int instance_material(const Scene& scene, const Instance& inst) {
+  return inst.shape >= 0 ? scene.shapes[size_t(inst.shape)].material
+                         : scene.meshes[size_t(inst.mesh)].material;
+}
 /// Appends a world-space mesh with its identity instance; returns the mesh index.
 int add_world_mesh(Scene& scene, Mesh mesh);
 
-/// World-space bounds of every instance's positions (empty box for an empty scene); exact
+/// World-space bounds of every instance's positions and shapes (empty box for an empty scene); exact
 /// unless the meshes placed by non-identity instances hold more than `exact_vertex_limit`
 /// vertices in all, then each such placement contributes the mapped box of its mesh
 /// (conservative, and as cheap for a million placements as for one).
 Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64_t(1) << 24);
+/// Shapes rendered: each shape counted once per instance.
+uint64_t count_shape_instances(const Scene& scene);
 /// Triangles rendered: each mesh counted once per instance.
 uint64_t count_triangles(const Scene& scene);
 /// Triangles stored: each mesh once.
 uint64_t count_stored_triangles(const Scene& scene);
 
-/// Bytes held by the scene's arrays (mesh attributes, instances, texture pyramids), for
+/// Bytes held by the scene's arrays (mesh attributes, shapes, instances, texture pyramids), for
 /// memory budgets.
 uint64_t scene_memory_bytes(const Scene& scene);
-/// Triangle `prim` of instance `inst` in world space: its vertex indices, its world positions
+/// Triangle `prim` of mesh instance `inst` in world space: its vertex indices, its world positions
 /// and its unit front-facing geometric normal (counter-clockwise side in object space; zero if
 /// degenerate).
 struct WorldTriangle {

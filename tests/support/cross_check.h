@@ -30,7 +30,7 @@ struct NamedAccel {
 };
 
 /// Every back end over `views` ("brute" keeps references: views must outlive the result).
-inline std::vector<NamedAccel> build_all(std::span<const TriangleMeshView> views,
+inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views,
                                          const AccelConfig& config = {}) {
   std::vector<NamedAccel> out;
   for (const auto& n : accelerator_names()) out.push_back({n, make_accelerator(n, views, config)});
@@ -60,8 +60,8 @@ inline std::string describe(const Hit& h) {
 
 /// True if the ray meets triangle (geom, prim) at distance t (tolerance eps in t), in
 /// double precision with a small barycentric tolerance: the test for a legitimate tie.
-inline bool meets_at(std::span<const TriangleMeshView> views, const Ray& r, uint32_t geom, uint32_t prim,
-                     float t, double eps) {
+inline bool meets_at(std::span<const GeometryView> views, const Ray& r, uint32_t geom, uint32_t prim, float t,
+                     double eps) {
   if (geom >= views.size() || size_t(prim) * 3 + 2 >= views[geom].indices.size()) return false;
   const auto& m = views[geom];
   const Vec3f a = m.positions[m.indices[prim * 3]], b = m.positions[m.indices[prim * 3 + 1]],
@@ -93,7 +93,7 @@ inline bool meets_at(std::span<const TriangleMeshView> views, const Ray& r, uint
 }
 
 /// The point of triangle (h.geom_id, h.prim_id) at barycentrics (h.u, h.v).
-inline Vec3f point_at(std::span<const TriangleMeshView> views, const Hit& h) {
+inline Vec3f point_at(std::span<const GeometryView> views, const Hit& h) {
   const auto& m = views[h.geom_id];
   const Vec3f a = m.positions[m.indices[h.prim_id * 3]], b = m.positions[m.indices[h.prim_id * 3 + 1]],
               c = m.positions[m.indices[h.prim_id * 3 + 2]];
@@ -101,7 +101,7 @@ inline Vec3f point_at(std::span<const TriangleMeshView> views, const Hit& h) {
 }
 
 /// Unit geometric normal of the hit triangle.
-inline Vec3f triangle_normal_of(std::span<const TriangleMeshView> views, const Hit& h) {
+inline Vec3f triangle_normal_of(std::span<const GeometryView> views, const Hit& h) {
   const auto& m = views[h.geom_id];
   return triangle_normal(m.positions[m.indices[h.prim_id * 3]], m.positions[m.indices[h.prim_id * 3 + 1]],
                          m.positions[m.indices[h.prim_id * 3 + 2]]);
@@ -109,7 +109,7 @@ inline Vec3f triangle_normal_of(std::span<const TriangleMeshView> views, const H
 
 /// Distance between the points at (ha.u, ha.v) and (hb.u, hb.v) on the same triangle,
 /// |(b - a) du + (c - a) dv| in double: independent of where the triangle sits.
-inline double point_distance(std::span<const TriangleMeshView> views, const Hit& ha, const Hit& hb) {
+inline double point_distance(std::span<const GeometryView> views, const Hit& ha, const Hit& hb) {
   const auto& m = views[ha.geom_id];
   const Vec3f a = m.positions[m.indices[ha.prim_id * 3]], b = m.positions[m.indices[ha.prim_id * 3 + 1]],
               c = m.positions[m.indices[ha.prim_id * 3 + 2]];
@@ -125,7 +125,7 @@ inline double point_distance(std::span<const TriangleMeshView> views, const Hit&
 /// How far a float triangle test's hit point can drift on triangle `h`: the longest edge L times
 /// float epsilon times the aspect L / h (h the smallest height). Negligible on well-shaped
 /// triangles; on a 70 m x 5 mm sliver it is centimetres, which Embree's barycentrics show.
-inline double barycentric_slack(std::span<const TriangleMeshView> views, const Hit& hit) {
+inline double barycentric_slack(std::span<const GeometryView> views, const Hit& hit) {
   const auto& m = views[hit.geom_id];
   const Vec3f a = m.positions[m.indices[hit.prim_id * 3]], b = m.positions[m.indices[hit.prim_id * 3 + 1]],
               c = m.positions[m.indices[hit.prim_id * 3 + 2]];
@@ -184,7 +184,7 @@ inline Reference reference(const Accelerator& ref, std::vector<Ray> rays) {
 /// two hit points p(u, v) on the triangle must agree to the t tolerance plus barycentric_slack()
 /// (except at the origin).
 inline CrossCheckResult cross_check(const Accelerator& a, const Reference& ref,
-                                    std::span<const TriangleMeshView> views, float scale, bool exact,
+                                    std::span<const GeometryView> views, float scale, bool exact,
                                     float uv_tol) {
   CrossCheckResult res;
   auto note = [&](const char* what, const Ray& r, const Hit& ha, const Hit& hb) {
@@ -308,7 +308,7 @@ struct SurfacePoint {
 
 /// Points where `rays` hit `ref`, computed from the barycentrics on the reference triangle.
 inline std::vector<SurfacePoint> surface_points(const Accelerator& ref, std::span<const Ray> rays,
-                                                std::span<const TriangleMeshView> views) {
+                                                std::span<const GeometryView> views) {
   std::vector<SurfacePoint> pts;
   for (const Ray& r : rays) {
     Hit h;
@@ -374,7 +374,7 @@ inline std::vector<Ray> bad_rays(const Bounds3f& b) {
 
 /// The whole ray collection for a scene: camera, random, bounce, on-surface and shadow rays.
 /// `scale` multiplies the counts (the [slow] variant uses more).
-inline std::vector<Ray> all_rays(const Accelerator& ref, std::span<const TriangleMeshView> views,
+inline std::vector<Ray> all_rays(const Accelerator& ref, std::span<const GeometryView> views,
                                  const Bounds3f& b, std::span<const Vec3f> lights, int scale, uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<Ray> rays = camera_rays(b, 16 * scale);
@@ -393,7 +393,7 @@ inline std::vector<Ray> all_rays(const Accelerator& ref, std::span<const Triangl
 
 // ---- Whole-scene checks (Catch assertions) --------------------------------------------------
 
-inline Bounds3f bounds_of(std::span<const TriangleMeshView> views) {
+inline Bounds3f bounds_of(std::span<const GeometryView> views) {
   Bounds3f b;
   for (const auto& m : views)
     for (Vec3f p : m.positions) b = merge(b, p);
@@ -405,7 +405,7 @@ inline Bounds3f bounds_of(std::span<const TriangleMeshView> views) {
 /// Back ends sharing the watertight test must match brute force exactly (u, v bit for bit).
 /// Brute force costs rays x triangles, so on big models it answers every k-th ray only
 /// (at most ~2e8 triangle tests); Embree answers all of them.
-inline void check_all(const std::string& scene, std::span<const TriangleMeshView> views,
+inline void check_all(const std::string& scene, std::span<const GeometryView> views,
                       const std::vector<Ray>& rays, const AccelConfig& config = {}) {
   const auto all = build_all(views, config);
   const Accelerator& brute = find(all, "brute");
@@ -435,7 +435,7 @@ inline void check_all(const std::string& scene, std::span<const TriangleMeshView
 }
 
 /// The standard ray collection (camera, random, bounces, on-surface, shadow, bad) for a scene.
-inline void check_scene(const std::string& scene, std::span<const TriangleMeshView> views,
+inline void check_scene(const std::string& scene, std::span<const GeometryView> views,
                         std::vector<Vec3f> lights, int scale = 1, std::vector<Ray> extra = {}) {
   const Bounds3f b = bounds_of(views);
   if (lights.empty()) lights = lights_around(b);
@@ -451,8 +451,8 @@ inline void check_scene(const std::string& scene, std::span<const TriangleMeshVi
 struct Soup {
   std::vector<std::vector<Vec3f>> positions;
   std::vector<std::vector<uint32_t>> indices;
-  std::vector<TriangleMeshView> views() const {
-    std::vector<TriangleMeshView> v;
+  std::vector<GeometryView> views() const {
+    std::vector<GeometryView> v;
     for (size_t i = 0; i < positions.size(); ++i) v.push_back({positions[i], indices[i]});
     return v;
   }
@@ -520,9 +520,9 @@ inline Soup icosphere(int level, float r, Vec3f c) {
 /// singular map get an empty view (they are never hit).
 struct Flattened {
   std::vector<std::vector<Vec3f>> positions;
-  std::vector<TriangleMeshView> views;
+  std::vector<GeometryView> views;
 };
-inline Flattened flatten(std::span<const TriangleMeshView> meshes, std::span<const InstanceView> instances) {
+inline Flattened flatten(std::span<const GeometryView> meshes, std::span<const InstanceView> instances) {
   Flattened f;
   f.positions.resize(instances.size());
   for (size_t i = 0; i < instances.size(); ++i) {
@@ -541,7 +541,7 @@ inline Flattened flatten(std::span<const TriangleMeshView> meshes, std::span<con
 /// copies (rounding apart: the ray is mapped into object space rather than the triangles into
 /// world space), and Penumbra's own back ends against the two-level brute force exactly (the same
 /// object-space rays meet the same watertight test).
-inline void check_instanced(const std::string& scene, std::span<const TriangleMeshView> meshes,
+inline void check_instanced(const std::string& scene, std::span<const GeometryView> meshes,
                             std::span<const InstanceView> instances, std::vector<Vec3f> lights,
                             uint32_t seed = 7) {
   const Flattened flat = flatten(meshes, instances);

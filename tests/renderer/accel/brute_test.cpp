@@ -17,7 +17,7 @@ struct TwoLayers {
   std::vector<Vec3f> far_pos{{-1, -1, -2}, {1, -1, -2}, {0, 1, -2}, {5, 5, -2}, {6, 5, -2}, {5, 6, -2}};
   std::vector<uint32_t> one{0, 1, 2};
   std::vector<uint32_t> two{3, 4, 5, 0, 1, 2};  // the hit triangle is prim 1
-  std::vector<TriangleMeshView> views{{near_pos, one}, {far_pos, two}};
+  std::vector<GeometryView> views{{near_pos, one}, {far_pos, two}};
 };
 }  // namespace
 

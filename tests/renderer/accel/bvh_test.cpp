@@ -17,7 +17,7 @@ using namespace penumbra::test;
 
 namespace {
 std::vector<Ray> scene_rays(const LoadedScene& l, const Accelerator& ref,
-                            std::span<const TriangleMeshView> views) {
+                            std::span<const GeometryView> views) {
   const Bounds3f b = compute_bounds(l.scene);
   return all_rays(ref, views, b, lights_around(b), 1, 99);
 }
@@ -90,8 +90,8 @@ TEST_CASE("bvh: axis-parallel rays through the faces and edges of 4-wide node bo
                                    {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3}};
         for (const auto& t : f) idx.insert(idx.end(), {base + t[0], base + t[1], base + t[2]});
       }
-  const TriangleMeshView view{pos, idx};
-  const std::span<const TriangleMeshView> views(&view, 1);
+  const GeometryView view{pos, idx};
+  const std::span<const GeometryView> views(&view, 1);
   std::vector<Ray> rays;
   for (int axis = 0; axis < 3; ++axis)
     for (float a = 0; a <= 8; a += 0.5f)
@@ -157,7 +157,7 @@ TEST_CASE("bvh: identical centroids and huge leaves fall back to median splits",
   std::vector<Vec3f> pos{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   std::vector<uint32_t> idx;
   for (int i = 0; i < 1000; ++i) idx.insert(idx.end(), {0, 1, 2});
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   const auto bvh = make_bvh_accelerator(std::span(&view, 1));
   CHECK(bvh->stats().max_leaf_prims <= 8);
   Hit h;

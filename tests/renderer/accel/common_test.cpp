@@ -74,17 +74,32 @@ TEST_CASE("slab test: NaN and infinite components never give NaN distances", "[a
   }
 }
 
-TEST_CASE("gather_triangles: mesh order, ids, and non-finite triangles dropped", "[accel][quick]") {
+TEST_CASE("gather_primitives: mesh order, ids, and non-finite triangles dropped", "[accel][quick]") {
   const std::vector<Vec3f> a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, std::nanf("")}};
   const std::vector<uint32_t> ai{0, 1, 2, 0, 1, 3};
   const std::vector<Vec3f> b{{0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
   const std::vector<uint32_t> bi{0, 1, 2, 2, 1, 0};
-  const std::vector<TriangleMeshView> views{{a, ai}, {b, bi}};
-  const std::vector<TriangleRecord> tris = gather_triangles(views);
-  REQUIRE(tris.size() == 3);
+  Shape sphere;
+  sphere.radius = 2;
+  const Shape unbounded = make_implicit_shape(SdfTree{{SdfNode{SdfKind::HalfSpace}}, {}, 0});
+  const std::vector<GeometryView> views{{a, ai}, {{}, {}, &unbounded}, {b, bi}, {{}, {}, &sphere}};
+  std::vector<Shape> shapes;
+  const std::vector<PrimitiveRecord> tris = gather_primitives(views, shapes);
+  REQUIRE(tris.size() == 4);
+  // The sphere is one record holding its bounds and its index in the shape table; the
+  // unbounded half-space is dropped.
+  REQUIRE(shapes.size() == 1);
+  CHECK(shapes[0].radius == 2);
+  CHECK(is_shape(tris[3]));
+  CHECK(tris[3].geom_id == 3);
+  CHECK((tris[3].prim_id & ~kShapeBit) == 0);
+  CHECK(primitive_bounds(tris[3]).lo.x == -2);
+  CHECK(primitive_bounds(tris[3]).hi.z == 2);
+  CHECK_FALSE(is_shape(tris[0]));
+  CHECK(count_input_shapes(views) == 2);
   CHECK((tris[0].geom_id == 0 && tris[0].prim_id == 0));
-  CHECK((tris[1].geom_id == 1 && tris[1].prim_id == 0));
-  CHECK((tris[2].geom_id == 1 && tris[2].prim_id == 1));
+  CHECK((tris[1].geom_id == 2 && tris[1].prim_id == 0));
+  CHECK((tris[2].geom_id == 2 && tris[2].prim_id == 1));
   CHECK(tris[2].a.y == 1);
   CHECK(count_input_triangles(views) == 4);
   CHECK(surface_area(Bounds3f{kLo, kHi}) == Approx(6));

@@ -20,7 +20,7 @@ struct Analytic {
   std::vector<uint32_t> quad_idx{0, 1, 2, 0, 2, 3};
   std::vector<Vec3f> tri{{-1, -1, -1}, {3, -1, -1}, {-1, 3, -1}};
   std::vector<uint32_t> tri_idx{0, 1, 2};
-  std::vector<TriangleMeshView> views{{quad, quad_idx}, {tri, tri_idx}};
+  std::vector<GeometryView> views{{quad, quad_idx}, {tri, tri_idx}};
 };
 
 std::vector<Ray> analytic_rays() {

@@ -10,7 +10,7 @@ using namespace penumbra;
 TEST_CASE("NaN, infinite and zero-direction rays miss in every back end", "[accel][quick]") {
   const std::vector<Vec3f> pos{{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
   const std::vector<uint32_t> idx{0, 1, 2};
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   for (const auto& name : accelerator_names()) {
     const auto accel = make_accelerator(name, std::span(&view, 1));
     const float nan = std::nanf("");
@@ -69,7 +69,7 @@ TEST_CASE("every back end reports its statistics", "[accel][quick]") {
       idx.insert(idx.end(), {uint32_t(pos.size()), uint32_t(pos.size() + 1), uint32_t(pos.size() + 2)});
       pos.insert(pos.end(), {{x0, y, 0}, {x0 + 1, y, 0}, {x0, y + 0.125f, 0}});
     }
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   for (const auto& name : accelerator_names()) {
     const auto accel = make_accelerator(name, std::span(&view, 1));
     const AccelStats s = accel->stats();

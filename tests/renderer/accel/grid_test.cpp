@@ -61,7 +61,7 @@ TEST_CASE("grid: about lambda cells per triangle, references only where triangle
       pos.insert(pos.end(), {o, o + Vec3f{0.1f, 0, 0}, o + Vec3f{0, 0.1f, 0}});
       idx.insert(idx.end(), {b, b + 1, b + 2});
     }
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   GridConfig c;
   c.lambda = 1;
   const AccelStats s = make_grid_accelerator(std::span(&view, 1), c)->stats();
@@ -94,7 +94,7 @@ TEST_CASE("grid: a flat scene gets one cell across its thickness", "[accel][grid
     pos.insert(pos.end(), {{float(i), 0, 0}, {float(i) + 1, 0, 0}, {float(i), 0, 1}});
     idx.insert(idx.end(), {b, b + 1, b + 2});
   }
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   const auto grid = make_grid_accelerator(std::span(&view, 1));
   CHECK_THAT(grid->stats().config, Catch::Contains("x1x"));
   Hit h;
@@ -129,7 +129,7 @@ TEST_CASE("grid: thousands of large overlapping triangles build quickly and stil
     pos.insert(pos.end(), {{-10, u(rng), -10}, {10, u(rng), -10}, {0, u(rng), 10}});
     idx.insert(idx.end(), {b, b + 1, b + 2});
   }
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   const auto grid = make_grid_accelerator(std::span(&view, 1));
   const AccelStats s = grid->stats();
   INFO(s.config << ", " << s.references << " references");

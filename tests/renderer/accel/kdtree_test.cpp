@@ -19,7 +19,7 @@ TEST_CASE("kdtree: splits off empty space and respects max_depth", "[accel][kdtr
   // Two small triangles far apart in a big box: the tree must cut the empty space between them.
   const std::vector<Vec3f> pos{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {100, 0, 0}, {101, 0, 0}, {100, 1, 0}};
   const std::vector<uint32_t> idx{0, 1, 2, 3, 4, 5};
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   const AccelStats s = make_kdtree_accelerator(std::span(&view, 1))->stats();
   CHECK(s.empty_leaves >= 1);
   CHECK(s.max_leaf_prims == 1);
@@ -45,7 +45,7 @@ TEST_CASE("kdtree: perfect splits keep a long diagonal triangle out of cells it 
       pos.insert(pos.end(), {o, o + Vec3f{0.2f, 0, 0}, o + Vec3f{0, 0.2f, 0}});
       idx.insert(idx.end(), {b, b + 1, b + 2});
     }
-  const TriangleMeshView view{pos, idx};
+  const GeometryView view{pos, idx};
   const auto kd = make_kdtree_accelerator(std::span(&view, 1));
   const AccelStats s = kd->stats();
   // Leaves overall: the sliver would be in nearly all of them without clipping.

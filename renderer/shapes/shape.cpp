@@ -1,0 +1,420 @@
+// Exact ray tests of the analytic primitives (in double, as roots of their equations), bounds of
+// CSG trees, and the per-kind dispatch every acceleration structure's leaves call.
+#include "renderer/shapes/shape.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace penumbra {
+
+namespace {
+
+struct DRay {
+  double ox, oy, oz, dx, dy, dz, tmin, tmax;
+};
+
+DRay to_double(const Ray& r) {
+  return {r.org.x,       r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, std::max(double(r.tnear), 0.0),
+          double(r.tfar)};
+}
+
+// Keeps the smaller of `best` and t when t lies in the ray's range.
+void consider(const DRay& r, double t, double& best) {
+  if (t >= r.tmin && t <= r.tmax && t < best) best = t;
+}
+
+// Both roots of a t^2 + 2 b t + c = 0 (a > 0), or false if none: the stable form that avoids
+// cancellation between -b and the square root (Press et al., Numerical Recipes, 5.6).
+bool solve_quadratic(double a, double b, double c, double& t0, double& t1) {
+  const double disc = b * b - a * c;
+  if (!(a > 0) || !(disc >= 0)) return false;
+  const double q = -(b + std::copysign(std::sqrt(disc), b));
+  t0 = q / a;
+  t1 = q != 0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  return true;
+}
+
+// Roots of the sphere |o + t d - centre|^2 = r^2, each kept if `keep(y at t)` holds.
+template <typename Keep>
+void sphere_roots(const DRay& r, double cy, double radius, double& best, Keep keep) {
+  const double oy = r.oy - cy;
+  const double a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
+  const double b = r.ox * r.dx + oy * r.dy + r.oz * r.dz;
+  const double c = r.ox * r.ox + oy * oy + r.oz * r.oz - radius * radius;
+  double t0, t1;
+  if (!solve_quadratic(a, b, c, t0, t1)) return;
+  if (keep(r.oy + t0 * r.dy)) consider(r, t0, best);
+  if (keep(r.oy + t1 * r.dy)) consider(r, t1, best);
+}
+
+double intersect_capsule(const DRay& r, double radius, double h) {
+  double best = kInfinity;
+  // The side: the infinite cylinder x^2 + z^2 = r^2, kept where |y| <= h.
+  const double a = r.dx * r.dx + r.dz * r.dz;
+  double t0, t1;
+  if (solve_quadratic(a, r.ox * r.dx + r.oz * r.dz, r.ox * r.ox + r.oz * r.oz - radius * radius, t0, t1)) {
+    if (std::abs(r.oy + t0 * r.dy) <= h) consider(r, t0, best);
+    if (std::abs(r.oy + t1 * r.dy) <= h) consider(r, t1, best);
+  }
+  // The caps: hemispheres beyond the segment's ends.
+  sphere_roots(r, h, radius, best, [&](double y) { return y >= h; });
+  sphere_roots(r, -h, radius, best, [&](double y) { return y <= -h; });
+  return best;
+}
+
+double intersect_box(const DRay& r, Vec3f half) {
+  const double o[3] = {r.ox, r.oy, r.oz}, d[3] = {r.dx, r.dy, r.dz}, hs[3] = {half.x, half.y, half.z};
+  double t_in = -kInfinity, t_out = kInfinity;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0) {
+      if (std::abs(o[k]) > hs[k]) return kInfinity;
+      continue;
+    }
+    double ta = (-hs[k] - o[k]) / d[k], tb = (hs[k] - o[k]) / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t_in = std::max(t_in, ta);
+    t_out = std::min(t_out, tb);
+  }
+  if (t_in > t_out) return kInfinity;
+  double best = kInfinity;
+  consider(r, t_in, best);
+  if (best == kInfinity) consider(r, t_out, best);
+  return best;
+}
+
+// Flat shapes at y = 0: the crossing of the plane, kept if `inside(x, z)` holds.
+template <typename Inside>
+double intersect_flat(const DRay& r, Inside inside) {
+  if (r.dy == 0) return kInfinity;
+  const double t = -r.oy / r.dy;
+  double best = kInfinity;
+  if (inside(r.ox + t * r.dx, r.oz + t * r.dz)) consider(r, t, best);
+  return best;
+}
+
+bool intersect_implicit(const Shape& s, const Ray& ray, ShapeHit& hit) {
+  // Clip the ray to the tree's bounds, then sphere trace the part inside them.
+  if (s.sdf_bounds.empty()) return false;
+  const Vec3f pad = s.sdf_bounds.extent() * 1e-4f + Vec3f{1e-6f, 1e-6f, 1e-6f};
+  const Vec3f lo = s.sdf_bounds.lo - pad, hi = s.sdf_bounds.hi + pad;
+  float t0 = std::max(ray.tnear, 0.0f), t1 = ray.tfar;
+  for (int k = 0; k < 3; ++k) {
+    const float o = ray.org[k], d = ray.dir[k];
+    if (d == 0) {
+      if (o < lo[k] || o > hi[k]) return false;
+      continue;
+    }
+    float ta = (lo[k] - o) / d, tb = (hi[k] - o) / d;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  Ray clipped = ray;
+  clipped.tnear = t0;
+  clipped.tfar = t1;
+  float t = 0;
+  int steps = 0;
+  const bool found = sphere_trace(s.sdf, s.lipschitz, clipped, s.trace, t, steps);
+  hit.evaluations = uint32_t(steps);
+  if (!found || t < std::max(ray.tnear, 0.0f) || t > ray.tfar) return false;
+  hit.t = t;
+  return true;
+}
+
+// A box and whether the set it bounds is unbounded (then the box is meaningless).
+struct TreeBox {
+  Bounds3f box;
+  bool unbounded = false;
+};
+
+TreeBox unbounded_box() {
+  return {Bounds3f{}, true};
+}
+
+TreeBox symmetric_box(float x, float y, float z) {
+  return {Bounds3f{{-x, -y, -z}, {x, y, z}}, false};
+}
+
+// The box of the convex polyhedron {p : n_i . p <= d_i + delta}: its vertices are the feasible
+// intersections of three planes. A cube of half size 1e7 is added to the planes, and a vertex on
+// that cube means the polyhedron is unbounded.
+TreeBox polyhedron_box(const std::vector<Vec4f>& planes, float delta) {
+  constexpr double kFar = 1e7;
+  std::vector<std::array<double, 4>> all;
+  for (const Vec4f& p : planes) all.push_back({p.x, p.y, p.z, double(p.w) + delta});
+  for (int k = 0; k < 3; ++k)
+    for (double s : {1.0, -1.0}) {
+      std::array<double, 4> q{0, 0, 0, kFar};
+      q[size_t(k)] = s;
+      all.push_back(q);
+    }
+  TreeBox out;
+  bool far = false;
+  const size_t n = all.size();
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j)
+      for (size_t k = j + 1; k < n; ++k) {
+        const auto &a = all[i], &b = all[j], &c = all[k];
+        // Cramer's rule on [a; b; c] x = (a3, b3, c3).
+        const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                           a[2] * (b[0] * c[1] - b[1] * c[0]);
+        if (std::abs(det) < 1e-12) continue;
+        const double x = (a[3] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[3] * c[2] - b[2] * c[3]) +
+                          a[2] * (b[3] * c[1] - b[1] * c[3])) /
+                         det;
+        const double y = (a[0] * (b[3] * c[2] - b[2] * c[3]) - a[3] * (b[0] * c[2] - b[2] * c[0]) +
+                          a[2] * (b[0] * c[3] - b[3] * c[0])) /
+                         det;
+        const double z = (a[0] * (b[1] * c[3] - b[3] * c[1]) - a[1] * (b[0] * c[3] - b[3] * c[0]) +
+                          a[3] * (b[0] * c[1] - b[1] * c[0])) /
+                         det;
+        bool feasible = true;
+        for (const auto& p : all)
+          if (p[0] * x + p[1] * y + p[2] * z > p[3] + 1e-6 * (1 + std::abs(p[3]))) feasible = false;
+        if (!feasible) continue;
+        if (std::max({std::abs(x), std::abs(y), std::abs(z)}) > 0.5 * kFar) far = true;
+        out.box = merge(out.box, Vec3f{float(x), float(y), float(z)});
+      }
+  out.unbounded = far;
+  return out;
+}
+
+TreeBox primitive_box(const SdfTree& tree, const SdfNode& n, float delta) {
+  const float d = delta;
+  switch (n.kind) {
+    case SdfKind::Sphere:
+      return symmetric_box(n.size.x + d, n.size.x + d, n.size.x + d);
+    case SdfKind::Box:
+    case SdfKind::RoundBox:
+      return symmetric_box(n.size.x + d, n.size.y + d, n.size.z + d);
+    case SdfKind::Capsule:
+      return symmetric_box(n.radius + d, n.size.y + n.radius + d, n.radius + d);
+    case SdfKind::Cylinder:
+    case SdfKind::Cone:
+      return symmetric_box(n.radius + d, n.size.y + d, n.radius + d);
+    case SdfKind::Torus:
+      return symmetric_box(n.size.x + n.radius + d, n.radius + d, n.size.x + n.radius + d);
+    case SdfKind::ConvexPolyhedron: {
+      const std::vector<Vec4f> planes(tree.planes.begin() + n.first_plane,
+                                      tree.planes.begin() + n.first_plane + n.plane_count);
+      return polyhedron_box(planes, d);
+    }
+    default:  // HalfSpace
+      return unbounded_box();
+  }
+}
+
+TreeBox overlap(const TreeBox& a, const TreeBox& b) {
+  if (a.unbounded) return b;
+  if (b.unbounded) return a;
+  return {Bounds3f{max(a.box.lo, b.box.lo), min(a.box.hi, b.box.hi)}, false};
+}
+
+// The box (in the parent's frame) of {p : f_node(p) <= delta}. Values pass through transforms
+// unchanged (f_node(p) = g(to_local p)), so delta does too; only the smooth union widens it,
+// since smin(a, b) >= min(a, b) - k / 4.
+TreeBox node_box(const SdfTree& tree, int index, float delta, int depth) {
+  if (index < 0 || size_t(index) >= tree.nodes.size() || depth > kMaxSdfDepth) return unbounded_box();
+  const SdfNode& n = tree.nodes[size_t(index)];
+  TreeBox local;
+  switch (n.kind) {
+    case SdfKind::Union:
+    case SdfKind::SmoothUnion: {
+      const float d = n.kind == SdfKind::Union ? delta : delta + 0.25f * n.radius;
+      const TreeBox a = node_box(tree, n.a, d, depth + 1), b = node_box(tree, n.b, d, depth + 1);
+      local = {merge(a.box, b.box), a.unbounded || b.unbounded};
+      break;
+    }
+    case SdfKind::Intersection:
+    case SdfKind::SmoothIntersection:
+      local = overlap(node_box(tree, n.a, delta, depth + 1), node_box(tree, n.b, delta, depth + 1));
+      break;
+    case SdfKind::Subtraction:
+    case SdfKind::SmoothSubtraction:
+      local = node_box(tree, n.a, delta, depth + 1);
+      break;
+    case SdfKind::Complement:
+      local = unbounded_box();
+      break;
+    default:
+      local = primitive_box(tree, n, delta);
+  }
+  if (local.unbounded || local.box.empty()) return local;
+  Affine3f to_parent;
+  if (!inverse(n.to_local, to_parent)) return unbounded_box();
+  return {transform_bounds(to_parent, local.box), false};
+}
+
+Vec2f sphere_uv(Vec3f p) {
+  const float r = length(p);
+  float phi = std::atan2(-p.z, p.x);
+  if (phi < 0) phi += 2 * kPi;
+  const float theta = std::acos(std::clamp(p.y / std::max(r, 1e-30f), -1.0f, 1.0f));
+  return {phi / (2 * kPi), theta / kPi};
+}
+
+}  // namespace
+
+const char* shape_kind_name(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::Sphere:
+      return "sphere";
+    case ShapeKind::Plane:
+      return "plane";
+    case ShapeKind::Disk:
+      return "disk";
+    case ShapeKind::Box:
+      return "box";
+    case ShapeKind::Capsule:
+      return "capsule";
+    case ShapeKind::Implicit:
+      return "implicit";
+  }
+  return "unknown";
+}
+
+Bounds3f sdf_tree_bounds(const SdfTree& tree) {
+  if (tree.root < 0) return {};
+  const TreeBox b = node_box(tree, tree.root, 0, 0);
+  return b.unbounded ? Bounds3f{} : b.box;
+}
+
+Shape make_implicit_shape(SdfTree tree, const SphereTraceConfig& trace) {
+  Shape s;
+  s.kind = ShapeKind::Implicit;
+  s.lipschitz = sdf_lipschitz(tree);
+  s.sdf_bounds = sdf_tree_bounds(tree);
+  s.sdf = std::move(tree);
+  s.trace = trace;
+  return s;
+}
+
+Bounds3f shape_bounds(const Shape& s) {
+  switch (s.kind) {
+    case ShapeKind::Sphere:
+      return {{-s.radius, -s.radius, -s.radius}, {s.radius, s.radius, s.radius}};
+    case ShapeKind::Plane:
+      return {{-s.half_size.x, 0, -s.half_size.z}, {s.half_size.x, 0, s.half_size.z}};
+    case ShapeKind::Disk:
+      return {{-s.radius, 0, -s.radius}, {s.radius, 0, s.radius}};
+    case ShapeKind::Box:
+      return {-s.half_size, s.half_size};
+    case ShapeKind::Capsule: {
+      const float y = s.half_height + s.radius;
+      return {{-s.radius, -y, -s.radius}, {s.radius, y, s.radius}};
+    }
+    case ShapeKind::Implicit:
+      return s.sdf_bounds;
+  }
+  return {};
+}
+
+bool intersect_shape(const Shape& s, const Ray& ray, ShapeHit& hit) {
+  hit = ShapeHit{};
+  if (s.kind == ShapeKind::Implicit) return intersect_implicit(s, ray, hit);
+  const DRay r = to_double(ray);
+  if (!(r.tmin <= r.tmax)) return false;
+  double t = kInfinity;
+  switch (s.kind) {
+    case ShapeKind::Sphere:
+      sphere_roots(r, 0, s.radius, t, [](double) { return true; });
+      break;
+    case ShapeKind::Plane: {
+      const double hx = s.half_size.x, hz = s.half_size.z;
+      t = intersect_flat(r, [&](double x, double z) { return std::abs(x) <= hx && std::abs(z) <= hz; });
+      break;
+    }
+    case ShapeKind::Disk: {
+      const double r2 = double(s.radius) * s.radius;
+      t = intersect_flat(r, [&](double x, double z) { return x * x + z * z <= r2; });
+      break;
+    }
+    case ShapeKind::Box:
+      t = intersect_box(r, s.half_size);
+      break;
+    case ShapeKind::Capsule:
+      t = intersect_capsule(r, s.radius, s.half_height);
+      break;
+    case ShapeKind::Implicit:
+      break;
+  }
+  if (!(t < kInfinity)) return false;
+  const float tf = float(t);
+  if (!(tf >= std::max(ray.tnear, 0.0f) && tf <= ray.tfar)) return false;  // rounding at the ends
+  hit.t = tf;
+  return true;
+}
+
+ShapeSurface shape_surface(const Shape& s, Vec3f p, float h) {
+  ShapeSurface out;
+  switch (s.kind) {
+    case ShapeKind::Sphere:
+      out.n = normalize(p);
+      out.uv = sphere_uv(p);
+      out.has_uv = true;
+      break;
+    case ShapeKind::Plane:
+      out.n = {0, 1, 0};
+      out.uv = {0.5f + 0.5f * p.x / s.half_size.x, 0.5f + 0.5f * p.z / s.half_size.z};
+      out.has_uv = true;
+      break;
+    case ShapeKind::Disk:
+      out.n = {0, 1, 0};
+      out.uv = {0.5f + 0.5f * p.x / s.radius, 0.5f + 0.5f * p.z / s.radius};
+      out.has_uv = true;
+      break;
+    case ShapeKind::Box: {
+      // The face whose plane the point is nearest, relative to the half extents.
+      const Vec3f q{std::abs(p.x) / s.half_size.x, std::abs(p.y) / s.half_size.y,
+                    std::abs(p.z) / s.half_size.z};
+      const int k = q.x >= q.y && q.x >= q.z ? 0 : (q.y >= q.z ? 1 : 2);
+      Vec3f n{0, 0, 0};
+      n[k] = p[k] < 0 ? -1.0f : 1.0f;
+      out.n = n;
+      const int a = (k + 1) % 3, b = (k + 2) % 3;
+      out.uv = {0.5f + 0.5f * p[a] / s.half_size[a], 0.5f + 0.5f * p[b] / s.half_size[b]};
+      out.has_uv = true;
+      break;
+    }
+    case ShapeKind::Capsule: {
+      const Vec3f axis{0, std::clamp(p.y, -s.half_height, s.half_height), 0};
+      out.n = normalize(p - axis);
+      float phi = std::atan2(-p.z, p.x);
+      if (phi < 0) phi += 2 * kPi;
+      const float total = 2 * (s.half_height + s.radius);
+      out.uv = {phi / (2 * kPi), 0.5f - p.y / total};
+      out.has_uv = true;
+      break;
+    }
+    case ShapeKind::Implicit:
+      out.n = sdf_normal(s.sdf, p, h);
+      if (!is_finite(out.n) || dot(out.n, out.n) == 0) out.n = {0, 1, 0};
+      break;
+  }
+  return out;
+}
+
+Vec3f snap_to_shape(const Shape& s, Vec3f p) {
+  switch (s.kind) {
+    case ShapeKind::Sphere: {
+      const float r = length(p);
+      return r > 0 ? p * (s.radius / r) : p;
+    }
+    case ShapeKind::Plane:
+    case ShapeKind::Disk:
+      return {p.x, 0, p.z};
+    default:
+      return p;
+  }
+}
+
+float shape_hit_tolerance(const Shape& s, float t, float dir_length) {
+  if (s.kind != ShapeKind::Implicit) return 0;
+  const float eps = std::max(s.trace.absolute_epsilon, s.trace.relative_epsilon * t * dir_length);
+  return eps;
+}
+
+}  // namespace penumbra
