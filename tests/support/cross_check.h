@@ -58,10 +58,23 @@ inline std::string describe(const Hit& h) {
   return buf;
 }
 
-/// True if the ray meets triangle (geom, prim) at distance t (tolerance eps in t), in
-/// double precision with a small barycentric tolerance: the test for a legitimate tie.
+/// True if the ray meets the shape at distance t within eps: its hit from just before t lands
+/// within eps of t.
+inline bool shape_meets_at(const Shape& shape, const Ray& r, float t, double eps) {
+  Ray q = r;
+  q.tnear = std::max(r.tnear, float(t - eps));
+  q.tfar = std::min(r.tfar, float(t + eps));
+  ShapeHit sh;
+  return intersect_shape(shape, q, sh);
+}
+
+/// True if the ray meets triangle (geom, prim) (or the shape of view geom) at distance t
+/// (tolerance eps in t), in double precision with a small barycentric tolerance: the test for a
+/// legitimate tie.
 inline bool meets_at(std::span<const GeometryView> views, const Ray& r, uint32_t geom, uint32_t prim, float t,
                      double eps) {
+  if (geom < views.size() && views[geom].shape)
+    return prim == 0 && shape_meets_at(*views[geom].shape, r, t, eps);
   if (geom >= views.size() || size_t(prim) * 3 + 2 >= views[geom].indices.size()) return false;
   const auto& m = views[geom];
   const Vec3f a = m.positions[m.indices[prim * 3]], b = m.positions[m.indices[prim * 3 + 1]],
@@ -92,7 +105,7 @@ inline bool meets_at(std::span<const GeometryView> views, const Ray& r, uint32_t
   return v >= -tol && w >= -tol && v + w <= 1 + tol;
 }
 
-/// The point of triangle (h.geom_id, h.prim_id) at barycentrics (h.u, h.v).
+/// The point of triangle (h.geom_id, h.prim_id) at barycentrics (h.u, h.v) (views of triangles only).
 inline Vec3f point_at(std::span<const GeometryView> views, const Hit& h) {
   const auto& m = views[h.geom_id];
   const Vec3f a = m.positions[m.indices[h.prim_id * 3]], b = m.positions[m.indices[h.prim_id * 3 + 1]],
@@ -100,9 +113,10 @@ inline Vec3f point_at(std::span<const GeometryView> views, const Hit& h) {
   return a * (1 - h.u - h.v) + b * h.u + c * h.v;
 }
 
-/// Unit geometric normal of the hit triangle.
-inline Vec3f triangle_normal_of(std::span<const GeometryView> views, const Hit& h) {
+/// Unit geometric normal of the hit triangle, or of the hit shape at the hit point.
+inline Vec3f triangle_normal_of(std::span<const GeometryView> views, const Ray& r, const Hit& h) {
   const auto& m = views[h.geom_id];
+  if (m.shape) return normalize(shape_surface(*m.shape, r.org + r.dir * h.t, 1e-4f).n);
   return triangle_normal(m.positions[m.indices[h.prim_id * 3]], m.positions[m.indices[h.prim_id * 3 + 1]],
                          m.positions[m.indices[h.prim_id * 3 + 2]]);
 }
@@ -111,6 +125,7 @@ inline Vec3f triangle_normal_of(std::span<const GeometryView> views, const Hit& 
 /// |(b - a) du + (c - a) dv| in double: independent of where the triangle sits.
 inline double point_distance(std::span<const GeometryView> views, const Hit& ha, const Hit& hb) {
   const auto& m = views[ha.geom_id];
+  if (m.shape) return 0;  // shapes report u = v = 0
   const Vec3f a = m.positions[m.indices[ha.prim_id * 3]], b = m.positions[m.indices[ha.prim_id * 3 + 1]],
               c = m.positions[m.indices[ha.prim_id * 3 + 2]];
   const double du = double(ha.u) - hb.u, dv = double(ha.v) - hb.v;
@@ -127,6 +142,7 @@ inline double point_distance(std::span<const GeometryView> views, const Hit& ha,
 /// triangles; on a 70 m x 5 mm sliver it is centimetres, which Embree's barycentrics show.
 inline double barycentric_slack(std::span<const GeometryView> views, const Hit& hit) {
   const auto& m = views[hit.geom_id];
+  if (m.shape) return 0;
   const Vec3f a = m.positions[m.indices[hit.prim_id * 3]], b = m.positions[m.indices[hit.prim_id * 3 + 1]],
               c = m.positions[m.indices[hit.prim_id * 3 + 2]];
   const double L = std::max({length(b - a), length(c - b), length(a - c)});
@@ -230,7 +246,7 @@ inline CrossCheckResult cross_check(const Accelerator& a, const Reference& ref,
     if (!a_hit) continue;
     // t along a ray meeting a surface at a grazing angle is ill-conditioned: a rounding-sized
     // shift of the hit point moves t by that shift / |cos theta|. Scale the tolerance by it.
-    const float cos_theta = std::fabs(dot(normalize(r.dir), triangle_normal_of(views, hb)));
+    const float cos_theta = std::fabs(dot(normalize(r.dir), triangle_normal_of(views, r, hb)));
     const float grazing = 1.0f / std::max(cos_theta, 1e-3f);
     if (!(std::fabs(ha.t - hb.t) <= tol(ha.t, hb.t) * grazing)) {
       const float tn = std::max(r.tnear, 0.0f), t = std::min(ha.t, hb.t);
@@ -306,7 +322,8 @@ struct SurfacePoint {
   Vec3f p, ng;  ///< point and geometric normal facing the ray that found it
 };
 
-/// Points where `rays` hit `ref`, computed from the barycentrics on the reference triangle.
+/// Points where `rays` hit `ref`, computed from the barycentrics on the reference triangle (on a
+/// shape: along the ray, with the shape's normal there).
 inline std::vector<SurfacePoint> surface_points(const Accelerator& ref, std::span<const Ray> rays,
                                                 std::span<const GeometryView> views) {
   std::vector<SurfacePoint> pts;
@@ -314,6 +331,15 @@ inline std::vector<SurfacePoint> surface_points(const Accelerator& ref, std::spa
     Hit h;
     if (!ref.intersect(r, h)) continue;
     const auto& m = views[h.geom_id];
+    if (m.shape) {
+      const Vec3f p = snap_to_shape(*m.shape, r.org + r.dir * h.t);
+      Vec3f ng = normalize(shape_surface(*m.shape, p, 1e-4f).n);
+      if (dot(ng, r.dir) > 0) ng = -ng;
+      // Implicit hits lie within the tracer's tolerance of the surface: step off it by more.
+      const float off = 4 * shape_hit_tolerance(*m.shape, h.t, length(r.dir));
+      pts.push_back({p - normalize(r.dir) * off, ng});
+      continue;
+    }
     Vec3f ng =
         triangle_normal(m.positions[m.indices[h.prim_id * 3]], m.positions[m.indices[h.prim_id * 3 + 1]],
                         m.positions[m.indices[h.prim_id * 3 + 2]]);
@@ -395,8 +421,10 @@ inline std::vector<Ray> all_rays(const Accelerator& ref, std::span<const Geometr
 
 inline Bounds3f bounds_of(std::span<const GeometryView> views) {
   Bounds3f b;
-  for (const auto& m : views)
+  for (const auto& m : views) {
+    if (m.shape && !shape_bounds(*m.shape).empty()) b = merge(b, shape_bounds(*m.shape));
     for (Vec3f p : m.positions) b = merge(b, p);
+  }
   if (b.empty()) b = {{-1, -1, -1}, {1, 1, 1}};
   return b;
 }
@@ -431,6 +459,7 @@ inline void check_all(const std::string& scene, std::span<const GeometryView> vi
     INFO(summary(scene + ": " + a.name + " vs embree", re));
     CHECK(re.failures() == 0);
     CHECK(a.accel->stats().triangles == brute.stats().triangles);
+    CHECK(a.accel->stats().shapes == brute.stats().shapes);
   }
 }
 

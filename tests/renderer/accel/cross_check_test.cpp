@@ -14,6 +14,7 @@
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
+#include "renderer/shapes/shape.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -181,6 +182,171 @@ TEST_CASE("cross-check: rays from inside a closed sphere always hit (watertightn
     CHECK(double(misses) <= 2e-5 * double(n));
     CHECK(double(occl_misses) <= 2e-5 * double(n));
   }
+}
+
+// ---- Shapes among triangles -----------------------------------------------------------------------
+
+namespace {
+
+Affine3f translated(Affine3f a, Vec3f t) {
+  a.m[0][3] += t.x, a.m[1][3] += t.y, a.m[2][3] += t.z;
+  return a;
+}
+
+SdfNode sdf_prim(SdfKind kind, Vec3f size, float radius = 0) {
+  SdfNode n;
+  n.kind = kind;
+  n.size = size;
+  n.radius = radius;
+  return n;
+}
+
+SdfNode sdf_op(SdfKind kind, int a, int b, float radius = 0) {
+  SdfNode n;
+  n.kind = kind;
+  n.a = a;
+  n.b = b;
+  n.radius = radius;
+  return n;
+}
+
+/// The classic CSG part: a sphere intersected with a cube, minus three orthogonal cylinders,
+/// centred at `centre` (to_local holds the inverse placement).
+Shape csg_part(Vec3f centre) {
+  SdfTree t;
+  t.nodes = {sdf_prim(SdfKind::Sphere, {0.65f, 0, 0}), sdf_prim(SdfKind::Box, {0.5f, 0.5f, 0.5f}),
+             sdf_op(SdfKind::Intersection, 0, 1)};
+  Affine3f rot_x, rot_z;  // the Y-axis cylinder turned onto X and Z
+  rot_x.m[0][0] = 0, rot_x.m[0][1] = 1, rot_x.m[1][0] = -1, rot_x.m[1][1] = 0;
+  rot_z.m[1][1] = 0, rot_z.m[1][2] = 1, rot_z.m[2][1] = -1, rot_z.m[2][2] = 0;
+  int body = 2;
+  for (const Affine3f& r : {Affine3f{}, rot_x, rot_z}) {
+    SdfNode cyl = sdf_prim(SdfKind::Cylinder, {0, 0.7f, 0}, 0.3f);
+    cyl.to_local = r;
+    t.nodes.push_back(cyl);
+    t.nodes.push_back(sdf_op(SdfKind::Subtraction, body, int(t.nodes.size()) - 1));
+    body = int(t.nodes.size()) - 1;
+  }
+  t.nodes[size_t(body)].to_local = translated(Affine3f{}, -centre);
+  t.root = body;
+  return make_implicit_shape(std::move(t));
+}
+
+/// A torus and a sphere blended by a smooth union, centred at `centre`.
+Shape blob(Vec3f centre) {
+  SdfTree t;
+  t.nodes = {sdf_prim(SdfKind::Torus, {0.6f, 0, 0}, 0.15f), sdf_prim(SdfKind::Sphere, {0.35f, 0, 0}),
+             sdf_op(SdfKind::SmoothUnion, 0, 1, 0.3f)};
+  t.nodes[1].to_local = translated(Affine3f{}, {0, -0.3f, 0});
+  t.nodes[2].to_local = translated(Affine3f{}, -centre);
+  t.root = 2;
+  return make_implicit_shape(std::move(t));
+}
+
+Shape analytic_shape(ShapeKind kind, float radius, Vec3f half = {1, 1, 1}, float half_height = 0.5f) {
+  Shape s;
+  s.kind = kind;
+  s.radius = radius;
+  s.half_size = half;
+  s.half_height = half_height;
+  return s;
+}
+
+/// Every back end over `instances` of `views` (meshes and shapes) against brute force over the
+/// same instances: Penumbra's own back ends exactly (the same object-space rays meet the same
+/// tests), Embree (which maps rays into object space itself) within a relative 1e-4 in t.
+void check_shape_instances(const std::string& scene, std::span<const GeometryView> views,
+                           std::span<const InstanceView> instances) {
+  const auto brute = make_accelerator("brute", views, instances);
+  const Bounds3f b = brute->bounds();
+  REQUIRE_FALSE(b.empty());
+  std::mt19937 rng(17);
+  std::vector<Ray> rays = camera_rays(b, 48);
+  const std::vector<Ray> rnd = random_rays(b, 6000, rng);
+  rays.insert(rays.end(), rnd.begin(), rnd.end());
+  const std::vector<Ray> bad = bad_rays(b);
+  rays.insert(rays.end(), bad.begin(), bad.end());
+  std::vector<Hit> ref(rays.size());
+  size_t hits = 0;
+  for (size_t i = 0; i < rays.size(); ++i) hits += brute->intersect(rays[i], ref[i]);
+  CHECK(hits >= rays.size() / 20);  // not a scene of misses
+  const float scale = length(b.extent());
+  for (const auto& name : accelerator_names()) {
+    const auto a = make_accelerator(name, views, instances);
+    const bool exact = name != "embree";
+    size_t mismatches = 0;
+    std::string first;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      Hit h;
+      const bool hit = a->intersect(rays[i], h);
+      bool same = hit == ref[i].valid() && a->occluded(rays[i]) == hit;
+      if (same && hit)
+        same = h.geom_id == ref[i].geom_id && h.prim_id == ref[i].prim_id &&
+               (exact ? h.t == ref[i].t && h.u == ref[i].u && h.v == ref[i].v
+                      : std::fabs(h.t - ref[i].t) <= 1e-4f * std::max({h.t, ref[i].t, 0.1f * scale}));
+      if (same) continue;
+      ++mismatches;
+      if (first.empty()) first = describe(rays[i]) + " -> " + describe(h) + " vs brute " + describe(ref[i]);
+    }
+    INFO(scene << ": " << name << " vs brute over " << rays.size() << " rays, " << mismatches
+               << " mismatches\n  first: " << first);
+    CHECK(mismatches == 0);
+    CHECK(a->stats().shapes == brute->stats().shapes);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("cross-check: triangles, analytic primitives and implicit shapes in one scene",
+          "[accel][crosscheck][shapes]") {
+  // Overlapping analytic shapes at the origin (closest hit among interpenetrating surfaces), CSG
+  // and smooth-union shapes beside them, an icosphere and a floor of triangles.
+  Soup s = icosphere(2, 0.8f, {0, 0, 3});
+  s.add_plane(1, -1.5f, -5.0f, 5.0f, 6);
+  const std::vector<Shape> shapes{analytic_shape(ShapeKind::Sphere, 0.5f),
+                                  analytic_shape(ShapeKind::Box, 1, {1, 0.3f, 0.7f}),
+                                  analytic_shape(ShapeKind::Capsule, 0.25f, {}, 1.2f),
+                                  analytic_shape(ShapeKind::Disk, 1.5f),
+                                  analytic_shape(ShapeKind::Plane, 1, {2.5f, 0, 0.4f}),
+                                  csg_part({3, 0, 0}),
+                                  blob({-3, 0, 0})};
+  std::vector<GeometryView> views = s.views();
+  for (const Shape& sh : shapes) views.push_back({{}, {}, &sh});
+  std::vector<Ray> extra;
+  // Straight at each shape's centre line and along the flat shapes' planes.
+  for (float x : {-3.0f, -0.6f, 0.0f, 0.6f, 3.0f})
+    for (float y : {-0.3f, 0.0f, 0.3f}) {
+      extra.push_back({{x, y, -6}, 0, {0, 0, 1}, kInfinity});
+      extra.push_back({{x, 6, y}, 0, {0, -1, 0}, kInfinity});
+    }
+  extra.push_back({{-6, 0, 0}, 0, {1, 0, 0}, kInfinity});  // in the disk's and plane's plane
+  check_scene("mixed", views, {}, 1, extra);
+}
+
+TEST_CASE("cross-check: instances of analytic and implicit shapes", "[accel][crosscheck][shapes]") {
+  const Soup s = icosphere(2, 0.5f, {0, 0, 0});
+  const std::vector<Shape> shapes{analytic_shape(ShapeKind::Sphere, 0.5f),
+                                  analytic_shape(ShapeKind::Box, 1, {0.4f, 0.3f, 0.2f}),
+                                  analytic_shape(ShapeKind::Capsule, 0.2f, {}, 0.3f),
+                                  analytic_shape(ShapeKind::Disk, 0.6f),
+                                  csg_part({0, 0, 0}),
+                                  blob({0, 0, 0})};
+  std::vector<GeometryView> views = s.views();
+  for (const Shape& sh : shapes) views.push_back({{}, {}, &sh});
+  // Each geometry placed twice: translated, and rotated, scaled non-uniformly or mirrored.
+  std::vector<InstanceView> instances;
+  for (uint32_t g = 0; g < views.size(); ++g) {
+    const float x = -3.5f + 1.2f * float(g);
+    instances.push_back({g, translated(Affine3f{}, {x, 0, 0})});
+    Affine3f m;
+    const float c = std::cos(0.7f + 0.3f * float(g)), sn = std::sin(0.7f + 0.3f * float(g));
+    m.m[0][0] = 1.3f * c, m.m[0][2] = sn;
+    m.m[1][1] = g % 2 ? 0.6f : -0.8f;  // odd: squashed; even: mirrored
+    m.m[2][0] = -1.3f * sn, m.m[2][2] = c;
+    instances.push_back({g, translated(m, {x, 1.5f, 0.5f})});
+  }
+  instances.push_back({uint32_t(views.size() - 1), Affine3f{}});  // one identity placement too
+  check_shape_instances("shape instances", views, instances);
 }
 
 // ---- Real scenes ----------------------------------------------------------------------------------
