@@ -136,6 +136,7 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
     if (buffers.cost.counted) {
       exr.extra.push_back({"cost.nodes", &buffers.cost.nodes});
       exr.extra.push_back({"cost.triangles", &buffers.cost.triangles});
+      exr.extra.push_back({"cost.shapes", &buffers.cost.shapes});
     }
     exr.extra.push_back({"cost.ns", &buffers.cost.nanoseconds});
   }

@@ -322,7 +322,7 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
       "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
       "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
-      "(cost.nodes, cost.triangles, cost.ns) and a heat map");
+      "(cost.nodes, cost.triangles, cost.shapes, cost.ns) and a heat map");
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }

@@ -9,10 +9,11 @@ namespace penumbra {
 
 CostImage render_cost(const Accelerator& accel, const Camera& camera, const RenderConfig& config,
                       IntegratorType integrator) {
-  CostImage img{config.width, config.height, {}, {}};
+  CostImage img{config.width, config.height, {}, {}, {}};
   const size_t n = size_t(config.width) * size_t(config.height);
   img.nodes.assign(n, 0.0f);
   img.triangles.assign(n, 0.0f);
+  img.shapes.assign(n, 0.0f);
   img.nanoseconds.assign(n, 0.0f);
   img.counted = accel.counts_traversal();
   const uint32_t spp = uint32_t(config.spp);
@@ -34,6 +35,7 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
         img.nanoseconds[i] = float(seconds * 1e9 / spp);
         img.nodes[i] = float(double(cost.nodes) / spp);
         img.triangles[i] = float(double(cost.triangles) / spp);
+        img.shapes[i] = float(double(cost.shapes + cost.evaluations) / spp);
       }
   });
   return img;
@@ -42,13 +44,13 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
 std::vector<float> total_cost(const CostImage& cost) {
   if (!cost.counted) return cost.nanoseconds;
   std::vector<float> total(cost.nodes.size());
-  for (size_t i = 0; i < total.size(); ++i) total[i] = cost.nodes[i] + cost.triangles[i];
+  for (size_t i = 0; i < total.size(); ++i) total[i] = cost.nodes[i] + cost.triangles[i] + cost.shapes[i];
   return total;
 }
 
 std::string cost_caption(const CostImage& cost, const std::string& accel_name) {
-  return accel_name +
-         (cost.counted ? ": nodes + triangles per camera ray" : ": nanoseconds per camera ray (wall clock)");
+  return accel_name + (cost.counted ? ": nodes + triangles + shape work per camera ray"
+                                    : ": nanoseconds per camera ray (wall clock)");
 }
 
 }  // namespace penumbra

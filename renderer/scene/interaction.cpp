@@ -50,7 +50,13 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
   Vec3f n = world_normal(inst, surf.n);
   if (!(dot(n, n) > 0) || !is_finite(n)) n = normalize(-ray.dir);
   si.uv[0] = si.uv[1] = surf.uv;
-  si.spawn_offset = 4 * world_tol;
+  // Spawned rays start beyond the tracer's tolerance, and beyond the rounding of mapping the
+  // point through the instance and back (a few float ulps of the point and the shape's size):
+  // a ray leaving a sphere at a grazing angle from just inside would meet its far side at once.
+  const Bounds3f b = shape_bounds(ss.shape);
+  const float obj_len = length(obj.dir), scale = obj_len > 0 ? length(ray.dir) / obj_len : 1.0f;
+  const float size = b.empty() ? 0.0f : max_component(b.extent()) * scale;
+  si.spawn_offset = std::max(4 * world_tol, 64 * 0x1p-23f * (max_component(abs(si.p)) + size));
   si.back_face = dot(n, ray.dir) > 0;
   if (si.back_face) n = -n;
   si.ng = si.ns = n;

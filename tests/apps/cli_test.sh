@@ -85,7 +85,7 @@ for accel in embree bvh kdtree grid; do
   expect 0 "cost-$accel.cost.png" -- "$bin" render "$src/scenes/default.gltf" -o "$work/cost-$accel.exr" --width 64 --spp 1 -q --aov cost --accel "$accel"
 done
 if command -v oiiotool >/dev/null; then
-  expect 0 "cost.nodes \(float\), cost.ns \(float\), cost.triangles \(float\)" -- oiiotool --info -v "$work/cost-bvh.exr"
+  expect 0 "cost.nodes \(float\), cost.ns \(float\), cost.shapes \(float\), cost.triangles \(float\)" -- oiiotool --info -v "$work/cost-bvh.exr"
   expect 0 "A \(half\), cost.ns \(float\)" -- oiiotool --info -v "$work/cost-embree.exr"
   expect 0 "64 x +[0-9]+, 3 channel, uint8 png" -- oiiotool --info "$work/cost-grid.cost.png"
 fi

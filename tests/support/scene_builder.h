@@ -117,6 +117,42 @@ inline int add_sphere(Scene& s, Vec3f c, float r, int level, int material) {
   return add_world_mesh(s, std::move(m));
 }
 
+/// Appends `shape` with `material`, placed by `to_world`; returns the instance index.
+inline int add_shape(Scene& s, Shape shape, const Affine3f& to_world, int material, int node = -1) {
+  SceneShape ss;
+  ss.name = "shape";
+  ss.shape = std::move(shape);
+  ss.material = material;
+  ss.node = node;
+  s.shapes.push_back(std::move(ss));
+  s.instances.push_back(make_shape_instance(int(s.shapes.size()) - 1, to_world, node));
+  return int(s.instances.size()) - 1;
+}
+
+/// An analytic sphere of radius r, or (implicit = true) the sphere traced SDF sphere.
+inline Shape sphere_shape(float r, bool implicit = false) {
+  if (implicit) {
+    SdfTree t;
+    SdfNode n;
+    n.kind = SdfKind::Sphere;
+    n.size = {r, 0, 0};
+    t.nodes.push_back(n);
+    t.root = 0;
+    return make_implicit_shape(std::move(t));
+  }
+  Shape sh;
+  sh.kind = ShapeKind::Sphere;
+  sh.radius = r;
+  return sh;
+}
+
+/// The translation by t.
+inline Affine3f translation(Vec3f t) {
+  Affine3f a;
+  a.m[0][3] = t.x, a.m[1][3] = t.y, a.m[2][3] = t.z;
+  return a;
+}
+
 /// A small render configuration for tests: w x h pixels, spp samples, 8-pixel tiles.
 inline RenderConfig small_render_config(int w, int h, int spp, int tile_size = 8) {
   RenderConfig c;

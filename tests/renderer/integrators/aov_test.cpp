@@ -60,6 +60,38 @@ TEST_CASE("aov: ids, depth, normal, position and albedo are exact on a known sce
   }
 }
 
+TEST_CASE("aov: depth, normal, position and ids on analytic and implicit spheres", "[aov][shapes]") {
+  // Orthographic view down -z from z = 5 onto a unit sphere at the origin: at (x, y) the depth is
+  // 5 - sqrt(1 - x^2 - y^2), the normal and the position (x, y, sqrt(1 - x^2 - y^2)).
+  for (bool implicit : {false, true}) {
+    Scene s;
+    const int mat = add_material(s, {0.8f, 0.1f, 0.1f}, 0, 1);
+    add_shape(s, sphere_shape(1, implicit), Affine3f{}, mat, /*node=*/3);
+    Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 1);
+    cam.projection = Projection::Orthographic;
+    cam.ymag = 1.6f;
+    const auto accel = make_scene_accelerator("bvh", s);
+    const DataAovs a = render_data_aovs(s, *accel, cam, config(32, 32, 4), IntegratorType::Whitted);
+    INFO((implicit ? "implicit" : "analytic"));
+    for (int y : {10, 13, 16, 20}) {
+      for (int x : {10, 14, 16, 20}) {
+        const size_t i = size_t(y * 32 + x);
+        const float px = -1.6f + 3.2f * (float(x) + 0.5f) / 32, py = 1.6f - 3.2f * (float(y) + 0.5f) / 32;
+        const float z = std::sqrt(1 - px * px - py * py);
+        // Within the pixel's footprint (0.1 wide) and the filter's spread.
+        CHECK(a.depth[i] == Approx(5 - z).margin(0.08));
+        CHECK(a.normal[i * 3 + 2] == Approx(z).margin(0.06));
+        CHECK(a.position[i * 3] == Approx(px).margin(0.06));
+        CHECK(a.object_id[i] == 4);
+        CHECK(a.material_id[i] == 1);
+        CHECK(a.albedo[i * 3] == Approx(0.8f));
+      }
+    }
+    CHECK(std::isinf(a.depth[0]));  // the corner is outside the sphere
+    CHECK(a.object_id[0] == 0);
+  }
+}
+
 TEST_CASE("aov: depth is camera-space distance along the view axis, not along the ray", "[aov][quick]") {
   Scene s;
   add_quad_z(s, -50, 50, -50, 50, -3, add_material(s, {1, 1, 1}, 0, 1));

@@ -41,6 +41,29 @@ TEST_CASE("cost map: brute force tests every triangle on every camera ray and vi
   }
 }
 
+TEST_CASE("cost map: shapes count one test each, implicit ones their SDF evaluations too", "[cost][quick]") {
+  Scene s = two_quads();
+  add_shape(s, sphere_shape(0.3f), Affine3f{}, -1);
+  add_shape(s, sphere_shape(0.5f, true), Affine3f{}, -1);
+  const auto views = mesh_views(s);  // world space: the shapes' placements are the identity
+  const auto brute = make_accelerator("brute", views);
+  RenderConfig cfg;
+  cfg.width = 12;
+  cfg.height = 8;
+  cfg.spp = 4;
+  const Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8f);
+  const CostImage c = render_cost(*brute, cam, cfg);
+  const std::vector<float> total = total_cost(c);
+  bool evaluated = false;
+  for (size_t i = 0; i < c.shapes.size(); ++i) {
+    CHECK(c.triangles[i] == 4);
+    CHECK(c.shapes[i] >= 2);  // both shapes tested on every ray, plus the tracer's evaluations
+    CHECK(total[i] == c.nodes[i] + c.triangles[i] + c.shapes[i]);
+    evaluated |= c.shapes[i] > 2;
+  }
+  CHECK(evaluated);  // some camera rays cross the implicit sphere's box
+}
+
 TEST_CASE("cost map: matches intersect_counted per ray, the same for 1 and 2 threads", "[cost]") {
   const Scene s = two_quads();
   const auto views = mesh_views(s);
@@ -115,7 +138,7 @@ TEST_CASE("cost map: Embree gets a time map; counted back ends get counts and ti
   CHECK(total_cost(e) == e.nanoseconds);
   const CostImage b = render_cost(*make_accelerator("bvh", views), cam, cfg);
   CHECK(b.counted);
-  CHECK(cost_caption(b, "bvh") == "bvh: nodes + triangles per camera ray");
+  CHECK(cost_caption(b, "bvh") == "bvh: nodes + triangles + shape work per camera ray");
   const auto t = total_cost(b);
   for (size_t i = 0; i < t.size(); ++i) CHECK(t[i] == b.nodes[i] + b.triangles[i]);
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "renderer/accel/factory.h"
+#include "renderer/core/geometry.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/scene_builder.h"
 
@@ -124,4 +125,79 @@ TEST_CASE("escaping rays see the background with zero coverage", "[whitted][quic
   const Vec3f L = shade(s, cfg, {{0, 0, 0}, 0, {0, 0, -1}, kInfinity}, coverage, counts);
   CHECK(L == cfg.background);
   CHECK(coverage == 0);
+}
+
+TEST_CASE("analytic and implicit spheres shade with the closed-form Lambert term in every back end",
+          "[whitted][shapes]") {
+  // A unit sphere centred at (0, 0, -3) seen from the origin: the hit is (0, 0, -2) with n = +z,
+  // lit by a point light at the eye, d = 2, n.l = n.h = 1 (roughness 1: Blinn-Phong exponent 0).
+  const Vec3f base{0.8f, 0.6f, 0.4f};
+  for (bool implicit : {false, true}) {
+    Scene s;
+    const int mat = add_material(s, base, 0.0f, 1.0f);
+    add_shape(s, sphere_shape(1, implicit), translation({0, 0, -3}), mat);
+    s.lights.push_back(point_light({0, 0, 0}, 4.0f));
+    WhittedConfig cfg;
+    cfg.ambient = {0.05f, 0.05f, 0.05f};
+    for (const auto& name : accelerator_names()) {
+      INFO((implicit ? "implicit" : "analytic") << " sphere, " << name);
+      const auto accel = make_scene_accelerator(name, s);
+      float coverage = 0;
+      RayCounts counts;
+      const Vec3f L = whitted_radiance(s, *accel, cfg, {{0, 0, 0}, 0, {0, 0, -1}, kInfinity},
+                                       RayDifferential{}, coverage, counts);
+      const WhittedParams w = whitted_params(s.materials[size_t(mat)]);
+      const double norm = (w.exponent + 8) / (8 * M_PI);  // Blinn-Phong normalisation, n.h = 1
+      for (int c = 0; c < 3; ++c) {
+        const double expected = w.ka[c] * 0.05 + 1.0 * (w.kd[c] / M_PI + w.ks[c] * norm);
+        CHECK(L[c] == Approx(expected).epsilon(implicit ? 1e-3 : 1e-5));
+      }
+      CHECK(coverage == 1);
+      // Off-centre: n.l = cos of the angle at the hit (light at the eye: l = v), from the quadratic.
+      const Vec3f d = normalize(Vec3f{0.2f, 0.1f, -3});
+      const Vec3f L2 =
+          whitted_radiance(s, *accel, cfg, {{0, 0, 0}, 0, d, kInfinity}, RayDifferential{}, coverage, counts);
+      float t = 0;
+      REQUIRE(intersect_sphere({{0, 0, 0}, 0, d, kInfinity}, {0, 0, -3}, 1, t));
+      const Vec3f p = d * t, n = normalize(p - Vec3f{0, 0, -3});
+      const double ndotl = dot(n, -d), E = 4.0 / double(t * t);
+      const double spec = w.ks.x * norm * std::pow(ndotl, w.exponent) * ndotl;  // h = l = v: n.h = n.l
+      CHECK(L2.x ==
+            Approx(w.ka.x * 0.05 + E * (w.kd.x / M_PI * ndotl + spec)).epsilon(implicit ? 2e-3 : 1e-4));
+    }
+  }
+}
+
+TEST_CASE("a shape casts shadows and shows in a mirror, with no self-shadowing", "[whitted][shapes][quick]") {
+  Scene s;
+  const Vec3f base{0.5f, 0.5f, 0.5f};
+  const int mat = add_material(s, base, 0.0f, 1.0f);
+  add_quad_z(s, -10, 10, -10, 10, 0, mat);
+  add_shape(s, sphere_shape(0.25f, true), translation({0, 0, 0.75f}), mat);  // over the origin
+  s.lights.push_back(point_light({0, 0, 3}, 5.0f));
+  WhittedConfig cfg;
+  cfg.ambient = {0.1f, 0.1f, 0.1f};
+  const auto accel = make_scene_accelerator("bvh", s);
+  float coverage = 0;
+  RayCounts counts;
+  // The floor point under the sphere is in its shadow: ambient only.
+  const Vec3f under =
+      whitted_radiance(s, *accel, cfg, {{-2, 0, 0.1f}, 0, normalize(Vec3f{2, 0, -0.1f}), kInfinity},
+                       RayDifferential{}, coverage, counts);
+  CHECK(under.x == Approx(0.5 * 0.1));
+  // The sphere's top faces the light: lit, not shadowed by itself.
+  const Vec3f top = whitted_radiance(s, *accel, cfg, {{0, 0, 2}, 0, {0, 0, -1}, kInfinity}, RayDifferential{},
+                                     coverage, counts);
+  CHECK(top.x > 0.5 * 0.1 + 0.1);
+  // A mirror sphere reflects the unlit wall behind the camera.
+  Scene m;
+  const int mirror = add_material(m, {0.9f, 0.9f, 0.9f}, 1.0f, 0.0f);
+  const int wall = add_material(m, {0.2f, 0.4f, 0.6f}, 0, 1, /*unlit=*/true);
+  add_shape(m, sphere_shape(1), translation({0, 0, -3}), mirror);
+  add_quad_z(m, -10, 10, -10, 10, 1, wall);
+  cfg.ambient = {0, 0, 0};
+  const auto maccel = make_scene_accelerator("kdtree", m);
+  const Vec3f refl = whitted_radiance(m, *maccel, cfg, {{0, 0, 0}, 0, {0, 0, -1}, kInfinity},
+                                      RayDifferential{}, coverage, counts);
+  CHECK(refl.z == Approx(0.9 * 0.6));
 }
