@@ -97,6 +97,118 @@ float eval(const SdfTree& tree, int index, Vec3f p_parent, int depth) {
   }
 }
 
+// The analytic gradient of a primitive's distance in its local frame (the cone, whose closest
+// feature is awkward to track, by central differences of its closed form).
+Vec3f primitive_gradient(const SdfTree& tree, const SdfNode& n, Vec3f p) {
+  const auto sgn = [](float x) { return x < 0 ? -1.0f : 1.0f; };
+  switch (n.kind) {
+    case SdfKind::Sphere:
+      return p;
+    case SdfKind::Box:
+    case SdfKind::RoundBox: {
+      const Vec3f h = n.kind == SdfKind::Box ? n.size : n.size - Vec3f{n.radius, n.radius, n.radius};
+      const Vec3f q = abs(p) - h;
+      const Vec3f outside = max(q, Vec3f{});
+      if (dot(outside, outside) > 0)
+        return {sgn(p.x) * outside.x, sgn(p.y) * outside.y, sgn(p.z) * outside.z};
+      const int k = q.x >= q.y && q.x >= q.z ? 0 : (q.y >= q.z ? 1 : 2);
+      return {k == 0 ? sgn(p.x) : 0.0f, k == 1 ? sgn(p.y) : 0.0f, k == 2 ? sgn(p.z) : 0.0f};
+    }
+    case SdfKind::Capsule:
+      return {p.x, p.y - std::clamp(p.y, -n.size.y, n.size.y), p.z};
+    case SdfKind::Cylinder: {
+      const float r = length2(p.x, p.z);
+      const Vec3f radial = r > 0 ? Vec3f{p.x / r, 0, p.z / r} : Vec3f{1, 0, 0};
+      const float dx = r - n.radius, dy = std::abs(p.y) - n.size.y;
+      const Vec3f axial{0, sgn(p.y), 0};
+      if (dx > 0 && dy > 0) return radial * dx + axial * dy;
+      return dx > dy ? radial : axial;
+    }
+    case SdfKind::Torus: {
+      const float r = length2(p.x, p.z);
+      const Vec3f radial = r > 0 ? Vec3f{p.x / r, 0, p.z / r} : Vec3f{1, 0, 0};
+      return radial * (r - n.size.x) + Vec3f{0, p.y, 0};
+    }
+    case SdfKind::HalfSpace:
+      return n.normal;
+    case SdfKind::ConvexPolyhedron: {
+      float best = -kInfinity;
+      Vec3f g{0, 1, 0};
+      for (int i = n.first_plane; i < n.first_plane + n.plane_count; ++i) {
+        const Vec4f& pl = tree.planes[size_t(i)];
+        const float d = pl.x * p.x + pl.y * p.y + pl.z * p.z - pl.w;
+        if (d > best) best = d, g = {pl.x, pl.y, pl.z};
+      }
+      return g;
+    }
+    default: {  // Cone
+      const float h = 1e-4f * std::max({n.size.y, n.radius, 1e-6f});
+      const Vec3f dx{h, 0, 0}, dy{0, h, 0}, dz{0, 0, h};
+      return {primitive(tree, n, p + dx) - primitive(tree, n, p - dx),
+              primitive(tree, n, p + dy) - primitive(tree, n, p - dy),
+              primitive(tree, n, p + dz) - primitive(tree, n, p - dz)};
+    }
+  }
+}
+
+// Weight h of the first operand in smooth_min(a, b, k): its gradient is h ga + (1 - h) gb.
+float smooth_weight(float a, float b, float k) {
+  return std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
+}
+
+// The value and the (unnormalised) gradient of node `index` at p_parent, in the parent's frame:
+// grad f(x) = L^T grad g(L x + t) for the node's to_local = (L, t).
+float eval_gradient(const SdfTree& tree, int index, Vec3f p_parent, Vec3f& grad, int depth) {
+  const SdfNode& n = tree.nodes[size_t(index)];
+  const Vec3f p = apply_point(n.to_local, p_parent);
+  float value = 0;
+  Vec3f g{0, 0, 0};
+  if (!is_operator(n.kind)) {
+    value = primitive(tree, n, p);
+    g = normalize(primitive_gradient(tree, n, p));
+  } else if (depth >= kMaxSdfDepth) {
+    grad = {0, 0, 0};
+    return kInfinity;
+  } else {
+    Vec3f ga, gb;
+    const float a = eval_gradient(tree, n.a, p, ga, depth + 1);
+    if (n.kind == SdfKind::Complement) {
+      value = -a, g = -ga;
+    } else {
+      const float b = eval_gradient(tree, n.b, p, gb, depth + 1);
+      switch (n.kind) {
+        case SdfKind::Union:
+          value = std::min(a, b), g = a <= b ? ga : gb;
+          break;
+        case SdfKind::Intersection:
+          value = std::max(a, b), g = a >= b ? ga : gb;
+          break;
+        case SdfKind::Subtraction:
+          value = std::max(a, -b), g = a >= -b ? ga : -gb;
+          break;
+        case SdfKind::SmoothUnion: {
+          const float h = smooth_weight(a, b, n.radius);
+          value = smooth_min(a, b, n.radius), g = ga * h + gb * (1 - h);
+          break;
+        }
+        case SdfKind::SmoothIntersection: {
+          const float h = smooth_weight(-a, -b, n.radius);
+          value = -smooth_min(-a, -b, n.radius), g = ga * h + gb * (1 - h);
+          break;
+        }
+        default: {  // SmoothSubtraction
+          const float h = smooth_weight(-a, b, n.radius);
+          value = -smooth_min(-a, b, n.radius), g = ga * h - gb * (1 - h);
+        }
+      }
+    }
+  }
+  const auto& m = n.to_local.m;  // L^T g
+  grad = {m[0][0] * g.x + m[1][0] * g.y + m[2][0] * g.z, m[0][1] * g.x + m[1][1] * g.y + m[2][1] * g.z,
+          m[0][2] * g.x + m[1][2] * g.y + m[2][2] * g.z};
+  return value;
+}
+
 float lipschitz(const SdfTree& tree, int index, int depth) {
   const SdfNode& n = tree.nodes[size_t(index)];
   float l = 1;
@@ -123,6 +235,13 @@ float sdf_eval(const SdfTree& tree, Vec3f p) {
 
 float sdf_lipschitz(const SdfTree& tree) {
   return tree.root < 0 ? 1.0f : lipschitz(tree, tree.root, 0);
+}
+
+Vec3f sdf_gradient_normal(const SdfTree& tree, Vec3f p) {
+  if (tree.root < 0) return {0, 0, 0};
+  Vec3f g;
+  eval_gradient(tree, tree.root, p, g, 0);
+  return is_finite(g) ? normalize(g) : Vec3f{0, 0, 0};
 }
 
 Vec3f sdf_normal(const SdfTree& tree, Vec3f p, float h) {
@@ -174,26 +293,33 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
   if (!(dir_len > 0) || !(lipschitz_bound > 0) || tree.root < 0) return false;
   const float step_scale = 1.0f / (lipschitz_bound * dir_len);  // |f| * step_scale never passes the surface
   float t = ray.tnear, prev_t = t, prev_f = 0;
+  // Bisection of a bracketed crossing [lo, hi] (f(lo) has the sign of flo) to float precision.
+  const auto bisect = [&](float lo, float hi, float flo) {
+    for (int i = 0; i < 40 && hi - lo > 1e-7f * std::max(1.0f, hi); ++i) {
+      const float mid = 0.5f * (lo + hi);
+      const float fm = sdf_eval(tree, ray.org + ray.dir * mid);
+      ++steps;
+      if ((fm < 0) == (flo < 0))
+        lo = mid, flo = fm;
+      else
+        hi = mid;
+    }
+    return hi;
+  };
   while (steps < config.max_steps && t <= ray.tfar) {
     const float f = sdf_eval(tree, ray.org + ray.dir * t);
     ++steps;
     const float eps = std::max(config.absolute_epsilon, config.relative_epsilon * t * dir_len);
-    if (steps > 1 && (f < 0) != (prev_f < 0)) {
-      // The minimum step crossed the surface: bisect between the last two samples.
-      float lo = prev_t, hi = t, flo = prev_f;
-      for (int i = 0; i < 40 && hi - lo > 1e-7f * std::max(1.0f, hi); ++i) {
-        const float mid = 0.5f * (lo + hi);
-        const float fm = sdf_eval(tree, ray.org + ray.dir * mid);
-        if ((fm < 0) == (flo < 0))
-          lo = mid, flo = fm;
-        else
-          hi = mid;
-      }
-      t_hit = hi;
+    if (steps > 1 && (f < 0) != (prev_f < 0)) {  // the minimum step crossed the surface
+      t_hit = bisect(prev_t, t, prev_f);
       return t_hit <= ray.tfar;
     }
     if (std::abs(f) / lipschitz_bound < eps) {
-      t_hit = t;
+      // Within the tolerance: refine to the crossing if it lies within two tolerances ahead.
+      const float probe = std::min(t + 2 * eps / dir_len, ray.tfar);
+      const float fp = sdf_eval(tree, ray.org + ray.dir * probe);
+      ++steps;
+      t_hit = (fp < 0) != (f < 0) ? bisect(t, probe, f) : t;
       return true;
     }
     prev_t = t;

@@ -70,6 +70,12 @@ float sdf_eval(const SdfTree& tree, int node, Vec3f p);
 /// combination of the children's), times the largest singular value of each node's to_local.
 float sdf_lipschitz(const SdfTree& tree);
 
+/// Unit outward normal at `p` from the analytic gradient: each primitive's closed-form gradient
+/// (the cone's by central differences), chained through the node transforms (L^T g), the active
+/// operand of min / max operators and the blend weights of smooth ones. Zero where the gradient
+/// vanishes or is not finite (a sphere's centre).
+Vec3f sdf_gradient_normal(const SdfTree& tree, Vec3f p);
+
 /// Unit outward normal at `p` from central differences of step `h`.
 Vec3f sdf_normal(const SdfTree& tree, Vec3f p, float h);
 
@@ -83,8 +89,11 @@ struct SphereTraceConfig {
 };
 
 /// Marches `ray` (any non-zero direction) from ray.tnear to ray.tfar with steps |f| / (L |dir|),
-/// starting inside or outside; on a hit sets t to the surface crossing (refined by bisection
-/// once the sign changes) and returns true. `steps` receives the number of evaluations.
+/// starting inside or outside. It stops when a step crosses the surface (f changes sign) or
+/// when |f| / L falls below the tolerance (then it looks two tolerances ahead for the crossing);
+/// a found crossing is refined by bisection to float precision (t is then just past the
+/// surface). Sets t and returns true on a hit; a ray still marching after config.max_steps
+/// evaluations is a miss. `steps` receives the number of evaluations, bisection included.
 bool sphere_trace(const SdfTree& tree, float lipschitz, const Ray& ray, const SphereTraceConfig& config,
                   float& t, int& steps);
 

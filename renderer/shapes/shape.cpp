@@ -390,7 +390,8 @@ ShapeSurface shape_surface(const Shape& s, Vec3f p, float h) {
       break;
     }
     case ShapeKind::Implicit:
-      out.n = sdf_normal(s.sdf, p, h);
+      out.n = sdf_gradient_normal(s.sdf, p);
+      if (!is_finite(out.n) || dot(out.n, out.n) == 0) out.n = sdf_normal(s.sdf, p, h);
       if (!is_finite(out.n) || dot(out.n, out.n) == 0) out.n = {0, 1, 0};
       break;
   }

@@ -78,7 +78,8 @@ struct ShapeSurface {
 };
 
 /// The shape's surface data at `p` (a point returned by intersect_shape). Implicit shapes take
-/// the normal from central differences of step `h` (> 0, in object units).
+/// the normal from the tree's analytic gradient, or where that vanishes from central
+/// differences of step `h` (> 0, in object units).
 ShapeSurface shape_surface(const Shape& shape, Vec3f p, float h);
 
 /// Moves a point found by intersect_shape onto the surface where that is exact (sphere:

@@ -161,6 +161,57 @@ TEST_CASE("sdf: the Lipschitz bound holds for every operator and transform", "[s
   CHECK(max_singular_value(rot_scale) == Approx(2));
 }
 
+TEST_CASE(
+    "sdf: the analytic gradient matches central differences for every primitive, operator and transform",
+    "[shapes][sdf][quick]") {
+  std::mt19937 rng(5);
+  Affine3f shear;
+  shear.m[0][0] = 0.5f, shear.m[1][1] = 1.5f, shear.m[2][2] = 1, shear.m[0][1] = 0.3f, shear.m[2][0] = -0.2f;
+  SdfNode half;
+  half.kind = SdfKind::HalfSpace;
+  half.normal = normalize(Vec3f{0.3f, 1, -0.2f});
+  SdfTree base;
+  base.planes = {{1, 0, 0, 0.6f},  {-1, 0, 0, 0.6f}, {0, 1, 0, 0.5f},
+                 {0, -1, 0, 0.5f}, {0, 0, 1, 0.4f},  {0, 0, -1, 0.4f}};
+  SdfNode poly;
+  poly.kind = SdfKind::ConvexPolyhedron;
+  poly.plane_count = 6;
+  const std::vector<SdfNode> primitives{prim(SdfKind::Sphere, {0.7f, 0, 0}),
+                                        prim(SdfKind::Box, {0.6f, 0.4f, 0.5f}),
+                                        prim(SdfKind::RoundBox, {0.6f, 0.4f, 0.5f}, 0.15f),
+                                        prim(SdfKind::Capsule, {0, 0.4f, 0}, 0.3f),
+                                        prim(SdfKind::Cylinder, {0, 0.5f, 0}, 0.4f),
+                                        prim(SdfKind::Cone, {0, 0.5f, 0}, 0.5f),
+                                        prim(SdfKind::Torus, {0.6f, 0, 0}, 0.2f),
+                                        half,
+                                        poly};
+  int checked = 0;
+  for (const SdfNode& p0 : primitives)
+    for (SdfKind k : {SdfKind::Union, SdfKind::Intersection, SdfKind::Subtraction, SdfKind::Complement,
+                      SdfKind::SmoothUnion, SdfKind::SmoothIntersection, SdfKind::SmoothSubtraction}) {
+      SdfTree t = base;
+      SdfNode a = p0;
+      a.to_local = shear;
+      const int ia = add(t, a);
+      SdfNode b = prim(SdfKind::Sphere, {0.45f, 0, 0});
+      b.to_local = translate({0.3f, 0.2f, 0});
+      const int ib = add(t, b);
+      t.root = add(t, op(k, ia, ib, 0.25f));
+      for (int i = 0; i < 400; ++i) {
+        const Vec3f x = random_point(rng, 1.2f);
+        // Compare only where f is smooth: central differences at two step sizes agree.
+        const Vec3f n1 = sdf_normal(t, x, 1e-3f), n2 = sdf_normal(t, x, 2e-3f);
+        if (!(dot(n1, n2) > 0.99999f)) continue;
+        const Vec3f g = sdf_gradient_normal(t, x);
+        INFO("primitive " << int(p0.kind) << " operator " << int(k) << " at (" << x.x << ", " << x.y << ", "
+                          << x.z << ")");
+        REQUIRE(dot(g, n1) > 0.999f);
+        ++checked;
+      }
+    }
+  CHECK(checked > 10000);
+}
+
 TEST_CASE("sdf: sphere tracing hits where the analytic tests hit", "[shapes][sdf][quick]") {
   SdfTree t;
   SdfNode sphere = prim(SdfKind::Sphere, {1.5f, 0, 0});
