@@ -35,6 +35,7 @@
 #include "renderer/integrators/cost_map.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
+#include "renderer/scene/interaction.h"
 #include "renderer/scene/scene.h"
 
 using namespace penumbra;
@@ -71,29 +72,20 @@ Camera bench_camera(const Scene& scene, int w, int h) {
 
 /// The four ray kinds of the benchmark (primary, shadow, diffuse, random), generated once per scene from a
 /// fixed seed. Primary rays come from the scene's first camera (or one framing the bounds) on a w x h grid;
-/// shadow and diffuse rays start at the primary hits (found with Embree), offset along the geometric normal.
-std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
-                                  std::span<const GeometryView> views, int w, int h,
+/// shadow and diffuse rays start at the primary hits (found with Embree, on triangles or shapes), offset
+/// off the surface as the integrators offset them.
+std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree, int w, int h,
                                   const std::vector<std::string>& kinds) {
   const Bounds3f b = compute_bounds(scene);
   const Camera cam = bench_camera(scene, w, h);
   std::vector<Ray> primary;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) primary.push_back(generate_camera_ray(cam, w, h, x + 0.5f, y + 0.5f));
-  struct Surface {
-    Vec3f p, n;
-  };
-  std::vector<Surface> surf;
+  std::vector<SurfaceInteraction> surf;  // triangles and shapes alike
   for (const Ray& r : primary) {
     Hit hit;
     if (!embree.intersect(r, hit)) continue;
-    const auto& m = views[hit.geom_id];
-    const Vec3f a = m.positions[m.indices[hit.prim_id * 3]], bb = m.positions[m.indices[hit.prim_id * 3 + 1]],
-                c = m.positions[m.indices[hit.prim_id * 3 + 2]];
-    Vec3f n = triangle_normal(a, bb, c);
-    if (dot(n, n) == 0) continue;
-    if (dot(n, r.dir) > 0) n = -n;
-    surf.push_back({a * (1 - hit.u - hit.v) + bb * hit.u + c * hit.v, n});
+    surf.push_back(make_interaction(scene, r, hit));
   }
   std::vector<Vec3f> lights;
   for (const auto& l : scene.lights)
@@ -115,13 +107,13 @@ std::vector<RaySet> make_ray_sets(const Scene& scene, const Accelerator& embree,
         const float dist = length(d);
         if (!(dist > 0)) continue;
         const Vec3f dir = d / dist;
-        s.rays.push_back({offset_ray_origin(surf[i].p, surf[i].n, dir), 0, dir, dist * (1 - 1e-4f)});
+        s.rays.push_back({spawn_origin(surf[i], dir), 0, dir, dist * (1 - 1e-4f)});
       }
     } else if (kind == "diffuse") {
       for (const auto& p : surf) {
-        Vec3f dir = normalize(p.n + random_direction(rng));
-        if (!(dot(dir, p.n) > 0)) dir = p.n;
-        s.rays.push_back({offset_ray_origin(p.p, p.n, dir), 0, dir, kInfinity});
+        Vec3f dir = normalize(p.ng + random_direction(rng));
+        if (!(dot(dir, p.ng) > 0)) dir = p.ng;
+        s.rays.push_back({spawn_origin(p, dir), 0, dir, kInfinity});
       }
     } else if (kind == "random") {
       std::uniform_real_distribution<float> u(0, 1);
@@ -159,6 +151,16 @@ double trace_seconds(const Accelerator& a, const RaySet& set, int threads, uint6
   hits = 0;
   for (uint8_t v : result) hits += v;
   return s;
+}
+
+/// SDF evaluations (sphere-tracing steps) per ray of `set`, from intersect_counted.
+double evaluations_per_ray(const Accelerator& a, const RaySet& set) {
+  TraversalCost cost;
+  for (const Ray& r : set.rays) {
+    Hit h;
+    a.intersect_counted(r, h, cost);
+  }
+  return set.rays.empty() ? 0.0 : double(cost.evaluations) / double(set.rays.size());
 }
 
 struct Agreement {
@@ -208,7 +210,9 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
         throw std::invalid_argument(spec + ": triangle count '" + count + "' is not a number");
     }
     Scene scene = bench::generate_scene(rest.substr(0, colon), seed, n);
-    name = rest.substr(0, colon) + "-" + std::to_string(count_triangles(scene) / 1000) + "k";
+    name = rest.substr(0, colon) + "-" +
+           (scene.shapes.empty() ? std::to_string(count_triangles(scene) / 1000) + "k"
+                                 : std::to_string(count_shape_instances(scene)) + "shapes");
     return scene;
   }
   name = std::filesystem::path(spec).filename().string();
@@ -222,7 +226,8 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
 
 struct Row {
   std::string scene, accel, kind, config;
-  uint64_t triangles = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
+  uint64_t triangles = 0, shapes = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
+  double evals = -1;  // SDF evaluations per ray (sphere-tracing steps); -1: not counted (Embree)
   double build_s = 0, sah = 0;
   std::vector<std::pair<int, double>> mrays;  // threads -> Mrays/s
   std::vector<double> vs_embree;              // per thread count
@@ -442,8 +447,8 @@ int main(int argc, char** argv) {
     if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end())
       std::rotate(accels.begin(), it, it + 1);
     // The table, one row as soon as it is measured (long runs show progress).
-    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s", "scene", "accel", "rays", "build ms", "MiB",
-                "B/tri", "SAH", "count", "wrong", "ties");
+    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s %9s", "scene", "accel", "rays", "build ms",
+                "MiB", "B/tri", "SAH", "count", "wrong", "ties", "evals/ray");
     for (int t : threads)
       std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
     std::printf("\n");
@@ -453,6 +458,10 @@ int main(int argc, char** argv) {
                   r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
                   static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches),
                   static_cast<unsigned long long>(r.ties));
+      if (r.evals >= 0)
+        std::printf(" %9.2f", r.evals);
+      else
+        std::printf(" %9s", "-");
       for (size_t i = 0; i < r.mrays.size(); ++i)
         std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second,
                     i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
@@ -465,10 +474,11 @@ int main(int argc, char** argv) {
       std::string name;
       const Scene scene = load_bench_scene(file, seed, name);
       const auto views = mesh_views(scene);
-      const auto embree = make_accelerator("embree", views);
-      const auto exact = make_accelerator("brute", views);  // settles disagreements with Embree
+      const auto instances = instance_views(scene);  // identity placements unless shapes are placed
+      const auto embree = make_accelerator("embree", views, instances);
+      const auto exact = make_accelerator("brute", views, instances);  // settles disagreements with Embree
       embree_reference = embree->stats().config;
-      const auto sets = make_ray_sets(scene, *embree, views, width, height, kinds);
+      const auto sets = make_ray_sets(scene, *embree, width, height, kinds);
       const float scale = length(compute_bounds(scene).extent());
       std::vector<Row> embree_rows;
       for (const auto& accel_name : accels) {
@@ -478,7 +488,7 @@ int main(int argc, char** argv) {
         for (int i = 0; i < builds; ++i) {
           accel.reset();
           const auto t0 = Clock::now();
-          accel = make_accelerator(accel_name, views, config);
+          accel = make_accelerator(accel_name, views, instances, config);
           times.push_back(seconds_since(t0));
         }
         const AccelStats st = accel->stats();
@@ -494,8 +504,9 @@ int main(int argc, char** argv) {
                         name + " " + cost_caption(cost, accel_name));
         }
         for (const auto& set : sets) {
-          Row row{name, accel_name, set.kind, st.config, st.triangles, set.rays.size()};
+          Row row{name, accel_name, set.kind, st.config, st.triangles, st.shapes, set.rays.size()};
           row.bytes = st.bytes;
+          if (accel->counts_traversal() && st.shapes > 0) row.evals = evaluations_per_ray(*accel, set);
           row.build_s = median(times);
           row.sah = st.sah_cost;
           const Agreement g = check_against_embree(*accel, *embree, *exact, set, scale);
@@ -528,14 +539,16 @@ int main(int argc, char** argv) {
     if (!csv.empty())
       write_atomically(csv, [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp);
-        f << "scene,accel,rays,triangles,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties";
+        f << "scene,accel,rays,triangles,shapes,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties,evals_"
+             "per_ray";
         for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
           f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
         f << "\n";
         for (const auto& r : rows) {
-          f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.build_s << ','
-            << r.bytes << ',' << r.sah << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ','
-            << r.ties;
+          f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.shapes << ','
+            << r.build_s << ',' << r.bytes << ',' << r.sah << ',' << r.rays << ',' << r.hits << ','
+            << r.mismatches << ',' << r.ties << ',';
+          if (r.evals >= 0) f << r.evals;
           for (size_t i = 0; i < r.mrays.size(); ++i)
             f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
           f << "\n";
@@ -552,9 +565,11 @@ int main(int argc, char** argv) {
           const auto& r = rows[i];
           f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel
             << "\", \"config\": \"" << json_escape(r.config) << "\", \"rays\": \"" << r.kind
-            << "\", \"triangles\": " << r.triangles << ", \"build_s\": " << r.build_s
-            << ", \"bytes\": " << r.bytes << ", \"sah_cost\": " << r.sah << ", \"ray_count\": " << r.rays
-            << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties << ", \"mrays\": {";
+            << "\", \"triangles\": " << r.triangles << ", \"shapes\": " << r.shapes
+            << ", \"evals_per_ray\": " << (r.evals >= 0 ? std::to_string(r.evals) : std::string("null"))
+            << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes << ", \"sah_cost\": " << r.sah
+            << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches
+            << ", \"ties\": " << r.ties << ", \"mrays\": {";
           for (size_t k = 0; k < r.mrays.size(); ++k)
             f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;
           f << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";

@@ -387,6 +387,59 @@ Scene terrain(uint64_t seed, uint64_t triangles) {
   return sc;
 }
 
+// ---- spheres ---------------------------------------------------------------------------------
+
+/// `count` spheres of seeded radii on a jittered square grid over a ground quad, each either an
+/// analytic sphere (one shape, placed by its instance) or tessellated into a UV sphere of 70 x 72
+/// quads (10,080 triangles, smooth normals) in world space: the same scene for both, so rays
+/// meet the same surfaces up to the tessellation.
+Scene spheres(uint64_t seed, uint64_t count, bool tessellate) {
+  Scene sc;
+  SceneRng rng(seed);
+  const int mat = material(sc, "ceramic", {0.8f, 0.75f, 0.7f}, 0, 0.3f);
+  const int side = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+  const float extent = 3.0f * float(side);
+  {
+    MeshBuilder ground{new_mesh(sc, "ground", material(sc, "ground", {0.5f, 0.5f, 0.5f}, 0, 0.9f))};
+    ground.box({-extent, -1, -extent}, {extent, 0, extent});
+  }
+  for (uint64_t i = 0; i < count; ++i) {
+    const float r = rng.uniform(0.6f, 1.2f);
+    const Vec3f c{3.0f * (2.0f * float(i % uint64_t(side)) - float(side) + 1) + rng.uniform(-0.4f, 0.4f), r,
+                  3.0f * (2.0f * float(i / uint64_t(side)) - float(side) + 1) + rng.uniform(-0.4f, 0.4f)};
+    if (!tessellate) {
+      SceneShape shape;
+      shape.name = "sphere" + std::to_string(i);
+      shape.shape.kind = ShapeKind::Sphere;
+      shape.shape.radius = r;
+      shape.material = mat;
+      sc.shapes.push_back(shape);
+      Affine3f place;
+      place.m[0][3] = c.x, place.m[1][3] = c.y, place.m[2][3] = c.z;
+      sc.instances.push_back(make_shape_instance(int(sc.shapes.size()) - 1, place));
+      continue;
+    }
+    MeshBuilder b{new_mesh(sc, "sphere", mat)};
+    constexpr int kRings = 70, kSegments = 72;
+    for (int y = 0; y <= kRings; ++y)
+      for (int x = 0; x <= kSegments; ++x) {
+        const float theta = kPi * float(y) / kRings, phi = kTwoPi * float(x) / kSegments;
+        b.vertex(c +
+                 Vec3f{std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)} *
+                     r);
+      }
+    for (int y = 0; y < kRings; ++y)
+      for (int x = 0; x < kSegments; ++x) {
+        const uint32_t a = uint32_t(y * (kSegments + 1) + x), d = a + kSegments + 1;
+        b.quad(a, d, d + 1, a + 1);
+      }
+  }
+  for (Mesh& m : sc.meshes) m.normals = compute_smooth_normals(m.positions, m.indices);
+  sc.lights.push_back(point_light("key", {extent, 4 * extent, extent * 0.5f}, 40 * extent * extent));
+  sc.cameras.push_back(camera("overview", {0.2f * extent, 0.9f * extent, 1.4f * extent}, {0, 0, 0}, 45));
+  return sc;
+}
+
 /// Runs `make(scale)` once at scale 1 and once more at the scale whose triangle count is
 /// nearest `target` (curved parts grow with scale^2).
 Scene fit(uint64_t target, const std::function<Scene(float)>& make) {
@@ -404,7 +457,9 @@ std::vector<GeneratorInfo> generators() {
           {"soup", "uniformly random triangles in a cube", 1000000},
           {"stadium", "teapot in a stadium: dense object in a huge sparse room", 250000},
           {"slivers", "long thin triangles along one axis", 500000},
-          {"terrain", "fBm heightfield for scaling (>= 5M triangles)", 5200000}};
+          {"terrain", "fBm heightfield for scaling (>= 5M triangles)", 5200000},
+          {"spheres", "analytic spheres on a ground quad, one per 10k requested triangles", 640000},
+          {"spheres-mesh", "the same spheres tessellated to 10,080 triangles each", 640000}};
 }
 
 Scene generate_scene(const std::string& name, uint64_t seed, uint64_t triangles) {
@@ -424,6 +479,8 @@ Scene generate_scene(const std::string& name, uint64_t seed, uint64_t triangles)
   if (name == "soup") return soup(seed, triangles);
   if (name == "stadium") return fit(triangles, [&](float s) { return stadium(seed, s); });
   if (name == "slivers") return slivers(seed, triangles);
+  if (name == "spheres" || name == "spheres-mesh")
+    return spheres(seed, std::max<uint64_t>(1, triangles / 10000), name == "spheres-mesh");
   return terrain(seed, triangles);
 }
 

@@ -27,6 +27,9 @@ struct GeneratorInfo {
 ///              huge, sparse bowl of large triangles. Uniform grids collapse on it.
 ///   slivers  - long thin triangles along one axis: overlapping boxes, bad for SAH and grids.
 ///   terrain  - fBm heightfield for the scaling series (default 5.2M triangles).
+///   spheres  - analytic spheres (one per 10,000 requested triangles) on a ground quad.
+///   spheres-mesh - the same spheres, each tessellated to 10,080 triangles: analytic shapes
+///              against the triangles they replace.
 std::vector<GeneratorInfo> generators();
 
 /// Generates scene `name` with about `triangles` triangles (0: the generator's default;
