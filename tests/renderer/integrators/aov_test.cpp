@@ -87,6 +87,15 @@ TEST_CASE("aov: depth, normal, position and ids on analytic and implicit spheres
         CHECK(a.albedo[i * 3] == Approx(0.8f));
       }
     }
+    // UV: spherical coordinates, analytic spheres only. At (x, y, z) on the sphere u = phi / 2 pi
+    // with phi = atan2(-z, x) in [0, 2 pi), v = acos(y) / pi: (0.75, 0.5) facing the camera.
+    const size_t centre = size_t(16 * 32 + 16);
+    if (!implicit) {
+      CHECK(a.uv[centre * 2] == Approx(0.75f).margin(0.02));
+      CHECK(a.uv[centre * 2 + 1] == Approx(0.5f).margin(0.02));
+    } else {
+      CHECK(a.uv[centre * 2] == 0);  // implicit shapes have no UVs
+    }
     CHECK(std::isinf(a.depth[0]));  // the corner is outside the sphere
     CHECK(a.object_id[0] == 0);
   }
