@@ -16,6 +16,7 @@
 #include "io/gltf/meshes.h"
 #include "io/gltf/nodes.h"
 #include "io/gltf/parse.h"
+#include "io/gltf/shapes.h"
 
 namespace penumbra {
 
@@ -23,6 +24,7 @@ std::vector<std::string> supported_gltf_extensions() {
   std::vector<std::string> out = {"KHR_lights_punctual"};
   for (auto& e : gltf::material_extensions()) out.push_back(std::move(e));
   out.push_back("EXT_mesh_gpu_instancing");
+  out.push_back(gltf::kShapesExtension);
   return out;
 }
 
@@ -89,9 +91,9 @@ void check_version_and_extensions(const GltfContext& ctx) {
 }
 
 // The conversion phases, in order: whole-model validation, materials (with their textures),
-// meshes in local space, the animated pose, then the node walk that places cameras, lights
-// and meshes.
-void convert(const GltfContext& ctx) {
+// meshes in local space, the animated pose, then the node walk that places cameras, lights,
+// meshes and the shapes read with the raw JSON.
+void convert(const GltfContext& ctx, std::vector<NodeShape>& shapes) {
   describe(ctx.model, ctx.out.info);
   check_version_and_extensions(ctx);
   validate_accessors(ctx);
@@ -106,12 +108,13 @@ void convert(const GltfContext& ctx) {
   if (ctx.options.time) poses = evaluate_animations(ctx, *ctx.options.time);
   const std::vector<int> roots = scene_roots(ctx);
   NodeTransforms nodes = link_nodes(ctx, poses);
-  const std::vector<MeshUse> uses = place_nodes(ctx, nodes, roots);
-  place_meshes(ctx, meshes, nodes, uses);
+  const NodeUses uses = place_nodes(ctx, nodes, roots);
+  place_meshes(ctx, meshes, nodes, uses.meshes);
+  place_shapes(ctx, shapes, nodes, uses.shapes);
   const int scene = ctx.out.info.scene_index;
-  if (ctx.out.scene.meshes.empty())
+  if (ctx.out.scene.meshes.empty() && ctx.out.scene.shapes.empty())
     ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
-             "no renderable triangles; the image shows only the background");
+             "no renderable triangles or shapes; the image shows only the background");
 }
 
 }  // namespace
@@ -122,9 +125,10 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
   gltf::MemoryBudget budget(name, options.max_memory_bytes);
   LoadedScene out;
   tinygltf::Model model;
-  gltf::parse_gltf(file, options, budget, out, model);
+  std::vector<gltf::NodeShape> shapes;
+  gltf::parse_gltf(file, options, budget, out, model, shapes);
   try {
-    gltf::convert(gltf::GltfContext{model, name, options, budget, out});
+    gltf::convert(gltf::GltfContext{model, name, options, budget, out}, shapes);
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while converting the scene");
   }

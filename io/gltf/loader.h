@@ -1,9 +1,10 @@
 // glTF 2.0 loading (.gltf with external or data-URI buffers, .glb) into a renderer Scene.
 // tinygltf parses; this module validates everything tinygltf does not (indices, accessor
 // ranges with overflow-safe arithmetic, node cycles, NaN data, URI escapes, JSON depth,
-// camera and light parameters) and flattens the node hierarchy into world-space meshes.
-// Images (PNG, JPEG from files, data URIs or bufferViews) are decoded through OpenImageIO
-// into MIP-mapped textures.
+// camera and light parameters) and flattens the node hierarchy into world-space meshes and
+// instances; the PENUMBRA_shapes node extension adds analytic and implicit shapes. Images
+// (PNG, JPEG from files, data URIs or bufferViews) are decoded through OpenImageIO into
+// MIP-mapped textures.
 #pragma once
 
 #include <cstdint>

@@ -387,83 +387,14 @@ void emit_primitives(const GltfContext& ctx, const std::vector<LocalPrimitive>& 
 void charge_placements(const GltfContext& ctx, const MeshUse& use) {
   if (use.mesh < 0 || size_t(use.mesh) >= ctx.model.meshes.size()) return;  // add_mesh reports it
   const auto& gnode = ctx.model.nodes[size_t(use.node)];
-  uint64_t count = 1;
+  const uint64_t count = declared_placements(ctx, use.node);
   std::string where = idx("nodes", size_t(use.node));
-  if (const auto ext = gnode.extensions.find("EXT_mesh_gpu_instancing"); ext != gnode.extensions.end()) {
-    // The instance count from the accessors' declared counts, before any is decoded (placements_of
-    // checks that they agree).
-    const tinygltf::Value& attributes = ext->second.Get("attributes");
-    where += ".extensions.EXT_mesh_gpu_instancing";
-    for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"}) {
-      if (!attributes.IsObject() || !attributes.Has(name) || !attributes.Get(name).IsInt()) continue;
-      const int a = attributes.Get(name).Get<int>();
-      if (a >= 0 && size_t(a) < ctx.model.accessors.size())
-        count = std::max<uint64_t>(count, ctx.model.accessors[size_t(a)].count);
-    }
-  }
+  if (gnode.extensions.count("EXT_mesh_gpu_instancing")) where += ".extensions.EXT_mesh_gpu_instancing";
   const uint64_t primitives = std::max<uint64_t>(1, ctx.model.meshes[size_t(use.mesh)].primitives.size());
   const uint64_t per_placement = sizeof(Transform) + primitives * (sizeof(Instance) + kAccelBytesPerInstance);
   uint64_t bytes = 0;
   if (!mul_ok(count, per_placement, bytes)) bytes = UINT64_MAX;
   ctx.charge(bytes, where, std::to_string(count) + (count == 1 ? " instance needs" : " instances need"));
-}
-
-// EXT_mesh_gpu_instancing: world x T_i R_i S_i per instance, or {world} without the extension.
-std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Transform& world) {
-  const auto& gnode = ctx.model.nodes[size_t(node)];
-  const auto ext = gnode.extensions.find("EXT_mesh_gpu_instancing");
-  if (ext == gnode.extensions.end()) return {world};
-  const std::string where = idx("nodes", size_t(node)) + ".extensions.EXT_mesh_gpu_instancing";
-  const tinygltf::Value& attributes = ext->second.Get("attributes");
-  // tinygltf stores an empty JSON object (and a missing member) as a null value.
-  if (attributes.Type() == tinygltf::NULL_TYPE) {
-    ctx.warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the mesh is placed once");
-    return {world};
-  }
-  if (!attributes.IsObject()) ctx.fail(where + ".attributes", "must be an object");
-  // TRANSLATION (VEC3 float), ROTATION (VEC4 float or normalized byte/short), SCALE (VEC3 float).
-  std::vector<double> values[3];
-  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
-  uint64_t count = 0;
-  std::string first;
-  for (int k = 0; k < 3; ++k) {
-    if (!attributes.Has(names[k])) continue;
-    const std::string aw = where + ".attributes." + names[k];
-    const tinygltf::Value& a = attributes.Get(names[k]);
-    if (!a.IsInt()) ctx.fail(aw, "must be an accessor index");
-    if (k == 1)
-      values[k] = read_accessor(
-          ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC4},
-          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
-    else
-      values[k] =
-          read_accessor(ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-    const uint64_t n = values[k].size() / (k == 1 ? 4 : 3);
-    if (!first.empty() && n != count)
-      ctx.fail(aw, "has " + std::to_string(n) + " elements but " + first + " has " + std::to_string(count) +
-                       " (all instance attributes must have the same count)");
-    if (first.empty()) first = names[k];
-    count = n;
-  }
-  for (const auto& key : attributes.Keys())
-    if (key != "TRANSLATION" && key != "ROTATION" && key != "SCALE" && (key.empty() || key[0] != '_'))
-      ctx.warn(where + ".attributes." + key, "unknown instance attribute; ignored");
-  if (first.empty()) {
-    ctx.warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the mesh is placed once");
-    return {world};
-  }
-  std::vector<Transform> out;
-  out.reserve(size_t(count));
-  for (size_t i = 0; i < count; ++i) {
-    std::array<double, 3> t{0, 0, 0}, sc{1, 1, 1};
-    Quat q;
-    if (!values[0].empty()) t = {values[0][3 * i], values[0][3 * i + 1], values[0][3 * i + 2]};
-    if (!values[1].empty())
-      q = {values[1][4 * i], values[1][4 * i + 1], values[1][4 * i + 2], values[1][4 * i + 3]};
-    if (!values[2].empty()) sc = {values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]};
-    out.push_back(world * compose_trs(t, q, sc));  // NodeWorldXform x InstanceXform
-  }
-  return out;
 }
 
 // (mesh, morph weights) -> the Scene::meshes of its object-space copy.
@@ -561,6 +492,78 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
 }
 
 }  // namespace
+
+uint64_t declared_placements(const GltfContext& ctx, int node) {
+  const auto& gnode = ctx.model.nodes[size_t(node)];
+  const auto ext = gnode.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == gnode.extensions.end()) return 1;
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  uint64_t count = 1;
+  for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"}) {
+    if (!attributes.IsObject() || !attributes.Has(name) || !attributes.Get(name).IsInt()) continue;
+    const int a = attributes.Get(name).Get<int>();
+    if (a >= 0 && size_t(a) < ctx.model.accessors.size())
+      count = std::max<uint64_t>(count, ctx.model.accessors[size_t(a)].count);
+  }
+  return count;
+}
+
+std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Transform& world) {
+  const auto& gnode = ctx.model.nodes[size_t(node)];
+  const auto ext = gnode.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == gnode.extensions.end()) return {world};
+  const std::string where = idx("nodes", size_t(node)) + ".extensions.EXT_mesh_gpu_instancing";
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  // tinygltf stores an empty JSON object (and a missing member) as a null value.
+  if (attributes.Type() == tinygltf::NULL_TYPE) {
+    ctx.warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the node is placed once");
+    return {world};
+  }
+  if (!attributes.IsObject()) ctx.fail(where + ".attributes", "must be an object");
+  // TRANSLATION (VEC3 float), ROTATION (VEC4 float or normalized byte/short), SCALE (VEC3 float).
+  std::vector<double> values[3];
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  uint64_t count = 0;
+  std::string first;
+  for (int k = 0; k < 3; ++k) {
+    if (!attributes.Has(names[k])) continue;
+    const std::string aw = where + ".attributes." + names[k];
+    const tinygltf::Value& a = attributes.Get(names[k]);
+    if (!a.IsInt()) ctx.fail(aw, "must be an accessor index");
+    if (k == 1)
+      values[k] = read_accessor(
+          ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC4},
+          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
+    else
+      values[k] =
+          read_accessor(ctx, a.Get<int>(), aw, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    const uint64_t n = values[k].size() / (k == 1 ? 4 : 3);
+    if (!first.empty() && n != count)
+      ctx.fail(aw, "has " + std::to_string(n) + " elements but " + first + " has " + std::to_string(count) +
+                       " (all instance attributes must have the same count)");
+    if (first.empty()) first = names[k];
+    count = n;
+  }
+  for (const auto& key : attributes.Keys())
+    if (key != "TRANSLATION" && key != "ROTATION" && key != "SCALE" && (key.empty() || key[0] != '_'))
+      ctx.warn(where + ".attributes." + key, "unknown instance attribute; ignored");
+  if (first.empty()) {
+    ctx.warn(where + ".attributes", "no TRANSLATION, ROTATION or SCALE; the node is placed once");
+    return {world};
+  }
+  std::vector<Transform> out;
+  out.reserve(size_t(count));
+  for (size_t i = 0; i < count; ++i) {
+    std::array<double, 3> t{0, 0, 0}, sc{1, 1, 1};
+    Quat q;
+    if (!values[0].empty()) t = {values[0][3 * i], values[0][3 * i + 1], values[0][3 * i + 2]};
+    if (!values[1].empty())
+      q = {values[1][4 * i], values[1][4 * i + 1], values[1][4 * i + 2], values[1][4 * i + 3]};
+    if (!values[2].empty()) sc = {values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]};
+    out.push_back(world * compose_trs(t, q, sc));  // NodeWorldXform x InstanceXform
+  }
+  return out;
+}
 
 std::vector<std::vector<LocalPrimitive>> decode_meshes(const GltfContext& ctx) {
   std::vector<std::vector<LocalPrimitive>> meshes(ctx.model.meshes.size());

@@ -34,6 +34,16 @@ struct LocalPrimitive {
   bool usable = false;  ///< false: skipped with a warning
 };
 
+/// The number of placements EXT_mesh_gpu_instancing declares on `node`: the largest count of its
+/// attribute accessors, read before any is decoded (placements_of checks that they agree); 1
+/// without the extension.
+uint64_t declared_placements(const GltfContext& ctx, int node);
+
+/// The placements of what `node` carries: `world` x T_i R_i S_i for each EXT_mesh_gpu_instancing
+/// instance i, or {world} without the extension (or, with a warning, without its attributes).
+/// Throws InputError naming the attribute for malformed instance data.
+std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Transform& world);
+
 /// Every primitive of every mesh, [mesh][primitive]. Points and lines, primitives without
 /// POSITION or triangles, and NaN positions are kept unusable with a warning; malformed
 /// accessors, modes, materials and attribute counts throw InputError naming the primitive.

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <set>
 
+#include "io/gltf/shapes.h"
+
 namespace penumbra::gltf {
 
 namespace {
@@ -257,8 +259,7 @@ const Transform& world_transform(const GltfContext& ctx, NodeTransforms& nodes, 
   return nodes.world[size_t(node)];
 }
 
-std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes,
-                                 const std::vector<int>& roots) {
+NodeUses place_nodes(const GltfContext& ctx, NodeTransforms& nodes, const std::vector<int>& roots) {
   const size_t n = ctx.model.nodes.size();
   std::set<int> seen_roots;
   std::vector<int> stack;
@@ -273,13 +274,14 @@ std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes,
     if (!seen_roots.insert(r).second) ctx.fail(idx("nodes", size_t(r)), "listed twice as a scene root");
     stack.push_back(r);
   }
-  std::vector<MeshUse> uses;
+  NodeUses uses;
   while (!stack.empty()) {
     const int index = stack.back();
     stack.pop_back();
     const auto& node = ctx.model.nodes[size_t(index)];
     const Transform world = world_transform(ctx, nodes, index);  // the parent's is known: pre-order
-    if (node.mesh >= 0 || node.mesh < -1) uses.push_back({node.mesh, index});
+    if (node.mesh >= 0 || node.mesh < -1) uses.meshes.push_back({node.mesh, index});
+    if (node.extensions.count(kShapesExtension)) uses.shapes.push_back(index);
     if (node.camera >= 0 || node.camera < -1) add_camera(ctx, node.camera, index, world);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
       const auto& li = it->second.Get("light");

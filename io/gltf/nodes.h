@@ -24,6 +24,12 @@ struct MeshUse {
   int mesh, node;
 };
 
+/// What the scene's walk found to place besides cameras and lights, in visit order.
+struct NodeUses {
+  std::vector<MeshUse> meshes;  ///< nodes with a mesh
+  std::vector<int> shapes;      ///< nodes with the PENUMBRA_shapes extension
+};
+
 /// Checks every camera's and light's parameters. Throws InputError naming them.
 void validate_cameras(const GltfContext& ctx);
 void validate_lights(const GltfContext& ctx);
@@ -40,8 +46,7 @@ NodeTransforms link_nodes(const GltfContext& ctx, const std::vector<NodePose>& p
 const Transform& world_transform(const GltfContext& ctx, NodeTransforms& nodes, int node);
 
 /// Walks the scene depth-first from `roots` (checked: in range, parentless, listed once),
-/// placing cameras and lights into ctx.out.scene; returns the nodes with meshes in visit order.
-std::vector<MeshUse> place_nodes(const GltfContext& ctx, NodeTransforms& nodes,
-                                 const std::vector<int>& roots);
+/// placing cameras and lights into ctx.out.scene; returns the nodes with meshes and with shapes.
+NodeUses place_nodes(const GltfContext& ctx, NodeTransforms& nodes, const std::vector<int>& roots);
 
 }  // namespace penumbra::gltf

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "io/gltf/context.h"
+#include "io/gltf/shapes.h"
 
 namespace tinygltf {
 class Model;
@@ -14,10 +15,11 @@ class Model;
 
 namespace penumbra::gltf {
 
-/// Parses `file` into `model`. GLB chunk warnings and tinygltf's warnings go to out.warnings;
-/// every file read goes to out.info.source_files (the scene file first). What parsing holds is
-/// charged to `budget`. Throws InputError.
+/// Parses `file` into `model`, and the nodes' PENUMBRA_shapes extensions (read from the raw JSON,
+/// read_node_shapes()) into `shapes`. GLB chunk warnings and tinygltf's warnings go to
+/// out.warnings; every file read goes to out.info.source_files (the scene file first). What
+/// parsing holds is charged to `budget`. Throws InputError.
 void parse_gltf(const std::filesystem::path& file, const GltfLoadOptions& options, MemoryBudget& budget,
-                LoadedScene& out, tinygltf::Model& model);
+                LoadedScene& out, tinygltf::Model& model, std::vector<NodeShape>& shapes);
 
 }  // namespace penumbra::gltf

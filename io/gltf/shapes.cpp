@@ -1,0 +1,596 @@
+// The PENUMBRA_shapes extension: each node's extension object read by kind (analytic shapes;
+// implicit shapes with their CSG trees: primitives, operators folded into binary nodes, node
+// transforms), then each shape placed by its node's world transform and instancing copies.
+#include "io/gltf/shapes.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <span>
+
+#include "io/gltf/meshes.h"
+
+namespace penumbra::gltf {
+
+namespace {
+
+using nlohmann::json;
+
+// A value for messages, cut to 40 characters; infinite numbers (which JSON cannot spell but an
+// overflowing literal such as 1e999 reads as) shown as inf.
+std::string shown(const json& v) {
+  if (v.is_number_float() && !std::isfinite(v.get<double>())) return v.get<double>() > 0 ? "inf" : "-inf";
+  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
+  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+}
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// What a number must be beyond finite as a 32-bit float.
+enum class Bound { Any, Positive, NonNegative, NonZero };
+
+// The schema's types: name, kind and the keys of that type beyond those every object has.
+struct ShapeType {
+  const char* name;
+  ShapeKind kind;
+  std::array<const char*, 3> keys;
+};
+constexpr ShapeType kShapeTypes[] = {
+    {"sphere", ShapeKind::Sphere, {"radius"}},
+    {"plane", ShapeKind::Plane, {"size"}},
+    {"disk", ShapeKind::Disk, {"radius"}},
+    {"box", ShapeKind::Box, {"size"}},
+    {"capsule", ShapeKind::Capsule, {"radius", "height"}},
+    {"implicit", ShapeKind::Implicit, {"csg", "maxSteps", "epsilon"}},
+};
+constexpr const char* kShapeCommonKeys[] = {"type", "material"};
+constexpr const char* kShapeKeys[] = {"type",   "material", "radius",   "size",
+                                      "height", "csg",      "maxSteps", "epsilon"};
+
+struct CsgType {
+  const char* name;
+  SdfKind kind;
+  std::array<const char*, 3> keys;
+};
+constexpr CsgType kCsgTypes[] = {
+    {"sphere", SdfKind::Sphere, {"radius"}},
+    {"box", SdfKind::Box, {"size"}},
+    {"roundBox", SdfKind::RoundBox, {"size", "radius"}},
+    {"capsule", SdfKind::Capsule, {"radius", "height"}},
+    {"cylinder", SdfKind::Cylinder, {"radius", "height"}},
+    {"cone", SdfKind::Cone, {"radius", "height"}},
+    {"torus", SdfKind::Torus, {"majorRadius", "minorRadius"}},
+    {"halfSpace", SdfKind::HalfSpace, {"normal", "offset"}},
+    {"convexPolyhedron", SdfKind::ConvexPolyhedron, {"planes"}},
+    {"union", SdfKind::Union, {"children"}},
+    {"intersection", SdfKind::Intersection, {"children"}},
+    {"subtraction", SdfKind::Subtraction, {"children"}},
+    {"complement", SdfKind::Complement, {"children"}},
+    {"smoothUnion", SdfKind::SmoothUnion, {"children", "radius"}},
+    {"smoothIntersection", SdfKind::SmoothIntersection, {"children", "radius"}},
+    {"smoothSubtraction", SdfKind::SmoothSubtraction, {"children", "radius"}},
+};
+constexpr const char* kCsgCommonKeys[] = {"type", "translation", "rotation", "scale", "matrix"};
+constexpr const char* kCsgKeys[] = {"type",   "translation", "rotation", "scale",       "matrix",
+                                    "radius", "size",        "height",   "majorRadius", "minorRadius",
+                                    "normal", "offset",      "planes",   "children"};
+
+bool is_smooth(SdfKind kind) {
+  return kind == SdfKind::SmoothUnion || kind == SdfKind::SmoothIntersection ||
+         kind == SdfKind::SmoothSubtraction;
+}
+
+template <class Spec, size_t N>
+const Spec* find_type(const Spec (&types)[N], const std::string& name) {
+  for (const Spec& t : types)
+    if (name == t.name) return &t;
+  return nullptr;
+}
+
+template <class Spec, size_t N>
+std::string type_names(const Spec (&types)[N]) {
+  std::string s;
+  for (const Spec& t : types) s += (s.empty() ? "" : ", ") + std::string(t.name);
+  return s;
+}
+
+// Whether the inside of tree node `index` may be unbounded by the rules sdf_tree_bounds
+// applies: half-spaces, open convex polyhedra and complements are; a union is if either part
+// is, an intersection if both are, a subtraction if its first operand is.
+bool may_be_unbounded(const SdfTree& tree, int index, int depth) {
+  const SdfNode& n = tree.nodes[size_t(index)];
+  if (depth > kMaxSdfDepth) return true;
+  switch (n.kind) {
+    case SdfKind::HalfSpace:
+    case SdfKind::Complement:
+      return true;
+    case SdfKind::ConvexPolyhedron: {
+      SdfTree alone;
+      alone.nodes.push_back(n);
+      alone.nodes[0].to_local = Affine3f{};
+      alone.planes = tree.planes;
+      alone.root = 0;
+      return sdf_tree_bounds(alone).empty();
+    }
+    case SdfKind::Union:
+    case SdfKind::SmoothUnion:
+      return may_be_unbounded(tree, n.a, depth + 1) || may_be_unbounded(tree, n.b, depth + 1);
+    case SdfKind::Intersection:
+    case SdfKind::SmoothIntersection:
+      return may_be_unbounded(tree, n.a, depth + 1) && may_be_unbounded(tree, n.b, depth + 1);
+    case SdfKind::Subtraction:
+    case SdfKind::SmoothSubtraction:
+      return may_be_unbounded(tree, n.a, depth + 1);
+    default:
+      return false;
+  }
+}
+
+// Reads extension objects into NodeShapes, one at a time; `m_tree` holds the CSG tree of the
+// implicit shape being read.
+class ShapeReader {
+ public:
+  ShapeReader(const std::string& file, size_t materials, MemoryBudget& budget)
+      : m_file(file), m_materials(materials), m_budget(budget) {}
+  NodeShape read(const json& ext, int node, const std::string& where);
+
+ private:
+  [[noreturn]] void fail(const std::string& where, const std::string& message) const {
+    throw InputError(m_file, where, message);
+  }
+  static const json* find(const json& obj, const char* key) {
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+  void check_keys(const json& obj, const std::string& where, const std::string& what,
+                  std::span<const char* const> common, std::span<const char* const> typed,
+                  std::span<const char* const> known) const;
+  float number(const json& v, const std::string& where, Bound bound) const;
+  float number_or(const json& obj, const char* key, const std::string& where, float fallback,
+                  Bound bound) const;
+  template <size_t N>
+  std::array<float, N> numbers(const json& v, const std::string& where, Bound bound) const;
+  Vec3f vec3_or(const json& obj, const char* key, const std::string& where, Vec3f fallback,
+                Bound bound) const;
+  int integer_or(const json& obj, const char* key, const std::string& where, int fallback, int lo,
+                 int hi) const;
+  int material(const json& ext, const std::string& where) const;
+  void analytic(const json& ext, const std::string& where, Shape& shape) const;
+  Shape implicit(const json& ext, const std::string& where);
+  int csg_node(const json& j, const std::string& where, int level);
+  int csg_operator(const json& j, const std::string& where, SdfKind kind, int level);
+  SdfNode csg_primitive(const json& j, const std::string& where, SdfKind kind);
+  void csg_planes(const json& j, const std::string& where, SdfNode& node);
+  Affine3f csg_transform(const json& j, const std::string& where) const;
+  int add_node(const SdfNode& node, const std::string& where);
+
+  const std::string& m_file;
+  size_t m_materials;
+  MemoryBudget& m_budget;
+  SdfTree m_tree;
+};
+
+void ShapeReader::check_keys(const json& obj, const std::string& where, const std::string& what,
+                             std::span<const char* const> common, std::span<const char* const> typed,
+                             std::span<const char* const> known) const {
+  auto listed = [](std::span<const char* const> keys, const std::string& key) {
+    return std::any_of(keys.begin(), keys.end(), [&](const char* k) { return k && key == k; });
+  };
+  for (const auto& [key, value] : obj.items()) {
+    if (listed(common, key) || listed(typed, key)) continue;
+    std::string keys;
+    for (auto list : {common, typed})
+      for (const char* k : list)
+        if (k) keys += (keys.empty() ? "" : ", ") + std::string(k);
+    if (listed(known, key))
+      fail(where + "." + key, "does not apply to " + what + " (its keys: " + keys + ")");
+    fail(where + "." + key, "unknown key (" + what + " has: " + keys + ")");
+  }
+}
+
+float ShapeReader::number(const json& v, const std::string& where, Bound bound) const {
+  if (!v.is_number()) fail(where, "must be a number (got " + shown(v) + ")");
+  const double d = v.get<double>();
+  const float f = float(d);
+  if (!std::isfinite(d)) fail(where, "must be a finite number (got " + shown(v) + ")");
+  if (!std::isfinite(f)) fail(where, "is beyond the 32-bit float range (got " + shown(v) + ")");
+  const char* rounded = d != 0 && f == 0 ? ", 0 as a 32-bit float" : "";
+  if (bound == Bound::Positive && !(f > 0)) fail(where, "must be > 0 (got " + shown(v) + rounded + ")");
+  if (bound == Bound::NonNegative && !(f >= 0)) fail(where, "must be >= 0 (got " + shown(v) + ")");
+  if (bound == Bound::NonZero && f == 0) fail(where, "must be non-zero (got " + shown(v) + rounded + ")");
+  return f;
+}
+
+float ShapeReader::number_or(const json& obj, const char* key, const std::string& where, float fallback,
+                             Bound bound) const {
+  const json* v = find(obj, key);
+  return v ? number(*v, where + "." + key, bound) : fallback;
+}
+
+template <size_t N>
+std::array<float, N> ShapeReader::numbers(const json& v, const std::string& where, Bound bound) const {
+  if (!v.is_array() || v.size() != N)
+    fail(where, "must be an array of " + std::to_string(N) + " numbers (got " + shown(v) + ")");
+  std::array<float, N> out;
+  for (size_t i = 0; i < N; ++i) out[i] = number(v[i], idx(where.c_str(), i), bound);
+  return out;
+}
+
+Vec3f ShapeReader::vec3_or(const json& obj, const char* key, const std::string& where, Vec3f fallback,
+                           Bound bound) const {
+  const json* v = find(obj, key);
+  if (!v) return fallback;
+  const auto a = numbers<3>(*v, where + "." + key, bound);
+  return {a[0], a[1], a[2]};
+}
+
+int ShapeReader::integer_or(const json& obj, const char* key, const std::string& where, int fallback, int lo,
+                            int hi) const {
+  const json* v = find(obj, key);
+  if (!v) return fallback;
+  const std::string kw = where + "." + key;
+  const std::string range = "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!v->is_number_integer()) fail(kw, "must be an integer " + range + " (got " + shown(*v) + ")");
+  const bool in_range = v->is_number_unsigned() ? v->get<uint64_t>() >= uint64_t(std::max(lo, 0)) &&
+                                                      v->get<uint64_t>() <= uint64_t(hi)
+                                                : v->get<int64_t>() >= lo && v->get<int64_t>() <= hi;
+  if (!in_range) fail(kw, "must be " + range + " (got " + shown(*v) + ")");
+  return int(v->get<int64_t>());
+}
+
+int ShapeReader::material(const json& ext, const std::string& where) const {
+  const json* m = find(ext, "material");
+  if (!m) return -1;
+  const std::string mw = where + ".material";
+  if (!m->is_number_integer()) fail(mw, "must be an integer material index (got " + shown(*m) + ")");
+  if (!m->is_number_unsigned()) fail(mw, "index " + shown(*m) + " is negative");
+  const uint64_t u = m->get<uint64_t>();
+  if (u >= m_materials)
+    fail(mw, "index " + std::to_string(u) + " out of range (" + std::to_string(m_materials) + " materials)");
+  return int(u);
+}
+
+NodeShape ShapeReader::read(const json& ext, int node, const std::string& where) {
+  if (!ext.is_object()) fail(where, "must be an object (got " + shown(ext) + ")");
+  const json* type = find(ext, "type");
+  if (!type) fail(where + ".type", "is required (one of " + type_names(kShapeTypes) + ")");
+  if (!type->is_string()) fail(where + ".type", "must be a string (got " + shown(*type) + ")");
+  const ShapeType* spec = find_type(kShapeTypes, type->get<std::string>());
+  if (!spec)
+    fail(where + ".type", "unknown shape type " + shown(*type) + " (known: " + type_names(kShapeTypes) + ")");
+  check_keys(ext, where, "a \"" + std::string(spec->name) + "\" shape", kShapeCommonKeys, spec->keys,
+             kShapeKeys);
+  m_budget.charge(sizeof(NodeShape) + sizeof(SceneShape), where, "its shape needs");
+  NodeShape out;
+  out.node = node;
+  out.material = material(ext, where);
+  if (spec->kind == ShapeKind::Implicit) {
+    out.shape = implicit(ext, where);
+  } else {
+    out.shape.kind = spec->kind;
+    analytic(ext, where, out.shape);
+  }
+  return out;
+}
+
+void ShapeReader::analytic(const json& ext, const std::string& where, Shape& shape) const {
+  switch (shape.kind) {
+    case ShapeKind::Sphere:
+    case ShapeKind::Disk:
+      shape.radius = number_or(ext, "radius", where, 1, Bound::Positive);
+      break;
+    case ShapeKind::Plane: {
+      std::array<float, 2> size{2, 2};
+      if (const json* v = find(ext, "size")) size = numbers<2>(*v, where + ".size", Bound::Positive);
+      shape.half_size = {size[0] / 2, 0, size[1] / 2};
+      break;
+    }
+    case ShapeKind::Box:
+      shape.half_size = vec3_or(ext, "size", where, {1, 1, 1}, Bound::Positive) * 0.5f;
+      break;
+    case ShapeKind::Capsule:
+      shape.radius = number_or(ext, "radius", where, 0.5f, Bound::Positive);
+      shape.half_height = number_or(ext, "height", where, 1, Bound::NonNegative) / 2;
+      break;
+    case ShapeKind::Implicit:
+      break;
+  }
+}
+
+Shape ShapeReader::implicit(const json& ext, const std::string& where) {
+  const std::string cw = where + ".csg";
+  const json* csg = find(ext, "csg");
+  if (!csg) fail(cw, "is required (the CSG tree of an implicit shape)");
+  SphereTraceConfig trace;
+  trace.max_steps = integer_or(ext, "maxSteps", where, 512, 1, 100000);
+  if (const json* e = find(ext, "epsilon")) {
+    trace.relative_epsilon = number(*e, where + ".epsilon", Bound::Positive);
+    if (!(trace.relative_epsilon < 0.1f)) fail(where + ".epsilon", "must be < 0.1 (got " + shown(*e) + ")");
+  }
+  m_tree = SdfTree{};
+  m_tree.root = csg_node(*csg, cw, 1);
+  m_tree.nodes.shrink_to_fit();
+  m_tree.planes.shrink_to_fit();
+  Shape shape = make_implicit_shape(std::move(m_tree), trace);
+  const Bounds3f& b = shape.sdf_bounds;
+  if (b.empty())
+    fail(cw,
+         may_be_unbounded(shape.sdf, shape.sdf.root, 0)
+             ? "the shape's inside is unbounded (intersect half-spaces and complements with a finite shape)"
+             : "the shape's inside is empty (the parts it intersects do not overlap)");
+  if (!is_finite(b.lo) || !is_finite(b.hi) || !(std::isfinite(shape.lipschitz) && shape.lipschitz > 0))
+    fail(cw, "the transforms scale the shape beyond the 32-bit float range");
+  return shape;
+}
+
+int ShapeReader::add_node(const SdfNode& node, const std::string& where) {
+  if (m_tree.nodes.size() >= size_t(kMaxCsgNodes))
+    fail(where, "the CSG tree has more than " + std::to_string(kMaxCsgNodes) +
+                    " nodes (counting the binary nodes operators with more than 2 children fold into)");
+  m_budget.charge(sizeof(SdfNode), where, "its CSG node needs");
+  m_tree.nodes.push_back(node);
+  return int(m_tree.nodes.size()) - 1;
+}
+
+// A CSG node at `level` (the root is level 1): its type, keys and transform, then its fields
+// or children. The level is checked before anything below is read, so recursion stays within
+// kMaxSdfDepth frames whatever the file's nesting.
+int ShapeReader::csg_node(const json& j, const std::string& where, int level) {
+  if (level > kMaxSdfDepth)
+    fail(where, "the CSG tree is deeper than " + std::to_string(kMaxSdfDepth) +
+                    " levels (an operator with n children counts n - 1 levels)");
+  if (!j.is_object()) fail(where, "must be a CSG node object (got " + shown(j) + ")");
+  const json* type = find(j, "type");
+  if (!type) fail(where + ".type", "is required (one of " + type_names(kCsgTypes) + ")");
+  if (!type->is_string()) fail(where + ".type", "must be a string (got " + shown(*type) + ")");
+  const CsgType* spec = find_type(kCsgTypes, type->get<std::string>());
+  if (!spec)
+    fail(where + ".type",
+         "unknown CSG node type " + shown(*type) + " (known: " + type_names(kCsgTypes) + ")");
+  check_keys(j, where, "a \"" + std::string(spec->name) + "\" CSG node", kCsgCommonKeys, spec->keys,
+             kCsgKeys);
+  const Affine3f to_local = csg_transform(j, where);
+  const int index = is_operator(spec->kind) ? csg_operator(j, where, spec->kind, level)
+                                            : add_node(csg_primitive(j, where, spec->kind), where);
+  m_tree.nodes[size_t(index)].to_local = to_local;
+  return index;
+}
+
+// An operator's children folded left to right into binary nodes, ((c0 op c1) op c2) ..., the
+// last one at `level`; returns it. Subtraction so takes each later child from the first.
+int ShapeReader::csg_operator(const json& j, const std::string& where, SdfKind kind, int level) {
+  const std::string cw = where + ".children";
+  const json* children = find(j, "children");
+  if (!children) fail(cw, "is required");
+  if (!children->is_array()) fail(cw, "must be an array of CSG nodes (got " + shown(*children) + ")");
+  const size_t n = children->size();
+  if (kind == SdfKind::Complement && n != 1)
+    fail(cw, "must hold exactly 1 CSG node (got " + std::to_string(n) + ")");
+  if (kind != SdfKind::Complement && n < 2)
+    fail(cw, "must hold at least 2 CSG nodes (got " + std::to_string(n) + ")");
+  if (uint64_t(level) + n - 1 > uint64_t(kMaxSdfDepth))
+    fail(cw, std::to_string(n) + " children fold into " + std::to_string(n - 1) +
+                 " nested binary nodes: the CSG tree would be deeper than " + std::to_string(kMaxSdfDepth) +
+                 " levels (nest balanced operators instead)");
+  SdfNode op;
+  op.kind = kind;
+  if (is_smooth(kind)) {
+    const json* r = find(j, "radius");
+    if (!r) fail(where + ".radius", "is required (the blend radius)");
+    op.radius = number(*r, where + ".radius", Bound::Positive);
+  }
+  if (kind == SdfKind::Complement) {
+    op.a = csg_node((*children)[0], idx(cw.c_str(), 0), level + 1);
+    return add_node(op, where);
+  }
+  op.a = csg_node((*children)[0], idx(cw.c_str(), 0), level + int(n) - 1);
+  for (size_t k = 1; k < n; ++k) {
+    op.b = csg_node((*children)[k], idx(cw.c_str(), k), level + int(n - k));
+    op.a = add_node(op, where);
+  }
+  return op.a;
+}
+
+SdfNode ShapeReader::csg_primitive(const json& j, const std::string& where, SdfKind kind) {
+  SdfNode n;
+  n.kind = kind;
+  switch (kind) {
+    case SdfKind::Sphere: {
+      const float r = number_or(j, "radius", where, 1, Bound::Positive);
+      n.size = {r, r, r};
+      break;
+    }
+    case SdfKind::Box:
+      n.size = vec3_or(j, "size", where, {1, 1, 1}, Bound::Positive) * 0.5f;
+      break;
+    case SdfKind::RoundBox: {
+      n.size = vec3_or(j, "size", where, {1, 1, 1}, Bound::Positive) * 0.5f;
+      const json* r = find(j, "radius");
+      if (!r) fail(where + ".radius", "is required (the edge radius)");
+      n.radius = number(*r, where + ".radius", Bound::Positive);
+      const float smallest = std::min({n.size.x, n.size.y, n.size.z});
+      if (n.radius > smallest)
+        fail(where + ".radius",
+             "must be <= the smallest half extent " + format_number(smallest) + " (got " + shown(*r) + ")");
+      break;
+    }
+    case SdfKind::Capsule:
+    case SdfKind::Cylinder:
+    case SdfKind::Cone:
+      n.radius = number_or(j, "radius", where, 0.5f, Bound::Positive);
+      n.size = {
+          n.radius,
+          number_or(j, "height", where, 1, kind == SdfKind::Capsule ? Bound::NonNegative : Bound::Positive) /
+              2,
+          n.radius};
+      break;
+    case SdfKind::Torus: {
+      n.size.x = number_or(j, "majorRadius", where, 1, Bound::Positive);
+      n.radius = number_or(j, "minorRadius", where, 0.25f, Bound::Positive);
+      if (!(n.radius < n.size.x))
+        fail(where + ".minorRadius",
+             "must be < majorRadius " + format_number(n.size.x) + " (got " + format_number(n.radius) + ")");
+      break;
+    }
+    case SdfKind::HalfSpace: {
+      const Vec3f v = vec3_or(j, "normal", where, {0, 1, 0}, Bound::Any);
+      const double len = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+      if (!(len > 0)) fail(where + ".normal", "must be non-zero");
+      n.normal = {float(v.x / len), float(v.y / len), float(v.z / len)};
+      n.offset = number_or(j, "offset", where, 0, Bound::Any);
+      break;
+    }
+    case SdfKind::ConvexPolyhedron:
+      csg_planes(j, where, n);
+      break;
+    default:
+      break;
+  }
+  return n;
+}
+
+void ShapeReader::csg_planes(const json& j, const std::string& where, SdfNode& node) {
+  const std::string pw = where + ".planes";
+  const json* planes = find(j, "planes");
+  if (!planes) fail(pw, "is required");
+  if (!planes->is_array())
+    fail(pw, "must be an array of [nx, ny, nz, d] planes (got " + shown(*planes) + ")");
+  const size_t n = planes->size();
+  if (n < 4 || n > 64) fail(pw, "must hold 4 to 64 planes (got " + std::to_string(n) + ")");
+  m_budget.charge(n * sizeof(Vec4f), pw, std::to_string(n) + " planes need");
+  node.first_plane = int(m_tree.planes.size());
+  node.plane_count = int(n);
+  for (size_t i = 0; i < n; ++i) {
+    const std::string w = idx(pw.c_str(), i);
+    const auto p = numbers<4>((*planes)[i], w, Bound::Any);
+    const double len = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+    if (!(len > 0)) fail(w, "the normal (the first three values) must be non-zero");
+    const Vec4f unit{float(p[0] / len), float(p[1] / len), float(p[2] / len), float(p[3] / len)};
+    if (!std::isfinite(unit.w)) fail(w, "d over the normal's length is beyond the 32-bit float range");
+    m_tree.planes.push_back(unit);
+  }
+}
+
+// The node's glTF-style transform (matrix, or translation x rotation x scale) placing its frame
+// in the parent's; returns its inverse, SdfNode::to_local.
+Affine3f ShapeReader::csg_transform(const json& j, const std::string& where) const {
+  Transform t;
+  const json* matrix = find(j, "matrix");
+  if (matrix) {
+    for (const char* key : {"translation", "rotation", "scale"})
+      if (find(j, key)) fail(where + ".matrix", std::string("cannot be given together with ") + key);
+    const auto m = numbers<16>(*matrix, where + ".matrix", Bound::Any);
+    if (m[3] != 0 || m[7] != 0 || m[11] != 0 || m[15] != 1)
+      fail(where + ".matrix", "must be affine (its last row 0, 0, 0, 1)");
+    std::array<double, 16> d;
+    std::copy(m.begin(), m.end(), d.begin());
+    t = from_column_major(d.data());
+  } else {
+    std::array<double, 3> tr{0, 0, 0}, sc{1, 1, 1};
+    Quat q;
+    if (const json* v = find(j, "translation")) {
+      const auto a = numbers<3>(*v, where + ".translation", Bound::Any);
+      tr = {a[0], a[1], a[2]};
+    }
+    if (const json* v = find(j, "rotation")) {
+      const auto a = numbers<4>(*v, where + ".rotation", Bound::Any);
+      q = {a[0], a[1], a[2], a[3]};
+      const double len = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+      if (!(std::fabs(len - 1) <= 1e-3))
+        fail(where + ".rotation", "must be a unit quaternion (length " + format_number(len) + ")");
+    }
+    if (const json* v = find(j, "scale")) {
+      const auto a = numbers<3>(*v, where + ".scale", Bound::NonZero);
+      sc = {a[0], a[1], a[2]};
+    }
+    t = compose_trs(tr, q, sc);
+  }
+  Transform inv;
+  Affine3f to_local, back;
+  if (!inverse(t, inv) || !is_finite(inv) || !inverse(to_local = to_affine(inv), back))
+    fail(matrix ? where + ".matrix" : where,
+         "the transform is singular or its inverse is beyond the 32-bit float range");
+  return to_local;
+}
+
+// One shape placed by its node: the SceneShape, then an instance per placement.
+void place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world) {
+  const int node = from.node;
+  const auto& gnode = ctx.model.nodes[size_t(node)];
+  const std::string where = idx("nodes", size_t(node));
+  const bool per_copy = gnode.extensions.count("EXT_mesh_gpu_instancing") > 0;
+  const uint64_t count = declared_placements(ctx, node);
+  uint64_t bytes = 0;
+  if (!mul_ok(count, sizeof(Transform) + sizeof(Instance) + kAccelBytesPerInstance, bytes))
+    bytes = UINT64_MAX;
+  ctx.charge(bytes, per_copy ? where + ".extensions.EXT_mesh_gpu_instancing" : where,
+             std::to_string(count) + (count == 1 ? " instance needs" : " instances need"));
+  const std::vector<Transform> placements = placements_of(ctx, node, world);
+  const int index = int(ctx.out.scene.shapes.size());
+  SceneShape& shape = ctx.out.scene.shapes.emplace_back();
+  shape.name = gnode.name.empty() ? where : gnode.name;
+  shape.shape = std::move(from.shape);
+  shape.material = from.material;
+  shape.node = node;
+  const Bounds3f object = shape_bounds(shape.shape);
+  uint64_t skipped = 0;
+  for (size_t k = 0; k < placements.size(); ++k) {
+    const Affine3f to_world = to_affine(placements[k]);
+    Affine3f to_object;
+    const Bounds3f b = transform_bounds(to_world, object);
+    const bool usable = inverse(to_world, to_object) && is_finite(b.lo) && is_finite(b.hi) &&
+                        std::max(max_component(abs(b.lo)), max_component(abs(b.hi))) <= 1e18f;
+    if (!usable) {
+      ++skipped;
+      continue;
+    }
+    Instance inst = make_shape_instance(index, to_world, node);
+    inst.copy = per_copy ? int(k) : -1;
+    ctx.out.scene.instances.push_back(inst);
+  }
+  if (skipped == 1 && placements.size() == 1)
+    ctx.warn(where, "singular, non-finite or huge transform; shape skipped");
+  else if (skipped > 0)
+    ctx.warn(where + ".extensions.EXT_mesh_gpu_instancing",
+             std::to_string(skipped) + " of " + std::to_string(placements.size()) +
+                 " instances have a singular, non-finite or huge transform; skipped");
+}
+
+}  // namespace
+
+std::vector<NodeShape> read_node_shapes(const json& doc, const std::string& file, MemoryBudget& budget) {
+  std::vector<NodeShape> out;
+  const auto nodes = doc.find("nodes");
+  if (nodes == doc.end() || !nodes->is_array()) return out;
+  const auto materials = doc.find("materials");
+  ShapeReader reader(file, materials != doc.end() && materials->is_array() ? materials->size() : 0, budget);
+  for (size_t i = 0; i < nodes->size(); ++i) {
+    const json& node = (*nodes)[i];
+    const auto extensions = node.find("extensions");
+    if (extensions == node.end() || !extensions->is_object()) continue;
+    const auto ext = extensions->find(kShapesExtension);
+    if (ext == extensions->end()) continue;
+    out.push_back(reader.read(*ext, int(i), idx("nodes", i) + ".extensions." + kShapesExtension));
+  }
+  return out;
+}
+
+void place_shapes(const GltfContext& ctx, std::vector<NodeShape>& shapes, NodeTransforms& nodes,
+                  const std::vector<int>& shape_nodes) {
+  for (const int node : shape_nodes) {
+    const auto it = std::lower_bound(shapes.begin(), shapes.end(), node,
+                                     [](const NodeShape& s, int n) { return s.node < n; });
+    if (it == shapes.end() || it->node != node) continue;
+    place_shape(ctx, *it, nodes.world[size_t(node)]);
+  }
+}
+
+}  // namespace penumbra::gltf
