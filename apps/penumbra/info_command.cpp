@@ -3,12 +3,63 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
 #include "renderer/integrators/scene_accel.h"
 
 namespace penumbra::cli {
+
+namespace {
+
+// A shape's kind and size in a few words: "sphere (radius 1)", "implicit (7 CSG nodes)".
+std::string describe_shape(const Shape& sh) {
+  char buf[96];
+  switch (sh.kind) {
+    case ShapeKind::Sphere:
+    case ShapeKind::Disk:
+      std::snprintf(buf, sizeof buf, "(radius %.4g)", sh.radius);
+      break;
+    case ShapeKind::Plane:
+      std::snprintf(buf, sizeof buf, "(%.4g x %.4g)", 2 * sh.half_size.x, 2 * sh.half_size.z);
+      break;
+    case ShapeKind::Box:
+      std::snprintf(buf, sizeof buf, "(%.4g x %.4g x %.4g)", 2 * sh.half_size.x, 2 * sh.half_size.y,
+                    2 * sh.half_size.z);
+      break;
+    case ShapeKind::Capsule:
+      std::snprintf(buf, sizeof buf, "(radius %.4g, height %.4g)", sh.radius, 2 * sh.half_height);
+      break;
+    case ShapeKind::Implicit:
+      std::snprintf(buf, sizeof buf, "(%zu CSG nodes)", sh.sdf.nodes.size());
+      break;
+  }
+  return std::string(shape_kind_name(sh.kind)) + " " + buf;
+}
+
+// The shapes line and one line per shape: its node, kind, material and instance count.
+void print_shapes(const Scene& s, const GltfInfo& i) {
+  std::vector<size_t> placed(s.shapes.size(), 0);
+  for (const Instance& inst : s.instances)
+    if (inst.shape >= 0) ++placed[size_t(inst.shape)];
+  std::printf("shapes       %zu, %llu instances\n", s.shapes.size(),
+              static_cast<unsigned long long>(count_shape_instances(s)));
+  for (size_t k = 0; k < s.shapes.size(); ++k) {
+    const SceneShape& sh = s.shapes[k];
+    const std::string node = sh.node >= 0 ? "nodes[" + std::to_string(sh.node) + "]" : "no node";
+    const bool named =
+        sh.node >= 0 && size_t(sh.node) < i.node_names.size() && i.node_names[size_t(sh.node)] != node;
+    const std::string material = sh.material >= 0 ? "material " + std::to_string(sh.material) + " '" +
+                                                        s.materials[size_t(sh.material)].name + "'"
+                                                  : "default material";
+    std::printf("  [%zu] %s%s%s: %s, %s, %zu instance%s\n", k, node.c_str(), named ? " '" : "",
+                named ? (i.node_names[size_t(sh.node)] + "'").c_str() : "", describe_shape(sh.shape).c_str(),
+                material.c_str(), placed[k], placed[k] == 1 ? "" : "s");
+  }
+}
+
+}  // namespace
 
 int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
              const std::string& accel_name, const std::vector<std::string>& accel_params) {
@@ -32,6 +83,7 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
   std::printf("instances    %zu (%zu in world space, %zu placed by a transform), %llu triangles rendered\n",
               s.instances.size(), s.instances.size() - placed, placed,
               static_cast<unsigned long long>(count_triangles(s)));
+  print_shapes(s, i);
   std::printf("materials    %zu\n", s.materials.size());
   for (size_t k = 0; k < s.materials.size(); ++k) {
     const auto& m = s.materials[k];

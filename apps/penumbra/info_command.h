@@ -1,4 +1,4 @@
-// `penumbra info`: what a glTF file holds (scenes, nodes, meshes, instances, materials,
+// `penumbra info`: what a glTF file holds (scenes, nodes, meshes, instances, shapes, materials,
 // cameras, lights, images, animations, extensions, bounds) and the statistics of the chosen
 // acceleration structure built over it.
 #pragma once
