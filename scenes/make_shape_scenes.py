@@ -1,0 +1,192 @@
+#!/usr/bin/env python3
+"""Writes scenes/csg.gltf and scenes/spheres.gltf: Penumbra's scenes of PENUMBRA_shapes shapes.
+
+csg.gltf: the classic CSG part (a sphere intersected with a cube, minus three orthogonal
+cylinders), a smooth union of four spheres (a blob) and a tilted torus, all implicit shapes, on
+an analytic ground plane, with two KHR_lights_punctual point lights and a perspective camera.
+
+spheres.gltf: analytic spheres of several materials (plastic, metal, chrome, matte) and a
+capsule in a room whose four walls are mirrors (metallic 1, roughness 0, analytic boxes) between
+an analytic floor and ceiling, with two point lights and a perspective camera.
+
+Both list PENUMBRA_shapes in extensionsUsed only, so tools that do not know the extension still
+load them (as empty nodes, cameras and lights). Pure JSON with no buffers; pure standard library;
+the output is deterministic, so re-running reproduces the committed files byte for byte.
+
+Usage: python3 scenes/make_shape_scenes.py [OUTPUT_DIR]   (default: scenes/)
+"""
+import json
+import math
+import os
+import sys
+
+
+class Builder:
+    def __init__(self, scene_name):
+        self.gltf = {
+            "asset": {"version": "2.0", "generator": "penumbra scenes/make_shape_scenes.py"},
+            "extensionsUsed": ["KHR_lights_punctual", "PENUMBRA_shapes"],
+            "scene": 0,
+            "scenes": [{"name": scene_name, "nodes": []}],
+            "nodes": [], "materials": [], "cameras": [],
+            "extensions": {"KHR_lights_punctual": {"lights": []}},
+        }
+
+    def material(self, name, base, metallic, roughness):
+        self.gltf["materials"].append({
+            "name": name, "doubleSided": True,
+            "pbrMetallicRoughness": {"baseColorFactor": list(base) + [1.0],
+                                     "metallicFactor": metallic, "roughnessFactor": roughness}})
+        return len(self.gltf["materials"]) - 1
+
+    def node(self, name, **fields):
+        self.gltf["nodes"].append(dict(name=name, **fields))
+        index = len(self.gltf["nodes"]) - 1
+        self.gltf["scenes"][0]["nodes"].append(index)
+        return index
+
+    def shape(self, name, shape, material, **transform):
+        """A node carrying a PENUMBRA_shapes shape (a dict with "type") with `material`."""
+        return self.node(name, extensions={"PENUMBRA_shapes": dict(shape, material=material)},
+                         **transform)
+
+    def point_light(self, name, color, intensity, position):
+        lights = self.gltf["extensions"]["KHR_lights_punctual"]["lights"]
+        lights.append({"name": name, "type": "point", "color": color, "intensity": intensity})
+        self.node(name, translation=position,
+                  extensions={"KHR_lights_punctual": {"light": len(lights) - 1}})
+
+    def camera(self, name, eye, target, yfov):
+        self.gltf["cameras"].append({"name": name, "type": "perspective", "perspective": {
+            "yfov": yfov, "aspectRatio": 16 / 9, "znear": 0.05, "zfar": 200.0}})
+        self.node(name, camera=len(self.gltf["cameras"]) - 1, translation=list(eye),
+                  rotation=look_rotation(eye, target))
+
+
+def rounded(values):
+    return [round(v, 9) + 0.0 for v in values]
+
+
+def quat_axis_angle(axis, degrees):
+    half = math.radians(degrees) / 2
+    n = math.sqrt(sum(c * c for c in axis))
+    return rounded([axis[0] / n * math.sin(half), axis[1] / n * math.sin(half),
+                    axis[2] / n * math.sin(half), math.cos(half)])
+
+
+def look_rotation(eye, target):
+    """The unit quaternion turning a glTF camera (looking down -Z, +Y up) towards `target`."""
+    f = [t - e for t, e in zip(target, eye)]
+    n = math.sqrt(sum(c * c for c in f))
+    back = [-c / n for c in f]                             # camera +Z
+    right = [back[2], 0.0, -back[0]]                       # up (0, 1, 0) x back
+    rn = math.sqrt(sum(c * c for c in right))
+    right = [c / rn for c in right]
+    up = [back[1] * right[2] - back[2] * right[1], back[2] * right[0] - back[0] * right[2],
+          back[0] * right[1] - back[1] * right[0]]
+    m = [[right[0], up[0], back[0]], [right[1], up[1], back[1]], [right[2], up[2], back[2]]]
+    w = math.sqrt(max(0.0, 1 + m[0][0] + m[1][1] + m[2][2])) / 2
+    return rounded([(m[2][1] - m[1][2]) / (4 * w), (m[0][2] - m[2][0]) / (4 * w),
+                    (m[1][0] - m[0][1]) / (4 * w), w])
+
+
+def implicit(csg, **fields):
+    return dict({"type": "implicit", "csg": csg}, **fields)
+
+
+def csg(type_, children=None, **fields):
+    node = {"type": type_}
+    if children is not None:
+        node["children"] = children
+    node.update(fields)
+    return node
+
+
+def build_csg():
+    b = Builder("csg")
+    ground = b.material("ground", (0.55, 0.55, 0.52), 0.0, 0.8)
+    red = b.material("red plastic", (0.8, 0.12, 0.08), 0.0, 0.35)
+    blue = b.material("glossy blue", (0.1, 0.25, 0.85), 0.0, 0.2)
+    gold = b.material("polished gold", (1.0, 0.78, 0.34), 1.0, 0.2)
+
+    b.shape("ground", {"type": "plane", "size": [40, 40]}, ground)
+    # The classic CSG part: (cube of edge 2 intersected with a sphere of radius 1.35) minus three
+    # cylinders of radius 0.55 along X, Y and Z.
+    cylinder = {"radius": 0.55, "height": 3}
+    part = csg("subtraction", [
+        csg("intersection", [csg("box", size=[2, 2, 2]), csg("sphere", radius=1.35)]),
+        csg("cylinder", **cylinder),
+        csg("cylinder", rotation=quat_axis_angle((0, 0, 1), 90), **cylinder),
+        csg("cylinder", rotation=quat_axis_angle((1, 0, 0), 90), **cylinder),
+    ])
+    b.shape("csg part", implicit(part), red, translation=[-2.6, 1.0, 0.0],
+            rotation=quat_axis_angle((0, 1, 0), 30))
+    # A blob: four spheres blended by a smooth union.
+    blob = csg("smoothUnion", [
+        csg("sphere", radius=0.7),
+        csg("sphere", radius=0.5, translation=[0.75, 0.35, 0.1]),
+        csg("sphere", radius=0.45, translation=[-0.55, 0.65, 0.3]),
+        csg("sphere", radius=0.4, translation=[0.15, 0.95, -0.45]),
+    ], radius=0.45)
+    b.shape("blob", implicit(blob), blue, translation=[0.0, 0.72, 0.4])
+    # A torus standing tilted on the ground.
+    torus = csg("torus", majorRadius=0.8, minorRadius=0.28)
+    b.shape("torus", implicit(torus), gold, translation=[2.6, 1.0, 0.0],
+            rotation=quat_axis_angle((1, 0, 0.3), 70))
+
+    b.point_light("warm key", [1.0, 0.88, 0.75], 80.0, [-3.0, 6.0, 4.5])
+    b.point_light("cool fill", [0.7, 0.8, 1.0], 35.0, [4.5, 4.0, 3.0])
+    b.camera("csg camera", [0.0, 3.2, 7.5], [0.0, 0.8, 0.0], 0.62)
+    return b.gltf
+
+
+def build_spheres():
+    b = Builder("mirror room")
+    mirror = b.material("mirror", (0.92, 0.92, 0.92), 1.0, 0.0)
+    floor = b.material("floor", (0.7, 0.68, 0.62), 0.0, 0.85)
+    ceiling = b.material("ceiling", (0.85, 0.85, 0.85), 0.0, 0.9)
+    materials = [
+        b.material("red plastic", (0.8, 0.1, 0.08), 0.0, 0.3),
+        b.material("gold", (1.0, 0.78, 0.34), 1.0, 0.15),
+        b.material("glossy blue", (0.08, 0.2, 0.8), 0.0, 0.2),
+        b.material("chrome", (0.95, 0.95, 0.95), 1.0, 0.0),
+        b.material("matte green", (0.15, 0.6, 0.2), 0.0, 1.0),
+    ]
+
+    W, H, D, T = 8.0, 4.0, 8.0, 0.1  # room width (x), height (y), depth (z), wall thickness
+    b.shape("floor", {"type": "plane", "size": [W, D]}, floor)
+    b.shape("ceiling", {"type": "plane", "size": [W, D]}, ceiling, translation=[0, H, 0],
+            rotation=quat_axis_angle((1, 0, 0), 180))
+    for name, size, position in [
+        ("back mirror", [W, H, T], [0, H / 2, -D / 2 - T / 2]),
+        ("front mirror", [W, H, T], [0, H / 2, D / 2 + T / 2]),
+        ("left mirror", [T, H, D], [-W / 2 - T / 2, H / 2, 0]),
+        ("right mirror", [T, H, D], [W / 2 + T / 2, H / 2, 0]),
+    ]:
+        b.shape(name, {"type": "box", "size": size}, mirror, translation=position)
+
+    for k, (radius, x, z) in enumerate([(0.7, -1.8, -0.8), (0.55, -0.2, -1.6), (0.8, 1.6, -0.6),
+                                        (0.45, 0.4, 0.5), (0.35, -1.1, 0.9)]):
+        b.shape("sphere %d" % k, {"type": "sphere", "radius": radius}, materials[k],
+                translation=[x, radius, z])
+    b.shape("capsule", {"type": "capsule", "radius": 0.3, "height": 1.2}, materials[1],
+            translation=[2.3, 0.9, -2.4], rotation=quat_axis_angle((0, 0, 1), 20))
+
+    b.point_light("key", [1.0, 0.9, 0.8], 16.0, [-1.5, 3.6, 1.5])
+    b.point_light("fill", [0.75, 0.85, 1.0], 9.0, [2.0, 3.5, -1.0])
+    b.camera("room camera", [0.0, 1.8, 3.6], [0.0, 0.6, -0.8], 0.9)
+    return b.gltf
+
+
+def main():
+    out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+    for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres)]:
+        path = os.path.join(out_dir, name)
+        with open(path, "w") as f:
+            json.dump(build(), f, indent=1)
+            f.write("\n")
+        print(path)
+
+
+if __name__ == "__main__":
+    main()
