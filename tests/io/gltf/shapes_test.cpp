@@ -2,7 +2,7 @@
 // primitives and operators against their closed-form distances, CSG and node transforms,
 // EXT_mesh_gpu_instancing and animation on shape nodes, materials, the extension lists, one test
 // per class of bad value (each error names the file, the JSON path and the field), the depth and
-// size limits.
+// size limits, and the shipped shape scenes rendered with every accelerator.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
@@ -669,5 +669,29 @@ TEST_CASE("shapes: shape placements are charged to the memory budget before they
                             Contains("over the 3.0 GiB budget"));
     else
       CHECK(count_shape_instances(test::write_and_load(w, next_name(), opt).scene) == 1000);
+  }
+}
+TEST_CASE("shapes: the shipped shape scenes load and render with every accelerator",
+          "[io][gltf][shapes][render]") {
+  for (const char* name : {"csg.gltf", "spheres.gltf"}) {
+    INFO(name);
+    const LoadedScene l = load_gltf(test::source_dir() / "scenes" / name);
+    CHECK(l.warnings.empty());
+    CHECK(l.scene.shapes.size() >= 3);
+    REQUIRE_FALSE(l.scene.cameras.empty());
+    CHECK_FALSE(l.scene.lights.empty());
+    RenderConfig cfg;
+    cfg.width = 48;
+    cfg.height = 32;
+    cfg.spp = 1;
+    for (const std::string& accel : accelerator_names()) {
+      INFO(accel);
+      const auto a = make_scene_accelerator(accel, l.scene);
+      const Film film = render_whitted(l.scene, *a, l.scene.cameras[0], cfg);
+      size_t lit = 0;
+      for (size_t i = 0; i < film.rgba.size(); i += 4)
+        if (std::max({film.rgba[i], film.rgba[i + 1], film.rgba[i + 2]}) > 0.02f) ++lit;
+      CHECK(lit > size_t(cfg.width * cfg.height) / 2);  // the shapes and the room fill most of the view
+    }
   }
 }

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# PENUMBRA_shapes through `penumbra`: files with bad shapes exit 2 from render and info with the
+# file, the JSON path and the field in the message and leave no output; the shipped shape scenes
+# render and `info` lists their shapes. Usage: shapes_test.sh PENUMBRA_BINARY SRC WORK_DIR
+set -u
+bin="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"
+fails=0; passes=0
+
+expect() {  # expect CODE PATTERN -- command...
+  local code="$1" pattern="$2"; shift 3
+  "$@" >"$work/out" 2>"$work/err"; local rc=$?
+  if [ "$rc" -ne "$code" ] || ! grep -qE -- "$pattern" "$work/out" "$work/err"; then
+    echo "FAIL: [$*] exit $rc (want $code), pattern '$pattern'"; sed 's/^/  | /' "$work/err" | head -5
+    fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+# A file whose one node carries the shape extension object $2, written to $work/$1.gltf.
+shape_file() {
+  printf '{"asset":{"version":"2.0"},"extensionsUsed":["PENUMBRA_shapes"],"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"extensions":{"PENUMBRA_shapes":%s}}]}\n' "$2" >"$work/$1.gltf"
+}
+
+ext='nodes\[0\]\.extensions\.PENUMBRA_shapes'
+shape_file radius '{"type":"implicit","csg":{"type":"union","children":[{"type":"sphere"},{"type":"sphere","radius":-1}]}}'
+shape_file type '{"type":"teapot"}'
+shape_file key '{"type":"box","radius":1}'
+shape_file unbounded '{"type":"implicit","csg":{"type":"halfSpace","normal":[0,1,0]}}'
+shape_file material '{"type":"sphere","material":0}'
+shape_file deep "{\"type\":\"implicit\",\"csg\":$(python3 -c 'import json; j={"type":"sphere"}
+for _ in range(70): j={"type":"complement","children":[j]}
+print(json.dumps({"type":"intersection","children":[j,{"type":"sphere"}]}))')}"
+for case in "radius|$ext\.csg\.children\[1\]\.radius: must be > 0" \
+            "type|$ext\.type: unknown shape type \"teapot\"" \
+            "key|$ext\.radius: does not apply to a \"box\" shape" \
+            "unbounded|$ext\.csg: the shape's inside is unbounded" \
+            "material|$ext\.material: index 0 out of range \(0 materials\)"; do
+  name="${case%%|*}"; pattern="${case#*|}"
+  rm -f "$work/$name.exr" "$work/$name.png"
+  expect 2 "penumbra: error: $work/$name.gltf: $pattern" -- "$bin" render "$work/$name.gltf" -o "$work/$name.exr" --width 32 --spp 1
+  if [ -e "$work/$name.exr" ] || [ -e "$work/$name.png" ]; then
+    echo "FAIL: $name: a refused render left $work/$name.exr"; fails=$((fails + 1))
+  fi
+  expect 2 "$pattern" -- "$bin" info "$work/$name.gltf"
+done
+# Too deep for the JSON nesting limit already (each CSG level is two JSON levels).
+expect 2 "nesting deeper than 64 levels" -- "$bin" info "$work/deep.gltf"
+
+# The shipped scenes: info lists the shapes; each renders.
+expect 0 "shapes       4, 4 instances" -- "$bin" info "$src/scenes/csg.gltf"
+expect 0 "\[1\] nodes\[1\] 'csg part': implicit \([0-9]+ CSG nodes\), material 1 'red plastic', 1 instance" -- "$bin" info "$src/scenes/csg.gltf"
+expect 0 "\[0\] nodes\[0\] 'ground': plane \(40 x 40\), material 0 'ground'" -- "$bin" info "$src/scenes/csg.gltf"
+expect 0 "sphere \(radius 0.7\)" -- "$bin" info "$src/scenes/spheres.gltf"
+expect 0 "capsule \(radius 0.3, height 1.2\)" -- "$bin" info "$src/scenes/spheres.gltf"
+for scene in csg spheres; do
+  expect 0 "$scene.png" -- "$bin" render "$src/scenes/$scene.gltf" -o "$work/$scene.exr" --width 48 --spp 1 -q
+  expect 0 "$scene-bvh.png" -- "$bin" render "$src/scenes/$scene.gltf" -o "$work/$scene-bvh.exr" --width 48 --spp 1 -q --accel bvh
+done
+# Listed in extensionsRequired, the extension loads.
+sed 's/"extensionsUsed"/"extensionsRequired":["PENUMBRA_shapes"],"extensionsUsed"/' "$work/key.gltf" | sed 's/"radius":1/"size":[1,2,3]/' >"$work/required.gltf"
+expect 0 "box \(1 x 2 x 3\), default material, 1 instance" -- "$bin" info "$work/required.gltf"
+expect 0 "required.png" -- "$bin" render "$work/required.gltf" -o "$work/required.exr" --width 32 --spp 1 -q
+
+echo "shapes cli: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]
