@@ -32,7 +32,8 @@ std::string describe_shape(const Shape& sh) {
       std::snprintf(buf, sizeof buf, "(radius %.4g, height %.4g)", sh.radius, 2 * sh.half_height);
       break;
     case ShapeKind::Implicit:
-      std::snprintf(buf, sizeof buf, "(%zu CSG nodes)", sh.sdf.nodes.size());
+      std::snprintf(buf, sizeof buf, "(%zu CSG node%s)", sh.sdf.nodes.size(),
+                    sh.sdf.nodes.size() == 1 ? "" : "s");
       break;
   }
   return std::string(shape_kind_name(sh.kind)) + " " + buf;
