@@ -653,6 +653,35 @@ TEST_CASE("shapes: CSG trees deeper than kMaxSdfDepth or larger than 4096 nodes 
   CHECK_THAT(error_of(implicit(balanced(12))), Contains("the CSG tree has more than 4096 nodes"));
 }
 
+TEST_CASE("shapes: CSG nodes are charged to the memory budget as they are read",
+          "[io][gltf][shapes][hostile][quick]") {
+  // The smallest budget that loads a 127-node tree is reached while its nodes are read (the
+  // raw JSON's DOM is still charged then); a byte less fails naming the tree.
+  GltfWriter w = shape_file(implicit(balanced(6)));
+  const auto dir = test::temp_dir(next_name());
+  w.write_embedded(dir / "scene.gltf");
+  auto loads = [&](uint64_t budget, std::string* error) {
+    GltfLoadOptions opt;
+    opt.max_memory_bytes = budget;
+    try {
+      load_gltf(dir / "scene.gltf", opt);
+      return true;
+    } catch (const InputError& e) {
+      if (error) *error = e.what();
+      return false;
+    }
+  };
+  uint64_t lo = 1, hi = 1ull << 30;  // loads(hi), !loads(lo)
+  REQUIRE(loads(hi, nullptr));
+  while (hi - lo > 1) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    (loads(mid, nullptr) ? hi : lo) = mid;
+  }
+  std::string error;
+  REQUIRE_FALSE(loads(lo, &error));
+  CHECK_THAT(error, Contains(kCsg) && Contains("its CSG node needs"));
+}
+
 TEST_CASE("shapes: shape placements are charged to the memory budget before they are made",
           "[io][gltf][shapes][hostile][quick]") {
   // Translations from an accessor without a bufferView (all zeros): 10^7 declared are refused
