@@ -21,7 +21,7 @@ class TwoLevelAccelerator final : public Accelerator {
     validate_instances(instances, meshes.size());
     const BuildTimer timer;
     std::vector<GeometryView> world;
-    std::vector<int> object_of(meshes.size(), -1);
+    std::vector<int> object_of(meshes.size(), -1), shape_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
       if (is_identity(inst.to_world)) {
@@ -31,6 +31,21 @@ class TwoLevelAccelerator final : public Accelerator {
       }
       Affine3f to_object;
       if (!inverse(inst.to_world, to_object)) continue;  // singular: never hit
+      if (const Shape* shape = meshes[inst.mesh].shape) {
+        // A placed shape is tested directly in the top level's leaf: a bottom-level structure
+        // over its one primitive would only add a traversal.
+        int& copy = shape_of[inst.mesh];
+        if (copy < 0) {
+          copy = int(m_shapes.size());
+          m_shapes.push_back(*shape);
+        }
+        const Bounds3f b = shape_bounds(*shape);
+        if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) continue;  // never hit
+        m_items.push_back(
+            {kShapeLevel, uint32_t(i), to_object, transform_bounds(inst.to_world, b), uint32_t(copy)});
+        ++m_instances;
+        continue;
+      }
       int& object = object_of[inst.mesh];
       if (object < 0) {
         object = int(m_levels.size());
@@ -40,7 +55,7 @@ class TwoLevelAccelerator final : public Accelerator {
                          transform_bounds(inst.to_world, m_levels[size_t(object)]->bounds())});
       ++m_instances;
     }
-    if (!world.empty()) {
+    if (!world.empty() || m_levels.empty()) {  // an empty world level still names the back end
       m_levels.push_back(build(world));
       m_items.push_back({uint32_t(m_levels.size() - 1), kWorld, Affine3f{}, m_levels.back()->bounds()});
     }
@@ -58,8 +73,11 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
   bool occluded(const Ray& ray) const override {
-    return walk(ray, ray.tfar, nullptr,
-                [&](const Item& item, const Ray& local) { return m_levels[item.level]->occluded(local); });
+    return walk(ray, ray.tfar, nullptr, [&](const Item& item, const Ray& local) {
+      if (item.level != kShapeLevel) return m_levels[item.level]->occluded(local);
+      ShapeHit sh;
+      return intersect_shape(m_shapes[item.shape], local, sh);
+    });
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -71,6 +89,7 @@ class TwoLevelAccelerator final : public Accelerator {
       s.config = m_stats_bottom.front().config;
     }
     s.instances = m_instances;
+    s.shapes = m_shapes.size();  // placed shapes; the levels add the world's
     uint64_t bottom_depth = 0;
     for (const AccelStats& b : m_stats_bottom) {
       s.triangles += b.triangles;
@@ -94,13 +113,15 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
  private:
-  static constexpr uint32_t kWorld = 0xffffffffu;  // Item::instance of the world-space level
+  static constexpr uint32_t kWorld = 0xffffffffu;       // Item::instance of the world-space level
+  static constexpr uint32_t kShapeLevel = 0xffffffffu;  // Item::level of a placed shape
 
   struct Item {
-    uint32_t level;     // index into m_levels
+    uint32_t level;     // index into m_levels, or kShapeLevel
     uint32_t instance;  // the instance index reported in hits, or kWorld
     Affine3f to_object;
-    Bounds3f box;  // world bounds
+    Bounds3f box;        // world bounds
+    uint32_t shape = 0;  // index into m_shapes when level == kShapeLevel
   };
 
   void build_top() {
@@ -126,7 +147,7 @@ class TwoLevelAccelerator final : public Accelerator {
     for (const BvhNode& n : m_nodes)
       if (n.count == 0) cost += surface_area({n.lo, n.hi}) / root_area;
     for (const Item& item : m_items) {
-      const double level_cost = m_stats_bottom[item.level].sah_cost;
+      const double level_cost = item.level == kShapeLevel ? 1.0 : m_stats_bottom[item.level].sah_cost;
       known = known && level_cost > 0;
       cost += surface_area(item.box) / root_area * level_cost;
     }
@@ -167,6 +188,15 @@ class TwoLevelAccelerator final : public Accelerator {
     hit = Hit{};
     float best = ray.tfar;
     walk(ray, best, cost, [&](const Item& item, const Ray& local) {
+      if (item.level == kShapeLevel) {
+        ShapeHit sh;
+        const bool found = intersect_shape(m_shapes[item.shape], local, sh);
+        if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
+        if (!found) return false;
+        best = sh.t;
+        hit = {sh.t, 0, 0, item.instance, 0};
+        return false;
+      }
       Hit h;
       const Accelerator& level = *m_levels[item.level];
       if (!(cost ? level.intersect_counted(local, h, *cost) : level.intersect(local, h))) return false;
@@ -179,6 +209,7 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
   std::vector<std::unique_ptr<Accelerator>> m_levels;  // bottom levels: per mesh, then world
+  std::vector<Shape> m_shapes;                         // the placed shapes, one copy per view
   std::vector<uint32_t> m_world_ids;                   // world level's geom_id -> instance index
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<BvhNode> m_nodes;                        // top level, depth first

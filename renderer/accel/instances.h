@@ -18,12 +18,14 @@ namespace penumbra {
 /// Builds one back end's structure over some meshes (geom_id = index in the span).
 using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<const GeometryView>)>;
 
-/// Two-level structure over `instances` of `meshes`; a Hit's geom_id is the instance index and
-/// its t is measured along the world ray (object-space rays keep the parameterisation: the
-/// direction is mapped, not normalised). `build` makes every bottom level: one per mesh used by a
-/// non-identity instance, and one over the identity instances' meshes. Instances with a singular
-/// or non-finite map are left out. Throws std::invalid_argument if an instance names a mesh
-/// outside `meshes`, and whatever `build` throws.
+/// Two-level structure over `instances` of `meshes` (views of meshes or shapes); a Hit's geom_id
+/// is the instance index and its t is measured along the world ray (object-space rays keep the
+/// parameterisation: the direction is mapped, not normalised). `build` makes every bottom level:
+/// one per mesh used by a non-identity instance, and one over the identity instances' views
+/// (built even when empty). A shape placed by a non-identity instance has no bottom level: the
+/// top level's leaf maps the ray and calls the shape test itself. Instances with a singular or
+/// non-finite map are left out. Throws std::invalid_argument if an instance names a mesh outside
+/// `meshes`, and whatever `build` throws.
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
                                                         std::span<const GeometryView> meshes,
                                                         std::span<const InstanceView> instances);
