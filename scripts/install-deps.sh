@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs Penumbra's build and runtime dependencies from Debian 12's archive.
+# Installs Penumbra's build and runtime dependencies from Debian 12's archive, and the tools
+# its tests run against (Blender's glTF importer, which needs NumPy).
 # Idempotent: only packages that are missing are installed. Needs root (or sudo).
 set -euo pipefail
 
@@ -11,6 +12,7 @@ PACKAGES=(
   libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
   catch2 libcli11-dev libbenchmark-dev
   python3 clang-format
+  blender python3-numpy
 )
 
 missing=()
