@@ -49,16 +49,20 @@ void print_render_summary(const RenderJob& job) {
                     stats.passes, stats.time_limited ? ", stopped by --time-limit" : "", a.sampler.c_str(),
                     cfg.adaptive_threshold > 0 ? ", adaptive" : "")
            : format("%d spp", cfg.spp);
+  const std::string shapes_text = scene.shapes.empty()
+                                      ? std::string()
+                                      : format(" and %zu shapes (%llu placed)", scene.shapes.size(),
+                                               static_cast<unsigned long long>(count_shape_instances(scene)));
   std::fprintf(
       stderr,
       "penumbra render %s\n"
-      "  scene    %zu meshes in %zu instances, %s triangles (%s stored), %zu materials, %zu lights%s\n"
+      "  scene    %zu meshes%s in %zu instances, %s triangles (%s stored), %zu materials, %zu lights%s\n"
       "  camera   %s (%s)\n"
       "  image    %dx%d, %s, %s max-depth %d, filter %s %.3g px, %d threads, accel %s\n"
       "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
       "  rays     camera %s  shadow %s  %s %s  total %s  (%.2f Mrays/s)\n"
       "  memory   peak %.1f MiB\n",
-      a.scene_file.c_str(), scene.meshes.size(), scene.instances.size(),
+      a.scene_file.c_str(), scene.meshes.size(), shapes_text.c_str(), scene.instances.size(),
       human_count(count_triangles(scene)).c_str(), human_count(count_stored_triangles(scene)).c_str(),
       scene.materials.size(), scene.lights.size(), job.default_light ? " (default key light)" : "",
       job.camera.name.c_str(),

@@ -43,6 +43,7 @@ std::string stats_json_text(const RenderJob& job) {
   j["mrays_per_second"] = stats.seconds > 0 ? double(stats.rays.total()) / stats.seconds / 1e6 : 0.0;
   j["peak_memory_mib"] = peak_memory_mib();
   j["triangles"] = count_triangles(scene);
+  j["shapes"] = count_shape_instances(scene);
   j["instances"] = scene.instances.size();
   j["lights"] = scene.lights.size();
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";

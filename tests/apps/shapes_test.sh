@@ -62,6 +62,10 @@ done
 sed 's/"extensionsUsed"/"extensionsRequired":["PENUMBRA_shapes"],"extensionsUsed"/' "$work/key.gltf" | sed 's/"radius":1/"size":[1,2,3]/' >"$work/required.gltf"
 expect 0 "box \(1 x 2 x 3\), default material, 1 instance" -- "$bin" info "$work/required.gltf"
 expect 0 "required.png" -- "$bin" render "$work/required.gltf" -o "$work/required.exr" --width 32 --spp 1 -q
+# The render summary and --stats-json count the placed shapes (csg.gltf: three implicit shapes
+# and the analytic ground).
+expect 0 "4 shapes \(4 placed\)" -- "$bin" render "$src/scenes/csg.gltf" -o "$work/csg.exr" --width 32 --spp 1 --no-png --stats-json "$work/csg.json"
+expect 0 '^4$' -- python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shapes"])' "$work/csg.json"
 
 echo "shapes cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]
