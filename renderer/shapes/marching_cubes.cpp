@@ -160,13 +160,14 @@ void triangulate_cell(const float f[8], CellSurface& out) {
   for (int e0 = 0; e0 < 12; ++e0) {
     if (next[e0] < 0 || visited[e0]) continue;
     const int begin = used;
-    for (int e = e0; !visited[e]; e = next[e]) {
+    for (int e = e0; e >= 0 && !visited[e] && used < 12; e = next[e]) {
       assert(next[e] >= 0);
       visited[e] = true;
       out.loop_edges[used++] = uint8_t(e);
     }
     const uint8_t* loop = out.loop_edges + begin;
     const int n = used - begin;
+    if (n < 3) continue;  // never: every crossing has one segment in and one out
     const int k = n == 3 ? 0 : best_fan_start(f, loop, n);
     if (k >= 0) {
       for (int j = 1; j <= n - 2; ++j) {
