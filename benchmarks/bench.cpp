@@ -2,10 +2,12 @@
 // seeded generated scenes) and the same pre-generated ray sets (primary, shadow, diffuse,
 // random), verifies every structure's answers against Embree (disagreements settled by the exact
 // brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
-// SVG chart and traversal-cost heat maps. See README, "Benchmarks", and benchmarks/RESULTS.md.
+// SVG chart and traversal-cost heat maps; with --marching-cubes, instead, isosurface extraction of
+// the classic CSG part in cells per second. See README, "Benchmarks", and benchmarks/RESULTS.md.
 #include <sys/utsname.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <tbb/version.h>
 
 #include <CLI/CLI.hpp>
@@ -37,6 +39,7 @@
 #include "renderer/scene/camera.h"
 #include "renderer/scene/interaction.h"
 #include "renderer/scene/scene.h"
+#include "renderer/shapes/marching_cubes.h"
 
 using namespace penumbra;
 
@@ -224,6 +227,62 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
   return load_gltf(spec, options).scene;
 }
 
+/// The classic CSG part: a sphere of radius 1.35 intersected with the cube [-1, 1]^3, minus three
+/// cylinders of radius 0.5 along X, Y and Z (the shape of the marching-cubes tests).
+SdfTree csg_part_tree() {
+  SdfTree t;
+  const auto add = [&](SdfKind kind, Vec3f size, float radius, int a = -1, int b = -1) {
+    SdfNode n;
+    n.kind = kind, n.size = size, n.radius = radius, n.a = a, n.b = b;
+    t.nodes.push_back(n);
+    return int(t.nodes.size()) - 1;
+  };
+  const int body = add(SdfKind::Intersection, {}, 0, add(SdfKind::Sphere, {1.35f, 0, 0}, 0),
+                       add(SdfKind::Box, {1, 1, 1}, 0));
+  const int along_y = add(SdfKind::Cylinder, {0, 1.5f, 0}, 0.5f);
+  const int along_x = add(SdfKind::Cylinder, {0, 1.5f, 0}, 0.5f);
+  const int along_z = add(SdfKind::Cylinder, {0, 1.5f, 0}, 0.5f);
+  t.nodes[size_t(along_x)].to_local = {{{0, 1, 0, 0}, {1, 0, 0, 0}, {0, 0, -1, 0}}};  // local y = x
+  t.nodes[size_t(along_z)].to_local = {{{1, 0, 0, 0}, {0, 0, 1, 0}, {0, -1, 0, 0}}};  // local y = z
+  const int holes = add(SdfKind::Union, {}, 0, along_x, add(SdfKind::Union, {}, 0, along_y, along_z));
+  t.root = add(SdfKind::Subtraction, {}, 0, body, holes);
+  return t;
+}
+
+/// --marching-cubes: extracts the CSG part's surface at each resolution on arenas of each thread
+/// count (one warm-up, then the median of `repeats`) and prints grid cells per second.
+int run_marching_cubes(const std::vector<int>& resolutions, const std::vector<int>& threads, int repeats) {
+  const SdfTree part = csg_part_tree();
+  const Bounds3f box{{-1, -1, -1}, {1, 1, 1}};
+  for (int r : resolutions) marching_cubes_grid(box, r, {});  // bad resolutions fail before measuring
+  std::printf("%-10s %5s %12s %10s %10s %9s", "shape", "res", "cells", "vertices", "triangles", "MiB");
+  for (int t : threads) std::printf("  %4dT ms  Mcells/s", t > 0 ? t : int(tbb::info::default_concurrency()));
+  std::printf("\n");
+  for (int r : resolutions) {
+    const MarchingCubesGrid g = marching_cubes_grid(box, r, {});
+    const double cells = double(g.n[0]) * double(g.n[1]) * double(g.n[2]);
+    IsosurfaceMesh mesh;
+    std::vector<double> ms;
+    for (int t : threads) {
+      tbb::task_arena arena(t > 0 ? t : int(tbb::info::default_concurrency()));
+      std::vector<double> secs;
+      for (int i = 0; i <= repeats; ++i) {
+        mesh = {};
+        const auto t0 = Clock::now();
+        arena.execute([&] { mesh = extract_isosurface(part, box, r); });
+        if (i > 0) secs.push_back(seconds_since(t0));  // the first run warms up
+      }
+      ms.push_back(median(secs) * 1e3);
+    }
+    std::printf("%-10s %5d %12.0f %10zu %10zu %9.1f", "csg-part", r, cells, mesh.positions.size(),
+                mesh.indices.size() / 3, double(marching_cubes_bytes(box, r)) / (1 << 20));
+    for (double m : ms) std::printf("  %8.1f %9.2f", m, cells / (m * 1e-3) / 1e6);
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 struct Row {
   std::string scene, accel, kind, config;
   uint64_t triangles = 0, shapes = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
@@ -385,6 +444,7 @@ int main(int argc, char** argv) {
   int width = 512, height = 288, builds = 5, repeats = 3;
   std::string csv, json, svg, heatmaps;
   uint64_t seed = 1;
+  std::vector<int> mc_resolutions;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
@@ -412,11 +472,21 @@ int main(int argc, char** argv) {
       "into this folder: SCENE.ACCEL.cost.png (for embree, which keeps no counts: nanoseconds per ray)");
   app.add_option("--svg", svg,
                  "also write a bar chart of throughput and build time as SVG (written atomically)");
+  app.add_option("--marching-cubes", mc_resolutions,
+                 "instead of the structures: extract the CSG part's surface at these resolutions (comma "
+                 "separated, e.g. 64,128,256,512) with each --threads count, --repeats times")
+      ->delimiter(',');
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;  // usage errors exit 2, as for penumbra
   }
+  if (!mc_resolutions.empty()) try {
+      return run_marching_cubes(mc_resolutions, threads, repeats);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
+    }
   if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
   std::string command;
   for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);

@@ -152,6 +152,9 @@ int best_fan_start(const float f[8], const uint8_t* loop, int n) {
 
 // The cell's loops and their triangles (counter-clockwise seen from outside).
 void triangulate_cell(const float f[8], CellSurface& out) {
+  unsigned in = 0;
+  for (int c = 0; c < 8; ++c) in |= unsigned(inside(f[c])) << c;
+  if (in == 0 || in == 255) return;  // no crossings
   int next[12];
   for (int& e : next) e = -1;
   join_face_crossings(f, next);
