@@ -423,14 +423,17 @@ uint64_t mesh_bytes(uint64_t vertices, uint64_t triangles) {
   return vertices * 2 * sizeof(Vec3f) + triangles * 3 * sizeof(uint32_t);
 }
 
+uint64_t marching_cubes_work_bytes(const Bounds3f& box, int resolution, const MarchingCubesConfig& config) {
+  const MarchingCubesGrid g = marching_cubes_grid(box, resolution, config);
+  const uint64_t rows = uint64_t(g.n[1] + 1) * uint64_t(g.n[2] + 1);
+  return rows * uint64_t(g.n[0] + 1) * sizeof(float) + 2 * (rows + 1) * sizeof(uint64_t);
+}
+
 uint64_t marching_cubes_bytes(const Bounds3f& box, int resolution, const MarchingCubesConfig& config) {
   const MarchingCubesGrid g = marching_cubes_grid(box, resolution, config);
   const uint64_t nx = uint64_t(g.n[0]), ny = uint64_t(g.n[1]), nz = uint64_t(g.n[2]);
-  const uint64_t rows = (ny + 1) * (nz + 1);
-  const uint64_t values = rows * (nx + 1) * sizeof(float);
-  const uint64_t offsets = 2 * (rows + 1) * sizeof(uint64_t);
   const uint64_t boundary_cells = 2 * (nx * ny + ny * nz + nx * nz);
-  return values + offsets + 2 * boundary_cells * mesh_bytes(1, 2);
+  return marching_cubes_work_bytes(box, resolution, config) + 2 * boundary_cells * mesh_bytes(1, 2);
 }
 
 IsosurfaceMesh extract_isosurface(const SdfTree& tree, const Bounds3f& box, int resolution,

@@ -50,11 +50,16 @@ struct IsosurfaceMesh {
 /// Bytes of a mesh's arrays.
 uint64_t mesh_bytes(uint64_t vertices, uint64_t triangles);
 
-/// What extract_isosurface() allocates, for memory budgets: the grid values (4 bytes per grid
-/// point) and two offset tables (16 bytes per grid row along x) exactly, plus an estimate of the
-/// mesh: a vertex and two triangles (48 bytes) per cell of the grid's boundary, twice over,
-/// which covers convex and moderately folded surfaces; config.max_output_bytes bounds the mesh
-/// exactly. Throws as marching_cubes_grid().
+/// The working memory of extract_isosurface() besides its mesh, exactly: the grid values (4 bytes
+/// per grid point) and two offset tables (16 bytes per grid row along x). Throws as
+/// marching_cubes_grid().
+uint64_t marching_cubes_work_bytes(const Bounds3f& box, int resolution,
+                                   const MarchingCubesConfig& config = {});
+
+/// What extract_isosurface() allocates, for memory budgets: its working memory plus an estimate
+/// of the mesh, a vertex and two triangles (48 bytes) per cell of the grid's boundary, twice over,
+/// which covers convex and moderately folded surfaces (config.max_output_bytes bounds the mesh
+/// exactly). Throws as marching_cubes_grid().
 uint64_t marching_cubes_bytes(const Bounds3f& box, int resolution, const MarchingCubesConfig& config = {});
 
 /// Extracts the surface f = 0 of `tree` (in the tree's frame) inside `box` at `resolution` cells
