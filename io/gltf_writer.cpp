@@ -205,12 +205,10 @@ void write_lights(Writer& wr, const Scene& scene) {
   }
 }
 
-}  // namespace
-
-void write_gltf(const Scene& scene, const std::filesystem::path& file) {
+// The document and its binary buffer; the buffer's uri is `bin_uri` (empty: none, for GLB).
+Writer build_document(const Scene& scene, const std::filesystem::path& file, const std::string& bin_uri) {
   Writer wr;
   wr.file = file.string();
-  const std::string bin_name = file.stem().string() + ".bin";
   wr.j = {{"asset", {{"version", "2.0"}, {"generator", "Penumbra write_gltf"}}},
           {"accessors", json::array()},
           {"bufferViews", json::array()},
@@ -228,24 +226,57 @@ void write_gltf(const Scene& scene, const std::filesystem::path& file) {
   if (emissive_strength) used.push_back("KHR_materials_emissive_strength");
   if (unlit) used.push_back("KHR_materials_unlit");
   if (!used.empty()) wr.j["extensionsUsed"] = used;
-  if (!wr.bin.empty()) wr.j["buffers"] = {{{"byteLength", wr.bin.size()}, {"uri", bin_name}}};
-
-  try {
-    if (!wr.bin.empty()) {
-      const auto bin_path = file.parent_path() / bin_name;
-      write_atomically(bin_path, [&](const std::filesystem::path& tmp) {
-        write_file_checked(tmp, wr.bin.data(), wr.bin.size(), bin_path);
-      });
-    }
-    const std::string text = wr.j.dump(1);
-    write_atomically(file, [&](const std::filesystem::path& tmp) {
-      write_file_checked(tmp, text.data(), text.size(), file);
-    });
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw InputError(wr.file, "", e.what());
+  if (!wr.bin.empty()) {
+    wr.j["buffers"] = {{{"byteLength", wr.bin.size()}}};
+    if (!bin_uri.empty()) wr.j["buffers"][0]["uri"] = bin_uri;
   }
+  return wr;
+}
+
+void append_u32(std::vector<uint8_t>& out, uint32_t v) {
+  for (int b = 0; b < 4; ++b) out.push_back(uint8_t(v >> (8 * b)));  // little endian
+}
+
+}  // namespace
+
+void write_gltf(const Scene& scene, const std::filesystem::path& file) {
+  const std::string bin_name = file.stem().string() + ".bin";
+  const Writer wr = build_document(scene, file, bin_name);
+  if (!wr.bin.empty()) {
+    const auto bin_path = file.parent_path() / bin_name;
+    write_atomically(bin_path, [&](const std::filesystem::path& tmp) {
+      write_file_checked(tmp, wr.bin.data(), wr.bin.size(), bin_path);
+    });
+  }
+  const std::string text = wr.j.dump(1);
+  write_atomically(file, [&](const std::filesystem::path& tmp) {
+    write_file_checked(tmp, text.data(), text.size(), file);
+  });
+}
+
+void write_glb(const Scene& scene, const std::filesystem::path& file) {
+  const Writer wr = build_document(scene, file, "");
+  std::string text = wr.j.dump();
+  while (text.size() % 4) text.push_back(' ');
+  const size_t bin_padded = (wr.bin.size() + 3) / 4 * 4;
+  const uint64_t total = 12 + 8 + text.size() + (wr.bin.empty() ? 0 : 8 + bin_padded);
+  if (total > UINT32_MAX) throw InputError(file.string(), "", "a GLB file is limited to 4 GiB");
+  std::vector<uint8_t> glb;
+  glb.reserve(size_t(total));
+  append_u32(glb, 0x46546C67u);  // "glTF"
+  append_u32(glb, 2);
+  append_u32(glb, uint32_t(total));
+  append_u32(glb, uint32_t(text.size()));
+  append_u32(glb, 0x4E4F534Au);  // "JSON"
+  glb.insert(glb.end(), text.begin(), text.end());
+  if (!wr.bin.empty()) {
+    append_u32(glb, uint32_t(bin_padded));
+    append_u32(glb, 0x004E4942u);  // "BIN\0"
+    glb.insert(glb.end(), wr.bin.begin(), wr.bin.end());
+    glb.resize(size_t(total), 0);
+  }
+  write_atomically(
+      file, [&](const std::filesystem::path& tmp) { write_file_checked(tmp, glb.data(), glb.size(), file); });
 }
 
 }  // namespace penumbra

@@ -1,6 +1,7 @@
 // glTF 2.0 writing: a renderer Scene (meshes placed by instances, metallic-roughness factors,
-// punctual lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it. Used by
-// the benchmark scene generator and the PLY converter; load_gltf() reads the result back.
+// punctual lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it, or as
+// one binary .glb. Used by the benchmark scene generator, the PLY converter and `penumbra mesh`;
+// load_gltf() reads the result back.
 #pragma once
 
 #include <filesystem>
@@ -15,9 +16,16 @@ namespace penumbra {
 /// using it (with a matrix unless the identity), so shared meshes stay shared; lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
 /// Shape instances are not written.
-/// Throws InputError naming the file if it cannot be written or the scene cannot be expressed
-/// (a buffer over 4 GiB, an index out of range, an index count not a multiple of 3, a non-finite
-/// position, an instance of a mesh that does not exist).
+/// Throws InputError naming the file if its target is refused (resolve_output) or the scene
+/// cannot be expressed (a buffer over 4 GiB, an index out of range, an index count not a
+/// multiple of 3, a non-finite position, an instance of a mesh that does not exist), and
+/// std::runtime_error with the system's reason if a write, sync or rename fails.
 void write_gltf(const Scene& scene, const std::filesystem::path& file);
+
+/// The same document as one binary glTF (.glb, glTF 2.0 spec 4.4), written atomically: a 12-byte
+/// header (magic "glTF", version 2, total length), the JSON chunk padded with spaces and the BIN
+/// chunk (the geometry, absent when there is none) padded with zeros to 4 bytes, little endian;
+/// the buffer has no uri. Throws as write_gltf(), and InputError for a file over 4 GiB.
+void write_glb(const Scene& scene, const std::filesystem::path& file);
 
 }  // namespace penumbra

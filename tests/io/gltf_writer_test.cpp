@@ -1,9 +1,13 @@
 // write_gltf: everything it writes comes back through load_gltf (geometry bit for bit,
-// materials, lights and cameras), and bad scenes or folders fail without leaving files.
+// materials, lights and cameras), as .gltf + .bin and as one .glb (its chunks checked byte by
+// byte), and bad scenes or folders fail without leaving files.
 #include "io/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <fstream>
+#include <iterator>
+#include <vector>
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
@@ -144,5 +148,61 @@ TEST_CASE("write_gltf: bad scenes and folders fail with the element named and le
                     Catch::Contains("meshes[0]: index count 4 is not a multiple of 3"));
   CHECK(std::filesystem::is_empty(dir));
   CHECK_THROWS_AS(write_gltf(sample_scene(), dir / "missing" / "x.gltf"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("write_glb: one binary file with aligned, padded chunks that load_gltf reads back",
+          "[gltf][writer]") {
+  const Scene s = sample_scene();
+  const auto dir = temp_dir("glb-writer");
+  write_glb(s, dir / "scene.glb");
+  CHECK(!std::filesystem::exists(dir / "scene.bin"));
+  // The container, byte by byte (glTF 2.0 spec 4.4): header, JSON chunk, BIN chunk.
+  std::ifstream f(dir / "scene.glb", std::ios::binary);
+  const std::vector<uint8_t> b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const auto u32 = [&](size_t at) {
+    return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 | uint32_t(b[at + 3]) << 24;
+  };
+  REQUIRE(b.size() >= 28);
+  CHECK(std::memcmp(b.data(), "glTF", 4) == 0);
+  CHECK(u32(4) == 2);
+  CHECK(u32(8) == b.size());
+  const uint32_t json_length = u32(12);
+  CHECK(json_length % 4 == 0);
+  CHECK(std::memcmp(b.data() + 16, "JSON", 4) == 0);
+  CHECK(b[20] == '{');
+  size_t last = 20 + json_length - 1;
+  while (b[last] == ' ') --last;
+  CHECK(b[last] == '}');
+  const size_t bin = 20 + json_length;
+  REQUIRE(b.size() >= bin + 8);
+  CHECK(std::memcmp(b.data() + bin + 4, "BIN\0", 4) == 0);
+  CHECK(u32(bin) % 4 == 0);
+  CHECK(bin + 8 + u32(bin) == b.size());
+  // The same scene as through write_gltf.
+  const LoadedScene l = load_gltf(dir / "scene.glb");
+  CHECK(l.warnings.empty());
+  REQUIRE(l.scene.meshes.size() == s.meshes.size());
+  for (size_t i = 0; i < s.meshes.size(); ++i) {
+    CHECK(l.scene.meshes[i].indices == s.meshes[i].indices);
+    REQUIRE(l.scene.meshes[i].positions.size() == s.meshes[i].positions.size());
+    CHECK(std::memcmp(l.scene.meshes[i].positions.data(), s.meshes[i].positions.data(),
+                      s.meshes[i].positions.size() * 12) == 0);
+    CHECK(l.scene.meshes[i].material == s.meshes[i].material);
+  }
+  CHECK(l.scene.materials.size() == 3);
+  CHECK(l.scene.cameras.size() == 2);
+  // A scene without geometry has no BIN chunk.
+  Scene empty;
+  empty.lights = s.lights;
+  write_glb(empty, dir / "empty.glb");
+  CHECK(std::filesystem::file_size(dir / "empty.glb") == 20 + [&] {
+    std::ifstream e(dir / "empty.glb", std::ios::binary);
+    uint8_t h[16];
+    e.read(reinterpret_cast<char*>(h), 16);
+    return size_t(h[12]) | size_t(h[13]) << 8 | size_t(h[14]) << 16 | size_t(h[15]) << 24;
+  }());
+  CHECK(load_gltf(dir / "empty.glb").scene.lights.size() == 3);
+  CHECK_THROWS_AS(write_glb(s, dir / "missing" / "x.glb"), InputError);
   std::filesystem::remove_all(dir);
 }
