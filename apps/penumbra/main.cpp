@@ -1,7 +1,8 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
-// `info`, assemble farm tiles with `merge`. This file wires the subcommands' flags (CLI11) and
-// maps errors to exit codes: 0 success, 2 bad input or usage, 1 a failure outside the input
-// (I/O, memory); a render ended by a signal returns 128 + signal. Only main() exits.
+// `info`, assemble farm tiles with `merge`, turn its implicit shapes into triangle meshes with
+// `mesh`. This file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success,
+// 2 bad input or usage, 1 a failure outside the input (I/O, memory); a render ended by a signal
+// returns 128 + signal. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
@@ -9,6 +10,7 @@
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/info_command.h"
 #include "apps/penumbra/merge_command.h"
+#include "apps/penumbra/mesh_command.h"
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
 #include "io/error.h"
@@ -47,6 +49,23 @@ void add_merge_options(CLI::App& merge, MergeArgs& a) {
       "cut by other tools); the windows and channels are still checked");
 }
 
+void add_mesh_options(CLI::App& mesh, MeshArgs& a) {
+  mesh.add_option("scene", a.scene_file, "glTF scene (.gltf or .glb)")->required();
+  mesh.add_option("-o,--output", a.output, "the meshes as .glb, or .gltf with OUT.bin beside it (atomically)")
+      ->required();
+  mesh.add_option("--resolution", a.resolution,
+                  "marching-cubes cells along the longest axis of each shape's bounds (1 to 4096)")
+      ->required();
+  mesh.add_option("--node", a.node, "only the implicit shapes of this glTF node (index or name)");
+  mesh.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
+  mesh.add_option(
+      "--max-memory", a.max_memory,
+      "one budget for the scene, the sampling grids and the meshes, e.g. 4G (default: half the RAM)");
+  mesh.add_flag("--allow-external-uris", a.allow_external,
+                "let buffer URIs reach files outside the scene's folder");
+  mesh.add_flag("-q,--quiet", a.quiet, "no warnings or summary");
+}
+
 int report(const char* kind, const char* what, int code) {
   std::fprintf(stderr, "penumbra: %s: %s\n", kind, what);
   return code;
@@ -70,6 +89,11 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand(
       "merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   add_merge_options(*merge, merge_args);
+  MeshArgs mesh_args;
+  auto* mesh = app.add_subcommand(
+      "mesh",
+      "Extract the implicit shapes of a glTF scene as triangle meshes (marching cubes) into a .glb or .gltf");
+  add_mesh_options(*mesh, mesh_args);
 
   try {
     app.parse(argc, argv);
@@ -81,6 +105,7 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
+    if (*mesh) return run_mesh(mesh_args);
     if (*info)
       return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,
                       info_args.accel, info_args.accel_params);
