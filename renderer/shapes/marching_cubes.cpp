@@ -62,6 +62,9 @@ constexpr CubeTables make_cube_tables() {
 
 constexpr CubeTables kCube = make_cube_tables();
 
+// Set bits of a 3-bit mask (std::popcount is a library call on portable x86-64).
+constexpr int kBitCount[8] = {0, 1, 1, 2, 1, 2, 2, 3};
+
 bool inside(float f) {
   return f < 0;  // f >= 0 and NaN are outside
 }
@@ -286,8 +289,8 @@ struct RowCursor {
 
   uint64_t vertex(int dx, int axis) const {
     const unsigned mask = dx ? mask_i1 : mask_i;
-    const uint64_t skip = dx ? before + std::popcount(mask_i) : before;
-    return base + skip + std::popcount(mask & ((1u << axis) - 1));
+    const uint64_t skip = dx ? before + kBitCount[mask_i] : before;
+    return base + skip + kBitCount[mask & ((1u << axis) - 1)];
   }
 };
 
@@ -299,13 +302,50 @@ size_t row_count(const MarchingCubesGrid& grid) {
   return size_t(grid.n[1] + 1) * size_t(grid.n[2] + 1);
 }
 
+// Grid points are sampled in blocks of kBlock^3. With skip_far_blocks, a block whose centre value
+// exceeds L times (its half-diagonal + one cell) has the centre's sign at every point within a
+// cell of it, so no crossing edge, four-crossing face or loop touches its points: they only need
+// that sign, and take the centre's value. The mesh is the same as with every point evaluated.
+constexpr int kBlock = 8;
+
+void sample_block(GridValues& g, float lipschitz, const int lo[3], const int hi[3]) {
+  if (lipschitz > 0) {
+    Vec3f centre, half;
+    for (int a = 0; a < 3; ++a) {
+      centre[a] = g.grid.origin[a] + g.grid.cell * 0.5f * float(lo[a] + hi[a] - 1);
+      half[a] = 0.5f * float(hi[a] - lo[a] - 1);
+    }
+    const float reach = lipschitz * g.grid.cell * (length(half) + 1);
+    const float fc = sdf_eval(g.tree, centre);
+    if (std::isfinite(fc) && std::abs(fc) > 1.01f * reach) {
+      for (int k = lo[2]; k < hi[2]; ++k)
+        for (int j = lo[1]; j < hi[1]; ++j)
+          for (int i = lo[0]; i < hi[0]; ++i) g.values[g.index(i, j, k)] = fc;
+      return;
+    }
+  }
+  for (int k = lo[2]; k < hi[2]; ++k)
+    for (int j = lo[1]; j < hi[1]; ++j)
+      for (int i = lo[0]; i < hi[0]; ++i) g.values[g.index(i, j, k)] = sdf_eval(g.tree, g.point(i, j, k));
+}
+
 void sample_grid(GridValues& g) {
-  const size_t rows = row_count(g.grid);
-  g.values.resize(rows * size_t(g.grid.n[0] + 1));
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t row = r.begin(); row != r.end(); ++row) {
-      const int j = int(row % size_t(g.grid.n[1] + 1)), k = int(row / size_t(g.grid.n[1] + 1));
-      for (int i = 0; i <= g.grid.n[0]; ++i) g.values[g.index(i, j, k)] = sdf_eval(g.tree, g.point(i, j, k));
+  g.values.resize(row_count(g.grid) * size_t(g.grid.n[0] + 1));
+  int blocks[3];
+  for (int a = 0; a < 3; ++a) blocks[a] = (g.grid.n[a] + 1 + kBlock - 1) / kBlock;
+  const float l = g.config.skip_far_blocks ? sdf_lipschitz(g.tree) : 0.0f;
+  const float lipschitz = std::isfinite(l) ? l : 0.0f;
+  const size_t count = size_t(blocks[0]) * size_t(blocks[1]) * size_t(blocks[2]);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t b = r.begin(); b != r.end(); ++b) {
+      const int index[3] = {int(b % size_t(blocks[0])), int(b / size_t(blocks[0]) % size_t(blocks[1])),
+                            int(b / (size_t(blocks[0]) * size_t(blocks[1])))};
+      int lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = index[a] * kBlock;
+        hi[a] = std::min(lo[a] + kBlock, g.grid.n[a] + 1);
+      }
+      sample_block(g, lipschitz, lo, hi);
     }
   });
 }
@@ -321,7 +361,7 @@ Offsets count_rows(const GridValues& g) {
     for (size_t row = r.begin(); row != r.end(); ++row) {
       const int j = int(row % size_t(g.grid.n[1] + 1)), k = int(row / size_t(g.grid.n[1] + 1));
       uint64_t vertices = 0, triangles = 0;
-      for (int i = 0; i <= g.grid.n[0]; ++i) vertices += std::popcount(g.crossings(i, j, k));
+      for (int i = 0; i <= g.grid.n[0]; ++i) vertices += kBitCount[g.crossings(i, j, k)];
       if (j < g.grid.n[1] && k < g.grid.n[2])
         for (int i = 0; i < g.grid.n[0]; ++i) {
           float f[8];
@@ -349,12 +389,13 @@ void fill_row(const GridValues& g, const Offsets& o, int j, int k, IsosurfaceMes
   const size_t ny1 = size_t(g.grid.n[1] + 1);
   const size_t row = size_t(j) + ny1 * size_t(k);
   uint64_t v = o.vertices[row];
+  if (v == o.vertices[row + 1] && o.triangles[row] == o.triangles[row + 1]) return;  // far from the surface
   for (int i = 0; i <= g.grid.n[0]; ++i) {
     const unsigned mask = g.crossings(i, j, k);
     for (int a = 0; a < 3; ++a)
       if (mask & (1u << a)) edge_vertex(g, i, j, k, a, mesh.positions[v], mesh.normals[v]), ++v;
   }
-  if (j >= g.grid.n[1] || k >= g.grid.n[2]) return;
+  if (j >= g.grid.n[1] || k >= g.grid.n[2] || o.triangles[row] == o.triangles[row + 1]) return;
   RowCursor rows[4];  // rows (j + dy, k + dz) at index dy | dz << 1
   for (int r = 0; r < 4; ++r) {
     const int jj = j + (r & 1), kk = k + (r >> 1);
@@ -369,7 +410,7 @@ void fill_row(const GridValues& g, const Offsets& o, int j, int k, IsosurfaceMes
     CellSurface cell;
     triangulate_cell(f, cell);
     uint64_t ids[16];
-    for (int e = 0; e < 12; ++e) {
+    for (int e = 0; e < 12 && cell.triangle_count > 0; ++e) {
       const int c = kCube.edge_corner[e][0];
       ids[e] = rows[((c >> 1) & 1) | ((c >> 2) << 1)].vertex(c & 1, e / 4);
     }
@@ -383,7 +424,7 @@ void fill_row(const GridValues& g, const Offsets& o, int j, int k, IsosurfaceMes
       for (int q = 0; q < 3; ++q) mesh.indices[3 * t + q] = uint32_t(ids[cell.triangles[m][q]]);
     for (int r = 0; r < 4; ++r) {
       const int jj = j + (r & 1), kk = k + (r >> 1);
-      rows[r].before += std::popcount(rows[r].mask_i);
+      rows[r].before += kBitCount[rows[r].mask_i];
       rows[r].mask_i = rows[r].mask_i1;
       rows[r].mask_i1 = i + 2 <= g.grid.n[0] ? g.crossings(i + 2, jj, kk) : 0;
     }

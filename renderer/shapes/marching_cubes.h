@@ -19,6 +19,9 @@ struct MarchingCubesConfig {
   int refine_steps = 3;      ///< regula falsi steps on the SDF per edge vertex, in [0, 16]
                              ///< (0 = linear interpolation of the grid values)
   float normal_step = 0.5f;  ///< central-difference step of the normals, in cells, in (0, 4]
+  /// Evaluate only the centre of each block of 8^3 grid points whose distance bound |f| / L keeps
+  /// the surface more than a cell away from it (L = sdf_lipschitz); the mesh is the same.
+  bool skip_far_blocks = true;
   /// The mesh (positions, normals, indices) may take at most this many bytes; a larger one is
   /// refused with std::length_error after counting, before its arrays are allocated.
   uint64_t max_output_bytes = UINT64_MAX;
@@ -64,7 +67,8 @@ uint64_t marching_cubes_bytes(const Bounds3f& box, int resolution, const Marchin
 
 /// Extracts the surface f = 0 of `tree` (in the tree's frame) inside `box` at `resolution` cells
 /// along the box's longest axis (see MarchingCubesGrid). Grid points with f >= 0 (or NaN) are
-/// outside, f < 0 inside. One vertex per sign-changing grid edge, shared by the cells around it,
+/// outside, f < 0 inside (sdf_eval must be L-Lipschitz with L = sdf_lipschitz(tree) when
+/// config.skip_far_blocks is set). One vertex per sign-changing grid edge, shared by the cells around it,
 /// placed by linear interpolation then config.refine_steps regula falsi steps on the edge; each
 /// cell face joins its crossings into segments (the asymptotic decider on faces with four), the
 /// segments of a cell form closed loops, and each loop becomes a fan of triangles (or, when every

@@ -235,6 +235,34 @@ TEST_CASE("marching cubes: the same bytes for any thread count", "[shapes][mc][q
   CHECK(same_bytes(one, all));
 }
 
+TEST_CASE("marching cubes: skipping far blocks gives the same bytes", "[shapes][mc][quick]") {
+  // Blocks far from the surface only need their sign; every value a vertex, a decider or a
+  // triangulation reads is still evaluated.
+  MarchingCubesConfig every_point;
+  every_point.skip_far_blocks = false;
+  std::vector<std::pair<SdfTree, Bounds3f>> cases = {{csg_part(), cube(1)},
+                                                     {sphere_pair(0.5f, 0.45f, 0.3f), cube(1)},
+                                                     {sphere_pair(0.5f, 0.501f), cube(1.01f)}};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> pos(-1, 1), rad(0.05f, 0.3f);
+  SdfTree soup;
+  for (int s = 0; s < 30; ++s) {
+    SdfNode n = sdf_primitive(SdfKind::Sphere, {rad(rng), 0, 0});
+    n.to_local = moved_by({pos(rng), pos(rng), pos(rng)});
+    const int id = add_node(soup, n);
+    soup.root = soup.root < 0 ? id : add_node(soup, sdf_operator(SdfKind::SmoothUnion, soup.root, id, 0.1f));
+  }
+  cases.push_back({soup, cube(1.3f)});
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (int res : {7, 16, 61, 100}) {
+      INFO("case " << c << " at " << res);
+      const IsosurfaceMesh skipped = extract_isosurface(cases[c].first, cases[c].second, res);
+      const IsosurfaceMesh full = extract_isosurface(cases[c].first, cases[c].second, res, every_point);
+      REQUIRE(!full.indices.empty());
+      CHECK(same_bytes(skipped, full));
+    }
+}
+
 TEST_CASE("marching cubes: the grid and its memory", "[shapes][mc][quick]") {
   const Bounds3f box{{0, 0, 0}, {2, 1, 0.01f}};
   const MarchingCubesGrid g = marching_cubes_grid(box, 10, {});
