@@ -218,8 +218,11 @@ struct GridValues {
   }
 };
 
+// The tree's analytic gradient direction; central differences where it vanishes; `fallback`
+// where both do.
 Vec3f unit_normal(const GridValues& g, Vec3f p, Vec3f fallback) {
-  const Vec3f n = sdf_normal(g.tree, p, g.config.normal_step * g.grid.cell);
+  Vec3f n = sdf_gradient_normal(g.tree, p);
+  if (!(is_finite(n) && dot(n, n) > 0.5f)) n = sdf_normal(g.tree, p, g.config.normal_step * g.grid.cell);
   return is_finite(n) && dot(n, n) > 0.5f ? n : fallback;
 }
 

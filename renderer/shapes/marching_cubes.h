@@ -18,7 +18,9 @@ struct MarchingCubesConfig {
                              ///< the box then never touch the grid's boundary)
   int refine_steps = 3;      ///< regula falsi steps on the SDF per edge vertex, in [0, 16]
                              ///< (0 = linear interpolation of the grid values)
-  float normal_step = 0.5f;  ///< central-difference step of the normals, in cells, in (0, 4]
+  float normal_step = 0.5f;  ///< central-difference step, in cells, in (0, 4], of the normals
+                             ///< where the analytic gradient vanishes (and of the centre
+                             ///< vertices' Newton steps)
   /// Evaluate only the centre of each block of 8^3 grid points whose distance bound |f| / L keeps
   /// the surface more than a cell away from it (L = sdf_lipschitz); the mesh is the same.
   bool skip_far_blocks = true;
@@ -43,7 +45,8 @@ inline constexpr int kMaxMarchingCubesResolution = 4096;
 MarchingCubesGrid marching_cubes_grid(const Bounds3f& box, int resolution, const MarchingCubesConfig& config);
 
 /// An indexed triangle mesh: 3 indices per triangle, counter-clockwise seen from f > 0
-/// (outward for a solid), one unit normal (the SDF's gradient direction) per position.
+/// (outward for a solid), one unit normal per position: sdf_gradient_normal, central differences
+/// where that vanishes.
 struct IsosurfaceMesh {
   std::vector<Vec3f> positions;
   std::vector<Vec3f> normals;
