@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/path_render.h"
 #include "apps/penumbra/scene_setup.h"
 #include "io/atomic_file.h"
 #include "io/gltf_writer.h"
@@ -63,6 +64,7 @@ int run_mesh(const MeshArgs& a) {
   for (const auto& [name, path] : outputs) resolve_output(path, name);
   check_distinct_files(outputs, {{"the scene", a.scene_file}});
   const uint64_t budget = memory_budget(a.max_memory);
+  install_signal_handlers();  // a signal removes the temporaries being written
 
   set_phase("loading the scene");
   const LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, a.quiet);
