@@ -1,8 +1,8 @@
 // Marching cubes without case tables: per cell, the crossings of each face are joined into
 // oriented segments (Nielson & Hamann's asymptotic decider on faces with four crossings), the
-// segments close into loops and each loop is triangulated. Parallel over grid rows in three
-// passes (grid values; counts per row; fill at prefix-sum offsets), so the output is the same
-// for any thread count.
+// segments close into loops and each loop is triangulated. Three parallel passes (grid values
+// by blocks; vertex and triangle counts per grid row; each row filled at its prefix-sum offsets),
+// so the output is the same for any thread count.
 #include "renderer/shapes/marching_cubes.h"
 
 #include <tbb/blocked_range.h>
