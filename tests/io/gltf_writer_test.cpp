@@ -1,6 +1,7 @@
 // write_gltf: everything it writes comes back through load_gltf (geometry bit for bit,
 // materials, lights and cameras), as .gltf + .bin and as one .glb (its chunks checked byte by
-// byte), and bad scenes or folders fail without leaving files.
+// byte), and bad scenes or folders fail without leaving files; implicit shapes loaded from
+// PENUMBRA_shapes, meshed and written as .glb come back closed and in place.
 #include "io/gltf_writer.h"
 
 #include <catch2/catch.hpp>
@@ -12,6 +13,10 @@
 #include "io/error.h"
 #include "io/gltf/loader.h"
 #include "renderer/scene/camera.h"
+#include "renderer/scene/shape_mesh.h"
+#include "support/gltf_load.h"
+#include "support/gltf_writer.h"
+#include "support/mesh_checks.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -204,5 +209,41 @@ TEST_CASE("write_glb: one binary file with aligned, padded chunks that load_gltf
   }());
   CHECK(load_gltf(dir / "empty.glb").scene.lights.size() == 3);
   CHECK_THROWS_AS(write_glb(s, dir / "missing" / "x.glb"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("write_glb: implicit shapes meshed from a PENUMBRA_shapes file come back closed",
+          "[gltf][writer]") {
+  // A unit sphere scaled by 0.5 and moved to (2, 0, 0), with material 0.
+  GltfWriter w;
+  w.j["materials"] = nlohmann::json::array({{{"name", "red"}}});
+  w.j["extensionsUsed"] = {"PENUMBRA_shapes"};
+  w.node({{"name", "ball"},
+          {"translation", {2, 0, 0}},
+          {"scale", {0.5, 0.5, 0.5}},
+          {"extensions",
+           {{"PENUMBRA_shapes",
+             {{"type", "implicit"}, {"material", 0}, {"csg", {{"type", "sphere"}, {"radius", 1}}}}}}}});
+  const LoadedScene shapes = write_and_load(w, "glb-shapes");
+  REQUIRE(shapes.scene.shapes.size() == 1);
+  ShapeMeshConfig config;
+  config.resolution = 48;
+  const ShapeMeshes meshed = mesh_implicit_shapes(shapes.scene, config);
+  const auto dir = temp_dir("glb-shapes-out");
+  write_glb(meshed.scene, dir / "ball.glb");
+  const LoadedScene back = load_gltf(dir / "ball.glb");
+  REQUIRE(back.scene.meshes.size() == 1);
+  const Mesh& m = back.scene.meshes[0];
+  CHECK(m.positions.size() > 0);
+  CHECK(m.material == 0);
+  const MeshTopology t = mesh_topology(m.positions.size(), m.indices);
+  CHECK(t.closed_manifold());
+  CHECK(t.euler == 2);
+  // Within one cell (0.5 * 2 / 48 in the world) of the ball's box (1.5, -0.5, -0.5)-(2.5, 0.5, 0.5).
+  const float cell = 0.5f * marching_cubes_grid(shapes.scene.shapes[0].shape.sdf_bounds, 48, {}).cell;
+  Bounds3f b;
+  for (const Vec3f& p : m.positions) b = merge(b, p);
+  check_vec(b.lo, {1.5f, -0.5f, -0.5f}, cell);
+  check_vec(b.hi, {2.5f, 0.5f, 0.5f}, cell);
   std::filesystem::remove_all(dir);
 }
