@@ -90,6 +90,8 @@ expect 2 "must be a .glb or .gltf" -- "$bin" mesh "$scene" --resolution 8 -o "$w
 expect 2 "does not exist" -- "$bin" mesh "$scene" --resolution 8 -o "$work/nodir/x.glb"
 expect 2 "would overwrite" -- "$bin" mesh "$scene" --resolution 8 -o "$scene"
 expect 2 "ball: meshing at resolution 2000 needs [0-9]+ bytes, more than the [0-9]+ bytes left" -- "$bin" mesh "$scene" --node ball --resolution 2000 --max-memory 64M -o "$work/x.glb"
+expect 2 "spheres.gltf: the scene places no implicit shape" -- "$bin" mesh "$src/scenes/spheres.gltf" --resolution 8 -o "$work/x.glb"
+expect 2 "default.gltf: the scene places no implicit shape" -- "$bin" mesh "$src/scenes/default.gltf" --resolution 8 -o "$work/x.glb"
 expect 2 "missing.gltf" -- "$bin" mesh "$work/missing.gltf" --resolution 8 -o "$work/x.glb"
 absent "$work/x.glb" "$work/x.obj"
 cmp -s "$scene" "$work/out" && { echo "FAIL: the scene was overwritten"; fails=$((fails + 1)); }
