@@ -131,11 +131,130 @@ std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
   return gltf_mesh;
 }
 
+/// Column-major 4x4 matrix of an affine map.
+json affine_matrix(const Affine3f& a) {
+  json matrix = json::array();
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) matrix.push_back(r < 3 ? a.m[r][c] : (c == 3 ? 1.0f : 0.0f));
+  return matrix;
+}
+
+/// CSG node `index` of `tree` as a PENUMBRA_shapes CSG object (the inverse of the loader's
+/// reading): its type and fields, a matrix placing its frame unless that is the identity, and
+/// its operands as children.
+json csg_json(const SdfTree& tree, int index, const std::string& file) {
+  const SdfNode& n = tree.nodes[size_t(index)];
+  static const char* const kNames[] = {"sphere",
+                                       "box",
+                                       "roundBox",
+                                       "capsule",
+                                       "cylinder",
+                                       "cone",
+                                       "torus",
+                                       "halfSpace",
+                                       "convexPolyhedron",
+                                       "union",
+                                       "intersection",
+                                       "subtraction",
+                                       "complement",
+                                       "smoothUnion",
+                                       "smoothIntersection",
+                                       "smoothSubtraction"};
+  json j = {{"type", kNames[int(n.kind)]}};
+  switch (n.kind) {
+    case SdfKind::Sphere:
+      j["radius"] = n.size.x;
+      break;
+    case SdfKind::Box:
+    case SdfKind::RoundBox:
+      j["size"] = {2 * n.size.x, 2 * n.size.y, 2 * n.size.z};
+      if (n.kind == SdfKind::RoundBox) j["radius"] = n.radius;
+      break;
+    case SdfKind::Capsule:
+    case SdfKind::Cylinder:
+    case SdfKind::Cone:
+      j["radius"] = n.radius;
+      j["height"] = 2 * n.size.y;
+      break;
+    case SdfKind::Torus:
+      j["majorRadius"] = n.size.x;
+      j["minorRadius"] = n.radius;
+      break;
+    case SdfKind::HalfSpace:
+      j["normal"] = {n.normal.x, n.normal.y, n.normal.z};
+      j["offset"] = n.offset;
+      break;
+    case SdfKind::ConvexPolyhedron:
+      j["planes"] = json::array();
+      for (int i = n.first_plane; i < n.first_plane + n.plane_count; ++i) {
+        const Vec4f& p = tree.planes[size_t(i)];
+        j["planes"].push_back({p.x, p.y, p.z, p.w});
+      }
+      break;
+    default:  // operators
+      j["children"] = json::array({csg_json(tree, n.a, file)});
+      if (n.kind != SdfKind::Complement) j["children"].push_back(csg_json(tree, n.b, file));
+      if (n.kind >= SdfKind::SmoothUnion) j["radius"] = n.radius;
+  }
+  if (!is_identity(n.to_local)) {
+    Affine3f to_parent;
+    if (!inverse(n.to_local, to_parent))
+      throw InputError(file, "shapes", "a CSG node's transform is singular");
+    j["matrix"] = affine_matrix(to_parent);
+  }
+  return j;
+}
+
+/// The PENUMBRA_shapes object of a scene shape.
+json shape_json(const SceneShape& ss, const std::string& file) {
+  const Shape& s = ss.shape;
+  json j = {{"type", shape_kind_name(s.kind)}};
+  switch (s.kind) {
+    case ShapeKind::Sphere:
+    case ShapeKind::Disk:
+      j["radius"] = s.radius;
+      break;
+    case ShapeKind::Plane:
+      j["size"] = {2 * s.half_size.x, 2 * s.half_size.z};
+      break;
+    case ShapeKind::Box:
+      j["size"] = {2 * s.half_size.x, 2 * s.half_size.y, 2 * s.half_size.z};
+      break;
+    case ShapeKind::Capsule:
+      j["radius"] = s.radius;
+      j["height"] = 2 * s.half_height;
+      break;
+    case ShapeKind::Implicit:
+      if (s.sdf.root < 0) throw InputError(file, "shapes", ss.name + ": an implicit shape without a tree");
+      j["csg"] = csg_json(s.sdf, s.sdf.root, file);
+      j["maxSteps"] = s.trace.max_steps;
+      j["epsilon"] = s.trace.relative_epsilon;
+      break;
+  }
+  if (ss.material >= 0) j["material"] = ss.material;
+  return j;
+}
+
+/// One node per shape instance, carrying the shape in PENUMBRA_shapes and its placement.
+void write_shape_instance(Writer& wr, const Scene& scene, const Instance& inst, size_t ii) {
+  if (size_t(inst.shape) >= scene.shapes.size())
+    throw InputError(wr.file, "instances[" + std::to_string(ii) + "]",
+                     "shape " + std::to_string(inst.shape) + " out of range");
+  const SceneShape& ss = scene.shapes[size_t(inst.shape)];
+  json node = {{"name", ss.name.empty() ? "shapes[" + std::to_string(inst.shape) + "]" : ss.name}};
+  node["extensions"]["PENUMBRA_shapes"] = shape_json(ss, wr.file);
+  if (!inst.identity) node["matrix"] = affine_matrix(inst.to_world);
+  add_root(wr, node);
+}
+
 /// One node per instance; shared meshes stay shared, placements become node matrices.
 void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& gltf_mesh) {
   for (size_t ii = 0; ii < scene.instances.size(); ++ii) {
     const Instance& inst = scene.instances[ii];
-    if (inst.shape >= 0) continue;  // shapes have no glTF form of their own
+    if (inst.shape >= 0) {
+      write_shape_instance(wr, scene, inst, ii);
+      continue;
+    }
     if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())
       throw InputError(wr.file, "instances[" + std::to_string(ii) + "]",
                        "mesh " + std::to_string(inst.mesh) + " out of range");
@@ -143,12 +262,7 @@ void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& glt
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     json node = {{"mesh", gltf_mesh[size_t(inst.mesh)]},
                  {"name", m.name.empty() ? "meshes[" + std::to_string(inst.mesh) + "]" : m.name}};
-    if (!inst.identity) {
-      json matrix = json::array();  // column-major
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) matrix.push_back(r < 3 ? inst.to_world.m[r][c] : (c == 3 ? 1.0f : 0.0f));
-      node["matrix"] = matrix;
-    }
+    if (!inst.identity) node["matrix"] = affine_matrix(inst.to_world);
     add_root(wr, node);
   }
 }
@@ -225,6 +339,7 @@ Writer build_document(const Scene& scene, const std::filesystem::path& file, con
   if (!scene.lights.empty()) used.push_back("KHR_lights_punctual");
   if (emissive_strength) used.push_back("KHR_materials_emissive_strength");
   if (unlit) used.push_back("KHR_materials_unlit");
+  if (count_shape_instances(scene) > 0) used.push_back("PENUMBRA_shapes");
   if (!used.empty()) wr.j["extensionsUsed"] = used;
   if (!wr.bin.empty()) {
     wr.j["buffers"] = {{{"byteLength", wr.bin.size()}}};

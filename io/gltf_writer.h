@@ -1,6 +1,6 @@
-// glTF 2.0 writing: a renderer Scene (meshes placed by instances, metallic-roughness factors,
-// punctual lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it, or as
-// one binary .glb. Used by the benchmark scene generator, the PLY converter and `penumbra mesh`;
+// glTF 2.0 writing: a renderer Scene (meshes and shapes placed by instances, metallic-roughness
+// factors, punctual lights, cameras) as a .gltf JSON file with its geometry in one external .bin beside it,
+// or as one binary .glb. Used by the benchmark scene generator, the PLY converter and `penumbra mesh`;
 // load_gltf() reads the result back.
 #pragma once
 
@@ -15,7 +15,8 @@ namespace penumbra {
 /// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices) and each instance one node
 /// using it (with a matrix unless the identity), so shared meshes stay shared; lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
-/// Shape instances are not written.
+/// Each shape instance becomes a node carrying its shape in PENUMBRA_shapes (listed in
+/// extensionsUsed), CSG trees with one matrix per node that is not the identity.
 /// Throws InputError naming the file if its target is refused (resolve_output) or the scene
 /// cannot be expressed (a buffer over 4 GiB, an index out of range, an index count not a
 /// multiple of 3, a non-finite position, an instance of a mesh that does not exist), and

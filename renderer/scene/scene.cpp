@@ -8,31 +8,33 @@
 
 namespace penumbra {
 
-Instance make_instance(int mesh, const Affine3f& to_world, int node) {
-  Instance inst;
-  inst.mesh = mesh;
+namespace {
+
+// `inst` placed by to_world: the inverse, identity and mirroring flags filled in. Throws
+// std::invalid_argument naming `what` if the map is singular or not finite.
+Instance placed(Instance inst, const Affine3f& to_world, int node, const std::string& what) {
   inst.node = node;
   inst.to_world = to_world;
   inst.identity = is_identity(to_world);
   if (!inverse(to_world, inst.to_object))
-    throw std::invalid_argument("instance of mesh " + std::to_string(mesh) +
-                                ": transform is singular or not finite");
+    throw std::invalid_argument("instance of " + what + ": transform is singular or not finite");
   inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
   return inst;
+}
+
+}  // namespace
+
+Instance make_instance(int mesh, const Affine3f& to_world, int node) {
+  Instance inst;
+  inst.mesh = mesh;
+  return placed(inst, to_world, node, "mesh " + std::to_string(mesh));
 }
 
 Instance make_shape_instance(int shape, const Affine3f& to_world, int node) {
   Instance inst;
   inst.mesh = -1;
   inst.shape = shape;
-  inst.node = node;
-  inst.to_world = to_world;
-  inst.identity = is_identity(to_world);
-  if (!inverse(to_world, inst.to_object))
-    throw std::invalid_argument("instance of shape " + std::to_string(shape) +
-                                ": transform is singular or not finite");
-  inst.mirrored = determinant3x3(to_transform(to_world)) < 0;
-  return inst;
+  return placed(inst, to_world, node, "shape " + std::to_string(shape));
 }
 
 int add_world_mesh(Scene& scene, Mesh mesh) {

@@ -1,13 +1,15 @@
 // write_gltf: everything it writes comes back through load_gltf (geometry bit for bit,
 // materials, lights and cameras), as .gltf + .bin and as one .glb (its chunks checked byte by
-// byte), and bad scenes or folders fail without leaving files; implicit shapes loaded from
-// PENUMBRA_shapes, meshed and written as .glb come back closed and in place.
+// byte), and bad scenes or folders fail without leaving files; shapes written as PENUMBRA_shapes
+// come back with every field and every CSG node; implicit shapes loaded from PENUMBRA_shapes,
+// meshed and written as .glb come back closed and in place.
 #include "io/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <vector>
 
 #include "io/error.h"
@@ -18,6 +20,7 @@
 #include "support/gltf_writer.h"
 #include "support/mesh_checks.h"
 #include "support/scene_builder.h"
+#include "support/sdf_trees.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -246,4 +249,83 @@ TEST_CASE("write_glb: implicit shapes meshed from a PENUMBRA_shapes file come ba
   check_vec(b.lo, {1.5f, -0.5f, -0.5f}, cell);
   check_vec(b.hi, {2.5f, 0.5f, 0.5f}, cell);
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("write_gltf: shapes come back through PENUMBRA_shapes with every field and CSG node",
+          "[gltf][writer][shapes]") {
+  Scene s;
+  s.materials.resize(2);
+  s.materials[1].name = "red";
+  std::vector<Shape> shapes(5);
+  shapes[0].kind = ShapeKind::Sphere, shapes[0].radius = 0.7f;
+  shapes[1].kind = ShapeKind::Plane, shapes[1].half_size = {2, 1, 3};
+  shapes[2].kind = ShapeKind::Disk, shapes[2].radius = 1.5f;
+  shapes[3].kind = ShapeKind::Box, shapes[3].half_size = {0.5f, 1, 1.5f};
+  shapes[4].kind = ShapeKind::Capsule, shapes[4].radius = 0.25f, shapes[4].half_height = 0.75f;
+  // Every CSG node kind once, with transforms.
+  SdfTree t = csg_part();
+  t.nodes[0].to_local = moved_by({0.1f, 0.2f, 0.3f});
+  SdfNode torus = sdf_primitive(SdfKind::Torus, {0.8f, 0, 0}, 0.2f),
+          cone = sdf_primitive(SdfKind::Cone, {0, 0.5f, 0}, 0.4f);
+  SdfNode round = sdf_primitive(SdfKind::RoundBox, {0.5f, 0.4f, 0.3f}, 0.1f),
+          capsule = sdf_primitive(SdfKind::Capsule, {0, 0.3f, 0}, 0.2f);
+  SdfNode half = sdf_primitive(SdfKind::HalfSpace, {});
+  half.normal = normalize(Vec3f{0.2f, 1, 0.1f}), half.offset = 0.3f;
+  SdfNode poly;
+  poly.kind = SdfKind::ConvexPolyhedron;
+  poly.first_plane = 0, poly.plane_count = 6;
+  for (int k = 0; k < 3; ++k)
+    for (float sgn : {1.0f, -1.0f})
+      t.planes.push_back({k == 0 ? sgn : 0, k == 1 ? sgn : 0, k == 2 ? sgn : 0, 0.6f});
+  const int a = add_node(t, sdf_operator(SdfKind::SmoothUnion, add_node(t, torus), add_node(t, cone), 0.2f));
+  const int b =
+      add_node(t, sdf_operator(SdfKind::SmoothIntersection, add_node(t, round), add_node(t, capsule), 0.1f));
+  const int c =
+      add_node(t, sdf_operator(SdfKind::SmoothSubtraction, add_node(t, poly), add_node(t, half), 0.15f));
+  const int d =
+      add_node(t, sdf_operator(SdfKind::Complement, add_node(t, sdf_primitive(SdfKind::Sphere, {5, 0, 0}))));
+  const int blend =
+      add_node(t, sdf_operator(SdfKind::Union, a, add_node(t, sdf_operator(SdfKind::Union, b, c))));
+  const int all = add_node(t, sdf_operator(SdfKind::Union, t.root, blend));
+  t.root = add_node(t, sdf_operator(SdfKind::Intersection, all, d));
+  SphereTraceConfig trace;
+  trace.max_steps = 300, trace.relative_epsilon = 2e-5f;
+  shapes.push_back(make_implicit_shape(t, trace));
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    s.shapes.push_back({"shape" + std::to_string(i), shapes[i], int(i % 2), -1});
+    s.instances.push_back(make_shape_instance(int(i), translation({float(i), 0.5f, -1}), -1));
+  }
+  const auto dir = temp_dir("gltf-writer-shapes");
+  write_gltf(s, dir / "shapes.gltf");
+  const LoadedScene l = load_gltf(dir / "shapes.gltf");
+  CHECK(l.warnings.empty());
+  const Scene& r = l.scene;
+  REQUIRE(r.shapes.size() == s.shapes.size());
+  REQUIRE(r.instances.size() == s.instances.size());
+  for (size_t i = 0; i < s.shapes.size(); ++i) {
+    INFO("shape " << i);
+    const Shape &x = s.shapes[i].shape, &y = r.shapes[size_t(r.instances[i].shape)].shape;
+    CHECK(r.shapes[size_t(r.instances[i].shape)].material == s.shapes[i].material);
+    CHECK(y.kind == x.kind);
+    check_vec(apply_point(r.instances[i].to_world, {0, 0, 0}), {float(i), 0.5f, -1});
+    if (x.kind != ShapeKind::Implicit) {
+      CHECK(y.radius == x.radius);
+      CHECK(y.half_height == x.half_height);
+      if (x.kind == ShapeKind::Box || x.kind == ShapeKind::Plane) {
+        CHECK(y.half_size.x == x.half_size.x);
+        CHECK(y.half_size.z == x.half_size.z);
+      }
+      continue;
+    }
+    CHECK(y.trace.max_steps == 300);
+    CHECK(y.trace.relative_epsilon == 2e-5f);
+    CHECK(y.sdf.nodes.size() == x.sdf.nodes.size());
+    // The same function: equal values at random points (transforms re-inverted in double).
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-2, 2);
+    for (int k = 0; k < 2000; ++k) {
+      const Vec3f p{u(rng), u(rng), u(rng)};
+      REQUIRE(sdf_eval(y.sdf, p) == Approx(sdf_eval(x.sdf, p)).margin(1e-5));
+    }
+  }
 }

@@ -5,6 +5,7 @@
 
 #include "renderer/integrators/render.h"
 #include "renderer/scene/scene.h"
+#include "support/sdf_trees.h"
 
 namespace penumbra::test {
 
@@ -131,15 +132,7 @@ inline int add_shape(Scene& s, Shape shape, const Affine3f& to_world, int materi
 
 /// An analytic sphere of radius r, or (implicit = true) the sphere traced SDF sphere.
 inline Shape sphere_shape(float r, bool implicit = false) {
-  if (implicit) {
-    SdfTree t;
-    SdfNode n;
-    n.kind = SdfKind::Sphere;
-    n.size = {r, 0, 0};
-    t.nodes.push_back(n);
-    t.root = 0;
-    return make_implicit_shape(std::move(t));
-  }
+  if (implicit) return make_implicit_shape(single_shape(sdf_primitive(SdfKind::Sphere, {r, 0, 0})));
   Shape sh;
   sh.kind = ShapeKind::Sphere;
   sh.radius = r;

@@ -15,6 +15,7 @@
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/shape.h"
+#include "support/sdf_trees.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -193,41 +194,24 @@ Affine3f translated(Affine3f a, Vec3f t) {
   return a;
 }
 
-SdfNode sdf_prim(SdfKind kind, Vec3f size, float radius = 0) {
-  SdfNode n;
-  n.kind = kind;
-  n.size = size;
-  n.radius = radius;
-  return n;
-}
-
-SdfNode sdf_op(SdfKind kind, int a, int b, float radius = 0) {
-  SdfNode n;
-  n.kind = kind;
-  n.a = a;
-  n.b = b;
-  n.radius = radius;
-  return n;
-}
-
 /// The classic CSG part: a sphere intersected with a cube, minus three orthogonal cylinders,
 /// centred at `centre` (to_local holds the inverse placement).
 Shape csg_part(Vec3f centre) {
   SdfTree t;
-  t.nodes = {sdf_prim(SdfKind::Sphere, {0.65f, 0, 0}), sdf_prim(SdfKind::Box, {0.5f, 0.5f, 0.5f}),
-             sdf_op(SdfKind::Intersection, 0, 1)};
+  t.nodes = {sdf_primitive(SdfKind::Sphere, {0.65f, 0, 0}), sdf_primitive(SdfKind::Box, {0.5f, 0.5f, 0.5f}),
+             sdf_operator(SdfKind::Intersection, 0, 1)};
   Affine3f rot_x, rot_z;  // the Y-axis cylinder turned onto X and Z
   rot_x.m[0][0] = 0, rot_x.m[0][1] = 1, rot_x.m[1][0] = -1, rot_x.m[1][1] = 0;
   rot_z.m[1][1] = 0, rot_z.m[1][2] = 1, rot_z.m[2][1] = -1, rot_z.m[2][2] = 0;
   int body = 2;
   for (const Affine3f& r : {Affine3f{}, rot_x, rot_z}) {
-    SdfNode cyl = sdf_prim(SdfKind::Cylinder, {0, 0.7f, 0}, 0.3f);
+    SdfNode cyl = sdf_primitive(SdfKind::Cylinder, {0, 0.7f, 0}, 0.3f);
     cyl.to_local = r;
     t.nodes.push_back(cyl);
-    t.nodes.push_back(sdf_op(SdfKind::Subtraction, body, int(t.nodes.size()) - 1));
+    t.nodes.push_back(sdf_operator(SdfKind::Subtraction, body, int(t.nodes.size()) - 1));
     body = int(t.nodes.size()) - 1;
   }
-  t.nodes[size_t(body)].to_local = translated(Affine3f{}, -centre);
+  t.nodes[size_t(body)].to_local = moved_by(centre);
   t.root = body;
   return make_implicit_shape(std::move(t));
 }
@@ -235,10 +219,10 @@ Shape csg_part(Vec3f centre) {
 /// A torus and a sphere blended by a smooth union, centred at `centre`.
 Shape blob(Vec3f centre) {
   SdfTree t;
-  t.nodes = {sdf_prim(SdfKind::Torus, {0.6f, 0, 0}, 0.15f), sdf_prim(SdfKind::Sphere, {0.35f, 0, 0}),
-             sdf_op(SdfKind::SmoothUnion, 0, 1, 0.3f)};
-  t.nodes[1].to_local = translated(Affine3f{}, {0, -0.3f, 0});
-  t.nodes[2].to_local = translated(Affine3f{}, -centre);
+  t.nodes = {sdf_primitive(SdfKind::Torus, {0.6f, 0, 0}, 0.15f),
+             sdf_primitive(SdfKind::Sphere, {0.35f, 0, 0}), sdf_operator(SdfKind::SmoothUnion, 0, 1, 0.3f)};
+  t.nodes[1].to_local = moved_by({0, 0.3f, 0});
+  t.nodes[2].to_local = moved_by(centre);
   t.root = 2;
   return make_implicit_shape(std::move(t));
 }

@@ -7,43 +7,12 @@
 #include <cmath>
 #include <random>
 
+#include "support/sdf_trees.h"
+
 using namespace penumbra;
+using namespace penumbra::test;
 
 namespace {
-
-int add(SdfTree& t, SdfNode n) {
-  t.nodes.push_back(n);
-  return int(t.nodes.size()) - 1;
-}
-
-SdfNode prim(SdfKind k, Vec3f size, float radius = 0) {
-  SdfNode n;
-  n.kind = k;
-  n.size = size;
-  n.radius = radius;
-  return n;
-}
-
-SdfNode op(SdfKind k, int a, int b = -1, float radius = 0) {
-  SdfNode n;
-  n.kind = k;
-  n.a = a;
-  n.b = b;
-  n.radius = radius;
-  return n;
-}
-
-SdfTree single(SdfNode n) {
-  SdfTree t;
-  t.root = add(t, n);
-  return t;
-}
-
-Affine3f translate(Vec3f d) {
-  Affine3f a;
-  a.m[0][3] = -d.x, a.m[1][3] = -d.y, a.m[2][3] = -d.z;  // world -> local of a shape moved by d
-  return a;
-}
 
 Vec3f random_point(std::mt19937& rng, float extent) {
   std::uniform_real_distribution<float> u(-extent, extent);
@@ -53,44 +22,44 @@ Vec3f random_point(std::mt19937& rng, float extent) {
 }  // namespace
 
 TEST_CASE("sdf: primitive distances match closed forms", "[shapes][sdf][quick]") {
-  const auto d = [](SdfNode n, Vec3f p) { return sdf_eval(single(n), p); };
+  const auto d = [](SdfNode n, Vec3f p) { return sdf_eval(single_shape(n), p); };
   // Sphere of radius 2.
-  CHECK(d(prim(SdfKind::Sphere, {2, 0, 0}), {5, 0, 0}) == Approx(3));
-  CHECK(d(prim(SdfKind::Sphere, {2, 0, 0}), {0, 0, 0}) == Approx(-2));
+  CHECK(d(sdf_primitive(SdfKind::Sphere, {2, 0, 0}), {5, 0, 0}) == Approx(3));
+  CHECK(d(sdf_primitive(SdfKind::Sphere, {2, 0, 0}), {0, 0, 0}) == Approx(-2));
   // Box of half extents (1, 2, 3): faces, an edge, a corner, inside.
-  const SdfNode box = prim(SdfKind::Box, {1, 2, 3});
+  const SdfNode box = sdf_primitive(SdfKind::Box, {1, 2, 3});
   CHECK(d(box, {3, 0, 0}) == Approx(2));
   CHECK(d(box, {0, 0, -4}) == Approx(1));
   CHECK(d(box, {2, 3, 0}) == Approx(std::sqrt(2.0f)));
   CHECK(d(box, {2, 3, 4}) == Approx(std::sqrt(3.0f)));
   CHECK(d(box, {0.5f, 0, 0}) == Approx(-0.5f));
   // Round box: the corner is rounded by the radius.
-  const SdfNode rbox = prim(SdfKind::RoundBox, {1, 1, 1}, 0.25f);
+  const SdfNode rbox = sdf_primitive(SdfKind::RoundBox, {1, 1, 1}, 0.25f);
   CHECK(d(rbox, {2, 0, 0}) == Approx(1));
   CHECK(d(rbox, {2, 2, 2}) == Approx(std::sqrt(3.0f) * 1.25f - 0.25f));
   // Capsule: segment y in [-1, 1], radius 0.5.
-  const SdfNode cap = prim(SdfKind::Capsule, {0, 1, 0}, 0.5f);
+  const SdfNode cap = sdf_primitive(SdfKind::Capsule, {0, 1, 0}, 0.5f);
   CHECK(d(cap, {2, 0.3f, 0}) == Approx(1.5f));
   CHECK(d(cap, {0, 3, 0}) == Approx(1.5f));
   // Cylinder radius 1, half height 2.
-  const SdfNode cyl = prim(SdfKind::Cylinder, {0, 2, 0}, 1);
+  const SdfNode cyl = sdf_primitive(SdfKind::Cylinder, {0, 2, 0}, 1);
   CHECK(d(cyl, {3, 0, 0}) == Approx(2));
   CHECK(d(cyl, {0, 5, 0}) == Approx(3));
   CHECK(d(cyl, {4, 6, 0}) == Approx(5));  // the rim at (1, 2): distance to the edge circle
   CHECK(d(cyl, {0, 0, 0}) == Approx(-1));
   // Cone: base radius 1 at y = -1, apex at y = +1.
-  const SdfNode cone = prim(SdfKind::Cone, {0, 1, 0}, 1);
+  const SdfNode cone = sdf_primitive(SdfKind::Cone, {0, 1, 0}, 1);
   CHECK(d(cone, {0, 3, 0}) == Approx(2));                     // above the apex
   CHECK(d(cone, {0, -3, 0}) == Approx(2));                    // below the base
   CHECK(d(cone, {0, 0, 0}) == Approx(-1 / std::sqrt(5.0f)));  // to the slanted side
   // Torus: major 2, minor 0.5.
-  const SdfNode torus = prim(SdfKind::Torus, {2, 0, 0}, 0.5f);
+  const SdfNode torus = sdf_primitive(SdfKind::Torus, {2, 0, 0}, 0.5f);
   CHECK(d(torus, {2, 0, 0}) == Approx(-0.5f));
   CHECK(d(torus, {0, 0, 0}) == Approx(1.5f));
   CHECK(d(torus, {0, 0, 2}) == Approx(-0.5f));
   CHECK(d(torus, {2, 3, 0}) == Approx(2.5f));
   // Half-space y <= 1.
-  SdfNode hs = prim(SdfKind::HalfSpace, {});
+  SdfNode hs = sdf_primitive(SdfKind::HalfSpace, {});
   hs.normal = {0, 1, 0};
   hs.offset = 1;
   CHECK(d(hs, {7, 4, -3}) == Approx(3));
@@ -99,25 +68,27 @@ TEST_CASE("sdf: primitive distances match closed forms", "[shapes][sdf][quick]")
   SdfTree poly;
   for (const Vec3f n : {Vec3f{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}})
     poly.planes.push_back({n.x, n.y, n.z, 1});
-  SdfNode pn = prim(SdfKind::ConvexPolyhedron, {});
+  SdfNode pn = sdf_primitive(SdfKind::ConvexPolyhedron, {});
   pn.plane_count = 6;
-  poly.root = add(poly, pn);
+  poly.root = add_node(poly, pn);
   CHECK(sdf_eval(poly, {3, 0, 0}) == Approx(2));
   CHECK(sdf_eval(poly, {0.25f, 0.5f, 0}) == Approx(-0.5f));
 }
 
 TEST_CASE("sdf: CSG identities hold pointwise", "[shapes][sdf][quick]") {
   SdfTree t;
-  const int a = add(t, prim(SdfKind::Sphere, {1, 0, 0}));
-  SdfNode bn = prim(SdfKind::Box, {0.7f, 0.7f, 0.7f});
-  bn.to_local = translate({0.6f, 0.2f, 0});
-  const int b = add(t, bn);
-  const int aua = add(t, op(SdfKind::Union, a, a));
-  const int aia = add(t, op(SdfKind::Intersection, a, a));
-  const int ama = add(t, op(SdfKind::Subtraction, a, a));
-  const int not_union = add(t, op(SdfKind::Complement, add(t, op(SdfKind::Union, a, b))));
-  const int inter_of_not = add(
-      t, op(SdfKind::Intersection, add(t, op(SdfKind::Complement, a)), add(t, op(SdfKind::Complement, b))));
+  const int a = add_node(t, sdf_primitive(SdfKind::Sphere, {1, 0, 0}));
+  SdfNode bn = sdf_primitive(SdfKind::Box, {0.7f, 0.7f, 0.7f});
+  bn.to_local = moved_by({0.6f, 0.2f, 0});
+  const int b = add_node(t, bn);
+  const int aua = add_node(t, sdf_operator(SdfKind::Union, a, a));
+  const int aia = add_node(t, sdf_operator(SdfKind::Intersection, a, a));
+  const int ama = add_node(t, sdf_operator(SdfKind::Subtraction, a, a));
+  const int not_union =
+      add_node(t, sdf_operator(SdfKind::Complement, add_node(t, sdf_operator(SdfKind::Union, a, b))));
+  const int inter_of_not =
+      add_node(t, sdf_operator(SdfKind::Intersection, add_node(t, sdf_operator(SdfKind::Complement, a)),
+                               add_node(t, sdf_operator(SdfKind::Complement, b))));
   std::mt19937 rng(3);
   for (int i = 0; i < 2000; ++i) {
     const Vec3f p = random_point(rng, 2.5f);
@@ -142,13 +113,13 @@ TEST_CASE("sdf: the Lipschitz bound holds for every operator and transform", "[s
     for (SdfKind k : {SdfKind::Union, SdfKind::Intersection, SdfKind::Subtraction, SdfKind::Complement,
                       SdfKind::SmoothUnion, SdfKind::SmoothIntersection, SdfKind::SmoothSubtraction}) {
       SdfTree t;
-      SdfNode torus = prim(SdfKind::Torus, {1, 0, 0}, 0.3f);
+      SdfNode torus = sdf_primitive(SdfKind::Torus, {1, 0, 0}, 0.3f);
       torus.to_local = xf;
-      const int a = add(t, torus);
-      const int b = add(t, prim(SdfKind::RoundBox, {0.8f, 0.4f, 0.6f}, 0.1f));
-      SdfNode root = op(k, a, b, 0.35f);
-      root.to_local = translate({0.1f, -0.2f, 0.3f});
-      t.root = add(t, root);
+      const int a = add_node(t, torus);
+      const int b = add_node(t, sdf_primitive(SdfKind::RoundBox, {0.8f, 0.4f, 0.6f}, 0.1f));
+      SdfNode root = sdf_operator(k, a, b, 0.35f);
+      root.to_local = moved_by({0.1f, -0.2f, 0.3f});
+      t.root = add_node(t, root);
       const float lip = sdf_lipschitz(t);
       CHECK(lip >= 1.0f);
       for (int i = 0; i < 3000; ++i) {
@@ -176,13 +147,13 @@ TEST_CASE(
   SdfNode poly;
   poly.kind = SdfKind::ConvexPolyhedron;
   poly.plane_count = 6;
-  const std::vector<SdfNode> primitives{prim(SdfKind::Sphere, {0.7f, 0, 0}),
-                                        prim(SdfKind::Box, {0.6f, 0.4f, 0.5f}),
-                                        prim(SdfKind::RoundBox, {0.6f, 0.4f, 0.5f}, 0.15f),
-                                        prim(SdfKind::Capsule, {0, 0.4f, 0}, 0.3f),
-                                        prim(SdfKind::Cylinder, {0, 0.5f, 0}, 0.4f),
-                                        prim(SdfKind::Cone, {0, 0.5f, 0}, 0.5f),
-                                        prim(SdfKind::Torus, {0.6f, 0, 0}, 0.2f),
+  const std::vector<SdfNode> primitives{sdf_primitive(SdfKind::Sphere, {0.7f, 0, 0}),
+                                        sdf_primitive(SdfKind::Box, {0.6f, 0.4f, 0.5f}),
+                                        sdf_primitive(SdfKind::RoundBox, {0.6f, 0.4f, 0.5f}, 0.15f),
+                                        sdf_primitive(SdfKind::Capsule, {0, 0.4f, 0}, 0.3f),
+                                        sdf_primitive(SdfKind::Cylinder, {0, 0.5f, 0}, 0.4f),
+                                        sdf_primitive(SdfKind::Cone, {0, 0.5f, 0}, 0.5f),
+                                        sdf_primitive(SdfKind::Torus, {0.6f, 0, 0}, 0.2f),
                                         half,
                                         poly};
   int checked = 0;
@@ -192,11 +163,11 @@ TEST_CASE(
       SdfTree t = base;
       SdfNode a = p0;
       a.to_local = shear;
-      const int ia = add(t, a);
-      SdfNode b = prim(SdfKind::Sphere, {0.45f, 0, 0});
-      b.to_local = translate({0.3f, 0.2f, 0});
-      const int ib = add(t, b);
-      t.root = add(t, op(k, ia, ib, 0.25f));
+      const int ia = add_node(t, a);
+      SdfNode b = sdf_primitive(SdfKind::Sphere, {0.45f, 0, 0});
+      b.to_local = moved_by({0.3f, 0.2f, 0});
+      const int ib = add_node(t, b);
+      t.root = add_node(t, sdf_operator(k, ia, ib, 0.25f));
       for (int i = 0; i < 400; ++i) {
         const Vec3f x = random_point(rng, 1.2f);
         // Compare only where f is smooth: central differences at two step sizes agree.
@@ -214,10 +185,10 @@ TEST_CASE(
 
 TEST_CASE("sdf: sphere tracing hits where the analytic tests hit", "[shapes][sdf][quick]") {
   SdfTree t;
-  SdfNode sphere = prim(SdfKind::Sphere, {1.5f, 0, 0});
+  SdfNode sphere = sdf_primitive(SdfKind::Sphere, {1.5f, 0, 0});
   const Vec3f centre{0.3f, -0.2f, 4};
-  sphere.to_local = translate(centre);
-  t.root = add(t, sphere);
+  sphere.to_local = moved_by(centre);
+  t.root = add_node(t, sphere);
   const float lip = sdf_lipschitz(t);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-1, 1);
@@ -260,10 +231,10 @@ TEST_CASE("sdf: sphere tracing hits where the analytic tests hit", "[shapes][sdf
   short_ray.tfar = 2;
   CHECK_FALSE(sphere_trace(t, lip, short_ray, {}, t_in, steps));
   // A plane seen at a grazing angle: t = distance / cos.
-  SdfNode ground = prim(SdfKind::HalfSpace, {});
+  SdfNode ground = sdf_primitive(SdfKind::HalfSpace, {});
   ground.normal = {0, 1, 0};
   ground.offset = -1;
-  const SdfTree plane = single(ground);
+  const SdfTree plane = single_shape(ground);
   Ray glancing;
   glancing.org = {0, 0, 0};
   glancing.dir = normalize(Vec3f{1, -0.05f, 0});

@@ -8,7 +8,10 @@
 #include <cmath>
 #include <random>
 
+#include "support/sdf_trees.h"
+
 using namespace penumbra;
+using namespace penumbra::test;
 
 namespace {
 
@@ -32,29 +35,6 @@ SdfTree tree_of(std::vector<SdfNode> nodes, int root) {
   t.nodes = std::move(nodes);
   t.root = root;
   return t;
-}
-
-SdfNode prim(SdfKind k, Vec3f size, float radius = 0) {
-  SdfNode n;
-  n.kind = k;
-  n.size = size;
-  n.radius = radius;
-  return n;
-}
-
-SdfNode op(SdfKind k, int a, int b, float radius = 0) {
-  SdfNode n;
-  n.kind = k;
-  n.a = a;
-  n.b = b;
-  n.radius = radius;
-  return n;
-}
-
-Affine3f translation(Vec3f t) {
-  Affine3f a;
-  a.m[0][3] = t.x, a.m[1][3] = t.y, a.m[2][3] = t.z;
-  return a;
 }
 
 }  // namespace
@@ -141,22 +121,23 @@ TEST_CASE("shape surfaces: normals and UVs", "[shapes][quick]") {
 TEST_CASE("CSG bounds: overlap, merge, the first operand, smooth widening, unbounded trees",
           "[shapes][quick]") {
   // Sphere r = 1.3 intersected with a cube of half size 1: the cube's box.
-  const SdfTree part = tree_of(
-      {prim(SdfKind::Sphere, {1.3f, 0, 0}), prim(SdfKind::Box, {1, 1, 1}), op(SdfKind::Intersection, 0, 1)},
-      2);
+  const SdfTree part =
+      tree_of({sdf_primitive(SdfKind::Sphere, {1.3f, 0, 0}), sdf_primitive(SdfKind::Box, {1, 1, 1}),
+               sdf_operator(SdfKind::Intersection, 0, 1)},
+              2);
   Bounds3f b = sdf_tree_bounds(part);
   CHECK(b.lo.x == Approx(-1));
   CHECK(b.hi.z == Approx(1));
   // Union of two translated spheres.
-  std::vector<SdfNode> nodes{prim(SdfKind::Sphere, {1, 0, 0}), prim(SdfKind::Sphere, {1, 0, 0}),
-                             op(SdfKind::Union, 0, 1)};
-  nodes[0].to_local = translation({2, 0, 0});   // the sphere sits at x = -2
-  nodes[1].to_local = translation({-3, 0, 0});  // and at x = +3
+  std::vector<SdfNode> nodes{sdf_primitive(SdfKind::Sphere, {1, 0, 0}),
+                             sdf_primitive(SdfKind::Sphere, {1, 0, 0}), sdf_operator(SdfKind::Union, 0, 1)};
+  nodes[0].to_local = moved_by({-2, 0, 0});
+  nodes[1].to_local = moved_by({3, 0, 0});
   b = sdf_tree_bounds(tree_of(nodes, 2));
   CHECK(b.lo.x == Approx(-3));
   CHECK(b.hi.x == Approx(4));
   // Smooth union widens by a quarter of the blend radius: smin >= min - k / 4.
-  nodes[2] = op(SdfKind::SmoothUnion, 0, 1, 0.8f);
+  nodes[2] = sdf_operator(SdfKind::SmoothUnion, 0, 1, 0.8f);
   const SdfTree blob = tree_of(nodes, 2);
   b = sdf_tree_bounds(blob);
   CHECK(b.lo.x == Approx(-3.2f));
@@ -171,17 +152,21 @@ TEST_CASE("CSG bounds: overlap, merge, the first operand, smooth widening, unbou
     if (outside_box) REQUIRE(sdf_eval(blob, p) > 0);
   }
   // Subtraction keeps the first operand's box; a half-space or complement alone is unbounded.
-  b = sdf_tree_bounds(tree_of(
-      {prim(SdfKind::Box, {1, 2, 3}), prim(SdfKind::Sphere, {5, 0, 0}), op(SdfKind::Subtraction, 0, 1)}, 2));
+  b = sdf_tree_bounds(
+      tree_of({sdf_primitive(SdfKind::Box, {1, 2, 3}), sdf_primitive(SdfKind::Sphere, {5, 0, 0}),
+               sdf_operator(SdfKind::Subtraction, 0, 1)},
+              2));
   CHECK(b.hi.z == Approx(3));
   SdfNode half;
   half.kind = SdfKind::HalfSpace;
   CHECK(sdf_tree_bounds(tree_of({half}, 0)).empty());
-  CHECK(sdf_tree_bounds(tree_of({prim(SdfKind::Sphere, {1, 0, 0}), op(SdfKind::Complement, 0, -1)}, 1))
+  CHECK(sdf_tree_bounds(
+            tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0}), sdf_operator(SdfKind::Complement, 0, -1)}, 1))
             .empty());
-  CHECK_FALSE(
-      sdf_tree_bounds(tree_of({half, prim(SdfKind::Sphere, {1, 0, 0}), op(SdfKind::Intersection, 0, 1)}, 2))
-          .empty());
+  CHECK_FALSE(sdf_tree_bounds(tree_of({half, sdf_primitive(SdfKind::Sphere, {1, 0, 0}),
+                                       sdf_operator(SdfKind::Intersection, 0, 1)},
+                                      2))
+                  .empty());
   // Convex polyhedra: a cube from six planes is bounded, three planes are not.
   SdfTree cube;
   for (int k = 0; k < 3; ++k)
@@ -203,9 +188,9 @@ TEST_CASE("CSG bounds: overlap, merge, the first operand, smooth widening, unbou
 
 TEST_CASE("implicit shapes hit where their analytic twins do", "[shapes]") {
   const Shape exact = analytic(ShapeKind::Sphere, 1);
-  const Shape traced = make_implicit_shape(tree_of({prim(SdfKind::Sphere, {1, 0, 0})}, 0));
+  const Shape traced = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0})}, 0));
   const Shape exact_box = analytic(ShapeKind::Box, 1, {0.5f, 1, 1.5f});
-  const Shape traced_box = make_implicit_shape(tree_of({prim(SdfKind::Box, {0.5f, 1, 1.5f})}, 0));
+  const Shape traced_box = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Box, {0.5f, 1, 1.5f})}, 0));
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1, 1);
   int hits = 0;
@@ -230,7 +215,7 @@ TEST_CASE("implicit shapes hit where their analytic twins do", "[shapes]") {
 
 TEST_CASE("sphere tracing does not leak through thin plates or at grazing angles", "[shapes]") {
   // A plate 1e-3 thick: rays from above at angles down to 3 degrees all hit it.
-  const Shape plate = make_implicit_shape(tree_of({prim(SdfKind::Box, {2, 5e-4f, 2})}, 0));
+  const Shape plate = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Box, {2, 5e-4f, 2})}, 0));
   for (float deg = 90; deg >= 3; deg -= 1) {
     const float a = deg * kPi / 180;
     const Vec3f d{std::cos(a), -std::sin(a), 0.1f * std::cos(a)};
@@ -240,7 +225,7 @@ TEST_CASE("sphere tracing does not leak through thin plates or at grazing angles
   }
   // Rays passing a sphere at impact parameters up to 0.995 r: hit where the quadratic says.
   const Shape exact = analytic(ShapeKind::Sphere, 1);
-  const Shape traced = make_implicit_shape(tree_of({prim(SdfKind::Sphere, {1, 0, 0})}, 0));
+  const Shape traced = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0})}, 0));
   for (float b = 0; b <= 0.995f; b += 0.005f) {
     const float ta = hit_t(exact, {b, 0, -4}, {0, 0, 1}), tb = hit_t(traced, {b, 0, -4}, {0, 0, 1});
     INFO("impact parameter " << b);
@@ -248,7 +233,7 @@ TEST_CASE("sphere tracing does not leak through thin plates or at grazing angles
     CHECK(tb == Approx(ta).margin(1e-3f));
   }
   // A thin torus tube seen edge-on.
-  std::vector<SdfNode> nodes{prim(SdfKind::Torus, {1, 0, 0}, 0.01f)};
+  std::vector<SdfNode> nodes{sdf_primitive(SdfKind::Torus, {1, 0, 0}, 0.01f)};
   const Shape ring = make_implicit_shape(tree_of(nodes, 0));
   CHECK(hit_t(ring, {1, 4, 0}, {0, -1, 0}) == Approx(3.99f).margin(1e-4f));
   CHECK(hit_t(ring, {-4, 0, 0}, {1, 0, 0}) == Approx(2.99f).margin(1e-4f));
