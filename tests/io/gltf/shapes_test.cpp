@@ -234,8 +234,8 @@ TEST_CASE("shapes: CSG primitives map their fields and give their closed-form di
     CHECK(h.offset == 1);
     CHECK(f(t, {0, 3, 0}) == Approx(2));
     CHECK(f(t, {0, -3, 0}) == Approx(-4));
-    const SdfNode& def =
-        node_of(tree_of(op("intersection", {{{"type", "halfSpace"}}, sphere(1)})), SdfKind::HalfSpace);
+    const SdfTree defaults = tree_of(op("intersection", {{{"type", "halfSpace"}}, sphere(1)}));
+    const SdfNode& def = node_of(defaults, SdfKind::HalfSpace);
     test::check_vec(def.normal, {0, 1, 0});
     CHECK(def.offset == 0);
   }
