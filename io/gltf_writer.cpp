@@ -142,7 +142,9 @@ json affine_matrix(const Affine3f& a) {
 /// CSG node `index` of `tree` as a PENUMBRA_shapes CSG object (the inverse of the loader's
 /// reading): its type and fields, a matrix placing its frame unless that is the identity, and
 /// its operands as children.
-json csg_json(const SdfTree& tree, int index, const std::string& file) {
+json csg_json(const SdfTree& tree, int index, const std::string& file, int depth = 1) {
+  if (depth > kMaxSdfDepth)
+    throw InputError(file, "shapes", "a CSG tree deeper than " + std::to_string(kMaxSdfDepth) + " levels");
   const SdfNode& n = tree.nodes[size_t(index)];
   static const char* const kNames[] = {"sphere",
                                        "box",
@@ -192,8 +194,8 @@ json csg_json(const SdfTree& tree, int index, const std::string& file) {
       }
       break;
     default:  // operators
-      j["children"] = json::array({csg_json(tree, n.a, file)});
-      if (n.kind != SdfKind::Complement) j["children"].push_back(csg_json(tree, n.b, file));
+      j["children"] = json::array({csg_json(tree, n.a, file, depth + 1)});
+      if (n.kind != SdfKind::Complement) j["children"].push_back(csg_json(tree, n.b, file, depth + 1));
       if (n.kind >= SdfKind::SmoothUnion) j["radius"] = n.radius;
   }
   if (!is_identity(n.to_local)) {
@@ -206,7 +208,7 @@ json csg_json(const SdfTree& tree, int index, const std::string& file) {
 }
 
 /// The PENUMBRA_shapes object of a scene shape.
-json shape_json(const SceneShape& ss, const std::string& file) {
+json shape_json(const SceneShape& ss, size_t material_count, const std::string& file) {
   const Shape& s = ss.shape;
   json j = {{"type", shape_kind_name(s.kind)}};
   switch (s.kind) {
@@ -231,7 +233,7 @@ json shape_json(const SceneShape& ss, const std::string& file) {
       j["epsilon"] = s.trace.relative_epsilon;
       break;
   }
-  if (ss.material >= 0) j["material"] = ss.material;
+  if (ss.material >= 0 && size_t(ss.material) < material_count) j["material"] = ss.material;
   return j;
 }
 
@@ -242,7 +244,7 @@ void write_shape_instance(Writer& wr, const Scene& scene, const Instance& inst, 
                      "shape " + std::to_string(inst.shape) + " out of range");
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   json node = {{"name", ss.name.empty() ? "shapes[" + std::to_string(inst.shape) + "]" : ss.name}};
-  node["extensions"]["PENUMBRA_shapes"] = shape_json(ss, wr.file);
+  node["extensions"]["PENUMBRA_shapes"] = shape_json(ss, scene.materials.size(), wr.file);
   if (!inst.identity) node["matrix"] = affine_matrix(inst.to_world);
   add_root(wr, node);
 }

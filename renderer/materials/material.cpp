@@ -66,7 +66,9 @@ float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, 
   const Instance& inst = scene.instances[instance];
   if (inst.shape >= 0) {
     const Material& mat = material_of(scene, scene.shapes[size_t(inst.shape)].material);
-    return mat.alpha_mode == AlphaMode::Opaque ? 1.0f : mat.alpha;
+    if (mat.alpha_mode == AlphaMode::Opaque) return 1;
+    if (mat.alpha_mode == AlphaMode::Mask) return mat.alpha >= mat.alpha_cutoff ? 1.0f : 0.0f;
+    return std::clamp(mat.alpha, 0.0f, 1.0f);
   }
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const Material& mat = material_of(scene, mesh.material);

@@ -53,9 +53,12 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
   // Spawned rays start beyond the tracer's tolerance, and beyond the rounding of mapping the
   // point through the instance and back (a few float ulps of the point and the shape's size):
   // a ray leaving a sphere at a grazing angle from just inside would meet its far side at once.
+  // Flat shapes and boxes are snapped onto their planes exactly: only the point's magnitude counts.
   const Bounds3f b = shape_bounds(ss.shape);
   const float obj_len = length(obj.dir), scale = obj_len > 0 ? length(ray.dir) / obj_len : 1.0f;
-  const float size = b.empty() ? 0.0f : max_component(b.extent()) * scale;
+  const bool curved = ss.shape.kind == ShapeKind::Sphere || ss.shape.kind == ShapeKind::Capsule ||
+                      ss.shape.kind == ShapeKind::Implicit;
+  const float size = !curved || b.empty() ? 0.0f : max_component(b.extent()) * scale;
   si.spawn_offset = std::max(4 * world_tol, 64 * 0x1p-23f * (max_component(abs(si.p)) + size));
   si.back_face = dot(n, ray.dir) > 0;
   if (si.back_face) n = -n;
@@ -96,7 +99,8 @@ Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   float world_tol = 0;
   const Vec3f p = shape_hit_point(ss, inst, ray, hit.t, world_tol);
-  return normalize(world_normal(inst, shape_surface(ss.shape, p, normal_step(ss.shape, world_tol)).n));
+  const float tol = shape_hit_tolerance(ss.shape, hit.t, length(to_object_ray(inst, ray).dir));
+  return normalize(world_normal(inst, shape_surface(ss.shape, p, normal_step(ss.shape, tol)).n));
 }
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {

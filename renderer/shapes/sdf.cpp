@@ -297,6 +297,7 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
   const auto bisect = [&](float lo, float hi, float flo) {
     for (int i = 0; i < 40 && hi - lo > 1e-7f * std::max(1.0f, hi); ++i) {
       const float mid = 0.5f * (lo + hi);
+      if (mid == lo || mid == hi) break;  // neighbouring floats
       const float fm = sdf_eval(tree, ray.org + ray.dir * mid);
       ++steps;
       if ((fm < 0) == (flo < 0))
@@ -315,12 +316,17 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
       return t_hit <= ray.tfar;
     }
     if (std::abs(f) / lipschitz_bound < eps) {
-      // Within the tolerance: refine to the crossing if it lies within two tolerances ahead.
+      // Within the tolerance: refine to the crossing if it lies within two tolerances ahead. At
+      // the ray's start a hit needs that crossing: a ray leaving the surface (or continued just
+      // past a hit) starts within the tolerance and must not find that surface again.
       const float probe = std::min(t + 2 * eps / dir_len, ray.tfar);
       const float fp = sdf_eval(tree, ray.org + ray.dir * probe);
       ++steps;
-      t_hit = (fp < 0) != (f < 0) ? bisect(t, probe, f) : t;
-      return true;
+      const bool crossing = (fp < 0) != (f < 0);
+      if (crossing || steps > 2) {
+        t_hit = crossing ? bisect(t, probe, f) : t;
+        return true;
+      }
     }
     prev_t = t;
     prev_f = f;

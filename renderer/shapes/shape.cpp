@@ -407,6 +407,15 @@ Vec3f snap_to_shape(const Shape& s, Vec3f p) {
     case ShapeKind::Plane:
     case ShapeKind::Disk:
       return {p.x, 0, p.z};
+    case ShapeKind::Box: {  // onto the face nearest relative to the half extents
+      const Vec3f q{std::abs(p.x) / s.half_size.x, std::abs(p.y) / s.half_size.y,
+                    std::abs(p.z) / s.half_size.z};
+      const int k = q.x >= q.y && q.x >= q.z ? 0 : (q.y >= q.z ? 1 : 2);
+      Vec3f out = p;
+      const float h = k == 0 ? s.half_size.x : (k == 1 ? s.half_size.y : s.half_size.z);
+      (k == 0 ? out.x : (k == 1 ? out.y : out.z)) = p[k] < 0 ? -h : h;
+      return out;
+    }
     default:
       return p;
   }

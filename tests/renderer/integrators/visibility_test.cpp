@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "renderer/accel/factory.h"
+#include "renderer/integrators/scene_accel.h"
 #include "support/material_scenes.h"
 #include "support/scene_builder.h"
 
@@ -69,4 +70,38 @@ TEST_CASE("material: single-sided back faces are invisible to camera rays but ca
   p.scene.materials[size_t(single)].double_sided = true;
   CHECK(p.at(0, 0, &h).base_color.x == 1);
   CHECK(scene_needs_hit_filter(p.scene) == false);
+}
+
+TEST_CASE("material: shapes are culled, cut out and blended as meshes are, implicit ones included",
+          "[material][shapes]") {
+  // A sphere of radius 1 at the origin: a ray along +x from x = -5 meets it at t = 4 (entering)
+  // and t = 6 (leaving); from the centre it meets only the far side at t = 1.
+  for (bool implicit : {false, true}) {
+    INFO((implicit ? "implicit" : "analytic"));
+    Scene s;
+    const int mat = add_material(s, {1, 1, 1}, 0, 1);
+    add_shape(s, sphere_shape(1, implicit), Affine3f{}, mat);
+    const auto accel = make_accelerator("bvh", mesh_views(s), instance_views(s));
+    Material& m = s.materials[size_t(mat)];
+    Hit h;
+    // Single-sided: seen from outside it is its front; from inside its back is culled.
+    m.double_sided = false;
+    REQUIRE(intersect_visible(s, *accel, {{-5, 0, 0}, 0, {1, 0, 0}, kInfinity}, h, true));
+    CHECK(h.t == Approx(4).margin(1e-3));
+    CHECK_FALSE(intersect_visible(s, *accel, {{0, 0, 0}, 0, {1, 0, 0}, kInfinity}, h, true));
+    m.double_sided = true;
+    REQUIRE(intersect_visible(s, *accel, {{0, 0, 0}, 0, {1, 0, 0}, kInfinity}, h, true));
+    CHECK(h.t == Approx(1).margin(1e-3));
+    // Blend: a shadow ray through both surfaces keeps (1 - alpha)^2.
+    m.alpha_mode = AlphaMode::Blend;
+    m.alpha = 0.5f;
+    CHECK(shadow_transmittance(s, *accel, {{-5, 0, 0}, 0, {1, 0, 0}, 10}, true) == Approx(0.25f));
+    // Mask: the cutoff decides between solid and invisible.
+    m.alpha_mode = AlphaMode::Mask;
+    m.alpha = 0.7f;
+    CHECK(shadow_transmittance(s, *accel, {{-5, 0, 0}, 0, {1, 0, 0}, 10}, true) == 0);
+    m.alpha_cutoff = 0.8f;
+    CHECK(shadow_transmittance(s, *accel, {{-5, 0, 0}, 0, {1, 0, 0}, 10}, true) == 1);
+    CHECK_FALSE(intersect_visible(s, *accel, {{-5, 0, 0}, 0, {1, 0, 0}, kInfinity}, h, true));
+  }
 }
