@@ -7,16 +7,8 @@ rm -rf "$work"; mkdir -p "$work"
 corpus="${PENUMBRA_CORPUS:-${PENUMBRA_CORPUS_DEFAULT:-$src/../shared/corpus}}"
 fails=0; passes=0
 
-expect() {  # expect CODE PATTERN -- command...
-  local code="$1" pattern="$2"; shift 3
-  "$@" >"$work/out" 2>"$work/err"; local rc=$?
-  if [ "$rc" -ne "$code" ] || ! grep -qE -- "$pattern" "$work/out" "$work/err"; then
-    echo "FAIL: [$*] exit $rc (want $code), pattern '$pattern'"; sed 's/^/  | /' "$work/err" | head -5
-    fails=$((fails + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
+# expect CODE PATTERN -- command...: counts a pass or a failure in $passes / $fails.
+source "$(dirname "$0")/expect.sh"
 
 expect 0 "penumbra [0-9]" -- "$bin" --version
 expect 2 "render|info" -- "$bin"

@@ -8,16 +8,8 @@ bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
 fails=0; passes=0
 
-expect() {  # expect CODE PATTERN -- command...
-  local code="$1" pattern="$2"; shift 3
-  "$@" >"$work/out" 2>"$work/err"; local rc=$?
-  if [ "$rc" -ne "$code" ] || ! grep -qE -- "$pattern" "$work/out" "$work/err"; then
-    echo "FAIL: [$*] exit $rc (want $code), pattern '$pattern'"; sed 's/^/  | /' "$work/err" | head -5
-    fails=$((fails + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
+# expect CODE PATTERN -- command...: counts a pass or a failure in $passes / $fails.
+source "$(dirname "$0")/expect.sh"
 absent() {  # absent FILE...: a refused run wrote nothing
   for f in "$@"; do [ ! -e "$f" ] || { echo "FAIL: a refused run wrote $f"; fails=$((fails + 1)); }; done
 }

@@ -1,10 +1,22 @@
-// SDF trees for tests: node builders and the named shapes the marching-cubes and mesh-command
-// tests share (primitives, the classic CSG part, a smooth-union blob).
+// Shapes for tests: SDF node builders and the named trees the marching-cubes and mesh-command
+// tests share (primitives, the classic CSG part, a smooth-union blob), and analytic shapes.
 #pragma once
 
 #include "renderer/shapes/sdf.h"
+#include "renderer/shapes/shape.h"
 
 namespace penumbra::test {
+
+/// An analytic shape of `kind` with the given radius, half extents and half height.
+inline Shape analytic_shape(ShapeKind kind, float radius = 1, Vec3f half = {1, 1, 1},
+                            float half_height = 0.5f) {
+  Shape s;
+  s.kind = kind;
+  s.radius = radius;
+  s.half_size = half;
+  s.half_height = half_height;
+  return s;
+}
 
 inline int add_node(SdfTree& t, SdfNode n) {
   t.nodes.push_back(n);

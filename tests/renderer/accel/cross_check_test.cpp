@@ -227,15 +227,6 @@ Shape blob(Vec3f centre) {
   return make_implicit_shape(std::move(t));
 }
 
-Shape analytic_shape(ShapeKind kind, float radius, Vec3f half = {1, 1, 1}, float half_height = 0.5f) {
-  Shape s;
-  s.kind = kind;
-  s.radius = radius;
-  s.half_size = half;
-  s.half_height = half_height;
-  return s;
-}
-
 /// Every back end over `instances` of `views` (meshes and shapes) against brute force over the
 /// same instances: Penumbra's own back ends exactly (the same object-space rays meet the same
 /// tests), Embree (which maps rays into object space itself) within a relative 1e-4 in t.

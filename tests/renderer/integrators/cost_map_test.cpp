@@ -28,10 +28,7 @@ TEST_CASE("cost map: brute force tests every triangle on every camera ray and vi
   const auto views = mesh_views(s);
   const auto brute = make_accelerator("brute", views);
   REQUIRE(brute->counts_traversal());
-  RenderConfig cfg;
-  cfg.width = 12;
-  cfg.height = 8;
-  cfg.spp = 4;
+  const RenderConfig cfg = small_render_config(12, 8, 4);
   const Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8f);
   const CostImage c = render_cost(*brute, cam, cfg);
   REQUIRE(c.nodes.size() == 96);
@@ -47,10 +44,7 @@ TEST_CASE("cost map: shapes count one test each, implicit ones their SDF evaluat
   add_shape(s, sphere_shape(0.5f, true), Affine3f{}, -1);
   const auto views = mesh_views(s);  // world space: the shapes' placements are the identity
   const auto brute = make_accelerator("brute", views);
-  RenderConfig cfg;
-  cfg.width = 12;
-  cfg.height = 8;
-  cfg.spp = 4;
+  const RenderConfig cfg = small_render_config(12, 8, 4);
   const Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8f);
   const CostImage c = render_cost(*brute, cam, cfg);
   const std::vector<float> total = total_cost(c);

@@ -15,15 +15,6 @@ using namespace penumbra::test;
 
 namespace {
 
-Shape analytic(ShapeKind kind, float radius = 1, Vec3f half = {1, 1, 1}, float half_height = 0.5f) {
-  Shape s;
-  s.kind = kind;
-  s.radius = radius;
-  s.half_size = half;
-  s.half_height = half_height;
-  return s;
-}
-
 // The hit distance, or -1 on a miss.
 float hit_t(const Shape& s, Vec3f o, Vec3f d, float tnear = 0, float tfar = kInfinity) {
   ShapeHit h;
@@ -40,7 +31,7 @@ SdfTree tree_of(std::vector<SdfNode> nodes, int root) {
 }  // namespace
 
 TEST_CASE("sphere: the quadratic's roots", "[shapes][quick]") {
-  const Shape s = analytic(ShapeKind::Sphere, 1);
+  const Shape s = analytic_shape(ShapeKind::Sphere, 1);
   CHECK(hit_t(s, {0, 0, -5}, {0, 0, 1}) == Approx(4));
   CHECK(hit_t(s, {0, 0, -5}, {0, 0, 2}) == Approx(2));           // t in units of the direction
   CHECK(hit_t(s, {1, 0, -5}, {0, 0, 1}) == Approx(5));           // tangent: the double root
@@ -52,12 +43,12 @@ TEST_CASE("sphere: the quadratic's roots", "[shapes][quick]") {
   CHECK(hit_t(s, {0, 0, -5}, {0, 0, 1}, 0, 4.0f) == Approx(4));  // tfar exactly at it
   CHECK(hit_t(s, {0, 0, -5}, {0, 0, 1}, 6.5f) == -1);            // both roots before tnear
   // A far-away sphere: the stable quadratic keeps its digits.
-  const Shape big = analytic(ShapeKind::Sphere, 1e-3f);
+  const Shape big = analytic_shape(ShapeKind::Sphere, 1e-3f);
   CHECK(hit_t(big, {0, 0, -1e4f}, {0, 0, 1}) == Approx(1e4f - 1e-3f).epsilon(1e-7));
 }
 
 TEST_CASE("plane and disk: the crossing of y = 0, inside the outline, from either side", "[shapes][quick]") {
-  const Shape plane = analytic(ShapeKind::Plane, 1, {1, 0, 2});
+  const Shape plane = analytic_shape(ShapeKind::Plane, 1, {1, 0, 2});
   CHECK(hit_t(plane, {0.5f, 3, -1.5f}, {0, -1, 0}) == Approx(3));
   CHECK(hit_t(plane, {0.5f, -3, -1.5f}, {0, 1, 0}) == Approx(3));  // from below: two-sided
   CHECK(hit_t(plane, {1.5f, 3, 0}, {0, -1, 0}) == -1);             // outside |x| <= 1
@@ -65,14 +56,14 @@ TEST_CASE("plane and disk: the crossing of y = 0, inside the outline, from eithe
   CHECK(hit_t(plane, {0, 1, 0}, {1, 0, 0}) == -1);                 // parallel
   CHECK(hit_t(plane, {0, 3, 0}, {0, 1, 0}) == -1);                 // away
   CHECK(hit_t(plane, {-1, 1, 0}, normalize(Vec3f{1, -1, 0})) == Approx(std::sqrt(2.0f)));
-  const Shape disk = analytic(ShapeKind::Disk, 1);
+  const Shape disk = analytic_shape(ShapeKind::Disk, 1);
   CHECK(hit_t(disk, {0.6f, 2, 0.7f}, {0, -1, 0}) == Approx(2));  // 0.36 + 0.49 <= 1
   CHECK(hit_t(disk, {0.8f, 2, 0.7f}, {0, -1, 0}) == -1);         // 0.64 + 0.49 > 1
   CHECK(hit_t(disk, {1, 2, 0}, {0, -1, 0}) == Approx(2));        // on the rim
 }
 
 TEST_CASE("box: slabs, from inside, along a face", "[shapes][quick]") {
-  const Shape box = analytic(ShapeKind::Box, 1, {1, 2, 3});
+  const Shape box = analytic_shape(ShapeKind::Box, 1, {1, 2, 3});
   CHECK(hit_t(box, {-5, 0, 0}, {1, 0, 0}) == Approx(4));
   CHECK(hit_t(box, {0, 0, 10}, {0, 0, -1}) == Approx(7));
   CHECK(hit_t(box, {0, 0, 0}, {0, 1, 0}) == Approx(2));   // inside: the exit face
@@ -86,7 +77,7 @@ TEST_CASE("box: slabs, from inside, along a face", "[shapes][quick]") {
 }
 
 TEST_CASE("capsule: the side, the caps and the seam between them", "[shapes][quick]") {
-  const Shape c = analytic(ShapeKind::Capsule, 0.5f, {1, 1, 1}, 0.5f);
+  const Shape c = analytic_shape(ShapeKind::Capsule, 0.5f, {1, 1, 1}, 0.5f);
   CHECK(hit_t(c, {-5, 0, 0}, {1, 0, 0}) == Approx(4.5f));  // the cylinder
   CHECK(hit_t(c, {0, 5, 0}, {0, -1, 0}) == Approx(4));     // top cap at y = 1
   CHECK(hit_t(c, {0, -5, 0}, {0, 1, 0}) == Approx(4));     // bottom cap at y = -1
@@ -100,7 +91,7 @@ TEST_CASE("capsule: the side, the caps and the seam between them", "[shapes][qui
 }
 
 TEST_CASE("shape surfaces: normals and UVs", "[shapes][quick]") {
-  const Shape sphere = analytic(ShapeKind::Sphere, 2);
+  const Shape sphere = analytic_shape(ShapeKind::Sphere, 2);
   const ShapeSurface top = shape_surface(sphere, {0, 2, 0}, 1e-4f);
   CHECK(top.n.y == Approx(1));
   CHECK(top.uv.y == Approx(0).margin(1e-6));
@@ -108,10 +99,10 @@ TEST_CASE("shape surfaces: normals and UVs", "[shapes][quick]") {
   CHECK(px.uv.x == Approx(0).margin(1e-6));
   CHECK(px.uv.y == Approx(0.5f));
   CHECK(shape_surface(sphere, {0, 0, -2}, 1e-4f).uv.x == Approx(0.25f));  // phi = 90 deg towards -Z
-  const Shape box = analytic(ShapeKind::Box, 1, {1, 2, 3});
+  const Shape box = analytic_shape(ShapeKind::Box, 1, {1, 2, 3});
   CHECK(shape_surface(box, {0.2f, -2, 1}, 1e-4f).n.y == -1);
   CHECK(shape_surface(box, {1, 0.3f, 1}, 1e-4f).n.x == 1);
-  const Shape cap = analytic(ShapeKind::Capsule, 0.5f, {1, 1, 1}, 0.5f);
+  const Shape cap = analytic_shape(ShapeKind::Capsule, 0.5f, {1, 1, 1}, 0.5f);
   const Vec3f n = shape_surface(cap, {0, 0.5f + 0.5f * std::sqrt(0.5f), 0.5f * std::sqrt(0.5f)}, 1e-4f).n;
   CHECK(n.y == Approx(std::sqrt(0.5f)));
   CHECK(n.z == Approx(std::sqrt(0.5f)));
@@ -187,9 +178,9 @@ TEST_CASE("CSG bounds: overlap, merge, the first operand, smooth widening, unbou
 }
 
 TEST_CASE("implicit shapes hit where their analytic twins do", "[shapes]") {
-  const Shape exact = analytic(ShapeKind::Sphere, 1);
+  const Shape exact = analytic_shape(ShapeKind::Sphere, 1);
   const Shape traced = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0})}, 0));
-  const Shape exact_box = analytic(ShapeKind::Box, 1, {0.5f, 1, 1.5f});
+  const Shape exact_box = analytic_shape(ShapeKind::Box, 1, {0.5f, 1, 1.5f});
   const Shape traced_box = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Box, {0.5f, 1, 1.5f})}, 0));
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1, 1);
@@ -224,7 +215,7 @@ TEST_CASE("sphere tracing does not leak through thin plates or at grazing angles
     CHECK(hit_t(plate, o, d) == Approx(3).margin(2e-3f));
   }
   // Rays passing a sphere at impact parameters up to 0.995 r: hit where the quadratic says.
-  const Shape exact = analytic(ShapeKind::Sphere, 1);
+  const Shape exact = analytic_shape(ShapeKind::Sphere, 1);
   const Shape traced = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0})}, 0));
   for (float b = 0; b <= 0.995f; b += 0.005f) {
     const float ta = hit_t(exact, {b, 0, -4}, {0, 0, 1}), tb = hit_t(traced, {b, 0, -4}, {0, 0, 1});
