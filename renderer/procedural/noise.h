@@ -71,13 +71,13 @@ enum class FractalKind : uint8_t {
 /// different fixed offset so that octaves do not share lattice points.
 struct FractalParams {
   FractalKind kind = FractalKind::Fbm;
-  float detail = 4;         ///< octaves beyond the first, in [0, 15]; a fractional part fades
-                            ///< the last octave in linearly
-  float roughness = 0.5f;   ///< amplitude gain per octave, in [0, 1]
-  float lacunarity = 2;     ///< frequency gain per octave, in [1.01, 16]
-  float offset = 1;         ///< Ridged: signal = (offset - |n|)^2, offset in [0, 2]
-  float gain = 2;           ///< Ridged: weight of octave k+1 = clamp(gain x signal_k, 0, 1)
-  float distortion = 0;     ///< domain distortion: p' = p + distortion x (3 decorrelated noises at p)
+  float detail = 4;        ///< octaves beyond the first, in [0, 15]; a fractional part fades
+                           ///< the last octave in linearly
+  float roughness = 0.5f;  ///< amplitude gain per octave, in [0, 1]
+  float lacunarity = 2;    ///< frequency gain per octave, in [1.01, 16]
+  float offset = 1;        ///< Ridged: signal = (offset - |n|)^2, offset in [0, 2]
+  float gain = 2;          ///< Ridged: weight of octave k+1 = clamp(gain x signal_k, 0, 1)
+  float distortion = 0;    ///< domain distortion: p' = p + distortion x (3 decorrelated noises at p)
 };
 
 /// The fractal sum at p with its gradient (chain rule through the distortion). `max_octaves`
@@ -110,9 +110,9 @@ struct WorleyParams {
 };
 
 struct WorleyValue {
-  float value = 0;      ///< the chosen feature distance
-  Vec3f grad;           ///< its gradient with respect to p (zero where undefined)
-  Vec3f nearest;        ///< the nearest feature point
+  float value = 0;        ///< the chosen feature distance
+  Vec3f grad;             ///< its gradient with respect to p (zero where undefined)
+  Vec3f nearest;          ///< the nearest feature point
   float cell_random = 0;  ///< a value in [0, 1) hashed from the nearest point's cell (per-cell colour)
 };
 
