@@ -63,9 +63,9 @@ int lattice_index(float integral) {
 // 3D Perlin's 12 cube-edge vectors padded to 16 with (1,1,0), (-1,1,0), (0,-1,1), (0,-1,-1);
 // 4D the 32 vectors with one zero coordinate and the others +-1 (zero at h >> 3, signs h & 7).
 constexpr float kGrad2[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
-constexpr float kGrad3[16][3] = {{1, 1, 0},  {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
-                                 {1, 0, -1}, {-1, 0, -1}, {0, 1, 1}, {0, -1, 1},  {0, 1, -1}, {0, -1, -1},
-                                 {1, 1, 0},  {-1, 1, 0}, {0, -1, 1}, {0, -1, -1}};
+constexpr float kGrad3[16][3] = {{1, 1, 0},  {-1, 1, 0},  {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+                                 {1, 0, -1}, {-1, 0, -1}, {0, 1, 1},  {0, -1, 1},  {0, 1, -1}, {0, -1, -1},
+                                 {1, 1, 0},  {-1, 1, 0},  {0, -1, 1}, {0, -1, -1}};
 
 template <int N>
 void corner_gradient(int h, float (&g)[N]) {
@@ -174,7 +174,8 @@ namespace {
 // octaves share lattice points (the fractional parts of (k + 1) x 0.31, 0.79, 0.57 never vanish
 // for k < 99). The distortion noises sample at p + kDistortionOffset[i].
 constexpr Vec3f kOctaveStep{17.31f, 41.79f, 29.57f};
-constexpr Vec3f kDistortionOffset[3] = {{5.37f, 11.83f, 2.71f}, {13.19f, 3.47f, 23.61f}, {31.73f, 19.29f, 7.13f}};
+constexpr Vec3f kDistortionOffset[3] = {
+    {5.37f, 11.83f, 2.71f}, {13.19f, 3.47f, 23.61f}, {31.73f, 19.29f, 7.13f}};
 
 FractalParams clamped(const FractalParams& in) {
   const auto fix = [](float v, float lo, float hi, float fallback) {
@@ -285,12 +286,14 @@ Noise3 fractal_noise(const PerlinTable& table, Vec3f p, const FractalParams& par
 
   Vec3f jacobian[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   const Vec3f q = fp.distortion != 0 ? distort(table, p, fp.distortion, jacobian) : p;
-  Noise3 sum = fp.kind == FractalKind::Ridged ? sum_ridged(table, q, fp, octaves) : sum_fbm(table, q, fp, octaves);
+  Noise3 sum =
+      fp.kind == FractalKind::Ridged ? sum_ridged(table, q, fp, octaves) : sum_fbm(table, q, fp, octaves);
 
   // Normalise by the uncapped sum's range, and take the gradient back through the distortion:
   // grad_p = J^T grad_q.
   float normaliser = amplitude_sum(fp);
-  if (fp.kind == FractalKind::Ridged) normaliser *= ridged_signal_root_max(fp.offset) * ridged_signal_root_max(fp.offset);
+  if (fp.kind == FractalKind::Ridged)
+    normaliser *= ridged_signal_root_max(fp.offset) * ridged_signal_root_max(fp.offset);
   const Vec3f g = sum.grad / normaliser;
   sum.value /= normaliser;
   sum.grad = jacobian[0] * g.x + jacobian[1] * g.y + jacobian[2] * g.z;

@@ -59,7 +59,8 @@ std::vector<Point<N>> gradient_set() {
         set.push_back(g);
       }
     if constexpr (N == 3) {  // Perlin's padding to 16
-      set.push_back({1, 1, 0}), set.push_back({-1, 1, 0}), set.push_back({0, -1, 1}), set.push_back({0, -1, -1});
+      set.push_back({1, 1, 0}), set.push_back({-1, 1, 0}), set.push_back({0, -1, 1}),
+          set.push_back({0, -1, -1});
     }
   }
   return set;
@@ -180,6 +181,15 @@ void fft(std::vector<std::complex<double>>& x) {
   }
 }
 
+// check(std::integral_constant<int, N>{}) for N = 1..4.
+template <class F>
+void for_each_dimension(const F& check) {
+  check(std::integral_constant<int, 1>{});
+  check(std::integral_constant<int, 2>{});
+  check(std::integral_constant<int, 3>{});
+  check(std::integral_constant<int, 4>{});
+}
+
 constexpr uint32_t kSeeds[] = {0, 1, 7, 0xDEADBEEF};
 
 }  // namespace
@@ -255,7 +265,8 @@ TEST_CASE("noise: values lie in [-1, 1] and come close to its ends", "[procedura
     const PerlinTable t = make_perlin_table(11);
     std::mt19937 rng(N);
     double m = 0;
-    for (long s = 0; s < samples; ++s) m = std::max(m, std::abs(eval_perlin<N>(t, random_point<N>(rng, -300, 300))));
+    for (long s = 0; s < samples; ++s)
+      m = std::max(m, std::abs(eval_perlin<N>(t, random_point<N>(rng, -300, 300))));
     INFO("dimension " << N << ": max |value| " << m);
     CHECK(m <= 1);
     CHECK(m > 0.6);
@@ -289,13 +300,11 @@ TEST_CASE("noise: value and gradient are continuous across cell borders", "[proc
       }
     }
   };
-  check(std::integral_constant<int, 1>{});
-  check(std::integral_constant<int, 2>{});
-  check(std::integral_constant<int, 3>{});
-  check(std::integral_constant<int, 4>{});
+  for_each_dimension(check);
 }
 
-TEST_CASE("noise: gradient noise's analytic gradient matches central differences", "[procedural][noise][quick]") {
+TEST_CASE("noise: gradient noise's analytic gradient matches central differences",
+          "[procedural][noise][quick]") {
   const auto check = [](auto dim) {
     constexpr int N = decltype(dim)::value;
     const PerlinTable t = make_perlin_table(4);
@@ -313,10 +322,7 @@ TEST_CASE("noise: gradient noise's analytic gradient matches central differences
       }
     }
   };
-  check(std::integral_constant<int, 1>{});
-  check(std::integral_constant<int, 2>{});
-  check(std::integral_constant<int, 3>{});
-  check(std::integral_constant<int, 4>{});
+  for_each_dimension(check);
 }
 
 TEST_CASE("noise: fractal gradients match central differences", "[procedural][noise][quick]") {
@@ -328,14 +334,16 @@ TEST_CASE("noise: fractal gradients match central differences", "[procedural][no
     CHECK(gradient_agreement([&](Vec3f p) { return fractal_noise(t, p, fbm); }, 1000, 2e-4f, 2e-2, 1) == 1);
     for (FractalKind kind : {FractalKind::Turbulence, FractalKind::Ridged}) {
       const FractalParams fp = fractal(kind, 3.5f, distortion);
-      const double agree = gradient_agreement([&](Vec3f p) { return fractal_noise(t, p, fp); }, 1000, 2e-4f, 2e-2, 2);
+      const double agree =
+          gradient_agreement([&](Vec3f p) { return fractal_noise(t, p, fp); }, 1000, 2e-4f, 2e-2, 2);
       INFO("kind " << int(kind) << ", distortion " << distortion);
       CHECK(agree >= 0.97);
     }
   }
 }
 
-TEST_CASE("noise: Worley gradients match central differences off the cell borders", "[procedural][noise][quick]") {
+TEST_CASE("noise: Worley gradients match central differences off the cell borders",
+          "[procedural][noise][quick]") {
   for (WorleyMetric metric : {WorleyMetric::Euclidean, WorleyMetric::Manhattan, WorleyMetric::Chebyshev})
     for (WorleyFeature feature : {WorleyFeature::F1, WorleyFeature::F2, WorleyFeature::F2MinusF1}) {
       const WorleyParams wp{feature, metric, 0.9f};
@@ -357,7 +365,8 @@ TEST_CASE("noise: mean and variance match the prediction from the gradient set",
     std::array<std::array<double, N>, N> ggt{};
     for (const auto& g : set)
       for (int i = 0; i < N; ++i)
-        for (int j = 0; j < N; ++j) ggt[size_t(i)][size_t(j)] += g[size_t(i)] * g[size_t(j)] / double(set.size());
+        for (int j = 0; j < N; ++j)
+          ggt[size_t(i)][size_t(j)] += g[size_t(i)] * g[size_t(j)] / double(set.size());
     const int q = N == 4 ? 12 : 24;
     double predicted = 0;
     long nodes = 0;
@@ -389,10 +398,7 @@ TEST_CASE("noise: mean and variance match the prediction from the gradient set",
     CHECK(std::abs(mean) < 0.01);
     CHECK(var == Approx(predicted).epsilon(0.1));
   };
-  check(std::integral_constant<int, 1>{});
-  check(std::integral_constant<int, 2>{});
-  check(std::integral_constant<int, 3>{});
-  check(std::integral_constant<int, 4>{});
+  for_each_dimension(check);
 }
 
 TEST_CASE("noise: fBm's band energies fall by roughness^2 per octave", "[procedural][noise]") {
@@ -411,19 +417,22 @@ TEST_CASE("noise: fBm's band energies fall by roughness^2 per octave", "[procedu
     for (int line = 0; line < 4; ++line) {
       const Vec3f origin{17.3f * float(line), 5.1f, -3.7f * float(line)};
       std::vector<std::complex<double>> x(n);
-      for (size_t i = 0; i < n; ++i) x[i] = fractal_noise(t, origin + dir * float(double(i) * spacing), fp).value;
+      for (size_t i = 0; i < n; ++i)
+        x[i] = fractal_noise(t, origin + dir * float(double(i) * spacing), fp).value;
       fft(x);
       for (size_t j = 0; j < band.size(); ++j)
         for (size_t b = 32u << j; b < (64u << j) && b < n / 2; ++b) band[j] += std::norm(x[b]);
     }
     for (size_t j = 3; j < 6; ++j) {
-      INFO("roughness " << roughness << ", bands " << j << ", " << j + 1 << ": ratio " << band[j + 1] / band[j]);
+      INFO("roughness " << roughness << ", bands " << j << ", " << j + 1 << ": ratio "
+                        << band[j + 1] / band[j]);
       CHECK(band[j + 1] / band[j] == Approx(double(roughness) * roughness).epsilon(0.15));
     }
   }
 }
 
-TEST_CASE("noise: the same seed gives the same field, other seeds uncorrelated ones", "[procedural][noise][quick]") {
+TEST_CASE("noise: the same seed gives the same field, other seeds uncorrelated ones",
+          "[procedural][noise][quick]") {
   const PerlinTable a = make_perlin_table(21), a2 = make_perlin_table(21), b = make_perlin_table(22);
   std::mt19937 rng(40);
   double sab = 0, saa = 0, sbb = 0;
@@ -443,7 +452,8 @@ TEST_CASE("noise: the same seed gives the same field, other seeds uncorrelated o
     w.emplace_back(worley(21, p, {}).value, worley(22, p, {}).value);
     ma += w.back().first / 50000, mb += w.back().second / 50000;
   }
-  for (const auto& [va, vb] : w) wab += (va - ma) * (vb - mb), waa += (va - ma) * (va - ma), wbb += (vb - mb) * (vb - mb);
+  for (const auto& [va, vb] : w)
+    wab += (va - ma) * (vb - mb), waa += (va - ma) * (va - ma), wbb += (vb - mb) * (vb - mb);
   CHECK(std::abs(wab / std::sqrt(waa * wbb)) < 0.03);
 }
 
@@ -474,7 +484,8 @@ TEST_CASE("noise: Worley F1 and F2 equal a brute-force search", "[procedural][no
         const WorleyValue w1 = worley(seed, p, {WorleyFeature::F1, metric, randomness});
         const WorleyValue w2 = worley(seed, p, {WorleyFeature::F2, metric, randomness});
         const WorleyValue w21 = worley(seed, p, {WorleyFeature::F2MinusF1, metric, randomness});
-        INFO("metric " << int(metric) << ", randomness " << randomness << ", p " << p.x << " " << p.y << " " << p.z);
+        INFO("metric " << int(metric) << ", randomness " << randomness << ", p " << p.x << " " << p.y << " "
+                       << p.z);
         CHECK(w1.value == Approx(f1).margin(1e-5));
         CHECK(w2.value == Approx(f2).margin(1e-5));
         CHECK(w21.value == Approx(f2 - f1).margin(2e-5));
@@ -505,7 +516,8 @@ TEST_CASE("noise: the fractal gradient bound holds", "[procedural][noise]") {
         worst = std::max(worst, length(fractal_noise(t, a, fp).grad));
         if (s % 4 == 0) {
           const Vec3f b = a + random_vec3(rng, -0.05f, 0.05f);
-          const float lip = std::abs(fractal_noise(t, a, fp).value - fractal_noise(t, b, fp).value) / length(a - b);
+          const float lip =
+              std::abs(fractal_noise(t, a, fp).value - fractal_noise(t, b, fp).value) / length(a - b);
           worst_lipschitz = std::max(worst_lipschitz, lip);
         }
       }
@@ -518,7 +530,8 @@ TEST_CASE("noise: the fractal gradient bound holds", "[procedural][noise]") {
   std::mt19937 rng(70);
   for (uint32_t seed : kSeeds) {
     const PerlinTable ts = make_perlin_table(seed);
-    for (int s = 0; s < 100000; ++s) worst = std::max(worst, length(perlin(ts, random_vec3(rng, -300, 300)).grad));
+    for (int s = 0; s < 100000; ++s)
+      worst = std::max(worst, length(perlin(ts, random_vec3(rng, -300, 300)).grad));
   }
   CHECK(worst <= kPerlinGradientBound3);
   CHECK(worst > 0.6f * kPerlinGradientBound3);
@@ -548,7 +561,8 @@ TEST_CASE("noise: capping the octaves keeps the uncapped normalisation", "[proce
     for (float cap : {1.0f, 2.5f, 3.0f, 4.7f}) {
       // Capped at m octaves = uncapped with detail m - 1, rescaled to the full normaliser.
       const FractalParams fewer = fractal(kind, cap - 1, 0.25f);
-      const double ratio = amplitude_sum(cap - 1, full.roughness) / amplitude_sum(full.detail, full.roughness);
+      const double ratio =
+          amplitude_sum(cap - 1, full.roughness) / amplitude_sum(full.detail, full.roughness);
       for (int s = 0; s < 200; ++s) {
         const Vec3f p = random_vec3(rng, -20, 20);
         const Noise3 capped = fractal_noise(t, p, full, cap), reference = fractal_noise(t, p, fewer);
@@ -558,7 +572,8 @@ TEST_CASE("noise: capping the octaves keeps the uncapped normalisation", "[proce
     }
     CHECK(fractal_noise(t, {0.3f, 0.4f, 0.5f}, full, 0).value == 0);
     CHECK(fractal_noise(t, {0.3f, 0.4f, 0.5f}, full, -1).grad == Vec3f{});
-    CHECK(fractal_noise(t, {0.3f, 0.4f, 0.5f}, full, 99).value == fractal_noise(t, {0.3f, 0.4f, 0.5f}, full).value);
+    CHECK(fractal_noise(t, {0.3f, 0.4f, 0.5f}, full, 99).value ==
+          fractal_noise(t, {0.3f, 0.4f, 0.5f}, full).value);
   }
   // fBm's variance drops with the cap.
   double previous = 1e30;
