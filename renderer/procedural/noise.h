@@ -63,7 +63,8 @@ extern const float kPerlinGradientBound3;
 enum class FractalKind : uint8_t {
   Fbm,         ///< sum of a_k n(f_k p), normalised by sum a_k: range [-1, 1]
   Turbulence,  ///< sum of a_k |n(f_k p)| / sum a_k: range [0, 1]
-  Ridged,      ///< Musgrave's ridged multifractal, normalised by offset^2 sum a_k: range [0, 1]
+  Ridged,      ///< Musgrave's ridged multifractal, normalised by M^2 sum a_k with
+               ///< M = max(offset, 1 - offset) (offset^2 for offset >= 0.5): range [0, 1]
 };
 
 /// Parameters of a fractal sum, with Blender's Noise / Musgrave texture names. Octave k (from 0)
@@ -84,8 +85,8 @@ struct FractalParams {
 /// caps the number of octaves (fractional: the last one kept fades in), for antialiasing by a
 /// footprint (fractal_octave_limit); octaves beyond the cap contribute their mean (0 for Fbm;
 /// Turbulence and Ridged likewise drop them) and the normalisation stays that of the uncapped
-/// sum. max_octaves <= 0 gives the sum's mean value (0 for Fbm). Params outside their documented
-/// ranges are clamped into them.
+/// sum. max_octaves <= 0 drops every octave: value and gradient 0 for every kind (the mean of
+/// Fbm). Params outside their documented ranges are clamped into them.
 Noise3 fractal_noise(const PerlinTable& table, Vec3f p, const FractalParams& params,
                      float max_octaves = kInfinity);
 
