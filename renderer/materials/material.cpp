@@ -1,5 +1,8 @@
-// Material evaluation: textures, factors, vertex colours, normal mapping, coverage.
+// Material evaluation: textures, factors, vertex colours, normal mapping, procedural textures,
+// coverage.
 #include "renderer/materials/material.h"
+
+#include <cmath>
 
 namespace penumbra {
 
@@ -10,6 +13,119 @@ Vec2f transform_uv(const TextureRef& ref, Vec2f uv, bool offset) {
   return {m[0][0] * uv.x + m[0][1] * uv.y + (offset ? m[0][2] : 0.0f),
           m[1][0] * uv.x + m[1][1] * uv.y + (offset ? m[1][2] : 0.0f)};
 }
+// Surface gradients of u and v of UV set `set` at si (world space, in the tangent plane): for a
+// triangle from its vertices' UVs, for a shape by differences of its UV map along two tangents.
+// False where the map is degenerate.
+bool uv_surface_gradients(const Scene& scene, const SurfaceInteraction& si, int set, Vec3f& gu, Vec3f& gv) {
+  const Instance& inst = scene.instances[si.instance];
+  if (si.shape >= 0) {
+    const Shape& shape = scene.shapes[size_t(si.shape)].shape;
+    const Vec3f t1 = normalize(std::fabs(si.ng.x) < 0.9f ? cross(si.ng, {1, 0, 0}) : cross(si.ng, {0, 1, 0}));
+    const Vec3f t2 = cross(si.ng, t1);
+    const Bounds3f b = shape_bounds(shape);
+    const float h = 1e-4f * (b.empty() ? 1.0f : std::max(max_component(b.extent()), 1e-3f));
+    const auto uv_at = [&](Vec3f p) {
+      return shape_surface(shape, inst.identity ? p : apply_point(inst.to_object, p), h).uv;
+    };
+    const Vec2f u0 = uv_at(si.p), u1 = uv_at(si.p + t1 * h), u2 = uv_at(si.p + t2 * h);
+    const Vec2f d1 = shape_uv_delta(shape, u0, u1), d2 = shape_uv_delta(shape, u0, u2);
+    gu = (t1 * d1.x + t2 * d2.x) / h;
+    gv = (t1 * d1.y + t2 * d2.y) / h;
+    return is_finite(gu) && is_finite(gv);
+  }
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const auto& uvs = set == 1 ? mesh.uvs1 : mesh.uvs;
+  if (uvs.empty()) return false;
+  const WorldTriangle tri = world_triangle(scene, inst, si.prim);
+  const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
+  const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);
+  const float det = a11 * a22 - a12 * a12;
+  if (!(det > 0) || !std::isfinite(det)) return false;
+  const Vec2f w0 = uvs[tri.index[0]], w1 = uvs[tri.index[1]], w2 = uvs[tri.index[2]];
+  // The gradient of a linear function with differences (d1, d2) along (e1, e2), in their plane.
+  auto gradient = [&](float d1, float d2) {
+    return e1 * ((a22 * d1 - a12 * d2) / det) + e2 * ((a11 * d2 - a12 * d1) / det);
+  };
+  gu = gradient(w1.x - w0.x, w2.x - w0.x);
+  gv = gradient(w1.y - w0.y, w2.y - w0.y);
+  return true;
+}
+
+// A procedural texture's point at si in pattern space, the pixel footprint there and the map
+// of pattern-space gradients to world-space surface gradients.
+struct PatternPoint {
+  Vec3f q;
+  float footprint = 0;
+};
+
+PatternPoint pattern_point(const Scene& scene, const ProceduralTexture& tex, const SurfaceInteraction& si) {
+  const Instance& inst = scene.instances[si.instance];
+  Vec3f x = si.p, dx = si.dpdx, dy = si.dpdy;
+  if (tex.space == ProceduralSpace::Object && !inst.identity) {
+    x = apply_point(inst.to_object, x);
+    dx = apply_vector(inst.to_object, dx);
+    dy = apply_vector(inst.to_object, dy);
+  } else if (tex.space == ProceduralSpace::Uv) {
+    const int set = tex.texcoord == 1 ? 1 : 0;
+    x = {si.uv[set].x, si.uv[set].y, 0};
+    dx = {si.duvdx[set].x, si.duvdx[set].y, 0};
+    dy = {si.duvdy[set].x, si.duvdy[set].y, 0};
+  }
+  PatternPoint pp;
+  pp.q = apply_point(tex.mapping, x);
+  pp.footprint = std::max(length(apply_vector(tex.mapping, dx)), length(apply_vector(tex.mapping, dy)));
+  return pp;
+}
+
+// The world-space gradient of the pattern along the surface at si, from its pattern-space
+// gradient g (chain rule through the mapping and the space).
+Vec3f surface_gradient(const Scene& scene, const ProceduralTexture& tex, const SurfaceInteraction& si,
+                       Vec3f g) {
+  const Vec3f gx = apply_normal(tex.mapping, g);  // mapping^T g: gradient in the texture's space
+  Vec3f gw = gx;
+  if (tex.space == ProceduralSpace::Uv) {
+    Vec3f gu, gv;
+    if (!uv_surface_gradients(scene, si, tex.texcoord == 1 ? 1 : 0, gu, gv)) return {};
+    gw = gu * gx.x + gv * gx.y;
+  } else if (tex.space == ProceduralSpace::Object) {
+    const Instance& inst = scene.instances[si.instance];
+    if (!inst.identity) gw = apply_normal(inst.to_object, gx);
+  }
+  return gw - si.ng * dot(gw, si.ng);
+}
+
+float drive(const ScalarDrive& d, float own, float t) {
+  const float v = eval_drive(d, t);
+  return d.compose == Compose::Replace ? v : own * v;
+}
+
+// Applies a material's procedural texture to the evaluated inputs: base colour through the ramp,
+// the scalar drives, and the bump of height bump_height x t (pbrt's bump mapping with the
+// pattern's analytic gradient instead of finite differences).
+void apply_procedural(const Scene& scene, const Material& mat, const SurfaceInteraction& si,
+                      MaterialPoint& mp) {
+  const ProceduralTexture& tex = scene.procedurals[size_t(mat.procedural)];
+  const PatternPoint pp = pattern_point(scene, tex, si);
+  const PatternSample s = eval_pattern(tex, pp.q, pp.footprint);
+  if (tex.drives_base_color) {
+    const Vec3f c = eval_ramp(tex.base_color, s.t);
+    mp.base_color = tex.base_color_compose == Compose::Replace ? c : mp.base_color * c;
+  }
+  if (tex.roughness.enabled) mp.roughness = std::clamp(drive(tex.roughness, mp.roughness, s.t), 0.0f, 1.0f);
+  if (tex.metallic.enabled) mp.metallic = std::clamp(drive(tex.metallic, mp.metallic, s.t), 0.0f, 1.0f);
+  if (tex.emission_strength.enabled) {
+    const float strength = std::max(eval_drive(tex.emission_strength, s.t), 0.0f);
+    mp.emissive = (tex.emission_strength.compose == Compose::Replace ? mat.emissive : mp.emissive) * strength;
+  }
+  if (tex.bump_height != 0) {
+    // The surface displaced by h t along its outward normal has normal n - grad(h t); seen from
+    // behind, the outward normal is -ns.
+    const Vec3f g = surface_gradient(scene, tex, si, s.grad) * tex.bump_height;
+    const Vec3f n = normalize(mp.ns - g * (si.back_face ? -1.0f : 1.0f));
+    if (is_finite(n) && dot(n, si.ng) > 0) mp.ns = n;
+  }
+}
+
 }  // namespace
 
 const Material& default_material() {
@@ -59,6 +175,7 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
     const Vec3f n = normalize(t * m.x + b * m.y + si.ns * m.z);
     if (dot(t, t) > 0 && dot(n, si.ng) > 0) mp.ns = n;
   }
+  if (mat.procedural >= 0) apply_procedural(scene, mat, si, mp);
   return mp;
 }
 

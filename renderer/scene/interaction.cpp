@@ -66,13 +66,6 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
   return si;
 }
 
-// Difference of two texture coordinates of a shape whose u wraps around (sphere, capsule).
-Vec2f uv_delta(const Shape& shape, Vec2f a, Vec2f b) {
-  Vec2f d{b.x - a.x, b.y - a.y};
-  if (shape.kind == ShapeKind::Sphere || shape.kind == ShapeKind::Capsule) d.x -= std::round(d.x);
-  return d;
-}
-
 void shape_differentials(const Scene& scene, SurfaceInteraction& si) {
   const Instance& inst = scene.instances[si.instance];
   const Shape& shape = scene.shapes[size_t(si.shape)].shape;
@@ -81,8 +74,8 @@ void shape_differentials(const Scene& scene, SurfaceInteraction& si) {
   const Vec2f uv = shape_surface(shape, p, 1e-4f).uv;
   const Vec2f ux = shape_surface(shape, to_obj(si.p + si.dpdx), 1e-4f).uv;
   const Vec2f uy = shape_surface(shape, to_obj(si.p + si.dpdy), 1e-4f).uv;
-  si.duvdx[0] = si.duvdx[1] = uv_delta(shape, uv, ux);
-  si.duvdy[0] = si.duvdy[1] = uv_delta(shape, uv, uy);
+  si.duvdx[0] = si.duvdx[1] = shape_uv_delta(shape, uv, ux);
+  si.duvdy[0] = si.duvdy[1] = shape_uv_delta(shape, uv, uy);
 }
 
 }  // namespace

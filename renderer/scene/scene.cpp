@@ -100,6 +100,8 @@ uint64_t scene_memory_bytes(const Scene& scene) {
   for (const SceneShape& s : scene.shapes) total += bytes(s.shape.sdf.nodes) + bytes(s.shape.sdf.planes);
   for (const Texture& t : scene.textures)
     for (const MipLevel& level : t.levels) total += bytes(level.texels);
+  total += bytes(scene.procedurals);
+  for (const ProceduralTexture& p : scene.procedurals) total += bytes(p.base_color.stops);
   return total;
 }
 

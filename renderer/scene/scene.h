@@ -1,7 +1,7 @@
 // The scene as plain data: triangle meshes, shapes (analytic primitives and implicit surfaces)
-// and their instances, materials, textures, punctual lights and cameras, addressed by int handles. Built by
-// io/ from glTF (or by tests directly); consumed by the integrators. No accelerators and no behaviour beyond
-// small free functions (integrators/scene_accel.h builds the accelerator over it).
+// and their instances, materials, image and procedural textures, punctual lights and cameras, addressed by
+// int handles. Built by io/ from glTF (or by tests directly); consumed by the integrators. No accelerators
+// and no behaviour beyond small free functions (integrators/scene_accel.h builds the accelerator over it).
 #pragma once
 
 #include <span>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "renderer/core/math.h"
+#include "renderer/procedural/pattern.h"
 #include "renderer/scene/texture.h"
 #include "renderer/shapes/shape.h"
 
@@ -49,6 +50,7 @@ struct Material {
   float specular = 1;                 ///< KHR_materials_specular specularFactor
   float transmission = 0;             ///< KHR_materials_transmission factor (thin-walled)
   TextureRef transmission_tex;        ///< R multiplies transmission (linear)
+  int procedural = -1;                ///< index into Scene::procedurals (PENUMBRA_procedural), -1 = none
 };
 
 /// A triangle mesh (one glTF primitive): in world space when its only instance is the identity
@@ -129,6 +131,7 @@ struct Scene {
   std::vector<Instance> instances;  ///< what is rendered: a mesh without an instance is not
   std::vector<Material> materials;
   std::vector<Texture> textures;
+  std::vector<ProceduralTexture> procedurals;  ///< procedural textures of materials
   std::vector<Light> lights;
   std::vector<Camera> cameras;
 };

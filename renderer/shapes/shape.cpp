@@ -348,6 +348,12 @@ bool intersect_shape(const Shape& s, const Ray& ray, ShapeHit& hit) {
   return true;
 }
 
+Vec2f shape_uv_delta(const Shape& shape, Vec2f a, Vec2f b) {
+  Vec2f d{b.x - a.x, b.y - a.y};
+  if (shape.kind == ShapeKind::Sphere || shape.kind == ShapeKind::Capsule) d.x -= std::round(d.x);
+  return d;
+}
+
 ShapeSurface shape_surface(const Shape& s, Vec3f p, float h) {
   ShapeSurface out;
   switch (s.kind) {

@@ -82,6 +82,10 @@ struct ShapeSurface {
 /// differences of step `h` (> 0, in object units).
 ShapeSurface shape_surface(const Shape& shape, Vec3f p, float h);
 
+/// The difference b - a of two of the shape's texture coordinates, u taken the short way round
+/// on shapes whose u wraps (sphere, capsule).
+Vec2f shape_uv_delta(const Shape& shape, Vec2f a, Vec2f b);
+
 /// Moves a point found by intersect_shape onto the surface where that is exact (sphere:
 /// radial projection; flat shapes: y = 0; box: its face), and returns it unchanged otherwise.
 Vec3f snap_to_shape(const Shape& shape, Vec3f p);
