@@ -39,6 +39,25 @@ std::string describe_shape(const Shape& sh) {
   return std::string(shape_kind_name(sh.kind)) + " " + buf;
 }
 
+// A procedural texture in one line: pattern, space and what it drives.
+std::string describe_procedural(const ProceduralTexture& t) {
+  static const char* kPatterns[] = {"noise", "voronoi", "wave"};
+  static const char* kFractals[] = {"fbm", "turbulence", "ridged"};
+  static const char* kSpaces[] = {"object", "world", "uv"};
+  std::string d = kPatterns[int(t.kind)];
+  if (t.kind != PatternKind::Voronoi) d += std::string(" (") + kFractals[int(t.fractal.kind)] + ")";
+  d += std::string(" in ") + kSpaces[int(t.space)] + " space, seed " + std::to_string(t.seed) + "; drives";
+  std::string drives;
+  if (t.drives_base_color) drives += " base colour,";
+  if (t.roughness.enabled) drives += " roughness,";
+  if (t.metallic.enabled) drives += " metallic,";
+  if (t.emission_strength.enabled) drives += " emission,";
+  if (t.bump_height != 0) drives += " bump,";
+  if (drives.empty()) drives = " nothing,";
+  drives.pop_back();
+  return d + drives;
+}
+
 // The shapes line and one line per shape: its node, kind, material and instance count.
 void print_shapes(const Scene& s, const GltfInfo& i) {
   std::vector<size_t> placed(s.shapes.size(), 0);
@@ -91,6 +110,8 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
     std::printf("  [%zu] %s: base (%.3g %.3g %.3g) metallic %.3g roughness %.3g emissive (%.3g %.3g %.3g)\n",
                 k, m.name.c_str(), m.base_color.x, m.base_color.y, m.base_color.z, m.metallic, m.roughness,
                 m.emissive.x, m.emissive.y, m.emissive.z);
+    if (m.procedural >= 0)
+      std::printf("      procedural: %s\n", describe_procedural(s.procedurals[size_t(m.procedural)]).c_str());
   }
   std::printf("cameras      %d defined, %zu in the scene (use --camera N or NAME)\n", i.gltf_camera_count,
               i.camera_instances.size());

@@ -25,6 +25,7 @@ std::vector<std::string> supported_gltf_extensions() {
   for (auto& e : gltf::material_extensions()) out.push_back(std::move(e));
   out.push_back("EXT_mesh_gpu_instancing");
   out.push_back(gltf::kShapesExtension);
+  out.push_back(gltf::kProceduralExtension);
   return out;
 }
 
@@ -93,7 +94,7 @@ void check_version_and_extensions(const GltfContext& ctx) {
 // The conversion phases, in order: whole-model validation, materials (with their textures),
 // meshes in local space, the animated pose, then the node walk that places cameras, lights,
 // meshes and the shapes read with the raw JSON.
-void convert(const GltfContext& ctx, std::vector<NodeShape>& shapes) {
+void convert(const GltfContext& ctx, VendorExtensions& vendor) {
   describe(ctx.model, ctx.out.info);
   check_version_and_extensions(ctx);
   validate_accessors(ctx);
@@ -101,6 +102,7 @@ void convert(const GltfContext& ctx, std::vector<NodeShape>& shapes) {
   validate_material_textures(ctx);
   TextureCache textures;
   convert_materials(ctx, textures);
+  attach_procedurals(ctx.out.scene, vendor.procedurals);
   validate_cameras(ctx);
   validate_lights(ctx);
   const std::vector<std::vector<LocalPrimitive>> meshes = decode_meshes(ctx);
@@ -110,7 +112,7 @@ void convert(const GltfContext& ctx, std::vector<NodeShape>& shapes) {
   NodeTransforms nodes = link_nodes(ctx, poses);
   const NodeUses uses = place_nodes(ctx, nodes, roots);
   place_meshes(ctx, meshes, nodes, uses.meshes);
-  place_shapes(ctx, shapes, nodes, uses.shapes);
+  place_shapes(ctx, vendor.shapes, nodes, uses.shapes);
   const int scene = ctx.out.info.scene_index;
   if (ctx.out.scene.meshes.empty() && ctx.out.scene.shapes.empty())
     ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
@@ -125,10 +127,10 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
   gltf::MemoryBudget budget(name, options.max_memory_bytes);
   LoadedScene out;
   tinygltf::Model model;
-  std::vector<gltf::NodeShape> shapes;
-  gltf::parse_gltf(file, options, budget, out, model, shapes);
+  gltf::VendorExtensions vendor;
+  gltf::parse_gltf(file, options, budget, out, model, vendor);
   try {
-    gltf::convert(gltf::GltfContext{model, name, options, budget, out}, shapes);
+    gltf::convert(gltf::GltfContext{model, name, options, budget, out}, vendor);
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while converting the scene");
   }

@@ -151,11 +151,11 @@ void resolve_external_files(const nlohmann::json& doc, const std::string& file, 
 }
 
 // The JSON checks that need the DOM, run on a DOM of the loader's own that is freed before
-// tinygltf builds its own: schema checks, element and buffer charges, the PENUMBRA_shapes
-// extensions, URI resolution.
+// tinygltf builds its own: schema checks, element and buffer charges, the vendor extensions,
+// URI resolution.
 void check_document(std::string_view json, const std::string& file, const fs::path& root,
                     const GltfLoadOptions& options, FileSandbox& box, MemoryBudget& budget,
-                    std::vector<std::string>& warnings, std::vector<NodeShape>& shapes) {
+                    std::vector<std::string>& warnings, VendorExtensions& vendor) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(json.begin(), json.end());
@@ -166,7 +166,8 @@ void check_document(std::string_view json, const std::string& file, const fs::pa
   }
   check_gltf_json(doc, file);
   charge_elements(doc, budget);
-  shapes = read_node_shapes(doc, file, budget);
+  vendor.shapes = read_node_shapes(doc, file, budget);
+  vendor.procedurals = read_material_procedurals(doc, file, budget);
   resolve_external_files(doc, file, root, options, box, budget, warnings);
 }
 
@@ -181,7 +182,7 @@ std::string one_line(std::string s) {
 }  // namespace
 
 void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudget& budget, LoadedScene& out,
-                tinygltf::Model& model, std::vector<NodeShape>& shapes) {
+                tinygltf::Model& model, VendorExtensions& vendor) {
   const std::string name = file.string();
   std::vector<unsigned char> bytes = read_scene_file(file, options.max_file_bytes, budget);
   const std::string scene_sha256 = sha256_hex({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
@@ -212,7 +213,7 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   box.max_bytes = options.max_file_bytes;
   box.read = &out.info.source_files;
   box.read_sha256 = &out.info.source_sha256;
-  check_document(json, name, root, options, box, budget, out.warnings, shapes);
+  check_document(json, name, root, options, box, budget, out.warnings, vendor);
 
   tinygltf::TinyGLTF parser;
   install_sandbox(parser, box);

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "io/gltf/context.h"
+#include "io/gltf/procedural.h"
 #include "io/gltf/shapes.h"
 
 namespace tinygltf {
@@ -15,11 +16,17 @@ class Model;
 
 namespace penumbra::gltf {
 
-/// Parses `file` into `model`, and the nodes' PENUMBRA_shapes extensions (read from the raw JSON,
-/// read_node_shapes()) into `shapes`. GLB chunk warnings and tinygltf's warnings go to
-/// out.warnings; every file read goes to out.info.source_files (the scene file first). What
+/// What the vendor extensions describe, read from the raw JSON: the nodes' PENUMBRA_shapes
+/// (read_node_shapes()) and the materials' PENUMBRA_procedural (read_material_procedurals()).
+struct VendorExtensions {
+  std::vector<NodeShape> shapes;
+  std::vector<MaterialProcedural> procedurals;
+};
+
+/// Parses `file` into `model`, and the vendor extensions into `vendor`. GLB chunk warnings and tinygltf's
+/// warnings go to out.warnings; every file read goes to out.info.source_files (the scene file first). What
 /// parsing holds is charged to `budget`. Throws InputError.
 void parse_gltf(const std::filesystem::path& file, const GltfLoadOptions& options, MemoryBudget& budget,
-                LoadedScene& out, tinygltf::Model& model, std::vector<NodeShape>& shapes);
+                LoadedScene& out, tinygltf::Model& model, VendorExtensions& vendor);
 
 }  // namespace penumbra::gltf

@@ -1,0 +1,38 @@
+// The PENUMBRA_procedural material extension for the glTF loader: a procedural texture (noise,
+// Voronoi or wave pattern with its mapping) driving base colour, roughness, metallic, emission
+// strength and a bump, read from the raw JSON and checked against the extension's schema
+// (README, "The PENUMBRA_procedural extension"). Internal to io/gltf/.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "io/gltf/context.h"
+#include "renderer/scene/scene.h"
+
+namespace penumbra::gltf {
+
+/// The extension's name on materials and in extensionsUsed / extensionsRequired.
+inline constexpr const char* kProceduralExtension = "PENUMBRA_procedural";
+
+/// Most colour ramp stops one procedural texture may hold.
+inline constexpr int kMaxRampStops = 64;
+
+/// One material's procedural texture.
+struct MaterialProcedural {
+  int material = -1;  ///< index into materials
+  ProceduralTexture texture;
+};
+
+/// Reads materials[i].extensions.PENUMBRA_procedural of every material of the raw JSON `doc`, in
+/// material order, each charged to `budget` before it is stored. Throws InputError(file, JSON path of the
+/// offending member, reason naming the material) for anything outside the schema: unknown keys, keys of
+/// another pattern type, wrong JSON types, values out of range, unsorted ramps, a singular mapping.
+std::vector<MaterialProcedural> read_material_procedurals(const nlohmann::json& doc, const std::string& file,
+                                                          MemoryBudget& budget);
+
+/// Moves each texture into scene.procedurals and links it from its material (which must exist).
+void attach_procedurals(Scene& scene, std::vector<MaterialProcedural>& procedurals);
+
+}  // namespace penumbra::gltf
