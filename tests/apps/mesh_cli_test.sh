@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end test of `penumbra mesh`: a scene with implicit shapes (PENUMBRA_shapes) meshed to
-# .glb and .gltf, read back by `penumbra info` (and Blender when installed); an unknown node, a
-# node without an implicit shape, bad resolutions and outputs, and a resolution over the memory
-# budget exit 2 before writing anything. Usage: mesh_cli_test.sh PENUMBRA SRC WORK
+# .glb and .gltf, read back by `penumbra info` (and Blender when installed); a displaced sphere
+# meshed to its relief; an unknown node, a node without an implicit shape, bad resolutions and
+# outputs, and a resolution over the memory budget exit 2 before writing anything.
+# Usage: mesh_cli_test.sh PENUMBRA SRC WORK
 set -u
 bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
@@ -68,6 +69,33 @@ expect 0 "meshes       1 " -- "$bin" info "$work/part.glb"
 # The shipped CSG scene: its three implicit shapes (the ground plane is analytic).
 expect 0 "3 shapes meshed at resolution 32" -- "$bin" mesh "$src/scenes/csg.gltf" --resolution 32 -o "$work/csg.glb"
 expect 0 "meshes       3 \(3 primitives\)" -- "$bin" info "$work/csg.glb"
+# A unit sphere displaced by fBm (amplitude 0.2): its mesh's box lies within 0.2 and a cell of the
+# sphere's, and its relief moves some face of the box more than two cells off the sphere's.
+rough="$work/rough.gltf"
+cat >"$rough" <<'JSON'
+{
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["PENUMBRA_shapes"],
+  "scenes": [{"nodes": [0]}],
+  "scene": 0,
+  "nodes": [
+    {"name": "rough", "extensions": {"PENUMBRA_shapes": {"type": "implicit", "csg": {
+      "type": "displace", "amplitude": 0.2, "frequency": 2, "seed": 5, "noise": "fbm", "detail": 3,
+      "children": [{"type": "sphere", "radius": 1}]}}}}
+  ]
+}
+JSON
+expect 0 "1 shapes meshed at resolution 48" -- "$bin" mesh "$rough" --resolution 48 -o "$work/rough.glb"
+"$bin" info "$work/rough.glb" >"$work/rough-info" 2>&1
+bounds=$(sed -n 's/^bounds *(\(.*\)) - (\(.*\))$/\1, \2/p' "$work/rough-info" | tr -d ' ')
+if python3 -c "
+import sys
+got = [float(x) for x in '$bounds'.split(',')]
+cell = 2.4 / 48
+sphere = [-1, -1, -1, 1, 1, 1]
+near = len(got) == 6 and all(abs(g - s) <= 0.2 + cell for g, s in zip(got, sphere))
+sys.exit(0 if near and max(abs(g - s) for g, s in zip(got, sphere)) > 2 * cell else 1)
+"; then passes=$((passes + 1)); else echo "FAIL: displaced sphere bounds '$bounds'"; fails=$((fails + 1)); fi
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Refusals: exit 2, the reason named, nothing written.
