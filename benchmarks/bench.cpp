@@ -3,7 +3,8 @@
 // random), verifies every structure's answers against Embree (disagreements settled by the exact
 // brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
 // SVG chart and traversal-cost heat maps; with --marching-cubes, instead, isosurface extraction of
-// the classic CSG part in cells per second. See README, "Benchmarks", and benchmarks/RESULTS.md.
+// the classic CSG part in cells per second; with --noise, noise evaluations per second. See README,
+// "Benchmarks", and benchmarks/RESULTS.md.
 #include <sys/utsname.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -36,6 +37,7 @@
 #include "renderer/core/rng.h"
 #include "renderer/integrators/cost_map.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/procedural/noise.h"
 #include "renderer/scene/camera.h"
 #include "renderer/scene/interaction.h"
 #include "renderer/scene/scene.h"
@@ -283,6 +285,40 @@ int run_marching_cubes(const std::vector<int>& resolutions, const std::vector<in
   return 0;
 }
 
+/// One --noise row: `eval` at every point, one warm-up pass, then the median of `repeats` passes.
+template <class Eval>
+void measure_noise(const char* name, const std::vector<Vec3f>& points, int repeats, const Eval& eval) {
+  std::vector<double> secs;
+  volatile float sink = 0;
+  for (int i = 0; i <= repeats; ++i) {
+    const auto t0 = Clock::now();
+    float sum = 0;
+    for (const Vec3f& p : points) sum += eval(p);
+    if (i > 0) secs.push_back(seconds_since(t0));  // the first pass warms up
+    sink = sink + sum;
+  }
+  const double s = median(secs), n = double(points.size());
+  std::printf("%-10s %12.0f %10.1f %10.2f %9.1f\n", name, n, s * 1e3, n / s / 1e6, s / n * 1e9);
+  std::fflush(stdout);
+}
+
+/// --noise: evaluates 3D Perlin noise, 5-octave fBm (detail 4) and Worley F1 at `count` seeded
+/// random points in [-64, 64]^3 on one thread and prints evaluations per second.
+int run_noise(int count, int repeats) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-64, 64);
+  std::vector<Vec3f> points(static_cast<size_t>(count));
+  for (Vec3f& p : points) p = {u(rng), u(rng), u(rng)};
+  const PerlinTable table = make_perlin_table(1);
+  const FractalParams fbm;  // detail 4: five octaves
+  const WorleyParams f1;
+  std::printf("%-10s %12s %10s %10s %9s\n", "noise", "evaluations", "1T ms", "Mevals/s", "ns/eval");
+  measure_noise("perlin-3d", points, repeats, [&](Vec3f p) { return perlin(table, p).value; });
+  measure_noise("fbm-5", points, repeats, [&](Vec3f p) { return fractal_noise(table, p, fbm).value; });
+  measure_noise("worley-f1", points, repeats, [&](Vec3f p) { return worley(1, p, f1).value; });
+  return 0;
+}
+
 struct Row {
   std::string scene, accel, kind, config;
   uint64_t triangles = 0, shapes = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
@@ -445,6 +481,7 @@ int main(int argc, char** argv) {
   std::string csv, json, svg, heatmaps;
   uint64_t seed = 1;
   std::vector<int> mc_resolutions;
+  int noise_count = 0;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
@@ -476,11 +513,16 @@ int main(int argc, char** argv) {
                  "instead of the structures: extract the CSG part's surface at these resolutions (comma "
                  "separated, e.g. 64,128,256,512) with each --threads count, --repeats times")
       ->delimiter(',');
+  app.add_option("--noise", noise_count,
+                 "instead of the structures: evaluate 3D Perlin noise, 5-octave fBm and Worley F1 at this "
+                 "many random points on one thread, --repeats times, and print evaluations per second")
+      ->check(CLI::Range(1, 1000000000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;  // usage errors exit 2, as for penumbra
   }
+  if (noise_count > 0) return run_noise(noise_count, repeats);
   if (!mc_resolutions.empty()) try {
       return run_marching_cubes(mc_resolutions, threads, repeats);
     } catch (const std::exception& e) {

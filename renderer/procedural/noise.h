@@ -63,7 +63,8 @@ extern const float kPerlinGradientBound3;
 enum class FractalKind : uint8_t {
   Fbm,         ///< sum of a_k n(f_k p), normalised by sum a_k: range [-1, 1]
   Turbulence,  ///< sum of a_k |n(f_k p)| / sum a_k: range [0, 1]
-  Ridged,      ///< Musgrave's ridged multifractal, normalised by offset^2 sum a_k: range [0, 1]
+  Ridged,      ///< Musgrave's ridged multifractal, normalised by M^2 sum a_k with
+               ///< M = max(offset, 1 - offset) (offset^2 for offset >= 0.5): range [0, 1]
 };
 
 /// Parameters of a fractal sum, with Blender's Noise / Musgrave texture names. Octave k (from 0)
@@ -71,21 +72,21 @@ enum class FractalKind : uint8_t {
 /// different fixed offset so that octaves do not share lattice points.
 struct FractalParams {
   FractalKind kind = FractalKind::Fbm;
-  float detail = 4;         ///< octaves beyond the first, in [0, 15]; a fractional part fades
-                            ///< the last octave in linearly
-  float roughness = 0.5f;   ///< amplitude gain per octave, in [0, 1]
-  float lacunarity = 2;     ///< frequency gain per octave, in [1.01, 16]
-  float offset = 1;         ///< Ridged: signal = (offset - |n|)^2, offset in [0, 2]
-  float gain = 2;           ///< Ridged: weight of octave k+1 = clamp(gain x signal_k, 0, 1)
-  float distortion = 0;     ///< domain distortion: p' = p + distortion x (3 decorrelated noises at p)
+  float detail = 4;        ///< octaves beyond the first, in [0, 15]; a fractional part fades
+                           ///< the last octave in linearly
+  float roughness = 0.5f;  ///< amplitude gain per octave, in [0, 1]
+  float lacunarity = 2;    ///< frequency gain per octave, in [1.01, 16]
+  float offset = 1;        ///< Ridged: signal = (offset - |n|)^2, offset in [0, 2]
+  float gain = 2;          ///< Ridged: weight of octave k+1 = clamp(gain x signal_k, 0, 1)
+  float distortion = 0;    ///< domain distortion: p' = p + distortion x (3 decorrelated noises at p)
 };
 
 /// The fractal sum at p with its gradient (chain rule through the distortion). `max_octaves`
 /// caps the number of octaves (fractional: the last one kept fades in), for antialiasing by a
 /// footprint (fractal_octave_limit); octaves beyond the cap contribute their mean (0 for Fbm;
 /// Turbulence and Ridged likewise drop them) and the normalisation stays that of the uncapped
-/// sum. max_octaves <= 0 gives the sum's mean value (0 for Fbm). Params outside their documented
-/// ranges are clamped into them.
+/// sum. max_octaves <= 0 drops every octave: value and gradient 0 for every kind (the mean of
+/// Fbm). Params outside their documented ranges are clamped into them.
 Noise3 fractal_noise(const PerlinTable& table, Vec3f p, const FractalParams& params,
                      float max_octaves = kInfinity);
 
@@ -110,9 +111,9 @@ struct WorleyParams {
 };
 
 struct WorleyValue {
-  float value = 0;      ///< the chosen feature distance
-  Vec3f grad;           ///< its gradient with respect to p (zero where undefined)
-  Vec3f nearest;        ///< the nearest feature point
+  float value = 0;        ///< the chosen feature distance
+  Vec3f grad;             ///< its gradient with respect to p (zero where undefined)
+  Vec3f nearest;          ///< the nearest feature point
   float cell_random = 0;  ///< a value in [0, 1) hashed from the nearest point's cell (per-cell colour)
 };
 
