@@ -139,6 +139,24 @@ json affine_matrix(const Affine3f& a) {
   return matrix;
 }
 
+/// A displace node's noise fields (offset and gain only for ridged noise, as the loader reads them).
+void displacement_json(const SdfDisplacement& d, json& j) {
+  static const char* const kNoiseNames[] = {"fbm", "turbulence", "ridged"};
+  const FractalParams& p = d.params;
+  j["amplitude"] = d.amplitude;
+  j["frequency"] = d.frequency;
+  j["seed"] = d.table.seed;
+  j["noise"] = kNoiseNames[int(p.kind)];
+  j["detail"] = p.detail;
+  j["roughness"] = p.roughness;
+  j["lacunarity"] = p.lacunarity;
+  j["distortion"] = p.distortion;
+  if (p.kind == FractalKind::Ridged) {
+    j["offset"] = p.offset;
+    j["gain"] = p.gain;
+  }
+}
+
 /// CSG node `index` of `tree` as a PENUMBRA_shapes CSG object (the inverse of the loader's
 /// reading): its type and fields, a matrix placing its frame unless that is the identity, and
 /// its operands as children.
@@ -161,7 +179,8 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
                                        "complement",
                                        "smoothUnion",
                                        "smoothIntersection",
-                                       "smoothSubtraction"};
+                                       "smoothSubtraction",
+                                       "displace"};
   json j = {{"type", kNames[int(n.kind)]}};
   switch (n.kind) {
     case SdfKind::Sphere:
@@ -193,10 +212,19 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
         j["planes"].push_back({p.x, p.y, p.z, p.w});
       }
       break;
-    default:  // operators
-      j["children"] = json::array({csg_json(tree, n.a, file, depth + 1)});
-      if (n.kind != SdfKind::Complement) j["children"].push_back(csg_json(tree, n.b, file, depth + 1));
-      if (n.kind >= SdfKind::SmoothUnion) j["radius"] = n.radius;
+    case SdfKind::Displace:
+      if (n.displacement < 0 || size_t(n.displacement) >= tree.displacements.size())
+        throw InputError(file, "shapes",
+                         "a displace node's noise " + std::to_string(n.displacement) + " out of range");
+      displacement_json(tree.displacements[size_t(n.displacement)], j);
+      break;
+    default:
+      break;
+  }
+  if (is_operator(n.kind)) {
+    j["children"] = json::array({csg_json(tree, n.a, file, depth + 1)});
+    if (!is_unary(n.kind)) j["children"].push_back(csg_json(tree, n.b, file, depth + 1));
+    if (n.kind >= SdfKind::SmoothUnion && n.kind <= SdfKind::SmoothSubtraction) j["radius"] = n.radius;
   }
   if (!is_identity(n.to_local)) {
     Affine3f to_parent;

@@ -1,6 +1,7 @@
 // The PENUMBRA_shapes extension: each node's extension object read by kind (analytic shapes;
-// implicit shapes with their CSG trees: primitives, operators folded into binary nodes, node
-// transforms), then each shape placed by its node's world transform and instancing copies.
+// implicit shapes with their CSG trees: primitives, operators folded into binary nodes, noise
+// displacement, node transforms), then each shape placed by its node's world transform and
+// instancing copies.
 #include "io/gltf/shapes.h"
 
 #include <tiny_gltf.h>
@@ -58,7 +59,7 @@ constexpr const char* kShapeKeys[] = {"type",   "material", "radius",   "size",
 struct CsgType {
   const char* name;
   SdfKind kind;
-  std::array<const char*, 3> keys;
+  std::array<const char*, 11> keys;
 };
 constexpr CsgType kCsgTypes[] = {
     {"sphere", SdfKind::Sphere, {"radius"}},
@@ -77,11 +78,25 @@ constexpr CsgType kCsgTypes[] = {
     {"smoothUnion", SdfKind::SmoothUnion, {"children", "radius"}},
     {"smoothIntersection", SdfKind::SmoothIntersection, {"children", "radius"}},
     {"smoothSubtraction", SdfKind::SmoothSubtraction, {"children", "radius"}},
+    {"displace",
+     SdfKind::Displace,
+     {"children", "amplitude", "frequency", "seed", "noise", "detail", "roughness", "lacunarity", "offset",
+      "gain", "distortion"}},
 };
 constexpr const char* kCsgCommonKeys[] = {"type", "translation", "rotation", "scale", "matrix"};
-constexpr const char* kCsgKeys[] = {"type",   "translation", "rotation", "scale",       "matrix",
-                                    "radius", "size",        "height",   "majorRadius", "minorRadius",
-                                    "normal", "offset",      "planes",   "children"};
+constexpr const char* kCsgKeys[] = {
+    "type",        "translation", "rotation", "scale",     "matrix",     "radius",   "size",      "height",
+    "majorRadius", "minorRadius", "normal",   "offset",    "planes",     "children", "amplitude", "frequency",
+    "seed",        "noise",       "detail",   "roughness", "lacunarity", "gain",     "distortion"};
+
+// The displace node's "noise" names, indexed by FractalKind.
+constexpr const char* kNoiseNames[] = {"fbm", "turbulence", "ridged"};
+
+// Limits of a displace node's fields beyond those FractalParams documents: |amplitude| and
+// frequency, the domain distortion, the ridged multifractal's gain.
+constexpr float kMaxDisplacement = 1e6f;
+constexpr float kMaxDistortion = 16;
+constexpr float kMaxRidgedGain = 16;
 
 bool is_smooth(SdfKind kind) {
   return kind == SdfKind::SmoothUnion || kind == SdfKind::SmoothIntersection ||
@@ -128,6 +143,7 @@ bool may_be_unbounded(const SdfTree& tree, int index, int depth) {
       return may_be_unbounded(tree, n.a, depth + 1) && may_be_unbounded(tree, n.b, depth + 1);
     case SdfKind::Subtraction:
     case SdfKind::SmoothSubtraction:
+    case SdfKind::Displace:
       return may_be_unbounded(tree, n.a, depth + 1);
     default:
       return false;
@@ -156,6 +172,8 @@ class ShapeReader {
   float number(const json& v, const std::string& where, Bound bound) const;
   float number_or(const json& obj, const char* key, const std::string& where, float fallback,
                   Bound bound) const;
+  float number_in(const json& obj, const char* key, const std::string& where, float fallback, float lo,
+                  float hi) const;
   template <size_t N>
   std::array<float, N> numbers(const json& v, const std::string& where, Bound bound) const;
   Vec3f vec3_or(const json& obj, const char* key, const std::string& where, Vec3f fallback,
@@ -169,6 +187,7 @@ class ShapeReader {
   int csg_operator(const json& j, const std::string& where, SdfKind kind, int level);
   SdfNode csg_primitive(const json& j, const std::string& where, SdfKind kind);
   void csg_planes(const json& j, const std::string& where, SdfNode& node);
+  int csg_displacement(const json& j, const std::string& where);
   Affine3f csg_transform(const json& j, const std::string& where) const;
   int add_node(const SdfNode& node, const std::string& where);
 
@@ -213,6 +232,17 @@ float ShapeReader::number_or(const json& obj, const char* key, const std::string
                              Bound bound) const {
   const json* v = find(obj, key);
   return v ? number(*v, where + "." + key, bound) : fallback;
+}
+
+float ShapeReader::number_in(const json& obj, const char* key, const std::string& where, float fallback,
+                             float lo, float hi) const {
+  const json* v = find(obj, key);
+  if (!v) return fallback;
+  const std::string kw = where + "." + key;
+  const float f = number(*v, kw, Bound::Any);
+  if (!(f >= lo && f <= hi))
+    fail(kw, "must be in [" + format_number(lo) + ", " + format_number(hi) + "] (got " + shown(*v) + ")");
+  return f;
 }
 
 template <size_t N>
@@ -319,6 +349,7 @@ Shape ShapeReader::implicit(const json& ext, const std::string& where) {
   m_tree.root = csg_node(*csg, cw, 1);
   m_tree.nodes.shrink_to_fit();
   m_tree.planes.shrink_to_fit();
+  m_tree.displacements.shrink_to_fit();
   Shape shape = make_implicit_shape(std::move(m_tree), trace);
   const Bounds3f& b = shape.sdf_bounds;
   if (b.empty())
@@ -372,10 +403,8 @@ int ShapeReader::csg_operator(const json& j, const std::string& where, SdfKind k
   if (!children) fail(cw, "is required");
   if (!children->is_array()) fail(cw, "must be an array of CSG nodes (got " + shown(*children) + ")");
   const size_t n = children->size();
-  if (kind == SdfKind::Complement && n != 1)
-    fail(cw, "must hold exactly 1 CSG node (got " + std::to_string(n) + ")");
-  if (kind != SdfKind::Complement && n < 2)
-    fail(cw, "must hold at least 2 CSG nodes (got " + std::to_string(n) + ")");
+  if (is_unary(kind) && n != 1) fail(cw, "must hold exactly 1 CSG node (got " + std::to_string(n) + ")");
+  if (!is_unary(kind) && n < 2) fail(cw, "must hold at least 2 CSG nodes (got " + std::to_string(n) + ")");
   if (uint64_t(level) + n - 1 > uint64_t(kMaxSdfDepth))
     fail(cw, std::to_string(n) + " children fold into " + std::to_string(n - 1) +
                  " nested binary nodes: the CSG tree would be deeper than " + std::to_string(kMaxSdfDepth) +
@@ -387,7 +416,8 @@ int ShapeReader::csg_operator(const json& j, const std::string& where, SdfKind k
     if (!r) fail(where + ".radius", "is required (the blend radius)");
     op.radius = number(*r, where + ".radius", Bound::Positive);
   }
-  if (kind == SdfKind::Complement) {
+  if (kind == SdfKind::Displace) op.displacement = csg_displacement(j, where);
+  if (is_unary(kind)) {
     op.a = csg_node((*children)[0], idx(cw.c_str(), 0), level + 1);
     return add_node(op, where);
   }
@@ -477,6 +507,51 @@ void ShapeReader::csg_planes(const json& j, const std::string& where, SdfNode& n
     if (!std::isfinite(unit.w)) fail(w, "d over the normal's length is beyond the 32-bit float range");
     m_tree.planes.push_back(unit);
   }
+}
+
+// A displace node's noise (amplitude, frequency, seed, fractal parameters), stored in the tree;
+// returns its index in SdfTree::displacements.
+int ShapeReader::csg_displacement(const json& j, const std::string& where) {
+  SdfDisplacement d;
+  if (!find(j, "amplitude")) fail(where + ".amplitude", "is required (the noise's largest displacement)");
+  d.amplitude = number_in(j, "amplitude", where, 0, -kMaxDisplacement, kMaxDisplacement);
+  d.frequency = number_or(j, "frequency", where, 1, Bound::Positive);
+  if (!(d.frequency <= kMaxDisplacement))
+    fail(where + ".frequency",
+         "must be <= " + format_number(kMaxDisplacement) + " (got " + format_number(d.frequency) + ")");
+  uint32_t seed = 0;
+  if (const json* v = find(j, "seed")) {
+    const char* range = "must be an integer in [0, 4294967295]";
+    if (!v->is_number_unsigned() || v->get<uint64_t>() > UINT32_MAX)
+      fail(where + ".seed", std::string(range) + " (got " + shown(*v) + ")");
+    seed = uint32_t(v->get<uint64_t>());
+  }
+  FractalParams& p = d.params;
+  if (const json* v = find(j, "noise")) {
+    const auto names = std::span(kNoiseNames);
+    const auto it =
+        v->is_string() ? std::find(names.begin(), names.end(), v->get<std::string>()) : names.end();
+    if (it == names.end())
+      fail(where + ".noise", "must be \"fbm\", \"turbulence\" or \"ridged\" (got " + shown(*v) + ")");
+    p.kind = FractalKind(it - names.begin());
+  }
+  p.detail = number_in(j, "detail", where, p.detail, 0, 15);
+  p.roughness = number_in(j, "roughness", where, p.roughness, 0, 1);
+  p.lacunarity = number_in(j, "lacunarity", where, p.lacunarity, 1.01f, 16);
+  p.distortion = number_in(j, "distortion", where, p.distortion, 0, kMaxDistortion);
+  if (p.kind == FractalKind::Ridged) {
+    p.offset = number_in(j, "offset", where, p.offset, 0, 2);
+    p.gain = number_in(j, "gain", where, p.gain, 0, kMaxRidgedGain);
+  } else {
+    for (const char* key : {"offset", "gain"})
+      if (find(j, key))
+        fail(where + "." + key, std::string("applies to \"ridged\" noise only (this node's is \"") +
+                                    kNoiseNames[int(p.kind)] + "\")");
+  }
+  m_budget.charge(sizeof(SdfDisplacement), where, "its noise table needs");
+  d.table = make_perlin_table(seed);
+  m_tree.displacements.push_back(d);
+  return int(m_tree.displacements.size()) - 1;
 }
 
 // The node's glTF-style transform (matrix, or translation x rotation x scale) placing its frame

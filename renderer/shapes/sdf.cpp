@@ -1,4 +1,5 @@
-// SDF primitives (closed forms), CSG operators, Lipschitz bounds and sphere tracing.
+// SDF primitives (closed forms), CSG operators, noise displacement, Lipschitz bounds and sphere
+// tracing.
 #include "renderer/shapes/sdf.h"
 
 #include <algorithm>
@@ -71,6 +72,13 @@ float primitive(const SdfTree& tree, const SdfNode& n, Vec3f p) {
   }
 }
 
+// The noise a Displace node adds at its local point p, with its gradient in that frame.
+Noise3 displacement(const SdfTree& tree, const SdfNode& n, Vec3f p) {
+  const SdfDisplacement& d = tree.displacements[size_t(n.displacement)];
+  const Noise3 noise = fractal_noise(d.table, p * d.frequency, d.params);
+  return {d.amplitude * noise.value, noise.grad * (d.amplitude * d.frequency)};
+}
+
 float eval(const SdfTree& tree, int index, Vec3f p_parent, int depth) {
   const SdfNode& n = tree.nodes[size_t(index)];
   const Vec3f p = apply_point(n.to_local, p_parent);
@@ -78,6 +86,7 @@ float eval(const SdfTree& tree, int index, Vec3f p_parent, int depth) {
   if (depth >= kMaxSdfDepth) return kInfinity;
   const float a = eval(tree, n.a, p, depth + 1);
   if (n.kind == SdfKind::Complement) return -a;
+  if (n.kind == SdfKind::Displace) return a + displacement(tree, n, p).value;
   const float b = eval(tree, n.b, p, depth + 1);
   switch (n.kind) {
     case SdfKind::Union:
@@ -174,6 +183,9 @@ float eval_gradient(const SdfTree& tree, int index, Vec3f p_parent, Vec3f& grad,
     const float a = eval_gradient(tree, n.a, p, ga, depth + 1);
     if (n.kind == SdfKind::Complement) {
       value = -a, g = -ga;
+    } else if (n.kind == SdfKind::Displace) {
+      const Noise3 d = displacement(tree, n, p);
+      value = a + d.value, g = ga + d.grad;
     } else {
       const float b = eval_gradient(tree, n.b, p, gb, depth + 1);
       switch (n.kind) {
@@ -209,12 +221,20 @@ float eval_gradient(const SdfTree& tree, int index, Vec3f p_parent, Vec3f& grad,
   return value;
 }
 
+// |grad (amplitude x noise(frequency x p))| <= |amplitude| x frequency x the noise's bound.
+float displacement_lipschitz(const SdfDisplacement& d) {
+  return std::abs(d.amplitude) * d.frequency * fractal_gradient_bound(d.params);
+}
+
 float lipschitz(const SdfTree& tree, int index, int depth) {
   const SdfNode& n = tree.nodes[size_t(index)];
   float l = 1;
   if (is_operator(n.kind) && depth < kMaxSdfDepth) {
     l = lipschitz(tree, n.a, depth + 1);
-    if (n.kind != SdfKind::Complement) l = std::max(l, lipschitz(tree, n.b, depth + 1));
+    if (n.kind == SdfKind::Displace)
+      l += displacement_lipschitz(tree.displacements[size_t(n.displacement)]);
+    else if (n.kind != SdfKind::Complement)
+      l = std::max(l, lipschitz(tree, n.b, depth + 1));
   }
   return l * max_singular_value(n.to_local);
 }
@@ -223,6 +243,10 @@ float lipschitz(const SdfTree& tree, int index, int depth) {
 
 bool is_operator(SdfKind kind) {
   return kind >= SdfKind::Union;
+}
+
+bool is_unary(SdfKind kind) {
+  return kind == SdfKind::Complement || kind == SdfKind::Displace;
 }
 
 float sdf_eval(const SdfTree& tree, int node, Vec3f p) {

@@ -1,8 +1,8 @@
 // Implicit surfaces as signed distance functions (f < 0 inside, f = 0 on the surface): SDF
 // primitives in canonical local frames, CSG trees over them (union, intersection, subtraction,
-// complement and their smooth variants), each node with its own transform, a Lipschitz bound per
-// tree, and sphere tracing (Hart, "Sphere tracing: a geometric method for the antialiased ray
-// tracing of implicit surfaces", The Visual Computer 12(10), 1996). Plain data and free
+// complement and their smooth variants, displacement by fractal noise), each node with its own
+// transform, a Lipschitz bound per tree, and sphere tracing (Hart, "Sphere tracing: a geometric method for
+// the antialiased ray tracing of implicit surfaces", The Visual Computer 12(10), 1996). Plain data and free
 // functions; evaluation never allocates, throws or logs.
 #pragma once
 
@@ -11,6 +11,7 @@
 
 #include "renderer/core/geometry.h"
 #include "renderer/core/math.h"
+#include "renderer/procedural/noise.h"
 
 namespace penumbra {
 
@@ -32,10 +33,25 @@ enum class SdfKind : uint8_t {
   SmoothUnion,         ///< polynomial smooth minimum of a and b with blend radius `radius`
   SmoothIntersection,  ///< smooth maximum of a and b
   SmoothSubtraction,   ///< smooth maximum of a and -b
+  Displace,            ///< a + amplitude x fractal_noise(frequency x p), with the noise of
+                       ///< SdfTree::displacements[displacement]
 };
 
 /// True for the operators (nodes with children).
 bool is_operator(SdfKind kind);
+
+/// True for the operators with one child (a): Complement and Displace.
+bool is_unary(SdfKind kind);
+
+/// The noise a Displace node adds to its child: amplitude x fractal_noise(table, frequency x p,
+/// params) at the node's local point p. |fractal_noise| <= 1, so the displaced surface lies
+/// within |amplitude| of the child's (in the child's value).
+struct SdfDisplacement {
+  PerlinTable table;     ///< make_perlin_table(seed)
+  FractalParams params;  ///< the fractal sum (kind, octaves, distortion)
+  float amplitude = 0;   ///< any finite value; 0 gives the child exactly, < 0 inverts the relief
+  float frequency = 1;   ///< > 0: the noise's lattice cells are 1 / frequency wide
+};
 
 struct SdfNode {
   SdfKind kind = SdfKind::Sphere;
@@ -44,7 +60,8 @@ struct SdfNode {
   Vec3f normal{0, 1, 0};                 ///< HalfSpace
   float offset = 0;                      ///< HalfSpace
   int first_plane = 0, plane_count = 0;  ///< ConvexPolyhedron: range in SdfTree::planes
-  int a = -1, b = -1;                    ///< operator children (Complement uses a only)
+  int a = -1, b = -1;                    ///< operator children (unary operators use a only)
+  int displacement = -1;                 ///< Displace: index into SdfTree::displacements
   /// Maps the parent's frame (the tree's frame at the root) into this node's local frame.
   Affine3f to_local;
 };
@@ -52,7 +69,8 @@ struct SdfNode {
 /// A CSG tree: nodes addressed by index, children before or after their parents.
 struct SdfTree {
   std::vector<SdfNode> nodes;
-  std::vector<Vec4f> planes;  ///< (unit normal, offset) of ConvexPolyhedron faces
+  std::vector<Vec4f> planes;                   ///< (unit normal, offset) of ConvexPolyhedron faces
+  std::vector<SdfDisplacement> displacements;  ///< the noise of Displace nodes
   int root = -1;
 };
 
@@ -67,12 +85,16 @@ float sdf_eval(const SdfTree& tree, int node, Vec3f p);
 
 /// An upper bound L on |f(x) - f(y)| / |x - y| over the whole tree: 1 for every primitive,
 /// the larger child bound for every operator (smooth ones included: their gradient is a convex
-/// combination of the children's), times the largest singular value of each node's to_local.
+/// combination of the children's), the child's bound plus |amplitude| x frequency x
+/// fractal_gradient_bound(params) for Displace (the noise's gradient bound, chained through the
+/// frequency), times the largest singular value of each node's to_local. Displacement thus
+/// shortens every sphere-tracing step.
 float sdf_lipschitz(const SdfTree& tree);
 
 /// Unit outward normal at `p` from the analytic gradient: each primitive's closed-form gradient
 /// (the cone's by central differences), chained through the node transforms (L^T g), the active
-/// operand of min / max operators and the blend weights of smooth ones. Zero where the gradient
+/// operand of min / max operators, the blend weights of smooth ones and, for Displace, the
+/// child's gradient plus amplitude x frequency x the noise's analytic gradient. Zero where the gradient
 /// vanishes or is not finite (a sphere's centre).
 Vec3f sdf_gradient_normal(const SdfTree& tree, Vec3f p);
 

@@ -214,8 +214,8 @@ TreeBox overlap(const TreeBox& a, const TreeBox& b) {
 }
 
 // The box (in the parent's frame) of {p : f_node(p) <= delta}. Values pass through transforms
-// unchanged (f_node(p) = g(to_local p)), so delta does too; only the smooth union widens it,
-// since smin(a, b) >= min(a, b) - k / 4.
+// unchanged (f_node(p) = g(to_local p)), so delta does too; the smooth union widens it, since
+// smin(a, b) >= min(a, b) - k / 4, and Displace by |amplitude|, since |fractal_noise| <= 1.
 TreeBox node_box(const SdfTree& tree, int index, float delta, int depth) {
   if (index < 0 || size_t(index) >= tree.nodes.size() || depth > kMaxSdfDepth) return unbounded_box();
   const SdfNode& n = tree.nodes[size_t(index)];
@@ -239,6 +239,11 @@ TreeBox node_box(const SdfTree& tree, int index, float delta, int depth) {
     case SdfKind::Complement:
       local = unbounded_box();
       break;
+    case SdfKind::Displace: {
+      const float amplitude = tree.displacements[size_t(n.displacement)].amplitude;
+      local = node_box(tree, n.a, delta + std::abs(amplitude), depth + 1);
+      break;
+    }
     default:
       local = primitive_box(tree, n, delta);
   }

@@ -49,7 +49,8 @@ Shape make_implicit_shape(SdfTree tree, const SphereTraceConfig& trace = {});
 /// A box holding every point where the tree is <= 0, in the tree's frame, from each primitive's
 /// extents mapped through the node transforms (union: merge; intersection: overlap; subtraction:
 /// the first operand; smooth operators: widened by the blend radius over the smallest singular
-/// value of the transforms below). Empty if unbounded or if the tree has no root.
+/// value of the transforms below; Displace: its child's, widened likewise by |amplitude|). Empty
+/// if unbounded or if the tree has no root.
 Bounds3f sdf_tree_bounds(const SdfTree& tree);
 
 /// Object-space bounds of the shape's surface (empty for an implicit shape without bounds).

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end test of `penumbra mesh`: a scene with implicit shapes (PENUMBRA_shapes) meshed to
-# .glb and .gltf, read back by `penumbra info` (and Blender when installed); an unknown node, a
-# node without an implicit shape, bad resolutions and outputs, and a resolution over the memory
-# budget exit 2 before writing anything. Usage: mesh_cli_test.sh PENUMBRA SRC WORK
+# .glb and .gltf, read back by `penumbra info` (and Blender when installed); a displaced sphere
+# meshed to its relief; an unknown node, a node without an implicit shape, bad resolutions and
+# outputs, and a resolution over the memory budget exit 2 before writing anything.
+# Usage: mesh_cli_test.sh PENUMBRA SRC WORK
 set -u
 bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
@@ -68,6 +69,37 @@ expect 0 "meshes       1 " -- "$bin" info "$work/part.glb"
 # The shipped CSG scene: its three implicit shapes (the ground plane is analytic).
 expect 0 "3 shapes meshed at resolution 32" -- "$bin" mesh "$src/scenes/csg.gltf" --resolution 32 -o "$work/csg.glb"
 expect 0 "meshes       3 \(3 primitives\)" -- "$bin" info "$work/csg.glb"
+# A unit sphere displaced by fBm (amplitude 0.2), meshed to .gltf + .bin: every vertex lies within
+# the amplitude and a cell of the unit sphere, and their radii spread over much of that relief (a
+# plain sphere's would agree within a cell).
+rough="$work/rough.gltf"
+cat >"$rough" <<'JSON'
+{
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["PENUMBRA_shapes"],
+  "scenes": [{"nodes": [0]}],
+  "scene": 0,
+  "nodes": [
+    {"name": "rough", "extensions": {"PENUMBRA_shapes": {"type": "implicit", "csg": {
+      "type": "displace", "amplitude": 0.2, "frequency": 2, "seed": 5, "noise": "fbm", "detail": 3,
+      "children": [{"type": "sphere", "radius": 1}]}}}}
+  ]
+}
+JSON
+expect 0 "1 shapes meshed at resolution 48" -- "$bin" mesh "$rough" --resolution 48 -o "$work/rough-mesh.gltf"
+if python3 -c "
+import json, math, struct, sys
+doc = json.load(open('$work/rough-mesh.gltf'))
+acc = doc['accessors'][doc['meshes'][0]['primitives'][0]['attributes']['POSITION']]
+view = doc['bufferViews'][acc['bufferView']]
+data = open('$work/' + doc['buffers'][view['buffer']]['uri'], 'rb').read()
+start = view.get('byteOffset', 0) + acc.get('byteOffset', 0)
+radii = [math.sqrt(sum(c * c for c in struct.unpack_from('<3f', data, start + 12 * i))) for i in range(acc['count'])]
+cell = 2.4 / 48
+ok = all(abs(r - 1) <= 0.2 + cell for r in radii) and max(radii) - min(radii) > 0.1
+print('vertex radii in [%.3f, %.3f]' % (min(radii), max(radii)))
+sys.exit(0 if ok else 1)
+"; then passes=$((passes + 1)); else echo "FAIL: the displaced sphere's vertex radii"; fails=$((fails + 1)); fi
 [ -z "$(ls -A "$work" | grep '\.tmp-')" ] || { echo "FAIL: temporaries left behind"; fails=$((fails + 1)); }
 
 # Refusals: exit 2, the reason named, nothing written.

@@ -5,6 +5,7 @@
 // meshed and written as .glb come back closed and in place.
 #include "io/gltf_writer.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <fstream>
@@ -284,8 +285,18 @@ TEST_CASE("write_gltf: shapes come back through PENUMBRA_shapes with every field
       add_node(t, sdf_operator(SdfKind::SmoothSubtraction, add_node(t, poly), add_node(t, half), 0.15f));
   const int d =
       add_node(t, sdf_operator(SdfKind::Complement, add_node(t, sdf_primitive(SdfKind::Sphere, {5, 0, 0}))));
+  // Displacement by each noise kind, every field away from its default, one under a transform.
+  FractalParams ridged;
+  ridged.kind = FractalKind::Ridged, ridged.detail = 2.5f, ridged.roughness = 0.6f, ridged.lacunarity = 2.2f;
+  ridged.offset = 0.8f, ridged.gain = 1.5f, ridged.distortion = 0.25f;
+  FractalParams turbulence;
+  turbulence.kind = FractalKind::Turbulence, turbulence.detail = 3, turbulence.roughness = 0.4f;
+  const int da = add_displace(t, a, 0.05f, 3, ridged, 99);
+  t.nodes[size_t(da)].to_local = moved_by({0, 0.1f, 0});
+  const int db = add_displace(t, b, -0.03f, 5.5f, turbulence, 4000000000u);
+  const int dc = add_displace(t, c, 0.02f, 2, FractalParams{}, 7);
   const int blend =
-      add_node(t, sdf_operator(SdfKind::Union, a, add_node(t, sdf_operator(SdfKind::Union, b, c))));
+      add_node(t, sdf_operator(SdfKind::Union, da, add_node(t, sdf_operator(SdfKind::Union, db, dc))));
   const int all = add_node(t, sdf_operator(SdfKind::Union, t.root, blend));
   t.root = add_node(t, sdf_operator(SdfKind::Intersection, all, d));
   SphereTraceConfig trace;
@@ -320,6 +331,23 @@ TEST_CASE("write_gltf: shapes come back through PENUMBRA_shapes with every field
     CHECK(y.trace.max_steps == 300);
     CHECK(y.trace.relative_epsilon == 2e-5f);
     CHECK(y.sdf.nodes.size() == x.sdf.nodes.size());
+    // The same noise (matched by seed, each seed used once): every field.
+    REQUIRE(y.sdf.displacements.size() == x.sdf.displacements.size());
+    for (const SdfDisplacement& dx : x.sdf.displacements) {
+      const auto dy = std::find_if(y.sdf.displacements.begin(), y.sdf.displacements.end(),
+                                   [&](const SdfDisplacement& e) { return e.table.seed == dx.table.seed; });
+      REQUIRE(dy != y.sdf.displacements.end());
+      CHECK(dy->table.perm == dx.table.perm);
+      CHECK(dy->amplitude == dx.amplitude);
+      CHECK(dy->frequency == dx.frequency);
+      CHECK(dy->params.kind == dx.params.kind);
+      CHECK(dy->params.detail == dx.params.detail);
+      CHECK(dy->params.roughness == dx.params.roughness);
+      CHECK(dy->params.lacunarity == dx.params.lacunarity);
+      CHECK(dy->params.offset == dx.params.offset);
+      CHECK(dy->params.gain == dx.params.gain);
+      CHECK(dy->params.distortion == dx.params.distortion);
+    }
     // The same function: equal values at random points (transforms re-inverted in double).
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-2, 2);

@@ -1,5 +1,6 @@
 // Shapes for tests: SDF node builders and the named trees the marching-cubes and mesh-command
-// tests share (primitives, the classic CSG part, a smooth-union blob), and analytic shapes.
+// tests share (primitives, the classic CSG part, a smooth-union blob, a displaced sphere), and
+// analytic shapes.
 #pragma once
 
 #include "renderer/shapes/sdf.h"
@@ -38,6 +39,21 @@ inline SdfNode sdf_operator(SdfKind k, int a, int b = -1, float radius = 0) {
   n.b = b;
   n.radius = radius;
   return n;
+}
+
+/// A Displace node over `child` adding amplitude x fractal_noise(frequency x p) with `params` and
+/// the table of `seed`; its noise is appended to t.displacements. Returns the node's index.
+inline int add_displace(SdfTree& t, int child, float amplitude, float frequency,
+                        const FractalParams& params = {}, uint32_t seed = 0) {
+  SdfDisplacement d;
+  d.table = make_perlin_table(seed);
+  d.params = params;
+  d.amplitude = amplitude;
+  d.frequency = frequency;
+  t.displacements.push_back(d);
+  SdfNode n = sdf_operator(SdfKind::Displace, child);
+  n.displacement = int(t.displacements.size()) - 1;
+  return add_node(t, n);
 }
 
 /// The parent-to-local map of a shape moved by d.
@@ -89,6 +105,18 @@ inline SdfTree sphere_pair(float r, float d, float k = 0) {
   s.to_local = moved_by({d, 0, 0});
   const int b = add_node(t, s);
   t.root = add_node(t, sdf_operator(k > 0 ? SdfKind::SmoothUnion : SdfKind::Union, a, b, k));
+  return t;
+}
+
+/// A sphere of radius `r` at the origin displaced by noise of `kind` (the other parameters at
+/// their defaults) with the given amplitude and frequency.
+inline SdfTree displaced_sphere(float r, float amplitude, float frequency,
+                                FractalKind kind = FractalKind::Fbm, uint32_t seed = 0) {
+  SdfTree t;
+  const int sphere = add_node(t, sdf_primitive(SdfKind::Sphere, {r, 0, 0}));
+  FractalParams params;
+  params.kind = kind;
+  t.root = add_displace(t, sphere, amplitude, frequency, params, seed);
   return t;
 }
 

@@ -724,3 +724,127 @@ TEST_CASE("shapes: the shipped shape scenes load and render with every accelerat
     }
   }
 }
+
+namespace {
+
+json displace(json child, double amplitude) {
+  json j = op("displace", {std::move(child)});
+  j["amplitude"] = amplitude;
+  return j;
+}
+
+}  // namespace
+
+TEST_CASE("shapes: displace nodes read every noise field and apply the defaults",
+          "[io][gltf][shapes][quick]") {
+  SECTION("defaults: fbm at frequency 1 with seed 0 and FractalParams' defaults") {
+    const SdfTree t = tree_of(displace(sphere(1), 0.1));
+    const SdfNode& root = t.nodes.at(size_t(t.root));
+    REQUIRE(root.kind == SdfKind::Displace);
+    CHECK(root.b == -1);
+    REQUIRE(t.displacements.size() == 1);
+    REQUIRE(root.displacement == 0);
+    const SdfDisplacement& d = t.displacements[0];
+    const FractalParams defaults;
+    CHECK(d.amplitude == 0.1f);
+    CHECK(d.frequency == 1);
+    CHECK(d.table.seed == 0);
+    CHECK(d.table.perm == make_perlin_table(0).perm);
+    CHECK(d.params.kind == FractalKind::Fbm);
+    CHECK(d.params.detail == defaults.detail);
+    CHECK(d.params.roughness == defaults.roughness);
+    CHECK(d.params.lacunarity == defaults.lacunarity);
+    CHECK(d.params.offset == defaults.offset);
+    CHECK(d.params.gain == defaults.gain);
+    CHECK(d.params.distortion == defaults.distortion);
+  }
+  SECTION("every field, under a transform: f = child + amplitude x noise(frequency x local p)") {
+    json j = displace(sphere(1), -0.25);
+    j["frequency"] = 3;
+    j["seed"] = 4000000000u;
+    j["noise"] = "ridged";
+    j["detail"] = 2.5;
+    j["roughness"] = 0.75;
+    j["lacunarity"] = 2.5;
+    j["offset"] = 0.9;
+    j["gain"] = 1.5;
+    j["distortion"] = 0.3;
+    j["translation"] = {1, 0, 0};
+    const SdfTree t = tree_of(j);
+    const SdfDisplacement& d = t.displacements.at(0);
+    CHECK(d.amplitude == -0.25f);
+    CHECK(d.frequency == 3);
+    CHECK(d.table.seed == 4000000000u);
+    CHECK(d.table.perm == make_perlin_table(4000000000u).perm);
+    CHECK(d.params.kind == FractalKind::Ridged);
+    CHECK(d.params.detail == 2.5f);
+    CHECK(d.params.roughness == 0.75f);
+    CHECK(d.params.lacunarity == 2.5f);
+    CHECK(d.params.offset == 0.9f);
+    CHECK(d.params.gain == 1.5f);
+    CHECK(d.params.distortion == 0.3f);
+    for (const Vec3f p : {Vec3f{1.5f, 0.2f, 0}, Vec3f{0, 0, 0}, Vec3f{2, 1, -1}}) {
+      const Vec3f local = p - Vec3f{1, 0, 0};
+      const float expected = length(local) - 1 - 0.25f * fractal_noise(d.table, local * 3, d.params).value;
+      CHECK(sdf_eval(t, p) == Approx(expected).margin(1e-6));
+    }
+  }
+  SECTION("turbulence, and amplitude 0") {
+    json j = displace(sphere(2), 0);
+    j["noise"] = "turbulence";
+    const SdfTree t = tree_of(j);
+    CHECK(t.displacements.at(0).params.kind == FractalKind::Turbulence);
+    CHECK(sdf_eval(t, {3, 0, 0}) == Approx(1));
+  }
+}
+
+TEST_CASE("shapes: bad displace fields are errors naming the node and the field",
+          "[io][gltf][shapes][hostile][quick]") {
+  const auto with = [](const char* key, json value) {
+    json j = displace(sphere(1), 0.1);
+    j[key] = std::move(value);
+    return error_of(implicit(op("union", {sphere(1, {3, 0, 0}), j})));
+  };
+  const std::string node = kCsg + ".children[1]";
+  CHECK_THAT(with("colour", 1),
+             Contains(node + ".colour: unknown key") && Contains("amplitude, frequency, seed"));
+  CHECK_THAT(with("radius", 1), Contains(node + ".radius: does not apply to a \"displace\" CSG node"));
+  CHECK_THAT(with("detail", 20), Contains(node + ".detail: must be in [0, 15] (got 20)"));
+  CHECK_THAT(with("detail", -1), Contains(node + ".detail: must be in [0, 15]"));
+  CHECK_THAT(with("roughness", -1), Contains(node + ".roughness: must be in [0, 1] (got -1)"));
+  CHECK_THAT(with("lacunarity", 1), Contains(node + ".lacunarity: must be in [1.01, 16] (got 1)"));
+  CHECK_THAT(with("lacunarity", 17), Contains(node + ".lacunarity: must be in [1.01, 16]"));
+  CHECK_THAT(with("distortion", -0.5), Contains(node + ".distortion: must be in [0, 16]"));
+  CHECK_THAT(with("frequency", 0), Contains(node + ".frequency: must be > 0 (got 0)"));
+  CHECK_THAT(with("frequency", -2), Contains(node + ".frequency: must be > 0"));
+  CHECK_THAT(with("frequency", 1e7), Contains(node + ".frequency: must be <= 1e+06"));
+  CHECK_THAT(with("amplitude", 1e7), Contains(node + ".amplitude: must be in [-1e+06, 1e+06]"));
+  CHECK_THAT(with("amplitude", "big"), Contains(node + ".amplitude: must be a number"));
+  CHECK_THAT(with("seed", 1.5), Contains(node + ".seed: must be an integer in [0, 4294967295] (got 1.5)"));
+  CHECK_THAT(with("seed", -1), Contains(node + ".seed: must be an integer in [0, 4294967295] (got -1)"));
+  CHECK_THAT(with("seed", 4294967296u), Contains(node + ".seed: must be an integer in [0, 4294967295]"));
+  CHECK_THAT(with("noise", "perlin"),
+             Contains(node + ".noise: must be \"fbm\", \"turbulence\" or \"ridged\""));
+  CHECK_THAT(with("noise", 2), Contains(node + ".noise: must be \"fbm\""));
+  CHECK_THAT(with("offset", 1),
+             Contains(node + ".offset: applies to \"ridged\" noise only (this node's is \"fbm\")"));
+  CHECK_THAT(with("gain", 1), Contains(node + ".gain: applies to \"ridged\" noise only"));
+  json ridged = displace(sphere(1), 0.1);
+  ridged["noise"] = "ridged";
+  ridged["offset"] = 2.5;
+  CHECK_THAT(error_of(implicit(ridged)), Contains(kCsg + ".offset: must be in [0, 2] (got 2.5)"));
+  ridged["offset"] = 1;
+  ridged["gain"] = -1;
+  CHECK_THAT(error_of(implicit(ridged)), Contains(kCsg + ".gain: must be in [0, 16]"));
+  json no_amplitude = op("displace", {sphere(1)});
+  CHECK_THAT(error_of(implicit(no_amplitude)), Contains(kCsg + ".amplitude: is required"));
+  CHECK_THAT(error_of(implicit({{"type", "displace"}, {"amplitude", 0.1}})),
+             Contains(kCsg + ".children: is required"));
+  json none = displace(sphere(1), 0.1);
+  none["children"] = json::array();
+  CHECK_THAT(error_of(implicit(none)), Contains(kCsg + ".children: must hold exactly 1 CSG node (got 0)"));
+  none["children"] = {sphere(1), sphere(2)};
+  CHECK_THAT(error_of(implicit(none)), Contains(kCsg + ".children: must hold exactly 1 CSG node (got 2)"));
+  CHECK_THAT(error_of(implicit(displace({{"type", "halfSpace"}}, 0.1))),
+             Contains(kCsg + ": the shape's inside is unbounded"));
+}

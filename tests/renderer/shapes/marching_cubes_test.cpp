@@ -154,6 +154,28 @@ TEST_CASE("marching cubes: the CSG part and a smooth blend have their genus", "[
   CHECK(max_vertex_error_cells(blob, m, box, 64) <= 1.0);
 }
 
+TEST_CASE("marching cubes: a displaced sphere meshes to its relief, not to the sphere",
+          "[shapes][mc][noise][quick]") {
+  // Radius 1, amplitude 0.15, fBm at frequency 2: every point of the surface lies within 0.15
+  // of the unit sphere, and the relief spans much of that.
+  const SdfTree rough = displaced_sphere(1, 0.15f, 2, FractalKind::Fbm, 3);
+  const Bounds3f box = sdf_tree_bounds(rough);
+  CHECK(box.hi.x == Approx(1.15f));
+  const int res = 96;
+  const IsosurfaceMesh m = extract_isosurface(rough, box, res);
+  REQUIRE(!m.positions.empty());
+  CHECK(topology(m).closed_manifold());
+  CHECK(max_vertex_error_cells(rough, m, box, res) <= 1.0);
+  const float cell = marching_cubes_grid(box, res, {}).cell;
+  float nearest = kInfinity, farthest = 0;
+  for (const Vec3f& p : m.positions) {
+    nearest = std::min(nearest, length(p)), farthest = std::max(farthest, length(p));
+    REQUIRE(std::abs(length(p) - 1) <= 0.15f + cell);
+  }
+  INFO("vertex radii in [" << nearest << ", " << farthest << "]");
+  CHECK(farthest - nearest > 0.1f);  // a plain sphere's would be within a cell
+}
+
 TEST_CASE("marching cubes: ambiguous faces still give closed manifolds", "[shapes][mc][quick]") {
   SECTION("two spheres almost touching, at many resolutions") {
     // The gap of 0.002 lies in one cell: the faces there are saddles the decider must settle

@@ -242,3 +242,181 @@ TEST_CASE("sdf: sphere tracing hits where the analytic tests hit", "[shapes][sdf
   REQUIRE(sphere_trace(plane, sdf_lipschitz(plane), glancing, {}, tp, steps));
   CHECK(tp == Approx(1 / 0.05f * length(Vec3f{1, -0.05f, 0})).epsilon(1e-3));
 }
+
+TEST_CASE("sdf: the displaced Lipschitz bound holds for every noise kind, transform and distortion",
+          "[shapes][sdf][noise]") {
+  std::mt19937 rng(23);
+  Affine3f shear;
+  shear.m[0][0] = 0.5f, shear.m[1][1] = 1.5f, shear.m[2][2] = 1, shear.m[0][1] = 0.3f, shear.m[2][0] = -0.2f;
+  Affine3f rot_scale;  // a rotation about Y with scale 1.5, moved
+  const float c = std::cos(0.4f), s = std::sin(0.4f);
+  rot_scale.m[0][0] = 1.5f * c, rot_scale.m[0][2] = 1.5f * s, rot_scale.m[2][0] = -1.5f * s;
+  rot_scale.m[2][2] = 1.5f * c, rot_scale.m[1][1] = 1.5f, rot_scale.m[0][3] = 0.2f;
+  for (const FractalKind kind : {FractalKind::Fbm, FractalKind::Turbulence, FractalKind::Ridged})
+    for (const float distortion : {0.0f, 0.6f}) {
+      SdfTree t;
+      SdfNode torus = sdf_primitive(SdfKind::Torus, {1, 0, 0}, 0.3f);
+      torus.to_local = shear;
+      FractalParams params;
+      params.kind = kind;
+      params.distortion = distortion;
+      params.detail = 3.5f;
+      const int displaced = add_displace(t, add_node(t, torus), 0.2f, 2.5f, params, 7);
+      t.nodes[size_t(displaced)].to_local = rot_scale;
+      t.root = displaced;
+      const float lip = sdf_lipschitz(t);
+      const float child = max_singular_value(shear) * max_singular_value(rot_scale);
+      CHECK(lip > child);  // the noise's gradient adds to the child's bound
+      double worst = 0;
+      for (int i = 0; i < 100000; ++i) {
+        const Vec3f x = random_point(rng, 2), y = x + random_point(rng, i % 2 ? 0.02f : 0.4f);
+        const float lhs = std::abs(sdf_eval(t, x) - sdf_eval(t, y));
+        INFO("noise " << int(kind) << " distortion " << distortion);
+        REQUIRE(lhs <= lip * length(x - y) + 1e-5f);
+        worst = std::max(worst, double(lhs) / length(x - y));
+      }
+      INFO("steepest slope seen " << worst << ", bound " << lip);
+      CHECK(worst > 0.25 * child);
+    }
+}
+
+TEST_CASE("sdf: displacement by amplitude 0 gives the child exactly", "[shapes][sdf][noise][quick]") {
+  std::mt19937 rng(3);
+  const SdfTree plain = single_shape(sdf_primitive(SdfKind::RoundBox, {0.8f, 0.5f, 0.6f}, 0.2f));
+  for (const FractalKind kind : {FractalKind::Fbm, FractalKind::Turbulence, FractalKind::Ridged}) {
+    SdfTree t = plain;
+    FractalParams params;
+    params.kind = kind;
+    params.distortion = 0.5f;
+    t.root = add_displace(t, plain.root, 0, 3, params, 11);
+    CHECK(sdf_lipschitz(t) == Approx(sdf_lipschitz(plain)).epsilon(1e-5));  // one more node's rounding
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3f p = random_point(rng, 1.5f);
+      REQUIRE(sdf_eval(t, p) == sdf_eval(plain, p));
+      const Vec3f g = sdf_gradient_normal(t, p), g0 = sdf_gradient_normal(plain, p);
+      REQUIRE((g.x == g0.x && g.y == g0.y && g.z == g0.z));
+    }
+  }
+}
+
+TEST_CASE("sdf: the displaced sphere's analytic gradient matches central differences",
+          "[shapes][sdf][noise][quick]") {
+  std::mt19937 rng(9);
+  for (const FractalKind kind : {FractalKind::Fbm, FractalKind::Turbulence, FractalKind::Ridged}) {
+    SdfTree t = displaced_sphere(1, 0.2f, 2, kind, 5);
+    t.nodes[size_t(t.root)].to_local = moved_by({0.1f, 0.2f, -0.3f});
+    int checked = 0, off = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3f p = random_point(rng, 1.4f);
+      // Where f is smooth: central differences at two steps agree.
+      const Vec3f n1 = sdf_normal(t, p, 2e-4f), n2 = sdf_normal(t, p, 4e-4f);
+      if (!(dot(n1, n2) > 0.99999f)) continue;
+      const Vec3f g = sdf_gradient_normal(t, p);
+      INFO("noise " << int(kind) << " at (" << p.x << ", " << p.y << ", " << p.z << ")");
+      if (kind == FractalKind::Fbm) REQUIRE(dot(g, n1) > 0.999f);
+      off += dot(g, n1) <= 0.999f;
+      ++checked;
+    }
+    // Turbulence and ridged noise fold every octave at |n| = 0, where central differences that
+    // straddle the crease differ from the one-sided analytic gradient: a few points only.
+    CHECK(checked > 1500);
+    CHECK(off <= checked / 100);
+  }
+}
+
+namespace {
+
+// The first crossing of f along the ray in [t0, t1] by marching with step dt and bisecting the
+// bracketing step. `clear` is false when |f| has a local minimum below L dt at a sample without
+// a crossing beside it: the ray grazes the surface there and two crossings between samples
+// cannot be ruled out. Elsewhere a step whose ends lie farther than L dt / 2 from the surface
+// cannot hold a crossing, and |f| falls steadily towards a crossing.
+struct BruteHit {
+  bool hit = false, clear = true;
+  float t = 0;
+};
+
+BruteHit brute_force_march(const SdfTree& tree, float lip, const Ray& r, float t0, float t1, float dt) {
+  BruteHit out;
+  const auto f = [&](float t) { return sdf_eval(tree, r.org + r.dir * t); };
+  float prev_t = t0, prev_f = f(t0), before = kInfinity;  // |f| one sample before prev
+  for (int i = 1; prev_t < t1; ++i) {
+    const float t = std::min(t0 + float(i) * dt, t1), ft = f(t);
+    if ((ft < 0) != (prev_f < 0)) {
+      float lo = prev_t, hi = t;
+      for (int k = 0; k < 60; ++k) {
+        const float mid = 0.5f * (lo + hi);
+        if (mid == lo || mid == hi) break;
+        ((f(mid) < 0) == (prev_f < 0) ? lo : hi) = mid;
+      }
+      out.hit = true;
+      out.t = hi;
+      return out;
+    }
+    if (std::abs(prev_f) <= before && std::abs(prev_f) <= std::abs(ft) && std::abs(prev_f) < lip * dt)
+      out.clear = false;
+    before = std::abs(prev_f);
+    prev_t = t, prev_f = ft;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("sdf: sphere tracing a displaced sphere agrees with a dense brute-force march",
+          "[shapes][sdf][noise]") {
+  // Features: the top octave of fBm at frequency 2 with detail 4 has period 1 / 32 ~ 0.03; the
+  // march steps 5e-4. Tolerance on t: 1e-3 beyond the tracer's own (see below).
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (const FractalKind kind : {FractalKind::Fbm, FractalKind::Ridged}) {
+    const float amplitude = 0.15f, radius = 1;
+    SdfTree t = displaced_sphere(radius, amplitude, 2, kind, 3);
+    const float lip = sdf_lipschitz(t);
+    const float reach = radius + amplitude;  // |noise| <= 1: every point with f <= 0 lies within
+    int hits = 0, misses = 0, unclear = 0;
+    const int rays = 300;
+    for (int i = 0; i < rays; ++i) {
+      Ray r;
+      r.org = {u(rng) * 0.5f, u(rng) * 0.5f, -3};
+      r.dir = normalize(Vec3f{u(rng) * 0.4f, u(rng) * 0.4f, 1});
+      // The march runs over the ray's part within `reach` of the origin.
+      r.tfar = 10;
+      const float mid = -dot(r.org, r.dir), d2 = dot(r.org, r.org) - mid * mid;
+      BruteHit brute;  // a ray passing farther than `reach` misses
+      if (d2 < reach * reach) {
+        const float half = std::sqrt(reach * reach - d2);
+        brute = brute_force_march(t, lip, r, mid - half - 1e-3f, mid + half + 1e-3f, 5e-4f);
+      }
+      if (!brute.clear) {
+        ++unclear;
+        continue;
+      }
+      float ts = 0;
+      int steps = 0;
+      const bool traced = sphere_trace(t, lip, r, {}, ts, steps);
+      INFO("noise " << int(kind) << " ray " << i << " steps " << steps);
+      REQUIRE(traced == brute.hit);
+      if (!traced) {
+        ++misses;
+        continue;
+      }
+      ++hits;
+      // The tracer stops where |f| / L < eps (or at the bisected crossing): up to eps L / slope
+      // before the crossing, where slope = |df/dt| there (small on grazing rays).
+      const SphereTraceConfig config;
+      const float eps = std::max(config.absolute_epsilon, config.relative_epsilon * ts);
+      const float h = 1e-4f;
+      const float slope =
+          std::abs(sdf_eval(t, r.org + r.dir * (brute.t + h)) - sdf_eval(t, r.org + r.dir * (brute.t - h))) /
+          (2 * h);
+      REQUIRE(ts == Approx(brute.t).margin(1e-3 + 2 * eps * lip / slope));
+      REQUIRE(std::abs(sdf_eval(t, r.org + r.dir * ts)) / lip < 1e-4f);
+    }
+    INFO("noise " << int(kind) << ": " << hits << " hits, " << misses << " misses, " << unclear
+                  << " unclear");
+    CHECK(hits > 100);
+    CHECK(misses > 20);
+    CHECK(unclear < rays / 10);
+  }
+}

@@ -177,6 +177,38 @@ TEST_CASE("CSG bounds: overlap, merge, the first operand, smooth widening, unbou
   CHECK(sdf_tree_bounds(cube).empty());
 }
 
+TEST_CASE("CSG bounds: displacement widens its child's box by |amplitude| through the transforms",
+          "[shapes][noise][quick]") {
+  for (const float amplitude : {0.3f, -0.3f}) {
+    SdfTree t;
+    const int box = add_node(t, sdf_primitive(SdfKind::Box, {1, 0.5f, 0.25f}));
+    FractalParams params;
+    params.kind = FractalKind::Ridged;  // range [0, 1]: the relief only grows for amplitude < 0
+    const int displaced = add_displace(t, box, amplitude, 4, params, 2);
+    SdfNode scaled = sdf_operator(SdfKind::Union, displaced, displaced);
+    scaled.to_local.m[0][0] = 0.5f;  // the parent's x is twice the local x
+    scaled.to_local.m[1][3] = -1;    // moved up by 1
+    t.root = add_node(t, scaled);
+    const Bounds3f b = sdf_tree_bounds(t);
+    CHECK(b.lo.x == Approx(-2 * 1.3f));
+    CHECK(b.hi.x == Approx(2 * 1.3f));
+    CHECK(b.lo.y == Approx(1 - 0.8f));
+    CHECK(b.hi.z == Approx(0.55f));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-4, 4);
+    int inside = 0;
+    for (int i = 0; i < 50000; ++i) {
+      const Vec3f p{u(rng), u(rng) * 0.5f + 1, u(rng) * 0.25f};
+      const bool outside_box =
+          p.x < b.lo.x || p.y < b.lo.y || p.z < b.lo.z || p.x > b.hi.x || p.y > b.hi.y || p.z > b.hi.z;
+      const float f = sdf_eval(t, p);
+      if (outside_box) REQUIRE(f > 0);
+      inside += f <= 0;
+    }
+    CHECK(inside > 0);
+  }
+}
+
 TEST_CASE("implicit shapes hit where their analytic twins do", "[shapes]") {
   const Shape exact = analytic_shape(ShapeKind::Sphere, 1);
   const Shape traced = make_implicit_shape(tree_of({sdf_primitive(SdfKind::Sphere, {1, 0, 0})}, 0));
