@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes scenes/csg.gltf and scenes/spheres.gltf: Penumbra's scenes of PENUMBRA_shapes shapes.
+"""Writes scenes/csg.gltf, scenes/spheres.gltf and scenes/procedural.gltf: Penumbra's scenes of
+PENUMBRA_shapes shapes and PENUMBRA_procedural materials.
 
 csg.gltf: the classic CSG part (a sphere intersected with a cube, minus three orthogonal
 cylinders), a smooth union of four spheres (a blob) and a tilted torus, all implicit shapes, on
@@ -9,7 +10,12 @@ spheres.gltf: analytic spheres of several materials (plastic, metal, chrome, mat
 capsule in a room whose four walls are mirrors (metallic 1, roughness 0, analytic boxes) between
 an analytic floor and ceiling, with two point lights and a perspective camera.
 
-Both list PENUMBRA_shapes in extensionsUsed only, so tools that do not know the extension still
+procedural.gltf: procedural materials: a marble sphere (sine bands distorted by turbulence), a
+wooden block (rings distorted by fBm), a rock (an implicit sphere displaced by fBm, coloured and
+bumped by noise) on a floor of square tiles (Chebyshev Worley F2 - F1 through a constant ramp,
+grooved grout).
+
+All list PENUMBRA_shapes and PENUMBRA_procedural in extensionsUsed only, so tools that do not know the extension still
 load them (as empty nodes, cameras and lights). Pure JSON with no buffers; pure standard library;
 the output is deterministic, so re-running reproduces the committed files byte for byte.
 
@@ -32,11 +38,16 @@ class Builder:
             "extensions": {"KHR_lights_punctual": {"lights": []}},
         }
 
-    def material(self, name, base, metallic, roughness):
-        self.gltf["materials"].append({
+    def material(self, name, base, metallic, roughness, procedural=None):
+        material = {
             "name": name, "doubleSided": True,
             "pbrMetallicRoughness": {"baseColorFactor": list(base) + [1.0],
-                                     "metallicFactor": metallic, "roughnessFactor": roughness}})
+                                     "metallicFactor": metallic, "roughnessFactor": roughness}}
+        if procedural is not None:
+            material["extensions"] = {"PENUMBRA_procedural": procedural}
+            if "PENUMBRA_procedural" not in self.gltf["extensionsUsed"]:
+                self.gltf["extensionsUsed"].append("PENUMBRA_procedural")
+        self.gltf["materials"].append(material)
         return len(self.gltf["materials"]) - 1
 
     def node(self, name, **fields):
@@ -178,9 +189,63 @@ def build_spheres():
     return b.gltf
 
 
+def ramp(*stops):
+    return [{"position": p, "color": list(c)} for p, c in stops]
+
+
+def build_procedural():
+    b = Builder("procedural")
+    tiles = b.material("tiles", (1, 1, 1), 0.0, 1.0, {
+        # The floor (y = 0) cuts the cells through their centres (q.y = 0.5), not along a face.
+        "space": "world", "scale": 1.25, "translation": [0, 0.5, 0],
+        "pattern": {"type": "voronoi", "feature": "f2-f1", "metric": "chebyshev", "randomness": 0},
+        "baseColor": {"ramp": ramp((0.0, (0.16, 0.15, 0.14)), (0.07, (0.66, 0.62, 0.55))),
+                      "interpolation": "constant", "compose": "replace"},
+        "roughness": {"range": [0.95, 0.35], "compose": "replace"},
+        "bump": {"height": 0.01}})
+    marble = b.material("marble", (1, 1, 1), 0.0, 0.25, {
+        "space": "object", "scale": 1.3, "rotation": [0, 0, 35],
+        "pattern": {"type": "wave", "profile": "sine", "phaseDistortion": 1.6,
+                    "fractal": "turbulence", "detail": 6, "roughness": 0.55, "seed": 3},
+        "baseColor": {"ramp": ramp((0.0, (0.1, 0.11, 0.12)), (0.3, (0.62, 0.63, 0.62)),
+                                   (0.6, (0.9, 0.9, 0.88)), (1.0, (0.96, 0.96, 0.94))),
+                      "compose": "replace"},
+        "bump": {"height": 0.003}})
+    wood = b.material("wood", (1, 1, 1), 0.0, 0.5, {
+        "space": "object", "scale": 5.0, "translation": [0.3, 0, 0.2],
+        "pattern": {"type": "wave", "wave": "rings", "axis": "y", "profile": "saw",
+                    "phaseDistortion": 0.35, "fractal": "fbm", "detail": 3, "seed": 11},
+        "baseColor": {"ramp": ramp((0.0, (0.72, 0.47, 0.25)), (0.75, (0.55, 0.33, 0.16)),
+                                   (1.0, (0.36, 0.2, 0.09))),
+                      "interpolation": "smoothstep", "compose": "replace"},
+        "roughness": {"range": [0.45, 0.7], "compose": "replace"}})
+    stone = b.material("stone", (1, 1, 1), 0.0, 0.8, {
+        "space": "object", "scale": 3.0,
+        "pattern": {"type": "noise", "fractal": "fbm", "detail": 5, "roughness": 0.6, "seed": 5},
+        "baseColor": {"ramp": ramp((0.2, (0.2, 0.18, 0.16)), (0.5, (0.42, 0.39, 0.35)),
+                                   (0.8, (0.6, 0.57, 0.5))),
+                      "compose": "replace"},
+        "bump": {"height": 0.02}})
+
+    b.shape("floor", {"type": "plane", "size": [30, 30]}, tiles)
+    b.shape("marble sphere", {"type": "sphere", "radius": 0.8}, marble, translation=[-2.1, 0.8, 0.0])
+    b.shape("wooden block", {"type": "box", "size": [1.4, 1.0, 1.0]}, wood,
+            translation=[0.05, 0.5, -0.2], rotation=quat_axis_angle((0, 1, 0), -25))
+    rock = csg("displace", [csg("roundBox", size=[1.5, 1.1, 1.3], radius=0.35)],
+               amplitude=0.14, frequency=2.2, seed=9, noise="fbm", detail=4, roughness=0.55)
+    b.shape("rock", implicit(rock), stone, translation=[2.15, 0.58, 0.2],
+            rotation=quat_axis_angle((0, 1, 0), 20))
+
+    b.point_light("key", [1.0, 0.9, 0.8], 60.0, [-3.0, 5.5, 4.0])
+    b.point_light("fill", [0.7, 0.8, 1.0], 25.0, [4.0, 3.5, 3.5])
+    b.camera("procedural camera", [0.0, 2.3, 6.0], [0.0, 0.55, 0.0], 0.58)
+    return b.gltf
+
+
 def main():
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
-    for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres)]:
+    for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres),
+                        ("procedural.gltf", build_procedural)]:
         path = os.path.join(out_dir, name)
         with open(path, "w") as f:
             json.dump(build(), f, indent=1)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Tools that do not know PENUMBRA_shapes still load the shipped shape scenes (the extension is
-# only in extensionsUsed): Blender's glTF importer imports each without a Python error. Skipped
-# (reported by ctest as skipped) when `blender` is not installed.
+# Tools that do not know PENUMBRA_shapes or PENUMBRA_procedural still load the shipped scenes that
+# use them (the extensions are only in extensionsUsed): Blender's glTF importer imports each
+# without a Python error. Skipped (reported by ctest as skipped) when `blender` is not installed.
 # Usage: blender_import_test.sh SRC WORK_DIR
 set -u
 src="$1"; work="$2"
@@ -11,7 +11,7 @@ if ! command -v blender >/dev/null; then
 fi
 rm -rf "$work"; mkdir -p "$work"
 fails=0
-for scene in csg spheres; do
+for scene in csg spheres procedural; do
   file="$src/scenes/$scene.gltf"
   blender -b --factory-startup --python-exit-code 1 \
     --python-expr "import bpy; bpy.ops.import_scene.gltf(filepath=r'''$file''')" >"$work/$scene.log" 2>&1
