@@ -52,7 +52,6 @@ class ProceduralReader : public JsonReader {
  private:
   void mapping(const json& ext, const std::string& where, ProceduralTexture& tex) const;
   void pattern(const json& p, const std::string& where, ProceduralTexture& tex) const;
-  FractalParams fractal(const json& p, const std::string& where) const;
   void base_color(const json& c, const std::string& where, ProceduralTexture& tex) const;
   ScalarDrive drive(const json& d, const std::string& where, float hi) const;
 };
@@ -102,18 +101,6 @@ void ProceduralReader::mapping(const json& ext, const std::string& where, Proced
   tex.mapping = procedural_mapping(t, r, s);
 }
 
-FractalParams ProceduralReader::fractal(const json& p, const std::string& where) const {
-  FractalParams f;
-  f.kind = FractalKind(choice_or(p, "fractal", where, kFractalKinds, 0));
-  f.detail = number_in(p, "detail", where, f.detail, 0, 15);
-  f.roughness = number_in(p, "roughness", where, f.roughness, 0, 1);
-  f.lacunarity = number_in(p, "lacunarity", where, f.lacunarity, 1.01f, 16);
-  f.offset = number_in(p, "offset", where, f.offset, 0, 2);
-  f.gain = number_in(p, "gain", where, f.gain, 0, 8);
-  f.distortion = number_in(p, "distortion", where, f.distortion, 0, 100);
-  return f;
-}
-
 void ProceduralReader::pattern(const json& p, const std::string& where, ProceduralTexture& tex) const {
   require_object(p, where, "a pattern");
   tex.kind = PatternKind(choice_or(p, "type", where, kPatternTypes, 0));
@@ -124,7 +111,7 @@ void ProceduralReader::pattern(const json& p, const std::string& where, Procedur
                                                         : Keys(kWaveKeys);
   check_keys(p, where, what, kPatternCommon, typed, kPatternKeys);
   tex.seed = uint32_or(p, "seed", where, 0);
-  if (tex.kind != PatternKind::Voronoi) tex.fractal = fractal(p, where);
+  if (tex.kind != PatternKind::Voronoi) tex.fractal = read_fractal_params(*this, p, where, "fractal");
   if (tex.kind == PatternKind::Voronoi) {
     tex.voronoi.feature = WorleyFeature(choice_or(p, "feature", where, kFeatures, 0));
     tex.voronoi.metric = WorleyMetric(choice_or(p, "metric", where, kMetrics, 0));
@@ -188,6 +175,26 @@ ScalarDrive ProceduralReader::drive(const json& d, const std::string& where, flo
 }
 
 }  // namespace
+
+FractalParams read_fractal_params(const JsonReader& reader, const json& j, const std::string& where,
+                                  const char* kind_key) {
+  FractalParams f;
+  f.kind = FractalKind(reader.choice_or(j, kind_key, where, kFractalKinds, 0));
+  f.detail = reader.number_in(j, "detail", where, f.detail, 0, 15);
+  f.roughness = reader.number_in(j, "roughness", where, f.roughness, 0, 1);
+  f.lacunarity = reader.number_in(j, "lacunarity", where, f.lacunarity, 1.01f, 16);
+  f.distortion = reader.number_in(j, "distortion", where, f.distortion, 0, 16);
+  if (f.kind == FractalKind::Ridged) {
+    f.offset = reader.number_in(j, "offset", where, f.offset, 0, 2);
+    f.gain = reader.number_in(j, "gain", where, f.gain, 0, 16);
+  } else {
+    for (const char* key : {"offset", "gain"})
+      if (JsonReader::find(j, key))
+        reader.fail(where + "." + key, std::string("applies to \"ridged\" ") + kind_key +
+                                           " only (this one is \"" + kFractalKinds[int(f.kind)] + "\")");
+  }
+  return f;
+}
 
 std::vector<MaterialProcedural> read_material_procedurals(const json& doc, const std::string& file,
                                                           MemoryBudget& budget) {

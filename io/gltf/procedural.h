@@ -19,6 +19,16 @@ inline constexpr const char* kProceduralExtension = "PENUMBRA_procedural";
 /// Most colour ramp stops one procedural texture may hold.
 inline constexpr int kMaxRampStops = 64;
 
+class JsonReader;
+
+/// The fractal-noise members of `j` (the fractal kind at key `kind_key`, then detail,
+/// roughness, lacunarity, distortion, and offset and gain, which apply to the ridged kind only),
+/// within the ranges FractalParams documents (distortion in [0, 16], gain in [0, 16]); absent
+/// members keep FractalParams' defaults. Shared by PENUMBRA_procedural patterns and
+/// PENUMBRA_shapes displacement.
+FractalParams read_fractal_params(const JsonReader& reader, const nlohmann::json& j, const std::string& where,
+                                  const char* kind_key);
+
 /// One material's procedural texture.
 struct MaterialProcedural {
   int material = -1;  ///< index into materials

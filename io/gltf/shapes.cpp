@@ -13,30 +13,15 @@
 #include <nlohmann/json.hpp>
 #include <span>
 
+#include "io/gltf/json_reader.h"
 #include "io/gltf/meshes.h"
+#include "io/gltf/procedural.h"
 
 namespace penumbra::gltf {
 
 namespace {
 
 using nlohmann::json;
-
-// A value for messages, cut to 40 characters; infinite numbers (which JSON cannot spell but an
-// overflowing literal such as 1e999 reads as) shown as inf.
-std::string shown(const json& v) {
-  if (v.is_number_float() && !std::isfinite(v.get<double>())) return v.get<double>() > 0 ? "inf" : "-inf";
-  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
-
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-// What a number must be beyond finite as a 32-bit float.
-enum class Bound { Any, Positive, NonNegative, NonZero };
 
 // The schema's types: name, kind and the keys of that type beyond those every object has.
 struct ShapeType {
@@ -89,14 +74,8 @@ constexpr const char* kCsgKeys[] = {
     "majorRadius", "minorRadius", "normal",   "offset",    "planes",     "children", "amplitude", "frequency",
     "seed",        "noise",       "detail",   "roughness", "lacunarity", "gain",     "distortion"};
 
-// The displace node's "noise" names, indexed by FractalKind.
-constexpr const char* kNoiseNames[] = {"fbm", "turbulence", "ridged"};
-
-// Limits of a displace node's fields beyond those FractalParams documents: |amplitude| and
-// frequency, the domain distortion, the ridged multifractal's gain.
+// Limit of a displace node's |amplitude| and frequency.
 constexpr float kMaxDisplacement = 1e6f;
-constexpr float kMaxDistortion = 16;
-constexpr float kMaxRidgedGain = 16;
 
 bool is_smooth(SdfKind kind) {
   return kind == SdfKind::SmoothUnion || kind == SdfKind::SmoothIntersection ||
@@ -152,34 +131,13 @@ bool may_be_unbounded(const SdfTree& tree, int index, int depth) {
 
 // Reads extension objects into NodeShapes, one at a time; `m_tree` holds the CSG tree of the
 // implicit shape being read.
-class ShapeReader {
+class ShapeReader : public JsonReader {
  public:
   ShapeReader(const std::string& file, size_t materials, MemoryBudget& budget)
-      : m_file(file), m_materials(materials), m_budget(budget) {}
+      : JsonReader(file), m_materials(materials), m_budget(budget) {}
   NodeShape read(const json& ext, int node, const std::string& where);
 
  private:
-  [[noreturn]] void fail(const std::string& where, const std::string& message) const {
-    throw InputError(m_file, where, message);
-  }
-  static const json* find(const json& obj, const char* key) {
-    const auto it = obj.find(key);
-    return it == obj.end() ? nullptr : &*it;
-  }
-  void check_keys(const json& obj, const std::string& where, const std::string& what,
-                  std::span<const char* const> common, std::span<const char* const> typed,
-                  std::span<const char* const> known) const;
-  float number(const json& v, const std::string& where, Bound bound) const;
-  float number_or(const json& obj, const char* key, const std::string& where, float fallback,
-                  Bound bound) const;
-  float number_in(const json& obj, const char* key, const std::string& where, float fallback, float lo,
-                  float hi) const;
-  template <size_t N>
-  std::array<float, N> numbers(const json& v, const std::string& where, Bound bound) const;
-  Vec3f vec3_or(const json& obj, const char* key, const std::string& where, Vec3f fallback,
-                Bound bound) const;
-  int integer_or(const json& obj, const char* key, const std::string& where, int fallback, int lo,
-                 int hi) const;
   int material(const json& ext, const std::string& where) const;
   void analytic(const json& ext, const std::string& where, Shape& shape) const;
   Shape implicit(const json& ext, const std::string& where);
@@ -191,90 +149,10 @@ class ShapeReader {
   Affine3f csg_transform(const json& j, const std::string& where) const;
   int add_node(const SdfNode& node, const std::string& where);
 
-  const std::string& m_file;
   size_t m_materials;
   MemoryBudget& m_budget;
   SdfTree m_tree;
 };
-
-void ShapeReader::check_keys(const json& obj, const std::string& where, const std::string& what,
-                             std::span<const char* const> common, std::span<const char* const> typed,
-                             std::span<const char* const> known) const {
-  auto listed = [](std::span<const char* const> keys, const std::string& key) {
-    return std::any_of(keys.begin(), keys.end(), [&](const char* k) { return k && key == k; });
-  };
-  for (const auto& [key, value] : obj.items()) {
-    if (listed(common, key) || listed(typed, key)) continue;
-    std::string keys;
-    for (auto list : {common, typed})
-      for (const char* k : list)
-        if (k) keys += (keys.empty() ? "" : ", ") + std::string(k);
-    if (listed(known, key))
-      fail(where + "." + key, "does not apply to " + what + " (its keys: " + keys + ")");
-    fail(where + "." + key, "unknown key (" + what + " has: " + keys + ")");
-  }
-}
-
-float ShapeReader::number(const json& v, const std::string& where, Bound bound) const {
-  if (!v.is_number()) fail(where, "must be a number (got " + shown(v) + ")");
-  const double d = v.get<double>();
-  const float f = float(d);
-  if (!std::isfinite(d)) fail(where, "must be a finite number (got " + shown(v) + ")");
-  if (!std::isfinite(f)) fail(where, "is beyond the 32-bit float range (got " + shown(v) + ")");
-  const char* rounded = d != 0 && f == 0 ? ", 0 as a 32-bit float" : "";
-  if (bound == Bound::Positive && !(f > 0)) fail(where, "must be > 0 (got " + shown(v) + rounded + ")");
-  if (bound == Bound::NonNegative && !(f >= 0)) fail(where, "must be >= 0 (got " + shown(v) + ")");
-  if (bound == Bound::NonZero && f == 0) fail(where, "must be non-zero (got " + shown(v) + rounded + ")");
-  return f;
-}
-
-float ShapeReader::number_or(const json& obj, const char* key, const std::string& where, float fallback,
-                             Bound bound) const {
-  const json* v = find(obj, key);
-  return v ? number(*v, where + "." + key, bound) : fallback;
-}
-
-float ShapeReader::number_in(const json& obj, const char* key, const std::string& where, float fallback,
-                             float lo, float hi) const {
-  const json* v = find(obj, key);
-  if (!v) return fallback;
-  const std::string kw = where + "." + key;
-  const float f = number(*v, kw, Bound::Any);
-  if (!(f >= lo && f <= hi))
-    fail(kw, "must be in [" + format_number(lo) + ", " + format_number(hi) + "] (got " + shown(*v) + ")");
-  return f;
-}
-
-template <size_t N>
-std::array<float, N> ShapeReader::numbers(const json& v, const std::string& where, Bound bound) const {
-  if (!v.is_array() || v.size() != N)
-    fail(where, "must be an array of " + std::to_string(N) + " numbers (got " + shown(v) + ")");
-  std::array<float, N> out;
-  for (size_t i = 0; i < N; ++i) out[i] = number(v[i], idx(where.c_str(), i), bound);
-  return out;
-}
-
-Vec3f ShapeReader::vec3_or(const json& obj, const char* key, const std::string& where, Vec3f fallback,
-                           Bound bound) const {
-  const json* v = find(obj, key);
-  if (!v) return fallback;
-  const auto a = numbers<3>(*v, where + "." + key, bound);
-  return {a[0], a[1], a[2]};
-}
-
-int ShapeReader::integer_or(const json& obj, const char* key, const std::string& where, int fallback, int lo,
-                            int hi) const {
-  const json* v = find(obj, key);
-  if (!v) return fallback;
-  const std::string kw = where + "." + key;
-  const std::string range = "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-  if (!v->is_number_integer()) fail(kw, "must be an integer " + range + " (got " + shown(*v) + ")");
-  const bool in_range = v->is_number_unsigned() ? v->get<uint64_t>() >= uint64_t(std::max(lo, 0)) &&
-                                                      v->get<uint64_t>() <= uint64_t(hi)
-                                                : v->get<int64_t>() >= lo && v->get<int64_t>() <= hi;
-  if (!in_range) fail(kw, "must be " + range + " (got " + shown(*v) + ")");
-  return int(v->get<int64_t>());
-}
 
 int ShapeReader::material(const json& ext, const std::string& where) const {
   const json* m = find(ext, "material");
@@ -519,35 +397,8 @@ int ShapeReader::csg_displacement(const json& j, const std::string& where) {
   if (!(d.frequency <= kMaxDisplacement))
     fail(where + ".frequency",
          "must be <= " + format_number(kMaxDisplacement) + " (got " + format_number(d.frequency) + ")");
-  uint32_t seed = 0;
-  if (const json* v = find(j, "seed")) {
-    const char* range = "must be an integer in [0, 4294967295]";
-    if (!v->is_number_unsigned() || v->get<uint64_t>() > UINT32_MAX)
-      fail(where + ".seed", std::string(range) + " (got " + shown(*v) + ")");
-    seed = uint32_t(v->get<uint64_t>());
-  }
-  FractalParams& p = d.params;
-  if (const json* v = find(j, "noise")) {
-    const auto names = std::span(kNoiseNames);
-    const auto it =
-        v->is_string() ? std::find(names.begin(), names.end(), v->get<std::string>()) : names.end();
-    if (it == names.end())
-      fail(where + ".noise", "must be \"fbm\", \"turbulence\" or \"ridged\" (got " + shown(*v) + ")");
-    p.kind = FractalKind(it - names.begin());
-  }
-  p.detail = number_in(j, "detail", where, p.detail, 0, 15);
-  p.roughness = number_in(j, "roughness", where, p.roughness, 0, 1);
-  p.lacunarity = number_in(j, "lacunarity", where, p.lacunarity, 1.01f, 16);
-  p.distortion = number_in(j, "distortion", where, p.distortion, 0, kMaxDistortion);
-  if (p.kind == FractalKind::Ridged) {
-    p.offset = number_in(j, "offset", where, p.offset, 0, 2);
-    p.gain = number_in(j, "gain", where, p.gain, 0, kMaxRidgedGain);
-  } else {
-    for (const char* key : {"offset", "gain"})
-      if (find(j, key))
-        fail(where + "." + key, std::string("applies to \"ridged\" noise only (this node's is \"") +
-                                    kNoiseNames[int(p.kind)] + "\")");
-  }
+  const uint32_t seed = uint32_or(j, "seed", where, 0);
+  d.params = read_fractal_params(*this, j, where, "noise");
   m_budget.charge(sizeof(SdfDisplacement), where, "its noise table needs");
   d.table = make_perlin_table(seed);
   m_tree.displacements.push_back(d);

@@ -220,6 +220,10 @@ TEST_CASE("procedural extension: bad values name the material and the field", "[
                 "does not apply to pattern type \"noise\"");
   require_error({{"pattern", {{"type", "voronoi"}, {"detail", 3}}}}, ".pattern.detail",
                 "does not apply to pattern type \"voronoi\"");
+  require_error({{"pattern", {{"gain", 2}}}}, ".pattern.gain",
+                "applies to \"ridged\" fractal only (this one is \"fbm\")");
+  require_error({{"pattern", {{"fractal", "ridged"}, {"distortion", 20}}}}, ".pattern.distortion",
+                "must be in [0, 16]");
   require_error({{"pattern", {{"type", "voronoi"}, {"randomness", 2}}}}, ".pattern.randomness",
                 "must be in [0, 1]");
   require_error({{"pattern", {{"type", "wave"}, {"axis", "w"}}}}, ".pattern.axis", "is not one of");

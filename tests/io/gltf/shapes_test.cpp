@@ -824,10 +824,10 @@ TEST_CASE("shapes: bad displace fields are errors naming the node and the field"
   CHECK_THAT(with("seed", -1), Contains(node + ".seed: must be an integer in [0, 4294967295] (got -1)"));
   CHECK_THAT(with("seed", 4294967296u), Contains(node + ".seed: must be an integer in [0, 4294967295]"));
   CHECK_THAT(with("noise", "perlin"),
-             Contains(node + ".noise: must be \"fbm\", \"turbulence\" or \"ridged\""));
-  CHECK_THAT(with("noise", 2), Contains(node + ".noise: must be \"fbm\""));
+             Contains(node + ".noise: 'perlin' is not one of \"fbm\", \"turbulence\", \"ridged\""));
+  CHECK_THAT(with("noise", 2), Contains(node + ".noise: must be one of \"fbm\""));
   CHECK_THAT(with("offset", 1),
-             Contains(node + ".offset: applies to \"ridged\" noise only (this node's is \"fbm\")"));
+             Contains(node + ".offset: applies to \"ridged\" noise only (this one is \"fbm\")"));
   CHECK_THAT(with("gain", 1), Contains(node + ".gain: applies to \"ridged\" noise only"));
   json ridged = displace(sphere(1), 0.1);
   ridged["noise"] = "ridged";
