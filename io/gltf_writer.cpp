@@ -10,6 +10,7 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "io/gltf/procedural.h"
 #include "renderer/scene/camera.h"
 
 namespace penumbra {
@@ -59,8 +60,8 @@ void add_root(Writer& wr, json node) {
   wr.j["scenes"][0]["nodes"].push_back(wr.j["nodes"].size() - 1);
 }
 
-/// The materials; sets which material extensions they use.
-void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bool& unlit) {
+/// The materials (with their procedural textures); sets which material extensions they use.
+void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bool& unlit, bool& procedural) {
   if (!scene.materials.empty()) wr.j["materials"] = json::array();
   for (const Material& m : scene.materials) {
     json mat = {{"pbrMetallicRoughness",
@@ -82,6 +83,11 @@ void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bo
     if (m.unlit) {
       mat["extensions"]["KHR_materials_unlit"] = json::object();
       unlit = true;
+    }
+    if (m.procedural >= 0 && size_t(m.procedural) < scene.procedurals.size()) {
+      mat["extensions"][gltf::kProceduralExtension] =
+          gltf::procedural_json(scene.procedurals[size_t(m.procedural)]);
+      procedural = true;
     }
     wr.j["materials"].push_back(mat);
   }
@@ -360,8 +366,8 @@ Writer build_document(const Scene& scene, const std::filesystem::path& file, con
           {"nodes", json::array()},
           {"scenes", {{{"nodes", json::array()}}}},
           {"scene", 0}};
-  bool emissive_strength = false, unlit = false;
-  write_materials(wr, scene, emissive_strength, unlit);
+  bool emissive_strength = false, unlit = false, procedural = false;
+  write_materials(wr, scene, emissive_strength, unlit, procedural);
   write_instances(wr, scene, write_meshes(wr, scene));
   write_cameras(wr, scene);
   write_lights(wr, scene);
@@ -370,6 +376,7 @@ Writer build_document(const Scene& scene, const std::filesystem::path& file, con
   if (emissive_strength) used.push_back("KHR_materials_emissive_strength");
   if (unlit) used.push_back("KHR_materials_unlit");
   if (count_shape_instances(scene) > 0) used.push_back("PENUMBRA_shapes");
+  if (procedural) used.push_back(gltf::kProceduralExtension);
   if (!used.empty()) wr.j["extensionsUsed"] = used;
   if (!wr.bin.empty()) {
     wr.j["buffers"] = {{{"byteLength", wr.bin.size()}}};

@@ -95,6 +95,21 @@ int JsonReader::integer_or(const json& obj, const char* key, const std::string& 
   return int(v->get<int64_t>());
 }
 
+bool JsonReader::matrix_or(const json& obj, const char* key, const std::string& where, Transform& t) const {
+  const json* matrix = find(obj, key);
+  if (!matrix) return false;
+  const std::string mw = where + "." + key;
+  for (const char* trs : {"translation", "rotation", "scale"})
+    if (find(obj, trs)) fail(mw, std::string("cannot be given together with ") + trs);
+  const auto m = numbers<16>(*matrix, mw, Bound::Any);
+  if (m[3] != 0 || m[7] != 0 || m[11] != 0 || m[15] != 1)
+    fail(mw, "must be affine (its last row 0, 0, 0, 1)");
+  std::array<double, 16> d;
+  std::copy(m.begin(), m.end(), d.begin());
+  t = from_column_major(d.data());
+  return true;
+}
+
 uint32_t JsonReader::uint32_or(const json& obj, const char* key, const std::string& where,
                                uint32_t fallback) const {
   const json* v = find(obj, key);

@@ -63,6 +63,9 @@ class JsonReader {
                 Bound bound) const;
   int integer_or(const nlohmann::json& obj, const char* key, const std::string& where, int fallback, int lo,
                  int hi) const;
+  /// obj[key] as an affine glTF matrix (16 numbers, column-major, last row 0 0 0 1), which
+  /// excludes the keys translation, rotation and scale; false (t untouched) if absent.
+  bool matrix_or(const nlohmann::json& obj, const char* key, const std::string& where, Transform& t) const;
   /// An unsigned 32-bit integer.
   uint32_t uint32_or(const nlohmann::json& obj, const char* key, const std::string& where,
                      uint32_t fallback) const;

@@ -2,6 +2,7 @@
 // scalar drives, each read and checked against the schema.
 #include "io/gltf/procedural.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -14,11 +15,9 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kTopKeys[] = {"space",     "texCoord",         "translation", "rotation",
-                                    "scale",     "filter",           "pattern",     "baseColor",
-                                    "roughness", "emissiveStrength", "metallic",    "bump"};
-constexpr const char* kSpaces[] = {"object", "world", "uv"};
-constexpr const char* kPatternTypes[] = {"noise", "voronoi", "wave"};
+constexpr const char* kTopKeys[] = {"space",    "texCoord",         "translation", "rotation",  "scale",
+                                    "matrix",   "filter",           "pattern",     "baseColor", "roughness",
+                                    "metallic", "emissiveStrength", "bump"};
 constexpr const char* kPatternCommon[] = {"type", "seed"};
 constexpr const char* kFractalKeys[] = {"fractal", "detail", "roughness", "lacunarity",
                                         "offset",  "gain",   "distortion"};
@@ -30,15 +29,6 @@ constexpr const char* kPatternKeys[] = {"type",       "seed",           "fractal
                                         "lacunarity", "offset",         "gain",    "distortion", "feature",
                                         "metric",     "randomness",     "output",  "wave",       "axis",
                                         "profile",    "phaseDistortion"};
-constexpr const char* kFractalKinds[] = {"fbm", "turbulence", "ridged"};
-constexpr const char* kFeatures[] = {"f1", "f2", "f2-f1"};
-constexpr const char* kMetrics[] = {"euclidean", "manhattan", "chebyshev"};
-constexpr const char* kVoronoiOutputs[] = {"distance", "cellRandom"};
-constexpr const char* kWaveTypes[] = {"bands", "rings"};
-constexpr const char* kAxes[] = {"x", "y", "z"};
-constexpr const char* kProfiles[] = {"sine", "saw", "triangle"};
-constexpr const char* kComposes[] = {"multiply", "replace"};
-constexpr const char* kInterpolations[] = {"linear", "constant", "smoothstep"};
 constexpr const char* kColorKeys[] = {"ramp", "interpolation", "compose"};
 constexpr const char* kDriveKeys[] = {"range", "compose"};
 constexpr const char* kStopKeys[] = {"position", "color"};
@@ -83,6 +73,13 @@ ProceduralTexture ProceduralReader::read(const json& ext, const std::string& whe
 }
 
 void ProceduralReader::mapping(const json& ext, const std::string& where, ProceduralTexture& tex) const {
+  Transform m;
+  if (matrix_or(ext, "matrix", where, m)) {
+    Affine3f inv;
+    tex.mapping = to_affine(m);
+    if (!inverse(tex.mapping, inv)) fail(where + ".matrix", "is singular");
+    return;
+  }
   const Vec3f t = vec3_or(ext, "translation", where, {}, Bound::Any);
   const Vec3f r = vec3_or(ext, "rotation", where, {}, Bound::Any);
   Vec3f s{1, 1, 1};
@@ -219,6 +216,54 @@ std::vector<MaterialProcedural> read_material_procedurals(const json& doc, const
     out.push_back({int(i), reader.read(*proc, where)});
   }
   return out;
+}
+
+json procedural_json(const ProceduralTexture& t) {
+  json j = {{"space", kSpaces[int(t.space)]}, {"filter", t.filter}};
+  if (t.space == ProceduralSpace::Uv) j["texCoord"] = t.texcoord;
+  if (!is_identity(t.mapping)) {
+    json m = json::array();
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m.push_back(r < 3 ? t.mapping.m[r][c] : (c == 3 ? 1.0f : 0.0f));
+    j["matrix"] = m;
+  }
+  json p = {{"type", kPatternTypes[int(t.kind)]}, {"seed", t.seed}};
+  if (t.kind != PatternKind::Voronoi) {
+    const FractalParams& f = t.fractal;
+    p.update({{"fractal", kFractalKinds[int(f.kind)]},
+              {"detail", f.detail},
+              {"roughness", f.roughness},
+              {"lacunarity", f.lacunarity},
+              {"distortion", f.distortion}});
+    if (f.kind == FractalKind::Ridged) p.update({{"offset", f.offset}, {"gain", f.gain}});
+  }
+  if (t.kind == PatternKind::Voronoi)
+    p.update({{"feature", kFeatures[int(t.voronoi.feature)]},
+              {"metric", kMetrics[int(t.voronoi.metric)]},
+              {"randomness", t.voronoi.randomness},
+              {"output", kVoronoiOutputs[int(t.voronoi_output)]}});
+  if (t.kind == PatternKind::Wave)
+    p.update({{"wave", kWaveTypes[int(t.wave.type)]},
+              {"axis", kAxes[std::clamp(t.wave.axis, 0, 2)]},
+              {"profile", kProfiles[int(t.wave.profile)]},
+              {"phaseDistortion", t.wave.distortion}});
+  j["pattern"] = p;
+  if (t.drives_base_color) {
+    json ramp = json::array();
+    for (const RampStop& s : t.base_color.stops)
+      ramp.push_back({{"position", s.position}, {"color", {s.color.x, s.color.y, s.color.z}}});
+    j["baseColor"] = {{"ramp", ramp},
+                      {"interpolation", kInterpolations[int(t.base_color.interpolation)]},
+                      {"compose", kComposes[int(t.base_color_compose)]}};
+  }
+  const auto drive = [&](const char* key, const ScalarDrive& d) {
+    if (d.enabled) j[key] = {{"range", {d.min, d.max}}, {"compose", kComposes[int(d.compose)]}};
+  };
+  drive("roughness", t.roughness);
+  drive("metallic", t.metallic);
+  drive("emissiveStrength", t.emission_strength);
+  if (t.bump_height != 0) j["bump"] = {{"height", t.bump_height}};
+  return j;
 }
 
 void attach_procedurals(Scene& scene, std::vector<MaterialProcedural>& procedurals) {

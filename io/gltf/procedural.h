@@ -16,6 +16,21 @@ namespace penumbra::gltf {
 /// The extension's name on materials and in extensionsUsed / extensionsRequired.
 inline constexpr const char* kProceduralExtension = "PENUMBRA_procedural";
 
+/// The schema's names, indexed by the enumerations they name (ProceduralSpace, PatternKind,
+/// FractalKind, WorleyFeature, WorleyMetric, VoronoiOutput, WaveType, axis 0-2, WaveProfile,
+/// Compose, RampInterpolation); the writer spells values with them.
+inline constexpr const char* kSpaces[] = {"object", "world", "uv"};
+inline constexpr const char* kPatternTypes[] = {"noise", "voronoi", "wave"};
+inline constexpr const char* kFractalKinds[] = {"fbm", "turbulence", "ridged"};
+inline constexpr const char* kFeatures[] = {"f1", "f2", "f2-f1"};
+inline constexpr const char* kMetrics[] = {"euclidean", "manhattan", "chebyshev"};
+inline constexpr const char* kVoronoiOutputs[] = {"distance", "cellRandom"};
+inline constexpr const char* kWaveTypes[] = {"bands", "rings"};
+inline constexpr const char* kAxes[] = {"x", "y", "z"};
+inline constexpr const char* kProfiles[] = {"sine", "saw", "triangle"};
+inline constexpr const char* kComposes[] = {"multiply", "replace"};
+inline constexpr const char* kInterpolations[] = {"linear", "constant", "smoothstep"};
+
 /// Most colour ramp stops one procedural texture may hold.
 inline constexpr int kMaxRampStops = 64;
 
@@ -41,6 +56,10 @@ struct MaterialProcedural {
 /// another pattern type, wrong JSON types, values out of range, unsorted ramps, a singular mapping.
 std::vector<MaterialProcedural> read_material_procedurals(const nlohmann::json& doc, const std::string& file,
                                                           MemoryBudget& budget);
+
+/// The extension object describing `tex` (every member, the mapping as a matrix), which
+/// read_material_procedurals reads back to the same texture.
+nlohmann::json procedural_json(const ProceduralTexture& tex);
 
 /// Moves each texture into scene.procedurals and links it from its material (which must exist).
 void attach_procedurals(Scene& scene, std::vector<MaterialProcedural>& procedurals);

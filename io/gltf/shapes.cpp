@@ -409,17 +409,8 @@ int ShapeReader::csg_displacement(const json& j, const std::string& where) {
 // in the parent's; returns its inverse, SdfNode::to_local.
 Affine3f ShapeReader::csg_transform(const json& j, const std::string& where) const {
   Transform t;
-  const json* matrix = find(j, "matrix");
-  if (matrix) {
-    for (const char* key : {"translation", "rotation", "scale"})
-      if (find(j, key)) fail(where + ".matrix", std::string("cannot be given together with ") + key);
-    const auto m = numbers<16>(*matrix, where + ".matrix", Bound::Any);
-    if (m[3] != 0 || m[7] != 0 || m[11] != 0 || m[15] != 1)
-      fail(where + ".matrix", "must be affine (its last row 0, 0, 0, 1)");
-    std::array<double, 16> d;
-    std::copy(m.begin(), m.end(), d.begin());
-    t = from_column_major(d.data());
-  } else {
+  const bool matrix = matrix_or(j, "matrix", where, t);
+  if (!matrix) {
     std::array<double, 3> tr{0, 0, 0}, sc{1, 1, 1};
     Quat q;
     if (const json* v = find(j, "translation")) {

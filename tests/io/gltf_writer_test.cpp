@@ -357,3 +357,103 @@ TEST_CASE("write_gltf: shapes come back through PENUMBRA_shapes with every field
     }
   }
 }
+
+TEST_CASE("write_gltf: procedural textures come back through PENUMBRA_procedural with every field",
+          "[gltf][writer][procedural]") {
+  Scene s;
+  std::vector<ProceduralTexture> textures(3);
+  ProceduralTexture& noise = textures[0];
+  noise.space = ProceduralSpace::Uv;
+  noise.texcoord = 1;
+  noise.mapping = procedural_mapping({1, 2, 3}, {10, 20, 30}, {2, 0.5f, 4});
+  noise.seed = 123456789u;
+  noise.fractal = {FractalKind::Ridged, 3.5f, 0.4f, 2.5f, 0.8f, 3, 0.25f};
+  noise.drives_base_color = true;
+  noise.base_color.stops = {{0, {0.1f, 0.2f, 0.3f}}, {0.4f, {0.9f, 0.5f, 0}}, {1, {1, 1, 1}}};
+  noise.base_color.interpolation = RampInterpolation::Smoothstep;
+  noise.base_color_compose = Compose::Replace;
+  noise.roughness = {true, 0.2f, 0.7f, Compose::Replace};
+  noise.metallic = {true, 0, 0.5f, Compose::Multiply};
+  noise.emission_strength = {true, 1, 30, Compose::Replace};
+  noise.bump_height = -0.02f;
+  noise.filter = false;
+  ProceduralTexture& cells = textures[1];
+  cells.space = ProceduralSpace::World;
+  cells.kind = PatternKind::Voronoi;
+  cells.voronoi = {WorleyFeature::F2, WorleyMetric::Manhattan, 0.3f};
+  cells.voronoi_output = VoronoiOutput::CellRandom;
+  cells.seed = 5;
+  ProceduralTexture& wave = textures[2];
+  wave.kind = PatternKind::Wave;
+  wave.wave = {WaveType::Rings, 1, WaveProfile::Triangle, 0.75f};
+  wave.fractal.kind = FractalKind::Turbulence;
+  wave.seed = 9;
+  for (size_t i = 0; i < textures.size(); ++i) {
+    textures[i].table = make_perlin_table(textures[i].seed);
+    const int m = add_material(s, {1, 1, 1}, 0, 1);
+    s.materials[size_t(m)].procedural = int(i);
+    add_quad_z(s, -1, 1, -1, 1, float(i), m);
+  }
+  s.procedurals = textures;
+  const auto dir = temp_dir("writer-procedural");
+  write_gltf(s, dir / "p.gltf");
+  const LoadedScene l = load_gltf(dir / "p.gltf");
+  REQUIRE(l.scene.procedurals.size() == 3);
+  for (size_t i = 0; i < 3; ++i) {
+    INFO("texture " << i);
+    REQUIRE(l.scene.materials[i].procedural == int(i));
+    const ProceduralTexture &x = textures[i], &y = l.scene.procedurals[i];
+    CHECK(y.space == x.space);
+    CHECK(y.texcoord == x.texcoord);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) CHECK(y.mapping.m[r][c] == Approx(x.mapping.m[r][c]).margin(1e-6));
+    CHECK(y.kind == x.kind);
+    CHECK(y.seed == x.seed);
+    CHECK(y.table.perm == x.table.perm);
+    CHECK(y.filter == x.filter);
+    if (x.kind != PatternKind::Voronoi) {
+      CHECK(y.fractal.kind == x.fractal.kind);
+      CHECK(y.fractal.detail == x.fractal.detail);
+      CHECK(y.fractal.roughness == x.fractal.roughness);
+      CHECK(y.fractal.lacunarity == x.fractal.lacunarity);
+      CHECK(y.fractal.offset == x.fractal.offset);
+      CHECK(y.fractal.gain == x.fractal.gain);
+      CHECK(y.fractal.distortion == x.fractal.distortion);
+    }
+    CHECK(y.voronoi.feature == x.voronoi.feature);
+    CHECK(y.voronoi.metric == x.voronoi.metric);
+    CHECK(y.voronoi.randomness == x.voronoi.randomness);
+    CHECK(y.voronoi_output == x.voronoi_output);
+    CHECK(y.wave.type == x.wave.type);
+    CHECK(y.wave.axis == x.wave.axis);
+    CHECK(y.wave.profile == x.wave.profile);
+    CHECK(y.wave.distortion == x.wave.distortion);
+    CHECK(y.drives_base_color == x.drives_base_color);
+    if (x.drives_base_color) {
+      REQUIRE(y.base_color.stops.size() == x.base_color.stops.size());
+      for (size_t k = 0; k < x.base_color.stops.size(); ++k) {
+        CHECK(y.base_color.stops[k].position == x.base_color.stops[k].position);
+        CHECK(y.base_color.stops[k].color == x.base_color.stops[k].color);
+      }
+      CHECK(y.base_color.interpolation == x.base_color.interpolation);
+      CHECK(y.base_color_compose == x.base_color_compose);
+    }
+    for (auto [dx, dy] : {std::pair{x.roughness, y.roughness}, std::pair{x.metallic, y.metallic},
+                          std::pair{x.emission_strength, y.emission_strength}}) {
+      CHECK(dy.enabled == dx.enabled);
+      if (!dx.enabled) continue;
+      CHECK(dy.min == dx.min);
+      CHECK(dy.max == dx.max);
+      CHECK(dy.compose == dx.compose);
+    }
+    CHECK(y.bump_height == x.bump_height);
+    // The same pattern: equal values at random points.
+    std::mt19937 rng{uint32_t(i)};
+    std::uniform_real_distribution<float> u(-3, 3);
+    for (int k = 0; k < 500; ++k) {
+      const Vec3f q{u(rng), u(rng), u(rng)};
+      REQUIRE(eval_pattern(y, apply_point(y.mapping, q), 0).t ==
+              Approx(eval_pattern(x, apply_point(x.mapping, q), 0).t).margin(1e-4));
+    }
+  }
+}
