@@ -29,20 +29,16 @@ const float kPerlinGradientBound3 = 3.73f;
 
 namespace {
 
-uint64_t splitmix64(uint64_t& state) {
-  uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+// splitmix64's finaliser (a bijection of 64-bit words).
+uint64_t mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
 
-// Murmur3's 32-bit finaliser.
-uint32_t mix32(uint32_t h) {
-  h ^= h >> 16;
-  h *= 0x85EBCA6Bu;
-  h ^= h >> 13;
-  h *= 0xC2B2AE35u;
-  return h ^ (h >> 16);
+// Steele, Lea and Flood's splitmix64 generator.
+uint64_t splitmix64(uint64_t& state) {
+  return mix64(state += 0x9E3779B97F4A7C15ull);
 }
 
 float fade(float t) {
@@ -96,17 +92,24 @@ float gradient_noise(const PerlinTable& table, const float (&p)[N], float (&grad
     u[i] = fade(t[i]);
     du[i] = fade_derivative(t[i]);
   }
+  // Corner c (bit i = offset along axis i) hashes to perm[...perm[perm[x_0] + x_1]... + x_{N-1}],
+  // built axis by axis: after axis i, hash[c] for c < 2^(i+1) holds the prefix over axes 0..i.
+  int hash[1 << N] = {0};
+  for (int i = 0; i < N; ++i) {
+    const int half = 1 << i;
+    for (int c = half; c < 2 * half; ++c) hash[c] = table.perm[size_t(hash[c - half] + cell[i] + 1)];
+    for (int c = 0; c < half; ++c) hash[c] = table.perm[size_t(hash[c] + cell[i])];
+  }
   float value = 0;
+#pragma GCC unroll 16
   for (int c = 0; c < (1 << N); ++c) {
-    int h = 0;
     float d[N], axis_weight[N], g[N];
     for (int i = 0; i < N; ++i) {
       const int bit = (c >> i) & 1;
-      h = table.perm[size_t(h + cell[i] + bit)];
       d[i] = t[i] - float(bit);
       axis_weight[i] = bit ? u[i] : 1 - u[i];
     }
-    corner_gradient<N>(h, g);
+    corner_gradient<N>(hash[c], g);
     float dot = 0, w = 1;
     for (int i = 0; i < N; ++i) dot += g[i] * d[i], w *= axis_weight[i];
     value += w * dot;
@@ -336,19 +339,20 @@ float fractal_gradient_bound(const FractalParams& params) {
 
 namespace {
 
-uint32_t cell_hash(uint32_t seed, int ix, int iy, int iz) {
-  uint32_t h = mix32(seed * 0x9E3779B9u + 0x632BE5ABu);
-  h = mix32(h ^ (uint32_t(ix) * 0x85EBCA6Bu));
-  h = mix32(h ^ (uint32_t(iy) * 0xC2B2AE35u));
-  return mix32(h ^ (uint32_t(iz) * 0x27D4EB2Fu));
+// 64 hashed bits of (seed, ix, iy, iz): for a fixed (seed, ix), a bijection of (iy, iz).
+uint64_t cell_hash(uint32_t seed, int ix, int iy, int iz) {
+  const uint64_t a = (uint64_t(seed) << 32) | uint32_t(ix);
+  const uint64_t b = (uint64_t(uint32_t(iy)) << 32) | uint32_t(iz);
+  return mix64(a ^ mix64(b + 0x9E3779B97F4A7C15ull));
 }
 
-// A value in [0, 1) from the top 24 bits of a hash.
-float unit_float(uint32_t h) {
-  return float(h >> 8) * (1.0f / 16777216.0f);
+// A value in [0, 1) from 21 bits of h starting at bit `shift`.
+float unit_float21(uint64_t h, int shift) {
+  return float((h >> shift) & 0x1FFFFF) * (1.0f / 2097152.0f);
 }
 
-float metric_length(Vec3f v, WorleyMetric metric) {
+// The metric's length of v, squared for Euclidean (the same order, without the root).
+float metric_rank(Vec3f v, WorleyMetric metric) {
   const Vec3f a = abs(v);
   switch (metric) {
     case WorleyMetric::Manhattan:
@@ -356,11 +360,18 @@ float metric_length(Vec3f v, WorleyMetric metric) {
     case WorleyMetric::Chebyshev:
       return max_component(a);
     default:
-      return length(v);
+      return dot(v, v);
   }
 }
 
-// d metric_length(v) / dv (zero where undefined: at v = 0).
+float rank_to_distance(float rank, WorleyMetric metric) {
+  return metric == WorleyMetric::Euclidean ? std::sqrt(rank) : rank;
+}
+float distance_to_rank(float distance, WorleyMetric metric) {
+  return metric == WorleyMetric::Euclidean ? distance * distance : distance;
+}
+
+// d |v|_metric / dv (zero where undefined: at v = 0).
 Vec3f metric_gradient(Vec3f v, WorleyMetric metric) {
   const auto sign = [](float x) { return x > 0 ? 1.0f : (x < 0 ? -1.0f : 0.0f); };
   switch (metric) {
@@ -378,6 +389,7 @@ Vec3f metric_gradient(Vec3f v, WorleyMetric metric) {
   }
 }
 
+// The two nearest feature points so far, with their metric_rank.
 struct Candidates {
   float d1 = kInfinity, d2 = kInfinity;
   Vec3f q1, q2;
@@ -385,7 +397,7 @@ struct Candidates {
 };
 
 // Visits cell k: skipped when even the nearest point of the box its feature point can lie in
-// (centre +- randomness / 2) is no closer than `limit` of the candidates.
+// (centre +- randomness / 2) is no closer than the current F2 (F1 if only F1 is wanted).
 void visit_cell(uint32_t seed, Vec3f p, const int (&k)[3], const WorleyParams& wp, bool only_f1,
                 Candidates& c) {
   Vec3f gap;
@@ -393,9 +405,9 @@ void visit_cell(uint32_t seed, Vec3f p, const int (&k)[3], const WorleyParams& w
     const float centre = float(k[i]) + 0.5f;
     gap[i] = std::max(0.0f, std::fabs(p[i] - centre) - 0.5f * wp.randomness);
   }
-  if (metric_length(gap, wp.metric) >= (only_f1 ? c.d1 : c.d2)) return;
+  if (metric_rank(gap, wp.metric) >= (only_f1 ? c.d1 : c.d2)) return;
   const Vec3f q = worley_feature_point(seed, k[0], k[1], k[2], wp.randomness);
-  const float d = metric_length(p - q, wp.metric);
+  const float d = metric_rank(p - q, wp.metric);
   if (d < c.d1) {
     c.d2 = c.d1, c.q2 = c.q1;
     c.d1 = d, c.q1 = q;
@@ -417,7 +429,8 @@ Candidates nearest_features(uint32_t seed, Vec3f p, const WorleyParams& wp) {
   const int base[3] = {int(std::floor(p.x)), int(std::floor(p.y)), int(std::floor(p.z))};
   Candidates c;
   for (int r = 0; r <= kMaxRing; ++r) {
-    if (r >= 2 && float(r - 1) + 0.5f * (1 - wp.randomness) >= (only_f1 ? c.d1 : c.d2)) break;
+    const float ring_distance = float(r - 1) + 0.5f * (1 - wp.randomness);
+    if (r >= 2 && distance_to_rank(ring_distance, wp.metric) >= (only_f1 ? c.d1 : c.d2)) break;
     for (int dz = -r; dz <= r; ++dz)
       for (int dy = -r; dy <= r; ++dy) {
         const bool on_shell = dz == -r || dz == r || dy == -r || dy == r;
@@ -433,9 +446,8 @@ Candidates nearest_features(uint32_t seed, Vec3f p, const WorleyParams& wp) {
 }  // namespace
 
 Vec3f worley_feature_point(uint32_t seed, int ix, int iy, int iz, float randomness) {
-  const uint32_t h = cell_hash(seed, ix, iy, iz);
-  const Vec3f jitter{unit_float(mix32(h + 0x9E3779B9u)) - 0.5f, unit_float(mix32(h + 0x3C6EF372u)) - 0.5f,
-                     unit_float(mix32(h + 0xDAA66D2Bu)) - 0.5f};
+  const uint64_t h = cell_hash(seed, ix, iy, iz);
+  const Vec3f jitter{unit_float21(h, 0) - 0.5f, unit_float21(h, 21) - 0.5f, unit_float21(h, 42) - 0.5f};
   return Vec3f{float(ix) + 0.5f, float(iy) + 0.5f, float(iz) + 0.5f} + jitter * randomness;
 }
 
@@ -447,20 +459,21 @@ WorleyValue worley(uint32_t seed, Vec3f p, const WorleyParams& params) {
   constexpr float kLimit = 1073741824.0f;
   p = {std::clamp(p.x, -kLimit, kLimit), std::clamp(p.y, -kLimit, kLimit), std::clamp(p.z, -kLimit, kLimit)};
   const Candidates c = nearest_features(seed, p, wp);
+  const float d1 = rank_to_distance(c.d1, wp.metric), d2 = rank_to_distance(c.d2, wp.metric);
 
   WorleyValue out;
   out.nearest = c.q1;
-  out.cell_random = unit_float(mix32(cell_hash(seed, c.cell1[0], c.cell1[1], c.cell1[2]) ^ 0x5BD1E995u));
+  out.cell_random = unit_float21(mix64(cell_hash(seed, c.cell1[0], c.cell1[1], c.cell1[2])), 40);
   const Vec3f g1 = metric_gradient(p - c.q1, wp.metric);
   switch (wp.feature) {
     case WorleyFeature::F2:
-      out.value = c.d2, out.grad = metric_gradient(p - c.q2, wp.metric);
+      out.value = d2, out.grad = metric_gradient(p - c.q2, wp.metric);
       break;
     case WorleyFeature::F2MinusF1:
-      out.value = c.d2 - c.d1, out.grad = metric_gradient(p - c.q2, wp.metric) - g1;
+      out.value = d2 - d1, out.grad = metric_gradient(p - c.q2, wp.metric) - g1;
       break;
     default:
-      out.value = c.d1, out.grad = g1;
+      out.value = d1, out.grad = g1;
   }
   return out;
 }
