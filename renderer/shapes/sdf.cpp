@@ -310,6 +310,10 @@ float max_singular_value(const Affine3f& a) {
   return float(std::sqrt(std::max(top, 0.0)) * (1 + 1e-6));  // rounded up: a bound stays a bound
 }
 
+// How far past a point within the tolerance sphere_trace looks for the crossing, at most, in
+// tolerances.
+constexpr float kMaxProbeTolerances = 1024;
+
 bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, const SphereTraceConfig& config,
                   float& t_hit, int& steps) {
   steps = 0;
@@ -340,10 +344,17 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
       return t_hit <= ray.tfar;
     }
     if (std::abs(f) / lipschitz_bound < eps) {
-      // Within the tolerance: refine to the crossing if it lies within two tolerances ahead. At
-      // the ray's start a hit needs that crossing: a ray leaving the surface (or continued just
-      // past a hit) starts within the tolerance and must not find that surface again.
-      const float probe = std::min(t + 2 * eps / dir_len, ray.tfar);
+      // Within the tolerance: refine to the crossing if it lies within two tolerances ahead, or
+      // within twice the secant estimate from the last step while |f| falls: where L exceeds
+      // the ray's slope |df/dt| (displaced surfaces, grazing rays) the steps shrink
+      // geometrically and stop up to eps L / slope before the crossing. At the ray's start a
+      // hit needs that crossing: a ray leaving the surface (or continued just past a hit)
+      // starts within the tolerance and must not find that surface again.
+      float ahead = 2 * eps / dir_len;
+      if (t > prev_t && std::abs(prev_f) > std::abs(f))
+        ahead = std::min(std::max(ahead, 2 * (t - prev_t) * std::abs(f) / (std::abs(prev_f) - std::abs(f))),
+                         kMaxProbeTolerances * eps / dir_len);
+      const float probe = std::min(t + ahead, ray.tfar);
       const float fp = sdf_eval(tree, ray.org + ray.dir * probe);
       ++steps;
       const bool crossing = (fp < 0) != (f < 0);

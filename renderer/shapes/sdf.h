@@ -112,9 +112,10 @@ struct SphereTraceConfig {
 
 /// Marches `ray` (any non-zero direction) from ray.tnear to ray.tfar with steps |f| / (L |dir|),
 /// starting inside or outside. It stops when a step crosses the surface (f changes sign) or
-/// when |f| / L falls below the tolerance (then it looks two tolerances ahead for the crossing,
-/// which a hit at the ray's first evaluation must find: a ray starting on the surface and not
-/// crossing it marches on);
+/// when |f| / L falls below the tolerance (then it looks for the crossing two tolerances ahead,
+/// or twice as far as the last step's secant puts it, up to 1024 tolerances, which a hit at the
+/// ray's first evaluation must find: a ray starting on the surface and not crossing it marches
+/// on);
 /// a found crossing is refined by bisection to float precision (t is then just past the
 /// surface). Sets t and returns true on a hit; a ray still marching after config.max_steps
 /// evaluations is a miss. `steps` receives the number of evaluations, bisection included.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # PENUMBRA_shapes through `penumbra`: files with bad shapes exit 2 from render and info with the
 # file, the JSON path and the field in the message and leave no output; the shipped shape scenes
-# render and `info` lists their shapes. Usage: shapes_test.sh PENUMBRA_BINARY SRC WORK_DIR
+# and a displaced sphere render and `info` lists their shapes. Usage: shapes_test.sh PENUMBRA_BINARY SRC WORK_DIR
 set -u
 bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
@@ -21,6 +21,8 @@ shape_file type '{"type":"teapot"}'
 shape_file key '{"type":"box","radius":1}'
 shape_file unbounded '{"type":"implicit","csg":{"type":"halfSpace","normal":[0,1,0]}}'
 shape_file material '{"type":"sphere","material":0}'
+shape_file detail '{"type":"implicit","csg":{"type":"displace","amplitude":0.1,"detail":20,"children":[{"type":"sphere"}]}}'
+shape_file rough '{"type":"implicit","csg":{"type":"displace","amplitude":0.2,"frequency":3,"noise":"ridged","children":[{"type":"sphere"}]}}'
 shape_file deep "{\"type\":\"implicit\",\"csg\":$(python3 -c 'import json; j={"type":"sphere"}
 for _ in range(70): j={"type":"complement","children":[j]}
 print(json.dumps({"type":"intersection","children":[j,{"type":"sphere"}]}))')}"
@@ -28,7 +30,8 @@ for case in "radius|$ext\.csg\.children\[1\]\.radius: must be > 0" \
             "type|$ext\.type: unknown shape type \"teapot\"" \
             "key|$ext\.radius: does not apply to a \"box\" shape" \
             "unbounded|$ext\.csg: the shape's inside is unbounded" \
-            "material|$ext\.material: index 0 out of range \(0 materials\)"; do
+            "material|$ext\.material: index 0 out of range \(0 materials\)" \
+            "detail|$ext\.csg\.detail: must be in \[0, 15\] \(got 20\)"; do
   name="${case%%|*}"; pattern="${case#*|}"
   rm -f "$work/$name.exr" "$work/$name.png"
   expect 2 "penumbra: error: $work/$name.gltf: $pattern" -- "$bin" render "$work/$name.gltf" -o "$work/$name.exr" --width 32 --spp 1
@@ -50,6 +53,10 @@ for scene in csg spheres; do
   expect 0 "$scene.png" -- "$bin" render "$src/scenes/$scene.gltf" -o "$work/$scene.exr" --width 48 --spp 1 -q
   expect 0 "$scene-bvh.png" -- "$bin" render "$src/scenes/$scene.gltf" -o "$work/$scene-bvh.exr" --width 48 --spp 1 -q --accel bvh
 done
+# A displaced sphere: info counts its CSG nodes; it renders with the default and the own BVH.
+expect 0 "implicit \(2 CSG nodes\)" -- "$bin" info "$work/rough.gltf"
+expect 0 "rough.png" -- "$bin" render "$work/rough.gltf" -o "$work/rough.exr" --width 32 --spp 1 -q
+expect 0 "rough-bvh.png" -- "$bin" render "$work/rough.gltf" -o "$work/rough-bvh.exr" --width 32 --spp 1 -q --accel bvh
 # Listed in extensionsRequired, the extension loads.
 sed 's/"extensionsUsed"/"extensionsRequired":["PENUMBRA_shapes"],"extensionsUsed"/' "$work/key.gltf" | sed 's/"radius":1/"size":[1,2,3]/' >"$work/required.gltf"
 expect 0 "box \(1 x 2 x 3\), default material, 1 instance" -- "$bin" info "$work/required.gltf"

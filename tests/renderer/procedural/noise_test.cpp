@@ -107,6 +107,43 @@ double separable_supremum_at(const Point<N>& t, const std::vector<Point<N>>& set
   return s;
 }
 
+// sup over gradient choices of |gradient| of the scaled 3D noise at t: the maximum over unit u
+// (a Fibonacci lattice of `directions` points) of sum_c max_g u.v_c(g), with
+// v_c(g) = grad(w_c) (g.d_c) + w_c g; the lattice misses the maximum by a factor cos(gap).
+double gradient_supremum_at(const Point<3>& t, const std::vector<Point<3>>& set, int directions) {
+  std::vector<Point<3>> v;  // v_c(g) for every corner and gradient, corner-major
+  for (int c = 0; c < 8; ++c) {
+    const double w = corner_weight<3>(t, c);
+    Point<3> dw, d;
+    for (int i = 0; i < 3; ++i) {
+      const double ti = t[size_t(i)], df = 30 * ti * ti * (1 - ti) * (1 - ti);
+      const double wi = (c >> i) & 1 ? fade(ti) : 1 - fade(ti);
+      dw[size_t(i)] = ((c >> i) & 1 ? df : -df) * (wi > 0 ? w / wi : 0);
+      d[size_t(i)] = ti - ((c >> i) & 1);
+    }
+    for (const auto& g : set) {
+      const double gd = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+      v.push_back({dw[0] * gd + w * g[0], dw[1] * gd + w * g[1], dw[2] * gd + w * g[2]});
+    }
+  }
+  double best = 0;
+  for (int k = 0; k < directions; ++k) {
+    const double z = 1 - (k + 0.5) / directions, r = std::sqrt(1 - z * z), phi = k * 2.399963229728653;
+    const Point<3> u{r * std::cos(phi), r * std::sin(phi), z};
+    double sum = 0;
+    for (size_t c = 0; c < 8; ++c) {
+      double m = -1e30;
+      for (size_t j = 0; j < set.size(); ++j) {
+        const Point<3>& x = v[c * set.size() + j];
+        m = std::max(m, u[0] * x[0] + u[1] * x[1] + u[2] * x[2]);
+      }
+      sum += m;
+    }
+    best = std::max(best, sum);
+  }
+  return best / kPerlinRawSupremum[2];
+}
+
 template <int N>
 Point<N> random_point(std::mt19937& rng, double lo, double hi) {
   std::uniform_real_distribution<double> u(lo, hi);
@@ -259,6 +296,18 @@ TEST_CASE("noise: the supremum constants match a re-derivation from the gradient
   check(std::integral_constant<int, 4>{}, 21, 0.5);
 }
 
+TEST_CASE("noise: the 3D gradient bound covers a re-derivation from the gradient set",
+          "[procedural][noise][quick]") {
+  // A coarse grid of the half cell (the set is symmetric under sign flips); +-u is covered by
+  // the hemisphere lattice because the set is symmetric under g -> -g.
+  const auto set = gradient_set<3>();
+  double sup = 0;
+  for_grid<3>(6, 0.5, [&](const Point<3>& t) { sup = std::max(sup, gradient_supremum_at(t, set, 1500)); });
+  INFO("re-derived " << sup << ", bound " << kPerlinGradientBound3);
+  CHECK(kPerlinGradientBound3 >= sup);
+  CHECK(kPerlinGradientBound3 <= 1.05 * sup);
+}
+
 TEST_CASE("noise: values lie in [-1, 1] and come close to its ends", "[procedural][noise]") {
   const auto max_abs = [](auto dim, long samples) {
     constexpr int N = decltype(dim)::value;
@@ -354,6 +403,25 @@ TEST_CASE("noise: Worley gradients match central differences off the cell border
       INFO("metric " << int(metric) << ", feature " << int(feature));
       CHECK(gradient_agreement(f, 2000, 1e-4f, 1e-2, 3) >= 0.97);
     }
+}
+
+TEST_CASE("noise: Euclidean F1's gradient is exact away from the Voronoi cells' borders",
+          "[procedural][noise][quick]") {
+  std::mt19937 rng(5);
+  const WorleyParams f1{WorleyFeature::F1, WorleyMetric::Euclidean, 1};
+  const WorleyParams gap{WorleyFeature::F2MinusF1, WorleyMetric::Euclidean, 1};
+  const auto value = [&](Vec3f q) { return worley(4, q, f1).value; };
+  int tested = 0;
+  for (int s = 0; s < 2000; ++s) {
+    const Vec3f p = random_vec3(rng, -10, 10);
+    if (worley(4, p, gap).value < 0.01f) continue;  // within 0.005 of a border
+    const WorleyValue w = worley(4, p, f1);
+    for (int i = 0; i < 3; ++i)
+      CHECK(central_difference(value, p, i, 1e-4f) == Approx(w.grad[i]).margin(5e-3));
+    CHECK(length(w.grad) == Approx(1).margin(1e-5));
+    ++tested;
+  }
+  CHECK(tested > 1900);
 }
 
 TEST_CASE("noise: mean and variance match the prediction from the gradient set", "[procedural][noise]") {
