@@ -473,7 +473,8 @@ TEST_CASE("noise: fBm's band energies fall by roughness^2 per octave", "[procedu
   // 2^16 samples 1/512 apart along a generic direction, 8 octaves (frequencies 1..128). Band j
   // holds frequencies [2^j, 2^(j+1)) / 4 cycles per unit (bins 32 2^j ..); bands 3..6 (2 to 32
   // cycles per unit) lie where every octave's scaled copy of the base spectrum is present and
-  // below aliasing, so consecutive bands' energies have the ratio roughness^2.
+  // below aliasing, so consecutive bands' energies have the ratio roughness^2 (checked to 15%;
+  // four lines of 256 bins or more per band keep the estimate's scatter to a few percent).
   const PerlinTable t = make_perlin_table(9);
   const size_t n = size_t(1) << 16;
   const double spacing = 1.0 / 512;
