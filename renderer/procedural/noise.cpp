@@ -11,8 +11,9 @@ namespace penumbra {
 
 // Supremum of |raw noise| over a cell and every choice of corner gradients. For a fixed point p
 // the choices are independent per corner, so the supremum over them is sum_c w_c(p) max_g
-// g.(p - c); its maximum over the cell was found offline (dense grid of the cell reduced by the
-// gradient sets' sign and axis symmetries, then pattern search from the 20 best grid points):
+// g.(p - c); its maximum over the cell was found offline (a dense grid of the cell, of the half
+// cell [0, 0.5]^N for 3D and 4D by the sets' sign symmetry, then pattern search from the 20 best
+// grid points):
 //   1D 0.5 at t = 0.5;  2D 1.0 at the cell centre;  3D 1.0363538 at (0.3553, 0.5, 0.4815)
 //   (and its mirror images);  4D 1.5365823 at (0.5, 0.4919, 0.4816, 0.3564).
 // The constants are those maxima plus 0.1%, so that scaled values are within [-1, 1].
@@ -39,6 +40,10 @@ uint64_t mix64(uint64_t z) {
 // Steele, Lea and Flood's splitmix64 generator.
 uint64_t splitmix64(uint64_t& state) {
   return mix64(state += 0x9E3779B97F4A7C15ull);
+}
+
+float sign_of(float x) {
+  return x > 0 ? 1.0f : (x < 0 ? -1.0f : 0.0f);
 }
 
 float fade(float t) {
@@ -227,7 +232,7 @@ Noise3 sum_fbm(const PerlinTable& table, Vec3f q, const FractalParams& p, float 
   for (int k = 0; k < octaves; ++k, a *= p.roughness, f *= p.lacunarity) {
     Noise3 n = octave_noise(table, q, f, k);
     if (p.kind == FractalKind::Turbulence) {
-      const float s = n.value > 0 ? 1.0f : (n.value < 0 ? -1.0f : 0.0f);
+      const float s = sign_of(n.value);
       n.value *= s, n.grad *= s;
     }
     const float c = a * octave_weight(octaves, k);
@@ -246,7 +251,7 @@ Noise3 sum_ridged(const PerlinTable& table, Vec3f q, const FractalParams& p, flo
   Vec3f dw{};
   for (int k = 0; k < octaves; ++k, a *= p.roughness, f *= p.lacunarity) {
     const Noise3 n = octave_noise(table, q, f, k);
-    const float sign = n.value > 0 ? 1.0f : (n.value < 0 ? -1.0f : 0.0f);
+    const float sign = sign_of(n.value);
     const float root = p.offset - std::fabs(n.value);
     const float s = root * root;
     const Vec3f ds = n.grad * (-2 * root * sign);
@@ -373,15 +378,14 @@ float distance_to_rank(float distance, WorleyMetric metric) {
 
 // d |v|_metric / dv (zero where undefined: at v = 0).
 Vec3f metric_gradient(Vec3f v, WorleyMetric metric) {
-  const auto sign = [](float x) { return x > 0 ? 1.0f : (x < 0 ? -1.0f : 0.0f); };
   switch (metric) {
     case WorleyMetric::Manhattan:
-      return {sign(v.x), sign(v.y), sign(v.z)};
+      return {sign_of(v.x), sign_of(v.y), sign_of(v.z)};
     case WorleyMetric::Chebyshev: {
       const Vec3f a = abs(v);
       const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
       Vec3f g{};
-      g[axis] = sign(v[axis]);
+      g[axis] = sign_of(v[axis]);
       return g;
     }
     default:
