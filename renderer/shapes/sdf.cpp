@@ -314,13 +314,44 @@ float max_singular_value(const Affine3f& a) {
 // tolerances.
 constexpr float kMaxProbeTolerances = 1024;
 
+namespace {
+
+// For a tree whose root displaces its child by at most |a|: marches `ray` from t with the child's
+// bound g = f_child - |a| (g <= f, so a step of g / L_child never passes the displaced surface;
+// L_child is smaller than the tree's bound and g costs no noise) until g falls below a tenth of
+// |a| (the shell the noise moves the surface in). Returns the t reached, kInfinity when the ray
+// leaves [t, tfar] first; `steps` counts the evaluations.
+float march_to_displacement_shell(const SdfTree& tree, const Ray& ray, float dir_len, float t, float tfar,
+                                  int max_steps, int& steps) {
+  const SdfNode& root = tree.nodes[size_t(tree.root)];
+  const float reach = std::abs(tree.displacements[size_t(root.displacement)].amplitude);
+  const float child_lipschitz = lipschitz(tree, root.a, 1) * max_singular_value(root.to_local);
+  const float step_scale = 1.0f / (child_lipschitz * dir_len);
+  while (steps < max_steps && t <= tfar) {
+    const float g = eval(tree, root.a, apply_point(root.to_local, ray.org + ray.dir * t), 1) - reach;
+    ++steps;
+    if (!(g > 0.1f * reach)) return t;
+    t += g * step_scale;
+  }
+  return t <= tfar ? t : kInfinity;
+}
+
+}  // namespace
+
 bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, const SphereTraceConfig& config,
                   float& t_hit, int& steps) {
   steps = 0;
   const float dir_len = length(ray.dir);
   if (!(dir_len > 0) || !(lipschitz_bound > 0) || tree.root < 0) return false;
   const float step_scale = 1.0f / (lipschitz_bound * dir_len);  // |f| * step_scale never passes the surface
-  float t = ray.tnear, prev_t = t, prev_f = 0;
+  float t = ray.tnear;
+  if (tree.nodes[size_t(tree.root)].kind == SdfKind::Displace) {
+    t = march_to_displacement_shell(tree, ray, dir_len, t, ray.tfar, config.max_steps, steps);
+    if (!(t <= ray.tfar)) return false;
+  }
+  const bool moved = t > ray.tnear;  // a ray moved to the shell is no longer at its start
+  float prev_t = t, prev_f = 0;
+  int iteration = 0;
   // Bisection of a bracketed crossing [lo, hi] (f(lo) has the sign of flo) to float precision.
   const auto bisect = [&](float lo, float hi, float flo) {
     for (int i = 0; i < 40 && hi - lo > 1e-7f * std::max(1.0f, hi); ++i) {
@@ -338,8 +369,9 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
   while (steps < config.max_steps && t <= ray.tfar) {
     const float f = sdf_eval(tree, ray.org + ray.dir * t);
     ++steps;
+    ++iteration;
     const float eps = std::max(config.absolute_epsilon, config.relative_epsilon * t * dir_len);
-    if (steps > 1 && (f < 0) != (prev_f < 0)) {  // the minimum step crossed the surface
+    if (iteration > 1 && (f < 0) != (prev_f < 0)) {  // the minimum step crossed the surface
       t_hit = bisect(prev_t, t, prev_f);
       return t_hit <= ray.tfar;
     }
@@ -358,7 +390,7 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
       const float fp = sdf_eval(tree, ray.org + ray.dir * probe);
       ++steps;
       const bool crossing = (fp < 0) != (f < 0);
-      if (crossing || steps > 2) {
+      if (crossing || iteration > 1 || moved) {
         t_hit = crossing ? bisect(t, probe, f) : t;
         return true;
       }
