@@ -119,8 +119,9 @@ struct SphereTraceConfig {
 /// a found crossing is refined by bisection to float precision (t is then just past the
 /// surface). A tree whose root is a Displace node is first marched with its child's bound
 /// f_child - |amplitude| and the child's Lipschitz bound (no noise, longer steps) until the ray
-/// nears the shell the noise can move the surface in. Sets t and returns true on a hit; a ray still marching after config.max_steps
-/// evaluations is a miss. `steps` receives the number of evaluations, bisection included.
+/// nears the shell the noise can move the surface in. Sets t and returns true on a hit; a ray still marching
+/// after config.max_steps evaluations is a miss. `steps` receives the number of evaluations, bisection
+/// included.
 bool sphere_trace(const SdfTree& tree, float lipschitz, const Ray& ray, const SphereTraceConfig& config,
                   float& t, int& steps);
 
