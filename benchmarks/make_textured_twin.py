@@ -7,7 +7,11 @@ Each procedural material loses its extension and gains what an artist would bake
 MIP-mapped PNGs written beside the twin. The twin renders the same geometry with the same lights,
 so rendering both measures what the procedural textures cost against image textures.
 
-Usage: python3 benchmarks/make_textured_twin.py SCENE.gltf OUT_DIR   (writes OUT_DIR/twin.gltf)
+With --undisplaced, both files also replace every displace CSG node by its child, so that the
+comparison is not dominated by sphere tracing the displaced surfaces both scenes share.
+
+Usage: python3 benchmarks/make_textured_twin.py [--undisplaced] SCENE.gltf OUT_DIR
+(writes OUT_DIR/procedural.gltf, the scene itself, and OUT_DIR/twin.gltf)
 """
 import json
 import math
@@ -41,13 +45,31 @@ def wave(x, y, k):
     return 0.5 + 0.5 * math.sin(2 * math.pi * (k * x / SIZE + 0.3 * math.sin(2 * math.pi * y / SIZE)))
 
 
+def undisplaced(csg):
+    """The CSG tree with every displace node replaced by its child."""
+    while csg.get("type") == "displace":
+        csg = csg["children"][0]
+    if "children" in csg:
+        csg = dict(csg, children=[undisplaced(c) for c in csg["children"]])
+    return csg
+
+
 def main():
-    if len(sys.argv) != 3:
+    args = [a for a in sys.argv[1:] if a != "--undisplaced"]
+    if len(args) != 2:
         sys.exit(__doc__)
-    scene, out_dir = sys.argv[1], sys.argv[2]
+    scene, out_dir = args
     os.makedirs(out_dir, exist_ok=True)
     with open(scene) as f:
         gltf = json.load(f)
+    if "--undisplaced" in sys.argv[1:]:
+        for node in gltf.get("nodes", []):
+            shape = node.get("extensions", {}).get("PENUMBRA_shapes", {})
+            if "csg" in shape:
+                shape["csg"] = undisplaced(shape["csg"])
+    with open(os.path.join(out_dir, "procedural.gltf"), "w") as f:
+        json.dump(gltf, f, indent=1)
+    gltf = json.loads(json.dumps(gltf))
     images = {
         "color.png": lambda x, y: (wave(x, y, 6), 0.6 * wave(x, y, 6), 0.3),
         "metal_rough.png": lambda x, y: (0, 0.3 + 0.5 * wave(y, x, 4), 0),
