@@ -319,21 +319,29 @@ namespace {
 // For a tree whose root displaces its child by at most |a|: marches `ray` from t with the child's
 // bound g = f_child - |a| (g <= f, so a step of g / L_child never passes the displaced surface;
 // L_child is smaller than the tree's bound and g costs no noise) until g falls below a tenth of
-// |a| (the shell the noise moves the surface in). Returns the t reached, kInfinity when the ray
-// leaves [t, tfar] first; `steps` counts the evaluations.
-float march_to_displacement_shell(const SdfTree& tree, const Ray& ray, float dir_len, float t, float tfar,
-                                  int max_steps, int& steps) {
+// |a| (the shell the noise moves the surface in), with steps of at least the tracer's
+// tolerance. Returns the t reached, kInfinity when the ray leaves [t, tfar] first; `steps`
+// counts the evaluations.
+float march_to_displacement_shell(const SdfTree& tree, const Ray& ray, const SphereTraceConfig& config,
+                                  float dir_len, float t, int& steps) {
   const SdfNode& root = tree.nodes[size_t(tree.root)];
   const float reach = std::abs(tree.displacements[size_t(root.displacement)].amplitude);
   const float child_lipschitz = lipschitz(tree, root.a, 1) * max_singular_value(root.to_local);
   const float step_scale = 1.0f / (child_lipschitz * dir_len);
-  while (steps < max_steps && t <= tfar) {
+  while (steps < config.max_steps && t <= ray.tfar) {
     const float g = eval(tree, root.a, apply_point(root.to_local, ray.org + ray.dir * t), 1) - reach;
     ++steps;
-    if (!(g > 0.1f * reach)) return t;
-    t += g * step_scale;
+    const float eps = std::max(config.absolute_epsilon, config.relative_epsilon * t * dir_len);
+    if (!(g > std::max(0.1f * reach, eps * child_lipschitz))) return t;
+    t += std::max(g * step_scale, eps / dir_len);
   }
-  return t <= tfar ? t : kInfinity;
+  return t <= ray.tfar ? t : kInfinity;
+}
+
+// Whether sphere_trace first marches to the displacement shell: a Displace root that displaces.
+bool shell_march_applies(const SdfTree& tree) {
+  const SdfNode& root = tree.nodes[size_t(tree.root)];
+  return root.kind == SdfKind::Displace && tree.displacements[size_t(root.displacement)].amplitude != 0;
 }
 
 }  // namespace
@@ -345,8 +353,8 @@ bool sphere_trace(const SdfTree& tree, float lipschitz_bound, const Ray& ray, co
   if (!(dir_len > 0) || !(lipschitz_bound > 0) || tree.root < 0) return false;
   const float step_scale = 1.0f / (lipschitz_bound * dir_len);  // |f| * step_scale never passes the surface
   float t = ray.tnear;
-  if (tree.nodes[size_t(tree.root)].kind == SdfKind::Displace) {
-    t = march_to_displacement_shell(tree, ray, dir_len, t, ray.tfar, config.max_steps, steps);
+  if (shell_march_applies(tree)) {
+    t = march_to_displacement_shell(tree, ray, config, dir_len, t, steps);
     if (!(t <= ray.tfar)) return false;
   }
   const bool moved = t > ray.tnear;  // a ray moved to the shell is no longer at its start

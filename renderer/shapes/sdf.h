@@ -117,11 +117,11 @@ struct SphereTraceConfig {
 /// ray's first evaluation must find: a ray starting on the surface and not crossing it marches
 /// on);
 /// a found crossing is refined by bisection to float precision (t is then just past the
-/// surface). A tree whose root is a Displace node is first marched with its child's bound
-/// f_child - |amplitude| and the child's Lipschitz bound (no noise, longer steps) until the ray
-/// nears the shell the noise can move the surface in. Sets t and returns true on a hit; a ray still marching
-/// after config.max_steps evaluations is a miss. `steps` receives the number of evaluations, bisection
-/// included.
+/// surface). A tree whose root is a Displace node of non-zero amplitude is first
+/// marched with its child's bound f_child - |amplitude| and the child's Lipschitz bound (no
+/// noise, longer steps) until the ray nears the shell the noise can move the surface in. Sets t and returns
+/// true on a hit; a ray still marching after config.max_steps evaluations is a miss. `steps` receives the
+/// number of evaluations, bisection included.
 bool sphere_trace(const SdfTree& tree, float lipschitz, const Ray& ray, const SphereTraceConfig& config,
                   float& t, int& steps);
 

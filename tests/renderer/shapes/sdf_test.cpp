@@ -470,3 +470,28 @@ TEST_CASE("sdf: the displacement-shell march finds the same hits as the full mar
   CHECK(hits > 150);
   CHECK(fewer > hits / 2);  // the shell march saves noise evaluations on most hits
 }
+
+TEST_CASE("sdf: grazing rays hit displaced spheres of zero and tiny amplitude as the sphere itself",
+          "[shapes][sdf][noise][quick]") {
+  // Rays along -z at impact parameters up to 0.999 of a unit sphere: with amplitude 0 the
+  // displaced tree is the sphere (hit iff b < 1, at t = 5 - sqrt(1 - b^2)); with amplitude 1e-4
+  // the same within the amplitude. Neither may run out of steps in the shell march.
+  for (float amplitude : {0.0f, 1e-4f}) {
+    const SdfTree t = displaced_sphere(1, amplitude, 3);
+    const float lip = sdf_lipschitz(t);
+    SphereTraceConfig cfg;
+    for (float b : {0.0f, 0.5f, 0.9f, 0.99f, 0.995f, 0.999f, 1.002f, 1.01f}) {
+      Ray r;
+      r.org = {b, 0, 5};
+      r.dir = {0, 0, -1};
+      r.tnear = 0;
+      r.tfar = 10;
+      float th = 0;
+      int steps = 0;
+      const bool hit = sphere_trace(t, lip, r, cfg, th, steps);
+      INFO("amplitude " << amplitude << " b " << b << " steps " << steps);
+      REQUIRE(hit == (b < 1));
+      if (hit) CHECK(th == Approx(5 - std::sqrt(1 - b * b)).margin(2e-3 + 40 * amplitude));
+    }
+  }
+}
