@@ -76,6 +76,9 @@ constexpr const char* kCsgKeys[] = {
 
 // Limit of a displace node's |amplitude| and frequency.
 constexpr float kMaxDisplacement = 1e6f;
+// Largest Lipschitz bound a displace node may add (|amplitude| x frequency x the noise's gradient
+// bound): sphere tracing steps by |f| / L, so beyond this a shape could not be traced.
+constexpr float kMaxDisplacementLipschitz = 1e4f;
 
 bool is_smooth(SdfKind kind) {
   return kind == SdfKind::SmoothUnion || kind == SdfKind::SmoothIntersection ||
@@ -399,6 +402,12 @@ int ShapeReader::csg_displacement(const json& j, const std::string& where) {
          "must be <= " + format_number(kMaxDisplacement) + " (got " + format_number(d.frequency) + ")");
   const uint32_t seed = uint32_or(j, "seed", where, 0);
   d.params = read_fractal_params(*this, j, where, "noise");
+  const double added = double(std::abs(d.amplitude)) * d.frequency * fractal_gradient_bound(d.params);
+  if (!(added <= kMaxDisplacementLipschitz))
+    fail(where,
+         "the noise raises the Lipschitz bound by " + format_number(added) + " (at most " +
+             format_number(kMaxDisplacementLipschitz) +
+             ": sphere tracing steps by |f| / L); lower amplitude, frequency, detail, lacunarity or gain");
   m_budget.charge(sizeof(SdfDisplacement), where, "its noise table needs");
   d.table = make_perlin_table(seed);
   m_tree.displacements.push_back(d);

@@ -836,6 +836,14 @@ TEST_CASE("shapes: bad displace fields are errors naming the node and the field"
   ridged["offset"] = 1;
   ridged["gain"] = -1;
   CHECK_THAT(error_of(implicit(ridged)), Contains(kCsg + ".gain: must be in [0, 16]"));
+  json steep = displace(sphere(1), 1);
+  steep["noise"] = "ridged";
+  steep["detail"] = 15;
+  steep["lacunarity"] = 16;
+  steep["gain"] = 16;
+  steep["frequency"] = 100;
+  CHECK_THAT(error_of(implicit(steep)),
+             Contains(kCsg + ": the noise raises the Lipschitz bound by") && Contains("(at most 10000"));
   json no_amplitude = op("displace", {sphere(1)});
   CHECK_THAT(error_of(implicit(no_amplitude)), Contains(kCsg + ".amplitude: is required"));
   CHECK_THAT(error_of(implicit({{"type", "displace"}, {"amplitude", 0.1}})),
