@@ -27,6 +27,7 @@ const std::array<float, 4> kPerlinRawSupremum = {0.5005f, 1.001f, 1.03739f, 1.53
 // the 8 best points: the maximum is 3.6148 (raw 3.75) at the cell centre. The constant adds 3%
 // for the discretisation of p and u.
 const float kPerlinGradientBound3 = 3.73f;
+const float kPerlinMeanAbs3 = 0.2125f;
 
 namespace {
 
@@ -206,12 +207,16 @@ float octave_weight(float octaves, int k) {
   return std::clamp(octaves - float(k), 0.0f, 1.0f);
 }
 
-// sum_k weight_k roughness^k over the uncapped octaves (detail + 1 of them).
-float amplitude_sum(const FractalParams& p) {
-  const float octaves = p.detail + 1;
+// sum_k weight_k roughness^k over `octaves` (fractional) octaves.
+float capped_amplitude_sum(const FractalParams& p, float octaves) {
   float sum = 0, a = 1;
   for (int k = 0; k < octaves; ++k, a *= p.roughness) sum += octave_weight(octaves, k) * a;
   return sum;
+}
+
+// The same over the uncapped octaves (detail + 1 of them).
+float amplitude_sum(const FractalParams& p) {
+  return capped_amplitude_sum(p, p.detail + 1);
 }
 
 // The largest |offset - |n|| for |n| <= 1: Ridged's signals are at most its square.
@@ -290,7 +295,13 @@ Vec3f distort(const PerlinTable& table, Vec3f p, float distortion, Vec3f (&jacob
 Noise3 fractal_noise(const PerlinTable& table, Vec3f p, const FractalParams& params, float max_octaves) {
   const FractalParams fp = clamped(params);
   const float octaves = std::min(fp.detail + 1, max_octaves);  // a NaN cap keeps detail + 1
-  if (!is_finite(p) || !(octaves > 0)) return {};
+  if (!is_finite(p)) return {};
+  // Turbulence's octaves past the cap are filtered to their mean |n|.
+  const float dropped_mean =
+      fp.kind == FractalKind::Turbulence && octaves < fp.detail + 1
+          ? kPerlinMeanAbs3 * (1 - capped_amplitude_sum(fp, octaves) / amplitude_sum(fp))
+          : 0.0f;
+  if (!(octaves > 0)) return {dropped_mean, {}};
 
   Vec3f jacobian[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   const Vec3f q = fp.distortion != 0 ? distort(table, p, fp.distortion, jacobian) : p;
@@ -305,6 +316,7 @@ Noise3 fractal_noise(const PerlinTable& table, Vec3f p, const FractalParams& par
   const Vec3f g = sum.grad / normaliser;
   sum.value /= normaliser;
   sum.grad = jacobian[0] * g.x + jacobian[1] * g.y + jacobian[2] * g.z;
+  sum.value += dropped_mean;
   return sum;
 }
 
