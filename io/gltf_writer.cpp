@@ -93,8 +93,28 @@ void write_materials(Writer& wr, const Scene& scene, bool& emissive_strength, bo
   }
 }
 
-/// One glTF mesh per non-empty scene mesh (positions checked first); returns scene mesh -> glTF
-/// mesh, -1 for an empty one.
+/// A world-space mesh moved there from a node (Mesh::object_from_world not the identity), mapped
+/// back into that node's frame so that object-space procedural textures keep it: positions,
+/// normals, and the winding turned back where the frame mirrors.
+struct NodeFrameMesh {
+  std::vector<Vec3f> positions, normals;
+  std::vector<uint32_t> indices;
+};
+NodeFrameMesh to_node_frame(const Mesh& m) {
+  NodeFrameMesh out;
+  Affine3f to_world;
+  if (!inverse(m.object_from_world, to_world)) return out;
+  out.positions.reserve(m.positions.size());
+  for (const Vec3f& p : m.positions) out.positions.push_back(apply_point(m.object_from_world, p));
+  for (const Vec3f& n : m.normals) out.normals.push_back(normalize(apply_normal(to_world, n)));
+  out.indices = m.indices;
+  if (determinant3x3(to_transform(m.object_from_world)) < 0)
+    for (size_t i = 0; i + 2 < out.indices.size(); i += 3) std::swap(out.indices[i + 1], out.indices[i + 2]);
+  return out;
+}
+
+/// One glTF mesh per non-empty scene mesh (positions checked first), in its node's frame when it
+/// has one; returns scene mesh -> glTF mesh, -1 for an empty one.
 std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
   std::vector<int> gltf_mesh(scene.meshes.size(), -1);  // scene mesh -> glTF mesh (-1: empty)
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
@@ -115,17 +135,26 @@ std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
             wr.file, where,
             "index " + std::to_string(i) + " >= vertex count " + std::to_string(m.positions.size()));
     if (m.positions.empty() || m.indices.size() < 3) continue;  // glTF has no empty primitives
+    const NodeFrameMesh framed = is_identity(m.object_from_world) ? NodeFrameMesh{} : to_node_frame(m);
+    const bool in_frame = !framed.positions.empty();
+    const std::vector<Vec3f>& positions = in_frame ? framed.positions : m.positions;
+    const std::vector<Vec3f>& normals = in_frame ? framed.normals : m.normals;
+    const std::vector<uint32_t>& indices = in_frame ? framed.indices : m.indices;
+    if (in_frame) {
+      b = {};
+      for (const Vec3f& p : positions) b = merge(b, p);
+    }
     const json minmax = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
-    json attributes = {{"POSITION", wr.accessor(m.positions.data(), m.positions.size() * 12, kFloat,
-                                                m.positions.size(), "VEC3", kArrayBuffer, minmax)}};
-    if (m.normals.size() == m.positions.size())
-      attributes["NORMAL"] = wr.accessor(m.normals.data(), m.normals.size() * 12, kFloat, m.normals.size(),
-                                         "VEC3", kArrayBuffer);
+    json attributes = {{"POSITION", wr.accessor(positions.data(), positions.size() * 12, kFloat,
+                                                positions.size(), "VEC3", kArrayBuffer, minmax)}};
+    if (normals.size() == positions.size())
+      attributes["NORMAL"] =
+          wr.accessor(normals.data(), normals.size() * 12, kFloat, normals.size(), "VEC3", kArrayBuffer);
     if (m.uvs.size() == m.positions.size())
       attributes["TEXCOORD_0"] =
           wr.accessor(m.uvs.data(), m.uvs.size() * 8, kFloat, m.uvs.size(), "VEC2", kArrayBuffer);
     json prim = {{"attributes", attributes},
-                 {"indices", wr.accessor(m.indices.data(), m.indices.size() * 4, kUint32, m.indices.size(),
+                 {"indices", wr.accessor(indices.data(), indices.size() * 4, kUint32, indices.size(),
                                          "SCALAR", kElementArrayBuffer)},
                  {"mode", 4}};
     if (m.material >= 0 && size_t(m.material) < scene.materials.size()) prim["material"] = m.material;
@@ -298,7 +327,11 @@ void write_instances(Writer& wr, const Scene& scene, const std::vector<int>& glt
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     json node = {{"mesh", gltf_mesh[size_t(inst.mesh)]},
                  {"name", m.name.empty() ? "meshes[" + std::to_string(inst.mesh) + "]" : m.name}};
-    if (!inst.identity) node["matrix"] = affine_matrix(inst.to_world);
+    Affine3f frame;
+    if (!inst.identity)
+      node["matrix"] = affine_matrix(inst.to_world);
+    else if (!is_identity(m.object_from_world) && inverse(m.object_from_world, frame))
+      node["matrix"] = affine_matrix(frame);  // the node the mesh was moved into world space from
     add_root(wr, node);
   }
 }

@@ -13,7 +13,9 @@ namespace penumbra {
 /// Writes `scene` to `file` (.gltf) and "<stem>.bin" in the same folder, both atomically
 /// (a failure leaves neither half-written). Each mesh becomes one glTF mesh with one primitive
 /// (POSITION, NORMAL and TEXCOORD_0 when present, uint32 indices) and each instance one node
-/// using it (with a matrix unless the identity), so shared meshes stay shared; lights use
+/// using it (with a matrix unless the identity), so shared meshes stay shared; a mesh moved into
+/// world space from a node (Mesh::object_from_world) is written in that node's frame under its
+/// matrix; materials carry their procedural textures as PENUMBRA_procedural; lights use
 /// KHR_lights_punctual; each camera becomes a node whose matrix is its (u, v, w, eye) frame.
 /// Each shape instance becomes a node carrying its shape in PENUMBRA_shapes (listed in
 /// extensionsUsed), CSG trees with one matrix per node that is not the identity.

@@ -373,6 +373,7 @@ void emit_primitives(const GltfContext& ctx, const std::vector<LocalPrimitive>& 
     if (!primitives[pi].usable) continue;
     Mesh out;
     if (!place_primitive(ctx, primitives[pi], e, pi, world, inv, flip, out)) continue;
+    if (!e.object_ids) out.object_from_world = to_affine(inv);
     if (e.object_ids) {
       e.object_ids->push_back(int(ctx.out.scene.meshes.size()));
       ctx.out.scene.meshes.push_back(std::move(out));

@@ -72,12 +72,22 @@ ProceduralTexture ProceduralReader::read(const json& ext, const std::string& whe
   return tex;
 }
 
+// The mapping's limits: every scale factor, translation and matrix entry within 1e6 in
+// magnitude and every scale factor at least 1e-6, so that the map and its inverse (written back as
+// a matrix) stay far inside the float range.
+constexpr float kMaxMapping = 1e6f, kMinScale = 1e-6f;
+
 void ProceduralReader::mapping(const json& ext, const std::string& where, ProceduralTexture& tex) const {
   Transform m;
   if (matrix_or(ext, "matrix", where, m)) {
-    Affine3f inv;
     tex.mapping = to_affine(m);
-    if (!inverse(tex.mapping, inv)) fail(where + ".matrix", "is singular");
+    Affine3f inv;
+    bool bounded = true;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) bounded = bounded && std::fabs(tex.mapping.m[r][c]) <= kMaxMapping;
+    if (!bounded) fail(where + ".matrix", "entries must be within 1e6 in magnitude");
+    if (!inverse(tex.mapping, inv) || !(std::fabs(determinant3x3(m)) >= 1e-18))
+      fail(where + ".matrix", "is singular or nearly so (|det| < 1e-18)");
     return;
   }
   const Vec3f t = vec3_or(ext, "translation", where, {}, Bound::Any);
@@ -91,10 +101,13 @@ void ProceduralReader::mapping(const json& ext, const std::string& where, Proced
     } else {
       s = vec3_or(ext, "scale", where, s, Bound::NonZero);
     }
-    if (!(std::fabs(s.x * s.y * s.z) > 1e-30f) || !(max_component(abs(s)) <= 1e6f))
-      fail(sw, "must be non-zero and at most 1e6 in magnitude on every axis");
+    const Vec3f a = abs(s);
+    if (!(std::min({a.x, a.y, a.z}) >= kMinScale && max_component(a) <= kMaxMapping))
+      fail(sw, "must be within [1e-6, 1e6] in magnitude on every axis");
   }
-  if (max_component(abs(r)) > 1e6f) fail(where + ".rotation", "angles must be within 1e6 degrees");
+  if (!(max_component(abs(t)) <= kMaxMapping))
+    fail(where + ".translation", "must be within 1e6 in magnitude");
+  if (!(max_component(abs(r)) <= kMaxMapping)) fail(where + ".rotation", "angles must be within 1e6 degrees");
   tex.mapping = procedural_mapping(t, r, s);
 }
 

@@ -22,8 +22,10 @@ bool uv_surface_gradients(const Scene& scene, const SurfaceInteraction& si, int 
     const Shape& shape = scene.shapes[size_t(si.shape)].shape;
     const Vec3f t1 = normalize(std::fabs(si.ng.x) < 0.9f ? cross(si.ng, {1, 0, 0}) : cross(si.ng, {0, 1, 0}));
     const Vec3f t2 = cross(si.ng, t1);
-    const Bounds3f b = shape_bounds(shape);
-    const float h = 1e-4f * (b.empty() ? 1.0f : std::max(max_component(b.extent()), 1e-3f));
+    // A step of 1e-4 of the shape's world-space size.
+    Bounds3f b = shape_bounds(shape);
+    if (!inst.identity && !b.empty()) b = transform_bounds(inst.to_world, b);
+    const float h = 1e-4f * (b.empty() ? 1.0f : std::max(max_component(b.extent()), 1e-12f));
     const auto uv_at = [&](Vec3f p) {
       return shape_surface(shape, inst.identity ? p : apply_point(inst.to_object, p), h).uv;
     };
@@ -58,13 +60,23 @@ struct PatternPoint {
   float footprint = 0;
 };
 
-PatternPoint pattern_point(const Scene& scene, const ProceduralTexture& tex, const SurfaceInteraction& si) {
+// The world -> object map of the surface at si: its instance's, or for a mesh moved into world
+// space its node's; nullptr for the identity.
+const Affine3f* object_map(const Scene& scene, const SurfaceInteraction& si) {
   const Instance& inst = scene.instances[si.instance];
+  if (!inst.identity) return &inst.to_object;
+  if (si.shape >= 0) return nullptr;
+  const Affine3f& m = scene.meshes[size_t(inst.mesh)].object_from_world;
+  return is_identity(m) ? nullptr : &m;
+}
+
+PatternPoint pattern_point(const Scene& scene, const ProceduralTexture& tex, const SurfaceInteraction& si) {
   Vec3f x = si.p, dx = si.dpdx, dy = si.dpdy;
-  if (tex.space == ProceduralSpace::Object && !inst.identity) {
-    x = apply_point(inst.to_object, x);
-    dx = apply_vector(inst.to_object, dx);
-    dy = apply_vector(inst.to_object, dy);
+  const Affine3f* to_object = tex.space == ProceduralSpace::Object ? object_map(scene, si) : nullptr;
+  if (to_object) {
+    x = apply_point(*to_object, x);
+    dx = apply_vector(*to_object, dx);
+    dy = apply_vector(*to_object, dy);
   } else if (tex.space == ProceduralSpace::Uv) {
     const int set = tex.texcoord == 1 ? 1 : 0;
     x = {si.uv[set].x, si.uv[set].y, 0};
@@ -88,8 +100,7 @@ Vec3f surface_gradient(const Scene& scene, const ProceduralTexture& tex, const S
     if (!uv_surface_gradients(scene, si, tex.texcoord == 1 ? 1 : 0, gu, gv)) return {};
     gw = gu * gx.x + gv * gx.y;
   } else if (tex.space == ProceduralSpace::Object) {
-    const Instance& inst = scene.instances[si.instance];
-    if (!inst.identity) gw = apply_normal(inst.to_object, gx);
+    if (const Affine3f* to_object = object_map(scene, si)) gw = apply_normal(*to_object, gx);
   }
   return gw - si.ng * dot(gw, si.ng);
 }

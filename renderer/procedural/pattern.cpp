@@ -88,6 +88,8 @@ PatternSample eval_pattern(const ProceduralTexture& tex, Vec3f q, float footprin
       break;
   }
   if (!std::isfinite(s.t) || !is_finite(s.grad)) return {};
+  // Feature distances can exceed 1 (Manhattan F2 reaches ~1.7): t is clamped, flat where clamped.
+  if (s.t < 0 || s.t > 1) return {std::clamp(s.t, 0.0f, 1.0f), {}};
   return s;
 }
 

@@ -98,9 +98,10 @@ struct PatternSample {
 /// (Blender's Mapping node in Point mode).
 Affine3f procedural_mapping(Vec3f translation, Vec3f rotation_degrees, Vec3f scale);
 
-/// The pattern at pattern-space point q. `footprint` is the width of a pixel in pattern space
-/// (0: unknown or a point sample); fractal octaves finer than half of it are dropped when
-/// tex.filter is set.
+/// The pattern at pattern-space point q, t clamped to [0, 1] (with a zero gradient where
+/// clamped: Voronoi distances can exceed 1). `footprint` is the width of a pixel in pattern space
+/// (0: unknown or a point sample); when tex.filter is set, fractal octaves whose period is under
+/// two footprints are dropped (fractal_octave_limit).
 PatternSample eval_pattern(const ProceduralTexture& tex, Vec3f q, float footprint);
 
 /// The ramp's colour at t.

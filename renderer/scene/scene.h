@@ -67,6 +67,9 @@ struct Mesh {
   std::vector<uint32_t> indices;  ///< 3 per triangle, counter-clockwise = front
   int material = -1;              ///< index into Scene::materials, -1 = default material
   int node = -1;                  ///< glTF node of a flattened mesh, -1 if shared or not from glTF
+  /// For a mesh moved into world space from a node: world -> the node's local frame, the object
+  /// space of procedural textures (identity otherwise: instances place object-space meshes).
+  Affine3f object_from_world;
 };
 
 /// An analytic primitive or an implicit surface in its object space with its material, placed

@@ -1,11 +1,16 @@
 // The PENUMBRA_procedural material extension (io/gltf/procedural.cpp): every field and its
-// default, the mapping against its closed form, the extension lists, and one test per class of
-// bad value (each error names the file, the JSON path, the field and the material).
+// default, the mapping against its closed form, the extension lists, one test per class of bad
+// value (each error names the file, the JSON path, the field and the material), and object space
+// following the node of a mesh whether it is moved into world space or instanced.
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
+#include "io/gltf_writer.h"
+#include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/visibility.h"
+#include "renderer/materials/material.h"
 #include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"
@@ -61,6 +66,24 @@ void require_error(json ext, const std::string& path, const std::string& reason)
 
 bool near(Vec3f a, Vec3f b, float eps = 1e-5f) {
   return length(a - b) <= eps;
+}
+
+/// A file with a 2x2 quad (mesh 0, facing +z) on a root node with `node` fields, its material
+/// "bands" of object-space sine bands along X, 0.7 periods per unit, replacing the base colour.
+GltfWriter banded_quad(json node) {
+  GltfWriter w;
+  w.j["materials"] = json::array(
+      {{{"name", "bands"},
+        {"extensions",
+         {{"PENUMBRA_procedural",
+           {{"scale", 0.7}, {"pattern", {{"type", "wave"}}}, {"baseColor", {{"compose", "replace"}}}}}}}}});
+  const int pos = w.positions({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0});
+  const int idx = w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3});
+  const int mesh = w.mesh(pos, idx);
+  w.j["meshes"][size_t(mesh)]["primitives"][0]["material"] = 0;
+  node["mesh"] = mesh;
+  w.node(std::move(node));
+  return w;
 }
 
 }  // namespace
@@ -207,6 +230,15 @@ TEST_CASE("procedural extension: bad values name the material and the field", "[
   require_error({{"space", "uv"}, {"texCoord", 2}}, ".texCoord", "must be in [0, 1]");
   require_error({{"scale", 0}}, ".scale", "must be non-zero");
   require_error({{"scale", {1, 0, 1}}}, ".scale[1]", "must be non-zero");
+  require_error({{"scale", {1e-39, 1e6, 1e6}}}, ".scale", "must be within [1e-6, 1e6] in magnitude");
+  require_error({{"scale", 2e6}}, ".scale", "must be within [1e-6, 1e6] in magnitude");
+  require_error({{"translation", {0, 2e6, 0}}}, ".translation", "must be within 1e6 in magnitude");
+  require_error({{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}, {"scale", 2}}, ".matrix",
+                "cannot be given together with scale");
+  require_error({{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 1}}}, ".matrix", "must be affine");
+  require_error({{"matrix", {1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}}, ".matrix", "is singular");
+  require_error({{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 3e6, 0, 0, 1}}}, ".matrix",
+                "entries must be within 1e6");
   require_error({{"rotation", {0, "90", 0}}}, ".rotation[1]", "must be a number");
   require_error({{"translation", {0, 1e39, 0}}}, ".translation[1]", "beyond the 32-bit float range");
   require_error({{"filter", 1}}, ".filter", "must be true or false");
@@ -244,4 +276,61 @@ TEST_CASE("procedural extension: bad values name the material and the field", "[
   require_error({{"emissiveStrength", {{"range", {-1, 2}}}}}, ".emissiveStrength.range[0]", "must be >= 0");
   require_error({{"bump", {{"height", NAN}}}}, ".bump.height", "must be a number");
   require_error({{"bump", {{"depth", 1}}}}, ".bump.depth", "unknown key");
+}
+
+TEST_CASE("procedural extension: object space is the node's frame, for flattened and instanced meshes",
+          "[io][procedural][quick]") {
+  // Sine bands along object X, 0.7 periods per unit, on a 2x2 quad placed by a node that moves
+  // it by +3 in x and scales it by 2: at world x the pattern is 0.5 + 0.5 sin(2 pi 0.7 (x - 3) / 2).
+  for (bool instanced : {false, true}) {
+    GltfWriter w = banded_quad({{"translation", {3, 0, 0}}, {"scale", {2, 2, 2}}});
+    if (instanced) w.node({{"mesh", 0}, {"translation", {40, 0, 0}}});
+    const LoadedScene l =
+        test::write_and_load(w, std::string("procedural-object-") + (instanced ? "i" : "f"));
+    REQUIRE(l.scene.instances.size() == (instanced ? 2u : 1u));
+    CHECK(l.scene.instances[0].identity == !instanced);
+    const auto accel = make_scene_accelerator("embree", l.scene);
+    for (float x : {1.4f, 2.2f, 3.3f, 4.5f}) {
+      Ray r;
+      r.org = {x, 0.3f, 5};
+      r.dir = {0, 0, -1};
+      Hit h;
+      REQUIRE(intersect_visible(l.scene, *accel, r, h, false));
+      const MaterialPoint mp = eval_material(l.scene, make_interaction(l.scene, r, h));
+      INFO("instanced " << instanced << " x " << x);
+      CHECK(mp.base_color.x == Approx(0.5f + 0.5f * std::sin(2 * kPi * 0.7f * (x - 3) / 2)).margin(1e-4));
+    }
+  }
+}
+
+TEST_CASE("procedural extension: write_gltf keeps a flattened mesh's node frame for object space",
+          "[io][procedural][writer][quick]") {
+  // The quad of the object-space test under a mirroring, scaling node: written and loaded back,
+  // the pattern, the positions and which side faces +z are the same.
+  GltfWriter w = banded_quad({{"translation", {3, 0, 0}}, {"scale", {-2, 2, 2}}});
+  const LoadedScene first = test::write_and_load(w, "procedural-writer-frame");
+  const auto dir = test::temp_dir("procedural-writer-frame-out");
+  write_gltf(first.scene, dir / "again.gltf");
+  const LoadedScene again = load_gltf(dir / "again.gltf");
+  REQUIRE(again.scene.meshes.size() == 1);
+  const Mesh &a = first.scene.meshes[0], &b = again.scene.meshes[0];
+  REQUIRE(a.positions.size() == b.positions.size());
+  for (size_t i = 0; i < a.positions.size(); ++i) CHECK(length(a.positions[i] - b.positions[i]) < 1e-5f);
+  const auto accel_a = make_scene_accelerator("embree", first.scene);
+  const auto accel_b = make_scene_accelerator("embree", again.scene);
+  for (float x : {1.4f, 2.2f, 3.3f, 4.5f}) {
+    Ray r;
+    r.org = {x, 0.3f, 5};
+    r.dir = {0, 0, -1};
+    Hit ha, hb;
+    REQUIRE(intersect_visible(first.scene, *accel_a, r, ha, false));
+    REQUIRE(intersect_visible(again.scene, *accel_b, r, hb, false));
+    const SurfaceInteraction sa = make_interaction(first.scene, r, ha),
+                             sb = make_interaction(again.scene, r, hb);
+    CHECK(sa.back_face == sb.back_face);
+    CHECK(eval_material(again.scene, sb).base_color.x ==
+          Approx(eval_material(first.scene, sa).base_color.x).margin(1e-4));
+    CHECK(eval_material(again.scene, sb).base_color.x ==
+          Approx(0.5f + 0.5f * std::sin(2 * kPi * 0.7f * (x - 3) / -2)).margin(1e-4));
+  }
 }
