@@ -19,7 +19,7 @@ std::invalid_argument too_large(const SceneShape& s, int resolution, uint64_t ne
                                " bytes left of the memory budget");
 }
 
-// The instance's mesh of the shape, moved into the world.
+// The instance's mesh of the shape, moved into the world (remembering the shape's frame).
 Mesh place(IsosurfaceMesh&& iso, const SceneShape& s, const Instance& inst) {
   Mesh m;
   m.name = s.name;
@@ -31,6 +31,7 @@ Mesh place(IsosurfaceMesh&& iso, const SceneShape& s, const Instance& inst) {
   if (!inst.identity) {
     for (Vec3f& p : m.positions) p = apply_point(inst.to_world, p);
     for (Vec3f& n : m.normals) n = normalize(apply_normal(inst.to_object, n));
+    m.object_from_world = inst.to_object;  // object-space procedural textures keep the shape's frame
   }
   if (inst.mirrored)
     for (size_t t = 0; t < m.indices.size(); t += 3) std::swap(m.indices[t + 1], m.indices[t + 2]);

@@ -1,5 +1,5 @@
 // Tests for renderer/scene/shape_mesh: implicit shapes placed by instances (moved, scaled,
-// mirrored) become closed outward world-space meshes with their materials; the node filter,
+// mirrored) become closed outward world-space meshes with their materials and object frames; the node filter,
 // analytic shapes, and the memory budget refused before meshing.
 #include "renderer/scene/shape_mesh.h"
 
@@ -84,6 +84,10 @@ TEST_CASE("shape meshes: placed implicit shapes become closed outward world mesh
       CHECK(std::abs(length(m.normals[v]) - 1) < 1e-4f);
       CHECK(dot(m.normals[v], local[v]) > 0);
     }
+    // The mesh keeps the shape's frame for object-space textures: its vertices map back onto
+    // the unit sphere.
+    for (size_t v = 0; v < m.positions.size(); v += 7)
+      CHECK(length(apply_point(m.object_from_world, m.positions[v])) == Approx(1).margin(cell));
   }
 }
 
