@@ -53,8 +53,7 @@ bool uv_surface_gradients(const Scene& scene, const SurfaceInteraction& si, int 
   return true;
 }
 
-// A procedural texture's point at si in pattern space, the pixel footprint there and the map
-// of pattern-space gradients to world-space surface gradients.
+// A procedural texture's point at si in pattern space and the pixel footprint there.
 struct PatternPoint {
   Vec3f q;
   float footprint = 0;
