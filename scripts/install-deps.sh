@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs Penumbra's build and runtime dependencies from Debian 12's archive, and the tools
-# its tests run against (Blender's glTF importer, which needs NumPy).
+# its tests run against (Blender's glTF importer, which needs NumPy; Slurm and munge for the
+# throw-away single-node cluster).
 # Idempotent: only packages that are missing are installed. Needs root (or sudo).
 set -euo pipefail
 
@@ -13,6 +14,7 @@ PACKAGES=(
   catch2 libcli11-dev libbenchmark-dev
   python3 clang-format
   blender python3-numpy
+  slurm-wlm munge
 )
 
 missing=()
