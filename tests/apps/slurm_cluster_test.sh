@@ -14,6 +14,8 @@ bin="$1"; src="$2"
 
 dir="$(mktemp -d "${TMPDIR:-/tmp}/penumbra-slurm.XXXXXX")" || exit 1
 trap 'slurm_cluster_stop; rm -rf "$dir"' EXIT
+# A signal ends the script through exit, which runs the EXIT trap.
+trap 'exit 1' HUP INT TERM
 start=$(date +%s)
 if ! command -v oiiotool >/dev/null; then
   echo "PENUMBRA_SKIP: oiiotool is not installed (scripts/install-deps.sh installs openimageio-tools)"
