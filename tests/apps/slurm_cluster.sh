@@ -19,12 +19,13 @@ SLURM_CLUSTER_PIDS=""
 SLURM_CLUSTER_NODE=""
 SLURM_CLUSTER_ERROR=""
 
-# Prints a TCP port in 20000-59999 that no socket is bound to, with the next port free too.
+# Prints a TCP port in 20000-59999 that no socket uses (/proc/net/tcp*), with the next port free too.
 slurm_cluster_free_port() {
   local port tries
   for tries in $(seq 1 200); do
     port=$((20000 + (RANDOM * 32768 + RANDOM) % 40000))
-    if ! ss -Htan 2>/dev/null | awk '{print $4}' | grep -Eq ":($port|$((port + 1)))\$"; then
+    if ! cat /proc/net/tcp /proc/net/tcp6 2>/dev/null | awk '{print $2}' |
+      grep -Eiq "$(printf ':(%04X|%04X)$' "$port" $((port + 1)))"; then
       echo "$port"
       return 0
     fi
@@ -88,7 +89,7 @@ slurm_cluster_start() {
     SLURM_CLUSTER_ERROR="a throw-away Slurm cluster needs root (slurmd runs jobs as their user)"
     return 1
   fi
-  for tool in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo ss; do
+  for tool in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo; do
     if ! command -v "$tool" >/dev/null; then
       SLURM_CLUSTER_ERROR="$tool is not installed (scripts/install-deps.sh installs slurm-wlm and munge)"
       return 1
