@@ -4,8 +4,8 @@
 # equal a separate --frame render of it (compared with idiff: the EXR metadata records each
 # command line, so the files differ in that attribute); --skip-existing keeps complete frames
 # untouched and renders again exactly the missing and the truncated ones; a scene without
-# animations is loaded once and gives the same frames; bad ranges and
-# patterns exit 2 before anything is written.
+# animations is loaded once and gives the same frames; a --tile stripe is skipped like a frame;
+# bad ranges and patterns exit 2 before anything is written.
 # Usage: frames_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -101,6 +101,9 @@ grep -q "frame 1 (1 of 3)" "$work/err" || fail "frame 1 was not rendered again"
 for n in 1 3; do
   expect 0 "PASS" -- idiff -a "$work/f.000$n.exr" "$work/single.$n.exr"
 done
+# A --tile stripe's EXR counts as complete too.
+expect 0 "t.0002.exr" -- "$bin" render "$scene" --frames 2 --tile 0/2 -o "$work/t.####.exr" "${common[@]}"
+expect 0 "frames 2: 0 rendered, 1 skipped" -- "$bin" render "$scene" --frames 2 --tile 0/2 -o "$work/t.####.exr" "${common[@]}" --skip-existing
 expect 0 "replace existing" -- "$bin" render --help
 expect 0 "frames 1-1: 1 rendered" -- "$bin" render "$scene" --frames 1-1 -o "$work/f.####.exr" "${common[@]}" --overwrite
 
