@@ -2,6 +2,10 @@
 #include "apps/penumbra/render_command.h"
 
 #include <cstdio>
+#include <map>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/exr_layers.h"
@@ -14,6 +18,7 @@
 #include "io/atomic_file.h"
 #include "io/environment_io.h"
 #include "io/file_checks.h"
+#include "io/frame_outputs.h"
 #include "io/hash.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/scene_accel.h"
@@ -67,12 +72,23 @@ uint64_t charge_image_budget(const RenderJob& job) {
   return image + scene_bytes;
 }
 
-void load_phase(RenderJob& job) {
+/// A scene without animations and its accelerator, kept from one frame of a range for the
+/// next: every frame of such a scene loads the same geometry. The accelerator's views point into
+/// the scene's vectors, whose storage moves with them.
+struct StaticScene {
+  LoadedScene loaded;
+  std::unique_ptr<Accelerator> accel;
+};
+
+void load_phase(RenderJob& job, std::optional<StaticScene>& kept) {
   const RenderArgs& a = job.args;
   set_phase("loading the scene");
   const auto t0 = Clock::now();
-  job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
-                          job.request.time);
+  if (kept)
+    job.loaded = std::move(kept->loaded);
+  else
+    job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
+                            job.request.time);
   job.load_s = seconds_since(t0);
   // No output may replace a buffer or image the scene was loaded from.
   std::vector<std::pair<std::string, fs::path>> inputs;
@@ -118,11 +134,23 @@ void setup_phase(RenderJob& job) {
   }
 }
 
-void build_phase(RenderJob& job) {
+void build_phase(RenderJob& job, std::optional<StaticScene>& kept) {
   set_phase("building the acceleration structure");
   const auto t0 = Clock::now();
-  job.accel = make_scene_accelerator(job.args.accel, job.loaded.scene, job.request.accel_config);
+  job.accel = kept ? std::move(kept->accel)
+                   : make_scene_accelerator(job.args.accel, job.loaded.scene, job.request.accel_config);
+  kept.reset();
   job.build_s = seconds_since(t0);
+}
+
+/// Keeps a scene without animations and its accelerator for the next frame, as loaded (without
+/// the default light setup_phase added).
+void keep_static_scene(RenderJob& job, std::optional<StaticScene>& kept) {
+  if (job.loaded.info.animation_count != 0) return;
+  if (job.default_light) job.loaded.scene.lights.pop_back();
+  kept.emplace();
+  kept->loaded = std::move(job.loaded);
+  kept->accel = std::move(job.accel);
 }
 
 /// --debug-pixel: one pixel exactly as the full render would compute it, printed on stdout.
@@ -177,20 +205,22 @@ void write_phase(RenderJob& job) {
   if (hashes) write_stats_json(job);
 }
 
-}  // namespace
-
-int run_render(const RenderArgs& a) {
+/// One render: load, set up, build, render, write, report. `kept` is a static scene from the
+/// previous frame, used instead of loading and building; on return it holds this frame's scene
+/// when the scene has no animations and `keep` is set.
+int render_frame(const RenderArgs& a, RenderRequest request, std::optional<StaticScene>& kept, bool keep) {
   RenderJob job(a);
-  job.request = check_render_args(a);  // everything typed is checked before loading
+  job.request = std::move(request);
   install_signal_handlers();
-  load_phase(job);
+  load_phase(job, kept);
   setup_phase(job);
-  build_phase(job);
+  build_phase(job, kept);
   if (!a.debug_pixel.empty()) return render_debug_pixel(job);
   render_phase(job);
   write_phase(job);
   if (job.remove_state) fs::remove(fs::path(job.request.out).concat(".resume"));
   if (!a.quiet) print_render_summary(job);
+  if (keep && !job.interrupted) keep_static_scene(job, kept);
   const RenderRequest& q = job.request;
   if (q.paths_to_stdout) {
     std::printf("%s\n", q.out.string().c_str());
@@ -208,6 +238,115 @@ int run_render(const RenderArgs& a) {
         "continue with the same command and --resume\n",
         job.interrupted, job.stats.passes, job.mean_spp);
   return 128 + job.interrupted;
+}
+
+/// One frame of the run: its number (none without --frame/--frames) and its arguments, with
+/// --frame set and every `#` in the output paths replaced.
+struct FramePlan {
+  std::optional<int64_t> number;
+  RenderArgs args;
+};
+
+/// The output paths a frame's number is substituted into, named by their options.
+std::vector<std::pair<const char*, std::string RenderArgs::*>> patterned_outputs() {
+  return {{"-o", &RenderArgs::output},
+          {"--png", &RenderArgs::png},
+          {"--cost-png", &RenderArgs::cost_png},
+          {"--stats-json", &RenderArgs::stats_json}};
+}
+
+FramePlan plan_frame(const RenderArgs& a, int64_t number) {
+  FramePlan p{number, a};
+  p.args.frames.reset();
+  p.args.frame = std::to_string(number);
+  for (const auto& [option, member] : patterned_outputs())
+    p.args.*member = substitute_frame(a.*member, number);
+  return p;
+}
+
+/// The frames to render: one without --frames (`#` then needs --frame), else every frame of
+/// the range, whose outputs must each hold a `#` so that no two frames write one file.
+std::vector<FramePlan> plan_frames(const RenderArgs& a) {
+  if (!a.frames) {
+    for (const auto& [option, member] : patterned_outputs())
+      if (has_frame_pattern(a.*member) && !a.frame)
+        throw UsageError(std::string("'#' in ") + option + " needs --frame or --frames");
+    if (!a.frame) return {{std::nullopt, a}};
+    return {plan_frame(a, parse_integer(*a.frame, -kMaxFrameNumber, kMaxFrameNumber, "--frame"))};
+  }
+  const FrameRange range = parse_frame_range(*a.frames);
+  for (const auto& [option, member] : patterned_outputs())
+    if (!(a.*member).empty() && !has_frame_pattern(a.*member))
+      throw UsageError(std::string("--frames needs a run of '#' in ") + option +
+                       " (e.g. out.####.exr): " + "otherwise every frame writes " + a.*member);
+  std::vector<FramePlan> plan;
+  plan.reserve(size_t(range.count()));
+  for (int64_t f = range.first; f <= range.last; f += range.step) plan.push_back(plan_frame(a, f));
+  return plan;
+}
+
+/// No file may be written by two frames (patterns of different options can meet).
+void check_frames_distinct(const std::vector<FramePlan>& plan, const std::vector<RenderRequest>& requests) {
+  std::map<std::string, int64_t> writer;
+  for (size_t i = 0; i < plan.size(); ++i)
+    for (const auto& [option, file] : requests[i].outputs) {
+      const auto [it, fresh] =
+          writer.emplace(fs::absolute(file).lexically_normal().string(), *plan[i].number);
+      if (!fresh && it->second != *plan[i].number)
+        throw UsageError(option + " " + file.string() + " would be written by frames " +
+                         std::to_string(it->second) + " and " + std::to_string(*plan[i].number));
+    }
+}
+
+/// With --skip-existing: true when the frame's EXR is complete; a file that is there but
+/// incomplete is reported and rendered again.
+bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q) {
+  if (!a.skip_existing) return false;
+  std::string problem;
+  const std::string label = p.number ? "frame " + std::to_string(*p.number) + ": " : "";
+  if (is_complete_exr(q.out, problem)) {
+    if (!a.quiet)
+      std::fprintf(stderr, "penumbra: %s%s is complete; skipped\n", label.c_str(), q.out.string().c_str());
+    return true;
+  }
+  std::error_code ec;
+  if (fs::exists(q.out, ec) && !a.quiet)
+    std::fprintf(stderr, "penumbra: warning: %s%s %s; rendering it again\n", label.c_str(),
+                 q.out.string().c_str(), problem.c_str());
+  return false;
+}
+
+}  // namespace
+
+int run_render(const RenderArgs& a) {
+  const auto t0 = Clock::now();
+  const std::vector<FramePlan> plan = plan_frames(a);
+  // Every frame's flags and outputs are checked before the first frame loads.
+  std::vector<RenderRequest> requests;
+  requests.reserve(plan.size());
+  for (const FramePlan& p : plan) requests.push_back(check_render_args(p.args));
+  if (a.frames) check_frames_distinct(plan, requests);
+  int64_t rendered = 0, skipped = 0;
+  std::optional<StaticScene> kept;
+  for (size_t i = 0; i < plan.size(); ++i) {
+    const FramePlan& p = plan[i];
+    if (frame_done(a, p, requests[i])) {
+      ++skipped;
+      continue;
+    }
+    if (a.frames && !a.quiet)
+      std::fprintf(stderr, "penumbra: frame %lld (%zu of %zu) -> %s%s\n", static_cast<long long>(*p.number),
+                   i + 1, plan.size(), requests[i].out.string().c_str(),
+                   kept ? " (static scene: loaded scene and acceleration structure reused)" : "");
+    if (const int rc = render_frame(p.args, std::move(requests[i]), kept, i + 1 < plan.size()); rc != kExitOk)
+      return rc;
+    ++rendered;
+  }
+  if (a.frames && !a.quiet)
+    std::fprintf(stderr, "penumbra: frames %s: %lld rendered, %lld skipped, %.2f s in total\n",
+                 a.frames->c_str(), static_cast<long long>(rendered), static_cast<long long>(skipped),
+                 seconds_since(t0));
+  return kExitOk;
 }
 
 }  // namespace penumbra::cli

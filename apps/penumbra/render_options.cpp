@@ -287,8 +287,20 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
   auto* time_opt = render.add_option("--time", args.time,
                                      "animation time in seconds: animations (node TRS, skins, morph weights) "
                                      "are evaluated there (default: the file's static pose)");
-  render.add_option("--frame", args.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
-  render.add_option("--fps", args.fps, "frames per second for --frame (default 24)");
+  auto* frame_opt =
+      render.add_option("--frame", args.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
+  render
+      .add_option("--frames", args.frames,
+                  "render frames A to B inclusive (A-B, A-B:STEP or N), each at time N / --fps; every "
+                  "output path needs a run of '#' for the frame number (#### -> 0012)")
+      ->excludes(time_opt)
+      ->excludes(frame_opt);
+  render.add_option("--fps", args.fps, "frames per second for --frame and --frames (default 24)");
+  auto* skip_opt = render.add_flag("--skip-existing", args.skip_existing,
+                                   "keep a frame whose -o already is a complete, readable EXR; render it "
+                                   "again (with a warning) when the file is truncated or unreadable");
+  render.add_flag("--overwrite", args.overwrite, "replace existing outputs (the default)")
+      ->excludes(skip_opt);
   render.add_option(
       "--max-memory", args.max_memory,
       "one memory budget for the scene, the acceleration structure, --env and the image buffers, e.g. 4G; "

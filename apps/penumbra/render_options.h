@@ -41,9 +41,12 @@ struct RenderArgs {
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
   double time_limit = 0;
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
-  std::optional<double> time;        ///< --time, seconds
-  std::optional<std::string> frame;  ///< --frame, an integer, converted with --fps
+  std::optional<double> time;         ///< --time, seconds
+  std::optional<std::string> frame;   ///< --frame, an integer, converted with --fps
+  std::optional<std::string> frames;  ///< --frames A-B[:STEP] or N, each frame as --frame
   double fps = 24;
+  bool skip_existing = false;  ///< keep a frame whose -o is already a complete EXR
+  bool overwrite = false;      ///< the default, accepted explicitly
 };
 
 /// Declares every flag of `render` on `render`, bound to `args`.
