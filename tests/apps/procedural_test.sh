@@ -8,7 +8,7 @@ bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
 fails=0; passes=0
 
-# expect CODE PATTERN -- command...: counts a pass or a failure in $passes / $fails.
+# expect CODE PATTERN -- command... and expect_refused NAME PATTERN count passes and failures.
 source "$(dirname "$0")/expect.sh"
 
 # A file with one analytic sphere whose material 'stone' carries the extension object $2,
@@ -26,13 +26,7 @@ for case in "detail|$ext\.pattern\.detail: must be in \[0, 15\] \(got 99\) \(mat
             "key|$ext\.pattern\.lacunarity: does not apply to pattern type \"voronoi\"" \
             "ramp|$ext\.baseColor\.ramp\[1\]\.position: positions must not decrease" \
             "unknown|$ext\.colour: unknown key"; do
-  name="${case%%|*}"; pattern="${case#*|}"
-  rm -f "$work/$name.exr" "$work/$name.png"
-  expect 2 "penumbra: error: $work/$name.gltf: $pattern" -- "$bin" render "$work/$name.gltf" -o "$work/$name.exr" --width 32 --spp 1
-  if [ -e "$work/$name.exr" ] || [ -e "$work/$name.png" ]; then
-    echo "FAIL: $name: a refused render left $work/$name.exr"; fails=$((fails + 1))
-  fi
-  expect 2 "$pattern" -- "$bin" info "$work/$name.gltf"
+  expect_refused "${case%%|*}" "${case#*|}"
 done
 
 # Listed in extensionsRequired, the extension loads; info describes the texture.

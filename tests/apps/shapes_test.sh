@@ -7,7 +7,7 @@ bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
 fails=0; passes=0
 
-# expect CODE PATTERN -- command...: counts a pass or a failure in $passes / $fails.
+# expect CODE PATTERN -- command... and expect_refused NAME PATTERN count passes and failures.
 source "$(dirname "$0")/expect.sh"
 
 # A file whose one node carries the shape extension object $2, written to $work/$1.gltf.
@@ -32,13 +32,7 @@ for case in "radius|$ext\.csg\.children\[1\]\.radius: must be > 0" \
             "unbounded|$ext\.csg: the shape's inside is unbounded" \
             "material|$ext\.material: index 0 out of range \(0 materials\)" \
             "detail|$ext\.csg\.detail: must be in \[0, 15\] \(got 20\)"; do
-  name="${case%%|*}"; pattern="${case#*|}"
-  rm -f "$work/$name.exr" "$work/$name.png"
-  expect 2 "penumbra: error: $work/$name.gltf: $pattern" -- "$bin" render "$work/$name.gltf" -o "$work/$name.exr" --width 32 --spp 1
-  if [ -e "$work/$name.exr" ] || [ -e "$work/$name.png" ]; then
-    echo "FAIL: $name: a refused render left $work/$name.exr"; fails=$((fails + 1))
-  fi
-  expect 2 "$pattern" -- "$bin" info "$work/$name.gltf"
+  expect_refused "${case%%|*}" "${case#*|}"
 done
 # Too deep for the JSON nesting limit already (each CSG level is two JSON levels).
 expect 2 "nesting deeper than 64 levels" -- "$bin" info "$work/deep.gltf"
