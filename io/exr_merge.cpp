@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -292,6 +293,51 @@ void copy_pixels(OIIO::ImageInput& in, const std::string& name, const std::vecto
   }
 }
 
+// Sums of the statistics that add up over a frame's parts; each is written only when every part
+// has it, and removed otherwise.
+struct PartStatistics {
+  bool has_samples = true, has_passes = true, has_seconds = true;
+  uint64_t samples = 0;
+  long long passes = 0;
+  double seconds = 0;
+
+  void add(const OIIO::ImageSpec& spec) {
+    const OIIO::ParamValue* s = string_attribute(spec, kSamplesAttribute);
+    const OIIO::ParamValue* p = string_attribute(spec, kPassesAttribute);
+    const OIIO::ParamValue* t = spec.find_attribute(kRenderSecondsAttribute, OIIO::TypeDesc::FLOAT);
+    has_samples = has_samples && s && add_count(s->get_string(), samples);
+    uint64_t part_passes = 0;
+    has_passes = has_passes && p && add_count(p->get_string(), part_passes);
+    passes = std::max(passes, static_cast<long long>(part_passes));
+    has_seconds = has_seconds && t;
+    if (t) seconds += double(t->get_float());
+  }
+  // Writes the frame's statistics into the header of an EXR part, where it has them (every part
+  // of a multi-part file repeats the metadata).
+  void apply(OIIO::ImageSpec& spec) const {
+    const uint64_t pixels = uint64_t(spec.full_width) * uint64_t(spec.full_height);
+    const auto replace = [&](bool keep, const char* name, auto value) {
+      if (!spec.find_attribute(name)) return;
+      if (keep)
+        spec.attribute(name, value);
+      else  // the first part's figure would describe that part alone
+        spec.erase_attribute(name);
+    };
+    replace(has_samples, kSamplesAttribute, std::to_string(samples));
+    replace(has_samples, kMeanSppAttribute, format_mean_spp(samples, pixels));
+    replace(has_passes, kPassesAttribute, std::to_string(passes));
+    replace(has_seconds, kRenderSecondsAttribute, float(seconds));
+  }
+
+ private:
+  // Adds the decimal count `text` to `sum`; false if it is not one or the sum overflows.
+  static bool add_count(const std::string& text, uint64_t& sum) {
+    if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos)
+      return false;
+    return !__builtin_add_overflow(sum, std::stoull(text), &sum);
+  }
+};
+
 void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> specs,
                  const std::vector<std::vector<unsigned char>>& pixels) {
   for (auto& sp : specs) {
@@ -299,6 +345,7 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
     sp.width = sp.full_width;
     sp.height = sp.full_height;
     sp.tile_width = sp.tile_height = 0;
+    sp.erase_attribute("openexr:chunkCount");  // a part's count; the writer counts the frame's
   }
   write_atomically(out, [&](const std::filesystem::path& temp) {
     auto o = OIIO::ImageOutput::create(out.string());
@@ -332,6 +379,7 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
   std::vector<std::vector<unsigned char>> pixels;  // per subimage, the whole frame
   std::vector<int> owner;                          // file that wrote each pixel, -1 = none
   PartIdentity first_id;                           // without options.force
+  PartStatistics statistics;
   double frame_bytes = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const std::string name = parts[k].string();
@@ -374,6 +422,7 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     }
     claim_pixels(parts, k, specs[0], owner);
     copy_pixels(*in, name, specs, pixels);
+    statistics.add(specs[0]);
   }
   for (size_t f = 0; f < owner.size(); ++f)
     if (owner[f] < 0)
@@ -381,7 +430,19 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
                        "the parts do not cover the frame: pixel " +
                            std::to_string(f % size_t(full[0].full_width)) + "," +
                            std::to_string(f / size_t(full[0].full_width)) + " is missing");
+  // The first part's capture date; OpenImageIO reads an empty one as none and would stamp the
+  // time of the merge.
+  for (auto& spec : full) {
+    statistics.apply(spec);
+    if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
+  }
   write_frame(out, full, pixels);
+}
+
+std::string format_mean_spp(uint64_t samples, uint64_t pixels) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.3f", pixels ? double(samples) / double(pixels) : 0.0);
+  return text;
 }
 
 }  // namespace penumbra

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace penumbra {
@@ -14,6 +15,19 @@ inline constexpr const char* kSceneHashAttribute = "penumbra:scene_sha256";
 /// String attribute of a tile: canonical_text (io/render_settings.h) of its render settings
 /// without the keys that differ between tiles of one frame (window, crop, tile).
 inline constexpr const char* kSettingsAttribute = "penumbra:settings";
+
+/// Path tracer statistics of a render, as strings: the camera samples taken, their mean per
+/// pixel (format_mean_spp) and the passes. A merged frame holds the sum of its parts' samples,
+/// their mean over the whole frame and the most passes of any part, as one render of the frame
+/// records them.
+inline constexpr const char* kSamplesAttribute = "penumbra:samples";
+inline constexpr const char* kMeanSppAttribute = "penumbra:mean_spp";
+inline constexpr const char* kPassesAttribute = "penumbra:passes";
+/// Float attribute: seconds spent rendering; a merged frame holds the sum of its parts'.
+inline constexpr const char* kRenderSecondsAttribute = "penumbra:render_seconds";
+
+/// `samples` / `pixels` with three decimals, as kMeanSppAttribute records it ("0.000" for no pixels).
+std::string format_mean_spp(uint64_t samples, uint64_t pixels);
 
 /// Largest part file merge_exr_parts opens.
 inline constexpr uint64_t kMaxMergePartBytes = uint64_t(16) << 30;
@@ -26,7 +40,10 @@ struct MergeOptions {
 
 /// Reads every part (an OpenEXR file whose data window lies inside its display window) and
 /// writes the full frame to `out` atomically, with each part's pixels copied unchanged (native
-/// channel types) and the first part's metadata. Throws InputError naming the part (or the
+/// channel types) and the first part's metadata, except for the statistics that add up over
+/// the parts (kSamplesAttribute and the attributes beside it, when every part has them): the
+/// merge of a frame's tiles equals a render of the whole frame byte for byte when the renders
+/// record no command line or timing (`render --reproducible`). Throws InputError naming the part (or the
 /// first uncovered pixel), and writes nothing, unless:
 ///  - every part is a regular file of at most kMaxMergePartBytes (checked before any is opened,
 ///    so a FIFO or /dev/zero is refused at once);

@@ -165,14 +165,20 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
                   {"penumbra:filter",
                    std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
   if (job.request.path) {
-    exr.metadata.push_back({"penumbra:mean_spp", format("%.3f", job.mean_spp)});
-    exr.metadata.push_back({"penumbra:passes", std::to_string(job.stats.passes)});
+    exr.metadata.push_back(
+        {kMeanSppAttribute,
+         format_mean_spp(job.stats.samples, uint64_t(job.film.width) * uint64_t(job.film.height))});
+    exr.metadata.push_back({kSamplesAttribute, std::to_string(job.stats.samples)});
+    exr.metadata.push_back({kPassesAttribute, std::to_string(job.stats.passes)});
   }
-  if (!cfg.window.empty()) add_part_identity(exr, job);
-  exr.metadata.push_back({"penumbra:command_line", a.command_line});
+  add_part_identity(exr, job);
+  if (!a.reproducible) exr.metadata.push_back({"penumbra:command_line", a.command_line});
+  // OpenImageIO stamps the time of writing into capDate unless DateTime is given; reproducible
+  // files carry it empty.
+  if (a.reproducible) exr.metadata.push_back({"DateTime", ""});
   exr.metadata.push_back({"penumbra:version", PENUMBRA_VERSION});
   add_camera_metadata(exr, job.camera, cfg.width, cfg.height);
-  exr.float_metadata.push_back({"penumbra:render_seconds", float(job.stats.seconds)});
+  if (!a.reproducible) exr.float_metadata.push_back({kRenderSecondsAttribute, float(job.stats.seconds)});
   if (job.request.data_aovs) add_data_channels(exr, job, buffers.data);
   add_render_channels(exr, job, buffers);
   return exr;

@@ -124,14 +124,12 @@ void setup_phase(RenderJob& job) {
     scene.lights.push_back(default_key_light(job.camera));
     job.default_light = true;
   }
-  // What this render is, for its resume state and the metadata of crops and tiles: the content
-  // of every file it loaded and every setting that decides its pixels.
-  if (q.path || !cfg.window.empty()) {
-    // The bytes as the loader read them, not the files as they are now.
-    job.scene_sha256 = sha256_of_set(job.loaded.info.source_files, job.loaded.info.source_sha256);
-    job.settings = pixel_settings(a, cfg, job.camera, job.scene_sha256,
-                                  !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
-  }
+  // What this render is, for its resume state and the EXR's metadata (which `merge` checks
+  // tiles by): the content of every file it loaded and every setting that decides its pixels.
+  // The bytes as the loader read them, not the files as they are now.
+  job.scene_sha256 = sha256_of_set(job.loaded.info.source_files, job.loaded.info.source_sha256);
+  job.settings = pixel_settings(a, cfg, job.camera, job.scene_sha256,
+                                !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
 }
 
 void build_phase(RenderJob& job, std::optional<StaticScene>& kept) {

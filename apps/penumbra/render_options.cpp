@@ -301,6 +301,9 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
                                    "again (with a warning) when the file is truncated or unreadable");
   render.add_flag("--overwrite", args.overwrite, "replace existing outputs (the default)")
       ->excludes(skip_opt);
+  render.add_flag("--reproducible", args.reproducible,
+                  "record no command line or render time in the EXR, so that renders of the same scene and "
+                  "settings (and merges of their tiles) are the same bytes");
   render.add_option(
       "--max-memory", args.max_memory,
       "one memory budget for the scene, the acceleration structure, --env and the image buffers, e.g. 4G; "

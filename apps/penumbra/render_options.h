@@ -47,6 +47,7 @@ struct RenderArgs {
   double fps = 24;
   bool skip_existing = false;  ///< keep a frame whose -o is already a complete EXR
   bool overwrite = false;      ///< the default, accepted explicitly
+  bool reproducible = false;   ///< no command line or timing in the EXR: equal renders, equal files
 };
 
 /// Declares every flag of `render` on `render`, bound to `args`.

@@ -222,9 +222,10 @@ expect 0 "mixed.exr" -- "$bin" merge "$work/m0.exr" "$work/o1.exr" -o "$work/mix
 "$bin" render "$scene" -o "$work/s1.exr" --width 48 --spp 2 --no-png -q --tile 1/2 >/dev/null || fail "tile with other spp"
 expect 2 "s1.exr: was rendered with other settings.*" -- "$bin" merge "$work/m0.exr" "$work/s1.exr" -o "$work/mixed2.exr"
 grep -q "spp: " "$work/err" && pass || fail "the refusal does not name spp"
-if command -v oiiotool >/dev/null; then  # crops cut by another tool carry no Penumbra metadata
+if command -v oiiotool >/dev/null; then  # crops cut by another tool that drops Penumbra's metadata
   "$bin" render "$scene" -o "$work/full.exr" "${tile[@]}" >/dev/null
-  oiiotool "$work/full.exr" --crop 48x14+0+0 -o "$work/c0.exr" && oiiotool "$work/full.exr" --crop 48x13+0+14 -o "$work/c1.exr"
+  oiiotool "$work/full.exr" --eraseattrib "penumbra:.*" --crop 48x14+0+0 -o "$work/c0.exr" &&
+    oiiotool "$work/full.exr" --eraseattrib "penumbra:.*" --crop 48x13+0+14 -o "$work/c1.exr"
   expect 2 "c0.exr: has no penumbra:scene_sha256 metadata.*--force" -- "$bin" merge "$work/c0.exr" "$work/c1.exr" -o "$work/cut.exr"
   expect 0 "cut.exr" -- "$bin" merge "$work/c0.exr" "$work/c1.exr" -o "$work/cut.exr" --force
   expect 0 "PASS" -- oiiotool "$work/full.exr" "$work/cut.exr" --fail 0 --diff
@@ -232,6 +233,19 @@ fi
 "$bin" render "$scene" -o "$work/i0.exr" --width 48 --spp 64 --no-png -q --tile 0/2 --integrator path --time-limit 1e-9 >/dev/null \
   || fail "time-limited tile"
 expect 2 "i0.exr: is incomplete" -- "$bin" merge "$work/i0.exr" "$work/m1.exr" -o "$work/inc.exr"
+# --reproducible: no command line or timing in the header, so the merge of a frame's tiles is the
+# whole-frame render's file byte for byte (path tracer: the merged samples, mean spp and passes).
+for layout in single --multipart; do
+  repro=(--width 48 --spp 3 --no-png -q --reproducible --integrator path --aov Z,samples)
+  [ "$layout" = single ] || repro+=("$layout")
+  "$bin" render "$scene" -o "$work/r.exr" "${repro[@]}" >/dev/null || fail "reproducible frame"
+  for i in 0 1 2; do "$bin" render "$scene" -o "$work/r$i.exr" "${repro[@]}" --tile $i/3 >/dev/null || fail "tile $i"; done
+  sleep 1  # a time stamp would now differ
+  expect 0 "r-merged.exr" -- "$bin" merge "$work/r0.exr" "$work/r1.exr" "$work/r2.exr" -o "$work/r-merged.exr"
+  cmp -s "$work/r.exr" "$work/r-merged.exr" && pass || fail "$layout: merged reproducible tiles differ from the whole frame"
+done
+if grep -aq "penumbra:command_line\|penumbra:render_seconds" "$work/r.exr"; then fail "--reproducible recorded the command line or time"; else pass; fi
+grep -aq "penumbra:command_line" "$work/m0.exr" && pass || fail "a render without --reproducible records no command line"
 expect 2 "/dev/zero: .*is a character device, not a regular file" -- "$bin" merge /dev/zero "$work/m1.exr" -o "$work/z.exr"
 expect 2 "in.fifo: .*is a FIFO, not a regular file" -- "$bin" merge "$work/m0.exr" "$work/in.fifo" -o "$work/z.exr"
 expect 2 "would overwrite part 1" -- "$bin" merge "$work/m0.exr" "$work/m1.exr" -o "$work/m0.exr"

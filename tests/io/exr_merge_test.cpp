@@ -60,7 +60,53 @@ void render_part(const Scene& s, const Accelerator& accel, const PathLights& lig
   opt.metadata = tile_metadata();
   write_exr(img.film, path, opt);
 }
+
+// A stripe of samples-per-pixel counts with the statistics a path-traced part records.
+void write_counted_part(const std::filesystem::path& path, int y0, int y1, uint32_t spp, int passes,
+                        float seconds) {
+  Film film = make_film(8, y1 - y0);
+  film.origin_y = y0;
+  film.full_height = 6;
+  const uint64_t samples = uint64_t(spp) * 8 * uint64_t(y1 - y0);
+  ExrOptions opt;
+  opt.metadata = tile_metadata();
+  opt.metadata.push_back({kSamplesAttribute, std::to_string(samples)});
+  opt.metadata.push_back({kMeanSppAttribute, format_mean_spp(samples, 8 * uint64_t(y1 - y0))});
+  opt.metadata.push_back({kPassesAttribute, std::to_string(passes)});
+  opt.float_metadata.push_back({kRenderSecondsAttribute, seconds});
+  write_exr(film, path, opt);
+}
+
+std::string string_metadata(const OIIO::ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(name, OIIO::TypeDesc::STRING);
+  return p ? p->get_string() : "(none)";
+}
 }  // namespace
+
+TEST_CASE("merge: sample counts, passes and times add up over the parts", "[io][exr][merge]") {
+  const auto dir = test::temp_dir("merge-stats");
+  // 8x6 pixels: rows 0-1 at 16 spp in 3 passes, rows 2-5 at 5 spp in 2 passes.
+  write_counted_part(dir / "top.exr", 0, 2, 16, 3, 1.5f);
+  write_counted_part(dir / "bottom.exr", 2, 6, 5, 2, 0.25f);
+  merge_exr_parts({dir / "top.exr", dir / "bottom.exr"}, dir / "frame.exr");
+  OIIO::ImageSpec spec;
+  native_pixels(dir / "frame.exr", spec);
+  CHECK(string_metadata(spec, kSamplesAttribute) == std::to_string(16 * 16 + 5 * 32));
+  CHECK(string_metadata(spec, kMeanSppAttribute) == "8.667");  // 416 samples / 48 pixels
+  CHECK(string_metadata(spec, kPassesAttribute) == "3");
+  CHECK(spec.get_float_attribute(kRenderSecondsAttribute) == 1.75f);
+  // A part without them (cut by another tool): the first part's figures would be wrong, so none.
+  Film plain = make_film(8, 4);
+  plain.origin_y = 2;
+  plain.full_height = 6;
+  write_exr(plain, dir / "plain.exr", {});
+  merge_exr_parts({dir / "top.exr", dir / "plain.exr"}, dir / "forced.exr", {.force = true});
+  native_pixels(dir / "forced.exr", spec);
+  CHECK(string_metadata(spec, kSamplesAttribute) == "(none)");
+  CHECK(string_metadata(spec, kMeanSppAttribute) == "(none)");
+  CHECK(string_metadata(spec, kPassesAttribute) == "(none)");
+  CHECK(spec.find_attribute(kRenderSecondsAttribute) == nullptr);
+}
 
 TEST_CASE("merge: tiles and crops reassemble the frame byte for byte", "[io][exr][merge]") {
   const auto dir = test::temp_dir("merge");
