@@ -432,7 +432,10 @@ void write_display_image(const Film& film, const std::filesystem::path& path, co
   std::vector<float> rgb(n * 3);
   const float gain = std::exp2(options.exposure);
   for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) rgb[i * 3 + size_t(c)] = film.rgba[i * 4 + size_t(c)] * gain;
+    for (int c = 0; c < 3; ++c) {
+      const float v = film.rgba[i * 4 + size_t(c)];
+      rgb[i * 3 + size_t(c)] = (options.half_beauty ? float(half(v)) : v) * gain;
+    }
   apply_display_transform(rgb, film.width, film.height, options);
   const std::string ext = lower_extension(path);
   const bool sixteen = ext == ".tif" || ext == ".tiff";
@@ -446,6 +449,38 @@ void write_display_image(const Film& film, const std::filesystem::path& path, co
         write_with_oiio(path, temp, spec, rgb.data(), OIIO::TypeDesc::FLOAT);
       },
       sha256);
+}
+
+Film read_exr_beauty(const std::filesystem::path& path, uint64_t max_bytes) {
+  const std::string name = path.string();
+  check_input_file(path, "", uint64_t(16) << 30);
+  auto in = OIIO::ImageInput::open(name);
+  if (!in) throw InputError(name, "", "cannot be read as an image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  int channel[4];
+  for (int c = 0; c < 4; ++c) {
+    channel[c] = spec.channelindex(std::string(1, "RGBA"[c]));
+    if (channel[c] < 0) throw InputError(name, "", std::string("has no channel ") + "RGBA"[c]);
+  }
+  const uint64_t pixels = uint64_t(spec.full_width) * uint64_t(spec.full_height);
+  const uint64_t floats = pixels * (4 + uint64_t(std::max(spec.nchannels, 0)));  // the film and the read
+  if (spec.full_width <= 0 || spec.full_height <= 0 || spec.width > spec.full_width ||
+      spec.height > spec.full_height || floats * sizeof(float) > max_bytes)
+    throw InputError(name, "",
+                     "its " + std::to_string(spec.full_width) + "x" + std::to_string(spec.full_height) +
+                         " pixels exceed the " + format_bytes(max_bytes) + " budget");
+  std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+    throw InputError(name, "", "cannot decode: " + in->geterror());
+  Film film = make_film(spec.full_width, spec.full_height);
+  for (int y = 0; y < spec.height; ++y)
+    for (int x = 0; x < spec.width; ++x) {
+      const int fx = spec.x + x, fy = spec.y + y;
+      if (fx < 0 || fy < 0 || fx >= film.width || fy >= film.height) continue;
+      const float* src = &all[(size_t(y) * size_t(spec.width) + size_t(x)) * size_t(spec.nchannels)];
+      for (int c = 0; c < 4; ++c) film.pixel(fx, fy)[c] = src[channel[c]];
+    }
+  return film;
 }
 
 }  // namespace penumbra

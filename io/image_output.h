@@ -48,12 +48,20 @@ struct ExrOptions {
 void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
                std::string* sha256 = nullptr);
 
+/// The beauty (R, G, B, A of the first part, premultiplied) of an EXR as a whole-frame film, to
+/// make a display image of a merged frame. Throws InputError naming the file when it is not a
+/// readable EXR with those channels or its pixels need more than `max_bytes`.
+Film read_exr_beauty(const std::filesystem::path& path, uint64_t max_bytes);
+
 struct DisplayOptions {
   std::string ocio_config;  ///< config file; empty = $OCIO if set, else Penumbra's shipped config
   std::string display;      ///< empty = the config's default display
   std::string view;         ///< empty = the display's default view
   std::string look;         ///< an OCIO look applied in scene-linear before the view; empty = none
   float exposure = 0;       ///< stops applied in scene-linear before the view transform
+  /// Round the beauty to half floats first, as a half EXR stores it: the display image of a
+  /// render then equals the one made from its EXR (a merged farm frame's).
+  bool half_beauty = false;
 };
 
 /// Writes the beauty (over black) through the display/view transform as 8-bit RGB (16-bit for

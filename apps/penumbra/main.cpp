@@ -1,12 +1,13 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
-// `info`, assemble farm tiles with `merge`, turn its implicit shapes into triangle meshes with
-// `mesh`. This file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success,
-// 2 bad input or usage, 1 a failure outside the input (I/O, memory); a render ended by a signal
+// `info`, assemble farm tiles with `merge`, render job files with `batch`, turn its implicit shapes into
+// triangle meshes with `mesh`. This file wires the subcommands' flags (CLI11) and maps errors to exit codes:
+// 0 success, 2 bad input or usage, 1 a failure outside the input (I/O, memory); a render ended by a signal
 // returns 128 + signal. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
 
+#include "apps/penumbra/batch_command.h"
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/info_command.h"
 #include "apps/penumbra/merge_command.h"
@@ -66,6 +67,24 @@ void add_mesh_options(CLI::App& mesh, MeshArgs& a) {
   mesh.add_flag("-q,--quiet", a.quiet, "no warnings or summary");
 }
 
+void add_batch_options(CLI::App& batch, BatchArgs& a) {
+  batch.add_option("job", a.job_file, "job file (.json): the shots to render")->required();
+  auto* list = batch.add_flag(
+      "--list", a.list, "print the work units, one per line: UNIT SHOT FRAME TILE OUTPUT (tab-separated)");
+  auto* unit =
+      batch.add_option("--unit", a.unit, "render work unit N only (0 = the first listed)")->excludes(list);
+  batch.add_flag("--merge", a.merge, "merge every tiled frame from its stripes and write its display image")
+      ->excludes(list)
+      ->excludes(unit);
+  batch
+      .add_option("--tiles", a.tiles,
+                  "split every frame of shots without \"tiles\" into N stripes (default 1)")
+      ->check(CLI::Range(1, kMaxJobTiles));
+  batch.add_flag("--skip-existing", a.skip_existing,
+                 "keep outputs that already are complete EXRs (frames, stripes, merged frames)");
+  batch.add_flag("-q,--quiet", a.quiet, "no progress, warnings or summaries on stderr");
+}
+
 int report(const char* kind, const char* what, int code) {
   std::fprintf(stderr, "penumbra: %s: %s\n", kind, what);
   return code;
@@ -89,6 +108,10 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand(
       "merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   add_merge_options(*merge, merge_args);
+  BatchArgs batch_args;
+  auto* batch = app.add_subcommand(
+      "batch", "Render the shots of a job file, or list its work units and render one of them (farms)");
+  add_batch_options(*batch, batch_args);
   MeshArgs mesh_args;
   auto* mesh = app.add_subcommand(
       "mesh",
@@ -105,6 +128,7 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
+    if (*batch) return run_batch(batch_args);
     if (*mesh) return run_mesh(mesh_args);
     if (*info)
       return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,

@@ -347,4 +347,16 @@ int run_render(const RenderArgs& a) {
   return kExitOk;
 }
 
+std::vector<std::pair<std::string, fs::path>> check_render(const RenderArgs& a) {
+  const std::vector<FramePlan> plan = plan_frames(a);
+  std::vector<RenderRequest> requests;
+  std::vector<std::pair<std::string, fs::path>> outputs;
+  for (const FramePlan& p : plan) {
+    requests.push_back(check_render_args(p.args));
+    outputs.insert(outputs.end(), requests.back().outputs.begin(), requests.back().outputs.end());
+  }
+  if (a.frames) check_frames_distinct(plan, requests);
+  return outputs;
+}
+
 }  // namespace penumbra::cli

@@ -40,6 +40,7 @@ void check_output_paths(const RenderArgs& a, RenderRequest& q) {
   q.display.view = a.view;
   q.display.look = a.look;
   q.display.exposure = a.exposure;
+  q.display.half_beauty = !a.use_float;  // the display image shows what the EXR holds
   if (q.png) {
     resolve_output(*q.png, "--png");
     check_display_output(*q.png, q.display);  // a typo must not cost a whole render

@@ -1,0 +1,288 @@
+// `penumbra batch`: job settings as `render` flags, the up-front checks, and the four modes.
+#include "apps/penumbra/batch_command.h"
+
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/render_command.h"
+#include "io/error.h"
+#include "io/exr_merge.h"
+#include "io/image_output.h"
+
+namespace penumbra::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// `render` flags a job sets through its own keys (or that make no sense in a job), with the
+/// key to use instead.
+const std::map<std::string, std::string>& reserved_settings() {
+  static const std::map<std::string, std::string> m = {
+      {"output", "the shot's \"output\""},
+      {"png", "the shot's \"png\""},
+      {"no-png", "the shot's \"png\" (a shot without one writes no display image)"},
+      {"camera", "the shot's \"camera\""},
+      {"frame", "the shot's \"frames\""},
+      {"frames", "the shot's \"frames\""},
+      {"time", "the shot's \"frames\" (with the \"fps\" setting)"},
+      {"tile", "the shot's \"tiles\""},
+      {"crop", "the shot's \"tiles\""},
+      {"stats-json", "the shot's \"stats_json\""},
+      {"skip-existing", "`penumbra batch --skip-existing`"},
+      {"overwrite", "`penumbra batch` (overwriting is the default)"},
+      {"reproducible", "nothing: batch renders are always reproducible"},
+      {"quiet", "`penumbra batch -q`"},
+      {"debug-pixel", "`penumbra render --debug-pixel`"},
+      {"help", "`penumbra render --help`"},
+  };
+  return m;
+}
+
+/// What a unit or a whole shot renders.
+struct Target {
+  std::optional<int64_t> frame;  ///< one frame; none with `range` or for a still
+  bool range = false;            ///< every frame of the shot
+  int tile = 0, tiles = 1;
+  bool quiet = false;
+};
+
+/// The command line of `render` for `target` of the shot, from its keys and settings; throws
+/// InputError naming the setting for one `render` does not have or that the job sets itself.
+std::vector<std::string> render_command_line(const Job& job, const JobShot& shot, const Target& t,
+                                             const CLI::App& render) {
+  std::vector<std::string> argv = {"penumbra-render", shot.scene.string()};
+  const std::string out = t.frame ? substitute_frame(shot.output, *t.frame) : shot.output;
+  argv.insert(argv.end(), {"-o", t.tiles > 1 ? tile_part_path(out, t.tile, t.tiles).string() : out});
+  if (shot.png.empty() || t.tiles > 1)
+    argv.push_back("--no-png");
+  else
+    argv.insert(argv.end(), {"--png", shot.png});
+  if (!shot.stats_json.empty() && t.tiles == 1) argv.insert(argv.end(), {"--stats-json", shot.stats_json});
+  if (!shot.camera.empty()) argv.insert(argv.end(), {"--camera", shot.camera});
+  if (t.range && shot.frames) argv.insert(argv.end(), {"--frames", shot.frames_text});
+  if (t.frame) argv.insert(argv.end(), {"--frame", std::to_string(*t.frame)});
+  if (t.tiles > 1)
+    argv.insert(argv.end(), {"--tile", std::to_string(t.tile) + "/" + std::to_string(t.tiles)});
+  argv.push_back("--reproducible");
+  if (t.quiet) argv.push_back("-q");
+  for (const JobSetting& s : shot.settings) {
+    const auto reserved = reserved_settings().find(s.key);
+    if (reserved != reserved_settings().end())
+      throw InputError(job.file.string(), s.where, "is set by " + reserved->second + ", not in settings");
+    const CLI::Option* opt = render.get_option_no_throw("--" + s.key);
+    if (!opt || s.key.size() < 2)
+      throw InputError(job.file.string(), s.where,
+                       "'" + s.key +
+                           "' is not a setting (the long name of a `penumbra render` flag, such as "
+                           "\"spp\" or \"integrator\")");
+    const bool is_flag = opt->get_type_size() == 0;
+    if (is_flag != s.flag)
+      throw InputError(
+          job.file.string(), s.where,
+          is_flag ? "is an on/off flag: give true or false" : "takes a value, not true or false");
+    if (s.flag) {
+      if (s.enabled) argv.push_back("--" + s.key);
+      continue;
+    }
+    for (const std::string& v : s.values) argv.insert(argv.end(), {"--" + s.key, v});
+  }
+  return argv;
+}
+
+/// `render`'s flags parsed from `argv` exactly as the command line would be.
+RenderArgs parse_render_args(const Job& job, const JobShot& shot, const std::vector<std::string>& argv,
+                             CLI::App& render, RenderArgs& args) {
+  std::vector<const char*> c;
+  for (const auto& s : argv) c.push_back(s.c_str());
+  try {
+    render.parse(int(c.size()), c.data());
+  } catch (const CLI::ParseError& e) {
+    throw InputError(job.file.string(), shot.where + ".settings", e.what());
+  }
+  note_given_options(render, int(c.size()), const_cast<char**>(c.data()), args);
+  return args;
+}
+
+RenderArgs shot_target_args(const Job& job, const JobShot& shot, const Target& t) {
+  RenderArgs args;
+  CLI::App render;
+  add_render_options(render, args);
+  return parse_render_args(job, shot, render_command_line(job, shot, t, render), render, args);
+}
+
+/// check_render() of the shot's flags, with the shot named in the message.
+std::vector<std::pair<std::string, fs::path>> check_shot(const Job& job, const JobShot& shot,
+                                                         const RenderArgs& args) {
+  try {
+    return check_render(args);
+  } catch (const InputError& e) {
+    throw InputError(job.file.string(), shot.where, e.what());
+  } catch (const UsageError& e) {
+    throw InputError(job.file.string(), shot.where, e.what());
+  } catch (const std::invalid_argument& e) {
+    throw InputError(job.file.string(), shot.where, e.what());
+  }
+}
+
+/// The tiled frames: per frame's first stripe unit, the units of its stripes.
+std::vector<size_t> first_stripes(const PreparedJob& pj) {
+  std::vector<size_t> out;
+  for (size_t n = 0; n < pj.units.size(); ++n)
+    if (pj.units[n].tiles > 1 && pj.units[n].tile == 0) out.push_back(n);
+  return out;
+}
+
+bool complete(const fs::path& exr) {
+  std::string problem;
+  return is_complete_exr(exr, problem);
+}
+
+int list_units(const PreparedJob& pj) {
+  for (size_t n = 0; n < pj.units.size(); ++n) {
+    const WorkUnit& u = pj.units[n];
+    const std::string frame = u.frame ? std::to_string(*u.frame) : "-";
+    const std::string tile = u.tiles > 1 ? std::to_string(u.tile) + "/" + std::to_string(u.tiles) : "-";
+    std::printf("%zu\t%s\t%s\t%s\t%s\n", n, pj.job.shots[u.shot].name.c_str(), frame.c_str(), tile.c_str(),
+                unit_output(pj.job, u).c_str());
+  }
+  return kExitOk;
+}
+
+int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
+  const WorkUnit& u = pj.units[n];
+  const fs::path final_exr = unit_output(pj.job, u);
+  if (b.skip_existing && u.tiles > 1 && complete(final_exr)) {
+    if (!b.quiet)
+      std::fprintf(stderr, "penumbra: unit %zu: frame %s is complete; skipped\n", n,
+                   final_exr.string().c_str());
+    return kExitOk;
+  }
+  RenderArgs args = unit_render_args(pj, n);
+  args.skip_existing = b.skip_existing;
+  return run_render(args);
+}
+
+/// Merges tiled frame `first` (its first stripe's unit) and writes its display image; false
+/// when a stripe is missing (reported).
+bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
+  const WorkUnit& u = pj.units[first];
+  const JobShot& shot = pj.job.shots[u.shot];
+  const fs::path final_exr = unit_output(pj.job, u);
+  if (b.skip_existing && complete(final_exr)) return true;
+  std::vector<fs::path> parts;
+  std::string missing;
+  for (int t = 0; t < u.tiles; ++t) {
+    parts.push_back(tile_part_path(final_exr, t, u.tiles));
+    if (!complete(parts.back())) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
+  }
+  if (!missing.empty()) {
+    std::fprintf(stderr,
+                 "penumbra: error: %s: cannot merge %s: the stripes of units %s are missing or incomplete\n",
+                 pj.job.file.string().c_str(), final_exr.string().c_str(), missing.c_str());
+    return false;
+  }
+  const RenderRequest q = check_render_args(pj.shot_args[u.shot]);
+  MergeOptions options;
+  options.max_memory_bytes = q.budget;
+  merge_exr_parts(parts, final_exr, options);
+  if (!shot.png.empty()) {
+    const fs::path png = substitute_frame(shot.png, u.frame.value_or(0));
+    write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
+  }
+  for (const fs::path& p : parts) fs::remove(p);
+  if (!b.quiet)
+    std::fprintf(stderr, "penumbra: merged %d stripes into %s\n", u.tiles, final_exr.string().c_str());
+  return true;
+}
+
+int merge_frames(const PreparedJob& pj, const BatchArgs& b) {
+  int failed = 0;
+  for (const size_t first : first_stripes(pj)) failed += merge_frame(pj, first, b) ? 0 : 1;
+  return failed ? kExitInternal : kExitOk;
+}
+
+int render_all(const PreparedJob& pj, const BatchArgs& b) {
+  for (size_t s = 0; s < pj.job.shots.size(); ++s) {
+    if (!b.quiet) std::fprintf(stderr, "penumbra: shot %s\n", pj.job.shots[s].name.c_str());
+    RenderArgs args = pj.shot_args[s];
+    args.skip_existing = b.skip_existing;
+    if (const int rc = run_render(args); rc != kExitOk) return rc;
+  }
+  return kExitOk;
+}
+
+/// Creates the folders every unit of `pj` writes into (a farm's output tree need not exist).
+void create_output_folders(const PreparedJob& pj) {
+  std::set<fs::path> folders;
+  for (const WorkUnit& u : pj.units) {
+    const JobShot& shot = pj.job.shots[u.shot];
+    for (const std::string* pattern : {&shot.output, &shot.png, &shot.stats_json})
+      if (!pattern->empty())
+        folders.insert(fs::path(u.frame ? substitute_frame(*pattern, *u.frame) : *pattern).parent_path());
+  }
+  for (const fs::path& f : folders) {
+    std::error_code ec;
+    fs::create_directories(f, ec);
+    if (ec)
+      throw InputError(pj.job.file.string(), "",
+                       "cannot create the output folder " + f.string() + ": " + ec.message());
+  }
+}
+
+}  // namespace
+
+PreparedJob prepare_job(const std::string& job_file, int default_tiles, bool quiet, bool create_folders) {
+  PreparedJob pj;
+  pj.job = read_job_file(job_file);
+  pj.units = job_units(pj.job, default_tiles);
+  if (create_folders) create_output_folders(pj);
+  std::map<std::string, std::string> writer;  // every output file -> the shot writing it
+  for (size_t s = 0; s < pj.job.shots.size(); ++s) {
+    const JobShot& shot = pj.job.shots[s];
+    pj.shot_args.push_back(shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, quiet}));
+    auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
+    for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
+      if (u.shot == s && u.tiles > 1) {
+        auto stripe =
+            check_shot(pj.job, shot, shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, quiet}));
+        break;
+      }
+    for (const auto& [option, file] : outputs) {
+      const auto [it, fresh] = writer.emplace(fs::absolute(file).lexically_normal().string(), shot.where);
+      if (!fresh && it->second != shot.where)
+        throw InputError(pj.job.file.string(), shot.where,
+                         file.string() + " is also written by " + it->second);
+    }
+  }
+  return pj;
+}
+
+RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
+  const WorkUnit& u = pj.units.at(n);
+  const JobShot& shot = pj.job.shots[u.shot];
+  return shot_target_args(pj.job, shot, {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet});
+}
+
+bool unit_complete(const PreparedJob& pj, size_t n) {
+  const WorkUnit& u = pj.units.at(n);
+  const fs::path final_exr = unit_output(pj.job, u);
+  return complete(final_exr) || (u.tiles > 1 && complete(tile_part_path(final_exr, u.tile, u.tiles)));
+}
+
+int run_batch(const BatchArgs& b) {
+  const PreparedJob pj = prepare_job(b.job_file, b.tiles, b.quiet, true);
+  if (b.list) return list_units(pj);
+  if (b.unit) {
+    if (*b.unit < 0 || uint64_t(*b.unit) >= pj.units.size())
+      throw UsageError("--unit " + std::to_string(*b.unit) + ": " + b.job_file + " has units 0 to " +
+                       std::to_string(pj.units.size() - 1) + " (`penumbra batch --list` prints them)");
+    return render_unit(pj, size_t(*b.unit), b);
+  }
+  if (b.merge) return merge_frames(pj, b);
+  return render_all(pj, b);
+}
+
+}  // namespace penumbra::cli

@@ -1,0 +1,50 @@
+// `penumbra batch JOB.json`: the shots of a job file rendered locally, listed as work units
+// (shot x frame x tile, one per line) for a farm, one unit rendered (`--unit N`), or the tiled
+// frames merged (`--merge`). The job and every unit's render flags are checked before anything
+// renders; every render is `--reproducible`, so a frame rendered whole, or in stripes on a farm
+// and merged, is the same file.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "apps/penumbra/render_options.h"
+#include "io/job_file.h"
+
+namespace penumbra::cli {
+
+struct BatchArgs {
+  std::string job_file;
+  bool list = false;            ///< print the work units
+  std::optional<int64_t> unit;  ///< render this unit only
+  bool merge = false;           ///< merge every tiled frame whose stripes are complete
+  int tiles = 1;                ///< stripes per frame for shots that give no "tiles"
+  bool skip_existing = false;   ///< keep complete outputs (the farm's re-runs)
+  bool quiet = false;
+};
+
+/// A checked job: the file, its units, and each shot's `render` flags for a whole range.
+struct PreparedJob {
+  Job job;
+  std::vector<WorkUnit> units;
+  std::vector<RenderArgs> shot_args;  ///< per shot: every frame, whole, into its outputs
+};
+
+/// Reads the job, maps every shot's settings onto `render`'s flags and checks them as `render`
+/// would (every frame's outputs, a tiled frame's stripes), and that no two shots write one
+/// file. With `create_folders` the folders the outputs go into are made first (a farm's output
+/// tree need not exist). Throws InputError naming the job file, the shot and the key.
+PreparedJob prepare_job(const std::string& job_file, int default_tiles, bool quiet, bool create_folders);
+
+/// The `render` flags of unit `n`: its frame, and for a stripe `--tile i/N` into
+/// tile_part_path() without display image or statistics.
+RenderArgs unit_render_args(const PreparedJob& job, size_t n);
+
+/// True when unit `n` needs no render: its frame's EXR is complete, or (a stripe) its part is.
+bool unit_complete(const PreparedJob& job, size_t n);
+
+/// Runs `batch`. Returns the exit code; throws for bad input.
+int run_batch(const BatchArgs& args);
+
+}  // namespace penumbra::cli
