@@ -47,6 +47,8 @@ struct Target {
   bool range = false;            ///< every frame of the shot
   int tile = 0, tiles = 1;
   bool quiet = false;
+  int threads = 0;         ///< for a shot whose settings give none
+  std::string max_memory;  ///< likewise
 };
 
 /// The command line of `render` for `target` of the shot, from its keys and settings; throws
@@ -68,6 +70,13 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
     argv.insert(argv.end(), {"--tile", std::to_string(t.tile) + "/" + std::to_string(t.tiles)});
   argv.push_back("--reproducible");
   if (t.quiet) argv.push_back("-q");
+  const auto sets = [&](const char* key) {
+    for (const JobSetting& s : shot.settings)
+      if (s.key == key) return true;
+    return false;
+  };
+  if (t.threads > 0 && !sets("threads")) argv.insert(argv.end(), {"--threads", std::to_string(t.threads)});
+  if (!t.max_memory.empty() && !sets("max-memory")) argv.insert(argv.end(), {"--max-memory", t.max_memory});
   for (const JobSetting& s : shot.settings) {
     const auto reserved = reserved_settings().find(s.key);
     if (reserved != reserved_settings().end())
@@ -234,20 +243,25 @@ void create_output_folders(const PreparedJob& pj) {
 
 }  // namespace
 
-PreparedJob prepare_job(const std::string& job_file, int default_tiles, bool quiet, bool create_folders) {
+PreparedJob prepare_job(const BatchArgs& b, bool create_folders) {
   PreparedJob pj;
-  pj.job = read_job_file(job_file);
-  pj.units = job_units(pj.job, default_tiles);
+  pj.job = read_job_file(b.job_file);
+  pj.units = job_units(pj.job, b.tiles);
+  pj.threads = b.threads;
+  pj.max_memory = b.max_memory;
+  const bool quiet = b.quiet;
   if (create_folders) create_output_folders(pj);
   std::map<std::string, std::string> writer;  // every output file -> the shot writing it
   for (size_t s = 0; s < pj.job.shots.size(); ++s) {
     const JobShot& shot = pj.job.shots[s];
-    pj.shot_args.push_back(shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, quiet}));
+    pj.shot_args.push_back(
+        shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, quiet, b.threads, b.max_memory}));
     auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
     for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
       if (u.shot == s && u.tiles > 1) {
-        auto stripe =
-            check_shot(pj.job, shot, shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, quiet}));
+        check_shot(
+            pj.job, shot,
+            shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, quiet, b.threads, b.max_memory}));
         break;
       }
     for (const auto& [option, file] : outputs) {
@@ -263,7 +277,8 @@ PreparedJob prepare_job(const std::string& job_file, int default_tiles, bool qui
 RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
   const WorkUnit& u = pj.units.at(n);
   const JobShot& shot = pj.job.shots[u.shot];
-  return shot_target_args(pj.job, shot, {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet});
+  return shot_target_args(
+      pj.job, shot, {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet, pj.threads, pj.max_memory});
 }
 
 bool unit_complete(const PreparedJob& pj, size_t n) {
@@ -273,7 +288,7 @@ bool unit_complete(const PreparedJob& pj, size_t n) {
 }
 
 int run_batch(const BatchArgs& b) {
-  const PreparedJob pj = prepare_job(b.job_file, b.tiles, b.quiet, true);
+  const PreparedJob pj = prepare_job(b, true);
   if (b.list) return list_units(pj);
   if (b.unit) {
     if (*b.unit < 0 || uint64_t(*b.unit) >= pj.units.size())

@@ -22,6 +22,8 @@ struct BatchArgs {
   int tiles = 1;                ///< stripes per frame for shots that give no "tiles"
   bool skip_existing = false;   ///< keep complete outputs (the farm's re-runs)
   bool quiet = false;
+  int threads = 0;         ///< `render --threads` for shots whose settings give none; 0 = none
+  std::string max_memory;  ///< `render --max-memory` for shots whose settings give none
 };
 
 /// A checked job: the file, its units, and each shot's `render` flags for a whole range.
@@ -29,13 +31,16 @@ struct PreparedJob {
   Job job;
   std::vector<WorkUnit> units;
   std::vector<RenderArgs> shot_args;  ///< per shot: every frame, whole, into its outputs
+  int threads = 0;                    ///< BatchArgs' defaults
+  std::string max_memory;
 };
 
 /// Reads the job, maps every shot's settings onto `render`'s flags and checks them as `render`
 /// would (every frame's outputs, a tiled frame's stripes), and that no two shots write one
-/// file. With `create_folders` the folders the outputs go into are made first (a farm's output
+/// file. `args` gives the job file, the default stripes, the default threads and memory and
+/// quiet. With `create_folders` the folders the outputs go into are made first (a farm's output
 /// tree need not exist). Throws InputError naming the job file, the shot and the key.
-PreparedJob prepare_job(const std::string& job_file, int default_tiles, bool quiet, bool create_folders);
+PreparedJob prepare_job(const BatchArgs& args, bool create_folders);
 
 /// The `render` flags of unit `n`: its frame, and for a stripe `--tile i/N` into
 /// tile_part_path() without display image or statistics.

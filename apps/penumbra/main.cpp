@@ -14,6 +14,7 @@
 #include "apps/penumbra/mesh_command.h"
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
+#include "apps/penumbra/submit_command.h"
 #include "io/error.h"
 
 using namespace penumbra;
@@ -83,6 +84,28 @@ void add_batch_options(CLI::App& batch, BatchArgs& a) {
   batch.add_flag("--skip-existing", a.skip_existing,
                  "keep outputs that already are complete EXRs (frames, stripes, merged frames)");
   batch.add_flag("-q,--quiet", a.quiet, "no progress, warnings or summaries on stderr");
+  batch.add_option("--threads", a.threads, "render --threads for shots whose settings give none")
+      ->check(CLI::Range(1, 1024));
+  batch.add_option("--max-memory", a.max_memory, "render --max-memory for shots whose settings give none");
+}
+
+void add_submit_slurm_options(CLI::App& slurm, SubmitArgs& a) {
+  slurm.add_option("job", a.job_file, "job file (.json)")->required();
+  slurm
+      .add_option("--tiles", a.tiles,
+                  "split every frame of shots without \"tiles\" into N stripes (default 1)")
+      ->check(CLI::Range(1, kMaxJobTiles));
+  slurm.add_option("--partition", a.partition, "Slurm partition (default: the cluster's)");
+  slurm.add_flag("--dry-run", a.dry_run, "print the sbatch scripts and commands; write and submit nothing");
+  slurm.add_option("--threads", a.threads, "CPUs per task for shots whose settings give no threads")
+      ->check(CLI::Range(1, 1024));
+  slurm.add_option("--max-memory", a.max_memory, "memory budget for shots whose settings give none, e.g. 4G");
+  slurm.add_option("--retries", a.retries, "runs of a failed unit after the first, per task (default 2)")
+      ->check(CLI::Range(0, 100));
+  slurm.add_option("--scripts", a.scripts,
+                   "folder for the scripts and logs (default: JOB.slurm beside the job)");
+  slurm.add_option("--time", a.time_limit,
+                   "Slurm time limit per task, e.g. 2:00:00 (default: the partition's)");
 }
 
 int report(const char* kind, const char* what, int code) {
@@ -112,6 +135,12 @@ int main(int argc, char** argv) {
   auto* batch = app.add_subcommand(
       "batch", "Render the shots of a job file, or list its work units and render one of them (farms)");
   add_batch_options(*batch, batch_args);
+  SubmitArgs submit_args;
+  auto* submit = app.add_subcommand("submit", "Submit a job file's work units to a farm scheduler");
+  submit->require_subcommand(1);
+  auto* submit_slurm = submit->add_subcommand(
+      "slurm", "Submit as a Slurm array job (one work unit per task) and a merge job for tiled frames");
+  add_submit_slurm_options(*submit_slurm, submit_args);
   MeshArgs mesh_args;
   auto* mesh = app.add_subcommand(
       "mesh",
@@ -129,6 +158,7 @@ int main(int argc, char** argv) {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
     if (*batch) return run_batch(batch_args);
+    if (*submit) return run_submit_slurm(submit_args);
     if (*mesh) return run_mesh(mesh_args);
     if (*info)
       return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,

@@ -1,0 +1,244 @@
+// `penumbra submit slurm`: resources, the sbatch scripts and their submission.
+#include "apps/penumbra/submit_command.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+#include "apps/penumbra/batch_command.h"
+#include "apps/penumbra/cli_support.h"
+#include "io/atomic_file.h"
+#include "io/error.h"
+#include "io/exr_merge.h"
+
+namespace penumbra::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Memory a task asks for beyond the render's budget: the program, its libraries and thread stacks.
+constexpr uint64_t kTaskOverheadMiB = 512;
+
+/// `s` in single quotes for sh.
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+/// What every task asks Slurm for: the most CPUs and memory any shot renders with.
+struct Resources {
+  int cpus = 1;
+  uint64_t mem_mib = 0;
+};
+
+Resources task_resources(const PreparedJob& pj) {
+  Resources r;
+  for (size_t s = 0; s < pj.job.shots.size(); ++s) {
+    const RenderArgs& args = pj.shot_args[s];
+    const std::string& where = pj.job.shots[s].where;
+    if (args.threads <= 0)
+      throw InputError(
+          pj.job.file.string(), where,
+          "gives no \"threads\" setting: the CPUs each task asks Slurm for (set it in the job, or "
+          "--threads)");
+    if (args.max_memory.empty())
+      throw InputError(
+          pj.job.file.string(), where,
+          "gives no \"max-memory\" setting: the memory each task asks Slurm for (set it in the job, "
+          "or --max-memory)");
+    r.cpus = std::max(r.cpus, args.threads);
+    r.mem_mib = std::max(r.mem_mib, (parse_bytes(args.max_memory) + (uint64_t(1) << 20) - 1) >> 20);
+  }
+  r.mem_mib += kTaskOverheadMiB;
+  return r;
+}
+
+/// "0-2,5,7-8" for the sorted indices.
+std::string array_spec(const std::vector<size_t>& units) {
+  std::string spec;
+  for (size_t i = 0; i < units.size();) {
+    size_t j = i;
+    while (j + 1 < units.size() && units[j + 1] == units[j] + 1) ++j;
+    spec +=
+        (spec.empty() ? "" : ",") + std::to_string(units[i]) + (j > i ? "-" + std::to_string(units[j]) : "");
+    i = j + 1;
+  }
+  return spec;
+}
+
+/// The `batch` options every task passes on, so that its units are the ones listed here.
+std::string batch_options(const SubmitArgs& a) {
+  std::string o;
+  if (a.tiles > 1) o += " --tiles " + std::to_string(a.tiles);
+  if (a.threads > 0) o += " --threads " + std::to_string(a.threads);
+  if (!a.max_memory.empty()) o += " --max-memory " + quoted(a.max_memory);
+  return o;
+}
+
+std::string sbatch_header(const std::string& name, const Resources& r, int cpus, const SubmitArgs& a,
+                          const fs::path& log) {
+  std::string h = "#!/bin/sh\n";
+  h += "#SBATCH --job-name=" + name + "\n";
+  h += "#SBATCH --cpus-per-task=" + std::to_string(cpus) + "\n";
+  h += "#SBATCH --mem=" + std::to_string(r.mem_mib) + "M\n";
+  h += "#SBATCH --requeue\n";
+  h += "#SBATCH --output=" + log.string() + "\n";
+  if (!a.partition.empty()) h += "#SBATCH --partition=" + a.partition + "\n";
+  if (!a.time_limit.empty()) h += "#SBATCH --time=" + a.time_limit + "\n";
+  return h;
+}
+
+std::string render_script(const PreparedJob& pj, const SubmitArgs& a, const Resources& r,
+                          const std::vector<size_t>& pending, const fs::path& dir, const std::string& exe) {
+  const std::string stem = pj.job.file.stem().string();
+  std::string s = sbatch_header("penumbra-" + stem, r, r.cpus, a, dir / "render-%A_%a.log");
+  s += "#SBATCH --array=" + array_spec(pending) + "\n";
+  s += "# One work unit of " + pj.job.file.string() +
+       " per array task (`penumbra batch --list` prints them).\n";
+  s += "# A failed unit is run again up to " + std::to_string(a.retries) +
+       " times; bad input (exit 2) and a cancel or interrupt (130, 143: Slurm requeues what it preempts) are "
+       "not.\n";
+  s += "retries=" + std::to_string(a.retries) + "\nattempt=0\n";
+  s += "while :; do\n";
+  s += "  " + quoted(exe) + " batch " + quoted(pj.job.file.string()) +
+       " --unit \"$SLURM_ARRAY_TASK_ID\" --skip-existing" + batch_options(a) + "\n";
+  s += "  rc=$?\n";
+  s += "  case \"$rc\" in 0 | 2 | 130 | 143) exit \"$rc\" ;; esac\n";
+  s += "  if [ \"$attempt\" -ge \"$retries\" ]; then exit \"$rc\"; fi\n";
+  s += "  attempt=$((attempt + 1))\n";
+  s += "  echo \"penumbra: unit $SLURM_ARRAY_TASK_ID exited with $rc; attempt $((attempt + 1)) of "
+       "$((retries + 1))\" >&2\n";
+  s += "done\n";
+  return s;
+}
+
+std::string merge_script(const PreparedJob& pj, const SubmitArgs& a, const Resources& r, const fs::path& dir,
+                         const std::string& exe) {
+  const std::string stem = pj.job.file.stem().string();
+  std::string s = sbatch_header("penumbra-merge-" + stem, r, 1, a, dir / "merge-%j.log");
+  s += "#SBATCH --kill-on-invalid-dep=yes\n";  // a failed array leaves no merge job waiting forever
+  s += "# Assembles every tiled frame of " + pj.job.file.string() + " from its stripes.\n";
+  s += "exec " + quoted(exe) + " batch " + quoted(pj.job.file.string()) + " --merge --skip-existing" +
+       batch_options(a) + "\n";
+  return s;
+}
+
+/// True when `sbatch` is an executable file in a folder of $PATH.
+bool sbatch_on_path() {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::string dirs = path;
+  for (size_t i = 0; i <= dirs.size();) {
+    const size_t j = std::min(dirs.find(':', i), dirs.size());
+    const fs::path candidate =
+        fs::path(dirs.substr(i, j - i).empty() ? "." : dirs.substr(i, j - i)) / "sbatch";
+    if (access(candidate.c_str(), X_OK) == 0) return true;
+    i = j + 1;
+  }
+  return false;
+}
+
+/// Runs `sbatch --parsable ARGS SCRIPT` and returns the job id; throws std::runtime_error with
+/// sbatch's output when it fails.
+std::string sbatch(const std::string& args, const fs::path& script) {
+  const std::string command = "sbatch --parsable " + args + " " + quoted(script.string()) + " 2>&1";
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) throw std::runtime_error("cannot run sbatch: " + std::string(std::strerror(errno)));
+  std::string out;
+  char buf[512];
+  while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int status = pclose(p);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  if (status != 0 || out.empty())
+    throw std::runtime_error("sbatch " + script.string() + " failed" +
+                             (WIFEXITED(status) ? " with exit " + std::to_string(WEXITSTATUS(status)) : "") +
+                             ": " + out);
+  const std::string id = out.substr(out.rfind('\n') == std::string::npos ? 0 : out.rfind('\n') + 1);
+  return id.substr(0, id.find(';'));
+}
+
+void write_script(const fs::path& path, const std::string& text) {
+  write_atomically(path,
+                   [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), path); });
+  fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+}
+
+}  // namespace
+
+int run_submit_slurm(const SubmitArgs& a) {
+  BatchArgs b;
+  b.job_file = a.job_file;
+  b.tiles = a.tiles;
+  b.threads = a.threads;
+  b.max_memory = a.max_memory;
+  b.quiet = true;
+  const PreparedJob pj = prepare_job(b, true);  // also for --dry-run: the checks need the folders
+  const Resources r = task_resources(pj);
+  std::vector<size_t> pending;
+  bool merge_needed = false;
+  for (size_t n = 0; n < pj.units.size(); ++n) {
+    if (!unit_complete(pj, n)) pending.push_back(n);
+    if (pj.units[n].tiles > 1) {
+      std::string problem;
+      merge_needed = merge_needed || !is_complete_exr(unit_output(pj.job, pj.units[n]), problem);
+    }
+  }
+  if (pending.empty() && !merge_needed) {
+    std::fprintf(stderr, "penumbra: every frame of %s is complete; nothing to submit\n", a.job_file.c_str());
+    return kExitOk;
+  }
+  const fs::path dir =
+      a.scripts.empty() ? fs::path(pj.job.file).replace_extension(".slurm") : fs::absolute(a.scripts);
+  const std::string exe = fs::read_symlink("/proc/self/exe").string();
+  const std::string render = pending.empty() ? "" : render_script(pj, a, r, pending, dir, exe);
+  const std::string merge = merge_needed ? merge_script(pj, a, r, dir, exe) : "";
+  if (a.dry_run) {
+    if (!render.empty())
+      std::printf("# %s\n%s\n# sbatch --parsable %s\n\n", (dir / "render.sbatch").c_str(), render.c_str(),
+                  (dir / "render.sbatch").c_str());
+    if (!merge.empty())
+      std::printf("# %s\n%s\n# sbatch --parsable%s %s\n", (dir / "merge.sbatch").c_str(), merge.c_str(),
+                  render.empty() ? "" : " --dependency=afterok:<the array job>",
+                  (dir / "merge.sbatch").c_str());
+    return kExitOk;
+  }
+  if (!sbatch_on_path())
+    throw std::runtime_error(
+        "sbatch is not on PATH: is Slurm installed on this machine? (--dry-run prints the "
+        "scripts without submitting)");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  std::string array_id;
+  if (!render.empty()) {
+    write_script(dir / "render.sbatch", render);
+    array_id = sbatch("", dir / "render.sbatch");
+    std::printf("array %s\n", array_id.c_str());
+    std::fprintf(stderr,
+                 "penumbra: submitted array job %s: %zu of %zu units (%s), %d CPUs and %llu MiB each\n",
+                 array_id.c_str(), pending.size(), pj.units.size(), array_spec(pending).c_str(), r.cpus,
+                 static_cast<unsigned long long>(r.mem_mib));
+  }
+  if (!merge.empty()) {
+    write_script(dir / "merge.sbatch", merge);
+    const std::string merge_id =
+        sbatch(array_id.empty() ? "" : "--dependency=afterok:" + array_id, dir / "merge.sbatch");
+    std::printf("merge %s\n", merge_id.c_str());
+    std::fprintf(stderr, "penumbra: submitted merge job %s%s\n", merge_id.c_str(),
+                 array_id.empty() ? "" : (" (runs when array job " + array_id + " has succeeded)").c_str());
+  }
+  std::fprintf(stderr, "penumbra: scripts and logs in %s\n", dir.c_str());
+  return kExitOk;
+}
+
+}  // namespace penumbra::cli
