@@ -122,11 +122,11 @@ RenderArgs shot_target_args(const Job& job, const JobShot& shot, const Target& t
   return parse_render_args(job, shot, render_command_line(job, shot, t, render), render, args);
 }
 
-/// check_render() of the shot's flags, with the shot named in the message.
-std::vector<std::pair<std::string, fs::path>> check_shot(const Job& job, const JobShot& shot,
-                                                         const RenderArgs& args) {
+/// f(), with bad input reported as an InputError that names the job file and the shot.
+template <class F>
+auto in_shot(const Job& job, const JobShot& shot, F f) -> decltype(f()) {
   try {
-    return check_render(args);
+    return f();
   } catch (const InputError& e) {
     throw InputError(job.file.string(), shot.where, e.what());
   } catch (const UsageError& e) {
@@ -134,6 +134,12 @@ std::vector<std::pair<std::string, fs::path>> check_shot(const Job& job, const J
   } catch (const std::invalid_argument& e) {
     throw InputError(job.file.string(), shot.where, e.what());
   }
+}
+
+/// check_render() of the shot's flags, with the shot named in the message.
+std::vector<std::pair<std::string, fs::path>> check_shot(const Job& job, const JobShot& shot,
+                                                         const RenderArgs& args) {
+  return in_shot(job, shot, [&] { return check_render(args); });
 }
 
 /// The tiled frames: per frame's first stripe unit, the units of its stripes.
@@ -171,7 +177,7 @@ int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
   }
   RenderArgs args = unit_render_args(pj, n);
   args.skip_existing = b.skip_existing;
-  return run_render(args);
+  return in_shot(pj.job, pj.job.shots[u.shot], [&] { return run_render(args); });
 }
 
 /// Merges tiled frame `first` (its first stripe's unit) and writes its display image; false
@@ -183,10 +189,14 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   if (b.skip_existing && complete(final_exr)) return true;
   std::vector<fs::path> parts;
   std::string missing;
+  bool any = false;
   for (int t = 0; t < u.tiles; ++t) {
     parts.push_back(tile_part_path(final_exr, t, u.tiles));
+    std::error_code ec;
+    any = any || fs::exists(parts.back(), ec);
     if (!complete(parts.back())) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
   }
+  if (!any && complete(final_exr)) return true;  // merged before, its stripes removed
   if (!missing.empty()) {
     std::fprintf(stderr,
                  "penumbra: error: %s: cannot merge %s: the stripes of units %s are missing or incomplete\n",
@@ -243,7 +253,7 @@ void create_output_folders(const PreparedJob& pj) {
 
 }  // namespace
 
-PreparedJob prepare_job(const BatchArgs& b, bool create_folders) {
+PreparedJob prepare_job(const BatchArgs& b, bool create_folders, bool check_frames) {
   PreparedJob pj;
   pj.job = read_job_file(b.job_file);
   pj.units = job_units(pj.job, b.tiles);
@@ -256,6 +266,7 @@ PreparedJob prepare_job(const BatchArgs& b, bool create_folders) {
     const JobShot& shot = pj.job.shots[s];
     pj.shot_args.push_back(
         shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, quiet, b.threads, b.max_memory}));
+    if (!check_frames) continue;
     auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
     for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
       if (u.shot == s && u.tiles > 1) {
@@ -288,7 +299,8 @@ bool unit_complete(const PreparedJob& pj, size_t n) {
 }
 
 int run_batch(const BatchArgs& b) {
-  const PreparedJob pj = prepare_job(b, true);
+  // A farm task checks its own unit (as `render` does) rather than every frame of the job.
+  const PreparedJob pj = prepare_job(b, true, !b.unit);
   if (b.list) return list_units(pj);
   if (b.unit) {
     if (*b.unit < 0 || uint64_t(*b.unit) >= pj.units.size())

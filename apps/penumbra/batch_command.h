@@ -39,8 +39,10 @@ struct PreparedJob {
 /// would (every frame's outputs, a tiled frame's stripes), and that no two shots write one
 /// file. `args` gives the job file, the default stripes, the default threads and memory and
 /// quiet. With `create_folders` the folders the outputs go into are made first (a farm's output
-/// tree need not exist). Throws InputError naming the job file, the shot and the key.
-PreparedJob prepare_job(const BatchArgs& args, bool create_folders);
+/// tree need not exist). Without `check_frames` only the settings are mapped and parsed, not every
+/// frame's outputs (a farm task checks its own unit when it renders). Throws InputError naming
+/// the job file, the shot and the key.
+PreparedJob prepare_job(const BatchArgs& args, bool create_folders, bool check_frames);
 
 /// The `render` flags of unit `n`: its frame, and for a stripe `--tile i/N` into
 /// tile_part_path() without display image or statistics.

@@ -182,7 +182,7 @@ int run_submit_slurm(const SubmitArgs& a) {
   b.threads = a.threads;
   b.max_memory = a.max_memory;
   b.quiet = true;
-  const PreparedJob pj = prepare_job(b, true);  // also for --dry-run: the checks need the folders
+  const PreparedJob pj = prepare_job(b, true, true);  // also for --dry-run: the checks need the folders
   const Resources r = task_resources(pj);
   std::vector<size_t> pending;
   bool merge_needed = false;
