@@ -2,6 +2,7 @@
 #include "io/job_file.h"
 
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -102,6 +103,10 @@ class JobReader {
   std::string scalar(const json& v, const std::string& where, long index) const {
     const std::string at = index < 0 ? where : where + "[" + std::to_string(index) + "]";
     if (v.is_string()) return v.get<std::string>();
+    // A whole number written as 1e3 or 4.0 reads as a float; an integer flag wants "1000".
+    if (v.is_number_float() && std::isfinite(v.get<double>()) &&
+        std::trunc(v.get<double>()) == v.get<double>() && std::fabs(v.get<double>()) < 9007199254740992.0)
+      return std::to_string(static_cast<long long>(v.get<double>()));
     if (v.is_number()) return v.dump();
     fail(at, "must be a string, a number, a boolean or an array of strings and numbers (got " +
                  gltf::shown(v) + ")");
@@ -155,7 +160,11 @@ JobShot read_shot(const JobReader& r, const json& j, size_t index, const std::ve
     r.fail(at + ".name", "'" + shot.name + "' must be 1 to 128 letters, digits, '.', '_' or '-'");
   shot.where = at + " (" + shot.name + ")";
   shot.scene = r.path(r.required_string(j, "scene", shot.where));
-  check_input_file(shot.scene, shot.where + ".scene", kMaxSceneFileBytes);
+  try {
+    check_input_file(shot.scene, "", kMaxSceneFileBytes);
+  } catch (const InputError& e) {
+    r.fail(shot.where + ".scene", e.what());
+  }
   shot.output = r.path(r.required_string(j, "output", shot.where)).string();
   if (const std::string png = r.string_or(j, "png", shot.where); !png.empty())
     shot.png = r.path(png).string();

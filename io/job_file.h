@@ -24,11 +24,12 @@ inline constexpr int kMaxJobTiles = 4096;
 /// One render setting: `render`'s flag `--key` with its values (one per occurrence; several for
 /// an array). A JSON boolean is a flag: true gives it without a value, false leaves it out.
 struct JobSetting {
-  std::string key;                  ///< the flag's long name without "--"
-  std::vector<std::string> values;  ///< numbers as written in the file, strings as they are
-  bool flag = false;                ///< a JSON boolean
-  bool enabled = true;              ///< the boolean's value
-  std::string where;                ///< its JSON path, for messages
+  std::string key;  ///< the flag's long name without "--"
+  std::vector<std::string>
+      values;           ///< numbers in JSON's notation (whole ones as integers), strings as they are
+  bool flag = false;    ///< a JSON boolean
+  bool enabled = true;  ///< the boolean's value
+  std::string where;    ///< its JSON path, for messages
 };
 
 struct JobShot {

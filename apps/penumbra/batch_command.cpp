@@ -87,7 +87,7 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
                        "'" + s.key +
                            "' is not a setting (the long name of a `penumbra render` flag, such as "
                            "\"spp\" or \"integrator\")");
-    const bool is_flag = opt->get_type_size() == 0;
+    const bool is_flag = opt->get_expected_max() == 0;  // CLI11's flags take no value
     if (is_flag != s.flag)
       throw InputError(
           job.file.string(), s.where,

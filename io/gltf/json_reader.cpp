@@ -38,8 +38,9 @@ void JsonReader::check_keys(const json& obj, const std::string& where, const std
       for (const char* k : list)
         if (k) keys += (keys.empty() ? "" : ", ") + std::string(k);
     if (listed(known, key))
-      fail(where + "." + key, "does not apply to " + what + " (its keys: " + keys + ")");
-    fail(where + "." + key, "unknown key (" + what + " has: " + keys + ")");
+      fail(where.empty() ? key : where + "." + key,
+           "does not apply to " + what + " (its keys: " + keys + ")");
+    fail(where.empty() ? key : where + "." + key, "unknown key (" + what + " has: " + keys + ")");
   }
 }
 
