@@ -168,6 +168,8 @@ class EmbreeAccelerator final : public Accelerator {
       const InstanceView& inst = instances[i];
       const GeometryView& mesh = meshes[inst.mesh];
       const unsigned id = unsigned(i);
+      m_meshes.push_back(inst.mesh);
+      m_kinds.push_back(instance_kind(inst));
       Affine3f inverse_map;
       if (is_identity(inst.to_world)) {
         attach_geometry(m_scene, mesh, id);
@@ -198,10 +200,7 @@ class EmbreeAccelerator final : public Accelerator {
     rtcCommitScene(m_scene);
     throw_if_error("building the scene (rtcCommitScene)");
     m_bytes = uint64_t(std::max<int64_t>(0, device_bytes() - bytes_before));
-    RTCBounds b;
-    rtcGetSceneBounds(m_scene, &b);
-    if (m_triangles + m_shapes.size() > 0)
-      m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+    read_bounds();
     m_build_seconds = timer.seconds();
   }
 
@@ -243,6 +242,28 @@ class EmbreeAccelerator final : public Accelerator {
 
   Bounds3f bounds() const override { return m_bounds; }
 
+  /// New transforms on the instance geometries, then the top scene committed again: the
+  /// instanced meshes' scenes are kept as they are.
+  bool update_instances(std::span<const InstanceView> instances) override {
+    if (instances.size() != m_kinds.size()) return false;
+    for (size_t i = 0; i < instances.size(); ++i)
+      if (instances[i].mesh != m_meshes[i] || instance_kind(instances[i]) != m_kinds[i]) return false;
+    const BuildTimer timer;
+    take_error();
+    for (size_t i = 0; i < instances.size(); ++i) {
+      if (m_kinds[i] != InstanceKind::Placed) continue;
+      RTCGeometry geom = rtcGetGeometry(m_scene, unsigned(i));
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &instances[i].to_world.m[0][0]);
+      rtcCommitGeometry(geom);
+    }
+    throw_if_error("moving the instances");
+    rtcCommitScene(m_scene);
+    throw_if_error("rebuilding the top level (rtcCommitScene)");
+    read_bounds();
+    m_build_seconds = timer.seconds();
+    return true;
+  }
+
   AccelStats stats() const override {
     AccelStats s;
     s.name = "embree";
@@ -259,6 +280,15 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
  private:
+  /// m_bounds from the committed top scene (empty without triangles or shapes).
+  void read_bounds() {
+    RTCBounds b;
+    rtcGetSceneBounds(m_scene, &b);
+    m_bounds = Bounds3f{};
+    if (m_triangles + m_shapes.size() > 0)
+      m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+  }
+
   /// Attaches a view as triangles, or its shape (copied) as user geometry.
   void attach_geometry(RTCScene scene, const GeometryView& view, unsigned id) {
     if (!view.shape) {
@@ -305,6 +335,8 @@ class EmbreeAccelerator final : public Accelerator {
   RTCScene m_scene = nullptr;
   std::vector<RTCScene> m_objects;               // per-geometry scenes of the instances
   std::vector<std::unique_ptr<Shape>> m_shapes;  // the user geometries' shapes (stable addresses)
+  std::vector<uint32_t> m_meshes;                // per instance: its mesh, as built
+  std::vector<InstanceKind> m_kinds;             // per instance: its kind, as built
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
   uint64_t m_instances = 0;

@@ -29,7 +29,8 @@ std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryVie
 /// Builds an Embree scene over placements of the meshes (geom_id in a Hit = instance index):
 /// identity placements as triangle geometries of the top scene, the others as Embree instances
 /// (RTC_GEOMETRY_TYPE_INSTANCE) of one scene per mesh. Instance mesh indices must be valid
-/// (the factory checks them).
+/// (the factory checks them). update_instances() sets the Embree instances' transforms and
+/// commits the top scene again; the per-mesh scenes are kept.
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config = {});
