@@ -85,19 +85,23 @@ struct KeptScene {
 };
 
 /// Readies the kept scene for the frame of `q`: a static scene as it is; an animated one posed
-/// at the frame's time (pose_gltf_scene) and its accelerator's instances moved, or dropped to be
-/// built anew where they cannot be. Drops the whole scene (the frame loads the file) when the
-/// animation changes more than placements. Returns the note for the frame's line. Throws
-/// InputError as loading the file at that time would.
+/// at the frame's time (pose_gltf_scene) and its accelerator's instances moved (kept as it is
+/// when only cameras and lights move), or dropped to be built anew where they cannot be. Drops
+/// the whole scene (the frame loads the file) when the animation changes more than placements.
+/// Returns the note for the frame's line. Throws InputError as loading the file at that time
+/// would.
 std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest& q) {
   if (!kept) return "";
   if (!kept->loaded.animation) return " (static scene: loaded scene and acceleration structure reused)";
   const auto t0 = Clock::now();
-  if (!q.time || !pose_gltf_scene(*kept->loaded.animation, *q.time, kept->loaded.scene)) {
+  uint64_t moved_instances = 0;
+  if (!q.time || !pose_gltf_scene(*kept->loaded.animation, *q.time, kept->loaded.scene, &moved_instances)) {
     kept.reset();
     return "";
   }
   kept->pose_s = seconds_since(t0);
+  if (moved_instances == 0)
+    return " (animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused)";
   const auto t1 = Clock::now();
   const bool moved = kept->accel->update_instances(instance_views(kept->loaded.scene));
   if (!moved) kept->accel.reset();

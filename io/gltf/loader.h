@@ -80,8 +80,11 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
 /// channels, skinned meshes, a flattened moving mesh, a placement left out as singular or huge
 /// (at the load or at `time`), another count of cameras or lights; the caller then loads the
 /// file again. Throws InputError naming the node or the animation element as load_gltf does
-/// (non-finite or singular transforms, malformed channels), leaving the scene unchanged.
-bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene);
+/// (non-finite or singular transforms, malformed channels), leaving the scene unchanged. When
+/// posed, `*moved_instances` (if given) is set to the number of instances of moving nodes, whose
+/// maps were set again (0: only cameras and lights move, the instances are as they were).
+bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene,
+                     uint64_t* moved_instances = nullptr);
 
 /// Maximum nesting depth of arrays/objects in a JSON text (strings are skipped correctly).
 /// Stops counting once `limit` is exceeded and returns limit + 1.

@@ -70,7 +70,7 @@ bool moved_instance(const Scene& scene, const Instance& old, const Transform& to
 
 }  // namespace gltf
 
-bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene) {
+bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene, uint64_t* moved_instances) {
   using namespace gltf;
   if (!animation.rigid || scene.cameras.size() != animation.cameras.size() ||
       scene.lights.size() != animation.lights.size())
@@ -112,6 +112,7 @@ bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene) 
   for (auto& [i, inst] : moved) scene.instances[i] = inst;
   scene.cameras = std::move(cameras);
   scene.lights = std::move(lights);
+  if (moved_instances) *moved_instances = moved.size();
   return true;
 }
 

@@ -3,8 +3,8 @@
 # animation, seen by a fixed camera): `#` patterns name each frame's files; every frame's pixels
 # equal a separate --frame render of it (compared with idiff: the EXR metadata records each
 # command line, so the files differ in that attribute), with the loaded scene reused and its
-# instances moved (the frame's line says so), also with the camera animated too and with
-# Penumbra's own BVH; --skip-existing keeps complete frames
+# instances moved (the frame's line says so), also with the camera animated too, with
+# Penumbra's own BVH, and with only the camera animated (the structure kept as it is); --skip-existing keeps complete frames
 # untouched and renders again exactly the missing and the truncated ones; a scene without
 # animations is loaded once and gives the same frames; a --tile stripe is skipped like a frame;
 # bad ranges and patterns exit 2 before anything is written.
@@ -21,7 +21,7 @@ for tool in python3 idiff; do
   command -v "$tool" >/dev/null || { echo "PENUMBRA_SKIP: $tool is not installed"; exit 0; }
 done
 
-python3 - "$work/anim.gltf" "$work/camera.gltf" <<'PY'
+python3 - "$work/anim.gltf" "$work/camera.gltf" "$work/camera-only.gltf" <<'PY'
 import base64, json, struct, sys
 pos = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
 quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
@@ -63,6 +63,9 @@ anim["samplers"] += [{"input": 2, "output": 4, "interpolation": "LINEAR"},
 anim["channels"] += [{"sampler": 1, "target": {"node": 1, "path": "translation"}},
                      {"sampler": 2, "target": {"node": 1, "path": "rotation"}}]
 json.dump(gltf, open(sys.argv[2], "w"))
+# Only the camera moves: the cube's channel removed.
+del anim["channels"][0]
+json.dump(gltf, open(sys.argv[3], "w"))
 PY
 scene="$work/anim.gltf"
 common=(--width 32 --spp 1 --no-png)
@@ -98,6 +101,13 @@ for accel in embree bvh; do
   done
 done
 idiff -a "$work/c.embree.0002.exr" "$work/f.0002.exr" >/dev/null 2>&1 && fail "the moving camera sees what the still one sees"
+
+# Only the camera moves: the acceleration structure is kept as it is.
+expect 0 "frame 3 \(3 of 3\) -> .*o.0003.exr \(animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused\)" -- "$bin" render "$work/camera-only.gltf" --frames 1-3 -o "$work/o.####.exr" "${common[@]}"
+for n in 1 3; do
+  expect 0 "os.$n.exr" -- "$bin" render "$work/camera-only.gltf" --frame "$n" -o "$work/os.$n.exr" "${common[@]}"
+  expect 0 "PASS" -- idiff -a "$work/o.000$n.exr" "$work/os.$n.exr"
+done
 
 # A scene without animations is loaded and built once; its frames equal a --frame render.
 python3 -c 'import json,sys; g=json.load(open(sys.argv[1])); del g["animations"]; json.dump(g, open(sys.argv[2], "w"))' "$scene" "$work/static.gltf"
