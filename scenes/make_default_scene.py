@@ -185,12 +185,17 @@ def build():
     return room().finish()
 
 
-def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "default.gltf")
+def write(gltf, name):
+    """Writes `gltf` to the path on the command line, else to scenes/NAME, and prints the path."""
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), name)
     with open(out, "w") as f:
-        json.dump(build(), f, indent=1)
+        json.dump(gltf, f, indent=1)
         f.write("\n")
     print(out)
+
+
+def main():
+    write(build(), "default.gltf")
 
 
 if __name__ == "__main__":

@@ -10,13 +10,10 @@ byte.
 
 Usage: python3 scenes/make_flythrough_scene.py [OUTPUT]   (default: scenes/flythrough.gltf)
 """
-import json
 import math
-import os
 import struct
-import sys
 
-from make_default_scene import quat_axis_angle, room
+from make_default_scene import quat_axis_angle, room, write
 
 SECONDS = 10.0
 TARGET = (0.2, 0.8, -0.4)  # what the camera looks at
@@ -89,11 +86,7 @@ def build():
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "flythrough.gltf")
-    with open(out, "w") as f:
-        json.dump(build(), f, indent=1)
-        f.write("\n")
-    print(out)
+    write(build(), "flythrough.gltf")
 
 
 if __name__ == "__main__":

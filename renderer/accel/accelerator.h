@@ -47,6 +47,24 @@ inline InstanceKind instance_kind(const InstanceView& inst) {
   return inverse(inst.to_world, to_object) ? InstanceKind::Placed : InstanceKind::Singular;
 }
 
+/// The mesh and kind of every instance of a build, which Accelerator::update_instances keeps.
+struct InstanceLayout {
+  std::vector<uint32_t> meshes;
+  std::vector<InstanceKind> kinds;
+
+  void add(const InstanceView& inst) {
+    meshes.push_back(inst.mesh);
+    kinds.push_back(instance_kind(inst));
+  }
+  /// True if `instances` has this layout's count, and each instance its mesh and kind.
+  bool matches(std::span<const InstanceView> instances) const {
+    if (instances.size() != kinds.size()) return false;
+    for (size_t i = 0; i < instances.size(); ++i)
+      if (instances[i].mesh != meshes[i] || instance_kind(instances[i]) != kinds[i]) return false;
+    return true;
+  }
+};
+
 /// Build and size statistics of an accelerator. Fields a back end cannot report are 0 (Embree
 /// does not expose its node counts). For the grid, "nodes" and "leaves" are cells.
 struct AccelStats {

@@ -168,8 +168,7 @@ class EmbreeAccelerator final : public Accelerator {
       const InstanceView& inst = instances[i];
       const GeometryView& mesh = meshes[inst.mesh];
       const unsigned id = unsigned(i);
-      m_meshes.push_back(inst.mesh);
-      m_kinds.push_back(instance_kind(inst));
+      m_layout.add(inst);
       Affine3f inverse_map;
       if (is_identity(inst.to_world)) {
         attach_geometry(m_scene, mesh, id);
@@ -245,13 +244,11 @@ class EmbreeAccelerator final : public Accelerator {
   /// New transforms on the instance geometries, then the top scene committed again: the
   /// instanced meshes' scenes are kept as they are.
   bool update_instances(std::span<const InstanceView> instances) override {
-    if (instances.size() != m_kinds.size()) return false;
-    for (size_t i = 0; i < instances.size(); ++i)
-      if (instances[i].mesh != m_meshes[i] || instance_kind(instances[i]) != m_kinds[i]) return false;
+    if (!m_layout.matches(instances)) return false;
     const BuildTimer timer;
     take_error();
     for (size_t i = 0; i < instances.size(); ++i) {
-      if (m_kinds[i] != InstanceKind::Placed) continue;
+      if (m_layout.kinds[i] != InstanceKind::Placed) continue;
       RTCGeometry geom = rtcGetGeometry(m_scene, unsigned(i));
       rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &instances[i].to_world.m[0][0]);
       rtcCommitGeometry(geom);
@@ -335,8 +332,7 @@ class EmbreeAccelerator final : public Accelerator {
   RTCScene m_scene = nullptr;
   std::vector<RTCScene> m_objects;               // per-geometry scenes of the instances
   std::vector<std::unique_ptr<Shape>> m_shapes;  // the user geometries' shapes (stable addresses)
-  std::vector<uint32_t> m_meshes;                // per instance: its mesh, as built
-  std::vector<InstanceKind> m_kinds;             // per instance: its kind, as built
+  InstanceLayout m_layout;                       // every instance's mesh and kind, as built
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
   uint64_t m_instances = 0;

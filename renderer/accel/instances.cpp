@@ -24,8 +24,7 @@ class TwoLevelAccelerator final : public Accelerator {
     std::vector<int> object_of(meshes.size(), -1), shape_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
-      m_meshes.push_back(inst.mesh);
-      m_kinds.push_back(instance_kind(inst));
+      m_layout.add(inst);
       if (is_identity(inst.to_world)) {
         world.push_back(meshes[inst.mesh]);
         m_world_ids.push_back(uint32_t(i));
@@ -88,9 +87,7 @@ class TwoLevelAccelerator final : public Accelerator {
   /// is built again from the items in the order the constructor made them (instance order, the
   /// world level last), so its tree is the one a fresh build makes.
   bool update_instances(std::span<const InstanceView> instances) override {
-    if (instances.size() != m_kinds.size()) return false;
-    for (size_t i = 0; i < instances.size(); ++i)
-      if (instances[i].mesh != m_meshes[i] || instance_kind(instances[i]) != m_kinds[i]) return false;
+    if (!m_layout.matches(instances)) return false;
     const BuildTimer timer;
     for (Item& item : m_items) {
       if (item.instance == kWorld) continue;
@@ -243,8 +240,7 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<BvhNode> m_nodes;                        // top level, depth first
   std::vector<AccelStats> m_stats_bottom;
-  std::vector<uint32_t> m_meshes;     // per instance: its mesh, as built
-  std::vector<InstanceKind> m_kinds;  // per instance: its kind, as built
+  InstanceLayout m_layout;  // every instance's mesh and kind, as built
   Bounds3f m_bounds;
   uint64_t m_instances = 0;
   uint64_t m_top_depth = 0;
