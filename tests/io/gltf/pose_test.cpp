@@ -2,10 +2,12 @@
 // with an animated parent and its child, an animated EXT_mesh_gpu_instancing node, an animated
 // shape, an animated camera and a light on the moving parent, the posed scene equals a fresh
 // load at each time; moving meshes stay in object space under non-identity instances; morph
-// weights and skins are refused with the scene unchanged.
+// weights and skins are refused with the scene unchanged; a transform that overflows at the
+// time is the load's error, with the scene unchanged.
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "io/error.h"
 #include "io/gltf/loader.h"
 #include "support/gltf_writer.h"
 #include "support/scene_builder.h"
@@ -167,4 +169,41 @@ TEST_CASE("pose: morph weights and skins are refused with the scene unchanged", 
   const std::vector<Vec3f> skin_before = skin.scene.meshes.at(0).positions;
   CHECK_FALSE(pose_gltf_scene(*skin.animation, 0.75, skin.scene));
   CHECK(skin.scene.meshes.at(0).positions == skin_before);
+}
+
+TEST_CASE("pose: a transform that overflows at the time is an error naming the node, the scene unchanged",
+          "[io][animation][quick]") {
+  // A chain of ten nodes whose scales step from 1 to 1e38 at t = 1: the world transform of the
+  // leaf's mesh overflows to infinity there, first at the ninth node (1e38^9 > 1e308).
+  test::GltfWriter w;
+  int parent = -1;
+  for (int k = 0; k < 10; ++k) {
+    json fields = json::object();
+    if (k == 9) fields["mesh"] = w.mesh(w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+    const int n = w.node(fields, parent < 0);
+    if (parent >= 0) w.j["nodes"][size_t(parent)]["children"] = {n};
+    w.channel(n, "scale", {0, 1}, {1, 1, 1, 1e38f, 1e38f, 1e38f}, "VEC3", 3, "STEP");
+    parent = n;
+  }
+  const auto dir = test::temp_dir("pose-overflow");
+  w.write_embedded(dir / "overflow.gltf");
+  std::string load_error;
+  try {
+    load_gltf(dir / "overflow.gltf", at(1.5));
+  } catch (const InputError& e) {
+    load_error = e.what();
+  }
+  REQUIRE_THAT(load_error, Catch::Matchers::Contains("nodes[") && Catch::Matchers::Contains("non-finite"));
+  LoadedScene loaded = load_gltf(dir / "overflow.gltf", at(0.5));
+  REQUIRE(loaded.animation);
+  const std::vector<Instance> before = loaded.scene.instances;
+  try {
+    pose_gltf_scene(*loaded.animation, 1.5, loaded.scene);
+    FAIL("no error for an overflowing transform");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == load_error);
+  }
+  REQUIRE(loaded.scene.instances.size() == before.size());
+  for (size_t i = 0; i < before.size(); ++i)
+    check_affine(loaded.scene.instances[i].to_world, before[i].to_world, 0);
 }
