@@ -169,9 +169,11 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   set_phase("building the acceleration structure");
   const auto t0 = Clock::now();
   const double moved_s = kept ? kept->update_s : 0;
-  job.accel = kept && kept->accel
-                  ? std::move(kept->accel)
-                  : make_scene_accelerator(job.args.accel, job.loaded.scene, job.request.accel_config);
+  // A scene that frames pose keeps Embree's still placements apart from the moving instances.
+  AccelConfig config = job.request.accel_config;
+  config.embree.world_apart = job.loaded.animation != nullptr;
+  job.accel = kept && kept->accel ? std::move(kept->accel)
+                                  : make_scene_accelerator(job.args.accel, job.loaded.scene, config);
   kept.reset();
   job.build_s = moved_s + seconds_since(t0);
 }

@@ -4,7 +4,8 @@
 # equal a separate --frame render of it (compared with idiff: the EXR metadata records each
 # command line, so the files differ in that attribute), with the loaded scene reused and its
 # instances moved (the frame's line says so), also with the camera animated too, with
-# Penumbra's own BVH, and with only the camera animated (the structure kept as it is); --skip-existing keeps complete frames
+# Penumbra's own BVH, with only the camera animated (the structure kept as it is), and on the
+# shipped fly-through; --skip-existing keeps complete frames
 # untouched and renders again exactly the missing and the truncated ones; a scene without
 # animations is loaded once and gives the same frames; a --tile stripe is skipped like a frame;
 # bad ranges and patterns exit 2 before anything is written.
@@ -101,6 +102,15 @@ for accel in embree bvh; do
   done
 done
 idiff -a "$work/c.embree.0002.exr" "$work/f.0002.exr" >/dev/null 2>&1 && fail "the moving camera sees what the still one sees"
+
+# The shipped fly-through: still meshes (in world space, and instanced walls) beside the turning
+# box and the flying camera; with Embree the still placements sit in a scene of their own.
+fly="$(cd "$(dirname "$0")/../.." && pwd)/scenes/flythrough.gltf"
+expect 0 "frame 60 \(2 of 2\) -> .*fly.0060.exr \(animated scene: loaded scene reused, instances moved, top level rebuilt\)" -- "$bin" render "$fly" --frames 30-60:30 -o "$work/fly.####.exr" "${common[@]}"
+for n in 30 60; do
+  expect 0 "flys.$n.exr" -- "$bin" render "$fly" --frame "$n" -o "$work/flys.$n.exr" "${common[@]}"
+  expect 0 "PASS" -- idiff -a "$work/fly.00$n.exr" "$work/flys.$n.exr"
+done
 
 # Only the camera moves: the acceleration structure is kept as it is.
 expect 0 "frame 3 \(3 of 3\) -> .*o.0003.exr \(animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused\)" -- "$bin" render "$work/camera-only.gltf" --frames 1-3 -o "$work/o.####.exr" "${common[@]}"
