@@ -110,7 +110,9 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
                : " (animated scene: loaded scene reused, instances moved, acceleration structure rebuilt)";
 }
 
-void load_phase(RenderJob& job, std::optional<KeptScene>& kept) {
+/// The scene: the kept one, else loaded (with what posing it needs when `keep`: a later frame
+/// follows).
+void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   const RenderArgs& a = job.args;
   set_phase("loading the scene");
   const auto t0 = Clock::now();
@@ -119,7 +121,7 @@ void load_phase(RenderJob& job, std::optional<KeptScene>& kept) {
     job.loaded = std::move(kept->loaded);
   else
     job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
-                            job.request.time);
+                            job.request.time, keep);
   job.load_s = posed_s + seconds_since(t0);
   // No output may replace a buffer or image the scene was loaded from.
   std::vector<std::pair<std::string, fs::path>> inputs;
@@ -169,9 +171,10 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   set_phase("building the acceleration structure");
   const auto t0 = Clock::now();
   const double moved_s = kept ? kept->update_s : 0;
-  // A scene that frames pose keeps Embree's still placements apart from the moving instances.
+  // An animated scene at a time keeps Embree's still placements apart from the instances that
+  // later frames move (as a single --frame render does, so that both see the same structure).
   AccelConfig config = job.request.accel_config;
-  config.embree.world_apart = job.loaded.animation != nullptr;
+  config.embree.world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
   job.accel = kept && kept->accel ? std::move(kept->accel)
                                   : make_scene_accelerator(job.args.accel, job.loaded.scene, config);
   kept.reset();
@@ -248,7 +251,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptS
   RenderJob job(a);
   job.request = std::move(request);
   install_signal_handlers();
-  load_phase(job, kept);
+  load_phase(job, kept, keep);
   setup_phase(job);
   build_phase(job, kept);
   if (!a.debug_pixel.empty()) return render_debug_pixel(job);

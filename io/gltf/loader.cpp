@@ -95,7 +95,7 @@ void check_version_and_extensions(const GltfContext& ctx) {
 // The conversion phases, in order: whole-model validation, materials (with their textures),
 // meshes in local space, the animated pose, then the node walk that places cameras, lights,
 // meshes and the shapes read with the raw JSON. Returns what posing the scene at another time
-// needs when a time is asked for and the file has animations, else null.
+// needs when a time and keep_animation are asked for and the file has animations, else null.
 std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions& vendor) {
   describe(ctx.model, ctx.out.info);
   check_version_and_extensions(ctx);
@@ -120,7 +120,7 @@ std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions&
   if (ctx.out.scene.meshes.empty() && ctx.out.scene.shapes.empty())
     ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
              "no renderable triangles or shapes; the image shows only the background");
-  if (!ctx.options.time || ctx.model.animations.empty()) return nullptr;
+  if (!ctx.options.time || !ctx.options.keep_animation || ctx.model.animations.empty()) return nullptr;
   return describe_animation(ctx, nodes, uses);
 }
 

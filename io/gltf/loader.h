@@ -34,6 +34,9 @@ struct GltfLoadOptions {
   /// and instanced; a mesh placed once is put in world space, unless a time is asked for and
   /// its node's world transform is animated (see pose_gltf_scene).
   bool flatten = false;
+  /// With a time and a file with animations: keep what pose_gltf_scene needs, the parsed file
+  /// with its buffers included, in LoadedScene::animation (memory held as long as the scene).
+  bool keep_animation = false;
 };
 
 /// Descriptive facts about the file, for `penumbra info`.
@@ -61,8 +64,9 @@ struct LoadedScene {
   Scene scene;
   GltfInfo info;
   std::vector<std::string> warnings;  ///< each names the element it concerns
-  /// Set when a time was asked for and the file has animations: pose_gltf_scene() moves this
-  /// scene's instances, cameras and lights to another time. Null otherwise.
+  /// Set when a time and keep_animation were asked for and the file has animations:
+  /// pose_gltf_scene() moves this scene's instances, cameras and lights to another time. Null
+  /// otherwise.
   std::shared_ptr<const GltfAnimation> animation;
 };
 

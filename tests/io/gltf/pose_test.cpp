@@ -21,6 +21,7 @@ namespace {
 GltfLoadOptions at(double t) {
   GltfLoadOptions o;
   o.time = t;
+  o.keep_animation = true;
   return o;
 }
 
@@ -127,8 +128,11 @@ TEST_CASE("pose: a scene posed at another time equals a fresh load at that time"
   // A time that moves the camera: its eye follows the channel.
   REQUIRE(pose_gltf_scene(*loaded.animation, 1.0, loaded.scene));
   test::check_vec(loaded.scene.cameras[0].eye, {3, 1, 5}, 1e-5f);
-  // Without a time there is nothing to pose with.
+  // Without a time there is nothing to pose with; without keep_animation nothing is kept.
   CHECK_FALSE(load_gltf(file).animation);
+  GltfLoadOptions unkept = at(0.5);
+  unkept.keep_animation = false;
+  CHECK_FALSE(load_gltf(file, unkept).animation);
 }
 
 TEST_CASE("pose: morph weights and skins are refused with the scene unchanged", "[io][animation][quick]") {
