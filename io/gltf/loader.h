@@ -4,7 +4,8 @@
 // camera and light parameters) and flattens the node hierarchy into world-space meshes and
 // instances; the PENUMBRA_shapes node extension adds analytic and implicit shapes. Images
 // (PNG, JPEG from files, data URIs or bufferViews) are decoded through OpenImageIO into
-// MIP-mapped textures.
+// MIP-mapped textures. A scene loaded at an animation time can be posed at another time without
+// loading it again (pose_gltf_scene) when its animations move only nodes.
 #pragma once
 
 #include <cstdint>
