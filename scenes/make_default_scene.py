@@ -35,8 +35,10 @@ class Builder:
             self.blob.append(0)
         offset = len(self.blob)
         self.blob += data
-        self.gltf["bufferViews"].append(
-            {"buffer": 0, "byteOffset": offset, "byteLength": len(data), "target": target})
+        view = {"buffer": 0, "byteOffset": offset, "byteLength": len(data)}
+        if target is not None:
+            view["target"] = target
+        self.gltf["bufferViews"].append(view)
         return len(self.gltf["bufferViews"]) - 1
 
     def _accessor(self, view, ctype, count, atype, lo=None, hi=None):
@@ -132,7 +134,8 @@ def quat_axis_angle(axis, degrees):
             axis[2] / n * math.sin(half), math.cos(half)]
 
 
-def build():
+def room():
+    """The room, its lights and its camera, before the buffer is written (see build())."""
     b = Builder()
     white = b.material("white wall", (0.8, 0.8, 0.8), 0.0, 0.9)
     red = b.material("red wall", (0.75, 0.08, 0.06), 0.0, 0.9)
@@ -175,15 +178,24 @@ def build():
     b.gltf["cameras"].append({"name": "room camera", "type": "perspective", "perspective": {
         "yfov": 0.95, "aspectRatio": 16 / 9, "znear": 0.05, "zfar": 100.0}})
     b.node("camera", camera=0, translation=[0.0, 1.6, 2.9], rotation=quat_axis_angle((1, 0, 0), -8))
-    return b.finish()
+    return b
+
+
+def build():
+    return room().finish()
+
+
+def write(gltf, name):
+    """Writes `gltf` to the path on the command line, else to scenes/NAME, and prints the path."""
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), name)
+    with open(out, "w") as f:
+        json.dump(gltf, f, indent=1)
+        f.write("\n")
+    print(out)
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "default.gltf")
-    with open(out, "w") as f:
-        json.dump(build(), f, indent=1)
-        f.write("\n")
-    print(out)
+    write(build(), "default.gltf")
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -72,24 +73,56 @@ uint64_t charge_image_budget(const RenderJob& job) {
   return image + scene_bytes;
 }
 
-/// A scene without animations and its accelerator, kept from one frame of a range for the
-/// next: every frame of such a scene loads the same geometry. The accelerator's views point into
-/// the scene's vectors, whose storage moves with them.
-struct StaticScene {
+/// A loaded scene and its accelerator, kept from one frame of a range for the next: a scene
+/// without animations, whose every frame loads the same geometry, or an animated one, posed at
+/// the next frame's time with its accelerator's instances moved (reuse_kept_scene). The
+/// accelerator's views point into the scene's vectors, whose storage moves with them.
+struct KeptScene {
   LoadedScene loaded;
-  std::unique_ptr<Accelerator> accel;
+  std::unique_ptr<Accelerator> accel;  ///< null: built anew for the next frame
+  double pose_s = 0;                   ///< seconds spent posing the scene for the next frame
+  double update_s = 0;                 ///< seconds spent moving the accelerator's instances
 };
 
-void load_phase(RenderJob& job, std::optional<StaticScene>& kept) {
+/// Readies the kept scene for the frame of `q`: a static scene as it is; an animated one posed
+/// at the frame's time (pose_gltf_scene) and its accelerator's instances moved (kept as it is
+/// when only cameras and lights move), or dropped to be built anew where they cannot be. Drops
+/// the whole scene (the frame loads the file) when the animation changes more than placements.
+/// Returns the note for the frame's line. Throws InputError as loading the file at that time
+/// would.
+std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest& q) {
+  if (!kept) return "";
+  if (!kept->loaded.animation) return " (static scene: loaded scene and acceleration structure reused)";
+  const auto t0 = Clock::now();
+  uint64_t moved_instances = 0;
+  if (!q.time || !pose_gltf_scene(*kept->loaded.animation, *q.time, kept->loaded.scene, &moved_instances)) {
+    kept.reset();
+    return "";
+  }
+  kept->pose_s = seconds_since(t0);
+  if (moved_instances == 0)
+    return " (animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused)";
+  const auto t1 = Clock::now();
+  const bool moved = kept->accel->update_instances(instance_views(kept->loaded.scene));
+  if (!moved) kept->accel.reset();
+  kept->update_s = seconds_since(t1);
+  return moved ? " (animated scene: loaded scene reused, instances moved, top level rebuilt)"
+               : " (animated scene: loaded scene reused, instances moved, acceleration structure rebuilt)";
+}
+
+/// The scene: the kept one, else loaded (with what posing it needs when `keep`: a later frame
+/// follows).
+void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   const RenderArgs& a = job.args;
   set_phase("loading the scene");
   const auto t0 = Clock::now();
+  const double posed_s = kept ? kept->pose_s : 0;
   if (kept)
     job.loaded = std::move(kept->loaded);
   else
     job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
-                            job.request.time);
-  job.load_s = seconds_since(t0);
+                            job.request.time, keep);
+  job.load_s = posed_s + seconds_since(t0);
   // No output may replace a buffer or image the scene was loaded from.
   std::vector<std::pair<std::string, fs::path>> inputs;
   for (const auto& f : job.loaded.info.source_files) inputs.push_back({"the scene's file", f});
@@ -132,19 +165,25 @@ void setup_phase(RenderJob& job) {
                                 !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
 }
 
-void build_phase(RenderJob& job, std::optional<StaticScene>& kept) {
+void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   set_phase("building the acceleration structure");
   const auto t0 = Clock::now();
-  job.accel = kept ? std::move(kept->accel)
-                   : make_scene_accelerator(job.args.accel, job.loaded.scene, job.request.accel_config);
+  const double moved_s = kept ? kept->update_s : 0;
+  // An animated scene at a time keeps Embree's still placements apart from the instances that
+  // later frames move (as a single --frame render does, so that both see the same structure).
+  AccelConfig config = job.request.accel_config;
+  config.embree.world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
+  job.accel = kept && kept->accel ? std::move(kept->accel)
+                                  : make_scene_accelerator(job.args.accel, job.loaded.scene, config);
   kept.reset();
-  job.build_s = seconds_since(t0);
+  job.build_s = moved_s + seconds_since(t0);
 }
 
-/// Keeps a scene without animations and its accelerator for the next frame, as loaded (without
-/// the default light setup_phase added).
-void keep_static_scene(RenderJob& job, std::optional<StaticScene>& kept) {
-  if (job.loaded.info.animation_count != 0) return;
+/// Keeps the frame's scene and accelerator for the next frame, as loaded (without the default
+/// light setup_phase added): a scene without animations, or one loaded at a time with what
+/// posing it needs (LoadedScene::animation).
+void keep_scene(RenderJob& job, std::optional<KeptScene>& kept) {
+  if (job.loaded.info.animation_count != 0 && !job.loaded.animation) return;
   if (job.default_light) job.loaded.scene.lights.pop_back();
   kept.emplace();
   kept->loaded = std::move(job.loaded);
@@ -203,14 +242,14 @@ void write_phase(RenderJob& job) {
   if (hashes) write_stats_json(job);
 }
 
-/// One render: load, set up, build, render, write, report. `kept` is a static scene from the
-/// previous frame, used instead of loading and building; on return it holds this frame's scene
-/// when the scene has no animations and `keep` is set.
-int render_frame(const RenderArgs& a, RenderRequest request, std::optional<StaticScene>& kept, bool keep) {
+/// One render: load, set up, build, render, write, report. `kept` is the previous frame's scene,
+/// readied by reuse_kept_scene and used instead of loading (and building, if it has an
+/// accelerator); on return it holds this frame's scene when `keep` is set and keep_scene keeps it.
+int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptScene>& kept, bool keep) {
   RenderJob job(a);
   job.request = std::move(request);
   install_signal_handlers();
-  load_phase(job, kept);
+  load_phase(job, kept, keep);
   setup_phase(job);
   build_phase(job, kept);
   if (!a.debug_pixel.empty()) return render_debug_pixel(job);
@@ -218,7 +257,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<Stati
   write_phase(job);
   if (job.remove_state) fs::remove(fs::path(job.request.out).concat(".resume"));
   if (!a.quiet) print_render_summary(job);
-  if (keep && !job.interrupted) keep_static_scene(job, kept);
+  if (keep && !job.interrupted) keep_scene(job, kept);
   const RenderRequest& q = job.request;
   if (q.paths_to_stdout) {
     std::printf("%s\n", q.out.string().c_str());
@@ -325,17 +364,17 @@ int run_render(const RenderArgs& a) {
   for (const FramePlan& p : plan) requests.push_back(check_render_args(p.args));
   if (a.frames) check_frames_distinct(plan, requests);
   int64_t rendered = 0, skipped = 0;
-  std::optional<StaticScene> kept;
+  std::optional<KeptScene> kept;
   for (size_t i = 0; i < plan.size(); ++i) {
     const FramePlan& p = plan[i];
     if (frame_done(a, p, requests[i])) {
       ++skipped;
       continue;
     }
+    const std::string reuse = reuse_kept_scene(kept, requests[i]);
     if (a.frames && !a.quiet)
       std::fprintf(stderr, "penumbra: frame %lld (%zu of %zu) -> %s%s\n", static_cast<long long>(*p.number),
-                   i + 1, plan.size(), requests[i].out.string().c_str(),
-                   kept ? " (static scene: loaded scene and acceleration structure reused)" : "");
+                   i + 1, plan.size(), requests[i].out.string().c_str(), reuse.c_str());
     if (const int rc = render_frame(p.args, std::move(requests[i]), kept, i + 1 < plan.size()); rc != kExitOk)
       return rc;
     ++rendered;

@@ -12,9 +12,10 @@
 namespace penumbra::cli {
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
-                       uint64_t max_memory, bool quiet, std::optional<double> time) {
+                       uint64_t max_memory, bool quiet, std::optional<double> time, bool keep_animation) {
   GltfLoadOptions opt;
   opt.time = time;
+  opt.keep_animation = keep_animation;
   opt.flatten = flatten;
   opt.scene = scene;
   opt.allow_external_uris = allow_external;

@@ -16,6 +16,7 @@
 #include "io/gltf/meshes.h"
 #include "io/gltf/nodes.h"
 #include "io/gltf/parse.h"
+#include "io/gltf/pose.h"
 #include "io/gltf/shapes.h"
 
 namespace penumbra {
@@ -93,8 +94,9 @@ void check_version_and_extensions(const GltfContext& ctx) {
 
 // The conversion phases, in order: whole-model validation, materials (with their textures),
 // meshes in local space, the animated pose, then the node walk that places cameras, lights,
-// meshes and the shapes read with the raw JSON.
-void convert(const GltfContext& ctx, VendorExtensions& vendor) {
+// meshes and the shapes read with the raw JSON. Returns what posing the scene at another time
+// needs when a time and keep_animation are asked for and the file has animations, else null.
+std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions& vendor) {
   describe(ctx.model, ctx.out.info);
   check_version_and_extensions(ctx);
   validate_accessors(ctx);
@@ -110,6 +112,7 @@ void convert(const GltfContext& ctx, VendorExtensions& vendor) {
   if (ctx.options.time) poses = evaluate_animations(ctx, *ctx.options.time);
   const std::vector<int> roots = scene_roots(ctx);
   NodeTransforms nodes = link_nodes(ctx, poses);
+  if (ctx.options.time) mark_moving_nodes(ctx, nodes);
   const NodeUses uses = place_nodes(ctx, nodes, roots);
   place_meshes(ctx, meshes, nodes, uses.meshes);
   place_shapes(ctx, vendor.shapes, nodes, uses.shapes);
@@ -117,6 +120,8 @@ void convert(const GltfContext& ctx, VendorExtensions& vendor) {
   if (ctx.out.scene.meshes.empty() && ctx.out.scene.shapes.empty())
     ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
              "no renderable triangles or shapes; the image shows only the background");
+  if (!ctx.options.time || !ctx.options.keep_animation || ctx.model.animations.empty()) return nullptr;
+  return describe_animation(ctx, nodes, uses);
 }
 
 }  // namespace
@@ -129,10 +134,15 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
   tinygltf::Model model;
   gltf::VendorExtensions vendor;
   gltf::parse_gltf(file, options, budget, out, model, vendor);
+  std::shared_ptr<GltfAnimation> animation;
   try {
-    gltf::convert(gltf::GltfContext{model, name, options, budget, out}, vendor);
+    animation = gltf::convert(gltf::GltfContext{model, name, options, budget, out}, vendor);
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while converting the scene");
+  }
+  if (animation) {
+    animation->model = std::move(model);
+    out.animation = std::move(animation);
   }
   return out;
 }

@@ -4,11 +4,13 @@
 // camera and light parameters) and flattens the node hierarchy into world-space meshes and
 // instances; the PENUMBRA_shapes node extension adds analytic and implicit shapes. Images
 // (PNG, JPEG from files, data URIs or bufferViews) are decoded through OpenImageIO into
-// MIP-mapped textures.
+// MIP-mapped textures. A scene loaded at an animation time can be posed at another time without
+// loading it again (pose_gltf_scene) when its animations move only nodes.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,8 +32,12 @@ struct GltfLoadOptions {
   std::optional<double> time;
   /// true: every placement of a mesh gets its own world-space copy (no instancing). false: a
   /// mesh placed more than once (by several nodes or EXT_mesh_gpu_instancing) is stored once
-  /// and instanced; a mesh placed once is put in world space either way.
+  /// and instanced; a mesh placed once is put in world space, unless a time is asked for and
+  /// its node's world transform is animated (see pose_gltf_scene).
   bool flatten = false;
+  /// With a time and a file with animations: keep what pose_gltf_scene needs, the parsed file
+  /// with its buffers included, in LoadedScene::animation (memory held as long as the scene).
+  bool keep_animation = false;
 };
 
 /// Descriptive facts about the file, for `penumbra info`.
@@ -50,16 +56,40 @@ struct GltfInfo {
   std::vector<std::string> source_sha256;
 };
 
+/// What pose_gltf_scene needs to pose a loaded scene at another time: the parsed file (its
+/// buffers included), the node links, which nodes move, and the node of each camera and light.
+/// Opaque outside io/gltf/.
+struct GltfAnimation;
+
 struct LoadedScene {
   Scene scene;
   GltfInfo info;
   std::vector<std::string> warnings;  ///< each names the element it concerns
+  /// Set when a time and keep_animation were asked for and the file has animations:
+  /// pose_gltf_scene() moves this scene's instances, cameras and lights to another time. Null
+  /// otherwise.
+  std::shared_ptr<const GltfAnimation> animation;
 };
 
 /// Loads `file`. Throws InputError (file + JSON path + reason) for anything malformed or
 /// hostile; degenerate but harmless content (points/lines primitives, NaN vertices, missing
 /// images) produces a warning instead and is skipped.
 LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options = {});
+
+/// Poses `scene`, loaded by load_gltf with a time and `animation` (LoadedScene::animation, the
+/// scene as loaded: no instance, camera or light added or removed), at `time` seconds: the
+/// instances of moving nodes (to_world, to_object, mirrored; never marked the identity), every
+/// camera's eye and frame and every punctual light's position and direction become those a
+/// fresh load_gltf at `time` gives; meshes, shapes and materials are untouched. Returns false,
+/// with the scene unchanged, when the animation changes more than placements: morph-weight
+/// channels, skinned meshes, a flattened moving mesh, a placement left out as singular or huge
+/// (at the load or at `time`), another count of cameras or lights; the caller then loads the
+/// file again. Throws InputError naming the node or the animation element as load_gltf does
+/// (non-finite or singular transforms, malformed channels), leaving the scene unchanged. When
+/// posed, `*moved_instances` (if given) is set to the number of instances of moving nodes, whose
+/// maps were set again (0: only cameras and lights move, the instances are as they were).
+bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene,
+                     uint64_t* moved_instances = nullptr);
 
 /// Maximum nesting depth of arrays/objects in a JSON text (strings are skipped correctly).
 /// Stops counting once `limit` is exceeded and returns limit + 1.

@@ -402,9 +402,11 @@ void charge_placements(const GltfContext& ctx, const MeshUse& use) {
 using ObjectMeshes = std::map<std::pair<int, std::vector<double>>, std::vector<int>>;
 
 // Instances of the object-space copy of mesh e.mesh (made on first use), one per placement and
-// primitive; returns how many placements were skipped as singular, non-finite or huge.
+// primitive; returns how many placements were skipped as singular, non-finite or huge. A moving
+// node's instances are never marked the identity, so that posing them leaves the vertices alone.
 uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>& primitives, Emit e,
-                       const std::vector<Transform>& placements, int node, ObjectMeshes& objects) {
+                       const std::vector<Transform>& placements, int node, bool moving,
+                       ObjectMeshes& objects) {
   auto [it, inserted] = objects.try_emplace({e.mesh, *e.morph});
   if (inserted) {
     e.node = -1;
@@ -428,6 +430,7 @@ uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>
       continue;
     }
     inst.copy = per_copy ? int(k) : -1;
+    if (moving) inst.identity = false;
     bool usable = true;  // world-space corners finite and not huge, as for flattened meshes
     for (const Bounds3f& b : object_bounds) {
       const Bounds3f w = transform_bounds(inst.to_world, b);
@@ -449,7 +452,8 @@ uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>
 
 // A node's mesh placed by `placements` (the node's world transform, or one per
 // EXT_mesh_gpu_instancing instance). shared: stored once in object space and instanced; else
-// one world-space copy per placement (skinned meshes always).
+// one world-space copy per placement (skinned meshes always). Placements of a moving node left
+// out are counted in nodes.moving_skipped.
 void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimitive>>& decoded,
               NodeTransforms& nodes, const MeshUse& use, const std::vector<Transform>& placements,
               bool shared, ObjectMeshes& objects) {
@@ -472,7 +476,7 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
   }
   uint64_t singular = 0;
   if (shared) {
-    singular = add_instances(ctx, primitives, e, placements, use.node, objects);
+    singular = add_instances(ctx, primitives, e, placements, use.node, is_moving(nodes, use.node), objects);
   } else {
     for (const Transform& world : placements) {
       Transform inv;
@@ -483,6 +487,7 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
       emit_primitives(ctx, primitives, e, world);
     }
   }
+  if (is_moving(nodes, use.node)) nodes.moving_skipped += singular;
   if (singular == 1 && placements.size() == 1)
     ctx.warn(node_where,
              "singular, non-finite or huge transform; mesh " + std::to_string(use.mesh) + " skipped");
@@ -578,7 +583,8 @@ void place_meshes(const GltfContext& ctx, const std::vector<std::vector<LocalPri
                   NodeTransforms& nodes, const std::vector<MeshUse>& uses) {
   // Meshes placed more than once are stored once and instanced (unless flattening is asked
   // for); a mesh placed once is put in world space, as Cycles applies the transform of a mesh
-  // with one user, so single-level scenes keep single-level structures.
+  // with one user, so single-level scenes keep single-level structures, unless its node moves:
+  // then it stays in object space, so that another pose moves only its instance.
   std::vector<std::vector<Transform>> placements;
   std::map<int, uint64_t> counts;
   for (const MeshUse& u : uses) {
@@ -588,8 +594,8 @@ void place_meshes(const GltfContext& ctx, const std::vector<std::vector<LocalPri
   }
   ObjectMeshes objects;
   for (size_t k = 0; k < uses.size(); ++k)
-    add_mesh(ctx, decoded, nodes, uses[k], placements[k], !ctx.options.flatten && counts[uses[k].mesh] > 1,
-             objects);
+    add_mesh(ctx, decoded, nodes, uses[k], placements[k],
+             !ctx.options.flatten && (counts[uses[k].mesh] > 1 || is_moving(nodes, uses[k].node)), objects);
 }
 
 }  // namespace penumbra::gltf

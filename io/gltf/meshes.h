@@ -49,9 +49,11 @@ std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Tra
 /// accessors, modes, materials and attribute counts throw InputError naming the primitive.
 std::vector<std::vector<LocalPrimitive>> decode_meshes(const GltfContext& ctx);
 
-/// Places the mesh of every use (in order) into ctx.out.scene. A mesh placed more than once is
-/// stored once in object space and instanced unless options.flatten; a mesh placed once, and a
-/// skinned mesh, is put in world space. Every placement is charged to the budget first.
+/// Places the mesh of every use (in order) into ctx.out.scene. A mesh placed more than once, or
+/// by a moving node (NodeTransforms::moving; its instances never marked the identity), is
+/// stored once in object space and instanced unless options.flatten; a mesh placed once by a
+/// still node, and a skinned mesh, is put in world space. Every placement is charged to the
+/// budget first; placements of moving nodes left out are counted in nodes.moving_skipped.
 void place_meshes(const GltfContext& ctx, const std::vector<std::vector<LocalPrimitive>>& decoded,
                   NodeTransforms& nodes, const std::vector<MeshUse>& uses);
 

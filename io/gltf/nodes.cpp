@@ -64,16 +64,7 @@ void add_camera(const GltfContext& ctx, int camera_index, int node, const Transf
   const auto& src = ctx.model.cameras[size_t(camera_index)];
   Camera cam;
   cam.name = src.name.empty() ? idx("cameras", size_t(camera_index)) : src.name;
-  cam.eye = transform_point(world, {0, 0, 0});
-  // Orthonormalise the node's axes (scale is not part of a camera placement).
-  const Vec3f w = normalize(transform_vector(world, {0, 0, 1}));
-  Vec3f u = transform_vector(world, {1, 0, 0});
-  u = normalize(u - w * dot(u, w));
-  if (!(dot(w, w) > 0) || !(dot(u, u) > 0) || !is_finite(cam.eye))
-    ctx.fail(node_where, "camera transform is singular");
-  cam.w = w;
-  cam.u = u;
-  cam.v = cross(w, u);
+  place_camera(ctx, node, world, cam);
   if (src.type == "perspective") {
     cam.projection = Projection::Perspective;
     cam.yfov = float(src.perspective.yfov);
@@ -110,14 +101,55 @@ void add_light(const GltfContext& ctx, int light_index, int node, const Transfor
   l.range = src.range > 0 ? float(src.range) : kInfinity;
   l.inner_cone = float(src.spot.innerConeAngle);
   l.outer_cone = float(src.spot.outerConeAngle);
-  l.position = transform_point(world, {0, 0, 0});
-  l.direction = normalize(transform_vector(world, {0, 0, -1}));
-  if (l.type != LightType::Point && !(dot(l.direction, l.direction) > 0))
-    ctx.fail(node_where, "light transform is singular");
+  place_light(ctx, node, world, l);
   ctx.out.scene.lights.push_back(l);
 }
 
 }  // namespace
+
+void place_camera(const GltfContext& ctx, int node, const Transform& world, Camera& cam) {
+  cam.eye = transform_point(world, {0, 0, 0});
+  // Orthonormalise the node's axes (scale is not part of a camera placement).
+  const Vec3f w = normalize(transform_vector(world, {0, 0, 1}));
+  Vec3f u = transform_vector(world, {1, 0, 0});
+  u = normalize(u - w * dot(u, w));
+  if (!(dot(w, w) > 0) || !(dot(u, u) > 0) || !is_finite(cam.eye))
+    ctx.fail(idx("nodes", size_t(node)), "camera transform is singular");
+  cam.w = w;
+  cam.u = u;
+  cam.v = cross(w, u);
+}
+
+void place_light(const GltfContext& ctx, int node, const Transform& world, Light& light) {
+  light.position = transform_point(world, {0, 0, 0});
+  light.direction = normalize(transform_vector(world, {0, 0, -1}));
+  if (light.type != LightType::Point && !(dot(light.direction, light.direction) > 0))
+    ctx.fail(idx("nodes", size_t(node)), "light transform is singular");
+}
+
+void mark_moving_nodes(const GltfContext& ctx, NodeTransforms& nodes) {
+  const size_t n = ctx.model.nodes.size();
+  std::vector<uint8_t> target(n, 0);
+  for (const auto& anim : ctx.model.animations)
+    for (const auto& ch : anim.channels)
+      if (ch.target_node >= 0 && size_t(ch.target_node) < n &&
+          (ch.target_path == "translation" || ch.target_path == "rotation" || ch.target_path == "scale"))
+        target[size_t(ch.target_node)] = 1;
+  // Each node once: up the parent chain (acyclic, link_nodes) to a known node, then down.
+  nodes.moving.assign(n, 0);
+  std::vector<uint8_t> known(n, 0);
+  std::vector<int> chain;
+  for (size_t i = 0; i < n; ++i) {
+    chain.clear();
+    for (int cur = int(i); cur >= 0 && !known[size_t(cur)]; cur = nodes.parent[size_t(cur)])
+      chain.push_back(cur);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const int p = nodes.parent[size_t(*it)];
+      nodes.moving[size_t(*it)] = target[size_t(*it)] || (p >= 0 && nodes.moving[size_t(p)]);
+      known[size_t(*it)] = 1;
+    }
+  }
+}
 
 void validate_cameras(const GltfContext& ctx) {
   for (size_t i = 0; i < ctx.model.cameras.size(); ++i) {
@@ -282,12 +314,16 @@ NodeUses place_nodes(const GltfContext& ctx, NodeTransforms& nodes, const std::v
     const Transform world = world_transform(ctx, nodes, index);  // the parent's is known: pre-order
     if (node.mesh >= 0 || node.mesh < -1) uses.meshes.push_back({node.mesh, index});
     if (node.extensions.count(kShapesExtension)) uses.shapes.push_back(index);
-    if (node.camera >= 0 || node.camera < -1) add_camera(ctx, node.camera, index, world);
+    if (node.camera >= 0 || node.camera < -1) {
+      add_camera(ctx, node.camera, index, world);
+      uses.cameras.push_back(index);
+    }
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
       const auto& li = it->second.Get("light");
       if (!li.IsNumber())
         ctx.fail(idx("nodes", size_t(index)) + ".extensions.KHR_lights_punctual.light", "must be an integer");
       add_light(ctx, int(li.GetNumberAsInt()), index, world);
+      uses.lights.push_back(index);
     }
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);
   }

@@ -17,7 +17,18 @@ struct NodeTransforms {
   std::vector<Transform> world;  ///< per node, valid where `known`
   std::vector<uint8_t> known;
   const std::vector<NodePose>* poses = nullptr;  ///< animated TRS overrides (may be empty)
+  /// Per node: its world transform is animated (the node or an ancestor is the target of a
+  /// translation, rotation or scale channel); empty without a time.
+  std::vector<uint8_t> moving;
+  /// Placements of moving nodes left out as singular, non-finite or huge (the loader counts
+  /// them: such a scene is not posed at another time without loading it again).
+  uint64_t moving_skipped = 0;
 };
+
+/// True if `node`'s world transform is animated (NodeTransforms::moving).
+inline bool is_moving(const NodeTransforms& nodes, int node) {
+  return node >= 0 && size_t(node) < nodes.moving.size() && nodes.moving[size_t(node)];
+}
 
 /// A node with a mesh, in traversal order.
 struct MeshUse {
@@ -28,6 +39,8 @@ struct MeshUse {
 struct NodeUses {
   std::vector<MeshUse> meshes;  ///< nodes with a mesh
   std::vector<int> shapes;      ///< nodes with the PENUMBRA_shapes extension
+  std::vector<int> cameras;     ///< the node of each camera placed (Scene::cameras order)
+  std::vector<int> lights;      ///< the node of each light placed (Scene::lights order)
 };
 
 /// Checks every camera's and light's parameters. Throws InputError naming them.
@@ -44,6 +57,18 @@ NodeTransforms link_nodes(const GltfContext& ctx, const std::vector<NodePose>& p
 /// The world transform of `node`: its parent's world x its local transform (TRS or matrix,
 /// animated if posed), computed once per node. Throws InputError if it is not finite.
 const Transform& world_transform(const GltfContext& ctx, NodeTransforms& nodes, int node);
+
+/// Marks NodeTransforms::moving from every animation's translation, rotation and scale
+/// channels (whose target nodes evaluate_animations has checked) and the parent links.
+void mark_moving_nodes(const GltfContext& ctx, NodeTransforms& nodes);
+
+/// Sets the eye and frame of `cam` from its node's world transform (scale removed). Throws
+/// InputError naming the node if the transform is singular.
+void place_camera(const GltfContext& ctx, int node, const Transform& world, Camera& cam);
+
+/// Sets the position and direction of `light` from its node's world transform. Throws
+/// InputError naming the node if a spot or directional light's transform is singular.
+void place_light(const GltfContext& ctx, int node, const Transform& world, Light& light);
 
 /// Walks the scene depth-first from `roots` (checked: in range, parentless, listed once),
 /// placing cameras and lights into ctx.out.scene; returns the nodes with meshes and with shapes.

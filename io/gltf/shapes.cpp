@@ -447,8 +447,9 @@ Affine3f ShapeReader::csg_transform(const json& j, const std::string& where) con
   return to_local;
 }
 
-// One shape placed by its node: the SceneShape, then an instance per placement.
-void place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world) {
+// One shape placed by its node: the SceneShape, then an instance per placement (never marked
+// the identity on a moving node). Returns how many placements were left out.
+uint64_t place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world, bool moving) {
   const int node = from.node;
   const auto& gnode = ctx.model.nodes[size_t(node)];
   const std::string where = idx("nodes", size_t(node));
@@ -480,6 +481,7 @@ void place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world
     }
     Instance inst = make_shape_instance(index, to_world, node);
     inst.copy = per_copy ? int(k) : -1;
+    if (moving) inst.identity = false;
     ctx.out.scene.instances.push_back(inst);
   }
   if (skipped == 1 && placements.size() == 1)
@@ -488,6 +490,7 @@ void place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world
     ctx.warn(where + ".extensions.EXT_mesh_gpu_instancing",
              std::to_string(skipped) + " of " + std::to_string(placements.size()) +
                  " instances have a singular, non-finite or huge transform; skipped");
+  return skipped;
 }
 
 }  // namespace
@@ -515,7 +518,8 @@ void place_shapes(const GltfContext& ctx, std::vector<NodeShape>& shapes, NodeTr
     const auto it = std::lower_bound(shapes.begin(), shapes.end(), node,
                                      [](const NodeShape& s, int n) { return s.node < n; });
     if (it == shapes.end() || it->node != node) continue;
-    place_shape(ctx, *it, nodes.world[size_t(node)]);
+    const uint64_t skipped = place_shape(ctx, *it, nodes.world[size_t(node)], is_moving(nodes, node));
+    if (is_moving(nodes, node)) nodes.moving_skipped += skipped;
   }
 }
 

@@ -39,7 +39,8 @@ std::vector<NodeShape> read_node_shapes(const nlohmann::json& doc, const std::st
 /// in visit order) into ctx.out.scene: one SceneShape per node, moved out of `shapes`, and one
 /// Instance per placement (the node's world transform, or each EXT_mesh_gpu_instancing copy),
 /// charged to the budget first. Singular, non-finite or huge placements are skipped with a
-/// warning naming the node.
+/// warning naming the node (and counted in nodes.moving_skipped for a moving node); a moving
+/// node's instances are never marked the identity.
 void place_shapes(const GltfContext& ctx, std::vector<NodeShape>& shapes, NodeTransforms& nodes,
                   const std::vector<int>& shape_nodes);
 

@@ -36,6 +36,35 @@ struct InstanceView {
   Affine3f to_world;
 };
 
+/// How a build over instances treats one: in world space (the identity map), never hit (a
+/// singular or non-finite map), or placed under the top level (Accelerator::update_instances
+/// keeps each instance's kind).
+enum class InstanceKind : uint8_t { Identity, Singular, Placed };
+
+inline InstanceKind instance_kind(const InstanceView& inst) {
+  if (is_identity(inst.to_world)) return InstanceKind::Identity;
+  Affine3f to_object;
+  return inverse(inst.to_world, to_object) ? InstanceKind::Placed : InstanceKind::Singular;
+}
+
+/// The mesh and kind of every instance of a build, which Accelerator::update_instances keeps.
+struct InstanceLayout {
+  std::vector<uint32_t> meshes;
+  std::vector<InstanceKind> kinds;
+
+  void add(const InstanceView& inst) {
+    meshes.push_back(inst.mesh);
+    kinds.push_back(instance_kind(inst));
+  }
+  /// True if `instances` has this layout's count, and each instance its mesh and kind.
+  bool matches(std::span<const InstanceView> instances) const {
+    if (instances.size() != kinds.size()) return false;
+    for (size_t i = 0; i < instances.size(); ++i)
+      if (instances[i].mesh != meshes[i] || instance_kind(instances[i]) != kinds[i]) return false;
+    return true;
+  }
+};
+
 /// Build and size statistics of an accelerator. Fields a back end cannot report are 0 (Embree
 /// does not expose its node counts). For the grid, "nodes" and "leaves" are cells.
 struct AccelStats {
@@ -94,6 +123,18 @@ class Accelerator {
   virtual bool counts_traversal() const { return false; }
   virtual Bounds3f bounds() const = 0;
   virtual AccelStats stats() const = 0;
+  /// Moves the instances of a build over instances to new maps and rebuilds only the top level
+  /// (the per-mesh structures are kept): `instances` has the build's count and meshes in the
+  /// same order, and every instance keeps its kind (the identity, singular, or placed by an
+  /// invertible map), so the answers equal a fresh build over `instances`. Returns false, with
+  /// the accelerator unchanged, when it cannot: another count, mesh or kind, or a back end
+  /// built in one level (the default); the caller then builds anew. The geometry views given
+  /// to the build must still be valid. Not thread-safe: no query may run during the call.
+  /// Throws std::runtime_error if the back end's rebuild fails.
+  virtual bool update_instances(std::span<const InstanceView> instances) {
+    (void)instances;
+    return false;
+  }
 };
 
 }  // namespace penumbra

@@ -164,13 +164,30 @@ class EmbreeAccelerator final : public Accelerator {
     take_error();
     m_scene = new_scene();
     std::vector<RTCScene> objects(meshes.size(), nullptr);
+    // The identity placements' own scene, when asked for and there are placed instances too.
+    const auto kind_in = [&](InstanceKind k) {
+      return std::any_of(instances.begin(), instances.end(),
+                         [&](const InstanceView& i) { return instance_kind(i) == k; });
+    };
+    RTCScene world = m_scene;
+    if (config.world_apart && kind_in(InstanceKind::Identity) && kind_in(InstanceKind::Placed)) {
+      world = new_scene();
+      m_objects.push_back(world);
+      m_world_id = unsigned(instances.size());
+    }
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
       const GeometryView& mesh = meshes[inst.mesh];
       const unsigned id = unsigned(i);
+      m_layout.add(inst);
       Affine3f inverse_map;
       if (is_identity(inst.to_world)) {
-        attach_geometry(m_scene, mesh, id);
+        if (world == m_scene) {
+          attach_geometry(m_scene, mesh, id);
+        } else {
+          attach_geometry(world, mesh, unsigned(m_world_ids.size()));
+          m_world_ids.push_back(id);
+        }
         continue;
       }
       if (!inverse(inst.to_world, inverse_map)) {  // singular: an empty mesh keeps the id
@@ -185,23 +202,18 @@ class EmbreeAccelerator final : public Accelerator {
         rtcCommitScene(object);
         throw_if_error("building an instanced mesh (rtcCommitScene)");
       }
-      RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(geom, object);
-      rtcSetGeometryTimeStepCount(geom, 1);
-      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &inst.to_world.m[0][0]);
-      rtcCommitGeometry(geom);
-      rtcAttachGeometryByID(m_scene, geom, id);
-      rtcReleaseGeometry(geom);
-      throw_if_error("attaching an instance");
+      attach_instance(object, inst.to_world, id);
       ++m_instances;
+    }
+    if (world != m_scene) {
+      rtcCommitScene(world);
+      throw_if_error("building the identity placements (rtcCommitScene)");
+      attach_instance(world, Affine3f{}, m_world_id);
     }
     rtcCommitScene(m_scene);
     throw_if_error("building the scene (rtcCommitScene)");
     m_bytes = uint64_t(std::max<int64_t>(0, device_bytes() - bytes_before));
-    RTCBounds b;
-    rtcGetSceneBounds(m_scene, &b);
-    if (m_triangles + m_shapes.size() > 0)
-      m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+    read_bounds();
     m_build_seconds = timer.seconds();
   }
 
@@ -226,7 +238,10 @@ class EmbreeAccelerator final : public Accelerator {
     hit.t = rh.ray.tfar;
     hit.u = rh.hit.u;
     hit.v = rh.hit.v;
-    hit.geom_id = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+    const unsigned inst = rh.hit.instID[0];
+    hit.geom_id = inst == RTC_INVALID_GEOMETRY_ID ? rh.hit.geomID
+                  : inst == m_world_id            ? m_world_ids[rh.hit.geomID]
+                                                  : inst;
     hit.prim_id = rh.hit.primID;
     return true;
   }
@@ -243,13 +258,34 @@ class EmbreeAccelerator final : public Accelerator {
 
   Bounds3f bounds() const override { return m_bounds; }
 
+  /// New transforms on the instance geometries, then the top scene committed again: the
+  /// instanced meshes' scenes are kept as they are.
+  bool update_instances(std::span<const InstanceView> instances) override {
+    if (!m_layout.matches(instances)) return false;
+    const BuildTimer timer;
+    take_error();
+    for (size_t i = 0; i < instances.size(); ++i) {
+      if (m_layout.kinds[i] != InstanceKind::Placed) continue;
+      RTCGeometry geom = rtcGetGeometry(m_scene, unsigned(i));
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &instances[i].to_world.m[0][0]);
+      rtcCommitGeometry(geom);
+    }
+    throw_if_error("moving the instances");
+    rtcCommitScene(m_scene);
+    throw_if_error("rebuilding the top level (rtcCommitScene)");
+    read_bounds();
+    m_build_seconds = timer.seconds();
+    return true;
+  }
+
   AccelStats stats() const override {
     AccelStats s;
     s.name = "embree";
     s.config = std::string("robust ") + (m_config.robust ? "1" : "0") + ", quality " +
                (m_config.quality == 0   ? "low"
                 : m_config.quality == 1 ? "medium"
-                                        : "high");
+                                        : "high") +
+               (m_world_id != RTC_INVALID_GEOMETRY_ID ? ", identity placements apart" : "");
     s.triangles = m_triangles;
     s.shapes = m_shapes.size();
     s.instances = m_instances;
@@ -259,6 +295,27 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
  private:
+  /// An Embree instance of `object` placed by `to_world`, attached to the top scene as `id`.
+  void attach_instance(RTCScene object, const Affine3f& to_world, unsigned id) {
+    RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(geom, object);
+    rtcSetGeometryTimeStepCount(geom, 1);
+    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &to_world.m[0][0]);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(m_scene, geom, id);
+    rtcReleaseGeometry(geom);
+    throw_if_error("attaching an instance");
+  }
+
+  /// m_bounds from the committed top scene (empty without triangles or shapes).
+  void read_bounds() {
+    RTCBounds b;
+    rtcGetSceneBounds(m_scene, &b);
+    m_bounds = Bounds3f{};
+    if (m_triangles + m_shapes.size() > 0)
+      m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
+  }
+
   /// Attaches a view as triangles, or its shape (copied) as user geometry.
   void attach_geometry(RTCScene scene, const GeometryView& view, unsigned id) {
     if (!view.shape) {
@@ -303,8 +360,11 @@ class EmbreeAccelerator final : public Accelerator {
 
   EmbreeConfig m_config;
   RTCScene m_scene = nullptr;
-  std::vector<RTCScene> m_objects;               // per-geometry scenes of the instances
-  std::vector<std::unique_ptr<Shape>> m_shapes;  // the user geometries' shapes (stable addresses)
+  std::vector<RTCScene> m_objects;                // per-geometry scenes of the instances (and the world's)
+  unsigned m_world_id = RTC_INVALID_GEOMETRY_ID;  // the world scene's instance in the top scene, if any
+  std::vector<uint32_t> m_world_ids;              // world scene geometry id -> instance index
+  std::vector<std::unique_ptr<Shape>> m_shapes;   // the user geometries' shapes (stable addresses)
+  InstanceLayout m_layout;                        // every instance's mesh and kind, as built
   Bounds3f m_bounds;
   uint64_t m_triangles = 0;
   uint64_t m_instances = 0;

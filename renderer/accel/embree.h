@@ -16,6 +16,13 @@ namespace penumbra {
 struct EmbreeConfig {
   bool robust = true;  ///< RTC_SCENE_FLAG_ROBUST: no cracks on shared edges (slower traversal)
   int quality = 1;     ///< build quality: 0 low, 1 medium (Embree's default), 2 high
+  /// A build over instances where some are the identity and some not: true puts the identity
+  /// placements in a scene of their own under one identity instance, so that
+  /// update_instances() rebuilds a top level of instances only (queries of the identity
+  /// placements pass one more level); false keeps them in the top scene, whose triangles an
+  /// update then rebuilds too. Chosen by the program (penumbra render sets it for animated
+  /// scenes), not an --accel-param.
+  bool world_apart = false;
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.
@@ -27,9 +34,11 @@ std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryVie
                                                      const EmbreeConfig& config = {});
 
 /// Builds an Embree scene over placements of the meshes (geom_id in a Hit = instance index):
-/// identity placements as triangle geometries of the top scene, the others as Embree instances
-/// (RTC_GEOMETRY_TYPE_INSTANCE) of one scene per mesh. Instance mesh indices must be valid
-/// (the factory checks them).
+/// identity placements as triangle geometries of the top scene (or of a world scene, see
+/// EmbreeConfig::world_apart), the others as Embree instances (RTC_GEOMETRY_TYPE_INSTANCE) of
+/// one scene per mesh. Instance mesh indices must be valid
+/// (the factory checks them). update_instances() sets the Embree instances' transforms and
+/// commits the top scene again; the per-mesh scenes are kept.
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config = {});

@@ -24,6 +24,7 @@ class TwoLevelAccelerator final : public Accelerator {
     std::vector<int> object_of(meshes.size(), -1), shape_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
+      m_layout.add(inst);
       if (is_identity(inst.to_world)) {
         world.push_back(meshes[inst.mesh]);
         m_world_ids.push_back(uint32_t(i));
@@ -81,6 +82,31 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
   Bounds3f bounds() const override { return m_bounds; }
+
+  /// New maps for the placed items; the bottom levels and the world level stay, the top level
+  /// is built again from the items in the order the constructor made them (instance order, the
+  /// world level last), so its tree is the one a fresh build makes.
+  bool update_instances(std::span<const InstanceView> instances) override {
+    if (!m_layout.matches(instances)) return false;
+    const BuildTimer timer;
+    for (Item& item : m_items) {
+      if (item.instance == kWorld) continue;
+      const Affine3f& to_world = instances[item.instance].to_world;
+      inverse(to_world, item.to_object);
+      const Bounds3f object =
+          item.level == kShapeLevel ? shape_bounds(m_shapes[item.shape]) : m_levels[item.level]->bounds();
+      item.box = transform_bounds(to_world, object);
+    }
+    std::sort(m_items.begin(), m_items.end(),
+              [](const Item& a, const Item& b) { return a.instance < b.instance; });
+    m_nodes.clear();
+    m_bounds = Bounds3f{};
+    m_top_depth = 0;
+    m_sah_cost = 0;
+    build_top();
+    m_build_seconds = timer.seconds();
+    return true;
+  }
 
   AccelStats stats() const override {
     AccelStats s;
@@ -214,6 +240,7 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<BvhNode> m_nodes;                        // top level, depth first
   std::vector<AccelStats> m_stats_bottom;
+  InstanceLayout m_layout;  // every instance's mesh and kind, as built
   Bounds3f m_bounds;
   uint64_t m_instances = 0;
   uint64_t m_top_depth = 0;

@@ -25,7 +25,8 @@ using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<
 /// (built even when empty). A shape placed by a non-identity instance has no bottom level: the
 /// top level's leaf maps the ray and calls the shape test itself. Instances with a singular or
 /// non-finite map are left out. Throws std::invalid_argument if an instance names a mesh outside
-/// `meshes`, and whatever `build` throws.
+/// `meshes`, and whatever `build` throws. update_instances() keeps every bottom level and builds
+/// the top level again over the instances' new world boxes.
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
                                                         std::span<const GeometryView> meshes,
                                                         std::span<const InstanceView> instances);

@@ -89,7 +89,8 @@ struct Instance {
   int shape = -1;         ///< index into Scene::shapes, or -1 for a mesh instance
   Affine3f to_world;      ///< object to world
   Affine3f to_object;     ///< its inverse
-  bool identity = true;   ///< to_world is the identity (the mesh is in world space)
+  bool identity = true;   ///< to_world is the identity (the mesh is in world space); false for an
+                          ///< instance that animation moves, whatever its map at this time
   bool mirrored = false;  ///< det(to_world) < 0: the front face is clockwise in world space
                           ///< (glTF 3.7.4), i.e. counter-clockwise in object space
   int node = -1;          ///< glTF node, -1 if not from glTF

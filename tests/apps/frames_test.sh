@@ -2,7 +2,10 @@
 # `penumbra render --frames` end to end on a generated glTF (a cube moved by a translation
 # animation, seen by a fixed camera): `#` patterns name each frame's files; every frame's pixels
 # equal a separate --frame render of it (compared with idiff: the EXR metadata records each
-# command line, so the files differ in that attribute); --skip-existing keeps complete frames
+# command line, so the files differ in that attribute), with the loaded scene reused and its
+# instances moved (the frame's line says so), also with the camera animated too, with
+# Penumbra's own BVH, with only the camera animated (the structure kept as it is), and on the
+# shipped fly-through; --skip-existing keeps complete frames
 # untouched and renders again exactly the missing and the truncated ones; a scene without
 # animations is loaded once and gives the same frames; a --tile stripe is skipped like a frame;
 # bad ranges and patterns exit 2 before anything is written.
@@ -19,7 +22,7 @@ for tool in python3 idiff; do
   command -v "$tool" >/dev/null || { echo "PENUMBRA_SKIP: $tool is not installed"; exit 0; }
 done
 
-python3 - "$work/anim.gltf" <<'PY'
+python3 - "$work/anim.gltf" "$work/camera.gltf" "$work/camera-only.gltf" <<'PY'
 import base64, json, struct, sys
 pos = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
 quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
@@ -30,7 +33,10 @@ blob = b"".join(struct.pack("<3f", *p) for p in pos) + struct.pack("<36H", *idx)
 blob += b"\0" * (-len(blob) % 4)
 t_off = len(blob)
 blob += struct.pack("<2f", *times) + b"".join(struct.pack("<3f", *m) for m in moves)
-views = [(0, 96), (96, 72), (t_off, 8), (t_off + 8, 24)]
+eyes = [(0.0, 0.0, 5.0), (1.5, 1.0, 4.0)]
+turns = [(0.0, 0.0, 0.0, 1.0), (-0.1, 0.15, 0.0, 0.983)]
+blob += b"".join(struct.pack("<3f", *e) for e in eyes) + b"".join(struct.pack("<4f", *q) for q in turns)
+views = [(0, 96), (96, 72), (t_off, 8), (t_off + 8, 24), (t_off + 32, 24), (t_off + 56, 32)]
 gltf = {
     "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
     "nodes": [{"mesh": 0, "translation": [-1, 0, 0]}, {"camera": 0, "translation": [0, 0, 5]}],
@@ -46,9 +52,21 @@ gltf = {
          "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
         {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
         {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [0.25]},
-        {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+        {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+        {"bufferView": 4, "componentType": 5126, "count": 2, "type": "VEC3"},
+        {"bufferView": 5, "componentType": 5126, "count": 2, "type": "VEC4"}],
 }
 json.dump(gltf, open(sys.argv[1], "w"))
+# The same cube, and the camera moved and turned by channels of its own.
+anim = gltf["animations"][0]
+anim["samplers"] += [{"input": 2, "output": 4, "interpolation": "LINEAR"},
+                     {"input": 2, "output": 5, "interpolation": "LINEAR"}]
+anim["channels"] += [{"sampler": 1, "target": {"node": 1, "path": "translation"}},
+                     {"sampler": 2, "target": {"node": 1, "path": "rotation"}}]
+json.dump(gltf, open(sys.argv[2], "w"))
+# Only the camera moves: the cube's channel removed.
+del anim["channels"][0]
+json.dump(gltf, open(sys.argv[3], "w"))
 PY
 scene="$work/anim.gltf"
 common=(--width 32 --spp 1 --no-png)
@@ -66,6 +84,40 @@ for n in 1 2 3; do
   expect 0 "PASS" -- idiff -a "$work/f.000$n.exr" "$work/single.$n.exr"
 done
 idiff -a "$work/f.0001.exr" "$work/f.0003.exr" >/dev/null 2>&1 && fail "frames 1 and 3 have equal pixels"
+
+# Only instances move: later frames reuse the loaded scene and move the cube's instance. At
+# frame 3 (t = 0.125) the cube passes through the origin, an identity placement, so the structure
+# is built again rather than updated; the pixels are the same either way.
+expect 0 "frame 2 \(2 of 3\) -> .*m.0002.exr \(animated scene: loaded scene reused, instances moved, top level rebuilt\)" -- "$bin" render "$scene" --frames 1-3 -o "$work/m.####.exr" "${common[@]}"
+grep -qE "frame 3 \(3 of 3\) -> .*m.0003.exr \(animated scene: loaded scene reused, instances moved, acceleration structure rebuilt\)" "$work/err" || fail "frame 3 did not say the structure was rebuilt"
+grep -qE "frame 1 \(1 of 3\) -> .*m.0001.exr$" "$work/err" || fail "frame 1 did not load the scene"
+
+# The camera moves too: each frame sees the cube from its own camera, as --frame does; the
+# same with Penumbra's own BVH (its two-level wrapper moves the instance).
+for accel in embree bvh; do
+  expect 0 "frame 2 \(2 of 3\) -> .*c.$accel.0002.exr \(animated scene: loaded scene reused, instances moved, top level rebuilt\)" -- "$bin" render "$work/camera.gltf" --frames 1-3 -o "$work/c.$accel.####.exr" --accel "$accel" "${common[@]}"
+  for n in 1 2 3; do
+    expect 0 "cs.$accel.$n.exr" -- "$bin" render "$work/camera.gltf" --frame "$n" -o "$work/cs.$accel.$n.exr" --accel "$accel" "${common[@]}"
+    expect 0 "PASS" -- idiff -a "$work/c.$accel.000$n.exr" "$work/cs.$accel.$n.exr"
+  done
+done
+idiff -a "$work/c.embree.0002.exr" "$work/f.0002.exr" >/dev/null 2>&1 && fail "the moving camera sees what the still one sees"
+
+# The shipped fly-through: still meshes (in world space, and instanced walls) beside the turning
+# box and the flying camera; with Embree the still placements sit in a scene of their own.
+fly="$(cd "$(dirname "$0")/../.." && pwd)/scenes/flythrough.gltf"
+expect 0 "frame 60 \(2 of 2\) -> .*fly.0060.exr \(animated scene: loaded scene reused, instances moved, top level rebuilt\)" -- "$bin" render "$fly" --frames 30-60:30 -o "$work/fly.####.exr" "${common[@]}"
+for n in 30 60; do
+  expect 0 "flys.$n.exr" -- "$bin" render "$fly" --frame "$n" -o "$work/flys.$n.exr" "${common[@]}"
+  expect 0 "PASS" -- idiff -a "$work/fly.00$n.exr" "$work/flys.$n.exr"
+done
+
+# Only the camera moves: the acceleration structure is kept as it is.
+expect 0 "frame 3 \(3 of 3\) -> .*o.0003.exr \(animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused\)" -- "$bin" render "$work/camera-only.gltf" --frames 1-3 -o "$work/o.####.exr" "${common[@]}"
+for n in 1 3; do
+  expect 0 "os.$n.exr" -- "$bin" render "$work/camera-only.gltf" --frame "$n" -o "$work/os.$n.exr" "${common[@]}"
+  expect 0 "PASS" -- idiff -a "$work/o.000$n.exr" "$work/os.$n.exr"
+done
 
 # A scene without animations is loaded and built once; its frames equal a --frame render.
 python3 -c 'import json,sys; g=json.load(open(sys.argv[1])); del g["animations"]; json.dump(g, open(sys.argv[2], "w"))' "$scene" "$work/static.gltf"

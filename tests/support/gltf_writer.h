@@ -43,12 +43,36 @@ class GltfWriter {
     const int ct = sizeof(T) == 1 ? 5121 : (sizeof(T) == 2 ? 5123 : 5125);
     return accessor(idx.data(), idx.size() * sizeof(T), ct, idx.size(), "SCALAR");
   }
+  /// A FLOAT accessor over `v`, `width` components per element of `type`.
+  int floats(const std::vector<float>& v, const char* type, size_t width) {
+    return accessor(v.data(), v.size() * 4, 5126, v.size() / width, type);
+  }
+  /// Adds a channel (node, path) with its own sampler over the keys to animations[0].
+  void channel(int node, const char* path, const std::vector<float>& times, const std::vector<float>& values,
+               const char* type, size_t width, const char* interpolation = "LINEAR") {
+    const int in = floats(times, "SCALAR", 1), out = floats(values, type, width);
+    if (!j.contains("animations"))
+      j["animations"] = nlohmann::json::array(
+          {{{"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}}});
+    auto& a = j["animations"][0];
+    a["samplers"].push_back({{"input", in}, {"output", out}, {"interpolation", interpolation}});
+    a["channels"].push_back(
+        {{"sampler", int(a["samplers"].size()) - 1}, {"target", {{"node", node}, {"path", path}}}});
+  }
   /// A mesh with one primitive; returns the mesh index.
   int mesh(int position_accessor, int index_accessor = -1, int mode = 4) {
     nlohmann::json prim = {{"attributes", {{"POSITION", position_accessor}}}, {"mode", mode}};
     if (index_accessor >= 0) prim["indices"] = index_accessor;
     j["meshes"].push_back({{"primitives", {prim}}});
     return int(j["meshes"].size()) - 1;
+  }
+  /// A mesh with one primitive and one morph target (POSITION deltas), default weight 0.
+  int morph_mesh(int position_accessor, int target_accessor) {
+    const int m = mesh(position_accessor);
+    j["meshes"][size_t(m)]["primitives"][0]["targets"] =
+        nlohmann::json::array({{{"POSITION", target_accessor}}});
+    j["meshes"][size_t(m)]["weights"] = {0.0};
+    return m;
   }
   /// A node (root unless `root` is false); returns its index.
   int node(nlohmann::json fields, bool root = true) {

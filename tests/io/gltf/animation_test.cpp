@@ -14,24 +14,6 @@ using namespace penumbra;
 using nlohmann::json;
 
 namespace {
-constexpr int kFloat = 5126;
-
-int floats(test::GltfWriter& w, const std::vector<float>& v, const char* type, size_t width) {
-  return w.accessor(v.data(), v.size() * 4, kFloat, v.size() / width, type);
-}
-
-// Adds animation channel (node, path) with the given keys and interpolation.
-void channel(test::GltfWriter& w, int node, const char* path, const std::vector<float>& times,
-             const std::vector<float>& values, const char* type, size_t width,
-             const char* interp = "LINEAR") {
-  const int in = floats(w, times, "SCALAR", 1), out = floats(w, values, type, width);
-  if (!w.j.contains("animations"))
-    w.j["animations"] = json::array({{{"channels", json::array()}, {"samplers", json::array()}}});
-  auto& a = w.j["animations"][0];
-  a["samplers"].push_back({{"input", in}, {"output", out}, {"interpolation", interp}});
-  a["channels"].push_back(
-      {{"sampler", int(a["samplers"].size()) - 1}, {"target", {{"node", node}, {"path", path}}}});
-}
 
 /// The world-space mesh a node places (its first instance).
 Mesh mesh_of_node(const Scene& s, int node) {
@@ -47,13 +29,11 @@ std::filesystem::path animated_file() {
   test::GltfWriter w;
   const int pos = w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   const int morph = w.positions({0, 0, 1, 0, 0, 1, 0, 0, 1});
-  const int mesh = w.mesh(pos);
-  w.j["meshes"][size_t(mesh)]["primitives"][0]["targets"] = json::array({{{"POSITION", morph}}});
-  w.j["meshes"][size_t(mesh)]["weights"] = {0.0};
+  const int mesh = w.morph_mesh(pos, morph);
   // Skinned mesh: vertex 0 on joint 0, vertex 1 on joint 1, vertex 2 half and half.
   const std::vector<uint8_t> joints = {0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
   const int ja = w.accessor(joints.data(), joints.size(), 5121, 3, "VEC4");
-  const int wa = floats(w, {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0}, "VEC4", 4);
+  const int wa = w.floats({1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0}, "VEC4", 4);
   const int skinned = w.mesh(pos);
   w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["JOINTS_0"] = ja;
   w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["WEIGHTS_0"] = wa;
@@ -67,16 +47,16 @@ std::filesystem::path animated_file() {
   const int j1 = w.node({{"name", "j1"}});                             // 6
   const int sk = w.node({{"mesh", skinned}, {"skin", 0}, {"translation", {10, 0, 0}}});  // 7
   w.j["skins"] = json::array({{{"joints", {j0, j1}}}});
-  channel(w, a, "translation", {0, 2}, {0, 0, 0, 4, 0, 0}, "VEC3", 3);
+  w.channel(a, "translation", {0, 2}, {0, 0, 0, 4, 0, 0}, "VEC3", 3);
   const float s45 = float(std::sqrt(0.5));
-  channel(w, b, "rotation", {0, 1}, {0, 0, 0, 1, 0, 0, s45, s45}, "VEC4", 4);
+  w.channel(b, "rotation", {0, 1}, {0, 0, 0, 1, 0, 0, s45, s45}, "VEC4", 4);
   // Cubic scale: keys t = 0, 1 with values 1 and 3, out-tangent 0 at the first, in-tangent 0
   // at the second: p(0.5) = 0.5 x 1 + 0.5 x 3 = 2.
-  channel(w, c, "scale", {0, 1}, {0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 3, 3, 3, 0, 0, 0}, "VEC3", 3,
-          "CUBICSPLINE");
-  channel(w, d, "weights", {0, 2}, {0, 1}, "SCALAR", 1);
-  channel(w, e, "translation", {0, 1}, {0, 0, 0, 0, 7, 0}, "VEC3", 3, "STEP");
-  channel(w, j1, "translation", {0, 1}, {0, 0, 0, 0, 0, 2}, "VEC3", 3);
+  w.channel(c, "scale", {0, 1}, {0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 3, 3, 3, 0, 0, 0}, "VEC3", 3,
+            "CUBICSPLINE");
+  w.channel(d, "weights", {0, 2}, {0, 1}, "SCALAR", 1);
+  w.channel(e, "translation", {0, 1}, {0, 0, 0, 0, 7, 0}, "VEC3", 3, "STEP");
+  w.channel(j1, "translation", {0, 1}, {0, 0, 0, 0, 0, 2}, "VEC3", 3);
   (void)sk;
   const auto dir = test::temp_dir("anim");
   w.write_embedded(dir / "anim.gltf");
@@ -143,22 +123,22 @@ TEST_CASE("animation: malformed channels are errors naming the animation element
   };
   expect_error(
       [](test::GltfWriter& w, int n) {
-        channel(w, n, "translation", {0, 1}, {0, 0, 0}, "VEC3", 3);
+        w.channel(n, "translation", {0, 1}, {0, 0, 0}, "VEC3", 3);
       },
       "animations[0].samplers[0].output");
   expect_error(
       [](test::GltfWriter& w, int n) {
-        channel(w, n, "translation", {1, 0}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
+        w.channel(n, "translation", {1, 0}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
       },
       "non-decreasing");
   expect_error(
       [](test::GltfWriter& w, int n) {
-        channel(w, n + 5, "translation", {0, 1}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
+        w.channel(n + 5, "translation", {0, 1}, {0, 0, 0, 1, 1, 1}, "VEC3", 3);
       },
       "animations[0].channels[0].target.node");
   expect_error(
       [](test::GltfWriter& w, int n) {
-        channel(w, n, "scale", {0, 1}, {1, 1, 1, 2, 2, 2}, "VEC3", 3, "QUADRATIC");
+        w.channel(n, "scale", {0, 1}, {1, 1, 1, 2, 2, 2}, "VEC3", 3, "QUADRATIC");
       },
       "interpolation");
   expect_error([](test::GltfWriter& w, int n) { w.j["nodes"][size_t(n)]["skin"] = 3; }, "nodes[0].skin");

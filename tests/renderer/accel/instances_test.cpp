@@ -1,13 +1,15 @@
 // Two-level instancing (renderer/accel/instances.cpp and Embree's instances): hits report the
 // instance, t along the world ray and the object triangle's barycentrics (analytic answers);
 // every back end over instances agrees with brute force over the flattened scene, and
-// Penumbra's back ends agree exactly with the two-level brute force.
+// Penumbra's back ends agree exactly with the two-level brute force; instances moved by
+// update_instances answer exactly as a fresh build over the new placements.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
 #include "renderer/accel/factory.h"
 #include "support/cross_check.h"
+#include "support/sdf_trees.h"
 
 using namespace penumbra;
 using namespace penumbra::test;
@@ -123,4 +125,95 @@ TEST_CASE("instances: every back end agrees with brute force over the flattened 
                       u(rng) * 3, {1 + u(rng) * 0.5f, 1, 1 + u(rng) * 0.5f})});
   instances.push_back({0, placement({9, 9, 9}, {0, 0, 1}, 0, {0, 0, 0})});  // singular: never hit
   check_instanced("instances", meshes, instances, {});
+}
+
+TEST_CASE("instances: update_instances moves the placements and answers as a fresh build does",
+          "[accel][instances][quick]") {
+  Soup s;
+  Soup sphere = icosphere(2, 1, {0, 0, 0});
+  s.add(sphere.positions[0], sphere.indices[0]);                 // mesh 0: sphere
+  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);                          // mesh 1: a 2 x 2 plane in y = 0
+  s.add({{0, 0, 0}, {0.3f, 0, 0}, {0, 0.3f, 0.1f}}, {0, 1, 2});  // mesh 2: one small triangle
+  const Shape ball = analytic_shape(ShapeKind::Sphere, 0.4f);
+  std::vector<GeometryView> meshes = s.views();
+  meshes.push_back({{}, {}, &ball});  // view 3: a shape
+  // Instances moved from frame to frame: every kind of placement, with the identity kept as
+  // the identity and a singular map kept singular.
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const auto frame = [&](int f) {
+    const float k = 0.3f * float(f);
+    std::vector<InstanceView> out = {
+        {0, Affine3f{}},
+        {0, placement({4 + k, 0, k}, normalize(Vec3f{1, 2, 3}), 0.7 + k, {1, 0.5f, 2})},
+        {0, placement({-4, 1 - k, 0}, {0, 1, 0}, 0.3, {-1, 1, 1 + k})},
+        {1, placement({0, -2, 0}, {1, 0, 0}, 0.2 * k, {10, 1, 10})},
+        {3, placement({k, 3, -k}, {0, 0, 1}, 0, {1, 1 + k, 1})},
+        {3, Affine3f{}},
+        {0, placement({9, 9, 9}, {0, 0, 1}, 0, {0, 0, 0})},  // singular
+    };
+    for (int i = 0; i < 200; ++i)
+      out.push_back({2, placement({u(rng) * 3, 2 + u(rng), u(rng) * 3}, normalize(Vec3f{u(rng), u(rng), 2}),
+                                  u(rng) * 3, {1 + u(rng) * 0.5f, 1, 1})});
+    return out;
+  };
+  const std::vector<InstanceView> first = frame(0);
+  // Every back end, and Embree with its identity placements in a scene of their own.
+  std::vector<std::pair<std::string, AccelConfig>> builds;
+  for (const auto& name : accelerator_names()) builds.push_back({name, {}});
+  builds.push_back({"embree", {}});
+  builds.back().second.embree.world_apart = true;
+  for (const auto& [name, config] : builds) {
+    INFO(name << (config.embree.world_apart ? " (identity placements apart)" : ""));
+    const auto moved = make_accelerator(name, meshes, first, config);
+    for (int f = 1; f <= 3; ++f) {
+      INFO("frame " << f);
+      const std::vector<InstanceView> next = frame(f);
+      REQUIRE(moved->update_instances(next));
+      const auto fresh = make_accelerator(name, meshes, next, config);
+      CHECK(moved->bounds().lo == fresh->bounds().lo);
+      CHECK(moved->bounds().hi == fresh->bounds().hi);
+      std::mt19937 ray_rng(100 + f);
+      int hits = 0;
+      for (const Ray& r : random_rays(fresh->bounds(), 4000, ray_rng)) {
+        Hit a, b;
+        const bool ha = moved->intersect(r, a), hb = fresh->intersect(r, b);
+        INFO(describe(r) << ": moved " << describe(a) << ", fresh " << describe(b));
+        REQUIRE(ha == hb);
+        REQUIRE(moved->occluded(r) == fresh->occluded(r));
+        if (!ha) continue;
+        ++hits;
+        REQUIRE(a.t == b.t);
+        REQUIRE(a.geom_id == b.geom_id);
+        REQUIRE(a.prim_id == b.prim_id);
+        REQUIRE(a.u == b.u);
+        REQUIRE(a.v == b.v);
+      }
+      CHECK(hits > 400);
+    }
+    // Another count, mesh or kind is refused and leaves the structure as it was.
+    std::vector<InstanceView> other = frame(4);
+    const std::vector<InstanceView> shorter(other.begin(), other.end() - 1);
+    CHECK_FALSE(moved->update_instances(shorter));
+    std::vector<InstanceView> remeshed = other;
+    remeshed[1].mesh = 1;
+    CHECK_FALSE(moved->update_instances(remeshed));
+    std::vector<InstanceView> to_identity = other;
+    to_identity[1].to_world = Affine3f{};
+    CHECK_FALSE(moved->update_instances(to_identity));
+    std::vector<InstanceView> from_identity = other;
+    from_identity[0].to_world = translation({1, 0, 0});
+    CHECK_FALSE(moved->update_instances(from_identity));
+    std::vector<InstanceView> unsingular = other;
+    unsingular[6].to_world = translation({9, 9, 9});
+    CHECK_FALSE(moved->update_instances(unsingular));
+  }
+  // A build in one level (every placement the identity) may refuse; a rebuild is the answer.
+  const std::vector<InstanceView> flat = {{0, Affine3f{}}, {1, Affine3f{}}};
+  for (const auto& name : accelerator_names()) {
+    INFO(name);
+    const auto a = make_accelerator(name, meshes, flat);
+    const std::vector<InstanceView> moved = {{0, translation({1, 0, 0})}, {1, Affine3f{}}};
+    CHECK_FALSE(a->update_instances(moved));
+  }
 }
