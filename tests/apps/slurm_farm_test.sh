@@ -27,15 +27,16 @@ echo "cluster up in $(($(date +%s) - start)) s on node $SLURM_CLUSTER_NODE"
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
-# The job: sh010 with the Whitted integrator, sh020 path traced and slow enough (about a second
-# per frame) for a task to be caught running.
+# The job: sh010 the fly-through (a camera flight and a turning box: the local batch poses one
+# loaded scene, each farm task loads its frame) with the Whitted integrator, sh020 path traced
+# and slow enough (about a second per frame) for a task to be caught running.
 write_job() {  # write_job FILE OUTPUT_FOLDER
   cat >"$1" <<EOF
 {
   "version": 1,
   "defaults": {"width": 64, "height": 36, "threads": 1, "max-memory": "1G", "seed": 7},
   "shots": [
-    {"name": "sh010", "scene": "$src/scenes/default.gltf", "frames": "1-3",
+    {"name": "sh010", "scene": "$src/scenes/flythrough.gltf", "frames": "1-3",
      "output": "$2/sh010.####.exr", "png": "$2/sh010.####.png", "settings": {"spp": 2}},
     {"name": "sh020", "scene": "$src/scenes/spheres.gltf", "frames": "1-3", "tiles": 4, "tile_frames": "2",
      "output": "$2/sh020.####.exr", "png": "$2/sh020.####.png",
