@@ -10,6 +10,8 @@
 #include <system_error>
 #include <vector>
 
+#include "io/exr_merge.h"
+
 namespace penumbra {
 
 namespace {
@@ -105,6 +107,18 @@ bool is_complete_exr(const std::filesystem::path& path, std::string& problem) {
   OIIO::ImageSpec spec;
   if (!in->open(path.string(), spec)) {
     problem = "cannot be read as OpenEXR: " + in->geterror();
+    return false;
+  }
+  // A render stopped by a signal, --time-limit or a checkpoint writes the image so far, marked
+  // as such, with its resume state beside it.
+  const OIIO::ParamValue* settings = spec.find_attribute(kSettingsAttribute, OIIO::TypeDesc::STRING);
+  const std::string text = settings ? settings->get_string() : std::string();
+  if (text.rfind("complete=0\n", 0) == 0 || text.find("\ncomplete=0\n") != std::string::npos) {
+    problem = "holds an unfinished render (its penumbra:settings say complete=0)";
+    return false;
+  }
+  if (std::filesystem::exists(std::filesystem::path(path).concat(".resume"), ec)) {
+    problem = "has a resume state beside it (" + path.filename().string() + ".resume: an unfinished render)";
     return false;
   }
   std::vector<unsigned char> pixels;

@@ -81,6 +81,18 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
     const auto reserved = reserved_settings().find(s.key);
     if (reserved != reserved_settings().end())
       throw InputError(job.file.string(), s.where, "is set by " + reserved->second + ", not in settings");
+    // Batch renders are reproducible: nothing that depends on the clock.
+    if (s.key == "time-limit")
+      throw InputError(job.file.string(), s.where,
+                       "a time limit makes a frame depend on the machine and differ between its stripes; "
+                       "batch renders take every sample");
+    if (s.key == "aov")
+      for (const std::string& v : s.values)
+        if (("," + v + ",").find(",cost,") != std::string::npos)
+          throw InputError(
+              job.file.string(), s.where,
+              "the cost layer records times (cost.ns), which differ between runs; render it with "
+              "`penumbra render --aov cost`");
     const CLI::Option* opt = render.get_option_no_throw("--" + s.key);
     if (!opt || s.key.size() < 2)
       throw InputError(job.file.string(), s.where,
@@ -177,6 +189,9 @@ int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
   }
   RenderArgs args = unit_render_args(pj, n);
   args.skip_existing = b.skip_existing;
+  // An unfinished render of this unit (cancelled, preempted) continues from its resume state.
+  std::error_code ec;
+  args.resume = args.integrator == "path" && fs::exists(fs::path(args.output).concat(".resume"), ec);
   return in_shot(pj.job, pj.job.shots[u.shot], [&] { return run_render(args); });
 }
 
@@ -186,13 +201,20 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   const WorkUnit& u = pj.units[first];
   const JobShot& shot = pj.job.shots[u.shot];
   const fs::path final_exr = unit_output(pj.job, u);
-  if (b.skip_existing && complete(final_exr)) return true;
+  const fs::path png =
+      shot.png.empty() ? fs::path() : fs::path(substitute_frame(shot.png, u.frame.value_or(0)));
+  const RenderRequest q = check_render_args(pj.shot_args[u.shot]);
+  std::error_code ec;
+  if (b.skip_existing && complete(final_exr)) {
+    if (!png.empty() && !fs::exists(png, ec))  // the merge ended before its display image
+      write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
+    return true;
+  }
   std::vector<fs::path> parts;
   std::string missing;
   bool any = false;
   for (int t = 0; t < u.tiles; ++t) {
     parts.push_back(tile_part_path(final_exr, t, u.tiles));
-    std::error_code ec;
     any = any || fs::exists(parts.back(), ec);
     if (!complete(parts.back())) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
   }
@@ -203,14 +225,19 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
                  pj.job.file.string().c_str(), final_exr.string().c_str(), missing.c_str());
     return false;
   }
-  const RenderRequest q = check_render_args(pj.shot_args[u.shot]);
   MergeOptions options;
   options.max_memory_bytes = q.budget;
-  merge_exr_parts(parts, final_exr, options);
-  if (!shot.png.empty()) {
-    const fs::path png = substitute_frame(shot.png, u.frame.value_or(0));
-    write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
+  try {
+    merge_exr_parts(parts, final_exr, options);
+  } catch (const InputError& e) {  // e.g. stripes of an earlier version of the job
+    std::fprintf(stderr,
+                 "penumbra: error: %s: cannot merge %s: %s (remove its .tile-*-of-%d.exr stripes and run "
+                 "units %zu to %zu again)\n",
+                 pj.job.file.string().c_str(), final_exr.string().c_str(), e.what(), u.tiles, first,
+                 first + size_t(u.tiles) - 1);
+    return false;
   }
+  if (!png.empty()) write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
   for (const fs::path& p : parts) fs::remove(p);
   if (!b.quiet)
     std::fprintf(stderr, "penumbra: merged %d stripes into %s\n", u.tiles, final_exr.string().c_str());
@@ -233,8 +260,9 @@ int render_all(const PreparedJob& pj, const BatchArgs& b) {
   return kExitOk;
 }
 
-/// Creates the folders every unit of `pj` writes into (a farm's output tree need not exist).
-void create_output_folders(const PreparedJob& pj) {
+/// Creates the folders every unit of `pj` writes into (a farm's output tree need not exist) and
+/// returns those it made, parents first.
+std::vector<fs::path> create_output_folders(const PreparedJob& pj) {
   std::set<fs::path> folders;
   for (const WorkUnit& u : pj.units) {
     const JobShot& shot = pj.job.shots[u.shot];
@@ -242,12 +270,46 @@ void create_output_folders(const PreparedJob& pj) {
       if (!pattern->empty())
         folders.insert(fs::path(u.frame ? substitute_frame(*pattern, *u.frame) : *pattern).parent_path());
   }
+  std::vector<fs::path> made;
   for (const fs::path& f : folders) {
+    std::vector<fs::path> missing;  // f and its parents that do not exist yet, innermost first
     std::error_code ec;
+    for (fs::path p = f; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+      missing.push_back(p);
+      if (p == p.parent_path()) break;
+    }
     fs::create_directories(f, ec);
     if (ec)
       throw InputError(pj.job.file.string(), "",
                        "cannot create the output folder " + f.string() + ": " + ec.message());
+    made.insert(made.end(), missing.rbegin(), missing.rend());
+  }
+  return made;
+}
+
+/// Maps every shot's settings onto `render`'s flags into pj.shot_args and, with `check_frames`,
+/// checks every frame's outputs, one stripe of each tiled shot and that no two shots write one file.
+void check_shots(PreparedJob& pj, const BatchArgs& b, bool check_frames) {
+  std::map<std::string, std::string> writer;  // every output file -> the shot writing it
+  for (size_t s = 0; s < pj.job.shots.size(); ++s) {
+    const JobShot& shot = pj.job.shots[s];
+    pj.shot_args.push_back(
+        shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, b.quiet, b.threads, b.max_memory}));
+    if (!check_frames) continue;
+    auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
+    for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
+      if (u.shot == s && u.tiles > 1) {
+        check_shot(
+            pj.job, shot,
+            shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, b.quiet, b.threads, b.max_memory}));
+        break;
+      }
+    for (const auto& [option, file] : outputs) {
+      const auto [it, fresh] = writer.emplace(fs::absolute(file).lexically_normal().string(), shot.where);
+      if (!fresh && it->second != shot.where)
+        throw InputError(pj.job.file.string(), shot.where,
+                         file.string() + " is also written by " + it->second);
+    }
   }
 }
 
@@ -259,30 +321,22 @@ PreparedJob prepare_job(const BatchArgs& b, bool create_folders, bool check_fram
   pj.units = job_units(pj.job, b.tiles);
   pj.threads = b.threads;
   pj.max_memory = b.max_memory;
-  const bool quiet = b.quiet;
-  if (create_folders) create_output_folders(pj);
-  std::map<std::string, std::string> writer;  // every output file -> the shot writing it
-  for (size_t s = 0; s < pj.job.shots.size(); ++s) {
-    const JobShot& shot = pj.job.shots[s];
-    pj.shot_args.push_back(
-        shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, quiet, b.threads, b.max_memory}));
-    if (!check_frames) continue;
-    auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
-    for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
-      if (u.shot == s && u.tiles > 1) {
-        check_shot(
-            pj.job, shot,
-            shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, quiet, b.threads, b.max_memory}));
-        break;
-      }
-    for (const auto& [option, file] : outputs) {
-      const auto [it, fresh] = writer.emplace(fs::absolute(file).lexically_normal().string(), shot.where);
-      if (!fresh && it->second != shot.where)
-        throw InputError(pj.job.file.string(), shot.where,
-                         file.string() + " is also written by " + it->second);
-    }
+  if (create_folders) pj.made_folders = create_output_folders(pj);
+  try {
+    check_shots(pj, b, check_frames);
+  } catch (...) {
+    remove_made_folders(pj);  // a refused job leaves nothing behind
+    throw;
   }
   return pj;
+}
+
+void remove_made_folders(PreparedJob& pj) {
+  for (auto it = pj.made_folders.rbegin(); it != pj.made_folders.rend(); ++it) {
+    std::error_code ec;
+    fs::remove(*it, ec);  // only while empty
+  }
+  pj.made_folders.clear();
 }
 
 RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
@@ -300,8 +354,11 @@ bool unit_complete(const PreparedJob& pj, size_t n) {
 
 int run_batch(const BatchArgs& b) {
   // A farm task checks its own unit (as `render` does) rather than every frame of the job.
-  const PreparedJob pj = prepare_job(b, true, !b.unit);
-  if (b.list) return list_units(pj);
+  PreparedJob pj = prepare_job(b, true, !b.unit);
+  if (b.list) {
+    remove_made_folders(pj);  // listing writes nothing
+    return list_units(pj);
+  }
   if (b.unit) {
     if (*b.unit < 0 || uint64_t(*b.unit) >= pj.units.size())
       throw UsageError("--unit " + std::to_string(*b.unit) + ": " + b.job_file + " has units 0 to " +

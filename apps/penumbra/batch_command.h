@@ -5,6 +5,7 @@
 // and merged, is the same file.
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +34,7 @@ struct PreparedJob {
   std::vector<RenderArgs> shot_args;  ///< per shot: every frame, whole, into its outputs
   int threads = 0;                    ///< BatchArgs' defaults
   std::string max_memory;
+  std::vector<std::filesystem::path> made_folders;  ///< output folders prepare_job created, parents first
 };
 
 /// Reads the job, maps every shot's settings onto `render`'s flags and checks them as `render`
@@ -43,6 +45,10 @@ struct PreparedJob {
 /// frame's outputs (a farm task checks its own unit when it renders). Throws InputError naming
 /// the job file, the shot and the key.
 PreparedJob prepare_job(const BatchArgs& args, bool create_folders, bool check_frames);
+
+/// Removes the folders prepare_job created while they are still empty (after a check that
+/// writes nothing: --list, --dry-run).
+void remove_made_folders(PreparedJob& job);
 
 /// The `render` flags of unit `n`: its frame, and for a stripe `--tile i/N` into
 /// tile_part_path() without display image or statistics.

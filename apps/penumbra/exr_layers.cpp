@@ -169,7 +169,7 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
         {kMeanSppAttribute,
          format_mean_spp(job.stats.samples, uint64_t(job.film.width) * uint64_t(job.film.height))});
     exr.metadata.push_back({kSamplesAttribute, std::to_string(job.stats.samples)});
-    exr.metadata.push_back({kPassesAttribute, std::to_string(job.stats.passes)});
+    exr.metadata.push_back({kPassesAttribute, std::to_string(job.stats.image_passes)});
   }
   add_part_identity(exr, job);
   if (!a.reproducible) exr.metadata.push_back({"penumbra:command_line", a.command_line});

@@ -342,6 +342,18 @@ bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q)
   std::string problem;
   const std::string label = p.number ? "frame " + std::to_string(*p.number) + ": " : "";
   if (is_complete_exr(q.out, problem)) {
+    // The display image and statistics of a frame whose run ended after its EXR.
+    std::vector<fs::path> others;
+    if (q.png) others.push_back(*q.png);
+    if (!a.stats_json.empty()) others.push_back(a.stats_json);
+    std::error_code ec;
+    for (const fs::path& other : others)
+      if (!fs::exists(other, ec)) {
+        if (!a.quiet)
+          std::fprintf(stderr, "penumbra: warning: %s%s is missing; rendering the frame again\n",
+                       label.c_str(), other.string().c_str());
+        return false;
+      }
     if (!a.quiet)
       std::fprintf(stderr, "penumbra: %s%s is complete; skipped\n", label.c_str(), q.out.string().c_str());
     return true;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -85,23 +86,49 @@ std::string batch_options(const SubmitArgs& a) {
   return o;
 }
 
-std::string sbatch_header(const std::string& name, const Resources& r, int cpus, const SubmitArgs& a,
-                          const fs::path& log) {
+/// The job's name on the cluster: the job file's stem (letters, digits, '.', '_', '-' kept) and
+/// a hash of its absolute path, so that two job files never share a name.
+std::string job_name(const fs::path& job_file, const char* kind) {
+  std::string stem;
+  for (const char c : job_file.stem().string())
+    stem += std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' ? c : '_';
+  uint32_t h = 2166136261u;  // FNV-1a
+  for (const char c : job_file.string()) h = (h ^ uint8_t(c)) * 16777619u;
+  char hex[9];
+  std::snprintf(hex, sizeof hex, "%08x", h);
+  return std::string("penumbra-") + kind + "-" + stem.substr(0, 64) + "-" + hex;
+}
+
+/// The sbatch options that hold text from outside (names, paths), quoted for the shell; `%` in
+/// the log path is Slurm's pattern character, doubled to stand for itself.
+std::string named_options(const std::string& name, const fs::path& log_dir, const std::string& log_pattern) {
+  std::string dir;
+  for (const char c : log_dir.string()) dir += c == '%' ? std::string("%%") : std::string(1, c);
+  return "--job-name=" + quoted(name) + " --output=" + quoted(dir + "/" + log_pattern);
+}
+
+/// Throws UsageError unless `value` is a plain Slurm word (a partition or a time limit).
+void check_slurm_word(const std::string& value, const char* option) {
+  if (value.empty()) return;
+  for (const char c : value)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && !std::strchr("_.,:-", c))
+      throw UsageError(std::string(option) + " '" + value +
+                       "': only letters, digits and _ . , : - (a Slurm partition name or time)");
+}
+
+std::string sbatch_header(const Resources& r, int cpus, const SubmitArgs& a) {
   std::string h = "#!/bin/sh\n";
-  h += "#SBATCH --job-name=" + name + "\n";
   h += "#SBATCH --cpus-per-task=" + std::to_string(cpus) + "\n";
   h += "#SBATCH --mem=" + std::to_string(r.mem_mib) + "M\n";
   h += "#SBATCH --requeue\n";
-  h += "#SBATCH --output=" + log.string() + "\n";
   if (!a.partition.empty()) h += "#SBATCH --partition=" + a.partition + "\n";
   if (!a.time_limit.empty()) h += "#SBATCH --time=" + a.time_limit + "\n";
   return h;
 }
 
 std::string render_script(const PreparedJob& pj, const SubmitArgs& a, const Resources& r,
-                          const std::vector<size_t>& pending, const fs::path& dir, const std::string& exe) {
-  const std::string stem = pj.job.file.stem().string();
-  std::string s = sbatch_header("penumbra-" + stem, r, r.cpus, a, dir / "render-%A_%a.log");
+                          const std::vector<size_t>& pending, const std::string& exe) {
+  std::string s = sbatch_header(r, r.cpus, a);
   s += "#SBATCH --array=" + array_spec(pending) + "\n";
   s += "# One work unit of " + pj.job.file.string() +
        " per array task (`penumbra batch --list` prints them).\n";
@@ -122,10 +149,9 @@ std::string render_script(const PreparedJob& pj, const SubmitArgs& a, const Reso
   return s;
 }
 
-std::string merge_script(const PreparedJob& pj, const SubmitArgs& a, const Resources& r, const fs::path& dir,
+std::string merge_script(const PreparedJob& pj, const SubmitArgs& a, const Resources& r,
                          const std::string& exe) {
-  const std::string stem = pj.job.file.stem().string();
-  std::string s = sbatch_header("penumbra-merge-" + stem, r, 1, a, dir / "merge-%j.log");
+  std::string s = sbatch_header(r, 1, a);
   s += "#SBATCH --kill-on-invalid-dep=yes\n";  // a failed array leaves no merge job waiting forever
   s += "# Assembles every tiled frame of " + pj.job.file.string() + " from its stripes.\n";
   s += "exec " + quoted(exe) + " batch " + quoted(pj.job.file.string()) + " --merge --skip-existing" +
@@ -148,10 +174,10 @@ bool sbatch_on_path() {
   return false;
 }
 
-/// Runs `sbatch --parsable ARGS SCRIPT` and returns the job id; throws std::runtime_error with
-/// sbatch's output when it fails.
+/// Runs `sbatch --parsable ARGS SCRIPT` (its messages go to stderr) and returns the job id;
+/// throws std::runtime_error when it fails or prints no job id.
 std::string sbatch(const std::string& args, const fs::path& script) {
-  const std::string command = "sbatch --parsable " + args + " " + quoted(script.string()) + " 2>&1";
+  const std::string command = "sbatch --parsable " + args + " " + quoted(script.string());
   FILE* p = popen(command.c_str(), "r");
   if (!p) throw std::runtime_error("cannot run sbatch: " + std::string(std::strerror(errno)));
   std::string out;
@@ -159,12 +185,30 @@ std::string sbatch(const std::string& args, const fs::path& script) {
   while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
   const int status = pclose(p);
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-  if (status != 0 || out.empty())
+  const std::string id = out.substr(0, out.find(';'));  // "ID" or "ID;CLUSTER"
+  const bool numeric = !id.empty() && id.find_first_not_of("0123456789") == std::string::npos;
+  if (status != 0 || !numeric)
     throw std::runtime_error("sbatch " + script.string() + " failed" +
-                             (WIFEXITED(status) ? " with exit " + std::to_string(WEXITSTATUS(status)) : "") +
-                             ": " + out);
-  const std::string id = out.substr(out.rfind('\n') == std::string::npos ? 0 : out.rfind('\n') + 1);
-  return id.substr(0, id.find(';'));
+                             (WIFEXITED(status) && WEXITSTATUS(status) != 0
+                                  ? " with exit " + std::to_string(WEXITSTATUS(status))
+                                  : "") +
+                             (numeric ? "" : " (it printed no job id: '" + out.substr(0, 200) + "')") +
+                             "; its messages are above");
+  return id;
+}
+
+/// The ids of the jobs of `name` still queued or running (empty when squeue cannot tell).
+std::string queued_jobs(const std::string& name) {
+  FILE* p = popen(("squeue -h -o %i -n " + quoted(name) + " 2>/dev/null").c_str(), "r");
+  if (!p) return "";
+  std::string out;
+  char buf[512];
+  while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  pclose(p);
+  for (char& c : out)
+    if (c == '\n') c = ' ';
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
 }
 
 void write_script(const fs::path& path, const std::string& text) {
@@ -176,14 +220,22 @@ void write_script(const fs::path& path, const std::string& text) {
 }  // namespace
 
 int run_submit_slurm(const SubmitArgs& a) {
+  check_slurm_word(a.partition, "--partition");
+  check_slurm_word(a.time_limit, "--time");
   BatchArgs b;
   b.job_file = a.job_file;
   b.tiles = a.tiles;
   b.threads = a.threads;
   b.max_memory = a.max_memory;
   b.quiet = true;
-  const PreparedJob pj = prepare_job(b, true, true);  // also for --dry-run: the checks need the folders
-  const Resources r = task_resources(pj);
+  PreparedJob pj = prepare_job(b, true, true);  // the checks need the output folders
+  Resources r;
+  try {
+    r = task_resources(pj);
+  } catch (...) {
+    remove_made_folders(pj);
+    throw;
+  }
   std::vector<size_t> pending;
   bool merge_needed = false;
   for (size_t n = 0; n < pj.units.size(); ++n) {
@@ -194,35 +246,46 @@ int run_submit_slurm(const SubmitArgs& a) {
     }
   }
   if (pending.empty() && !merge_needed) {
+    remove_made_folders(pj);
     std::fprintf(stderr, "penumbra: every frame of %s is complete; nothing to submit\n", a.job_file.c_str());
     return kExitOk;
   }
   const fs::path dir =
       a.scripts.empty() ? fs::path(pj.job.file).replace_extension(".slurm") : fs::absolute(a.scripts);
   const std::string exe = fs::read_symlink("/proc/self/exe").string();
-  const std::string render = pending.empty() ? "" : render_script(pj, a, r, pending, dir, exe);
-  const std::string merge = merge_needed ? merge_script(pj, a, r, dir, exe) : "";
+  const std::string render = pending.empty() ? "" : render_script(pj, a, r, pending, exe);
+  const std::string merge = merge_needed ? merge_script(pj, a, r, exe) : "";
+  const std::string render_name = job_name(pj.job.file, "render"),
+                    merge_name = job_name(pj.job.file, "merge");
+  const std::string render_options = named_options(render_name, dir, "render-%A_%a.log");
+  const std::string merge_options = named_options(merge_name, dir, "merge-%j.log");
   if (a.dry_run) {
+    remove_made_folders(pj);  // a dry run writes nothing
     if (!render.empty())
-      std::printf("# %s\n%s\n# sbatch --parsable %s\n\n", (dir / "render.sbatch").c_str(), render.c_str(),
-                  (dir / "render.sbatch").c_str());
+      std::printf("# %s\n%s\n# sbatch --parsable %s %s\n\n", (dir / "render.sbatch").c_str(), render.c_str(),
+                  render_options.c_str(), quoted((dir / "render.sbatch").string()).c_str());
     if (!merge.empty())
-      std::printf("# %s\n%s\n# sbatch --parsable%s %s\n", (dir / "merge.sbatch").c_str(), merge.c_str(),
-                  render.empty() ? "" : " --dependency=afterok:<the array job>",
-                  (dir / "merge.sbatch").c_str());
+      std::printf("# %s\n%s\n# sbatch --parsable %s%s %s\n", (dir / "merge.sbatch").c_str(), merge.c_str(),
+                  merge_options.c_str(), render.empty() ? "" : " --dependency=afterok:<the array job>",
+                  quoted((dir / "merge.sbatch").string()).c_str());
     return kExitOk;
   }
   if (!sbatch_on_path())
     throw std::runtime_error(
         "sbatch is not on PATH: is Slurm installed on this machine? (--dry-run prints the "
         "scripts without submitting)");
+  // Units still running would be submitted twice, and two merges of one frame race.
+  for (const std::string& name : {render_name, merge_name})
+    if (const std::string ids = queued_jobs(name); !ids.empty())
+      throw UsageError("jobs of " + pj.job.file.string() + " are still queued or running (" + ids +
+                       "); submit again when they have ended, or scancel them");
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
   std::string array_id;
   if (!render.empty()) {
     write_script(dir / "render.sbatch", render);
-    array_id = sbatch("", dir / "render.sbatch");
+    array_id = sbatch(render_options, dir / "render.sbatch");
     std::printf("array %s\n", array_id.c_str());
     std::fprintf(stderr,
                  "penumbra: submitted array job %s: %zu of %zu units (%s), %d CPUs and %llu MiB each\n",
@@ -231,8 +294,15 @@ int run_submit_slurm(const SubmitArgs& a) {
   }
   if (!merge.empty()) {
     write_script(dir / "merge.sbatch", merge);
-    const std::string merge_id =
-        sbatch(array_id.empty() ? "" : "--dependency=afterok:" + array_id, dir / "merge.sbatch");
+    std::string merge_id;
+    try {
+      merge_id = sbatch(merge_options + (array_id.empty() ? "" : " --dependency=afterok:" + array_id),
+                        dir / "merge.sbatch");
+    } catch (const std::runtime_error& e) {
+      if (array_id.empty()) throw;
+      throw std::runtime_error(std::string(e.what()) + "; array job " + array_id +
+                               " is submitted: when it has ended, submit again for the merge");
+    }
     std::printf("merge %s\n", merge_id.c_str());
     std::fprintf(stderr, "penumbra: submitted merge job %s%s\n", merge_id.c_str(),
                  array_id.empty() ? "" : (" (runs when array job " + array_id + " has succeeded)").c_str());

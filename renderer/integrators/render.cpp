@@ -321,6 +321,7 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->threads = scheduler.threads();
     stats->passes = passes;
+    stats->image_passes = state.passes;
     stats->samples = total_samples;
     stats->time_limited = time_limited;
   }

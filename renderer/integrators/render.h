@@ -28,7 +28,8 @@ struct RenderStats {
   RayCounts rays;
   double seconds = 0;
   int threads = 0;
-  int passes = 0;             ///< path: passes rendered
+  int passes = 0;             ///< path: passes rendered by this call
+  int image_passes = 0;       ///< path: passes the image holds, a resumed render's earlier ones included
   uint64_t samples = 0;       ///< camera samples taken in all
   bool time_limited = false;  ///< path: the time limit ended the render early
 };

@@ -185,7 +185,7 @@ for want in "^# $sub/tiled.slurm/render.sbatch$" "^# $sub/tiled.slurm/merge.sbat
             "#SBATCH --cpus-per-task=3$" "#SBATCH --mem=812M$" \
             "batch '$sub/tiled.json' --unit \"\\\$SLURM_ARRAY_TASK_ID\" --skip-existing" \
             "batch '$sub/tiled.json' --merge --skip-existing" \
-            "# sbatch --parsable --dependency=afterok:"; do
+            "# sbatch --parsable --job-name=.* --dependency=afterok:"; do
   grep -qE -- "$want" "$work/out" || fail "--dry-run printed no line matching '$want'"
 done
 [ "$(grep -c '^#SBATCH --cpus-per-task=' "$work/out")" -eq 2 ] || fail "--dry-run did not print two scripts"
@@ -216,7 +216,8 @@ fake="$work/fake"
 mkdir -p "$fake"
 printf '#!/bin/sh\necho "sbatch: error: Batch job submission failed: Invalid partition" >&2\nexit 1\n' >"$fake/sbatch"
 chmod +x "$fake/sbatch"
-expect 1 "sbatch .*render.sbatch failed.*Invalid partition" -- env PATH="$fake:$PATH" "$bin" submit slurm "$sub/tiled.json"
+expect 1 "render.sbatch failed with exit 1" -- env PATH="$fake:$PATH" "$bin" submit slurm "$sub/tiled.json"
+grep -q "Invalid partition" "$work/err" || fail "sbatch's own message is not shown"
 # A working sbatch: the array job and the merge job, the scripts under JOB.slurm/.
 printf '#!/bin/sh\nprintf "%%s\\n" "$*" >>"%s/args"\necho 123\n' "$fake" >"$fake/sbatch"
 run 0 -- env PATH="$fake:$PATH" "$bin" submit slurm "$sub/tiled.json"

@@ -4,9 +4,9 @@
 # of 9 units and a merge job after it; every frame (EXR and PNG) must be byte-identical (cmp) to
 # `penumbra batch` of the same shots in one local process, and no stripe may be left. Then one
 # finished frame is deleted and two others are rendered again, one of whose tasks is cancelled
-# (scancel) while it runs: the array ends with that task CANCELLED, the merge job is dropped,
-# nothing is half-written, and a re-submission queues exactly the missing units and completes the
-# job, identical again. A third submission has nothing to do. Skipped (with the reason) when the
+# (scancel) while it renders: the array ends with that task CANCELLED, its frame absent or marked
+# unfinished beside its resume state, no temporary left; a re-submission queues exactly that unit,
+# resumes it and completes the job, identical again. A third submission has nothing to do. Skipped (with the reason) when the
 # cluster cannot start.
 # Usage: slurm_farm_test.sh PENUMBRA SRC
 set -u
@@ -70,7 +70,7 @@ identical() {
       fi
     done
   done
-  leftovers="$(cd "$dir/out" && ls | grep -E 'tile-|\.tmp-' | xargs)"
+  leftovers="$(cd "$dir/out" && ls -a | grep -E 'tile-|\.tmp-|\.resume' | xargs)"
   [ -z "$leftovers" ] || fail "$1: left behind: $leftovers"
 }
 
@@ -99,19 +99,27 @@ if [ "$submit_rc" -ne 0 ] || [ -z "$array" ]; then
 else
   grep -q "3 of 9 units (1,3,8)" "$dir/submit.err" || fail "second submission: $(cat "$dir/submit.err")"
   [ -z "$merge" ] || fail "a merge job ($merge) was submitted with every tiled frame complete"
+  # Cancelled once its render has made progress: mid-frame, not before the scene loads.
+  log="$dir/farm.slurm/render-${array}_8.log"
   for i in $(seq 1 600); do
-    [ "$(slurm_cluster_job_states "${array}_8")" = "RUNNING" ] && break
+    grep -q "^render .*%" "$log" 2>/dev/null && break
     sleep 0.1
   done
-  if [ "$(slurm_cluster_job_states "${array}_8")" != "RUNNING" ]; then
-    fail "unit 8 never ran (state '$(slurm_cluster_job_states "${array}_8")')"
+  if ! grep -q "^render .*%" "$log" 2>/dev/null; then
+    fail "unit 8 never rendered (state '$(slurm_cluster_job_states "${array}_8")')"; cat "$log" 2>/dev/null
   else
     scancel "${array}_8" || fail "scancel ${array}_8 failed"
   fi
   slurm_cluster_wait_jobs 120 "$array" || fail "array $array still queued 120 s after scancel"
   [ "$(slurm_cluster_job_states "${array}_8")" = "CANCELLED" ] ||
     fail "unit 8: state '$(slurm_cluster_job_states "${array}_8")' after scancel, expected CANCELLED"
-  [ ! -e "$dir/out/sh020.0003.exr" ] || fail "the cancelled unit left sh020.0003.exr"
+  # The interrupted frame is either absent or marked unfinished with its resume state beside it.
+  if [ -e "$dir/out/sh020.0003.exr" ]; then
+    grep -aq "complete=0" "$dir/out/sh020.0003.exr" || fail "the cancelled unit left a frame not marked unfinished"
+    [ -f "$dir/out/sh020.0003.exr.resume" ] || fail "the cancelled unit left no resume state"
+  fi
+  leftovers="$(cd "$dir/out" && ls -a | grep -E '\.tmp-' | xargs)"
+  [ -z "$leftovers" ] || fail "the cancelled unit left temporaries: $leftovers"
   [ -f "$dir/out/sh010.0002.exr" ] || fail "unit 1 did not render sh010.0002 again"
 fi
 submit

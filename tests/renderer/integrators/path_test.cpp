@@ -457,6 +457,7 @@ TEST_CASE("path: a render stopped between passes and resumed equals the uninterr
   const PathImage resumed = render_path(s, *accel, lights, s.cameras.at(0), cfg, &second, {}, &copy);
   CHECK(copy.complete);
   CHECK(second.passes == int(path_pass_ends(40).size()) - 3);
+  CHECK(second.image_passes == int(path_pass_ends(40).size()));  // the image's, the first run's included
   CHECK(std::memcmp(whole.film.rgba.data(), resumed.film.rgba.data(),
                     whole.film.rgba.size() * sizeof(float)) == 0);
   CHECK(whole.samples == resumed.samples);
