@@ -121,7 +121,8 @@ std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions&
     ctx.warn(scene >= 0 ? idx("scenes", size_t(scene)) : "scenes",
              "no renderable triangles or shapes; the image shows only the background");
   if (!ctx.options.time || !ctx.options.keep_animation || ctx.model.animations.empty()) return nullptr;
-  return describe_animation(ctx, nodes, uses);
+  std::shared_ptr<GltfAnimation> animation = describe_animation(ctx, nodes, uses);
+  return animation->rigid ? animation : nullptr;  // a scene that cannot be posed is loaded again
 }
 
 }  // namespace
@@ -141,6 +142,8 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
     throw InputError(name, "", "out of memory while converting the scene");
   }
   if (animation) {
+    for (const auto& b : model.buffers) out.animation_bytes += b.data.size();
+    for (const auto& i : model.images) out.animation_bytes += i.image.size();
     animation->model = std::move(model);
     out.animation = std::move(animation);
   }

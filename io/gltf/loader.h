@@ -65,10 +65,12 @@ struct LoadedScene {
   Scene scene;
   GltfInfo info;
   std::vector<std::string> warnings;  ///< each names the element it concerns
-  /// Set when a time and keep_animation were asked for and the file has animations:
+  /// Set when a time and keep_animation were asked for and the file has animations that only
+  /// move placements (see pose_gltf_scene):
   /// pose_gltf_scene() moves this scene's instances, cameras and lights to another time. Null
   /// otherwise.
   std::shared_ptr<const GltfAnimation> animation;
+  uint64_t animation_bytes = 0;  ///< what `animation` holds of the file (buffers, images), for budgets
 };
 
 /// Loads `file`. Throws InputError (file + JSON path + reason) for anything malformed or
