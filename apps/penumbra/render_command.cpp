@@ -62,7 +62,8 @@ uint64_t charge_image_budget(const RenderJob& job) {
   const uint64_t image =
       uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
   const Scene& scene = job.loaded.scene;
-  const uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle +
+  const uint64_t scene_bytes = scene_memory_bytes(scene) +
+                               count_stored_triangles(scene) * kAccelBytesPerTriangle +
                                job.loaded.animation_bytes;
   if (image > budget || scene_bytes > budget - image)
     throw UsageError("image " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " (" +
