@@ -1,4 +1,7 @@
 # A throw-away single-node Slurm cluster for tests, to be sourced by bash.
+#   slurm_cluster_scratch NAME
+#                             sets $dir to a new temporary folder and stops the cluster and removes
+#                             the folder when the script exits (EXIT, HUP, INT, TERM traps).
 #   slurm_cluster_start DIR   generates a munge key, starts munged, slurmctld and slurmd with all
 #                             their files under DIR (which must be an empty private directory, e.g.
 #                             from mktemp -d), exports SLURM_CONF and waits until the node is idle.
@@ -81,6 +84,13 @@ slurm_cluster_fail() {
   slurm_cluster_logs
   slurm_cluster_stop
   return 1
+}
+
+slurm_cluster_scratch() {
+  dir="$(mktemp -d "${TMPDIR:-/tmp}/$1.XXXXXX")" || return 1
+  trap 'slurm_cluster_stop; rm -rf "$dir"' EXIT
+  # A signal ends the script through exit, which runs the EXIT trap.
+  trap 'exit 1' HUP INT TERM
 }
 
 slurm_cluster_start() {

@@ -12,10 +12,7 @@ bin="$1"; src="$2"
 # shellcheck source=slurm_cluster.sh
 . "$(dirname "$0")/slurm_cluster.sh"
 
-dir="$(mktemp -d "${TMPDIR:-/tmp}/penumbra-slurm.XXXXXX")" || exit 1
-trap 'slurm_cluster_stop; rm -rf "$dir"' EXIT
-# A signal ends the script through exit, which runs the EXIT trap.
-trap 'exit 1' HUP INT TERM
+slurm_cluster_scratch penumbra-slurm || exit 1
 start=$(date +%s)
 if ! command -v oiiotool >/dev/null; then
   echo "PENUMBRA_SKIP: oiiotool is not installed (scripts/install-deps.sh installs openimageio-tools)"

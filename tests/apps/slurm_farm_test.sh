@@ -14,9 +14,7 @@ bin="$1"; src="$2"
 # shellcheck source=slurm_cluster.sh
 . "$(dirname "$0")/slurm_cluster.sh"
 
-dir="$(mktemp -d "${TMPDIR:-/tmp}/penumbra-farm.XXXXXX")" || exit 1
-trap 'slurm_cluster_stop; rm -rf "$dir"' EXIT
-trap 'exit 1' HUP INT TERM
+slurm_cluster_scratch penumbra-farm || exit 1
 start=$(date +%s)
 if ! slurm_cluster_start "$dir"; then
   echo "PENUMBRA_SKIP: $SLURM_CLUSTER_ERROR"

@@ -74,6 +74,17 @@ class GltfWriter {
     j["meshes"][size_t(m)]["weights"] = {0.0};
     return m;
   }
+  /// A mesh with one primitive skinned by JOINTS_0 (4 unsigned bytes per vertex) and WEIGHTS_0
+  /// (4 floats per vertex); returns the mesh index.
+  int skinned_mesh(int position_accessor, const std::vector<uint8_t>& joints,
+                   const std::vector<float>& weights) {
+    const int ja = accessor(joints.data(), joints.size(), 5121, joints.size() / 4, "VEC4");
+    const int wa = floats(weights, "VEC4", 4);
+    const int m = mesh(position_accessor);
+    j["meshes"][size_t(m)]["primitives"][0]["attributes"]["JOINTS_0"] = ja;
+    j["meshes"][size_t(m)]["primitives"][0]["attributes"]["WEIGHTS_0"] = wa;
+    return m;
+  }
   /// A node (root unless `root` is false); returns its index.
   int node(nlohmann::json fields, bool root = true) {
     j["nodes"].push_back(std::move(fields));

@@ -31,12 +31,8 @@ std::filesystem::path animated_file() {
   const int morph = w.positions({0, 0, 1, 0, 0, 1, 0, 0, 1});
   const int mesh = w.morph_mesh(pos, morph);
   // Skinned mesh: vertex 0 on joint 0, vertex 1 on joint 1, vertex 2 half and half.
-  const std::vector<uint8_t> joints = {0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
-  const int ja = w.accessor(joints.data(), joints.size(), 5121, 3, "VEC4");
-  const int wa = w.floats({1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0}, "VEC4", 4);
-  const int skinned = w.mesh(pos);
-  w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["JOINTS_0"] = ja;
-  w.j["meshes"][size_t(skinned)]["primitives"][0]["attributes"]["WEIGHTS_0"] = wa;
+  const int skinned =
+      w.skinned_mesh(pos, {0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0}, {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0});
 
   const int a = w.node({{"mesh", mesh}});                              // 0: translation
   const int b = w.node({{"mesh", mesh}});                              // 1: rotation
