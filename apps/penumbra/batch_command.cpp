@@ -108,7 +108,8 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
       if (s.enabled) argv.push_back("--" + s.key);
       continue;
     }
-    for (const std::string& v : s.values) argv.insert(argv.end(), {"--" + s.key, v});
+    for (const std::string& v : s.values)
+      argv.push_back("--" + s.key + "=" + v);  // a value may start with '-'
   }
   return argv;
 }

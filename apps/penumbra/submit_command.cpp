@@ -174,16 +174,23 @@ bool sbatch_on_path() {
   return false;
 }
 
-/// Runs `sbatch --parsable ARGS SCRIPT` (its messages go to stderr) and returns the job id;
-/// throws std::runtime_error when it fails or prints no job id.
-std::string sbatch(const std::string& args, const fs::path& script) {
-  const std::string command = "sbatch --parsable " + args + " " + quoted(script.string());
+/// The standard output of the shell command `command` and its wait status in `status`; throws
+/// std::runtime_error when it cannot be started.
+std::string command_output(const std::string& command, int& status) {
   FILE* p = popen(command.c_str(), "r");
-  if (!p) throw std::runtime_error("cannot run sbatch: " + std::string(std::strerror(errno)));
+  if (!p) throw std::runtime_error("cannot run " + command + ": " + std::string(std::strerror(errno)));
   std::string out;
   char buf[512];
   while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int status = pclose(p);
+  status = pclose(p);
+  return out;
+}
+
+/// Runs `sbatch --parsable ARGS SCRIPT` (its messages go to stderr) and returns the job id;
+/// throws std::runtime_error when it fails or prints no job id.
+std::string sbatch(const std::string& args, const fs::path& script) {
+  int status = 0;
+  std::string out = command_output("sbatch --parsable " + args + " " + quoted(script.string()), status);
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
   const std::string id = out.substr(0, out.find(';'));  // "ID" or "ID;CLUSTER"
   const bool numeric = !id.empty() && id.find_first_not_of("0123456789") == std::string::npos;
@@ -199,12 +206,9 @@ std::string sbatch(const std::string& args, const fs::path& script) {
 
 /// The ids of the jobs of `name` still queued or running (empty when squeue cannot tell).
 std::string queued_jobs(const std::string& name) {
-  FILE* p = popen(("squeue -h -o %i -n " + quoted(name) + " 2>/dev/null").c_str(), "r");
-  if (!p) return "";
-  std::string out;
-  char buf[512];
-  while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  pclose(p);
+  int status = 0;
+  std::string out = command_output("squeue -h -o %i -n " + quoted(name) + " 2>/dev/null", status);
+  if (status != 0) return "";
   for (char& c : out)
     if (c == '\n') c = ' ';
   while (!out.empty() && out.back() == ' ') out.pop_back();
