@@ -1,8 +1,8 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
-// `info`, assemble farm tiles with `merge`, render job files with `batch`, turn its implicit shapes into
-// triangle meshes with `mesh`. This file wires the subcommands' flags (CLI11) and maps errors to exit codes:
-// 0 success, 2 bad input or usage, 1 a failure outside the input (I/O, memory); a render ended by a signal
-// returns 128 + signal. Only main() exits.
+// `info`, assemble farm tiles with `merge`, render job files with `batch` and submit them to Slurm with
+// `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`. This file wires the subcommands'
+// flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1 a failure outside the input
+// (I/O, memory); a render ended by a signal returns 128 + signal. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
