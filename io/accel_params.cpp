@@ -38,7 +38,8 @@ std::vector<AccelParamInfo> accel_param_keys() {
   return {
       {"embree.robust", d.embree.robust ? "1" : "0", "RTC_SCENE_FLAG_ROBUST, 0 or 1"},
       {"embree.quality", std::to_string(d.embree.quality), "build quality: 0 low, 1 medium, 2 high"},
-      {"bvh.width", std::to_string(d.bvh.width), "node width: 2 (binary) or 4 (SSE, 4 boxes per test)"},
+      {"bvh.width", std::to_string(d.bvh.width),
+       "node width: 0 (the CPU's widest), 8 (AVX2), 4 (SSE) or 2 (binary)"},
       {"bvh.max_leaf_size", std::to_string(d.bvh.max_leaf_size), "largest leaf, [1, 255]"},
       {"bvh.bin_count", std::to_string(d.bvh.bin_count), "SAH bins per axis, [2, 256]"},
       {"bvh.traversal_cost", num(d.bvh.traversal_cost), "SAH cost of a node visit, > 0"},

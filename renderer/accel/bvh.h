@@ -1,10 +1,12 @@
-// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007), binary or
-// 4-wide SSE nodes, front-to-back traversal with a fixed stack.
+// Penumbra's reference bounding volume hierarchy: binned SAH build (Wald 2007), binary, 4-wide
+// (SSE) or 8-wide (AVX2) nodes, front-to-back traversal with a fixed stack.
 #pragma once
 
-// The binary build tree is either flattened into 32-byte binary nodes (width 2) or collapsed
-// into 4-wide nodes whose four boxes are tested at once with SSE (width 4, the default). It
-// builds from triangle bounds only and calls the shared watertight triangle test in its leaves.
+// The binary build tree is either flattened into 32-byte binary nodes (width 2: the scalar
+// reference, one watertight test per triangle) or collapsed into 4-wide nodes (SSE) or 8-wide
+// nodes (AVX2) whose boxes are tested at once and whose leaves are blocks of four triangles
+// filtered in SSE before the same watertight test (accel/bvh_wide.h). By default the width is
+// the widest the CPU runs, checked at run time. It builds from primitive bounds only.
 
 #include <cstddef>
 #include <memory>
@@ -21,13 +23,15 @@ struct BvhConfig {
   float traversal_cost = 1.0f;  ///< > 0: cost of visiting one node (3 suits big dense meshes, see RESULTS.md)
   float intersection_cost = 1.0f;    ///< > 0: cost of one triangle test
   size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks
-  int width = 4;                     ///< 2 (binary nodes) or 4 (4-wide nodes, SSE box tests)
+  int width = 0;  ///< 0 (8 if the CPU has AVX2, else 4), 2 (binary), 4 (SSE) or 8 (AVX2; refused without it)
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.
 void validate(const BvhConfig& config);
 
-/// Builds a BVH over copies of the triangles (`meshes` need not outlive it).
+/// Builds a BVH over copies of the triangles (`meshes` need not outlive it). Throws
+/// std::invalid_argument for an invalid config, width 8 on a CPU without AVX2, or more than
+/// 2^31 - 1 triangles in a wide layout.
 std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const GeometryView> meshes,
                                                   const BvhConfig& config = {});
 

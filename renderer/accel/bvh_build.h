@@ -1,4 +1,4 @@
-// The BVH builder of accel/bvh.cpp exposed for other structures over boxes (the instance top
+// The BVH builder (accel/bvh_build.cpp) shared by the BVH and other structures over boxes (the instance top
 // level of accel/instances.cpp): binned SAH (Wald 2007) over bounds and centroids only, and the
 // flattening into 32-byte binary nodes in depth-first order (pbrt-v4's LinearBVHNode).
 #pragma once
@@ -13,12 +13,20 @@
 
 namespace penumbra {
 
-/// One primitive as the builder sees it: its box, its centroid and the caller's index.
-struct BvhBuildRef {
-  Bounds3f box;
-  Vec3f centroid;
-  uint32_t index;
+/// One primitive as the builder sees it, 32 bytes: its box and the caller's index. The
+/// centroid is the box's centre, recomputed where needed (memory traffic bounds the build).
+struct alignas(16) BvhBuildRef {
+  Vec3f lo;
+  uint32_t index = 0;
+  Vec3f hi;
+  float pad = 0;
+
+  BvhBuildRef() = default;
+  BvhBuildRef(const Bounds3f& b, uint32_t i) : lo(b.lo), index(i), hi(b.hi) {}
+  Bounds3f box() const { return {lo, hi}; }
+  Vec3f centroid() const { return (lo + hi) * 0.5f; }
 };
+static_assert(sizeof(BvhBuildRef) == 32);
 
 /// Binary build tree. A leaf (no children) covers refs [first, first + count).
 struct BvhBuildNode {
@@ -45,8 +53,11 @@ static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
 inline constexpr int kBvhStackSize = 128;
 
 /// Builds the tree over `refs` (non-empty; config validated), reordering them so every leaf is
-/// a contiguous range. The shape never depends on thread scheduling.
-std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config);
+/// a contiguous range. The SAH charges a leaf's intersection cost per block of `block`
+/// primitives (4 for the wide layouts, whose leaves hold blocks of four; Embree does the same),
+/// and config.width is not read. The shape never depends on thread scheduling.
+std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config,
+                                             int block = 1);
 
 /// Appends `b`'s subtree to `nodes` depth first, boxes widened by widen_for_rounding(); returns
 /// the index of `b`'s node.

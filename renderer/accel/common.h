@@ -169,12 +169,16 @@ inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const Primitiv
 }
 
 /// Node counters for traversals: NoCount compiles away; CountNodes adds to a TraversalCost.
+/// triangles(n) counts triangle tests a traversal settles itself (the wide BVH's SIMD filter);
+/// the visitors count the ones they make.
 struct NoCount {
   void node() const {}
+  void triangles(uint32_t) const {}
 };
 struct CountNodes {
   TraversalCost& cost;
   void node() const { ++cost.nodes; }
+  void triangles(uint32_t n) const { cost.triangles += n; }
 };
 
 /// intersect(), intersect_counted() and occluded() of the reference structures, written once

@@ -153,7 +153,7 @@ class TwoLevelAccelerator final : public Accelerator {
   void build_top() {
     std::vector<BvhBuildRef> refs;
     for (uint32_t i = 0; i < m_items.size(); ++i)
-      if (!m_items[i].box.empty()) refs.push_back({m_items[i].box, m_items[i].box.center(), i});
+      if (!m_items[i].box.empty()) refs.emplace_back(m_items[i].box, i);
     if (refs.empty()) return;
     BvhConfig config;
     config.max_leaf_size = 1;  // an item costs a whole bottom-level query

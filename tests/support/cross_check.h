@@ -29,11 +29,21 @@ struct NamedAccel {
   std::unique_ptr<Accelerator> accel;
 };
 
-/// Every back end over `views` ("brute" keeps references: views must outlive the result).
+/// Every back end over `views`, the BVH in each width, in accelerator_names() order ("brute"
+/// keeps references: views must outlive the result).
 inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views,
                                          const AccelConfig& config = {}) {
   std::vector<NamedAccel> out;
-  for (const auto& n : accelerator_names()) out.push_back({n, make_accelerator(n, views, config)});
+  for (const auto& n : accelerator_names()) {
+    out.push_back({n, make_accelerator(n, views, config)});
+    if (n != "bvh" || config.bvh.width != 0) continue;
+    // Every BVH width, not only the CPU's widest that "bvh" builds by default.
+    for (int width : {2, 4}) {
+      AccelConfig c = config;
+      c.bvh.width = width;
+      out.push_back({"bvh/width=" + std::to_string(width), make_accelerator("bvh", views, c)});
+    }
+  }
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include "io/gltf/loader.h"
+#include "renderer/accel/bvh_wide.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "support/cross_check.h"
@@ -46,35 +47,93 @@ TEST_CASE("bvh: leaves respect max_leaf_size, every triangle is referenced once,
   }
 }
 
-TEST_CASE("bvh: width 4 collapses the same leaves into 4-wide nodes of 128 bytes", "[accel][bvh]") {
+namespace {
+/// The wide widths this CPU runs.
+std::vector<int> wide_widths() {
+  if (cpu_has_avx2()) return {4, 8};
+  return {4};
+}
+}  // namespace
+
+TEST_CASE("bvh: widths 4 and 8 collapse the binary tree into wide nodes of 128 bytes with leaf blocks",
+          "[accel][bvh]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   const auto views = mesh_views(l.scene);
-  for (int leaf : {1, 4, 8}) {
-    BvhConfig c2, c4;
-    c2.width = 2;
-    c2.max_leaf_size = c4.max_leaf_size = leaf;
-    const AccelStats s2 = make_bvh_accelerator(views, c2)->stats(),
-                     s4 = make_bvh_accelerator(views, c4)->stats();
-    INFO("max_leaf_size " << leaf);
-    CHECK(s4.config.find("width 4") != std::string::npos);
-    // The same binary build underneath: the same leaves.
-    CHECK(s4.leaves == s2.leaves);
-    CHECK(s4.references == s2.references);
-    CHECK(s4.max_leaf_prims == s2.max_leaf_prims);
-    // Every 4-wide node has 2 to 4 children and all but the root are someone's child.
-    const uint64_t interior = s4.nodes - s4.leaves;
-    CHECK(s4.nodes - 1 <= 4 * interior);
-    CHECK(s4.nodes - 1 >= 2 * interior);
-    // Shallower, and no shallower than a perfect 4-ary tree.
-    CHECK(s4.max_depth < s2.max_depth);
-    CHECK(s4.max_depth >= uint64_t(std::ceil(std::log(double(s4.triangles) / leaf) / std::log(4.0))));
-    CHECK(s4.bytes == interior * 128 + s4.triangles * 44);
-    CHECK(s4.sah_cost > 0);
-    CHECK(s4.sah_cost < s2.sah_cost);  // fewer node visits for the same leaves
-  }
+  for (int width : wide_widths())
+    for (int leaf : {1, 4, 8}) {
+      BvhConfig c2, cw;
+      c2.width = 2;
+      cw.width = width;
+      c2.max_leaf_size = cw.max_leaf_size = leaf;
+      const AccelStats s2 = make_bvh_accelerator(views, c2)->stats(),
+                       s = make_bvh_accelerator(views, cw)->stats();
+      INFO("width " << width << ", max_leaf_size " << leaf);
+      CHECK(s.config.find("width " + std::to_string(width)) != std::string::npos);
+      CHECK(s.references == s.triangles);
+      CHECK(s.max_leaf_prims <= uint64_t(leaf));
+      // Every wide node has 2 to `width` children and all but the root are someone's child.
+      const uint64_t interior = s.nodes - s.leaves;
+      CHECK(s.nodes - 1 <= uint64_t(width) * interior);
+      CHECK(s.nodes - 1 >= 2 * interior);
+      // Shallower than the binary tree, and no shallower than a perfect width-ary one.
+      CHECK(s.max_depth < s2.max_depth);
+      CHECK(s.max_depth >=
+            uint64_t(std::ceil(std::log(double(s.triangles) / leaf) / std::log(double(width)))));
+      // 128-byte nodes and 160-byte blocks of four: at least ceil(n / 4) blocks, at most one
+      // partly filled block per leaf; plus a word per view for the hit ids.
+      const uint64_t min_blocks = (s.triangles + 3) / 4, max_blocks = s.triangles / 4 + s.leaves;
+      const uint64_t ids = (views.size() + 1) * 4;
+      CHECK(s.bytes >= interior * 128 + min_blocks * 160 + ids);
+      CHECK(s.bytes <= interior * 128 + max_blocks * 160 + ids);
+      CHECK(s.sah_cost > 0);
+    }
 }
 
-TEST_CASE("bvh: axis-parallel rays through the faces and edges of 4-wide node boxes", "[accel][bvh]") {
+TEST_CASE("bvh: width 0 is the CPU's widest; width 8 needs AVX2", "[accel][bvh][quick]") {
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  const AccelStats s = make_bvh_accelerator(views)->stats();
+  CHECK(s.config.find(cpu_has_avx2() ? "width 8" : "width 4") != std::string::npos);
+  BvhConfig c;
+  c.width = 8;
+  if (cpu_has_avx2())
+    CHECK_NOTHROW(make_bvh_accelerator(views, c));
+  else
+    CHECK_THROWS_WITH(make_bvh_accelerator(views, c), Catch::Contains("AVX2"));
+}
+
+TEST_CASE("bvh: quantised 8-wide boxes contain their children", "[accel][bvh][quick]") {
+  // Child boxes of every scale and position, degenerate ones included: each decoded box must
+  // contain its child exactly (no ray that meets a child may miss its decoded box).
+  Rng rng;
+  const float scales[] = {1e-30f, 1e-6f, 1.0f, 3e4f, 1e30f};
+  const float offsets[] = {0.0f, -1.0f, 1e7f, -3e20f, 1e36f};
+  for (float scale : scales)
+    for (float offset : offsets)
+      for (int trial = 0; trial < 50; ++trial) {
+        Bounds3f boxes[8];
+        const int n = 1 + int(rng.next_float() * 8) % 8;
+        for (int i = 0; i < n; ++i) {
+          Vec3f a, b;
+          for (int k = 0; k < 3; ++k) {
+            a[k] = offset + scale * (rng.next_float() - 0.5f);
+            b[k] = trial % 5 == 0 ? a[k] : offset + scale * (rng.next_float() - 0.5f);  // flat boxes too
+          }
+          boxes[i] = merge(Bounds3f{a, a}, b);
+        }
+        QuantizedNode8 node{};
+        set_child_boxes(node, boxes, n);
+        INFO("scale " << scale << ", offset " << offset << ", trial " << trial);
+        CHECK(node.valid == (1u << n) - 1);
+        for (int i = 0; i < n; ++i)
+          for (int k = 0; k < 3; ++k) {
+            CHECK(node.dequantize(k, node.qlo[k][i]) <= boxes[i].lo[k]);
+            CHECK(node.dequantize(k, node.qhi[k][i]) >= boxes[i].hi[k]);
+          }
+      }
+}
+
+TEST_CASE("bvh: axis-parallel rays through the faces and edges of wide node boxes", "[accel][bvh]") {
   // A 4 x 4 x 4 lattice of small cubes: node boxes share planes with the lattice rays, which
   // start on box faces and run inside them (0 * inf in the SSE slab test).
   std::vector<Vec3f> pos;
@@ -107,15 +166,17 @@ TEST_CASE("bvh: axis-parallel rays through the faces and edges of 4-wide node bo
           }
   const auto brute = make_accelerator("brute", views);
   const Reference ref = reference(*brute, rays);
-  for (int leaf : {1, 2, 8}) {
-    BvhConfig c;
-    c.max_leaf_size = leaf;
-    const auto bvh = make_bvh_accelerator(views, c);
-    const auto r = cross_check(*bvh, ref, views, 14, true, 0.0f);
-    INFO(summary("bvh4 lattice leaf " + std::to_string(leaf), r));
-    CHECK(r.failures() == 0);
-    CHECK(r.hits > rays.size() / 4);
-  }
+  for (int width : wide_widths())
+    for (int leaf : {1, 2, 8}) {
+      BvhConfig c;
+      c.width = width;
+      c.max_leaf_size = leaf;
+      const auto bvh = make_bvh_accelerator(views, c);
+      const auto r = cross_check(*bvh, ref, views, 14, true, 0.0f);
+      INFO(summary("bvh width " + std::to_string(width) + " lattice leaf " + std::to_string(leaf), r));
+      CHECK(r.failures() == 0);
+      CHECK(r.hits > rays.size() / 4);
+    }
 }
 
 TEST_CASE("bvh: any leaf size and bin count gives brute force's answers", "[accel][bvh]") {
@@ -124,19 +185,22 @@ TEST_CASE("bvh: any leaf size and bin count gives brute force's answers", "[acce
   const auto brute = make_accelerator("brute", views);
   const Reference ref = reference(*brute, scene_rays(l, *brute, views));
   const float scale = length(compute_bounds(l.scene).extent());
-  for (auto [leaf, bins] : {std::pair{1, 2}, std::pair{2, 7}, std::pair{255, 256}, std::pair{-4, 16}}) {
-    BvhConfig c;
-    c.width = leaf < 0 ? 2 : 4;  // -4: the binary layout with leaves of 4
-    c.max_leaf_size = std::abs(leaf);
-    c.bin_count = bins;
-    c.parallel_threshold = 64;  // exercise the parallel build on a small scene
-    const auto bvh = make_bvh_accelerator(views, c);
-    const auto r = cross_check(*bvh, ref, views, scale, true, 0.0f);
-    INFO(summary("bvh width " + std::to_string(c.width) + " leaf " + std::to_string(leaf) + " bins " +
-                     std::to_string(bins),
-                 r));
-    CHECK(r.failures() == 0);
-  }
+  std::vector<int> widths = wide_widths();
+  widths.push_back(2);
+  for (int width : widths)
+    for (auto [leaf, bins] : {std::pair{1, 2}, std::pair{2, 7}, std::pair{255, 256}, std::pair{4, 16}}) {
+      BvhConfig c;
+      c.width = width;
+      c.max_leaf_size = leaf;
+      c.bin_count = bins;
+      c.parallel_threshold = 64;  // exercise the parallel build on a small scene
+      const auto bvh = make_bvh_accelerator(views, c);
+      const auto r = cross_check(*bvh, ref, views, scale, true, 0.0f);
+      INFO(summary("bvh width " + std::to_string(c.width) + " leaf " + std::to_string(leaf) + " bins " +
+                       std::to_string(bins),
+                   r));
+      CHECK(r.failures() == 0);
+    }
 }
 
 TEST_CASE("bvh: the build is the same for 1 and 2 threads", "[accel][bvh]") {
@@ -176,7 +240,7 @@ TEST_CASE("bvh: configuration is validated", "[accel][bvh][quick]") {
   c.traversal_cost = 0;
   CHECK_THROWS_AS(validate(c), std::invalid_argument);
   c = {};
-  c.width = 8;
-  CHECK_THROWS_WITH(validate(c), Catch::Contains("width must be 2 or 4"));
+  c.width = 3;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("width must be 0"));
   CHECK_NOTHROW(validate(BvhConfig{}));
 }
