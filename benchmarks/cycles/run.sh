@@ -5,7 +5,8 @@
 # renderer itself (render only, no loading), with the RMSE of R, G, B against its own
 # reference (oiiotool --diff). Writes benchmarks/results/cycles-<date>.txt.
 #
-# usage: benchmarks/cycles/run.sh [PENUMBRA_BINARY]   (env: REF_SPP=1024 SPPS="16 64 256" THREADS=2)
+# usage: benchmarks/cycles/run.sh [PENUMBRA_BINARY]
+#   env: REF_SPP=1024 SPPS="16 64 256" THREADS=2 SCENES="cornell helmet ..." (default: every scene)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -14,15 +15,22 @@ corpus=${PENUMBRA_CORPUS:-$root/../shared/corpus}
 REF_SPP=${REF_SPP:-1024}
 SPPS=${SPPS:-"16 64 256"}
 THREADS=${THREADS:-2}
+SCENES=${SCENES:-}
 W=640 H=360
 work=$(mktemp -d /tmp/penumbra-cycles.XXXXXX)
 out="$root/benchmarks/results/cycles-$(date +%Y-%m-%d).txt"
 command -v blender >/dev/null || { echo "blender not installed (apt-get install blender python3-numpy)"; exit 2; }
 
-# name, file, eye x y z, yfov, pitch (degrees about +X), world radiance
+# name, file, eye x y z, yfov, pitch (degrees about +X), world radiance. Each camera looks down
+# -Z at the centre of the model's bounds, far enough back that the model fills most of the height.
+v=$corpus/valid
 scenes=(
-  "cornell|$corpus/valid/CornellBox-Vinc3r/glTF/cornellBox-2.80-Eevee-gltf.gltf|0 1.5 5.6|0.75|0|0"
-  "helmet|$corpus/valid/DamagedHelmet/glTF-Binary/DamagedHelmet.glb|0 0 2.7|0.75|0|1"
+  "cornell|$v/CornellBox-Vinc3r/glTF/cornellBox-2.80-Eevee-gltf.gltf|0 1.5 5.6|0.75|0|0"
+  "helmet|$v/DamagedHelmet/glTF-Binary/DamagedHelmet.glb|0 0 2.7|0.75|0|1"
+  "bottle|$v/WaterBottle/glTF/WaterBottle.gltf|0 0 0.37|0.75|0|1"
+  "avocado|$v/Avocado/glTF/Avocado.gltf|0 0.031 0.1|0.75|0|1"
+  "suzanne|$v/Suzanne/glTF/Suzanne.gltf|0 0 3.3|0.75|0|1"
+  "duck|$v/Duck/glTF-Binary/Duck.glb|0.13 0.87 2.6|0.75|0|1"
 )
 
 rmse() { oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | awk '/RMS error/ {print $4}'; }
@@ -44,6 +52,7 @@ cyc() {
 
 for s in "${scenes[@]}"; do
   IFS='|' read -r name file eye fov pitch bg <<<"$s"
+  [ -z "$SCENES" ] || [[ " $SCENES " == *" $name "* ]] || continue
   scene=$(python3 "$here/add_camera.py" "$file" "$work/$name" $eye "$fov" "$pitch")
   for r in penumbra cycles; do
     f=$([ $r = penumbra ] && echo pen || echo cyc)
