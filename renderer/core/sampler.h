@@ -47,11 +47,29 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 inline uint32_t sobol_dim0(uint32_t i) {
   return reverse_bits(i);
 }
-inline uint32_t sobol_dim1(uint32_t i) {
+/// Sobol dimension 1 by bit loop: the XOR of the direction numbers v_k of i's set bits.
+constexpr uint32_t sobol_dim1_loop(uint32_t i, uint32_t v = 1u << 31) {
   uint32_t r = 0;
-  for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
+  for (; i; i >>= 1, v ^= v >> 1)
     if (i & 1) r ^= v;
   return r;
+}
+/// Dimension 1 is linear over GF(2) in i's bits, so it is the XOR of four byte tables: entry b
+/// of table k is the contribution of byte k of i holding b.
+struct SobolDim1Tables {
+  uint32_t t[4][256]{};
+  constexpr SobolDim1Tables() {
+    uint32_t v = 1u << 31;  // direction number of bit 8k
+    for (int k = 0; k < 4; ++k) {
+      for (uint32_t b = 0; b < 256; ++b) t[k][b] = sobol_dim1_loop(b, v);
+      for (int j = 0; j < 8; ++j) v ^= v >> 1;
+    }
+  }
+};
+inline constexpr SobolDim1Tables kSobolDim1{};
+inline uint32_t sobol_dim1(uint32_t i) {
+  return kSobolDim1.t[0][i & 0xff] ^ kSobolDim1.t[1][(i >> 8) & 0xff] ^ kSobolDim1.t[2][(i >> 16) & 0xff] ^
+         kSobolDim1.t[3][i >> 24];
 }
 
 inline uint32_t hash32(uint64_t a, uint64_t b) {
@@ -67,22 +85,25 @@ inline float fraction_to_float(uint32_t x) {
 struct SampleStream {
   SamplerType type = SamplerType::Sobol;
   uint64_t pixel_key = 0;  ///< hash of (pixel, seed)
+  uint64_t key_mix = 0;    ///< splitmix64(pixel_key), the first half of every dimension's hash32
   uint32_t index = 0;      ///< sample index within the pixel
   uint32_t dim = 0;        ///< next dimension
   Rng rng;                 ///< Independent only
 
   float get1d() {
     if (type == SamplerType::Independent) return rng.next_float();
-    const uint32_t seed = hash32(pixel_key, dim++);
+    const uint32_t seed = dimension_seed();
     const uint32_t i = nested_uniform_scramble(index, seed);
     return fraction_to_float(nested_uniform_scramble(sobol_dim0(i), hash32(seed, 0)));
   }
+  /// hash32(pixel_key, dim++), with splitmix64(pixel_key) computed once per stream.
+  uint32_t dimension_seed() { return uint32_t(splitmix64(key_mix ^ dim++) >> 32); }
   Vec2f get2d() {
     if (type == SamplerType::Independent) {
       const float a = rng.next_float();
       return {a, rng.next_float()};
     }
-    const uint32_t seed = hash32(pixel_key, dim++);
+    const uint32_t seed = dimension_seed();
     const uint32_t i = nested_uniform_scramble(index, seed);
     return {fraction_to_float(nested_uniform_scramble(sobol_dim0(i), hash32(seed, 0))),
             fraction_to_float(nested_uniform_scramble(sobol_dim1(i), hash32(seed, 1)))};
@@ -96,6 +117,7 @@ inline SampleStream make_sample_stream(SamplerType type, uint32_t x, uint32_t y,
   s.type = type;
   s.index = sample;
   s.pixel_key = splitmix64(splitmix64(seed ^ 0x5eed5eed5eedull) ^ ((uint64_t(y) << 32) | x));
+  s.key_mix = splitmix64(s.pixel_key);
   if (type == SamplerType::Independent) s.rng = make_pixel_rng(x, y, sample, seed);
   return s;
 }

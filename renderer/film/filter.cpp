@@ -82,6 +82,11 @@ PixelFilter make_filter(FilterType type, float width) {
   }
   for (int i = 0; i <= n; ++i) f.cdf[size_t(i)] = acc > 0 ? float(c[size_t(i)] / acc) : float(i) / float(n);
   f.cdf[size_t(n)] = 1;
+  for (int j = 0; j < PixelFilter::kGuideSize; ++j) {
+    const float u = float(j) / float(PixelFilter::kGuideSize);
+    const auto it = std::upper_bound(f.cdf.begin(), f.cdf.end(), u);
+    f.guide[size_t(j)] = uint16_t(std::clamp(int(it - f.cdf.begin()) - 1, 0, n - 1));
+  }
   return f;
 }
 
@@ -94,9 +99,17 @@ float sample_1d(const PixelFilter& f, float u) {
     case FilterType::Tent:  // inverse CDF of the triangle on [-r, r]
       return u < 0.5f ? r * (std::sqrt(2 * u) - 1) : r * (1 - std::sqrt(2 * (1 - u)));
     default: {
-      // Piecewise-linear CDF: find the bin, then interpolate inside it.
-      const auto it = std::upper_bound(f.cdf.begin(), f.cdf.end(), u);
-      const int i = std::clamp(int(it - f.cdf.begin()) - 1, 0, PixelFilter::kTableSize - 1);
+      // Piecewise-linear CDF: find the bin (the last i with cdf[i] <= u, from the guide
+      // table's bin onwards), then interpolate inside it.
+      constexpr int n = PixelFilter::kTableSize, g = PixelFilter::kGuideSize;
+      int i = 0;
+      if (u >= 0 && u < 1) {
+        i = f.guide[size_t(std::min(int(u * float(g)), g - 1))];
+        while (i < n - 1 && f.cdf[size_t(i) + 1] <= u) ++i;
+      } else {
+        const auto it = std::upper_bound(f.cdf.begin(), f.cdf.end(), u);
+        i = std::clamp(int(it - f.cdf.begin()) - 1, 0, n - 1);
+      }
       const float c0 = f.cdf[size_t(i)], c1 = f.cdf[size_t(i) + 1];
       const float t = c1 > c0 ? (u - c0) / (c1 - c0) : 0.5f;
       return ((float(i) + t) / float(PixelFilter::kTableSize)) * f.width - r;

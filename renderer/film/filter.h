@@ -21,6 +21,11 @@ struct PixelFilter {
   float width = 1;
   static constexpr int kTableSize = 256;
   std::array<float, kTableSize + 1> cdf{};  ///< tabulated 1D CDF over [-r, r] (Gaussian, B-H)
+  /// Guide table (the cutpoint method, Chen & Asau 1974): guide[j] is the last
+  /// bin i with cdf[i] <= j / kGuideSize, so sampling scans forward from there instead of
+  /// searching the whole CDF. Filled by make_filter.
+  static constexpr int kGuideSize = 64;
+  std::array<uint16_t, kGuideSize> guide{};
 };
 
 float default_filter_width(FilterType type);

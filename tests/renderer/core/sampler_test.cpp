@@ -82,3 +82,13 @@ TEST_CASE("sampler: streams are deterministic and decorrelated across pixels and
   CHECK(sum / n == Approx(0.5).margin(0.02));
   CHECK(sum2 / n - (sum / n) * (sum / n) == Approx(1.0 / 12).margin(0.01));
 }
+
+TEST_CASE("sampler: the byte tables of Sobol dimension 1 equal its bit loop", "[sampler][quick]") {
+  Rng rng = make_pixel_rng(3, 5, 7, 11);
+  for (uint32_t i = 0; i < 70000; ++i) {
+    const uint32_t x = i < 65536 ? i : rng.next_u32();
+    INFO(x);
+    REQUIRE(sobol_dim1(x) == sobol_dim1_loop(x));
+  }
+  REQUIRE(sobol_dim1(0xffffffffu) == sobol_dim1_loop(0xffffffffu));
+}

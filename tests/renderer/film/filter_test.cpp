@@ -2,7 +2,10 @@
 // filter profile (moments against quadrature), inside the support, monotone in u.
 #include "renderer/film/filter.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <vector>
 
 using namespace penumbra;
 
@@ -54,4 +57,29 @@ TEST_CASE("filter: names parse and unknown names are refused", "[filter][quick]"
   CHECK(parse_filter_type("gaussian", t));
   CHECK(t == FilterType::Gaussian);
   CHECK_FALSE(parse_filter_type("mitchell", t));
+}
+
+TEST_CASE("filter: the guide table finds the bin a full search of the CDF finds", "[filter][quick]") {
+  for (FilterType t : {FilterType::Gaussian, FilterType::BlackmanHarris}) {
+    const PixelFilter f = make_filter(t, default_filter_width(t));
+    INFO(filter_name(t));
+    // The offset of the bin the whole-table search picks, interpolated as sample_filter does.
+    const auto searched = [&](float u) {
+      constexpr int n = PixelFilter::kTableSize;
+      const auto it = std::upper_bound(f.cdf.begin(), f.cdf.end(), u);
+      const int i = std::clamp(int(it - f.cdf.begin()) - 1, 0, n - 1);
+      const float c0 = f.cdf[size_t(i)], c1 = f.cdf[size_t(i) + 1];
+      const float tt = c1 > c0 ? (u - c0) / (c1 - c0) : 0.5f;
+      return ((float(i) + tt) / float(n)) * f.width - f.width / 2;
+    };
+    std::vector<float> us;
+    for (int i = 0; i < (1 << 16); ++i) us.push_back(float(i) / float(1 << 16));
+    for (float c : f.cdf) us.insert(us.end(), {c, std::nextafter(c, 0.0f), std::nextafter(c, 1.0f)});
+    us.push_back(0x1.fffffep-1f);
+    for (float u : us) {
+      if (!(u >= 0 && u < 1)) continue;
+      INFO(u);
+      REQUIRE(sample_filter(f, {u, u}).x == searched(u));
+    }
+  }
 }
