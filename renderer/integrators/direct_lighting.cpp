@@ -34,8 +34,7 @@ bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float 
   lh.v = ls.v;
   lh.geom_id = ls.instance;
   lh.prim_id = ls.prim;
-  const MaterialPoint lp = eval_material(scene, make_interaction(scene, to_light, lh));
-  const Vec3f le = lp.emissive * lp.alpha;
+  const Vec3f le = eval_emission(scene, make_interaction(scene, to_light, lh));
   if (!(max_component(le) > 0)) return false;
   out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};
   return true;

@@ -136,6 +136,13 @@ bool survives_roulette(SampleStream& samples, Vec3f& beta) {
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
                     SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups) {
+  const LazyDifferential lazy{[](const void* ctx) { return *static_cast<const RayDifferential*>(ctx); }, &rd};
+  return path_radiance(scene, accel, lights, cfg, camera_ray, lazy, samples, coverage, counts, groups);
+}
+
+Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                    const PathConfig& cfg, const Ray& camera_ray, const LazyDifferential& rd,
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups) {
   ++counts.camera;
   coverage = 0;
   PathRadiance path;
@@ -160,8 +167,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       break;
     }
     SurfaceInteraction si = make_interaction(scene, seg.ray, hit);
-    if (vertex == 0 && seg.layers == 0) compute_differentials(scene, si, rd);
-    const MaterialPoint mp = eval_material(scene, si);
+    if (vertex == 0 && seg.layers == 0 && rd.make &&
+        material_reads_footprint(material_of(scene, si.material)))
+      compute_differentials(scene, si, rd.make(rd.ctx));
+    const MaterialPoint mp = eval_material(scene, si, false);  // occlusion is ambient-only
 
     // Blend: hit with probability alpha, else continue along the same ray.
     const float a = seg.layers < cfg.max_blend_layers ? mp.alpha : 1.0f;

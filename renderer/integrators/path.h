@@ -46,6 +46,13 @@ struct PathConfig {
   bool hit_filter = true;     ///< as WhittedConfig::hit_filter
 };
 
+/// A camera ray's differentials, made on demand: only a first hit whose material reads texture
+/// footprints asks for them. make(ctx) returns them; make == nullptr: none (finest level).
+struct LazyDifferential {
+  RayDifferential (*make)(const void* ctx) = nullptr;
+  const void* ctx = nullptr;
+};
+
 /// Radiance along a camera ray (counted as one camera ray; bounce rays are counted as
 /// `reflection`, shadow rays as `shadow`). `rd` gives texture footprints at the first hit
 /// (may be invalid). `coverage` is 1 if the path hit a surface, 0 if the camera ray escaped
@@ -54,6 +61,10 @@ struct PathConfig {
 /// light group. Thread-safe; never allocates, throws or logs.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);
+/// As above, with the differentials made only if the first hit's material reads them.
+Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                    const PathConfig& cfg, const Ray& camera_ray, const LazyDifferential& rd,
                     SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);
 
 }  // namespace penumbra

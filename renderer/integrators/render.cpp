@@ -35,11 +35,10 @@ Vec2f whitted_position(const RenderConfig& config, int x, int y, uint32_t s) {
 // A camera ray at raster position (px, py) with differentials `step` pixels apart.
 Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float py, float step,
                RayDifferential& rd) {
-  const Ray ray = generate_camera_ray(camera, config.width, config.height, px, py);
-  const Ray rx = generate_camera_ray(camera, config.width, config.height, px + step, py);
-  const Ray ry = generate_camera_ray(camera, config.width, config.height, px, py + step);
-  rd = RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
-  return ray;
+  Ray r[3];
+  generate_camera_rays(camera, config.width, config.height, px, py, step, r);
+  rd = RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir};
+  return r[0];
 }
 
 // Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
@@ -162,15 +161,28 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
                   const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
                   uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr) {
   const float step = differential_step(config.spp);
+  // The differential rays of camera ray p, made only for a first hit that needs them.
+  struct Footprint {
+    const Camera& camera;
+    const RenderConfig& config;
+    Vec2f p;
+    float step;
+  };
+  const auto make_rd = [](const void* ctx) {
+    const Footprint& f = *static_cast<const Footprint*>(ctx);
+    RayDifferential rd;
+    camera_ray(f.camera, f.config, f.p.x, f.p.y, f.step, rd);
+    return rd;
+  };
+  const CameraRaster raster = camera_raster(camera, config.width, config.height);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Vec2f p = filtered_position(config, x, y, samples.get2d());
-    RayDifferential rd;
-    const Ray ray = camera_ray(camera, config, p.x, p.y, step, rd);
+    const Footprint fp{camera, config, filtered_position(config, x, y, samples.get2d()), step};
+    const Ray ray = raster_ray(camera, raster, fp.p.x, fp.p.y);
     float coverage = 0;
     LightGroups lg;
-    const Vec3f l =
-        path_radiance(scene, accel, lights, pc, ray, rd, samples, coverage, counts, groups ? &lg : nullptr);
+    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples,
+                                  coverage, counts, groups ? &lg : nullptr);
     if (groups) add_light_groups(lg, groups);
     acc.rgba[0] += l.x;
     acc.rgba[1] += l.y;

@@ -152,25 +152,49 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
       texture_lod(tex, transform_uv(ref, si.duvdx[set], false), transform_uv(ref, si.duvdy[set], false)));
 }
 
-MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si) {
+namespace {
+// Coverage from the base colour texture's alpha bc_a (see MaterialPoint::alpha).
+float coverage(const Material& mat, const SurfaceInteraction& si, float bc_a) {
+  if (mat.alpha_mode == AlphaMode::Opaque) return 1;
+  const float alpha = mat.alpha * bc_a * si.color.w;
+  if (mat.alpha_mode == AlphaMode::Mask) return alpha >= mat.alpha_cutoff ? 1.0f : 0.0f;
+  return alpha;
+}
+
+Vec3f emission(const Scene& scene, const Material& mat, const SurfaceInteraction& si) {
+  const Vec4f em = eval_texture(scene, mat.emissive_tex, si);
+  return mat.emissive * Vec3f{em.x, em.y, em.z};
+}
+}  // namespace
+
+Vec3f eval_emission(const Scene& scene, const SurfaceInteraction& si) {
+  const Material& mat = material_of(scene, si.material);
+  if (mat.procedural >= 0) {  // a procedural texture may drive the emission
+    const MaterialPoint mp = eval_material(scene, si, false);
+    return mp.emissive * mp.alpha;
+  }
+  const Vec3f emissive = emission(scene, mat, si);
+  if (mat.alpha_mode == AlphaMode::Opaque) return emissive;  // alpha 1
+  return emissive * coverage(mat, si, eval_texture(scene, mat.base_color_tex, si).w);
+}
+
+MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bool with_occlusion) {
   const Material& mat = material_of(scene, si.material);
   MaterialPoint mp;
   mp.unlit = mat.unlit;
   const Vec4f bc = eval_texture(scene, mat.base_color_tex, si);
   mp.base_color = mat.base_color * Vec3f{bc.x, bc.y, bc.z} * Vec3f{si.color.x, si.color.y, si.color.z};
-  mp.alpha = mat.alpha_mode == AlphaMode::Opaque ? 1.0f : mat.alpha * bc.w * si.color.w;
-  if (mat.alpha_mode == AlphaMode::Mask) mp.alpha = mp.alpha >= mat.alpha_cutoff ? 1.0f : 0.0f;
+  mp.alpha = coverage(mat, si, bc.w);
   const Vec4f mr = eval_texture(scene, mat.metallic_roughness_tex, si);
   mp.metallic = std::clamp(mat.metallic * mr.z, 0.0f, 1.0f);
   mp.roughness = std::clamp(mat.roughness * mr.y, 0.0f, 1.0f);
-  const Vec4f em = eval_texture(scene, mat.emissive_tex, si);
-  mp.emissive = mat.emissive * Vec3f{em.x, em.y, em.z};
+  mp.emissive = emission(scene, mat, si);
   mp.f0 = ior_to_f0(mat.ior);
   mp.specular = mat.specular;
   mp.transmission = mat.transmission;
   if (mat.transmission > 0 && mat.transmission_tex.texture >= 0)
     mp.transmission *= eval_texture(scene, mat.transmission_tex, si).x;
-  if (mat.occlusion_tex.texture >= 0)
+  if (with_occlusion && mat.occlusion_tex.texture >= 0)
     mp.occlusion = 1 + mat.occlusion_strength * (eval_texture(scene, mat.occlusion_tex, si).x - 1);
   mp.ns = si.ns;
   if (mat.normal_tex.texture >= 0 && si.tangent.w != 0) {

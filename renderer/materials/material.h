@@ -35,13 +35,26 @@ inline const Material& material_of(const Scene& scene, int material) {
   return material >= 0 ? scene.materials[size_t(material)] : default_material();
 }
 
+/// True if evaluating the material reads si's derivatives (it has a texture or a procedural
+/// texture); otherwise compute_differentials changes none of its values.
+inline bool material_reads_footprint(const Material& m) {
+  return m.base_color_tex.texture >= 0 || m.metallic_roughness_tex.texture >= 0 ||
+         m.normal_tex.texture >= 0 || m.occlusion_tex.texture >= 0 || m.emissive_tex.texture >= 0 ||
+         m.transmission_tex.texture >= 0 || m.procedural >= 0;
+}
+
 /// Value of a texture reference at si (uv set, KHR_texture_transform, filtered at the level
 /// si's UV derivatives select). {1,1,1,1} for ref.texture < 0.
 Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInteraction& si);
 
 /// Evaluates every material input at si (si must come from make_interaction; derivatives
-/// from compute_differentials are optional). Never allocates.
-MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si);
+/// from compute_differentials are optional). with_occlusion = false leaves occlusion at 1
+/// without its texture lookup (for integrators that ignore it). Never allocates.
+MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bool with_occlusion = true);
+
+/// Emitted radiance times coverage at si: eval_material's emissive * alpha, bit for bit,
+/// reading only the textures those two need. Never allocates.
+Vec3f eval_emission(const Scene& scene, const SurfaceInteraction& si);
 
 /// Coverage of the surface at barycentrics (u, v) of triangle `prim` of instance `instance`: alpha
 /// factor x base colour texture alpha (finest level) x COLOR_0 alpha; for a shape instance the

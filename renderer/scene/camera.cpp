@@ -3,21 +3,28 @@
 
 namespace penumbra {
 
-Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y) {
-  const float aspect = float(width) / float(height);
-  const float sx = 2.0f * x / float(width) - 1.0f;   // -1 left .. +1 right
-  const float sy = 1.0f - 2.0f * y / float(height);  // +1 top .. -1 bottom
+CameraRaster camera_raster(const Camera& cam, int width, int height) {
+  CameraRaster m{float(width), float(height), float(width) / float(height)};
+  if (cam.projection != Projection::Orthographic) {
+    m.tan_y = std::tan(0.5f * cam.yfov);
+    m.tan_x = m.tan_y * m.aspect;
+  }
+  return m;
+}
+
+Ray raster_ray(const Camera& cam, const CameraRaster& m, float x, float y) {
+  const float sx = 2.0f * x / m.width - 1.0f;   // -1 left .. +1 right
+  const float sy = 1.0f - 2.0f * y / m.height;  // +1 top .. -1 bottom
   Ray ray;
   if (cam.projection == Projection::Orthographic) {
-    const float half_h = cam.ymag, half_w = cam.ymag * aspect;
+    const float half_h = cam.ymag, half_w = cam.ymag * m.aspect;
     ray.org = cam.eye + cam.u * (sx * half_w) + cam.v * (sy * half_h);
     ray.dir = -cam.w;
     ray.tnear = cam.znear;
     ray.tfar = cam.zfar;
     return ray;
   }
-  const float tan_y = std::tan(0.5f * cam.yfov), tan_x = tan_y * aspect;
-  const Vec3f d = -cam.w + cam.u * (sx * tan_x) + cam.v * (sy * tan_y);
+  const Vec3f d = -cam.w + cam.u * (sx * m.tan_x) + cam.v * (sy * m.tan_y);
   const float len = length(d);
   ray.org = cam.eye;
   ray.dir = d / len;
@@ -25,6 +32,18 @@ Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float
   ray.tnear = cam.znear * len;
   ray.tfar = cam.zfar * len;
   return ray;
+}
+
+Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y) {
+  return raster_ray(cam, camera_raster(cam, width, height), x, y);
+}
+
+void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step,
+                          Ray out[3]) {
+  const CameraRaster m = camera_raster(cam, width, height);
+  out[0] = raster_ray(cam, m, x, y);
+  out[1] = raster_ray(cam, m, x + step, y);
+  out[2] = raster_ray(cam, m, x, y + step);
 }
 
 Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov) {

@@ -15,6 +15,20 @@ namespace penumbra {
 /// Orthographic: origin on the image plane (ymag half-height, xmag' = ymag * aspect), dir = -w.
 Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y);
 
+/// The per-image terms of generate_camera_ray for one camera and image size.
+struct CameraRaster {
+  float width, height, aspect;
+  float tan_y = 0, tan_x = 0;  ///< perspective: half-extents of the image plane at depth 1
+};
+CameraRaster camera_raster(const Camera& cam, int width, int height);
+/// generate_camera_ray(cam, width, height, x, y), bit for bit, from camera_raster(cam, width, height).
+Ray raster_ray(const Camera& cam, const CameraRaster& raster, float x, float y);
+
+/// The rays through (x, y), (x + step, y) and (x, y + step) (out[0..2]): a camera ray and its
+/// two differential rays, exactly as three generate_camera_ray calls give them, sharing the
+/// per-camera terms.
+void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step, Ray out[3]);
+
 /// A camera at `eye` looking at `target` with approximate up vector `up` (right-handed frame).
 Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov);
 

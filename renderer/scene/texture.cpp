@@ -16,6 +16,7 @@ uint16_t to_unorm16(float v) {
 
 // Wraps integer texel coordinate i into [0, n).
 int wrap_index(int64_t i, int n, TextureWrap mode) {
+  if (i >= 0 && i < n) return int(i);  // inside the texture: every mode leaves it
   switch (mode) {
     case TextureWrap::ClampToEdge:
       return int(std::clamp<int64_t>(i, 0, n - 1));
