@@ -24,7 +24,7 @@ struct PixelFilter {
   /// Guide table (the cutpoint method, Chen & Asau 1974): guide[j] is the last
   /// bin i with cdf[i] <= j / kGuideSize, so sampling scans forward from there instead of
   /// searching the whole CDF. Filled by make_filter.
-  static constexpr int kGuideSize = 64;
+  static constexpr int kGuideSize = 1024;
   std::array<uint16_t, kGuideSize> guide{};
 };
 

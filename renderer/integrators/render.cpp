@@ -164,20 +164,20 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
   // The differential rays of camera ray p, made only for a first hit that needs them.
   struct Footprint {
     const Camera& camera;
-    const RenderConfig& config;
+    const CameraRaster& raster;
     Vec2f p;
     float step;
   };
   const auto make_rd = [](const void* ctx) {
     const Footprint& f = *static_cast<const Footprint*>(ctx);
-    RayDifferential rd;
-    camera_ray(f.camera, f.config, f.p.x, f.p.y, f.step, rd);
-    return rd;
+    const Ray rx = raster_ray(f.camera, f.raster, f.p.x + f.step, f.p.y);
+    const Ray ry = raster_ray(f.camera, f.raster, f.p.x, f.p.y + f.step);
+    return RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
   };
   const CameraRaster raster = camera_raster(camera, config.width, config.height);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Footprint fp{camera, config, filtered_position(config, x, y, samples.get2d()), step};
+    const Footprint fp{camera, raster, filtered_position(config, x, y, samples.get2d()), step};
     const Ray ray = raster_ray(camera, raster, fp.p.x, fp.p.y);
     float coverage = 0;
     LightGroups lg;
