@@ -25,16 +25,19 @@ bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float 
   const Material& lm = material_of(scene, scene.meshes[size_t(scene.instances[ls.instance].mesh)].material);
   const bool visible_side = lm.double_sided || cos_l < 0;
   if (!(dist2 > 0 && std::isfinite(dist) && visible_side && std::fabs(cos_l) > 0)) return false;
-  Ray to_light;
-  to_light.org = p;
-  to_light.dir = wi;
-  Hit lh;
-  lh.t = dist;
-  lh.u = ls.u;
-  lh.v = ls.v;
-  lh.geom_id = ls.instance;
-  lh.prim_id = ls.prim;
-  const Vec3f le = eval_emission(scene, make_interaction(scene, to_light, lh));
+  Vec3f le = lm.emissive;
+  if (!emission_is_uniform(lm)) {
+    Ray to_light;
+    to_light.org = p;
+    to_light.dir = wi;
+    Hit lh;
+    lh.t = dist;
+    lh.u = ls.u;
+    lh.v = ls.v;
+    lh.geom_id = ls.instance;
+    lh.prim_id = ls.prim;
+    le = eval_emission(scene, make_interaction(scene, to_light, lh));
+  }
   if (!(max_component(le) > 0)) return false;
   out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};
   return true;

@@ -52,6 +52,12 @@ Vec4f eval_texture(const Scene& scene, const TextureRef& ref, const SurfaceInter
 /// without its texture lookup (for integrators that ignore it). Never allocates.
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bool with_occlusion = true);
 
+/// True if eval_emission is the same at every point of a surface of this material (then it is
+/// m.emissive): opaque, no emissive texture, no procedural texture.
+inline bool emission_is_uniform(const Material& m) {
+  return m.alpha_mode == AlphaMode::Opaque && m.emissive_tex.texture < 0 && m.procedural < 0;
+}
+
 /// Emitted radiance times coverage at si: eval_material's emissive * alpha, bit for bit,
 /// reading only the textures those two need. Never allocates.
 Vec3f eval_emission(const Scene& scene, const SurfaceInteraction& si);
