@@ -256,9 +256,18 @@ bool traverse(const WideBvh<kWidth>& bvh, const PrimitiveIds& ids, const Ray& ra
       }
       continue;
     }
-    // Children met, sorted far to near (insertion sort), then pushed; the next pops' nodes and
+    // One child met: it is the next entry, without a trip through the stack (the common case
+    // for incoherent rays, and its sort and stack stores would cost branch misses).
+    const int c0 = __builtin_ctz(unsigned(mask));
+    mask &= mask - 1;
+    if (mask == 0) {
+      stack[sp++] = {n.child[c0], n.count[c0], tn[c0]};
+      continue;
+    }
+    // Two or more: sorted far to near (insertion sort), then pushed; the next pops' nodes and
     // blocks are prefetched (traversal waits on memory on big scenes).
-    int order[kWidth], k = 0;
+    int order[kWidth], k = 1;
+    order[0] = c0;
     for (; mask; mask &= mask - 1) {
       const int c = __builtin_ctz(unsigned(mask));
       int j = k++;
@@ -271,6 +280,7 @@ bool traverse(const WideBvh<kWidth>& bvh, const PrimitiveIds& ids, const Ray& ra
     for (int j = 0; j < k; ++j) {
       const int c = order[j];
       stack[sp++] = {n.child[c], n.count[c], tn[c]};
+      if (j == k - 1) break;  // popped next: fetched then
       if (n.count[c] == 0)
         prefetch_node(&bvh.nodes[n.child[c]]);
       else
