@@ -1,9 +1,11 @@
 // The one ray-query interface of Penumbra. Every back end (Embree, BVH, kD-tree, grid, brute
 // force) builds from geometry views (triangle meshes and shapes: analytic primitives and implicit
-// surfaces) and answers closest-hit and occlusion queries with the same Hit record. Accelerators
-// know nothing of materials or film. Back ends are chosen by name through accel/factory.h.
+// surfaces) and answers closest-hit and occlusion queries with the same Hit record, optionally
+// through an any-hit filter evaluated inside traversal. Accelerators know nothing of materials or
+// film (a filter's context is the caller's). Back ends are chosen by name through accel/factory.h.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -104,6 +106,45 @@ inline bool is_valid_query(const Ray& r) {
          r.tnear <= r.tfar && dot(r.dir, r.dir) > 0;
 }
 
+/// An any-hit filter evaluated inside traversal. accept(context, ray, hit) is called with each
+/// candidate hit whose t lies in the query's range, the hit as intersect() would report it
+/// (geom_id the view's or, over instances, the instance's index) and `ray` the query's ray. A
+/// rejected candidate does not narrow the search. The same hit may be offered more than once
+/// (structures with duplicated references: kD-tree, grid, Embree's spatial splits), so the
+/// answer must depend on (ray, hit) alone. `accept` is non-null, thread-safe, and never
+/// allocates, throws or logs; `context` is passed through untouched (it stays the caller's).
+struct HitFilter {
+  bool (*accept)(const void* context, const Ray& ray, const Hit& hit) = nullptr;
+  const void* context = nullptr;
+
+  bool operator()(const Ray& ray, const Hit& hit) const { return accept(context, ray, hit); }
+};
+
+/// Most hits of one shape a filtered query tests along a ray before giving up on it.
+inline constexpr int kMaxShapeCrossings = 1024;
+
+/// The nearest hit of `shape` along `ray` (the shape's space, t in the ray's range) for which
+/// accept(t) is true: a shape, unlike a triangle, may meet a ray more than once, so the test is
+/// repeated just past each rejected hit (at most kMaxShapeCrossings times, then no hit). Each
+/// test adds to `cost` when non-null. What every back end's filtered queries do for a shape.
+template <typename Accept>
+bool intersect_shape_accepted(const Shape& shape, const Ray& ray, Accept&& accept, ShapeHit& hit,
+                              TraversalCost* cost) {
+  Ray r = ray;
+  for (int i = 0; i < kMaxShapeCrossings; ++i) {
+    ShapeHit sh;
+    const bool found = intersect_shape(shape, r, sh);
+    if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
+    if (!found) return false;
+    if (accept(sh.t)) {
+      hit = sh;
+      return true;
+    }
+    r.tnear = std::nextafter(std::max(sh.t, r.tnear), kInfinity);
+  }
+  return false;
+}
+
 class Accelerator {
  public:
   virtual ~Accelerator() = default;
@@ -113,6 +154,12 @@ class Accelerator {
   virtual bool intersect(const Ray& ray, Hit& hit) const = 0;
   /// True iff some triangle or shape is hit with t in [max(ray.tnear, 0), ray.tfar]. Thread-safe.
   virtual bool occluded(const Ray& ray) const = 0;
+  /// The closest hit in intersect()'s range that `filter` accepts (rejected ones are skipped):
+  /// what re-shooting intersect() just past each rejected hit until one is accepted gives.
+  /// Returns hit.valid(); hit is reset on a miss. Thread-safe; never allocates, throws or logs.
+  virtual bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const = 0;
+  /// True iff some hit in occluded()'s range is accepted by `filter`. Thread-safe.
+  virtual bool occluded(const Ray& ray, const HitFilter& filter) const = 0;
   /// intersect(), also adding the work it did to `cost`. Back ends that cannot count (Embree
   /// keeps no statistics in release builds) answer without counting: see counts_traversal().
   virtual bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const {

@@ -24,29 +24,22 @@ class BruteAccelerator final : public Accelerator {
   }
 
   bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const override {
-    return closest(ray, hit, &cost);
+    return scan(ray, hit, &cost, nullptr, false);
   }
   bool counts_traversal() const override { return true; }
 
-  bool intersect(const Ray& ray, Hit& hit) const override { return closest(ray, hit, nullptr); }
+  bool intersect(const Ray& ray, Hit& hit) const override { return scan(ray, hit, nullptr, nullptr, false); }
+  bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const override {
+    return scan(ray, hit, nullptr, &filter, false);
+  }
 
   bool occluded(const Ray& ray) const override {
-    const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid) return false;
-    for (const auto& m : m_meshes) {
-      if (m.shape) {
-        ShapeHit sh;
-        if (intersect_shape(*m.shape, ray, sh)) return true;
-        continue;
-      }
-      for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
-        float t, u, v;
-        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
-                                          m.positions[m.indices[i + 2]], ray.tfar, t, u, v))
-          return true;
-      }
-    }
-    return false;
+    Hit hit;
+    return scan(ray, hit, nullptr, nullptr, true);
+  }
+  bool occluded(const Ray& ray, const HitFilter& filter) const override {
+    Hit hit;
+    return scan(ray, hit, nullptr, &filter, true);
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -65,7 +58,9 @@ class BruteAccelerator final : public Accelerator {
   }
 
  private:
-  bool closest(const Ray& ray, Hit& hit, TraversalCost* cost) const {
+  /// Every triangle and shape in turn: the closest hit `filter` (null: every hit) accepts, or
+  /// with `any_hit` the first one found.
+  bool scan(const Ray& ray, Hit& hit, TraversalCost* cost, const HitFilter* filter, bool any_hit) const {
     hit = Hit{};
     const WatertightRay w = prepare_watertight(ray);
     if (!w.valid) return false;
@@ -76,22 +71,25 @@ class BruteAccelerator final : public Accelerator {
         Ray r = ray;
         r.tfar = tfar;
         ShapeHit sh;
-        const bool found = intersect_shape(*m.shape, r, sh);
-        if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
-        if (found) {
+        const auto accept = [&](float t) { return !filter || (*filter)(ray, Hit{t, 0, 0, g, 0}); };
+        if (intersect_shape_accepted(*m.shape, r, accept, sh, cost)) {
           tfar = sh.t;
           hit = {sh.t, 0, 0, g, 0};
+          if (any_hit) return true;
         }
         continue;
       }
       if (cost) cost->triangles += m.indices.size() / 3;
       for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
         float t, u, v;
-        if (intersect_triangle_watertight(ray, w, m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
-                                          m.positions[m.indices[i + 2]], tfar, t, u, v)) {
-          tfar = t;
-          hit = {t, u, v, g, uint32_t(i / 3)};
-        }
+        if (!intersect_triangle_watertight(ray, w, m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
+                                           m.positions[m.indices[i + 2]], tfar, t, u, v))
+          continue;
+        const Hit candidate{t, u, v, g, uint32_t(i / 3)};
+        if (filter && !(*filter)(ray, candidate)) continue;
+        tfar = t;
+        hit = candidate;
+        if (any_hit) return true;
       }
     }
     return hit.valid();

@@ -1,6 +1,7 @@
 // Pieces shared by Penumbra's own acceleration structures (BVH, kD-tree, grid): the packed
 // triangle array they all build over, the robust ray-box slab test, and the leaf loop that
-// calls the one watertight triangle test. Not used by Embree; nothing here knows materials.
+// calls the one watertight triangle test (with or without a hit filter). Not used by Embree;
+// nothing here knows materials.
 #pragma once
 
 #include <cstdint>
@@ -129,23 +130,25 @@ inline float pad_up(float t) {
   return t * kSlabPad;
 }
 
-/// The shape test of a leaf: the ray against shapes[record's index], counting into `cost`.
-inline bool intersect_shape_record(const Ray& ray, const PrimitiveRecord& rec, const Shape* shapes,
-                                   float tfar, ShapeHit& sh, TraversalCost* cost) {
-  Ray r = ray;
-  r.tfar = tfar;
-  const bool found = intersect_shape(shapes[rec.prim_id & ~kShapeBit], r, sh);
-  if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
-  return found;
-}
+/// The filter of unfiltered queries: accepts every hit, and compiles away.
+struct AcceptAll {
+  bool operator()(const Ray&, const Hit&) const { return true; }
+};
 
 /// Closest-hit leaf test, dispatching on the primitive's kind to the one shared test per kind;
-/// narrows `tfar` and fills `hit` on a hit. `cost` (may be null) counts the tests.
+/// narrows `tfar` and fills `hit` on a hit that `filter` (AcceptAll or a HitFilter, offered the
+/// query's ray) accepts; a rejected one leaves both alone, and a shape is tested again past it
+/// (intersect_shape_accepted). `cost` (may be null) counts the tests.
+template <typename Filter = AcceptAll>
 inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const PrimitiveRecord& rec,
-                           const Shape* shapes, float& tfar, Hit& hit, TraversalCost* cost) {
+                           const Shape* shapes, float& tfar, Hit& hit, TraversalCost* cost,
+                           const Filter& filter = {}) {
   if (is_shape(rec)) {
+    Ray r = ray;
+    r.tfar = tfar;
     ShapeHit sh;
-    if (!intersect_shape_record(ray, rec, shapes, tfar, sh, cost)) return false;
+    const auto accept = [&](float t) { return filter(ray, Hit{t, 0, 0, rec.geom_id, 0}); };
+    if (!intersect_shape_accepted(shapes[rec.prim_id & ~kShapeBit], r, accept, sh, cost)) return false;
     tfar = sh.t;
     hit = {sh.t, 0, 0, rec.geom_id, 0};
     return true;
@@ -153,19 +156,20 @@ inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const Primiti
   if (cost) ++cost->triangles;
   float t, u, v;
   if (!intersect_triangle_watertight(ray, w, rec.a, rec.b, rec.c, tfar, t, u, v)) return false;
+  const Hit candidate{t, u, v, rec.geom_id, rec.prim_id};
+  if (!filter(ray, candidate)) return false;
   tfar = t;
-  hit = {t, u, v, rec.geom_id, rec.prim_id};
+  hit = candidate;
   return true;
 }
 
+/// Any-hit leaf test: whether `rec` has a hit in the ray's range that `filter` accepts.
+template <typename Filter = AcceptAll>
 inline bool occluded_leaf(const Ray& ray, const WatertightRay& w, const PrimitiveRecord& rec,
-                          const Shape* shapes) {
-  if (is_shape(rec)) {
-    ShapeHit sh;
-    return intersect_shape_record(ray, rec, shapes, ray.tfar, sh, nullptr);
-  }
-  float t, u, v;
-  return intersect_triangle_watertight(ray, w, rec.a, rec.b, rec.c, ray.tfar, t, u, v);
+                          const Shape* shapes, const Filter& filter = {}) {
+  float tfar = ray.tfar;
+  Hit candidate;
+  return intersect_leaf(ray, w, rec, shapes, tfar, candidate, nullptr, filter);
 }
 
 /// Node counters for traversals: NoCount compiles away; CountNodes adds to a TraversalCost.
@@ -191,41 +195,52 @@ struct CountNodes {
 /// which walks the cells or leaves the ray may meet (skipping those beyond `best`), calls
 /// counter.node() per node or cell visited, and calls visit(w, record) on their primitives until it
 /// returns true (CRTP, so the visitors inline). AnyHit is true for occlusion queries, where any
-/// hit ends the query and visiting order does not matter.
+/// hit ends the query and visiting order does not matter. The filtered queries apply the
+/// HitFilter in the same visitors, so a rejected candidate never narrows `best`.
 template <typename Derived>
 class TraversalAccelerator : public Accelerator {
  public:
-  bool intersect(const Ray& ray, Hit& hit) const final { return closest(ray, hit, NoCount{}, nullptr); }
+  bool intersect(const Ray& ray, Hit& hit) const final {
+    return closest(ray, hit, NoCount{}, nullptr, AcceptAll{});
+  }
+
+  bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const final {
+    return closest(ray, hit, NoCount{}, nullptr, filter);
+  }
 
   bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const final {
-    return closest(ray, hit, CountNodes{cost}, &cost);
+    return closest(ray, hit, CountNodes{cost}, &cost, AcceptAll{});
   }
   bool counts_traversal() const final { return true; }
 
-  bool occluded(const Ray& ray) const final {
-    const float tfar = ray.tfar;
-    const Shape* shapes = m_shapes.data();
-    return static_cast<const Derived*>(this)->traverse(
-        ray, tfar,
-        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
-          return occluded_leaf(ray, w, rec, shapes);
-        },
-        NoCount{}, std::true_type{});
-  }
+  bool occluded(const Ray& ray) const final { return any(ray, AcceptAll{}); }
+  bool occluded(const Ray& ray, const HitFilter& filter) const final { return any(ray, filter); }
 
  protected:
   std::vector<Shape> m_shapes;  ///< the shapes the records point at (gather_primitives fills it)
 
  private:
-  template <typename Counter>
-  bool closest(const Ray& ray, Hit& hit, const Counter& counter, TraversalCost* cost) const {
+  template <typename Filter>
+  bool any(const Ray& ray, const Filter& filter) const {
+    const Shape* shapes = m_shapes.data();
+    return static_cast<const Derived*>(this)->traverse(
+        ray, ray.tfar,
+        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
+          return occluded_leaf(ray, w, rec, shapes, filter);
+        },
+        NoCount{}, std::true_type{});
+  }
+
+  template <typename Counter, typename Filter>
+  bool closest(const Ray& ray, Hit& hit, const Counter& counter, TraversalCost* cost,
+               const Filter& filter) const {
     hit = Hit{};
     float best = ray.tfar;
     const Shape* shapes = m_shapes.data();
     static_cast<const Derived*>(this)->traverse(
         ray, best,
         [&](const WatertightRay& w, const PrimitiveRecord& rec) {
-          intersect_leaf(ray, w, rec, shapes, best, hit, cost);
+          intersect_leaf(ray, w, rec, shapes, best, hit, cost, filter);
           return false;
         },
         counter, std::false_type{});

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "renderer/accel/stats.h"
@@ -109,6 +110,34 @@ void user_shape_bounds(const RTCBoundsFunctionArguments* args) {
   o->upper_x = b.hi.x, o->upper_y = b.hi.y, o->upper_z = b.hi.z;
 }
 
+/// The hit a user geometry offers to the context's filter (through rtcFilterIntersection /
+/// rtcFilterOcclusion, which run it): u, v and the normal 0, as a shape's Hit has them.
+RTCHit shape_candidate(unsigned geom_id, unsigned prim_id, const RTCIntersectContext* context) {
+  RTCHit h;
+  h.Ng_x = h.Ng_y = h.Ng_z = 0;
+  h.u = h.v = 0;
+  h.primID = prim_id;
+  h.geomID = geom_id;
+  h.instID[0] = context->instID[0];
+  return h;
+}
+
+/// Offers the shape hit at t to the filters with `tfar` set to t, as Embree does for its own
+/// primitives; restores `tfar` and returns whether the hit was accepted.
+template <typename Args, typename Invoke>
+bool offer_shape_hit(const Args* args, RTCRayN* ray, float& tfar, float t, Invoke&& invoke) {
+  if (!args->context->filter) return true;
+  RTCHit candidate = shape_candidate(args->geomID, args->primID, args->context);
+  int valid = -1;
+  const RTCFilterFunctionNArguments fargs{
+      &valid, args->geometryUserPtr, args->context, ray, reinterpret_cast<RTCHitN*>(&candidate), 1};
+  const float saved = tfar;
+  tfar = t;
+  invoke(args, &fargs);
+  tfar = saved;
+  return valid != 0;
+}
+
 void user_shape_intersect(const RTCIntersectFunctionNArguments* args) {
   if (args->N != 1 || !args->valid[0]) return;
   auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
@@ -116,14 +145,15 @@ void user_shape_intersect(const RTCIntersectFunctionNArguments* args) {
               rh->ray.tnear,
               {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z},
               rh->ray.tfar};
+  const auto accept = [&](float t) {
+    return offer_shape_hit(args, reinterpret_cast<RTCRayN*>(&rh->ray), rh->ray.tfar, t,
+                           rtcFilterIntersection);
+  };
   ShapeHit sh;
-  if (!intersect_shape(*static_cast<const Shape*>(args->geometryUserPtr), r, sh)) return;
+  if (!intersect_shape_accepted(*static_cast<const Shape*>(args->geometryUserPtr), r, accept, sh, nullptr))
+    return;
   rh->ray.tfar = sh.t;
-  rh->hit.u = rh->hit.v = 0;
-  rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0;
-  rh->hit.primID = args->primID;
-  rh->hit.geomID = args->geomID;
-  rh->hit.instID[0] = args->context->instID[0];
+  rh->hit = shape_candidate(args->geomID, args->primID, args->context);
 }
 
 void user_shape_occluded(const RTCOccludedFunctionNArguments* args) {
@@ -131,8 +161,12 @@ void user_shape_occluded(const RTCOccludedFunctionNArguments* args) {
   auto* ray = reinterpret_cast<RTCRay*>(args->ray);
   const Ray r{
       {ray->org_x, ray->org_y, ray->org_z}, ray->tnear, {ray->dir_x, ray->dir_y, ray->dir_z}, ray->tfar};
+  const auto accept = [&](float t) {
+    return offer_shape_hit(args, args->ray, ray->tfar, t, rtcFilterOcclusion);
+  };
   ShapeHit sh;
-  if (intersect_shape(*static_cast<const Shape*>(args->geometryUserPtr), r, sh)) ray->tfar = -kInfinity;
+  if (intersect_shape_accepted(*static_cast<const Shape*>(args->geometryUserPtr), r, accept, sh, nullptr))
+    ray->tfar = -kInfinity;
 }
 
 /// A new user geometry of one primitive over `shape` (which must outlive it), committed and
@@ -225,35 +259,25 @@ class EmbreeAccelerator final : public Accelerator {
   EmbreeAccelerator& operator=(const EmbreeAccelerator&) = delete;
 
   bool intersect(const Ray& ray, Hit& hit) const override {
-    hit = Hit{};
-    if (!is_valid_query(ray)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRayHit rh;
-    fill_ray(ray, rh.ray);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(m_scene, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    hit.t = rh.ray.tfar;
-    hit.u = rh.hit.u;
-    hit.v = rh.hit.v;
-    const unsigned inst = rh.hit.instID[0];
-    hit.geom_id = inst == RTC_INVALID_GEOMETRY_ID ? rh.hit.geomID
-                  : inst == m_world_id            ? m_world_ids[rh.hit.geomID]
-                                                  : inst;
-    hit.prim_id = rh.hit.primID;
-    return true;
+    return closest(ray, hit, ctx);
+  }
+
+  bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const override {
+    FilterContext ctx(*this, ray, filter);
+    return closest(ray, hit, ctx.rtc);
   }
 
   bool occluded(const Ray& ray) const override {
-    if (!is_valid_query(ray)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRay r;
-    fill_ray(ray, r);
-    rtcOccluded1(m_scene, &ctx, &r);
-    return r.tfar < 0;  // Embree sets tfar = -inf on occlusion
+    return any_hit(ray, ctx);
+  }
+
+  bool occluded(const Ray& ray, const HitFilter& filter) const override {
+    FilterContext ctx(*this, ray, filter);
+    return any_hit(ray, ctx.rtc);
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -295,6 +319,70 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
  private:
+  /// An intersection context whose filter function (RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION)
+  /// offers Embree's candidate hits to a HitFilter. `rtc` comes first, so the callback finds the
+  /// rest from the context pointer Embree passes it.
+  struct FilterContext {
+    RTCIntersectContext rtc;
+    const EmbreeAccelerator* self;
+    const Ray* ray;  // the query's world-space ray (Embree passes instanced hits the object-space one)
+    const HitFilter* filter;
+
+    FilterContext(const EmbreeAccelerator& s, const Ray& r, const HitFilter& f)
+        : self(&s), ray(&r), filter(&f) {
+      rtcInitIntersectContext(&rtc);
+      rtc.filter = &FilterContext::run;
+    }
+
+    static void run(const RTCFilterFunctionNArguments* args) {
+      const auto& c = *reinterpret_cast<const FilterContext*>(args->context);
+      for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        Hit h;
+        h.t = RTCRayN_tfar(args->ray, args->N, i);
+        h.u = RTCHitN_u(args->hit, args->N, i);
+        h.v = RTCHitN_v(args->hit, args->N, i);
+        h.geom_id = c.self->instance_of(RTCHitN_geomID(args->hit, args->N, i),
+                                        RTCHitN_instID(args->hit, args->N, i, 0));
+        h.prim_id = RTCHitN_primID(args->hit, args->N, i);
+        if (!(*c.filter)(*c.ray, h)) args->valid[i] = 0;
+      }
+    }
+  };
+  static_assert(std::is_standard_layout_v<FilterContext>);
+
+  /// The instance index a hit reports as geom_id, from Embree's geometry and instance ids.
+  uint32_t instance_of(unsigned geom_id, unsigned inst_id) const {
+    return inst_id == RTC_INVALID_GEOMETRY_ID ? geom_id
+           : inst_id == m_world_id            ? m_world_ids[geom_id]
+                                              : inst_id;
+  }
+
+  bool closest(const Ray& ray, Hit& hit, RTCIntersectContext& ctx) const {
+    hit = Hit{};
+    if (!is_valid_query(ray)) return false;
+    RTCRayHit rh;
+    fill_ray(ray, rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(m_scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit.t = rh.ray.tfar;
+    hit.u = rh.hit.u;
+    hit.v = rh.hit.v;
+    hit.geom_id = instance_of(rh.hit.geomID, rh.hit.instID[0]);
+    hit.prim_id = rh.hit.primID;
+    return true;
+  }
+
+  bool any_hit(const Ray& ray, RTCIntersectContext& ctx) const {
+    if (!is_valid_query(ray)) return false;
+    RTCRay r;
+    fill_ray(ray, r);
+    rtcOccluded1(m_scene, &ctx, &r);
+    return r.tfar < 0;  // Embree sets tfar = -inf on occlusion
+  }
+
   /// An Embree instance of `object` placed by `to_world`, attached to the top scene as `id`.
   void attach_instance(RTCScene object, const Affine3f& to_world, unsigned id) {
     RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
@@ -351,7 +439,9 @@ class EmbreeAccelerator final : public Accelerator {
   RTCScene new_scene() const {
     RTCScene scene = rtcNewScene(device());
     throw_if_error("rtcNewScene");
-    if (m_config.robust) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    // Every scene, instanced ones included, runs the context's filter when a query sets one.
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION |
+                                (m_config.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE));
     const RTCBuildQuality quality[] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM,
                                        RTC_BUILD_QUALITY_HIGH};
     rtcSetSceneBuildQuality(scene, quality[m_config.quality]);

@@ -65,9 +65,12 @@ class TwoLevelAccelerator final : public Accelerator {
     m_build_seconds = timer.seconds();
   }
 
-  bool intersect(const Ray& ray, Hit& hit) const override { return closest(ray, hit, nullptr); }
+  bool intersect(const Ray& ray, Hit& hit) const override { return closest(ray, hit, nullptr, nullptr); }
+  bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const override {
+    return closest(ray, hit, nullptr, &filter);
+  }
   bool intersect_counted(const Ray& ray, Hit& hit, TraversalCost& cost) const override {
-    return closest(ray, hit, &cost);
+    return closest(ray, hit, &cost, nullptr);
   }
   bool counts_traversal() const override {
     return std::all_of(m_levels.begin(), m_levels.end(), [](const auto& l) { return l->counts_traversal(); });
@@ -78,6 +81,18 @@ class TwoLevelAccelerator final : public Accelerator {
       if (item.level != kShapeLevel) return m_levels[item.level]->occluded(local);
       ShapeHit sh;
       return intersect_shape(m_shapes[item.shape], local, sh);
+    });
+  }
+
+  bool occluded(const Ray& ray, const HitFilter& filter) const override {
+    return walk(ray, ray.tfar, nullptr, [&](const Item& item, const Ray& local) {
+      if (item.level != kShapeLevel) {
+        const ItemFilter seen{filter, ray, *this, item.instance};
+        return m_levels[item.level]->occluded(local, seen.filter());
+      }
+      ShapeHit sh;
+      const auto accept = [&](float t) { return filter(ray, Hit{t, 0, 0, item.instance, 0}); };
+      return intersect_shape_accepted(m_shapes[item.shape], local, accept, sh, nullptr);
     });
   }
 
@@ -150,6 +165,28 @@ class TwoLevelAccelerator final : public Accelerator {
     uint32_t shape = 0;  // index into m_shapes when level == kShapeLevel
   };
 
+  /// The caller's filter as a bottom level must apply it: to the world ray, with the bottom
+  /// level's geom_id replaced by the instance index (Hit's geom_id over instances).
+  struct ItemFilter {
+    const HitFilter& outer;
+    const Ray& world_ray;
+    const TwoLevelAccelerator& self;
+    uint32_t instance;  // Item::instance: kWorld maps the world level's geom_id
+
+    static bool accept(const void* context, const Ray&, const Hit& hit) {
+      const auto& f = *static_cast<const ItemFilter*>(context);
+      Hit h = hit;
+      h.geom_id = f.self.instance_of(f.instance, hit.geom_id);
+      return f.outer(f.world_ray, h);
+    }
+    HitFilter filter() const { return {&ItemFilter::accept, this}; }
+  };
+
+  /// The instance index a hit of item `instance`'s bottom level reports as geom_id.
+  uint32_t instance_of(uint32_t instance, uint32_t level_geom_id) const {
+    return instance == kWorld ? m_world_ids[level_geom_id] : instance;
+  }
+
   void build_top() {
     std::vector<BvhBuildRef> refs;
     for (uint32_t i = 0; i < m_items.size(); ++i)
@@ -210,25 +247,34 @@ class TwoLevelAccelerator final : public Accelerator {
         });
   }
 
-  bool closest(const Ray& ray, Hit& hit, TraversalCost* cost) const {
+  /// The closest hit over the items the ray meets, through `filter` when non-null.
+  bool closest(const Ray& ray, Hit& hit, TraversalCost* cost, const HitFilter* filter) const {
     hit = Hit{};
     float best = ray.tfar;
     walk(ray, best, cost, [&](const Item& item, const Ray& local) {
       if (item.level == kShapeLevel) {
         ShapeHit sh;
-        const bool found = intersect_shape(m_shapes[item.shape], local, sh);
-        if (cost) ++cost->shapes, cost->evaluations += sh.evaluations;
-        if (!found) return false;
+        const auto accept = [&](float t) {
+          return !filter || (*filter)(ray, Hit{t, 0, 0, item.instance, 0});
+        };
+        if (!intersect_shape_accepted(m_shapes[item.shape], local, accept, sh, cost)) return false;
         best = sh.t;
         hit = {sh.t, 0, 0, item.instance, 0};
         return false;
       }
       Hit h;
       const Accelerator& level = *m_levels[item.level];
-      if (!(cost ? level.intersect_counted(local, h, *cost) : level.intersect(local, h))) return false;
+      bool found;
+      if (filter) {
+        const ItemFilter seen{*filter, ray, *this, item.instance};
+        found = level.intersect(local, h, seen.filter());
+      } else {
+        found = cost ? level.intersect_counted(local, h, *cost) : level.intersect(local, h);
+      }
+      if (!found) return false;
       best = h.t;
       hit = h;
-      hit.geom_id = item.instance == kWorld ? m_world_ids[h.geom_id] : item.instance;
+      hit.geom_id = instance_of(item.instance, h.geom_id);
       return false;
     });
     return hit.valid();

@@ -15,6 +15,36 @@ Ray past(const Ray& ray, float t) {
   r.tnear = std::nextafter(std::max(t, ray.tnear), kInfinity);
   return r;
 }
+
+// The hit filter of camera and mirror rays (context: the Scene): rejects the back faces of
+// single-sided materials and Mask texels below the cut-off.
+bool accept_visible(const void* context, const Ray& ray, const Hit& hit) {
+  const Scene& scene = *static_cast<const Scene*>(context);
+  const Material& m = material_of(scene, instance_material(scene, scene.instances[hit.geom_id]));
+  if (!m.double_sided && dot(hit_front_normal(scene, ray, hit), ray.dir) > 0) return false;
+  return m.alpha_mode != AlphaMode::Mask || eval_alpha(scene, hit.geom_id, hit.prim_id, hit.u, hit.v) >= 1;
+}
+
+// What a shadow ray's filters see: the scene, and whether a partly transparent (Blend) layer was
+// offered; set by accept_opaque, whose decisions stay a function of the hit alone.
+struct ShadowContext {
+  const Scene& scene;
+  mutable bool translucent = false;
+};
+
+// Accepts the surfaces that stop all light (alpha 1), noting the translucent ones it rejects.
+bool accept_opaque(const void* context, const Ray&, const Hit& hit) {
+  const auto& c = *static_cast<const ShadowContext*>(context);
+  const float alpha = eval_alpha(c.scene, hit.geom_id, hit.prim_id, hit.u, hit.v);
+  if (alpha > 0 && alpha < 1) c.translucent = true;
+  return alpha >= 1;
+}
+
+// Accepts every surface that stops some light (alpha > 0): Mask holes are skipped.
+bool accept_covering(const void* context, const Ray&, const Hit& hit) {
+  const auto& c = *static_cast<const ShadowContext*>(context);
+  return eval_alpha(c.scene, hit.geom_id, hit.prim_id, hit.u, hit.v) > 0;
+}
 }  // namespace
 
 bool scene_needs_hit_filter(const Scene& scene) {
@@ -27,30 +57,24 @@ bool scene_needs_hit_filter(const Scene& scene) {
 
 bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter) {
   if (!filter) return accel.intersect(ray, hit);
-  Ray r = ray;
-  for (int layer = 0; layer < kMaxLayers; ++layer) {
-    hit = Hit{};
-    if (!accel.intersect(r, hit)) return false;
-    const Instance& inst = scene.instances[hit.geom_id];
-    const Material& m = material_of(scene, instance_material(scene, inst));
-    bool skip = false;
-    if (!m.double_sided) skip = dot(hit_front_normal(scene, r, hit), r.dir) > 0;
-    if (!skip && m.alpha_mode == AlphaMode::Mask)
-      skip = eval_alpha(scene, hit.geom_id, hit.prim_id, hit.u, hit.v) < 1;
-    if (!skip) return true;
-    r = past(ray, hit.t);
-  }
-  return true;
+  return accel.intersect(ray, hit, HitFilter{&accept_visible, &scene});
 }
 
 float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray, bool filter) {
   if (!filter) return accel.occluded(ray) ? 0.0f : 1.0f;
-  if (!accel.occluded(ray)) return 1;  // nothing at all in the way
+  // One filtered occlusion query settles opaque blockers and rays crossing only holes. An
+  // unoccluded query has been offered every hit in range, so `translucent` is then exact.
+  ShadowContext context{scene};
+  if (accel.occluded(ray, HitFilter{&accept_opaque, &context})) return 0;
+  if (!context.translucent) return 1;
+  // Blend layers (and nothing opaque) in the way: the product of (1 - alpha) over them, layer
+  // by layer, the holes skipped inside traversal.
+  const HitFilter covering{&accept_covering, &context};
   float transmittance = 1;
   Ray r = ray;
   for (int layer = 0; layer < kMaxLayers; ++layer) {
     Hit hit;
-    if (!accel.intersect(r, hit)) return transmittance;
+    if (!accel.intersect(r, hit, covering)) return transmittance;
     transmittance *= 1 - eval_alpha(scene, hit.geom_id, hit.prim_id, hit.u, hit.v);
     if (!(transmittance > 0)) return 0;
     r = past(ray, hit.t);

@@ -1,7 +1,8 @@
 // The ray queries of every integrator, AOV and light sample: closest visible hit and shadow
-// transmittance, which filter the accelerator's hits by material (Mask cut-outs, Blend layers,
-// single-sided back faces) in an any-hit loop over closest hits, and the one construction of
-// a shadow ray. Accelerators stay material-agnostic; materials stay free of ray queries.
+// transmittance, which filter the accelerator's hits by material (Mask cut-outs, single-sided
+// back faces) with a HitFilter evaluated inside traversal, and composite Blend layers in a loop
+// over them; and the one construction of a shadow ray. Accelerators stay material-agnostic (the
+// filters and their context live here); materials stay free of ray queries.
 #pragma once
 
 #include "renderer/accel/accelerator.h"
@@ -15,15 +16,16 @@ namespace penumbra {
 bool scene_needs_hit_filter(const Scene& scene);
 
 /// Closest hit that a camera or mirror ray sees: skips Mask texels below the cut-off and the
-/// back faces of single-sided materials (glTF doubleSided = false), by re-shooting the same
-/// ray past each rejected hit (at most 1024 times; then the last hit counts as opaque).
-/// Blend surfaces are returned; the integrator composites them. `filter` false: one plain
-/// accelerator query.
+/// back faces of single-sided materials (glTF doubleSided = false) inside the accelerator's
+/// traversal (one filtered query, however many surfaces are skipped). Blend surfaces are
+/// returned; the integrator composites them. `filter` false: one plain accelerator query.
 bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter);
 
 /// Fraction of light passing along a shadow ray: 0 if an opaque surface blocks it, else the
 /// product of (1 - alpha) over the Blend surfaces it crosses; Mask holes let light through.
-/// Back faces cast shadows whatever the material's sidedness.
+/// Back faces cast shadows whatever the material's sidedness. One filtered occlusion query
+/// unless Blend surfaces lie on the ray; those are then visited one by one (at most 1024; more
+/// count as opaque).
 float shadow_transmittance(const Scene& scene, const Accelerator& accel, const Ray& ray, bool filter);
 
 /// The shadow ray from surface point si towards unit direction wi, offset off the surface
