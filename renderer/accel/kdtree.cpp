@@ -21,19 +21,21 @@
 namespace penumbra {
 namespace {
 
-/// Flattened node, 8 bytes. The child below the split is the next node in the array.
+/// Flattened node, 8 bytes. The two children of an interior node are adjacent (below, then
+/// above), so the far child usually shares the near child's cache line (Wald, "Realtime Ray
+/// Tracing and Interactive Global Illumination", PhD thesis, 2004, sec. 7.3).
 struct KdNode {
   union {
     float split;           // 4 bytes: interior: split position along `axis`
-    uint32_t one_prim;     //          leaf with one triangle: its index
-    uint32_t prim_offset;  //          leaf with several: first entry in the reference array
+    uint32_t prim_offset;  //          leaf: first of its records in the leaf record array
   };
   uint32_t flags;  // 4 bytes: low 2 bits: 0/1/2 = split axis, 3 = leaf;
-                   //          high 30 bits: interior: index of the above child; leaf: count
+                   //          high 30 bits: interior: index of the below child (the above child
+                   //          follows it); leaf: count
   bool leaf() const { return (flags & 3u) == 3u; }
   int axis() const { return int(flags & 3u); }
   uint32_t count() const { return flags >> 2; }
-  uint32_t above() const { return flags >> 2; }
+  uint32_t below() const { return flags >> 2; }
 };
 static_assert(sizeof(KdNode) == 8, "KdNode must stay 8 bytes");
 
@@ -280,6 +282,27 @@ class Builder {
   tbb::enumerable_thread_specific<std::vector<uint8_t>> m_classes;
 };
 
+/// The triangles a ray tested last (Amanatides & Woo 1987, "mailboxing"; a small per-ray ring
+/// as in Havran's thesis, sec. 1.11): a triangle clipped into several leaves along the ray is
+/// tested once. Skipping the repeat never changes an answer: the test depends only on the ray
+/// and its far limit, which only shrinks, so a triangle that missed misses again and one that
+/// hit is already the closest hit or behind it. Shapes are always tested.
+struct Mailbox {
+  static constexpr int kSize = 8;
+  uint64_t keys[kSize] = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
+  int next = 0;
+  /// True if `rec` was tested before; records it otherwise.
+  bool seen(const PrimitiveRecord& rec) {
+    if (is_shape(rec)) return false;
+    const uint64_t key = (uint64_t(rec.geom_id) << 32) | rec.prim_id;
+    for (const uint64_t k : keys)
+      if (k == key) return true;
+    keys[next] = key;
+    next = (next + 1) & (kSize - 1);
+    return false;
+  }
+};
+
 // ---- The accelerator ----------------------------------------------------------------------------
 
 class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
@@ -289,29 +312,30 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   KdTreeAccelerator(std::span<const GeometryView> meshes, const KdTreeConfig& config) : m_config(config) {
     validate(config);
     const BuildTimer timer;
-    m_tris = gather_primitives(meshes, m_shapes);
+    const std::vector<PrimitiveRecord> prims = gather_primitives(meshes, m_shapes);
     m_input_triangles = count_input_triangles(meshes);
-    if (m_tris.size() > kMaxIndex) throw std::runtime_error("kdtree: too many primitives (max 2^30 - 1)");
+    if (prims.size() > kMaxIndex) throw std::runtime_error("kdtree: too many primitives (max 2^30 - 1)");
     m_max_depth =
         config.max_depth > 0
             ? config.max_depth
-            : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(m_tris.size(), 1)))));
-    if (!m_tris.empty()) {
+            : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(prims.size(), 1)))));
+    if (!prims.empty()) {
       std::vector<Event> events;
-      events.reserve(m_tris.size() * 6);
-      for (uint32_t i = 0; i < m_tris.size(); ++i) {
-        const Bounds3f b = primitive_bounds(m_tris[i]);
+      events.reserve(prims.size() * 6);
+      for (uint32_t i = 0; i < prims.size(); ++i) {
+        const Bounds3f b = primitive_bounds(prims[i]);
         m_bounds = merge(m_bounds, b);
         add_events(events, i, b);
       }
       std::sort(events.begin(), events.end());
-      Builder builder(m_config, m_tris, m_max_depth);
-      auto root = builder.build(std::move(events), uint32_t(m_tris.size()), m_bounds, 0);
+      Builder builder(m_config, prims, m_max_depth);
+      auto root = builder.build(std::move(events), uint32_t(prims.size()), m_bounds, 0);
       m_root_area = surface_area(m_bounds);
       m_clip = widen_for_rounding(m_bounds);
       m_band = rounding_band(m_bounds);
-      flatten(*root, 0);
-      if (m_nodes.size() > kMaxIndex || m_refs.size() > kMaxIndex)
+      m_nodes.emplace_back();
+      flatten(*root, 0, 0, prims);
+      if (m_nodes.size() > kMaxIndex || m_leaf_prims.size() > kMaxIndex)
         throw std::runtime_error("kdtree: tree too large (more than 2^30 nodes or references)");
       m_tally.fill(m_stats);
     }
@@ -321,15 +345,13 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    AccelStats s =
-        make_stats(m_stats, "kdtree",
-                   "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
-                       format_number(m_config.intersection_cost) + ", empty_bonus " +
-                       format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth),
-                   m_input_triangles,
-                   m_nodes.size() * sizeof(KdNode) + m_refs.size() * sizeof(uint32_t) +
-                       m_tris.size() * sizeof(PrimitiveRecord),
-                   m_build_seconds);
+    AccelStats s = make_stats(
+        m_stats, "kdtree",
+        "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
+            format_number(m_config.intersection_cost) + ", empty_bonus " +
+            format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth),
+        m_input_triangles, m_nodes.size() * sizeof(KdNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
+        m_build_seconds);
     s.nodes = m_nodes.size();
     s.shapes = m_shapes.size();
     return s;
@@ -339,6 +361,12 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
   struct Todo {
     uint32_t node;
     float tmin, tmax;
+  };
+
+  /// The ray's origin, direction and reciprocal direction as arrays, so a node step reads its
+  /// split axis with one indexed load.
+  struct PlaneQuery {
+    float org[3], dir[3], inv_dir[3];
   };
 
   /// Front-to-back traversal with early exit: stops once `best` (narrowed by closest-hit
@@ -352,24 +380,24 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     const RayBoxQuery q = prepare_box_query(ray);
     float tmin = w.tnear, tmax = ray.tfar;
     if (!intersect_box(m_clip.lo, m_clip.hi, q, tmin, tmax)) return false;
+    const PlaneQuery pq{{ray.org.x, ray.org.y, ray.org.z},
+                        {ray.dir.x, ray.dir.y, ray.dir.z},
+                        {q.inv_dir.x, q.inv_dir.y, q.inv_dir.z}};
     Todo todo[kMaxDepth + 1];
     int sp = 0;
     uint32_t idx = 0;
+    Mailbox mailbox;
     for (;;) {
       if (best < tmin) return false;  // nothing further can be closer
       const KdNode& node = m_nodes[idx];
       counter.node();
       if (!node.leaf()) {
-        idx = step(node, idx, ray, q, tmin, tmax, todo, sp);
+        idx = step(node, pq, tmin, tmax, todo, sp);
         continue;
       }
-      const uint32_t cnt = node.count();
-      if (cnt == 1) {
-        if (visit(w, m_tris[node.one_prim])) return true;
-      } else {
-        for (uint32_t i = 0; i < cnt; ++i)
-          if (visit(w, m_tris[m_refs[node.prim_offset + i]])) return true;
-      }
+      const PrimitiveRecord* recs = m_leaf_prims.data() + node.prim_offset;
+      for (uint32_t i = 0, cnt = node.count(); i < cnt; ++i)
+        if (!mailbox.seen(recs[i]) && visit(w, recs[i])) return true;
       if (sp == 0) return false;
       --sp;
       idx = todo[sp].node;
@@ -380,70 +408,72 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
 
   /// One interior-node step (pbrt-v3 KdTreeAccel::Intersect): returns the node to visit next,
   /// narrowing [tmin, tmax] and pushing the far child when the ray crosses the plane.
-  uint32_t step(const KdNode& node, uint32_t idx, const Ray& ray, const RayBoxQuery& q, float& tmin,
-                float& tmax, Todo* todo, int& sp) const {
+  uint32_t step(const KdNode& node, const PlaneQuery& q, float& tmin, float& tmax, Todo* todo,
+                int& sp) const {
     const int axis = node.axis();
-    const float o = q.org[axis], d = ray.dir[axis];
+    const float o = q.org[axis], d = q.dir[axis];
     const bool below_first = o < node.split || (o == node.split && d <= 0);
-    const uint32_t first = below_first ? idx + 1 : node.above();
-    const uint32_t second = below_first ? node.above() : idx + 1;
-    const float tplane = (node.split - o) * q.inv_dir[axis];
-    const bool on_plane = std::fabs(node.split - o) <= m_band;
+    const uint32_t below = node.below(), above = below + 1;
+    const uint32_t first = below_first ? below : above;
+    const uint32_t second = below_first ? above : below;
+    const float delta = node.split - o;
+    const float tplane = delta * q.inv_dir[axis];
+    const bool on_plane = std::fabs(delta) <= m_band;
+    if (!on_plane && d != 0 && !std::isnan(tplane)) [[likely]] {
+      // The common case as selects rather than branches (the three outcomes are unpredictable
+      // for incoherent rays): near child only, far child only, or both with the far one pushed.
+      const bool near_only = tplane > pad_up(tmax) || tplane < 0;
+      const bool far_only = !near_only && tplane < tmin * (2.0f - kSlabPad);
+      const bool both = !near_only && !far_only;
+      todo[sp] = {second, tplane, tmax};  // kept only when both children are visited
+      sp += int(both);
+      tmax = both ? tplane : tmax;
+      return far_only ? second : first;
+    }
     if (d == 0 || std::isnan(tplane)) {  // parallel to the plane: the origin's side, or both
       if (on_plane) todo[sp++] = {second, tmin, tmax};
       return first;
     }
-    if (on_plane) {
-      // Origin on the plane (within rounding): the ray heads into `into`, but surfaces lying in
-      // the plane may be stored on the other side. Visit that side first, over [tmin, tplane]
-      // (at least tmin), then `into`, so the stack stays ordered front to back.
-      const uint32_t into = d > 0 ? node.above() : idx + 1;
-      const uint32_t other = d > 0 ? idx + 1 : node.above();
-      todo[sp++] = {into, tmin, tmax};
-      tmax = std::clamp(tplane, tmin, tmax);
-      return other;
-    }
-    if (tplane > pad_up(tmax) || tplane < 0) return first;
-    if (tplane < tmin * (2.0f - kSlabPad)) return second;
-    todo[sp++] = {second, tplane, tmax};
-    tmax = tplane;
-    return first;
+    // Origin on the plane (within rounding): the ray heads into `into`, but surfaces lying in
+    // the plane may be stored on the other side. Visit that side first, over [tmin, tplane] (at
+    // least tmin), then `into`, so the stack stays ordered front to back.
+    const uint32_t into = d > 0 ? above : below;
+    const uint32_t other = d > 0 ? below : above;
+    todo[sp++] = {into, tmin, tmax};
+    tmax = std::clamp(tplane, tmin, tmax);
+    return other;
   }
 
-  uint32_t flatten(const BuildNode& b, uint64_t depth) {
-    const uint32_t idx = uint32_t(m_nodes.size());
-    m_nodes.push_back({});
+  /// Writes build node `b` into m_nodes[idx] (already allocated), its children as an adjacent
+  /// pair after every node written so far, and a leaf's records contiguously into m_leaf_prims.
+  void flatten(const BuildNode& b, uint32_t idx, uint64_t depth, const std::vector<PrimitiveRecord>& prims) {
     m_stats.max_depth = std::max(m_stats.max_depth, depth);
     const double rel = m_root_area > 0 ? surface_area(b.box) / m_root_area : 1.0;
     if (b.axis < 0) {
       const uint32_t n = uint32_t(b.tris.size());
       m_tally.add(n);
       m_stats.sah_cost += rel * m_config.intersection_cost * n;
-      if (n == 1) {
-        m_nodes[idx].one_prim = b.tris[0];
-      } else {
-        m_nodes[idx].prim_offset = uint32_t(m_refs.size());
-        m_refs.insert(m_refs.end(), b.tris.begin(), b.tris.end());
-      }
+      m_nodes[idx].prim_offset = uint32_t(m_leaf_prims.size());
+      for (const uint32_t t : b.tris) m_leaf_prims.push_back(prims[t]);
       m_nodes[idx].flags = (n << 2) | 3u;
-      return idx;
+      return;
     }
     m_stats.sah_cost += rel * m_config.traversal_cost;
+    const uint32_t below = uint32_t(m_nodes.size());
+    m_nodes.resize(m_nodes.size() + 2);
     m_nodes[idx].split = b.split;
-    flatten(*b.below, depth + 1);
-    const uint32_t above = flatten(*b.above, depth + 1);
-    m_nodes[idx].flags = (above << 2) | uint32_t(b.axis);
-    return idx;
+    m_nodes[idx].flags = (below << 2) | uint32_t(b.axis);
+    flatten(*b.below, below, depth + 1, prims);
+    flatten(*b.above, below + 1, depth + 1, prims);
   }
 
   KdTreeConfig m_config;
   int m_max_depth = 0;
-  std::vector<KdNode> m_nodes;  // depth-first; node 0 is the root
-  std::vector<uint32_t> m_refs;
-  std::vector<PrimitiveRecord> m_tris;
-  Bounds3f m_bounds;  // exact bounds of the triangles
-  Bounds3f m_clip;    // m_bounds widened by m_band, for clipping rays
-  float m_band = 0;   // origins this close to a split plane count as on it
+  std::vector<KdNode> m_nodes;                // node 0 is the root; children in adjacent pairs, depth first
+  std::vector<PrimitiveRecord> m_leaf_prims;  // each leaf's records, contiguous, in leaf order
+  Bounds3f m_bounds;                          // exact bounds of the triangles
+  Bounds3f m_clip;                            // m_bounds widened by m_band, for clipping rays
+  float m_band = 0;                           // origins this close to a split plane count as on it
   uint64_t m_input_triangles = 0;
   double m_root_area = 0;
   LeafTally m_tally;

@@ -1,7 +1,8 @@
 // Penumbra's reference kD-tree: SAH build in O(N log N) with perfect splits (Wald & Havran 2006),
-// 8-byte nodes, front-to-back traversal with early exit (pbrt-v3 style). Builds from triangle
-// bounds (and, for perfect splits, clips triangles to node boxes); leaves call the shared
-// watertight triangle test.
+// 8-byte nodes with sibling children adjacent, each leaf's triangles stored contiguously,
+// front-to-back traversal with early exit and a per-ray mailbox (pbrt-v3 style). Builds from
+// triangle bounds (and, for perfect splits, clips triangles to node boxes); leaves call the
+// shared watertight triangle test.
 #pragma once
 
 #include <cstddef>

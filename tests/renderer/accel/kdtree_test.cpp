@@ -15,6 +15,22 @@
 using namespace penumbra;
 using namespace penumbra::test;
 
+namespace {
+
+/// Checks `kd` against brute force over the rays of all_rays(scale, seed): hit/miss and t exact.
+void check_against_brute(const std::string& what, const Accelerator& kd, const GeometryView& view, int scale,
+                         uint32_t seed) {
+  const auto brute = make_accelerator("brute", std::span(&view, 1));
+  const Bounds3f b = brute->bounds();
+  const Reference ref =
+      reference(*brute, all_rays(*brute, std::span(&view, 1), b, lights_around(b), scale, seed));
+  const auto r = cross_check(kd, ref, std::span(&view, 1), length(b.extent()), true, 0.0f);
+  INFO(summary(what, r));
+  CHECK(r.failures() == 0);
+}
+
+}  // namespace
+
 TEST_CASE("kdtree: splits off empty space and respects max_depth", "[accel][kdtree]") {
   // Two small triangles far apart in a big box: the tree must cut the empty space between them.
   const std::vector<Vec3f> pos{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {100, 0, 0}, {101, 0, 0}, {100, 1, 0}};
@@ -51,12 +67,7 @@ TEST_CASE("kdtree: perfect splits keep a long diagonal triangle out of cells it 
   // Leaves overall: the sliver would be in nearly all of them without clipping.
   CHECK(s.references < s.triangles + s.leaves / 2);
   // And it still answers like brute force.
-  const auto brute = make_accelerator("brute", std::span(&view, 1));
-  const Bounds3f b = brute->bounds();
-  const Reference ref = reference(*brute, all_rays(*brute, std::span(&view, 1), b, lights_around(b), 1, 5));
-  const auto r = cross_check(*kd, ref, std::span(&view, 1), length(b.extent()), true, 0.0f);
-  INFO(summary("sliver", r));
-  CHECK(r.failures() == 0);
+  check_against_brute("sliver", *kd, view, 1, 5);
 }
 
 TEST_CASE("kdtree: other cost constants give brute force's answers, and the build is thread-independent",
@@ -100,4 +111,34 @@ TEST_CASE("kdtree: configuration is validated", "[accel][kdtree][quick]") {
   c.intersection_cost = -1;
   CHECK_THROWS_AS(validate(c), std::invalid_argument);
   CHECK_NOTHROW(validate(KdTreeConfig{}));
+}
+
+TEST_CASE("kdtree: triangles referenced by many leaves answer like brute force", "[accel][kdtree]") {
+  // Large overlapping and coplanar triangles over a grid of small ones: the large ones are clipped
+  // into many leaves, so a ray meets the same triangle in several leaves in a row (each tested
+  // once), and coplanar pairs tie on t.
+  std::vector<Vec3f> pos;
+  std::vector<uint32_t> idx;
+  const auto add = [&](Vec3f a, Vec3f b, Vec3f c) {
+    const uint32_t base = uint32_t(pos.size());
+    pos.insert(pos.end(), {a, b, c});
+    idx.insert(idx.end(), {base, base + 1, base + 2});
+  };
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const Vec3f o{float(x), float(y), float((x * 7 + y * 3) % 5) * 0.25f};
+      add(o, o + Vec3f{0.3f, 0, 0}, o + Vec3f{0, 0.3f, 0.1f});
+    }
+  add({-1, -1, 0.5f}, {13, -1, 0.5f}, {-1, 13, 0.5f});  // a plane through the grid
+  add({-1, -1, 0.5f}, {13, -1, 0.5f}, {-1, 13, 0.5f});  // the same triangle again
+  add({13, 13, 0.5f}, {13, -1, 0.5f}, {-1, 13, 0.5f});  // coplanar, sharing an edge
+  add({-1, 6, -1}, {13, 6, -1}, {6, 6, 3});             // a wall crossing everything
+  add({0, 0, 0}, {12, 12, 1}, {12, 12.01f, 1});         // a long sliver
+  const GeometryView view{pos, idx};
+  const auto kd = make_kdtree_accelerator(std::span(&view, 1));
+  const AccelStats s = kd->stats();
+  CHECK(s.references > s.triangles);
+  // Each leaf stores its triangles' records (44 bytes) contiguously; nodes are 8 bytes.
+  CHECK(s.bytes == s.nodes * 8 + s.references * 44);
+  check_against_brute("many references", *kd, view, 3, 20);
 }
