@@ -48,9 +48,14 @@ std::vector<AccelParamInfo> accel_param_keys() {
       {"kdtree.intersection_cost", num(d.kdtree.intersection_cost), "K_I, > 0"},
       {"kdtree.empty_bonus", num(d.kdtree.empty_bonus), "cost reduction for an empty side, [0, 1)"},
       {"kdtree.max_depth", std::to_string(d.kdtree.max_depth), "[0, 64]; 0 = 8 + 1.3 log2 N"},
-      {"grid.lambda", num(d.grid.lambda), "cells per triangle, (0, 64]"},
+      {"grid.lambda", num(d.grid.lambda), "cells per triangle of the finest grids, (0, 64]"},
+      {"grid.coarse_lambda", num(d.grid.coarse_lambda),
+       "cells per triangle of grids with sub-grids, (0, 64]"},
       {"grid.max_resolution", std::to_string(d.grid.max_resolution), "cells along one axis, [1, 4096]"},
-      {"grid.max_cells", std::to_string(d.grid.max_cells), "total cells, [1, 2^30]"},
+      {"grid.max_cells", std::to_string(d.grid.max_cells), "cells of one grid or sub-grid, [1, 2^30]"},
+      {"grid.max_depth", std::to_string(d.grid.max_depth), "grid levels, [1, 4]; 1 = flat uniform grid"},
+      {"grid.split_threshold", std::to_string(d.grid.split_threshold),
+       "a cell with more triangles gets a sub-grid, [1, 2^20]"},
   };
 }
 
@@ -87,10 +92,16 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.kdtree.max_depth = parse_value<int>(key, value);
   else if (key == "grid.lambda")
     c.grid.lambda = parse_value<float>(key, value);
+  else if (key == "grid.coarse_lambda")
+    c.grid.coarse_lambda = parse_value<float>(key, value);
   else if (key == "grid.max_resolution")
     c.grid.max_resolution = parse_value<uint32_t>(key, value);
   else if (key == "grid.max_cells")
     c.grid.max_cells = parse_value<uint64_t>(key, value);
+  else if (key == "grid.max_depth")
+    c.grid.max_depth = parse_value<uint32_t>(key, value);
+  else if (key == "grid.split_threshold")
+    c.grid.split_threshold = parse_value<uint32_t>(key, value);
   else {
     std::string known;
     for (const auto& k : accel_param_keys()) known += (known.empty() ? "" : ", ") + k.key;

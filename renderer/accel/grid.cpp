@@ -70,7 +70,50 @@ bool box_overlap(const double lo[3], const double hi[3], Vec3f a, Vec3f b) {
   return true;
 }
 
+// The float box enclosing the double box [lo, hi] (rounded outward).
+Bounds3f outward_box(const double lo[3], const double hi[3]) {
+  Bounds3f b;
+  for (int k = 0; k < 3; ++k) {
+    float l = float(lo[k]), h = float(hi[k]);
+    if (double(l) > lo[k]) l = std::nextafter(l, -kInfinity);
+    if (double(h) < hi[k]) h = std::nextafter(h, kInfinity);
+    b.lo[k] = l;
+    b.hi[k] = h;
+  }
+  return b;
+}
+
 constexpr int kMailboxSize = 64;  // power of two
+constexpr uint32_t kNoChild = 0xffffffffu;
+// Most cell references a level may create, bounded by the triangles' bounding boxes: the top
+// level 2^26 (256 MiB), a sub-grid kChildRefsPerTriangle per triangle of its cell.
+constexpr uint64_t kMaxCandidateRefs = 1ull << 26;
+constexpr uint64_t kChildRefsPerTriangle = 8;
+
+/// One grid of the hierarchy: the top grid, or the sub-grid of one cell of its parent, spanning
+/// the part of that cell its triangles occupy. 88 bytes: lo, cell_size (2 x 24) + box (24) +
+/// res (12) + first_cell (4).
+struct GridLevel {
+  double lo[3] = {0, 0, 0};         ///< low corner of cell (0, 0, 0)
+  double cell_size[3] = {0, 0, 0};  ///< cell extent per axis
+  Bounds3f box;                     ///< the grid's box (rays are clipped to it), rounded outward
+  uint32_t res[3] = {0, 0, 0};      ///< cells per axis
+  uint32_t first_cell = 0;          ///< index of cell (0, 0, 0) in the cell arrays (x fastest)
+};
+static_assert(sizeof(GridLevel) == 88);
+
+/// A built grid and its sub-grids: levels[0] is the grid itself; cell and level indices are
+/// local (the parent shifts them when it appends this subtree after its own cells).
+struct GridTree {
+  std::vector<GridLevel> levels;
+  std::vector<uint32_t> offsets;  ///< per cell: first reference; cells + 1 entries
+  std::vector<uint32_t> child;    ///< per cell: the level of its sub-grid, or kNoChild
+  std::vector<uint32_t> refs;     ///< triangle indices, grouped by cell
+  uint32_t depth = 0;             ///< levels on the deepest path (0: nothing built)
+};
+
+/// Result of one step of the DDA at some level.
+enum class Walk { Continue, Stop, Done };  // go on; a visitor stopped; the closest hit is found
 
 class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   friend class TraversalAccelerator<GridAccelerator>;
@@ -89,11 +132,16 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
-    char config[160];
-    std::snprintf(config, sizeof config, "lambda %g, resolution %ux%ux%u", double(m_config.lambda), m_res[0],
-                  m_res[1], m_res[2]);
+    char config[200];
+    const uint32_t* res = m_levels.empty() ? nullptr : m_levels[0].res;
+    std::snprintf(config, sizeof config,
+                  "lambda %g (coarse %g), levels %u, split above %u, resolution %ux%ux%u, %zu sub-grids",
+                  double(m_config.lambda), double(m_config.coarse_lambda), m_config.max_depth,
+                  m_config.split_threshold, res ? res[0] : 0, res ? res[1] : 0, res ? res[2] : 0,
+                  m_levels.empty() ? size_t(0) : m_levels.size() - 1);
     AccelStats s = make_stats(m_stats, "grid", config, m_input_triangles,
-                              m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
+                              m_offsets.size() * sizeof(uint32_t) + m_child.size() * sizeof(uint32_t) +
+                                  m_refs.size() * sizeof(uint32_t) + m_levels.size() * sizeof(GridLevel) +
                                   m_tris.size() * sizeof(PrimitiveRecord),
                               m_build_seconds);
     s.shapes = m_shapes.size();
@@ -101,18 +149,33 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   }
 
  private:
-  /// 3D-DDA over the cells the ray crosses, front to back. `visit(w, tri)` is called once per
-  /// triangle (mailboxed) and returns true to stop (any-hit). `best` is the current closest hit
-  /// distance (updated by the visitor for closest-hit queries): traversal stops as soon as it
-  /// lies within the current cell. Returns true iff a visitor returned true.
+  /// 3D-DDA over the cells the ray crosses, front to back, descending into sub-grids.
+  /// `visit(w, tri)` is called once per triangle (mailboxed) and returns true to stop (any-hit).
+  /// `best` is the current closest hit distance (updated by the visitor for closest-hit
+  /// queries): traversal stops as soon as it lies within the current cell. Returns true iff a
+  /// visitor returned true.
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
     const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid || m_tris.empty()) return false;
+    if (!w.valid || m_levels.empty()) return false;
     const RayBoxQuery q = prepare_box_query(ray);
-    float t0 = w.tnear, t1 = ray.tfar;
-    if (!intersect_box(m_grid.lo, m_grid.hi, q, t0, t1)) return false;
+    uint32_t mailbox[kMailboxSize];
+    std::fill(mailbox, mailbox + kMailboxSize, Hit::kInvalidId);
+    const double inv_dir[3] = {1.0 / double(ray.dir.x), 1.0 / double(ray.dir.y), 1.0 / double(ray.dir.z)};
+    return walk(0, ray, w, q, inv_dir, best, visit, counter, mailbox) == Walk::Stop;
+  }
+
+  /// The DDA through level `li` over the ray's range clipped to the level's box and to `best`
+  /// (sub-grids nest at most GridConfig::max_depth deep, so the recursion is bounded).
+  /// `inv_dir` is 1 / ray.dir in double (infinite where a component is 0, then unused).
+  template <typename Visit, typename Counter>
+  Walk walk(uint32_t li, const Ray& ray, const WatertightRay& w, const RayBoxQuery& q,
+            const double inv_dir[3], const float& best, Visit& visit, const Counter& counter,
+            uint32_t* mailbox) const {
+    const GridLevel& g = m_levels[li];
+    float t0 = w.tnear, t1 = best;
+    if (!intersect_box(g.box.lo, g.box.hi, q, t0, t1)) return Walk::Continue;
 
     // Set-up: entry cell, distance to the next cell boundary per axis, step per axis.
     int cell[3], step[3], out[3];
@@ -120,176 +183,314 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     for (int k = 0; k < 3; ++k) {
       const double o = ray.org[k], d = ray.dir[k];
       const double p = o + d * double(std::max(t0, 0.0f));
-      cell[k] = m_cell_size[k] > 0
-                    ? int(std::clamp(std::floor((p - m_lo[k]) / m_cell_size[k]), 0.0, double(m_res[k] - 1)))
+      cell[k] = g.cell_size[k] > 0
+                    ? int(std::clamp(std::floor((p - g.lo[k]) / g.cell_size[k]), 0.0, double(g.res[k] - 1)))
                     : 0;
       if (d > 0) {
         step[k] = 1;
-        out[k] = int(m_res[k]);
-        next[k] = (m_lo[k] + (cell[k] + 1) * m_cell_size[k] - o) / d;
+        out[k] = int(g.res[k]);
+        next[k] = (g.lo[k] + (cell[k] + 1) * g.cell_size[k] - o) * inv_dir[k];
       } else if (d < 0) {
         step[k] = -1;
         out[k] = -1;
-        next[k] = (m_lo[k] + cell[k] * m_cell_size[k] - o) / d;
+        next[k] = (g.lo[k] + cell[k] * g.cell_size[k] - o) * inv_dir[k];
       } else {
         step[k] = 0;
         out[k] = -1;
         next[k] = kInfinity;
       }
     }
-    uint32_t mailbox[kMailboxSize];
-    std::fill(mailbox, mailbox + kMailboxSize, Hit::kInvalidId);
 
     // Walk.
     for (;;) {
-      const size_t c = (size_t(cell[2]) * m_res[1] + size_t(cell[1])) * m_res[0] + size_t(cell[0]);
+      const size_t c =
+          g.first_cell + (size_t(cell[2]) * g.res[1] + size_t(cell[1])) * g.res[0] + size_t(cell[0]);
       counter.node();
+      if (m_child[c] != kNoChild) {
+        const Walk r = walk(m_child[c], ray, w, q, inv_dir, best, visit, counter, mailbox);
+        if (r != Walk::Continue) return r;
+      }
       for (uint32_t i = m_offsets[c], e = m_offsets[c + 1]; i < e; ++i) {
         const uint32_t r = m_refs[i];
         uint32_t& slot = mailbox[r & (kMailboxSize - 1)];
         if (slot == r) continue;  // already tested against this ray
         slot = r;
-        if (visit(w, m_tris[r])) return true;
+        if (visit(w, m_tris[r])) return Walk::Stop;
       }
       const int k = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-      if (double(best) <= next[k]) break;  // the closest hit lies in this cell
-      if (next[k] > double(t1)) break;     // the ray leaves the grid or its range
+      if (double(best) <= next[k]) return Walk::Done;   // the closest hit lies in this cell
+      if (next[k] > double(t1)) return Walk::Continue;  // the ray leaves the level or its range
       cell[k] += step[k];
-      if (cell[k] == out[k]) break;
+      if (cell[k] == out[k]) return Walk::Continue;
       // Recompute from the cell index rather than accumulate, so long rays do not drift.
-      next[k] = (m_lo[k] + (cell[k] + (step[k] > 0 ? 1 : 0)) * m_cell_size[k] - double(ray.org[k])) /
-                double(ray.dir[k]);
+      next[k] =
+          (g.lo[k] + (cell[k] + (step[k] > 0 ? 1 : 0)) * g.cell_size[k] - double(ray.org[k])) * inv_dir[k];
+    }
+  }
+
+  void build() {
+    // The top grid spans the bounds widened by the rounding band (see common.h).
+    m_band = rounding_band(m_bounds);
+    std::vector<uint32_t> all(m_tris.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+    GridTree tree = build_tree(widen_for_rounding(m_bounds), all, 0);
+    m_levels = std::move(tree.levels);
+    m_offsets = std::move(tree.offsets);
+    m_child = std::move(tree.child);
+    m_refs = std::move(tree.refs);
+
+    LeafTally tally;
+    for (size_t c = 0; c + 1 < m_offsets.size(); ++c)
+      if (m_child[c] == kNoChild) tally.add(m_offsets[c + 1] - m_offsets[c]);
+    tally.fill(m_stats);
+    m_stats.nodes = m_child.size();
+    m_stats.max_depth = tree.depth > 0 ? tree.depth - 1 : 0;
+  }
+
+  /// Cells per axis for a grid over `box` holding triangles `tris` (Cleary & Wyvill's rule,
+  /// about lambda cells per triangle). Cells are cubes, except when the median triangle is
+  /// longer than two cubic cells along exactly one axis (needles, not plates): along it a cell
+  /// is as long as the median triangle and the other axes are refined to keep lambda N cells,
+  /// so that long thin triangles along one direction are not each listed in hundreds of cells. Coarsened
+  /// until the cells and the references bounded by bounding boxes fit `ref_limit`. False if nothing fits.
+  bool choose_resolution(const Bounds3f& box, std::span<const uint32_t> tris, float lambda,
+                         uint64_t ref_limit, uint32_t res[3]) const {
+    const Vec3f ext = box.extent();
+    const double max_ext = max_component(ext);
+    bool flat[3];
+    double s[3], volume = 1;
+    int dims = 0;
+    for (int k = 0; k < 3; ++k) {
+      flat[k] = !(ext[k] > 1e-7 * max_ext);
+      if (!flat[k]) volume *= ext[k], ++dims;
+    }
+    const double cells = std::max(double(lambda) * double(tris.size()), 1.0);
+    const double cube = dims > 0 ? std::pow(volume / cells, 1.0 / dims) : 1.0;
+    const Vec3f median = median_extent(tris);
+    double fixed_cells = 1, free_volume = 1;
+    int free_dims = 0;
+    for (int k = 0; k < 3; ++k) {
+      s[k] = cube;
+      if (flat[k]) continue;
+      if (median[k] > 2 * cube) {
+        s[k] = std::min(double(median[k]), double(ext[k]));
+        fixed_cells *= double(ext[k]) / s[k];
+      } else {
+        free_volume *= ext[k], ++free_dims;
+      }
+    }
+    if (dims > 1 && free_dims == dims - 1) {
+      const double free = std::pow(free_volume / std::max(cells / fixed_cells, 1.0), 1.0 / free_dims);
+      for (int k = 0; k < 3; ++k)
+        if (!flat[k] && !(median[k] > 2 * cube)) s[k] = free;
+    } else {
+      for (int k = 0; k < 3; ++k) s[k] = cube;
+    }
+    for (int iter = 0; iter < 200; ++iter) {
+      uint64_t n = 1;
+      for (int k = 0; k < 3; ++k) {
+        res[k] = flat[k]
+                     ? 1u
+                     : uint32_t(std::clamp(std::ceil(ext[k] / s[k]), 1.0, double(m_config.max_resolution)));
+        n *= res[k];
+      }
+      // Too many cells, or (for large overlapping triangles) too many candidate references:
+      // coarsen. This bounds both build time and memory, whatever the input.
+      if (n <= m_config.max_cells && bbox_references(tris, box, res, ref_limit) <= ref_limit) return true;
+      if (n == 1) return false;
+      for (double& v : s) v *= 1.25;
     }
     return false;
   }
 
-  void build() {
-    // Phase 1: resolution. Cell size s with (prod of non-flat extents) / s^k = lambda N. The
-    // grid spans the bounds widened by the rounding band (see common.h).
-    m_grid = widen_for_rounding(m_bounds);
-    const Vec3f ext = m_grid.extent();
-    const double max_ext = max_component(ext);
-    double volume = 1;
-    int dims = 0;
-    for (int k = 0; k < 3; ++k)
-      if (ext[k] > 1e-7 * max_ext) volume *= ext[k], ++dims;
-    const double n = double(m_tris.size());
-    double s = dims > 0 ? std::pow(volume / (double(m_config.lambda) * n), 1.0 / dims) : 1.0;
-    for (;;) {
-      uint64_t cells = 1;
-      for (int k = 0; k < 3; ++k) {
-        const bool flat = !(ext[k] > 1e-7 * max_ext);
-        m_res[k] =
-            flat ? 1u : uint32_t(std::clamp(std::ceil(ext[k] / s), 1.0, double(m_config.max_resolution)));
-        cells *= m_res[k];
-      }
-      // Too many cells, or (for scenes of large overlapping triangles) too many candidate
-      // cell references, bounded by the triangles' bounding boxes: coarsen. This bounds both
-      // build time and memory, whatever the input.
-      if (cells <= m_config.max_cells && bbox_references(ext, s) <= kMaxCandidateRefs) break;
-      s *= 1.25;
+  /// Per axis, the median extent of the triangles (of at most 1025 evenly spaced ones).
+  Vec3f median_extent(std::span<const uint32_t> tris) const {
+    if (tris.empty()) return {0, 0, 0};
+    const size_t stride = std::max<size_t>(1, tris.size() / 1024);
+    std::vector<float> e[3];
+    for (size_t i = 0; i < tris.size(); i += stride) {
+      const Vec3f x = primitive_bounds(m_tris[tris[i]]).extent();
+      for (int k = 0; k < 3; ++k) e[k].push_back(x[k]);
     }
+    Vec3f m;
+    for (int k = 0; k < 3; ++k) {
+      std::nth_element(e[k].begin(), e[k].begin() + e[k].size() / 2, e[k].end());
+      m[k] = e[k][e[k].size() / 2];
+    }
+    return m;
+  }
+
+  /// Upper bound on the cell references of a grid of res cells over `box`: the cells each
+  /// triangle's bounding box covers, summed (stops counting past the limit).
+  uint64_t bbox_references(std::span<const uint32_t> tris, const Bounds3f& box, const uint32_t res[3],
+                           uint64_t limit) const {
+    double scale[3];
+    for (int k = 0; k < 3; ++k) {
+      const double e = double(box.hi[k]) - double(box.lo[k]);
+      scale[k] = e > 0 ? res[k] / e : 0;
+    }
+    uint64_t total = 0;
+    for (uint32_t i : tris) {
+      const Bounds3f b = primitive_bounds(m_tris[i]);
+      uint64_t c = 1;
+      for (int k = 0; k < 3; ++k) {
+        const double last = double(res[k]) - 1;
+        const double lo = std::clamp(std::floor((b.lo[k] - box.lo[k]) * scale[k]), 0.0, last);
+        const double hi = std::clamp(std::floor((b.hi[k] - box.lo[k]) * scale[k]), 0.0, last);
+        c *= uint64_t(hi - lo) + 1;
+      }
+      total += c;
+      if (total > limit) break;
+    }
+    return total;
+  }
+
+  /// The grid over `box` holding triangles `tris` at depth `depth` (0: the top grid), with a
+  /// sub-grid for every cell holding more than split_threshold triangles while levels remain
+  /// (Jevans & Wyvill, "Adaptive voxel subdivision for ray tracing", Graphics Interface 1989;
+  /// Kalojanov, Billeter & Slusallek, "Two-Level Grids for Ray Tracing on GPUs", Eurographics
+  /// 2011). A sub-grid spans its cell clipped to its triangles' bounds. Empty (depth 0) when a
+  /// sub-grid cannot be finer than one cell.
+  GridTree build_tree(const Bounds3f& box, std::span<const uint32_t> tris, uint32_t depth) const {
+    GridTree tree;
+    // Phase 1: resolution and cell geometry.
+    GridLevel g;
+    const uint64_t ref_limit = depth == 0 ? kMaxCandidateRefs : kChildRefsPerTriangle * tris.size();
+    const float lambda = depth + 1 < m_config.max_depth ? m_config.coarse_lambda : m_config.lambda;
+    if (!choose_resolution(box, tris, lambda, ref_limit, g.res) && depth > 0) return tree;
+    if (depth > 0 && g.res[0] * g.res[1] * g.res[2] == 1) return tree;
+    g.box = box;
     double max_abs = 0;
     for (int k = 0; k < 3; ++k) {
-      m_lo[k] = m_grid.lo[k];
-      m_cell_size[k] = (double(m_grid.hi[k]) - double(m_grid.lo[k])) / m_res[k];
-      max_abs = std::max({max_abs, std::fabs(double(m_grid.lo[k])), std::fabs(double(m_grid.hi[k]))});
+      g.lo[k] = box.lo[k];
+      g.cell_size[k] = (double(box.hi[k]) - double(box.lo[k])) / g.res[k];
+      max_abs = std::max({max_abs, std::fabs(double(box.lo[k])), std::fabs(double(box.hi[k]))});
     }
     // Cells are widened by a margin for the overlap test, so a triangle that touches a cell
     // within rounding error is listed in it (a ray may enter either neighbour).
     double margin[3];
-    for (int k = 0; k < 3; ++k) margin[k] = 1e-5 * m_cell_size[k] + 1e-6 * max_abs + 1e-30;
-    const size_t ncells = size_t(m_res[0]) * m_res[1] * m_res[2];
-
-    // Phase 2: per triangle, the cells it overlaps (counted, then written), in parallel.
-    auto cell_range = [&](const PrimitiveRecord& t, int lo[3], int hi[3]) {
-      const Bounds3f b = primitive_bounds(t);
+    for (int k = 0; k < 3; ++k) margin[k] = 1e-5 * g.cell_size[k] + 1e-6 * max_abs + 1e-30;
+    const size_t ncells = size_t(g.res[0]) * g.res[1] * g.res[2];
+    auto cell_box = [&](const int idx[3], double blo[3], double bhi[3]) {
       for (int k = 0; k < 3; ++k) {
-        if (m_cell_size[k] <= 0) {
-          lo[k] = hi[k] = 0;
-          continue;
-        }
-        const int last = int(m_res[k]) - 1;
-        lo[k] =
-            int(std::clamp(std::floor((b.lo[k] - margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
-        hi[k] =
-            int(std::clamp(std::floor((b.hi[k] + margin[k] - m_lo[k]) / m_cell_size[k]), 0.0, double(last)));
+        blo[k] = g.lo[k] + idx[k] * g.cell_size[k] - margin[k];
+        bhi[k] = g.lo[k] + (idx[k] + 1) * g.cell_size[k] + margin[k];
       }
     };
+
+    // Phase 2: per triangle, the cells it overlaps (counted, then written), in parallel.
     auto for_each_cell = [&](const PrimitiveRecord& t, auto&& f) {
+      const Bounds3f b = primitive_bounds(t);
       int lo[3], hi[3];
-      cell_range(t, lo, hi);
+      for (int k = 0; k < 3; ++k) {
+        const double last = double(g.res[k]) - 1;
+        lo[k] = g.cell_size[k] > 0
+                    ? int(std::clamp(std::floor((b.lo[k] - margin[k] - g.lo[k]) / g.cell_size[k]), 0.0, last))
+                    : 0;
+        hi[k] = g.cell_size[k] > 0
+                    ? int(std::clamp(std::floor((b.hi[k] + margin[k] - g.lo[k]) / g.cell_size[k]), 0.0, last))
+                    : 0;
+      }
       for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y)
           for (int x = lo[0]; x <= hi[0]; ++x) {
             const int idx[3] = {x, y, z};
             double blo[3], bhi[3];
-            for (int k = 0; k < 3; ++k) {
-              blo[k] = m_lo[k] + idx[k] * m_cell_size[k] - margin[k];
-              bhi[k] = m_lo[k] + (idx[k] + 1) * m_cell_size[k] + margin[k];
-            }
+            cell_box(idx, blo, bhi);
             if (is_shape(t) ? box_overlap(blo, bhi, t.a, t.b) : triangle_box_overlap(blo, bhi, t.a, t.b, t.c))
-              f(uint32_t((size_t(z) * m_res[1] + size_t(y)) * m_res[0] + size_t(x)));
+              f(uint32_t((size_t(z) * g.res[1] + size_t(y)) * g.res[0] + size_t(x)));
           }
     };
-    std::vector<uint64_t> tri_offset(m_tris.size() + 1, 0);
-    tbb::parallel_for(size_t(0), m_tris.size(), [&](size_t i) {
+    std::vector<uint64_t> tri_offset(tris.size() + 1, 0);
+    tbb::parallel_for(size_t(0), tris.size(), [&](size_t i) {
       uint64_t cnt = 0;
-      for_each_cell(m_tris[i], [&](uint32_t) { ++cnt; });
+      for_each_cell(m_tris[tris[i]], [&](uint32_t) { ++cnt; });
       tri_offset[i + 1] = cnt;
     });
-    for (size_t i = 0; i < m_tris.size(); ++i) tri_offset[i + 1] += tri_offset[i];
+    for (size_t i = 0; i < tris.size(); ++i) tri_offset[i + 1] += tri_offset[i];
     const uint64_t total = tri_offset.back();
     if (total >= 0xffffffffull)
       throw std::runtime_error("grid: more than 2^32 cell references; lower lambda or max_cells");
     std::vector<uint32_t> pair_cell(total);
-    tbb::parallel_for(size_t(0), m_tris.size(), [&](size_t i) {
+    tbb::parallel_for(size_t(0), tris.size(), [&](size_t i) {
       uint64_t o = tri_offset[i];
-      for_each_cell(m_tris[i], [&](uint32_t c) { pair_cell[o++] = c; });
+      for_each_cell(m_tris[tris[i]], [&](uint32_t c) { pair_cell[o++] = c; });
     });
 
     // Phase 3: counting sort by cell, keeping triangle order within each cell (deterministic).
-    m_offsets.assign(ncells + 1, 0);
-    for (uint32_t c : pair_cell) ++m_offsets[c + 1];
-    for (size_t c = 0; c < ncells; ++c) m_offsets[c + 1] += m_offsets[c];
-    m_refs.resize(total);
-    std::vector<uint32_t> fill(m_offsets.begin(), m_offsets.end() - 1);
-    for (size_t i = 0; i < m_tris.size(); ++i)
-      for (uint64_t j = tri_offset[i]; j < tri_offset[i + 1]; ++j) m_refs[fill[pair_cell[j]]++] = uint32_t(i);
+    std::vector<uint32_t> offsets(ncells + 1, 0), refs(total);
+    for (uint32_t c : pair_cell) ++offsets[c + 1];
+    for (size_t c = 0; c < ncells; ++c) offsets[c + 1] += offsets[c];
+    std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (size_t i = 0; i < tris.size(); ++i)
+      for (uint64_t j = tri_offset[i]; j < tri_offset[i + 1]; ++j) refs[fill[pair_cell[j]]++] = tris[i];
 
-    LeafTally tally;
-    for (size_t c = 0; c < ncells; ++c) tally.add(m_offsets[c + 1] - m_offsets[c]);
-    tally.fill(m_stats);
-    m_stats.nodes = ncells;
-  }
-
-  /// Upper bound on the cell references with cell size s: the cells each triangle's bounding
-  /// box covers, summed (stops counting past the limit).
-  uint64_t bbox_references(const Vec3f& ext, double s) const {
-    uint64_t total = 0;
-    for (const auto& t : m_tris) {
-      const Bounds3f b = primitive_bounds(t);
-      uint64_t c = 1;
+    // Phase 4: sub-grids of the crowded cells, in parallel, over each cell's box clipped to
+    // the bounds of its triangles (widened by the rounding band).
+    std::vector<uint32_t> split;
+    if (depth + 1 < m_config.max_depth)
+      for (size_t c = 0; c < ncells; ++c)
+        if (offsets[c + 1] - offsets[c] > m_config.split_threshold) split.push_back(uint32_t(c));
+    std::vector<GridTree> children(split.size());
+    tbb::parallel_for(size_t(0), split.size(), [&](size_t i) {
+      const uint32_t c = split[i];
+      const std::span<const uint32_t> in(refs.data() + offsets[c], offsets[c + 1] - offsets[c]);
+      Bounds3f tb;
+      for (uint32_t t : in) tb = merge(tb, primitive_bounds(m_tris[t]));
+      const int idx[3] = {int(c % g.res[0]), int(c / g.res[0] % g.res[1]), int(c / g.res[0] / g.res[1])};
+      double blo[3], bhi[3];
+      cell_box(idx, blo, bhi);
       for (int k = 0; k < 3; ++k) {
-        const double res = std::ceil(ext[k] / s);
-        c *= uint64_t(std::min(res, std::floor((b.hi[k] - b.lo[k]) / s) + 2.0));
+        blo[k] = std::max(blo[k], double(tb.lo[k]) - m_band);
+        bhi[k] = std::min(bhi[k], double(tb.hi[k]) + m_band);
       }
-      total += c;
-      if (total > kMaxCandidateRefs) break;
-    }
-    return total;
-  }
+      children[i] = build_tree(outward_box(blo, bhi), in, depth + 1);
+    });
 
-  static constexpr uint64_t kMaxCandidateRefs = 1ull << 26;  // 256 MiB of references at most
+    // Phase 5: this level's cells and references, then each sub-grid's after them.
+    tree.levels.push_back(g);
+    tree.child.assign(ncells, kNoChild);
+    tree.offsets.reserve(ncells + 1);
+    size_t next_split = 0;
+    for (size_t c = 0; c < ncells; ++c) {
+      tree.offsets.push_back(uint32_t(tree.refs.size()));
+      const bool has_child =
+          next_split < split.size() && split[next_split] == c && children[next_split].depth > 0;
+      if (next_split < split.size() && split[next_split] == c) ++next_split;
+      if (has_child) continue;
+      tree.refs.insert(tree.refs.end(), refs.begin() + offsets[c], refs.begin() + offsets[c + 1]);
+    }
+    uint32_t depth_below = 0;
+    for (size_t i = 0; i < split.size(); ++i) {
+      GridTree& ch = children[i];
+      if (ch.depth == 0) continue;
+      const uint32_t level_base = uint32_t(tree.levels.size()), cell_base = uint32_t(tree.child.size());
+      const uint32_t ref_base = uint32_t(tree.refs.size());
+      tree.child[split[i]] = level_base;
+      for (GridLevel l : ch.levels) {
+        l.first_cell += cell_base;
+        tree.levels.push_back(l);
+      }
+      for (size_t c = 0; c + 1 < ch.offsets.size(); ++c) {
+        tree.offsets.push_back(ch.offsets[c] + ref_base);
+        tree.child.push_back(ch.child[c] == kNoChild ? kNoChild : ch.child[c] + level_base);
+      }
+      tree.refs.insert(tree.refs.end(), ch.refs.begin(), ch.refs.end());
+      depth_below = std::max(depth_below, ch.depth);
+    }
+    tree.offsets.push_back(uint32_t(tree.refs.size()));
+    tree.depth = 1 + depth_below;
+    return tree;
+  }
 
   GridConfig m_config;
   std::vector<PrimitiveRecord> m_tris;
-  std::vector<uint32_t> m_offsets;  // per cell (x fastest): first reference; ncells + 1 entries
+  std::vector<GridLevel> m_levels;  // the top grid first, then the sub-grids
+  std::vector<uint32_t> m_offsets;  // per cell of every level: first reference; cells + 1 entries
+  std::vector<uint32_t> m_child;    // per cell: the level of its sub-grid, or kNoChild
   std::vector<uint32_t> m_refs;     // triangle indices, grouped by cell
   Bounds3f m_bounds;                // exact bounds of the triangles
-  Bounds3f m_grid;                  // the grid's box: m_bounds widened by the rounding band
-  double m_lo[3] = {0, 0, 0}, m_cell_size[3] = {0, 0, 0};
-  uint32_t m_res[3] = {0, 0, 0};
+  float m_band = 0;                 // rounding band of m_bounds: sub-grid boxes are widened by it
   uint64_t m_input_triangles = 0;
   AccelStats m_stats;
   double m_build_seconds = 0;
@@ -303,6 +504,11 @@ void validate(const GridConfig& c) {
     throw std::invalid_argument("grid: max_resolution must be in [1, 4096]");
   if (c.max_cells < 1 || c.max_cells > (1ull << 30))
     throw std::invalid_argument("grid: max_cells must be in [1, 2^30]");
+  if (!(c.coarse_lambda > 0 && c.coarse_lambda <= 64))
+    throw std::invalid_argument("grid: coarse_lambda must be in (0, 64]");
+  if (c.max_depth < 1 || c.max_depth > 4) throw std::invalid_argument("grid: max_depth must be in [1, 4]");
+  if (c.split_threshold < 1 || c.split_threshold > (1u << 20))
+    throw std::invalid_argument("grid: split_threshold must be in [1, 2^20]");
 }
 
 std::unique_ptr<Accelerator> make_grid_accelerator(std::span<const GeometryView> meshes,

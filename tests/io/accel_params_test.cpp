@@ -12,7 +12,8 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
        {"embree.robust=0", "embree.quality=2", "bvh.width=2", "bvh.max_leaf_size=3", "bvh.bin_count=32",
         "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5", "kdtree.traversal_cost=1",
         "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5", "kdtree.max_depth=30", "grid.lambda=8",
-        "grid.max_resolution=64", "grid.max_cells=4096"})
+        "grid.max_resolution=64", "grid.max_cells=4096", "grid.coarse_lambda=0.5", "grid.max_depth=1",
+        "grid.split_threshold=40"})
     apply_accel_param(c, kv);
   CHECK_FALSE(c.embree.robust);
   CHECK(c.embree.quality == 2);
@@ -28,7 +29,10 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.grid.lambda == 8);
   CHECK(c.grid.max_resolution == 64);
   CHECK(c.grid.max_cells == 4096);
-  CHECK(accel_param_keys().size() == 14);
+  CHECK(c.grid.coarse_lambda == 0.5f);
+  CHECK(c.grid.max_depth == 1);
+  CHECK(c.grid.split_threshold == 40);
+  CHECK(accel_param_keys().size() == 17);
 }
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {

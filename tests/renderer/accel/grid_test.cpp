@@ -41,6 +41,7 @@ TEST_CASE("grid: about lambda cells per triangle, references only where triangle
   for (float lambda : {1.0f, 4.0f, 16.0f}) {
     GridConfig c;
     c.lambda = lambda;
+    c.max_depth = 1;  // the flat uniform grid: every cell a leaf
     const AccelStats s = make_grid_accelerator(views, c)->stats();
     const double target = lambda * double(s.triangles);
     INFO("lambda " << lambda << ": " << s.nodes << " cells, " << s.config);
@@ -64,6 +65,7 @@ TEST_CASE("grid: about lambda cells per triangle, references only where triangle
   const GeometryView view{pos, idx};
   GridConfig c;
   c.lambda = 1;
+  c.max_depth = 1;
   const AccelStats s = make_grid_accelerator(std::span(&view, 1), c)->stats();
   INFO(s.config << ", " << s.references << " references for " << s.triangles << " triangles");
   CHECK(s.references < s.triangles + s.nodes / 4);
@@ -113,6 +115,14 @@ TEST_CASE("grid: configuration is validated", "[accel][grid][quick]") {
   c = {};
   c.max_cells = 0;
   CHECK_THROWS_AS(validate(c), std::invalid_argument);
+  c = {};
+  c.max_depth = 0;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("max_depth"));
+  c.max_depth = 5;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("max_depth"));
+  c = {};
+  c.split_threshold = 0;
+  CHECK_THROWS_WITH(validate(c), Catch::Contains("split_threshold"));
   CHECK_NOTHROW(validate(GridConfig{}));
 }
 
@@ -149,5 +159,120 @@ TEST_CASE("grid: thousands of large overlapping triangles build quickly and stil
     INFO(summary(std::string("overlapping ") + name, ra) << "; " << a->stats().references << " references");
     CHECK(ra.failures() == 0);
     CHECK(a->stats().references <= 64 * a->stats().triangles);
+  }
+}
+
+namespace {
+
+/// The grid built with `c` must answer `rays` exactly as brute force does.
+void check_against_brute(const std::string& what, std::span<const GeometryView> views,
+                         const std::vector<Ray>& rays, const GridConfig& c) {
+  const auto brute = make_accelerator("brute", views);
+  const Reference ref = reference(*brute, rays);
+  const auto grid = make_grid_accelerator(views, c);
+  const auto r = cross_check(*grid, ref, views, length(bounds_of(views).extent()), true, 0.0f);
+  INFO(summary(what + ", grid " + grid->stats().config, r));
+  CHECK(r.failures() == 0);
+}
+
+/// A dense sphere of 5120 triangles at the origin inside a room 800 m wide and 50 m high
+/// (floor, ceiling and four walls of a few large quads): the "teapot in a stadium".
+Soup sphere_in_stadium() {
+  Soup s = icosphere(4, 1, {0, 0.5f, 0});
+  s.add_plane(1, -1, -400, 400, 4);
+  s.add_plane(1, 50, -400, 400, 2);
+  for (int axis : {0, 2})
+    for (float v : {-400.0f, 400.0f}) s.add_plane(axis, v, -400, 400, 2);
+  return s;
+}
+
+/// Rays for the room as a whole and for the region around the dense object.
+std::vector<Ray> stadium_rays(std::span<const GeometryView> views) {
+  const auto brute = make_accelerator("brute", views);
+  const Bounds3f room = bounds_of(views);
+  const Bounds3f object{{-1.5f, -1, -1.5f}, {1.5f, 2, 1.5f}};
+  std::vector<Ray> rays = all_rays(*brute, views, room, lights_around(room), 1, 5);
+  const std::vector<Ray> near = all_rays(*brute, views, object, lights_around(object), 1, 6);
+  rays.insert(rays.end(), near.begin(), near.end());
+  return rays;
+}
+
+/// n slivers as in the benchmark's scene: 60-80 long along x, 5-20 thousandths wide, in a 4 x 4
+/// cross-section.
+Soup slivers(int n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<Vec3f> pos;
+  std::vector<uint32_t> idx;
+  for (int i = 0; i < n; ++i) {
+    const float x0 = -50 + 20 * u(rng), len = 60 + 20 * u(rng), y = -2 + 4 * u(rng), z = -2 + 4 * u(rng);
+    const float w = 0.005f + 0.015f * u(rng), a = 6.2831853f * u(rng);
+    const Vec3f off{0, w * std::cos(a), w * std::sin(a)};
+    const uint32_t b = uint32_t(pos.size());
+    pos.insert(pos.end(), {{x0, y, z}, Vec3f{x0 + len, y, z} + off, Vec3f{x0 + len, y, z} - off});
+    idx.insert(idx.end(), {b, b + 1, b + 2});
+  }
+  Soup s;
+  s.add(std::move(pos), std::move(idx));
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("grid: a dense object in a huge room gets sub-grids, tests fewer triangles, and answers exactly",
+          "[accel][grid]") {
+  const Soup soup = sphere_in_stadium();
+  const auto views = soup.views();
+  const std::vector<Ray> rays = stadium_rays(views);
+  GridConfig flat;
+  flat.max_depth = 1;
+  const auto hier = make_grid_accelerator(views);
+  const auto uniform = make_grid_accelerator(views, flat);
+  const AccelStats hs = hier->stats(), us = uniform->stats();
+  INFO(hs.config << "; flat: " << us.config);
+  CHECK_THAT(hs.config, !Catch::Contains(" 0 sub-grids"));
+  CHECK(hs.max_depth >= 1);
+  CHECK(hs.leaves < hs.nodes);
+  CHECK_THAT(us.config, Catch::Contains(" 0 sub-grids"));
+  CHECK(us.max_depth == 0);
+  CHECK(us.leaves == us.nodes);
+  // The sphere lies in few cells of the flat grid, so rays that reach it test most of its
+  // triangles there; the sub-grids test only those near the ray.
+  TraversalCost hc, uc;
+  for (const Ray& r : rays) {
+    Hit h;
+    hier->intersect_counted(r, h, hc);
+    uniform->intersect_counted(r, h, uc);
+  }
+  INFO("triangle tests: " << hc.triangles << " hierarchical, " << uc.triangles << " flat");
+  CHECK(hc.triangles * 4 < uc.triangles);
+
+  for (uint32_t depth : {1u, 2u, 3u, 4u})
+    for (uint32_t split : {1u, 16u}) {
+      GridConfig c;
+      c.max_depth = depth;
+      c.split_threshold = split;
+      check_against_brute("stadium", views, rays, c);
+    }
+}
+
+TEST_CASE("grid: long thin triangles get long cells and answer exactly", "[accel][grid]") {
+  const Soup soup = slivers(3000);
+  const auto views = soup.views();
+  for (uint32_t depth : {1u, 3u}) {
+    GridConfig c;
+    c.max_depth = depth;
+    const AccelStats s = make_grid_accelerator(views, c)->stats();
+    INFO(s.config << ": " << s.references << " references for " << s.triangles << " triangles");
+    // Cubic cells of the lambda N rule would be 0.5 wide: each sliver in over 100 cells.
+    CHECK(s.references < 16 * s.triangles);
+  }
+  const auto brute = make_accelerator("brute", views);
+  const Bounds3f b = bounds_of(views);
+  const std::vector<Ray> rays = all_rays(*brute, views, b, lights_around(b), 1, 8);
+  for (uint32_t depth : {1u, 2u, 3u}) {
+    GridConfig c;
+    c.max_depth = depth;
+    check_against_brute("slivers", views, rays, c);
   }
 }
