@@ -84,7 +84,10 @@ Bounds3f outward_box(const double lo[3], const double hi[3]) {
 }
 
 constexpr int kMailboxSize = 64;  // power of two
-constexpr uint32_t kNoChild = 0xffffffffu;
+// A cell's first-reference offset with this bit set holds a sub-grid: its one "reference" is
+// the sub-grid's level index. The flag shares the cell's cache line with its range.
+constexpr uint32_t kChildBit = 0x80000000u;
+constexpr uint32_t kOffsetMask = ~kChildBit;
 // Most cell references a level may create, bounded by the triangles' bounding boxes: the top
 // level 2^26 (256 MiB), a sub-grid kChildRefsPerTriangle per triangle of its cell.
 constexpr uint64_t kMaxCandidateRefs = 1ull << 26;
@@ -106,9 +109,8 @@ static_assert(sizeof(GridLevel) == 88);
 /// local (the parent shifts them when it appends this subtree after its own cells).
 struct GridTree {
   std::vector<GridLevel> levels;
-  std::vector<uint32_t> offsets;  ///< per cell: first reference; cells + 1 entries
-  std::vector<uint32_t> child;    ///< per cell: the level of its sub-grid, or kNoChild
-  std::vector<uint32_t> refs;     ///< triangle indices, grouped by cell
+  std::vector<uint32_t> offsets;  ///< per cell: first reference (| kChildBit); cells + 1 entries
+  std::vector<uint32_t> refs;     ///< triangle indices grouped by cell, or a sub-grid's level
   uint32_t depth = 0;             ///< levels on the deepest path (0: nothing built)
 };
 
@@ -139,11 +141,11 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
                   double(m_config.lambda), double(m_config.coarse_lambda), m_config.max_depth,
                   m_config.split_threshold, res ? res[0] : 0, res ? res[1] : 0, res ? res[2] : 0,
                   m_levels.empty() ? size_t(0) : m_levels.size() - 1);
-    AccelStats s = make_stats(m_stats, "grid", config, m_input_triangles,
-                              m_offsets.size() * sizeof(uint32_t) + m_child.size() * sizeof(uint32_t) +
-                                  m_refs.size() * sizeof(uint32_t) + m_levels.size() * sizeof(GridLevel) +
-                                  m_tris.size() * sizeof(PrimitiveRecord),
-                              m_build_seconds);
+    AccelStats s =
+        make_stats(m_stats, "grid", config, m_input_triangles,
+                   m_offsets.size() * sizeof(uint32_t) + m_refs.size() * sizeof(uint32_t) +
+                       m_levels.size() * sizeof(GridLevel) + m_tris.size() * sizeof(PrimitiveRecord),
+                   m_build_seconds);
     s.shapes = m_shapes.size();
     return s;
   }
@@ -206,16 +208,18 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
       const size_t c =
           g.first_cell + (size_t(cell[2]) * g.res[1] + size_t(cell[1])) * g.res[0] + size_t(cell[0]);
       counter.node();
-      if (m_child[c] != kNoChild) {
-        const Walk r = walk(m_child[c], ray, w, q, inv_dir, best, visit, counter, mailbox);
+      const uint32_t begin = m_offsets[c];
+      if (begin & kChildBit) {
+        const Walk r = walk(m_refs[begin & kOffsetMask], ray, w, q, inv_dir, best, visit, counter, mailbox);
         if (r != Walk::Continue) return r;
-      }
-      for (uint32_t i = m_offsets[c], e = m_offsets[c + 1]; i < e; ++i) {
-        const uint32_t r = m_refs[i];
-        uint32_t& slot = mailbox[r & (kMailboxSize - 1)];
-        if (slot == r) continue;  // already tested against this ray
-        slot = r;
-        if (visit(w, m_tris[r])) return Walk::Stop;
+      } else {
+        for (uint32_t i = begin, e = m_offsets[c + 1] & kOffsetMask; i < e; ++i) {
+          const uint32_t r = m_refs[i];
+          uint32_t& slot = mailbox[r & (kMailboxSize - 1)];
+          if (slot == r) continue;  // already tested against this ray
+          slot = r;
+          if (visit(w, m_tris[r])) return Walk::Stop;
+        }
       }
       const int k = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
       if (double(best) <= next[k]) return Walk::Done;   // the closest hit lies in this cell
@@ -236,14 +240,13 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     GridTree tree = build_tree(widen_for_rounding(m_bounds), all, 0);
     m_levels = std::move(tree.levels);
     m_offsets = std::move(tree.offsets);
-    m_child = std::move(tree.child);
     m_refs = std::move(tree.refs);
 
     LeafTally tally;
     for (size_t c = 0; c + 1 < m_offsets.size(); ++c)
-      if (m_child[c] == kNoChild) tally.add(m_offsets[c + 1] - m_offsets[c]);
+      if (!(m_offsets[c] & kChildBit)) tally.add((m_offsets[c + 1] & kOffsetMask) - m_offsets[c]);
     tally.fill(m_stats);
-    m_stats.nodes = m_child.size();
+    m_stats.nodes = m_offsets.size() - 1;
     m_stats.max_depth = tree.depth > 0 ? tree.depth - 1 : 0;
   }
 
@@ -409,8 +412,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     });
     for (size_t i = 0; i < tris.size(); ++i) tri_offset[i + 1] += tri_offset[i];
     const uint64_t total = tri_offset.back();
-    if (total >= 0xffffffffull)
-      throw std::runtime_error("grid: more than 2^32 cell references; lower lambda or max_cells");
+    if (total >= kChildBit)
+      throw std::runtime_error("grid: more than 2^31 cell references; lower lambda or max_cells");
     std::vector<uint32_t> pair_cell(total);
     tbb::parallel_for(size_t(0), tris.size(), [&](size_t i) {
       uint64_t o = tri_offset[i];
@@ -447,37 +450,47 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
       children[i] = build_tree(outward_box(blo, bhi), in, depth + 1);
     });
 
-    // Phase 5: this level's cells and references, then each sub-grid's after them.
+    // Phase 5: this level's cells and references, then each sub-grid's after them (sub-grid
+    // i becomes level level_base[i]).
+    std::vector<uint32_t> level_base(split.size());
+    uint32_t levels = 1;
+    for (size_t i = 0; i < split.size(); ++i) {
+      level_base[i] = levels;
+      levels += uint32_t(children[i].levels.size());
+    }
     tree.levels.push_back(g);
-    tree.child.assign(ncells, kNoChild);
     tree.offsets.reserve(ncells + 1);
     size_t next_split = 0;
     for (size_t c = 0; c < ncells; ++c) {
-      tree.offsets.push_back(uint32_t(tree.refs.size()));
-      const bool has_child =
-          next_split < split.size() && split[next_split] == c && children[next_split].depth > 0;
-      if (next_split < split.size() && split[next_split] == c) ++next_split;
-      if (has_child) continue;
-      tree.refs.insert(tree.refs.end(), refs.begin() + offsets[c], refs.begin() + offsets[c + 1]);
+      const bool split_here = next_split < split.size() && split[next_split] == c;
+      if (split_here && children[next_split].depth > 0) {
+        tree.offsets.push_back(uint32_t(tree.refs.size()) | kChildBit);
+        tree.refs.push_back(level_base[next_split]);
+      } else {
+        tree.offsets.push_back(uint32_t(tree.refs.size()));
+        tree.refs.insert(tree.refs.end(), refs.begin() + offsets[c], refs.begin() + offsets[c + 1]);
+      }
+      next_split += split_here;
     }
     uint32_t depth_below = 0;
     for (size_t i = 0; i < split.size(); ++i) {
       GridTree& ch = children[i];
       if (ch.depth == 0) continue;
-      const uint32_t level_base = uint32_t(tree.levels.size()), cell_base = uint32_t(tree.child.size());
-      const uint32_t ref_base = uint32_t(tree.refs.size());
-      tree.child[split[i]] = level_base;
+      const uint32_t cell_base = uint32_t(tree.offsets.size()), ref_base = uint32_t(tree.refs.size());
       for (GridLevel l : ch.levels) {
         l.first_cell += cell_base;
         tree.levels.push_back(l);
       }
       for (size_t c = 0; c + 1 < ch.offsets.size(); ++c) {
-        tree.offsets.push_back(ch.offsets[c] + ref_base);
-        tree.child.push_back(ch.child[c] == kNoChild ? kNoChild : ch.child[c] + level_base);
+        const uint32_t o = ch.offsets[c];
+        if (o & kChildBit) ch.refs[o & kOffsetMask] += level_base[i];
+        tree.offsets.push_back(((o & kOffsetMask) + ref_base) | (o & kChildBit));
       }
       tree.refs.insert(tree.refs.end(), ch.refs.begin(), ch.refs.end());
       depth_below = std::max(depth_below, ch.depth);
     }
+    if (tree.refs.size() >= kChildBit)
+      throw std::runtime_error("grid: more than 2^31 cell references; lower lambda or max_cells");
     tree.offsets.push_back(uint32_t(tree.refs.size()));
     tree.depth = 1 + depth_below;
     return tree;
@@ -486,9 +499,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
   GridConfig m_config;
   std::vector<PrimitiveRecord> m_tris;
   std::vector<GridLevel> m_levels;  // the top grid first, then the sub-grids
-  std::vector<uint32_t> m_offsets;  // per cell of every level: first reference; cells + 1 entries
-  std::vector<uint32_t> m_child;    // per cell: the level of its sub-grid, or kNoChild
-  std::vector<uint32_t> m_refs;     // triangle indices, grouped by cell
+  std::vector<uint32_t> m_offsets;  // per cell of every level: first reference (| kChildBit); + 1
+  std::vector<uint32_t> m_refs;     // triangle indices grouped by cell, or a sub-grid's level
   Bounds3f m_bounds;                // exact bounds of the triangles
   float m_band = 0;                 // rounding band of m_bounds: sub-grid boxes are widened by it
   uint64_t m_input_triangles = 0;
