@@ -21,7 +21,7 @@ struct GridConfig {
   uint32_t max_resolution = 1024;   ///< [1, 4096]: cap on the cells along any one axis
   uint64_t max_cells = 1ull << 24;  ///< [1, 2^30]: cap on the cells of any one grid or sub-grid
   uint32_t max_depth = 3;           ///< [1, 4]: grid levels; 1 is the flat uniform grid
-  uint32_t split_threshold = 16;    ///< [1, 2^20]: a cell holding more triangles gets a sub-grid
+  uint32_t split_threshold = 8;     ///< [1, 2^20]: a cell holding more triangles gets a sub-grid
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.
