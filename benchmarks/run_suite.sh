@@ -18,9 +18,9 @@ models=$(bash benchmarks/fetch_models.sh "$BUILD_DIR")
 dragon=$(echo "$models" | grep dragon.gltf)
 bunny=$(echo "$models" | grep bunny.gltf)
 corpus_scenes=()
-for m in MetalRoughSpheresNoTextures TransmissionTest DamagedHelmet; do
-  f="$corpus/valid/$m/glTF-Binary/$m.glb"
-  if [[ -f "$f" ]]; then corpus_scenes+=("$f"); else echo "run_suite: $f not found: skipped" >&2; fi
+for m in MetalRoughSpheresNoTextures TransmissionTest DamagedHelmet WaterBottle Suzanne; do
+  f=$(ls "$corpus/valid/$m"/glTF-Binary/*.glb "$corpus/valid/$m"/glTF/*.gltf 2>/dev/null | head -1 || true)
+  if [[ -n "$f" ]]; then corpus_scenes+=("$f"); else echo "run_suite: $corpus/valid/$m not found: skipped" >&2; fi
 done
 
 run() {  # run NAME ARGS...: one penumbra-bench invocation, its table kept in NAME.txt
@@ -29,18 +29,24 @@ run() {  # run NAME ARGS...: one penumbra-bench invocation, its table kept in NA
   "$bench" "$@" --csv "$out/$name.csv" --json "$out/$name.json" --svg "$out/$name.svg" | tee "$out/$name.txt"
 }
 
-# 1. Real models and generated interiors: every structure, every ray kind, 1 and 2 threads.
-run models "$dragon" "$bunny" "${corpus_scenes[@]}" gen:atrium gen:soup \
-  --accel embree,bvh,kdtree,grid --threads 1,2 --builds 5 --repeats 3 --heatmaps "$out/heatmaps"
-# 2. The binary BVH against the 4-wide one on the dragon.
-run bvh-width "$dragon" --accel embree,bvh --accel-param bvh.width=2 --accel-param bvh.traversal_cost=1 \
-  --threads 1,2 --builds 5 --repeats 3
+# 1. Real models, generated interiors and a terrain of 1M triangles: every structure, every ray
+# kind, one thread, medians of 5 passes; builds with every core (medians of 5).
+run models "$dragon" "$bunny" "${corpus_scenes[@]}" gen:atrium gen:soup gen:terrain:1000000 \
+  --accel embree,bvh,kdtree,grid --threads 1 --builds 5 --repeats 5 --heatmaps "$out/heatmaps"
+# 2. The BVH's other widths (the default is the CPU's widest): 4-wide SSE and the binary tree.
+for w in 4 2; do
+  run "bvh-width$w" "$dragon" "$bunny" gen:atrium --accel embree,bvh --accel-param "bvh.width=$w" \
+    --threads 1 --builds 3 --repeats 5
+done
 # 3. Where a uniform grid collapses: the teapot in a stadium (the teapot falls into a few cells)
-# and long slivers (every cell along them lists them all): tens of thousands of triangle tests per
-# ray, so fewer rays and smaller scenes.
-run collapse gen:stadium:50000 gen:slivers:100000 --accel embree,bvh,kdtree,grid --threads 1,2 --builds 3 \
-  --repeats 3 --width 128 --height 72 --heatmaps "$out/heatmaps"
-# 4. Scaling: build time and memory against N up to 5.2M triangles (2 threads).
-run scaling gen:terrain:500000 gen:terrain:1000000 gen:terrain:2000000 gen:terrain:5200000 \
+# and long slivers (every cell along them lists them all); the hierarchical grid's default
+# against its flat form (grid.max_depth=1: tens of thousands of triangle tests per ray, so
+# fewer rays and smaller scenes).
+run collapse gen:stadium:50000 gen:slivers:100000 --accel embree,bvh,kdtree,grid --threads 1 --builds 3 \
+  --repeats 5 --width 128 --height 72 --heatmaps "$out/heatmaps"
+run collapse-flat gen:stadium:50000 gen:slivers:100000 --accel grid --accel-param grid.max_depth=1 \
+  --threads 1 --builds 1 --repeats 1 --width 128 --height 72
+# 4. Scaling: build time and memory against N (2 threads).
+run scaling gen:terrain:500000 gen:terrain:1000000 gen:terrain:2000000 \
   --accel embree,bvh,kdtree,grid --rays random,primary --threads 0 --builds 3 --repeats 3
 echo "$out"
