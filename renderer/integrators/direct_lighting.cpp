@@ -17,7 +17,7 @@ bool sample_incident(const Light& light, Vec3f p, IncidentLight& out) {
 bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float u1, Vec2f u2,
                      IncidentLight& out) {
   AreaLightSample ls;
-  if (!sample_area_light(area, scene, u1, u2, ls)) return false;
+  if (!sample_area_light(area, u1, u2, ls)) return false;
   const Vec3f d = ls.p - p;
   const float dist2 = dot(d, d), dist = std::sqrt(dist2);
   const Vec3f wi = d / dist;
@@ -36,7 +36,7 @@ bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float 
     lh.v = ls.v;
     lh.geom_id = ls.instance;
     lh.prim_id = ls.prim;
-    le = eval_emission(scene, make_interaction(scene, to_light, lh));
+    le = eval_emission(scene, make_interaction(scene, to_light, lh, *ls.tri));
   }
   if (!(max_component(le) > 0)) return false;
   out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};

@@ -55,7 +55,7 @@ AreaLights build_area_lights(const Scene& scene) {
     for (uint32_t prim = 0; prim < n; ++prim) {
       const WorldTriangle tri = world_triangle(scene, inst, prim);
       const float area = 0.5f * length(cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
-      EmissiveTriangle t{uint32_t(i), prim, std::isfinite(area) ? area : 0.0f};
+      EmissiveTriangle t{uint32_t(i), prim, std::isfinite(area) ? area : 0.0f, tri};
       double p = 0;
       if (t.area > 0)
         p = double(emission_estimate(scene, t.instance, prim, tri, mat)) * t.area *
@@ -88,8 +88,7 @@ float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim)
   return t.area > 0 ? lights.pmf[k] / t.area : 0.0f;
 }
 
-bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, Vec2f u,
-                       AreaLightSample& out) {
+bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSample& out) {
   if (lights.pmf.empty()) return false;
   const size_t n = lights.triangles.size();
   auto it = std::upper_bound(lights.cdf.begin(), lights.cdf.end(), u1);
@@ -97,7 +96,7 @@ bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, V
   while (k + 1 < n && !(lights.pmf[k] > 0)) ++k;  // rounding may land on a zero-power entry
   if (!(lights.pmf[k] > 0)) return false;
   const EmissiveTriangle& t = lights.triangles[k];
-  const WorldTriangle tri = world_triangle(scene, scene.instances[t.instance], t.prim);
+  const WorldTriangle& tri = t.tri;
   // Uniform point: b0 = 1 - sqrt(u.x), b1 = u.y sqrt(u.x), b2 = (1 - u.y) sqrt(u.x)
   // (pbrt-v3 UniformSampleTriangle); the Hit convention's (u, v) are (b1, b2).
   const float su = std::sqrt(u.x);
@@ -107,6 +106,7 @@ bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, V
   out.v = (1 - u.y) * su;
   out.p = tri.p[0] * (1 - out.u - out.v) + tri.p[1] * out.u + tri.p[2] * out.v;
   out.ng = tri.ng;
+  out.tri = &t.tri;
   out.pdf_area = t.area > 0 ? lights.pmf[k] / t.area : 0.0f;
   return out.pdf_area > 0 && dot(out.ng, out.ng) > 0;
 }

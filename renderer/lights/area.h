@@ -20,7 +20,8 @@ namespace penumbra {
 
 struct EmissiveTriangle {
   uint32_t instance = 0, prim = 0;
-  float area = 0;  ///< world-space area
+  float area = 0;     ///< world-space area
+  WorldTriangle tri;  ///< world_triangle() of the triangle, kept so sampling does not rebuild it
 };
 
 struct AreaLights {
@@ -41,14 +42,15 @@ float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim)
 
 struct AreaLightSample {
   uint32_t instance = 0, prim = 0;
-  float u = 0, v = 0;  ///< barycentrics of the point (Hit convention)
-  Vec3f p;             ///< world point
-  Vec3f ng;            ///< unit front-side geometric normal
-  float pdf_area = 0;  ///< pmf / area
+  float u = 0, v = 0;                  ///< barycentrics of the point (Hit convention)
+  Vec3f p;                             ///< world point
+  Vec3f ng;                            ///< unit front-side geometric normal
+  float pdf_area = 0;                  ///< pmf / area
+  const WorldTriangle* tri = nullptr;  ///< the light's world triangle (points into AreaLights)
 };
 
 /// Picks a triangle by power with u1 and a uniform point on it with u. False if there are
 /// no lights (or the chosen triangle is degenerate). Never allocates.
-bool sample_area_light(const AreaLights& lights, const Scene& scene, float u1, Vec2f u, AreaLightSample& out);
+bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSample& out);
 
 }  // namespace penumbra

@@ -38,7 +38,7 @@ bool uv_surface_gradients(const Scene& scene, const SurfaceInteraction& si, int 
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const auto& uvs = set == 1 ? mesh.uvs1 : mesh.uvs;
   if (uvs.empty()) return false;
-  const WorldTriangle tri = world_triangle(scene, inst, si.prim);
+  const WorldTriangle& tri = si.tri;
   const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
   const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);
   const float det = a11 * a22 - a12 * a12;

@@ -99,14 +99,21 @@ Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {
   const Instance& inst = scene.instances[hit.geom_id];
   if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
+  return make_interaction(scene, ray, hit, world_triangle(scene, inst, hit.prim_id));
+}
+
+SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit,
+                                    const WorldTriangle& tri) {
+  const Instance& inst = scene.instances[hit.geom_id];
+  if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-  const WorldTriangle tri = world_triangle(scene, inst, hit.prim_id);
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const float w = 1.0f - hit.u - hit.v;
   SurfaceInteraction si;
   si.instance = hit.geom_id;
   si.mesh = uint32_t(inst.mesh);
   si.prim = hit.prim_id;
+  si.tri = tri;
   si.p = tri.p[0] * w + tri.p[1] * hit.u + tri.p[2] * hit.v;
   si.material = mesh.material;
   si.ng = tri.ng;
@@ -165,7 +172,7 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
   // Barycentric derivatives: least-squares solve of dp = e1 db1 + e2 db2.
   const Instance& inst = scene.instances[si.instance];
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-  const WorldTriangle tri = world_triangle(scene, inst, si.prim);
+  const WorldTriangle& tri = si.tri;
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
   const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);

@@ -35,11 +35,18 @@ struct SurfaceInteraction {
   Vec3f dpdx, dpdy;          ///< of the hit point
   Vec3f dndx, dndy;          ///< of the (unnormalised) interpolated normal
   Vec2f duvdx[2], duvdy[2];  ///< of each UV set
+  WorldTriangle tri{};       ///< the hit triangle in world space, unfaced (meshes only), so
+                             ///< derivatives and normal mapping do not rebuild it
 };
 
 /// Requires hit.valid() and hit ids inside the scene (as any accelerator over mesh_views()
 /// and instance_views() returns). Everything is in world space.
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit);
+
+/// make_interaction for a mesh hit whose world triangle is already known: `tri` must equal
+/// world_triangle(scene, scene.instances[hit.geom_id], hit.prim_id) (shape hits ignore it).
+SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit,
+                                    const WorldTriangle& tri);
 
 /// The origin of a ray leaving si.p in direction `dir`: offset_ray_origin() plus si.spawn_offset
 /// along the side of ng that `dir` points to, so the ray does not find the same surface again.
