@@ -25,7 +25,8 @@ float alpha_of(const GltfBrdf& b) {
 }
 
 Vec3f schlick(Vec3f f0, float cos_theta) {
-  const float k = std::pow(std::clamp(1 - cos_theta, 0.0f, 1.0f), 5.0f);
+  const float m = std::clamp(1 - cos_theta, 0.0f, 1.0f), m2 = m * m;
+  const float k = m2 * m2 * m;  // (1 - cos)^5
   return f0 + (Vec3f{1, 1, 1} - f0) * k;
 }
 

@@ -365,3 +365,47 @@ TEST_CASE("material: both integrators and the albedo AOV see the procedural colo
   CHECK(d.albedo[centre] == Approx(color.x));
   CHECK(d.albedo[centre + 2] == Approx(color.z));
 }
+
+TEST_CASE(
+    "material: eval_emission equals eval_material's emissive x alpha, with and without an emissive texture",
+    "[material][quick]") {
+  // Texels (RGBA): top-left red, top-right green, bottom-left blue (alpha 1), bottom-right white
+  // with alpha 0.25. Emissive factor (2, 1, 0.5).
+  const float xs[] = {-0.5f, 0.5f, -0.5f, 0.5f}, ys[] = {0.5f, 0.5f, -0.5f, -0.5f};
+  for (const bool textured : {false, true}) {
+    for (const AlphaMode mode : {AlphaMode::Opaque, AlphaMode::Mask, AlphaMode::Blend}) {
+      Probe p;
+      const int tex = add_quadrant_texture(p.scene);
+      const int mat = add_material(p.scene, {0.5f, 1, 1}, 0, 1);
+      Material& m = p.scene.materials[size_t(mat)];
+      m.base_color_tex.texture = tex;
+      m.emissive = {2, 1, 0.5f};
+      if (textured) m.emissive_tex.texture = tex;
+      m.alpha_mode = mode;
+      add_uv_quad(p.scene, 0, mat);
+      p.build();
+      for (int k = 0; k < 4; ++k) {
+        Ray r;
+        r.org = {xs[k], ys[k], 10};
+        r.dir = {0, 0, -1};
+        Hit h;
+        REQUIRE(p.accel->intersect(r, h));
+        const SurfaceInteraction si = make_interaction(p.scene, r, h);
+        const MaterialPoint mp = eval_material(p.scene, si);
+        const Vec3f e = eval_emission(p.scene, si);
+        INFO("textured " << textured << " mode " << int(mode) << " point " << k);
+        CHECK(e.x == Approx(mp.emissive.x * mp.alpha).margin(1e-7));
+        CHECK(e.y == Approx(mp.emissive.y * mp.alpha).margin(1e-7));
+        CHECK(e.z == Approx(mp.emissive.z * mp.alpha).margin(1e-7));
+      }
+      // The bottom-right texel (white, alpha 0.25): emission 2 x 1 x coverage.
+      Ray r;
+      r.org = {0.5f, -0.5f, 10};
+      r.dir = {0, 0, -1};
+      Hit h;
+      REQUIRE(p.accel->intersect(r, h));
+      const float cover = mode == AlphaMode::Opaque ? 1.0f : mode == AlphaMode::Blend ? 0.25f : 0.0f;
+      CHECK(eval_emission(p.scene, make_interaction(p.scene, r, h)).x == Approx(2 * cover).margin(kEps));
+    }
+  }
+}
