@@ -56,7 +56,13 @@ bool scene_needs_hit_filter(const Scene& scene) {
 }
 
 bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter) {
-  if (!filter) return accel.intersect(ray, hit);
+  if (!accel.intersect(ray, hit)) return false;
+  if (!filter) return true;
+  // The plain closest hit is the answer when the filter accepts it, the common case (glTF
+  // materials are single-sided by default, and most rays meet front faces): one filter call
+  // instead of one per candidate. Otherwise the filtered query finds the closest accepted hit.
+  if (accept_visible(&scene, ray, hit)) return true;
+  hit = Hit{};
   return accel.intersect(ray, hit, HitFilter{&accept_visible, &scene});
 }
 

@@ -17,8 +17,9 @@ bool scene_needs_hit_filter(const Scene& scene);
 
 /// Closest hit that a camera or mirror ray sees: skips Mask texels below the cut-off and the
 /// back faces of single-sided materials (glTF doubleSided = false) inside the accelerator's
-/// traversal (one filtered query, however many surfaces are skipped). Blend surfaces are
-/// returned; the integrator composites them. `filter` false: one plain accelerator query.
+/// traversal: the plain closest hit if the filter accepts it, else one filtered query, however
+/// many surfaces are skipped. Blend surfaces are returned; the integrator composites them.
+/// `filter` false: one plain accelerator query.
 bool intersect_visible(const Scene& scene, const Accelerator& accel, const Ray& ray, Hit& hit, bool filter);
 
 /// Fraction of light passing along a shadow ray: 0 if an opaque surface blocks it, else the
