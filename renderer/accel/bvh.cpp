@@ -58,19 +58,22 @@ void set_child_boxes(QuantizedNode8& node, const Bounds3f* boxes, int n) {
   for (int k = 0; k < 3; ++k) {
     // The step: the extent over 255 steps, grown until the last step reaches the top.
     node.origin[k] = all.lo[k];
-    float step = (all.hi[k] - all.lo[k]) / 255.0f;
-    if (!(step > 0)) step = std::max(std::fabs(all.lo[k]) * 0x1p-23f, std::numeric_limits<float>::min());
+    // At least FLT_MIN (no subnormal steps, which growing by a relative factor could not move).
+    float step = std::max((all.hi[k] - all.lo[k]) / 255.0f, std::numeric_limits<float>::min());
     if (!std::isfinite(step)) step = std::numeric_limits<float>::max() / 256;  // grown to inf below
     node.scale[k] = step;
-    while (node.dequantize(k, 255) < all.hi[k]) node.scale[k] = step = step * (1 + 0x1p-10f);
+    while (node.dequantize(k, 255) < all.hi[k])
+      node.scale[k] = step = std::max(step * (1 + 0x1p-10f), std::nextafter(step, kInfinity));
     for (int i = 0; i < 8; ++i) {
       if (i >= n) {
         node.qlo[k][i] = 255, node.qhi[k][i] = 0;
         continue;
       }
       // Round outward, then step further out until the decoded bound contains the box.
-      int lo = std::clamp(int(std::floor((boxes[i].lo[k] - all.lo[k]) / step)), 0, 255);
-      int hi = std::clamp(int(std::ceil((boxes[i].hi[k] - all.lo[k]) / step)), 0, 255);
+      // Clamped in float before the conversion (a non-finite quotient has no int value).
+      const auto level = [](float q) { return int(std::clamp(q, 0.0f, 255.0f)); };
+      int lo = level(std::floor((boxes[i].lo[k] - all.lo[k]) / step));
+      int hi = level(std::ceil((boxes[i].hi[k] - all.lo[k]) / step));
       while (lo > 0 && node.dequantize(k, uint8_t(lo)) > boxes[i].lo[k]) --lo;
       while (hi < 255 && node.dequantize(k, uint8_t(hi)) < boxes[i].hi[k]) ++hi;
       node.qlo[k][i] = uint8_t(lo);

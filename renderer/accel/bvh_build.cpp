@@ -20,6 +20,7 @@ namespace {
 /// SAH depth limit: below it, splits fall back to the object median, which bounds the
 /// remaining depth by log2(n) and keeps every path within kBvhStackSize.
 constexpr int kMaxSahDepth = 64;
+static_assert(kMaxSahDepth + 32 <= kBvhStackSize, "median splits of up to 2^32 references fit the stacks");
 
 /// The references of one node: their range, box and centroid bounds.
 struct Range {
@@ -33,12 +34,16 @@ void add(Range& side, const BvhBuildRef& ref) {
   side.centroids = merge(side.centroids, ref.centroid());
 }
 
-/// A reference's box corners in SSE registers (lane 3 holds the index or padding: unused).
+/// A reference's box corners in SSE registers, lane 3 (the index or padding) cleared so that
+/// no arithmetic runs on its bits (a subnormal as a float).
+inline __m128 xyz_only(__m128 v) {
+  return _mm_and_ps(v, _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
 inline __m128 ref_lo(const BvhBuildRef& r) {
-  return _mm_load_ps(&r.lo.x);
+  return xyz_only(_mm_load_ps(&r.lo.x));
 }
 inline __m128 ref_hi(const BvhBuildRef& r) {
-  return _mm_load_ps(&r.hi.x);
+  return xyz_only(_mm_load_ps(&r.hi.x));
 }
 
 /// A box in SSE registers (lane 3 unused): the build's inner loops merge with one min and one

@@ -106,7 +106,7 @@ TEST_CASE("bvh: quantised 8-wide boxes contain their children", "[accel][bvh][qu
   // Child boxes of every scale and position, degenerate ones included: each decoded box must
   // contain its child exactly (no ray that meets a child may miss its decoded box).
   Rng rng;
-  const float scales[] = {1e-30f, 1e-6f, 1.0f, 3e4f, 1e30f};
+  const float scales[] = {1e-42f, 1e-36f, 1e-30f, 1e-6f, 1.0f, 3e4f, 1e30f};  // subnormal extents too
   const float offsets[] = {0.0f, -1.0f, 1e7f, -3e20f, 1e36f};
   for (float scale : scales)
     for (float offset : offsets)
