@@ -20,13 +20,24 @@
 using namespace penumbra;
 using namespace penumbra::test;
 
+namespace {
+/// The quadrant texture and a material of base colour (0.5, 1, 1) x that texture on a unit quad.
+struct QuadrantQuad {
+  int tex, mat;
+};
+QuadrantQuad add_quadrant_quad(Scene& s, float metallic, float roughness) {
+  const int tex = add_quadrant_texture(s);
+  const int mat = add_material(s, {0.5f, 1, 1}, metallic, roughness);
+  s.materials[size_t(mat)].base_color_tex.texture = tex;
+  add_uv_quad(s, 0, mat);
+  return {tex, mat};
+}
+}  // namespace
+
 TEST_CASE("material: base colour = factor x texel; KHR_texture_transform and TEXCOORD_1 pick texels",
           "[material][quick]") {
   Probe p;
-  const int tex = add_quadrant_texture(p.scene);
-  const int mat = add_material(p.scene, {0.5f, 1, 1}, 0, 1);
-  p.scene.materials[size_t(mat)].base_color_tex.texture = tex;
-  add_uv_quad(p.scene, 0, mat);
+  const auto [tex, mat] = add_quadrant_quad(p.scene, 0, 1);
   p.build();
   MaterialPoint m = p.at(-0.5f, 0.5f);  // top-left of the quad = top-left texel (red)
   CHECK(m.base_color.x == Approx(0.5).margin(kEps));
@@ -175,12 +186,9 @@ float sine_band(float x, float periods) {
 TEST_CASE("material: a procedural texture multiplies or replaces factor x image texture",
           "[material][procedural][quick]") {
   Probe p;
-  const int tex = add_quadrant_texture(p.scene);
-  const int mat = add_material(p.scene, {0.5f, 1, 1}, 0.8f, 0.6f);
+  const int mat = add_quadrant_quad(p.scene, 0.8f, 0.6f).mat;
   Material& m = p.scene.materials[size_t(mat)];
-  m.base_color_tex.texture = tex;
   m.emissive = {1, 0.5f, 0.25f};
-  add_uv_quad(p.scene, 0, mat);
   // A one-stop ramp and flat ranges: every output is a constant whatever the pattern gives.
   ProceduralTexture t = gray_ramp(PatternKind::Noise, ProceduralSpace::World, 3);
   t.base_color.stops = {{0.5f, {0.2f, 0.4f, 0.8f}}};
@@ -375,14 +383,11 @@ TEST_CASE(
   for (const bool textured : {false, true}) {
     for (const AlphaMode mode : {AlphaMode::Opaque, AlphaMode::Mask, AlphaMode::Blend}) {
       Probe p;
-      const int tex = add_quadrant_texture(p.scene);
-      const int mat = add_material(p.scene, {0.5f, 1, 1}, 0, 1);
-      Material& m = p.scene.materials[size_t(mat)];
-      m.base_color_tex.texture = tex;
+      const QuadrantQuad q = add_quadrant_quad(p.scene, 0, 1);
+      Material& m = p.scene.materials[size_t(q.mat)];
       m.emissive = {2, 1, 0.5f};
-      if (textured) m.emissive_tex.texture = tex;
+      if (textured) m.emissive_tex.texture = q.tex;
       m.alpha_mode = mode;
-      add_uv_quad(p.scene, 0, mat);
       p.build();
       for (int k = 0; k < 4; ++k) {
         Ray r;
