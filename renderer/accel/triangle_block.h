@@ -13,7 +13,9 @@
 #include <emmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <vector>
 
 #include "renderer/accel/common.h"
 #include "renderer/accel/triangle.h"
@@ -39,11 +41,13 @@ inline int triangle_lanes(const TriangleBlock4& b) {
   return ~_mm_movemask_ps(_mm_castsi128_ps(id)) & 0xf;  // kShapeBit is the sign bit
 }
 
-/// Lanes holding shapes.
+/// Lanes holding shapes: a sign bit (kShapeBit) that is not an empty lane's.
 inline int shape_lanes(const TriangleBlock4& b) {
-  int m = 0;
-  for (int l = 0; l < 4; ++l) m |= int((b.id[l] & kShapeBit) != 0 && b.id[l] != kEmptyLane) << l;
-  return m;
+  const __m128i id = _mm_load_si128(reinterpret_cast<const __m128i*>(b.id));
+  const int flagged = _mm_movemask_ps(_mm_castsi128_ps(id));
+  if (flagged == 0) return 0;
+  const __m128i empty = _mm_cmpeq_epi32(id, _mm_set1_epi32(int(kEmptyLane)));
+  return flagged & ~_mm_movemask_ps(_mm_castsi128_ps(empty));
 }
 
 /// Maps a block lane's id back to the ids a Hit reports: the view (geom_id) and the triangle
@@ -67,12 +71,9 @@ struct PrimitiveIds {
       r.prim_id = id;
       return r;
     }
-    // The last view whose first triangle is <= id (views without triangles share a start).
-    uint32_t lo = 0, hi = uint32_t(first.size()) - 1;
-    while (hi - lo > 1) {
-      const uint32_t mid = (lo + hi) / 2;
-      (first[mid] <= id ? lo : hi) = mid;
-    }
+    // The last view whose first triangle is <= id (views without triangles share a start and
+    // come before the one holding it).
+    const uint32_t lo = uint32_t(std::upper_bound(first.begin(), first.end(), id) - first.begin()) - 1;
     r.geom_id = lo;
     r.prim_id = id - first[lo];
     return r;
