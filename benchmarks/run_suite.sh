@@ -3,7 +3,7 @@
 # build) and, for the Stanford models, node/npm (benchmarks/fetch_models.sh is called).
 #   benchmarks/run_suite.sh [OUT_DIR]       (default: build/bench-results)
 # Writes, per part, a table (.txt), CSV, JSON and SVG chart, and the cost heat maps, to OUT_DIR.
-# Takes about 15 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
+# Takes about 20 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
 # ../shared/corpus); corpus models are skipped when it is absent.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -38,6 +38,9 @@ for w in 4 2; do
   run "bvh-width$w" "$dragon" "$bunny" gen:atrium --accel embree,bvh --accel-param "bvh.width=$w" \
     --threads 1 --builds 3 --repeats 5
 done
+# 2b. Spatial splits (a quality setting) against the default object splits, same run.
+run bvh-spatial "$dragon" "$bunny" "${corpus_scenes[@]}" gen:atrium gen:stadium scenes/default.gltf --accel embree,bvh \
+  --accel-param bvh.spatial_alpha=1e-5 --threads 1 --builds 3 --repeats 5
 # 3. Where a uniform grid collapses: the teapot in a stadium (the teapot falls into a few cells)
 # and long slivers (every cell along them lists them all); the hierarchical grid's default
 # against its flat form (grid.max_depth=1: tens of thousands of triangle tests per ray, so

@@ -44,6 +44,11 @@ std::vector<AccelParamInfo> accel_param_keys() {
       {"bvh.bin_count", std::to_string(d.bvh.bin_count), "SAH bins per axis, [2, 256]"},
       {"bvh.traversal_cost", num(d.bvh.traversal_cost), "SAH cost of a node visit, > 0"},
       {"bvh.intersection_cost", num(d.bvh.intersection_cost), "SAH cost of a triangle test, > 0"},
+      {"bvh.spatial_alpha", num(d.bvh.spatial_alpha),
+       "spatial splits where object-split children overlap by more than this fraction of the root's area, "
+       "[0, 1] (0: off)"},
+      {"bvh.spatial_budget", num(d.bvh.spatial_budget),
+       "references spatial splits may add, per triangle, [0, 4]"},
       {"kdtree.traversal_cost", num(d.kdtree.traversal_cost), "K_T, > 0"},
       {"kdtree.intersection_cost", num(d.kdtree.intersection_cost), "K_I, > 0"},
       {"kdtree.empty_bonus", num(d.kdtree.empty_bonus), "cost reduction for an empty side, [0, 1)"},
@@ -82,6 +87,10 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.bvh.traversal_cost = parse_value<float>(key, value);
   else if (key == "bvh.intersection_cost")
     c.bvh.intersection_cost = parse_value<float>(key, value);
+  else if (key == "bvh.spatial_alpha")
+    c.bvh.spatial_alpha = parse_value<float>(key, value);
+  else if (key == "bvh.spatial_budget")
+    c.bvh.spatial_budget = parse_value<float>(key, value);
   else if (key == "kdtree.traversal_cost")
     c.kdtree.traversal_cost = parse_value<float>(key, value);
   else if (key == "kdtree.intersection_cost")

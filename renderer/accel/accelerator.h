@@ -110,7 +110,7 @@ inline bool is_valid_query(const Ray& r) {
 /// candidate hit whose t lies in the query's range, the hit as intersect() would report it
 /// (geom_id the view's or, over instances, the instance's index) and `ray` the query's ray. A
 /// rejected candidate does not narrow the search. The same hit may be offered more than once
-/// (structures with duplicated references: kD-tree, grid, Embree's spatial splits), so the
+/// (structures with duplicated references: kD-tree, grid, spatial splits in the BVH and Embree), so the
 /// answer must depend on (ray, hit) alone. `accept` is non-null, thread-safe, and never
 /// allocates, throws or logs; `context` is passed through untouched (it stays the caller's).
 struct HitFilter {

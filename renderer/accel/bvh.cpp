@@ -138,7 +138,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
                                   std::to_string(m_config.max_leaf_size) + ", bin_count " +
                                   std::to_string(m_config.bin_count) + ", traversal_cost " +
                                   format_number(m_config.traversal_cost) + ", intersection_cost " +
-                                  format_number(m_config.intersection_cost),
+                                  format_number(m_config.intersection_cost) + spatial_description(),
                               m_input_triangles, bytes, m_build_seconds);
     const uint64_t interior = m_width == 4 ? m_wide4.nodes.size() : m_wide8.nodes.size();
     s.nodes = m_width == 2 ? m_nodes.size() : interior + m_tally.leaves;
@@ -147,6 +147,13 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   }
 
  private:
+  /// The spatial-split settings and the references they made, when they are on.
+  std::string spatial_description() const {
+    if (!(m_config.spatial_alpha > 0)) return "";
+    return ", spatial_alpha " + format_number(m_config.spatial_alpha) + ", spatial_budget " +
+           format_number(m_config.spatial_budget) + " (" + std::to_string(m_references) + " references)";
+  }
+
   void build(std::vector<PrimitiveRecord> tris) {
     std::vector<BvhBuildRef> refs(tris.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 1 << 14),
@@ -154,20 +161,27 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
                         for (size_t i = rg.begin(); i < rg.end(); ++i)
                           refs[i] = {primitive_bounds(tris[i]), uint32_t(i)};
                       });
-    auto root = build_bvh_tree(refs, m_config, m_width == 2 ? 1 : 4);
+    const ReferenceClipper clip = [&](const BvhBuildRef& ref, int axis, float pos, Bounds3f& l, Bounds3f& r) {
+      const PrimitiveRecord& t = tris[ref.index];
+      if (is_shape(t)) return split_box_bounds(ref.box(), axis, pos, l, r);
+      const Vec3f v[3] = {t.a, t.b, t.c};
+      split_triangle_bounds(v, ref.box(), axis, pos, l, r);
+    };
+    auto root = build_bvh_tree(refs, m_config, m_width == 2 ? 1 : 4, &clip);
+    m_references = refs.size();
     m_bounds = root->box;
     m_sah_root_area = surface_area(root->box);
     // Leaf ranges index `refs`, whose order is the leaves' order.
     if (m_width == 2) {
-      m_tris.resize(tris.size());
+      m_tris.resize(refs.size());
       for (size_t i = 0; i < refs.size(); ++i) m_tris[i] = tris[refs[i].index];
       flatten_bvh(*root, m_nodes);
       compute_stats(*root, 0);
     } else if (m_width == 4) {
-      m_wide4.blocks.reserve(tris.size() / 4 + tris.size() / 8);
+      m_wide4.blocks.reserve(refs.size() / 4 + refs.size() / 8);
       collapse(m_wide4, tris, refs, *root, 0);
     } else {
-      m_wide8.blocks.reserve(tris.size() / 4 + tris.size() / 8);
+      m_wide8.blocks.reserve(refs.size() / 4 + refs.size() / 8);
       collapse(m_wide8, tris, refs, *root, 0);
     }
     m_tally.fill(m_stats);
@@ -310,6 +324,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   PrimitiveIds m_ids;                   // widths 4 and 8: block lane ids to hit ids
   Bounds3f m_bounds;                    // exact bounds of the primitives
   uint64_t m_input_triangles = 0;
+  uint64_t m_references = 0;  // leaf entries: the primitives plus the spatial splits' duplicates
   double m_sah_root_area = 0;
   LeafTally m_tally;
   AccelStats m_stats;
@@ -329,6 +344,12 @@ void validate(const BvhConfig& c) {
                                 std::to_string(c.width));
   if (!(c.traversal_cost > 0) || !(c.intersection_cost > 0))
     throw std::invalid_argument("bvh: traversal_cost and intersection_cost must be > 0");
+  if (!(c.spatial_alpha >= 0 && c.spatial_alpha <= 1))
+    throw std::invalid_argument("bvh: spatial_alpha must be in [0, 1], got " +
+                                format_number(c.spatial_alpha));
+  if (!(c.spatial_budget >= 0 && c.spatial_budget <= 4))
+    throw std::invalid_argument("bvh: spatial_budget must be in [0, 4], got " +
+                                format_number(c.spatial_budget));
 }
 
 std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const GeometryView> meshes,

@@ -24,6 +24,12 @@ struct BvhConfig {
   float intersection_cost = 1.0f;    ///< > 0: cost of one triangle test
   size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks
   int width = 0;  ///< 0 (8 if the CPU has AVX2, else 4), 2 (binary), 4 (SSE) or 8 (AVX2; refused without it)
+  /// [0, 1]: spatial splits (Stich et al. 2009) are tried at nodes whose object split leaves
+  /// children overlapping by more than this fraction of the root's surface area; 0 turns them
+  /// off (Stich et al. use 1e-5).
+  float spatial_alpha = 0.0f;
+  /// [0, 4]: references that spatial splits may add, as a fraction of the primitive count.
+  float spatial_budget = 1.0f;
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.

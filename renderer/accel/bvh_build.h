@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -52,12 +53,29 @@ static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
 /// median splits halve the rest), so fixed traversal stacks of this size never overflow.
 inline constexpr int kBvhStackSize = 128;
 
+/// Cuts reference `ref` at the plane x[axis] = pos: `left` and `right` bound the parts of its
+/// primitive within ref's box on either side (either may be empty). Used by spatial splits.
+using ReferenceClipper =
+    std::function<void(const BvhBuildRef& ref, int axis, float pos, Bounds3f& left, Bounds3f& right)>;
+
 /// Builds the tree over `refs` (non-empty; config validated), reordering them so every leaf is
 /// a contiguous range. The SAH charges a leaf's intersection cost per block of `block`
 /// primitives (4 for the wide layouts, whose leaves hold blocks of four; Embree does the same),
-/// and config.width is not read. The shape never depends on thread scheduling.
+/// and config.width is not read. With a clipper and config.spatial_alpha > 0 it also makes
+/// spatial splits, and `refs` may come back longer: a primitive cut by them appears once per
+/// leaf it reaches (index repeated, each with the box of its part there), at most
+/// spatial_budget times the count more references. The shape never depends on thread
+/// scheduling.
 std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config,
-                                             int block = 1);
+                                             int block = 1, const ReferenceClipper* clip = nullptr);
+
+/// The boxes of the parts of triangle v on either side of x[axis] = pos, within `box`: the
+/// triangle's vertices and edge crossings on each side, intersected with `box`.
+void split_triangle_bounds(const Vec3f v[3], const Bounds3f& box, int axis, float pos, Bounds3f& left,
+                           Bounds3f& right);
+
+/// `box` cut at x[axis] = pos (the clipper of primitives known only by their box).
+void split_box_bounds(const Bounds3f& box, int axis, float pos, Bounds3f& left, Bounds3f& right);
 
 /// Appends `b`'s subtree to `nodes` depth first, boxes widened by widen_for_rounding(); returns
 /// the index of `b`'s node.

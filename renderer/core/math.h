@@ -113,6 +113,10 @@ inline Bounds3f merge(Bounds3f b, Vec3f p) {
 inline Bounds3f merge(Bounds3f a, Bounds3f b) {
   return {min(a.lo, b.lo), max(a.hi, b.hi)};
 }
+/// The common part of two boxes; empty() if they do not overlap.
+inline Bounds3f intersect(Bounds3f a, Bounds3f b) {
+  return {max(a.lo, b.lo), min(a.hi, b.hi)};
+}
 
 /// Unit quaternion (x, y, z, w) in glTF order.
 struct Quat {

@@ -10,10 +10,10 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   AccelConfig c;
   for (const char* kv :
        {"embree.robust=0", "embree.quality=2", "bvh.width=2", "bvh.max_leaf_size=3", "bvh.bin_count=32",
-        "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5", "kdtree.traversal_cost=1",
-        "kdtree.intersection_cost=80", "kdtree.empty_bonus=0.5", "kdtree.max_depth=30", "grid.lambda=8",
-        "grid.max_resolution=64", "grid.max_cells=4096", "grid.coarse_lambda=0.5", "grid.max_depth=1",
-        "grid.split_threshold=40"})
+        "bvh.traversal_cost=2.5", "bvh.intersection_cost=0.5", "bvh.spatial_alpha=1e-4",
+        "bvh.spatial_budget=0.5", "kdtree.traversal_cost=1", "kdtree.intersection_cost=80",
+        "kdtree.empty_bonus=0.5", "kdtree.max_depth=30", "grid.lambda=8", "grid.max_resolution=64",
+        "grid.max_cells=4096", "grid.coarse_lambda=0.5", "grid.max_depth=1", "grid.split_threshold=40"})
     apply_accel_param(c, kv);
   CHECK_FALSE(c.embree.robust);
   CHECK(c.embree.quality == 2);
@@ -22,6 +22,8 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.bvh.bin_count == 32);
   CHECK(c.bvh.traversal_cost == 2.5f);
   CHECK(c.bvh.intersection_cost == 0.5f);
+  CHECK(c.bvh.spatial_alpha == 1e-4f);
+  CHECK(c.bvh.spatial_budget == 0.5f);
   CHECK(c.kdtree.traversal_cost == 1);
   CHECK(c.kdtree.intersection_cost == 80);
   CHECK(c.kdtree.empty_bonus == 0.5f);
@@ -32,7 +34,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.grid.coarse_lambda == 0.5f);
   CHECK(c.grid.max_depth == 1);
   CHECK(c.grid.split_threshold == 40);
-  CHECK(accel_param_keys().size() == 17);
+  CHECK(accel_param_keys().size() == 19);
 }
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {

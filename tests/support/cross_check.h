@@ -29,7 +29,8 @@ struct NamedAccel {
   std::unique_ptr<Accelerator> accel;
 };
 
-/// Every back end over `views`, the BVH in each width, in accelerator_names() order ("brute"
+/// Every back end over `views`, the BVH in each width and with spatial splits, in
+/// accelerator_names() order ("brute"
 /// keeps references: views must outlive the result).
 inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views,
                                          const AccelConfig& config = {}) {
@@ -43,6 +44,10 @@ inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views,
       c.bvh.width = width;
       out.push_back({"bvh/width=" + std::to_string(width), make_accelerator("bvh", views, c)});
     }
+    // Spatial splits: primitives referenced from several leaves.
+    AccelConfig c = config;
+    c.bvh.spatial_alpha = 1e-5f;
+    out.push_back({"bvh/spatial", make_accelerator("bvh", views, c)});
   }
   return out;
 }
