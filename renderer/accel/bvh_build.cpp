@@ -533,10 +533,17 @@ void split_triangle_bounds(const Vec3f v[3], const Bounds3f& box, int axis, floa
     if (a[axis] <= pos) left = merge(left, a);
     if (a[axis] >= pos) right = merge(right, a);
     if ((a[axis] < pos && b[axis] > pos) || (a[axis] > pos && b[axis] < pos)) {
+      // The crossing, padded on the other axes by a bound on its rounding error (a few ulps of
+      // the vertices' magnitude): the boxes must contain the exact crossing, and a big
+      // triangle's error can exceed the margin traversal adds to a small node's box.
       Vec3f p = a + (b - a) * ((pos - a[axis]) / (b[axis] - a[axis]));
       p[axis] = pos;
-      left = merge(left, p);
-      right = merge(right, p);
+      Vec3f e = (abs(a) + abs(b)) * 0x1p-20f;
+      e[axis] = 0;
+      for (const Vec3f q : {p - e, p + e}) {
+        left = merge(left, q);
+        right = merge(right, q);
+      }
     }
   }
   left = intersect(left, box);

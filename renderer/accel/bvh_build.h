@@ -70,7 +70,8 @@ std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, con
                                              int block = 1, const ReferenceClipper* clip = nullptr);
 
 /// The boxes of the parts of triangle v on either side of x[axis] = pos, within `box`: the
-/// triangle's vertices and edge crossings on each side, intersected with `box`.
+/// triangle's vertices and edge crossings on each side (crossings padded by their rounding
+/// error), intersected with `box`.
 void split_triangle_bounds(const Vec3f v[3], const Bounds3f& box, int axis, float pos, Bounds3f& left,
                            Bounds3f& right);
 
