@@ -421,11 +421,14 @@ class SpatialBuilder {
     tag(*b.child[1], chunk);
   }
 
+  /// Slabs per axis of the spatial binning: the configured bins, at most 64.
+  int spatial_bins() const { return std::min(m_config.bin_count, 64); }
+
   /// Bins the references spatially along each axis, cutting each at the slab planes it
   /// crosses, and sweeps for the cheapest plane that duplicates at most `budget` references.
   SpatialSplit best_spatial_split(const std::vector<BvhBuildRef>& refs, const Bounds3f& box,
                                   uint32_t budget) const {
-    const int nb = std::min(m_config.bin_count, 64);
+    const int nb = spatial_bins();
     const uint32_t n = uint32_t(refs.size());
     SpatialSplit best;
     std::array<Bounds3f, 64> bin_box, right_box;
@@ -478,7 +481,7 @@ class SpatialBuilder {
                            std::vector<BvhBuildRef>& lv, std::vector<BvhBuildRef>& rv, Range& left,
                            Range& right) const {
     const int k = s.axis;
-    const Slabs slabs = make_slabs(box, k, std::min(m_config.bin_count, 64));
+    const Slabs slabs = make_slabs(box, k, spatial_bins());
     const float pos = slabs.plane(s.bin);
     for (const BvhBuildRef& ref : refs) {
       if (slabs.bin(ref.hi[k]) <= s.bin) {
