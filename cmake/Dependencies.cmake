@@ -7,6 +7,7 @@ find_package(TinyGLTF CONFIG REQUIRED)            # TinyGLTF::TinyGLTF (shared l
 find_package(nlohmann_json 3 CONFIG REQUIRED)     # nlohmann_json::nlohmann_json
 find_package(CLI11 CONFIG REQUIRED)               # CLI11::CLI11
 find_package(OpenImageIO CONFIG REQUIRED)         # OpenImageIO::OpenImageIO
+find_package(meshoptimizer CONFIG REQUIRED)       # meshoptimizer::meshoptimizer
 
 # Debian's OpenImageIO target lists /usr/include/opencv4, which does not exist without OpenCV.
 foreach(_oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)
@@ -23,6 +24,13 @@ endforeach()
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
 add_library(Penumbra::OpenColorIO ALIAS PkgConfig::OCIO)
+# Draco, linked statically: Debian's libdraco.so exports its own copy of tinygltf, whose
+# symbols would interpose on libtinygltf's; the decoder objects of libdraco.a use none of it.
+find_path(DRACO_INCLUDE_DIR draco/compression/decode.h REQUIRED)
+find_library(DRACO_STATIC_LIBRARY NAMES libdraco.a REQUIRED)
+add_library(Penumbra::Draco STATIC IMPORTED)
+set_target_properties(Penumbra::Draco PROPERTIES IMPORTED_LOCATION "${DRACO_STATIC_LIBRARY}"
+                      INTERFACE_INCLUDE_DIRECTORIES "${DRACO_INCLUDE_DIR}")
 
 if(PENUMBRA_BUILD_TESTS)
   find_package(Catch2 2 CONFIG REQUIRED)          # Catch2::Catch2 (v2, single header)

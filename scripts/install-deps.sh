@@ -11,6 +11,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libopenexr-dev openexr
   libopencolorio-dev opencolorio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
+  libdraco-dev draco libmeshoptimizer-dev gltfpack
   catch2 libcli11-dev libbenchmark-dev
   python3 clang-format
   blender python3-numpy

@@ -10,6 +10,7 @@
 
 #include "io/gltf/accessors.h"
 #include "io/gltf/animation.h"
+#include "io/gltf/compression.h"
 #include "io/gltf/context.h"
 #include "io/gltf/images.h"
 #include "io/gltf/materials.h"
@@ -24,6 +25,7 @@ namespace penumbra {
 std::vector<std::string> supported_gltf_extensions() {
   std::vector<std::string> out = {"KHR_lights_punctual"};
   for (auto& e : gltf::material_extensions()) out.push_back(std::move(e));
+  for (auto& e : gltf::compression_extensions()) out.push_back(std::move(e));
   out.push_back("EXT_mesh_gpu_instancing");
   out.push_back(gltf::kShapesExtension);
   out.push_back(gltf::kProceduralExtension);
@@ -137,6 +139,7 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
   gltf::parse_gltf(file, options, budget, out, model, vendor);
   std::shared_ptr<GltfAnimation> animation;
   try {
+    gltf::decompress_model(model, name, budget);
     animation = gltf::convert(gltf::GltfContext{model, name, options, budget, out}, vendor);
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while converting the scene");

@@ -5,6 +5,7 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -14,6 +15,20 @@
 namespace penumbra::gltf {
 
 namespace {
+
+// KHR_mesh_quantization's component types: any integer type, normalized or not (positions,
+// texture coordinates), or signed normalized integers (normals, tangents).
+constexpr std::initializer_list<int> kQuantizedAny = {
+    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+    TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
+constexpr std::initializer_list<int> kQuantizedDirection = {
+    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT};
+
+// True if the file declares KHR_mesh_quantization (then attributes may be integers).
+bool uses_quantization(const GltfContext& ctx) {
+  const auto& used = ctx.model.extensionsUsed;
+  return std::find(used.begin(), used.end(), "KHR_mesh_quantization") != used.end();
+}
 
 float finite_or_zero(double v) {
   return std::isfinite(v) ? float(v) : 0.0f;
@@ -59,9 +74,12 @@ std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Prim
 // anything is dropped, so a malformed one is an error even on a primitive that is skipped.
 void read_vertex_attributes(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where,
                             size_t nv, RawAttributes& raw) {
+  const bool quantized = uses_quantization(ctx);
   if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-    raw.nrm = read_accessor(ctx, it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
-                            {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    raw.nrm = quantized ? read_accessor(ctx, it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
+                                        kQuantizedDirection, true)
+                        : read_accessor(ctx, it->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
+                                        {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
     if (raw.nrm.size() != raw.pos.size())
       ctx.fail(where + ".attributes.NORMAL", "count differs from POSITION count");
   }
@@ -69,15 +87,19 @@ void read_vertex_attributes(const GltfContext& ctx, const tinygltf::Primitive& p
     auto it = prim.attributes.find(name);
     if (it == prim.attributes.end()) continue;
     auto& dst = name[9] == '0' ? raw.uv : raw.uv1;
-    dst = read_accessor(ctx, it->second, where + ".attributes." + name, {TINYGLTF_TYPE_VEC2},
-                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-                        true);
+    dst = quantized ? read_accessor(ctx, it->second, where + ".attributes." + name, {TINYGLTF_TYPE_VEC2},
+                                    kQuantizedAny, true, true)
+                    : read_accessor(ctx, it->second, where + ".attributes." + name, {TINYGLTF_TYPE_VEC2},
+                                    {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                                    true);
     if (dst.size() / 2 != nv) ctx.fail(where + ".attributes." + name, "count differs from POSITION count");
   }
   if (auto it = prim.attributes.find("TANGENT"); it != prim.attributes.end()) {
-    raw.tan = read_accessor(ctx, it->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4},
-                            {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    raw.tan = quantized ? read_accessor(ctx, it->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4},
+                                        kQuantizedDirection, true)
+                        : read_accessor(ctx, it->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4},
+                                        {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
     if (raw.tan.size() / 4 != nv)
       ctx.fail(where + ".attributes.TANGENT", "count differs from POSITION count");
   }
@@ -129,7 +151,8 @@ void read_morph_targets(const GltfContext& ctx, const tinygltf::Primitive& prim,
       if (name != "POSITION" && name != "NORMAL") continue;
       const auto d = read_accessor(
           ctx, accessor, tw + "." + name, {TINYGLTF_TYPE_VEC3},
-          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true);
+          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, true,
+          uses_quantization(ctx) && name == "POSITION");
       if (d.size() != nv * 3) ctx.fail(tw + "." + name, "count differs from POSITION count");
       auto& dst = name == "POSITION" ? dp : dn;
       dst.resize(nv);
@@ -222,8 +245,11 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
     return out;
   }
   RawAttributes raw;
-  raw.pos = read_accessor(ctx, pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
-                          {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+  raw.pos = uses_quantization(ctx)
+                ? read_accessor(ctx, pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                                kQuantizedAny, true, true)
+                : read_accessor(ctx, pos_it->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                                {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
   const size_t nv = raw.pos.size() / 3;
   if (nv >= 0xffffffffu) ctx.fail(where, "too many vertices");
   out.indices = triangle_list(ctx, prim, where, nv);

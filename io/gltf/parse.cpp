@@ -179,6 +179,77 @@ std::string one_line(std::string s) {
   return s;
 }
 
+// Two compression layouts tinygltf refuses, made acceptable before it parses the JSON:
+// - a primitive whose indices accessor has no bufferView, which is how KHR_draco_mesh_compression
+//   primitives declare their decoded indices: such accessors are given the primitive's Draco
+//   bufferView (decompress_model() then points them at the decoded indices);
+// - a buffer without a uri other than a GLB's first, which is how EXT_/KHR_meshopt_compression
+//   declare the fallback buffer that decoding fills: such buffers become 4 zero bytes
+//   (decompress_model() gives every compressed bufferView a buffer of its own).
+// Returns the rewritten JSON, or an empty string when nothing needs it.
+std::string prepare_compressed(std::string_view json) {
+  if (json.find("KHR_draco_mesh_compression") == std::string_view::npos &&
+      json.find("meshopt_compression") == std::string_view::npos)
+    return {};
+  nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+  if (doc.is_discarded() || !doc.contains("meshes") || !doc["meshes"].is_array() ||
+      !doc.contains("accessors") || !doc["accessors"].is_array())
+    return {};
+  auto& accessors = doc["accessors"];
+  bool changed = false;
+  if (doc.contains("buffers") && doc["buffers"].is_array()) {
+    for (auto& b : doc["buffers"]) {
+      if (!b.is_object() || b.contains("uri") || !b.contains("extensions") || !b["extensions"].is_object())
+        continue;
+      const auto& x = b["extensions"];
+      const auto fallback = [&](const char* name) {
+        return x.contains(name) && x[name].is_object() && x[name].value("fallback", false) == true;
+      };
+      if (!fallback("EXT_meshopt_compression") && !fallback("KHR_meshopt_compression")) continue;
+      b["uri"] = "data:application/octet-stream;base64,AAAAAA==";
+      b["byteLength"] = 4;
+      changed = true;
+    }
+  }
+  for (auto& mesh : doc["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (auto& prim : mesh["primitives"]) {
+      if (!prim.is_object() || !prim.contains("indices") || !prim["indices"].is_number_unsigned()) continue;
+      const auto ext = prim.find("extensions");
+      if (ext == prim.end() || !ext->is_object() || !ext->contains("KHR_draco_mesh_compression")) continue;
+      const auto& draco = (*ext)["KHR_draco_mesh_compression"];
+      if (!draco.is_object() || !draco.contains("bufferView") || !draco["bufferView"].is_number_unsigned())
+        continue;
+      const size_t a = prim["indices"].get<size_t>();
+      if (a >= accessors.size() || !accessors[a].is_object() || accessors[a].contains("bufferView")) continue;
+      accessors[a]["bufferView"] = draco["bufferView"];
+      changed = true;
+    }
+  }
+  return changed ? doc.dump() : std::string();
+}
+
+// `bytes` with its JSON (the whole file, or a GLB's JSON chunk of `glb_json_length` bytes)
+// replaced by `json`; a GLB keeps its BIN chunk and drops what follows kept_length.
+std::vector<unsigned char> replace_json(const std::vector<unsigned char>& bytes, bool is_glb,
+                                        uint64_t kept_length, std::string json) {
+  if (!is_glb) return {json.begin(), json.end()};
+  while (json.size() % 4) json.push_back(' ');
+  uint32_t old_json = 0;
+  std::memcpy(&old_json, bytes.data() + 12, 4);
+  const size_t rest = size_t(20 + uint64_t(old_json)), end = size_t(kept_length);
+  std::vector<unsigned char> out(12 + 8 + json.size() + (end > rest ? end - rest : 0));
+  const uint32_t version = 2, total = uint32_t(out.size()), length = uint32_t(json.size());
+  std::memcpy(out.data(), "glTF", 4);
+  std::memcpy(out.data() + 4, &version, 4);
+  std::memcpy(out.data() + 8, &total, 4);
+  std::memcpy(out.data() + 12, &length, 4);
+  std::memcpy(out.data() + 16, "JSON", 4);
+  std::memcpy(out.data() + 20, json.data(), json.size());
+  if (end > rest) std::memcpy(out.data() + 20 + json.size(), bytes.data() + rest, end - rest);
+  return out;
+}
+
 }  // namespace
 
 void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudget& budget, LoadedScene& out,
@@ -215,6 +286,14 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   box.read_sha256 = &out.info.source_sha256;
   check_document(json, name, root, options, box, budget, out.warnings, vendor);
 
+  const uint64_t json_bytes = json.size();
+  if (std::string patched = prepare_compressed(json); !patched.empty()) {
+    budget.charge(patched.size(), "JSON", "the JSON prepared for decompression needs");
+    bytes = replace_json(bytes, is_glb, parse_bytes, std::move(patched));
+    parse_bytes = bytes.size();
+    json = {};  // pointed into the old bytes
+  }
+
   tinygltf::TinyGLTF parser;
   install_sandbox(parser, box);
   keep_encoded_images(parser);
@@ -231,7 +310,7 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   } catch (const std::exception& e) {
     throw InputError(name, "", std::string("parse error: ") + e.what());
   }
-  budget.release(uint64_t(json.size()) * kJsonDomBytesPerByte);  // tinygltf's DOM is gone
+  budget.release(json_bytes * kJsonDomBytesPerByte);  // tinygltf's DOM is gone
   if (!ok) throw InputError(name, "", terr.empty() ? "tinygltf could not parse the file" : one_line(terr));
   if (!twarn.empty()) out.warnings.push_back("tinygltf: " + one_line(twarn));
 }
