@@ -79,6 +79,21 @@ void print_shapes(const Scene& s, const GltfInfo& i) {
   }
 }
 
+// Each used extension as supported, partially supported (with what is missing) or not supported.
+void print_extension_support(const std::vector<std::string>& used) {
+  const std::vector<std::string> supported = supported_gltf_extensions();
+  const auto partial = partial_gltf_extensions();
+  for (const auto& e : used) {
+    const auto p = std::find_if(partial.begin(), partial.end(), [&](const auto& x) { return x.first == e; });
+    if (p != partial.end())
+      std::printf("  %-40s partially supported: %s\n", e.c_str(), p->second.c_str());
+    else if (std::find(supported.begin(), supported.end(), e) != supported.end())
+      std::printf("  %-40s supported\n", e.c_str());
+    else
+      std::printf("  %-40s not supported (ignored)\n", e.c_str());
+  }
+}
+
 }  // namespace
 
 int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
@@ -134,6 +149,8 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
   };
   std::printf("extensions   used: %s; required: %s\n", join(i.extensions_used).c_str(),
               join(i.extensions_required).c_str());
+  print_extension_support(i.extensions_used);
+  if (!i.variants.empty()) std::printf("variants     %s (--variant NAME)\n", join(i.variants).c_str());
   const Bounds3f b = compute_bounds(s);
   if (!b.empty())
     std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,

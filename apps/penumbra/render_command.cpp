@@ -122,7 +122,7 @@ void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
     job.loaded = std::move(kept->loaded);
   else
     job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
-                            job.request.time, keep);
+                            job.request.time, keep, a.variant);
   job.load_s = posed_s + seconds_since(t0);
   // No output may replace a buffer or image the scene was loaded from.
   std::vector<std::pair<std::string, fs::path>> inputs;

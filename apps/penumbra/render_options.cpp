@@ -252,6 +252,9 @@ void add_scene_options(CLI::App& render, RenderArgs& args) {
       ->check(CLI::Range(0, 1024));
   render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")
       ->check(CLI::Range(0, 1 << 30));
+  render.add_option("--variant", args.variant,
+                    "KHR_materials_variants variant to render (names: `penumbra info`; default: the "
+                    "primitives' own materials)");
   render.add_option("--camera", args.camera,
                     "camera instance: index as listed by `penumbra info`, or name (default 0; none in the "
                     "file: frame the bounds)");

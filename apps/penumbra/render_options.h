@@ -25,6 +25,7 @@ struct RenderArgs {
   bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
   int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
   std::string camera;      ///< index or name; empty = the first camera, or framing
+  std::string variant;     ///< KHR_materials_variants name; empty = the primitives' own materials
   std::string seed = "0";  ///< parsed as an unsigned 64-bit integer
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";

@@ -12,8 +12,10 @@
 namespace penumbra::cli {
 
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
-                       uint64_t max_memory, bool quiet, std::optional<double> time, bool keep_animation) {
+                       uint64_t max_memory, bool quiet, std::optional<double> time, bool keep_animation,
+                       const std::string& variant) {
   GltfLoadOptions opt;
+  opt.variant = variant;
   opt.time = time;
   opt.keep_animation = keep_animation;
   opt.flatten = flatten;

@@ -12,12 +12,13 @@
 
 namespace penumbra::cli {
 
-/// Loads `file` with the loader's options (`keep_animation`: GltfLoadOptions::keep_animation);
+/// Loads `file` with the loader's options (`keep_animation`: GltfLoadOptions::keep_animation,
+/// `variant`: GltfLoadOptions::variant);
 /// unless `quiet`, prints up to 20 warnings on stderr (and how many more there were). Throws
 /// what load_gltf throws.
 LoadedScene load_scene(const std::string& file, int scene, bool allow_external, bool flatten,
                        uint64_t max_memory, bool quiet, std::optional<double> time = {},
-                       bool keep_animation = false);
+                       bool keep_animation = false, const std::string& variant = {});
 
 /// The camera instance `spec` names: an index as `penumbra info` lists them, or a camera name.
 /// Throws InputError listing the cameras if there is no such camera or the name is ambiguous.

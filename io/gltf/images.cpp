@@ -35,6 +35,10 @@ std::span<const unsigned char> encoded_bytes(const GltfContext& ctx, const tinyg
 std::string sniff_format(std::span<const unsigned char> data) {
   if (data.size() >= 8 && std::memcmp(data.data(), "\x89PNG\r\n\x1a\n", 8) == 0) return "png";
   if (data.size() >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) return "jpg";
+  if (data.size() >= 12 && std::memcmp(data.data(), "RIFF", 4) == 0 &&
+      std::memcmp(data.data() + 8, "WEBP", 4) == 0)
+    return "webp";
+  if (data.size() >= 12 && std::memcmp(data.data(), "\xABKTX 20\xBB\r\n\x1A\n", 12) == 0) return "ktx2";
   return "";
 }
 
@@ -162,19 +166,26 @@ const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, i
     return out;
   }
   const std::string ext = sniff_format(data);
+  if (ext == "ktx2") {
+    ctx.warn(where,
+             "a KTX2 image (KHR_texture_basisu), which this build cannot decode (Debian 12 ships no KTX2 "
+             "decoder) and which has no fallback source; textures using it (" +
+                 user + ") are ignored, the material's factors apply");
+    return out;
+  }
   if (ext.empty()) {
-    ctx.warn(where, "not a PNG or JPEG image; textures using it (" + user + ") are ignored");
+    ctx.warn(where, "not a PNG, JPEG or WebP image; textures using it (" + user + ") are ignored");
     return out;
   }
   decode_into(ctx, data, ext, where, out);
   return out;
 }
 
-int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb,
+int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, int image, bool srgb,
                   const std::string& where) {
   if (auto it = cache.textures.find({texture, srgb}); it != cache.textures.end()) return it->second;
   const auto& t = ctx.model.textures[size_t(texture)];
-  const DecodedImage& img = decoded_image(ctx, cache, t.source, where);
+  const DecodedImage& img = decoded_image(ctx, cache, image, where);
   if (!img.ok) {
     cache.textures[{texture, srgb}] = -1;
     return -1;
@@ -186,17 +197,46 @@ int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool
   if (srgb)
     for (size_t i = 0; i < rgba.size(); i += 4)
       for (size_t c = 0; c < 3; ++c) rgba[i + c] = srgb_to_linear(std::clamp(rgba[i + c], 0.0f, 1.0f));
-  const auto& image = ctx.model.images[size_t(t.source)];
+  const auto& source = ctx.model.images[size_t(image)];
   ctx.charge(texture_bytes_for(img.width, img.height), where, "its MIP-mapped texture needs");
   const int index = int(ctx.out.scene.textures.size());
-  ctx.out.scene.textures.push_back(make_texture(
-      idx("textures", size_t(texture)) + " (" + idx("images", size_t(t.source)) +
-          (image.name.empty() ? (image.uri.empty() ? "" : " '" + image.uri + "'") : " '" + image.name + "'") +
-          ")",
-      img.width, img.height, rgba, smp));
+  ctx.out.scene.textures.push_back(
+      make_texture(idx("textures", size_t(texture)) + " (" + idx("images", size_t(image)) +
+                       (source.name.empty() ? (source.uri.empty() ? "" : " '" + source.uri + "'")
+                                            : " '" + source.name + "'") +
+                       ")",
+                   img.width, img.height, rgba, smp));
   ctx.budget.release(copy_bytes);  // rgba is freed on return
   cache.textures[{texture, srgb}] = index;
   return index;
+}
+
+int texture_image(const GltfContext& ctx, int texture) {
+  const auto& t = ctx.model.textures[size_t(texture)];
+  const std::string where = idx("textures", size_t(texture));
+  const int images = int(ctx.model.images.size());
+  auto extension_source = [&](const char* name) {
+    const auto it = t.extensions.find(name);
+    if (it == t.extensions.end()) return -2;  // absent
+    const auto& s = it->second.Get("source");
+    if (!s.IsInt() || s.GetNumberAsInt() < 0 || s.GetNumberAsInt() >= images) {
+      ctx.warn(where + ".extensions." + name + ".source", "image index out of range (" +
+                                                              std::to_string(images) +
+                                                              " images); the texture's own source is used");
+      return -1;
+    }
+    return s.GetNumberAsInt();
+  };
+  if (const int webp = extension_source("EXT_texture_webp"); webp >= 0) return webp;
+  const bool basisu = extension_source("KHR_texture_basisu") != -2;
+  if (t.source >= 0 && t.source < images) return t.source;
+  if (basisu)
+    ctx.warn(where,
+             "KHR_texture_basisu image without a fallback source: this build cannot decode KTX2 (Debian 12 "
+             "ships no decoder); the material's factors apply");
+  else if (t.source < 0)
+    ctx.warn(where, "has no image source; ignored");
+  return -1;
 }
 
 void validate_textures(const GltfContext& ctx) {

@@ -42,10 +42,17 @@ struct TextureCache {
 const DecodedImage& decoded_image(const GltfContext& ctx, TextureCache& cache, int image,
                                   const std::string& user);
 
-/// The Scene::textures index of textures[texture] with its sampler, sRGB-decoded if `srgb`, made
-/// on first use; -1 if its image is unusable. `texture` and its source are valid indices.
-int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, bool srgb,
+/// The Scene::textures index of textures[texture] made from images[image] (its source, or an
+/// extension's: texture_image()) with its sampler, sRGB-decoded if `srgb`, made on first use; -1
+/// if the image is unusable. `texture` and `image` are valid indices.
+int scene_texture(const GltfContext& ctx, TextureCache& cache, int texture, int image, bool srgb,
                   const std::string& where);
+
+/// The image textures[texture] reads: EXT_texture_webp's source when present (OpenImageIO
+/// decodes WebP), else the core source; under KHR_texture_basisu the core source is the
+/// fallback (KTX2 is not decoded), and without one a warning names the texture. -1 (with a
+/// warning) if there is none usable; `texture` is a valid index.
+int texture_image(const GltfContext& ctx, int texture);
 
 /// Warns about textures whose source or sampler index is out of range (they are ignored or use
 /// the default sampler).

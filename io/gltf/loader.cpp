@@ -27,9 +27,22 @@ std::vector<std::string> supported_gltf_extensions() {
   for (auto& e : gltf::material_extensions()) out.push_back(std::move(e));
   for (auto& e : gltf::compression_extensions()) out.push_back(std::move(e));
   out.push_back("EXT_mesh_gpu_instancing");
+  out.push_back("KHR_materials_variants");
+  out.push_back("KHR_materials_pbrSpecularGlossiness");
+  out.push_back("EXT_texture_webp");
+  out.push_back("KHR_texture_basisu");
   out.push_back(gltf::kShapesExtension);
   out.push_back(gltf::kProceduralExtension);
   return out;
+}
+
+std::vector<std::pair<std::string, std::string>> partial_gltf_extensions() {
+  return {{"KHR_texture_basisu",
+           "KTX2 images are not decoded (no decoder in Debian 12): the texture's "
+           "fallback source is used, else the material's factors"},
+          {"KHR_materials_pbrSpecularGlossiness",
+           "converted to metallic-roughness from its factors and diffuse texture; the "
+           "specular-glossiness texture is not used"}};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {
@@ -79,6 +92,30 @@ void describe(const tinygltf::Model& model, GltfInfo& info) {
   info.extensions_required = model.extensionsRequired;
 }
 
+// KHR_materials_variants: the variant names, and the index of the one the options ask for.
+void select_variant(const GltfContext& ctx) {
+  GltfInfo& info = ctx.out.info;
+  const std::string where = "extensions.KHR_materials_variants.variants";
+  if (auto it = ctx.model.extensions.find("KHR_materials_variants"); it != ctx.model.extensions.end()) {
+    const auto& variants = it->second.Get("variants");
+    if (!variants.IsArray()) ctx.fail(where, "must be an array");
+    for (size_t i = 0; i < variants.ArrayLen(); ++i) {
+      const auto& name = variants.Get(int(i)).Get("name");
+      if (!name.IsString()) ctx.fail(where + "[" + std::to_string(i) + "].name", "must be a string");
+      info.variants.push_back(name.Get<std::string>());
+    }
+  }
+  if (ctx.options.variant.empty()) return;
+  const auto found = std::find(info.variants.begin(), info.variants.end(), ctx.options.variant);
+  if (found == info.variants.end()) {
+    std::string list;
+    for (const auto& v : info.variants) list += (list.empty() ? "" : ", ") + ("'" + v + "'");
+    ctx.fail(where, "no variant '" + ctx.options.variant + "'; " +
+                        (list.empty() ? std::string("the file defines no variants") : "variants: " + list));
+  }
+  info.variant = int(found - info.variants.begin());
+}
+
 // The asset version and the extensions: a required one outside supported_gltf_extensions() is
 // an error, a used one a warning.
 void check_version_and_extensions(const GltfContext& ctx) {
@@ -101,6 +138,7 @@ void check_version_and_extensions(const GltfContext& ctx) {
 std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions& vendor) {
   describe(ctx.model, ctx.out.info);
   check_version_and_extensions(ctx);
+  select_variant(ctx);
   validate_accessors(ctx);
   validate_textures(ctx);
   validate_material_textures(ctx);

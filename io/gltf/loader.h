@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/scene/scene.h"
@@ -38,6 +39,9 @@ struct GltfLoadOptions {
   /// With a time and a file with animations: keep what pose_gltf_scene needs, the parsed file
   /// with its buffers included, in LoadedScene::animation (memory held as long as the scene).
   bool keep_animation = false;
+  /// KHR_materials_variants: the variant whose materials the primitives use (empty: each
+  /// primitive's own material). A name the file does not define is an error listing its variants.
+  std::string variant;
 };
 
 /// Descriptive facts about the file, for `penumbra info`.
@@ -48,6 +52,8 @@ struct GltfInfo {
   int node_count = 0, mesh_count = 0, primitive_count = 0;
   int gltf_camera_count = 0, gltf_light_count = 0, image_count = 0, animation_count = 0;
   std::vector<std::string> extensions_used, extensions_required;
+  std::vector<std::string> variants;                ///< KHR_materials_variants names, in file order
+  int variant = -1;                                 ///< the variant used (index into variants), -1: none
   std::vector<std::string> camera_instances;        ///< "name (perspective, node 3)" in scene order
   std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
@@ -99,5 +105,8 @@ int json_nesting_depth(std::string_view json, int limit);
 
 /// The extensions this loader implements (an extensionsRequired entry outside it is an error).
 std::vector<std::string> supported_gltf_extensions();
+/// The subset of supported_gltf_extensions() implemented in part, each with what is missing
+/// (e.g. KHR_texture_basisu: fallback images only).
+std::vector<std::pair<std::string, std::string>> partial_gltf_extensions();
 
 }  // namespace penumbra

@@ -9,8 +9,19 @@
 namespace penumbra::gltf {
 
 std::vector<std::string> material_extensions() {
-  return {"KHR_materials_emissive_strength", "KHR_materials_unlit",        "KHR_materials_ior",
-          "KHR_materials_specular",          "KHR_materials_transmission", "KHR_texture_transform"};
+  return {"KHR_materials_emissive_strength",
+          "KHR_materials_unlit",
+          "KHR_materials_ior",
+          "KHR_materials_specular",
+          "KHR_materials_transmission",
+          "KHR_materials_volume",
+          "KHR_materials_clearcoat",
+          "KHR_materials_sheen",
+          "KHR_materials_anisotropy",
+          "KHR_materials_iridescence",
+          "KHR_materials_dispersion",
+          "KHR_materials_diffuse_transmission",
+          "KHR_texture_transform"};
 }
 
 namespace {
@@ -56,11 +67,8 @@ TextureRef texture_ref(const GltfContext& ctx, TextureCache& cache, int texture,
   const tinygltf::Model& model = ctx.model;
   if (texture < 0 || size_t(texture) >= model.textures.size())
     return ref;  // warned by validate_material_textures
-  const auto& t = model.textures[size_t(texture)];
-  if (t.source < 0 || size_t(t.source) >= model.images.size()) {
-    if (t.source < 0) ctx.warn(idx("textures", size_t(texture)), "has no image source; ignored");
-    return ref;
-  }
+  const int image = texture_image(ctx, texture);
+  if (image < 0) return ref;
   if (auto it = extensions.find("KHR_texture_transform"); it != extensions.end())
     read_texture_transform(ctx, it->second, where, ref, texcoord);
   if (texcoord < 0 || texcoord > 1) {
@@ -69,7 +77,7 @@ TextureRef texture_ref(const GltfContext& ctx, TextureCache& cache, int texture,
     return ref;
   }
   ref.texcoord = texcoord;
-  ref.texture = scene_texture(ctx, cache, texture, srgb, where);
+  ref.texture = scene_texture(ctx, cache, texture, image, srgb, where);
   return ref;
 }
 
@@ -108,6 +116,50 @@ void extension_number(const GltfContext& ctx, const tinygltf::Material& src, con
   out = float(x);
 }
 
+// Three numbers in [0, 1] at extensions.<ext>.<key> (absent: `out` keeps its default).
+void extension_color(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where,
+                     const char* ext, const char* key, Vec3f& out) {
+  auto it = src.extensions.find(ext);
+  if (it == src.extensions.end()) return;
+  const auto& v = it->second.Get(key);
+  if (v.Type() == tinygltf::NULL_TYPE) return;
+  const std::string w = where + ".extensions." + ext + "." + key;
+  if (!v.IsArray() || v.ArrayLen() != 3) ctx.fail(w, "must be 3 numbers");
+  for (int c = 0; c < 3; ++c) {
+    const auto& x = v.Get(c);
+    if (!x.IsNumber()) ctx.fail(w, "must be 3 numbers");
+    out[c] = float(std::clamp(finite_or_fail(ctx, x.GetNumberAsDouble(), w), 0.0, 1.0));
+  }
+}
+
+// The texture info at extensions.<ext>.<key> (none: texture -1); `scale`, if given, receives a
+// normal texture's scale.
+TextureRef extension_texture(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
+                             const std::string& where, const char* ext, const char* key, bool srgb,
+                             float* scale = nullptr) {
+  auto it = src.extensions.find(ext);
+  if (it == src.extensions.end()) return {};
+  const auto& info = it->second.Get(key);
+  const std::string w = where + ".extensions." + ext + "." + key;
+  if (info.Type() == tinygltf::NULL_TYPE) return {};
+  if (!info.IsObject() || !info.Get("index").IsInt())
+    ctx.fail(w, "must be a texture info with an integer index");
+  const int index = info.Get("index").GetNumberAsInt();
+  if (index < 0 || size_t(index) >= ctx.model.textures.size()) {
+    ctx.warn(w, "texture index " + std::to_string(index) + " out of range (" +
+                    std::to_string(ctx.model.textures.size()) + " textures); ignored");
+    return {};
+  }
+  if (scale && info.Get("scale").IsNumber())
+    *scale = float(finite_or_fail(ctx, info.Get("scale").GetNumberAsDouble(), w + ".scale"));
+  tinygltf::ExtensionMap texture_extensions;
+  const auto& e = info.Get("extensions");
+  if (e.IsObject())
+    for (const auto& k : e.Keys()) texture_extensions[k] = e.Get(k);
+  const int tc = info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
+  return texture_ref(ctx, cache, index, tc, texture_extensions, srgb, w);
+}
+
 // KHR_materials_emissive_strength, _unlit, _ior, _specular and _transmission.
 void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
                          const std::string& where, Material& m) {
@@ -129,20 +181,135 @@ void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tiny
                    "in [0, 1]");
   extension_number(ctx, src, where, "KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0,
                    1.0, "in [0, 1]");
-  if (auto it = src.extensions.find("KHR_materials_transmission");
-      it != src.extensions.end() && m.transmission > 0) {
-    const auto& info = it->second.Get("transmissionTexture");
-    if (info.IsObject() && info.Get("index").IsInt()) {
-      tinygltf::ExtensionMap texture_extensions;
-      const auto& e = info.Get("extensions");
-      if (e.IsObject())
-        for (const auto& key : e.Keys()) texture_extensions[key] = e.Get(key);
-      const int tc = info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
-      m.transmission_tex =
-          texture_ref(ctx, cache, info.Get("index").GetNumberAsInt(), tc, texture_extensions, false,
-                      where + ".extensions.KHR_materials_transmission.transmissionTexture");
-    }
+  if (m.transmission > 0)
+    m.transmission_tex =
+        extension_texture(ctx, cache, src, where, "KHR_materials_transmission", "transmissionTexture", false);
+}
+
+// KHR_materials_volume (a volume when thicknessFactor > 0) and KHR_materials_dispersion.
+void read_volume(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where,
+                 Material& m) {
+  float thickness = 0;
+  extension_number(ctx, src, where, "KHR_materials_volume", "thicknessFactor", thickness, 0.0, 1e30, ">= 0");
+  m.volume = thickness > 0;
+  extension_number(ctx, src, where, "KHR_materials_volume", "attenuationDistance", m.attenuation_distance,
+                   0.0, 1e30, "> 0");
+  if (src.extensions.count("KHR_materials_volume") && !(m.attenuation_distance > 0))
+    ctx.fail(where + ".extensions.KHR_materials_volume.attenuationDistance", "must be > 0");
+  extension_color(ctx, src, where, "KHR_materials_volume", "attenuationColor", m.attenuation_color);
+  extension_number(ctx, src, where, "KHR_materials_dispersion", "dispersion", m.dispersion, 0.0, 1e3, ">= 0");
+}
+
+// KHR_materials_clearcoat, _sheen, _anisotropy, _iridescence and _diffuse_transmission.
+void read_layers(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
+                 const std::string& where, Material& m) {
+  const char* cc = "KHR_materials_clearcoat";
+  extension_number(ctx, src, where, cc, "clearcoatFactor", m.clearcoat, 0.0, 1.0, "in [0, 1]");
+  extension_number(ctx, src, where, cc, "clearcoatRoughnessFactor", m.clearcoat_roughness, 0.0, 1.0,
+                   "in [0, 1]");
+  if (m.clearcoat > 0) {
+    m.clearcoat_tex = extension_texture(ctx, cache, src, where, cc, "clearcoatTexture", false);
+    m.clearcoat_roughness_tex =
+        extension_texture(ctx, cache, src, where, cc, "clearcoatRoughnessTexture", false);
+    m.clearcoat_normal_tex = extension_texture(ctx, cache, src, where, cc, "clearcoatNormalTexture", false,
+                                               &m.clearcoat_normal_scale);
   }
+  const char* sh = "KHR_materials_sheen";
+  extension_color(ctx, src, where, sh, "sheenColorFactor", m.sheen_color);
+  extension_number(ctx, src, where, sh, "sheenRoughnessFactor", m.sheen_roughness, 0.0, 1.0, "in [0, 1]");
+  if (max_component(m.sheen_color) > 0) {
+    m.sheen_color_tex = extension_texture(ctx, cache, src, where, sh, "sheenColorTexture", true);
+    m.sheen_roughness_tex = extension_texture(ctx, cache, src, where, sh, "sheenRoughnessTexture", false);
+  }
+  const char* an = "KHR_materials_anisotropy";
+  extension_number(ctx, src, where, an, "anisotropyStrength", m.anisotropy, 0.0, 1.0, "in [0, 1]");
+  extension_number(ctx, src, where, an, "anisotropyRotation", m.anisotropy_rotation, -1e6, 1e6, "finite");
+  if (m.anisotropy > 0)
+    m.anisotropy_tex = extension_texture(ctx, cache, src, where, an, "anisotropyTexture", false);
+  const char* ir = "KHR_materials_iridescence";
+  extension_number(ctx, src, where, ir, "iridescenceFactor", m.iridescence, 0.0, 1.0, "in [0, 1]");
+  extension_number(ctx, src, where, ir, "iridescenceIor", m.iridescence_ior, 1.0, 1e3, ">= 1");
+  extension_number(ctx, src, where, ir, "iridescenceThicknessMinimum", m.iridescence_thickness_min, 0.0, 1e6,
+                   "in [0, 1e6] nm");
+  extension_number(ctx, src, where, ir, "iridescenceThicknessMaximum", m.iridescence_thickness_max, 0.0, 1e6,
+                   "in [0, 1e6] nm");
+  if (m.iridescence > 0) {
+    m.iridescence_tex = extension_texture(ctx, cache, src, where, ir, "iridescenceTexture", false);
+    m.iridescence_thickness_tex =
+        extension_texture(ctx, cache, src, where, ir, "iridescenceThicknessTexture", false);
+  }
+  const char* dt = "KHR_materials_diffuse_transmission";
+  extension_number(ctx, src, where, dt, "diffuseTransmissionFactor", m.diffuse_transmission, 0.0, 1.0,
+                   "in [0, 1]");
+  extension_color(ctx, src, where, dt, "diffuseTransmissionColorFactor", m.diffuse_transmission_color);
+  if (m.diffuse_transmission > 0) {
+    m.diffuse_transmission_tex =
+        extension_texture(ctx, cache, src, where, dt, "diffuseTransmissionTexture", false);
+    m.diffuse_transmission_color_tex =
+        extension_texture(ctx, cache, src, where, dt, "diffuseTransmissionColorTexture", true);
+  }
+}
+
+// Perceived brightness of a colour (the specular-glossiness converter's measure).
+double perceived(const double c[3]) {
+  return std::sqrt(0.299 * c[0] * c[0] + 0.587 * c[1] * c[1] + 0.114 * c[2] * c[2]);
+}
+
+// KHR_materials_pbrSpecularGlossiness (archived), converted to metallic-roughness from its
+// factors by the Khronos converter's rule: metallic solves the dielectric/metal mix of the two
+// colours' brightness, the base colour blends the colour each explains by metallic^2, roughness
+// = 1 - glossiness. diffuseTexture becomes the base colour texture; the specular-glossiness
+// texture has no per-texel equivalent and is not used. Warns that the material is converted.
+void read_specular_glossiness(const GltfContext& ctx, TextureCache& cache, const tinygltf::Material& src,
+                              const std::string& where, Material& m) {
+  const char* ext = "KHR_materials_pbrSpecularGlossiness";
+  auto it = src.extensions.find(ext);
+  if (it == src.extensions.end()) return;
+  const std::string xw = where + ".extensions." + ext;
+  double diffuse[4] = {1, 1, 1, 1}, specular[3] = {1, 1, 1}, gloss = 1;
+  auto read = [&](const char* key, double* out, int n) {
+    const auto& v = it->second.Get(key);
+    if (v.Type() == tinygltf::NULL_TYPE) return;
+    if (n == 1) {
+      if (!v.IsNumber()) ctx.fail(xw + "." + key, "must be a number");
+      out[0] = std::clamp(finite_or_fail(ctx, v.GetNumberAsDouble(), xw + "." + key), 0.0, 1.0);
+      return;
+    }
+    if (!v.IsArray() || int(v.ArrayLen()) != n)
+      ctx.fail(xw + "." + key, "must be " + std::to_string(n) + " numbers");
+    for (int c = 0; c < n; ++c) {
+      if (!v.Get(c).IsNumber()) ctx.fail(xw + "." + key, "must be " + std::to_string(n) + " numbers");
+      out[c] = std::clamp(finite_or_fail(ctx, v.Get(c).GetNumberAsDouble(), xw + "." + key), 0.0, 1.0);
+    }
+  };
+  read("diffuseFactor", diffuse, 4);
+  read("specularFactor", specular, 3);
+  read("glossinessFactor", &gloss, 1);
+  constexpr double kDielectric = 0.04, kEps = 1e-6;
+  const double one_minus = 1 - std::max({specular[0], specular[1], specular[2]});
+  const double d = perceived(diffuse), s = perceived(specular);
+  double metallic = 0;
+  if (s >= kDielectric) {
+    const double a = kDielectric, b = d * one_minus / (1 - kDielectric) + s - 2 * kDielectric,
+                 c = kDielectric - s;
+    metallic = std::clamp((-b + std::sqrt(std::max(0.0, b * b - 4 * a * c))) / (2 * a), 0.0, 1.0);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double from_diffuse = diffuse[k] * one_minus / (1 - kDielectric) / std::max(1 - metallic, kEps);
+    const double from_specular = (specular[k] - kDielectric * (1 - metallic)) / std::max(metallic, kEps);
+    const double t = metallic * metallic;
+    m.base_color[k] = float(std::clamp(from_diffuse * (1 - t) + from_specular * t, 0.0, 1.0));
+  }
+  m.alpha = float(diffuse[3]);
+  m.metallic = float(metallic);
+  m.roughness = float(1 - gloss);
+  m.metallic_roughness_tex = {};
+  m.base_color_tex = extension_texture(ctx, cache, src, where, ext, "diffuseTexture", true);
+  ctx.warn(
+      xw,
+      "archived extension converted to metallic-roughness (metallic " + std::to_string(m.metallic) +
+          ", roughness " + std::to_string(m.roughness) + ")" +
+          (it->second.Has("specularGlossinessTexture") ? "; its specularGlossinessTexture is not used" : ""));
 }
 
 // Alpha mode and cutoff, sidedness, and the core textures (baseColor and emissive in sRGB).
@@ -208,7 +375,10 @@ void convert_materials(const GltfContext& ctx, TextureCache& cache) {
     m.name = src.name.empty() ? where : src.name;
     read_core_factors(ctx, src, where, m);
     read_khr_extensions(ctx, cache, src, where, m);
+    read_volume(ctx, src, where, m);
+    read_layers(ctx, cache, src, where, m);
     read_alpha_and_textures(ctx, cache, src, where, m);
+    read_specular_glossiness(ctx, cache, src, where, m);
     ctx.out.scene.materials.push_back(m);
   }
 }

@@ -34,6 +34,35 @@ float finite_or_zero(double v) {
   return std::isfinite(v) ? float(v) : 0.0f;
 }
 
+// The material of the selected KHR_materials_variants variant for `prim`, else `material`.
+int variant_material(const GltfContext& ctx, const tinygltf::Primitive& prim, const std::string& where,
+                     int material) {
+  const int variant = ctx.out.info.variant;
+  const auto it = prim.extensions.find("KHR_materials_variants");
+  if (variant < 0 || it == prim.extensions.end()) return material;
+  const std::string mw = where + ".extensions.KHR_materials_variants.mappings";
+  const auto& mappings = it->second.Get("mappings");
+  if (!mappings.IsArray()) ctx.fail(mw, "must be an array");
+  for (size_t i = 0; i < mappings.ArrayLen(); ++i) {
+    const auto& m = mappings.Get(int(i));
+    const std::string w = mw + "[" + std::to_string(i) + "]";
+    const auto& variants = m.Get("variants");
+    if (!m.Get("material").IsInt() || !variants.IsArray()) ctx.fail(w, "needs a material and variants");
+    const int mat = m.Get("material").GetNumberAsInt();
+    if (mat < 0 || mat >= int(ctx.model.materials.size()))
+      ctx.fail(w + ".material", "material index " + std::to_string(mat) + " out of range (" +
+                                    std::to_string(ctx.model.materials.size()) + " materials)");
+    for (size_t k = 0; k < variants.ArrayLen(); ++k) {
+      const auto& v = variants.Get(int(k));
+      if (!v.IsInt() || v.GetNumberAsInt() < 0 || v.GetNumberAsInt() >= int(ctx.out.info.variants.size()))
+        ctx.fail(w + ".variants", "variant index out of range (" +
+                                      std::to_string(ctx.out.info.variants.size()) + " variants)");
+      if (v.GetNumberAsInt() == variant) return mat;
+    }
+  }
+  return material;
+}
+
 // The vertex attributes of a primitive as read, before conversion.
 struct RawAttributes {
   std::vector<double> pos, nrm, uv, uv1, tan, col;
@@ -237,7 +266,7 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   if (prim.material < -1 || prim.material >= int(ctx.model.materials.size()))
     ctx.fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
                                       std::to_string(ctx.model.materials.size()) + " materials)");
-  out.material = prim.material;
+  out.material = variant_material(ctx, prim, where, prim.material);
   // Positions, then indices and topology, then the other attributes.
   const auto pos_it = prim.attributes.find("POSITION");
   if (pos_it == prim.attributes.end()) {
@@ -320,12 +349,19 @@ std::vector<Transform> skin_transforms(const GltfContext& ctx, const LocalPrimit
   return vertex_xf;
 }
 
-// Tangents only where a normal map needs them: the file's (to world space; a mirroring
-// transform flips the bitangent sign), else generated from the map's UV set.
+// Tangents only where a normal map (the base's or the clear coat's) or anisotropy needs them:
+// the file's (to world space; a mirroring transform flips the bitangent sign), else generated
+// from the UV set of the map (or of the anisotropy texture).
 void add_tangents(const GltfContext& ctx, const LocalPrimitive& local, const Transform& world, bool flip,
                   const std::string& where, Mesh& out) {
   if (local.material < 0) return;
-  const TextureRef& nt = ctx.out.scene.materials[size_t(local.material)].normal_tex;
+  const Material& mat = ctx.out.scene.materials[size_t(local.material)];
+  TextureRef nt = mat.normal_tex;
+  if (nt.texture < 0) nt = mat.clearcoat_normal_tex;
+  if (nt.texture < 0 && mat.anisotropy > 0) {
+    nt = mat.anisotropy_tex;
+    nt.texture = 0;  // tangents are needed with or without the texture
+  }
   const auto& nuv = nt.texcoord == 1 ? out.uvs1 : out.uvs;
   if (nt.texture >= 0 && !local.tangents.empty()) {
     out.tangents.resize(local.tangents.size());

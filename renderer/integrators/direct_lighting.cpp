@@ -53,12 +53,16 @@ bool sample_incident(const Environment& env, Vec2f u, IncidentLight& out) {
 
 namespace {
 
-// One light sample's contribution: BRDF, shadow ray, MIS weight.
+// One light sample's contribution: BSDF, shadow ray, MIS weight.
 void estimate(const Scene& scene, const Accelerator& accel, const DirectLightingVertex& v,
               const DirectLightingMode& mode, const IncidentLight& l, RayCounts& counts, PathRadiance& out) {
-  if (!(dot(l.wi, v.si.ng) > 0)) return;  // light below the geometric surface
+  // A light below the geometric surface lights it only through a transmission lobe, and the
+  // shading normal must see it on the same side.
+  const bool below = !(dot(l.wi, v.si.ng) > 0);
+  if (below && !has_transmission_lobes(v.brdf)) return;
+  if (below != (dot(l.wi, v.brdf.n) < 0)) return;
   float pdf_b = 0;
-  const Vec3f f = brdf_eval_pdf(v.brdf, v.wo, l.wi, pdf_b);
+  const Vec3f f = bsdf_eval_pdf(v.brdf, v.wo, l.wi, pdf_b);
   if (!(max_component(f) > 0)) return;
   ++counts.shadow;
   const float t = shadow_transmittance(scene, accel, shadow_ray(v.si, l.wi, l.distance), mode.hit_filter);
@@ -66,7 +70,7 @@ void estimate(const Scene& scene, const Accelerator& accel, const DirectLighting
   if (!(t > 0 && w > 0)) return;
   const bool split = out.groups && v.vertex == 0;
   const Vec3f share = split ? diffuse_share(v.brdf, v.wo, l.wi) : Vec3f{};
-  out.add(v.beta * f * l.li * (std::max(0.0f, dot(v.brdf.n, l.wi)) * t * w / l.pdf), v.vertex,
+  out.add(v.beta * f * l.li * (std::fabs(dot(v.brdf.n, l.wi)) * t * w / l.pdf), v.vertex,
           split ? &share : nullptr);
 }
 

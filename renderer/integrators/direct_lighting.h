@@ -46,7 +46,7 @@ bool sample_incident(const Environment& env, Vec2f u, IncidentLight& out);
 /// The shading point and path state next-event estimation works on.
 struct DirectLightingVertex {
   const SurfaceInteraction& si;
-  const GltfBrdf& brdf;  ///< its n is the shading normal
+  const GltfBsdf& brdf;  ///< its n is the shading normal
   Vec3f wo;              ///< unit direction towards the previous vertex
   Vec3f beta;            ///< path throughput up to this vertex
   int vertex = 0;        ///< surface hit index along the path (0 = first)

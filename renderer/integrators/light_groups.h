@@ -45,9 +45,9 @@ inline Vec3f diffuse_share(Vec3f d, Vec3f s) {
 }
 
 /// The diffuse share of the BRDF's value towards wi (the light-group split of a direction).
-inline Vec3f diffuse_share(const GltfBrdf& brdf, Vec3f wo, Vec3f wi) {
+inline Vec3f diffuse_share(const GltfBsdf& brdf, Vec3f wo, Vec3f wi) {
   Vec3f d, sp;
-  brdf_eval_parts(brdf, wo, wi, d, sp);
+  bsdf_eval_parts(brdf, wo, wi, d, sp);
   return diffuse_share(d, sp);
 }
 

@@ -28,15 +28,17 @@ struct Segment {
   float prev_pdf = 0;      // solid-angle density of the direction that produced `ray`
   bool prev_delta = true;  // the camera ray or a delta lobe produced `ray`: no MIS
   int layers = 0;          // Blend surfaces passed on this segment
+  Vec3f sigma_a{0, 0, 0};  // absorption coefficient of the volume the ray travels in
+  int channel = -1;        // RGB channel a dispersive volume restricted the path to, -1: none
 };
 
-// The BRDF at a hit and the choice between it and thin transmission (a delta lobe straight
-// through, chosen with probability p_t).
+// The BSDF at a hit and the choice between it and thin transmission (a delta lobe straight
+// through, chosen with probability p_t; materials without a volume only).
 struct Lobes {
-  GltfBrdf brdf;
+  GltfBsdf brdf;
   Vec3f trans_weight;
   float p_t = 0;
-  float p_r = 1;  // share of the BRDF's (non-delta) sampling
+  float p_r = 1;  // share of the BSDF's (non-delta) sampling
 };
 
 // Emitter hit: the environment seen by a ray that escaped, MIS-weighted against the
@@ -72,55 +74,66 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, co
   if (w > 0) path.add(seg.beta * mp.emissive * w, vertex - 1);
 }
 
-// The BRDF and the transmission/reflection choice by estimated energy: transmitted vs
-// reflected (Fresnel-weighted specular plus the remaining diffuse) at this view angle.
-Lobes choose_lobes(const MaterialPoint& mp, Vec3f wo) {
+// The BSDF and, for thin-walled transmission, the transmission/reflection choice by
+// estimated energy: transmitted vs reflected (Fresnel-weighted specular plus the remaining
+// diffuse) at this view angle.
+Lobes choose_lobes(const MaterialPoint& mp, const SurfaceInteraction& si, Vec3f wo, int channel) {
   Lobes l;
-  l.brdf.base_color = mp.base_color;
-  l.brdf.metallic = mp.metallic;
-  l.brdf.roughness = mp.roughness;
-  l.brdf.n = mp.ns;
-  l.brdf.f0 = mp.f0;
-  l.brdf.specular = mp.specular;
-  l.brdf.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
+  l.brdf = make_bsdf(mp, si.back_face, channel);
+  if (l.brdf.volume || !(l.brdf.transmission > 0)) return l;
   const float cos_o = std::fabs(dot(mp.ns, wo));
-  l.trans_weight =
-      mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - dielectric_fresnel(l.brdf, cos_o)));
-  if (l.brdf.transmission > 0) {
-    const float t = luminance(l.trans_weight);
-    const float fd = dielectric_fresnel(l.brdf, cos_o);
-    const float r =
-        (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
-        mp.metallic * luminance(mp.base_color);
-    l.p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
-  }
+  const float fd = dielectric_fresnel(l.brdf, cos_o);
+  l.trans_weight = mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - fd));
+  const float t = luminance(l.trans_weight);
+  const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
+                  mp.metallic * luminance(mp.base_color);
+  l.p_t = t + r > 0 ? std::clamp(t / (t + r), 0.0f, 1.0f) : 0.0f;
   l.p_r = 1 - l.p_t;
   return l;
 }
 
-// BSDF sampling: the next direction (transmission or the BRDF), updating the throughput and
-// the MIS state. False when the path ends here.
-bool sample_bsdf(const Lobes& lobes, const SurfaceInteraction& si, Vec3f wo, int vertex,
-                 SampleStream& samples, Segment& seg, PathRadiance& path, Vec3f& wi) {
+// A dispersive volume restricts the path to one RGB channel, chosen uniformly (the throughput
+// keeps that channel, times 3); the channel's index of refraction then applies (material.h).
+void choose_channel(const MaterialPoint& mp, SampleStream& samples, Segment& seg) {
+  if (seg.channel >= 0 || !mp.volume || !(mp.dispersion > 0)) return;
+  seg.channel = std::min(2, int(samples.get1d() * 3));
+  Vec3f keep{0, 0, 0};
+  keep[seg.channel] = 3;
+  seg.beta *= keep;
+}
+
+// BSDF sampling: the next direction (thin transmission or the BSDF), updating the throughput,
+// the MIS state and the volume the ray travels in. False when the path ends here.
+bool sample_bsdf(const Lobes& lobes, const SurfaceInteraction& si, const MaterialPoint& mp, Vec3f wo,
+                 int vertex, SampleStream& samples, Segment& seg, PathRadiance& path, Vec3f& wi) {
   const float u_lobe = samples.get1d();
   const Vec2f u_dir = samples.get2d();
   if (u_lobe < lobes.p_t) {
     wi = seg.ray.dir;
-    if (vertex == 0) path.share0 = {0, 0, 0};  // transmission counts as specular
+    if (mp.volume) seg.sigma_a = si.back_face ? Vec3f{} : mp.sigma_a;  // through a volume of index 1
+    if (vertex == 0) path.share0 = {0, 0, 0};                          // transmission counts as specular
     seg.beta *= lobes.trans_weight / lobes.p_t;
     seg.prev_delta = true;
     seg.prev_pdf = 0;
   } else {
-    BrdfSample bs;
-    if (!brdf_sample(lobes.brdf, wo, (u_lobe - lobes.p_t) / lobes.p_r, u_dir, bs)) return false;
-    if (dot(bs.wi, si.ng) <= 0) return false;  // below the geometric surface
+    BsdfSample bs;
+    if (!bsdf_sample(lobes.brdf, wo, (u_lobe - lobes.p_t) / lobes.p_r, u_dir, bs)) return false;
+    // The geometric surface must agree with the shading side the lobe chose.
+    const bool through = dot(bs.wi, lobes.brdf.n) < 0;
+    if ((dot(bs.wi, si.ng) <= 0) != through) return false;
     wi = bs.wi;
+    if (through && mp.volume) seg.sigma_a = si.back_face ? Vec3f{} : mp.sigma_a;  // into or out of the volume
     if (vertex == 0 && path.groups) path.share0 = diffuse_share(lobes.brdf, wo, wi);
     seg.beta *= bs.weight / lobes.p_r;
     seg.prev_delta = false;
     seg.prev_pdf = lobes.p_r * bs.pdf;
   }
   return max_component(seg.beta) > 0 && is_finite(seg.beta);
+}
+
+// Beer-Lambert transmittance exp(-sigma_a d) over distance d.
+Vec3f beer_lambert(Vec3f sigma_a, float d) {
+  return {std::exp(-sigma_a.x * d), std::exp(-sigma_a.y * d), std::exp(-sigma_a.z * d)};
 }
 
 // Russian roulette (Arvo & Kirk 1990): survive with probability min(1, max beta), reweighted.
@@ -166,6 +179,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       add_escaped(ctx, seg, vertex, path);
       break;
     }
+    if (max_component(seg.sigma_a) > 0) seg.beta *= beer_lambert(seg.sigma_a, hit.t - seg.ray.tnear);
     SurfaceInteraction si = make_interaction(scene, seg.ray, hit);
     if (vertex == 0 && seg.layers == 0 && rd.make &&
         material_reads_footprint(material_of(scene, si.material)))
@@ -192,13 +206,14 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
 
     // Next-event estimation.
     const Vec3f wo = -seg.ray.dir;
-    const Lobes lobes = choose_lobes(mp, wo);
+    choose_channel(mp, samples, seg);
+    const Lobes lobes = choose_lobes(mp, si, wo, seg.channel);
     sample_direct_lighting(scene, accel, lights, {si, lobes.brdf, wo, seg.beta, vertex, lobes.p_r}, mode,
                            samples, counts, path);
 
     // BSDF sampling.
     Vec3f wi;
-    if (!sample_bsdf(lobes, si, wo, vertex, samples, seg, path, wi)) break;
+    if (!sample_bsdf(lobes, si, mp, wo, vertex, samples, seg, path, wi)) break;
     ++vertex;
 
     // Russian roulette.

@@ -4,22 +4,35 @@
 
 #include "renderer/integrators/visibility.h"
 #include "renderer/lights/punctual.h"
+#include "renderer/materials/sheen.h"
+#include "renderer/materials/thin_film.h"
 
 namespace penumbra {
 
 WhittedParams whitted_params(const MaterialPoint& m) {
   const float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
   const float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+  const float t = std::clamp(m.transmission, 0.0f, 1.0f);
+  const float d = std::clamp(m.diffuse_transmission, 0.0f, 1.0f);
+  const float coat = std::clamp(m.clearcoat, 0.0f, 1.0f);
   const float d0 = m.specular * m.f0;  // 0.04 for the core glTF model
-  const Vec3f f0 = Vec3f{d0, d0, d0} * (1 - metallic) + m.base_color * metallic;
+  Vec3f f0 = Vec3f{d0, d0, d0} * (1 - metallic) + m.base_color * metallic;
+  if (m.iridescence > 0)
+    f0 = f0 * (1 - m.iridescence) +
+         iridescence_fresnel(1, m.iridescence_ior, 1, m.iridescence_thickness, f0) * m.iridescence;
   WhittedParams w;
-  w.kd = m.base_color * (1 - metallic);
+  w.kd = m.base_color * ((1 - metallic) * (1 - t) * (1 - d) * (1 - 0.04f * coat));
+  if (max_component(m.sheen_color) > 0) w.kd += m.sheen_color * sheen_albedo(1, m.sheen_roughness);
   w.ka = w.kd;
-  w.ks = f0;
+  const float coat_mirror = 0.04f * coat * (1 - m.clearcoat_roughness) * (1 - m.clearcoat_roughness);
+  w.ks = f0 + Vec3f{0.04f, 0.04f, 0.04f} * coat;
   const float alpha = std::max(roughness * roughness, 1e-3f);
   w.exponent = std::clamp(2.0f / (alpha * alpha) - 2.0f, 1.0f, 10000.0f);
-  w.kr = f0 * ((1 - roughness) * (1 - roughness));
+  w.kr = f0 * ((1 - roughness) * (1 - roughness)) + Vec3f{coat_mirror, coat_mirror, coat_mirror};
   w.emission = m.emissive;
+  w.kt = m.base_color * ((1 - metallic) * t * (1 - d0));
+  w.kdt = m.diffuse_transmission_color * ((1 - metallic) * (1 - t) * d);
+  w.ior = m.volume ? std::max(1.0f, m.ior) : 1.0f;
   return w;
 }
 
@@ -31,6 +44,18 @@ WhittedParams whitted_params(const Material& m) {
   mp.emissive = m.emissive;
   mp.f0 = ior_to_f0(m.ior);
   mp.specular = m.specular;
+  mp.ior = m.ior;
+  mp.transmission = m.transmission;
+  mp.volume = m.volume && m.transmission > 0;
+  mp.clearcoat = m.clearcoat;
+  mp.clearcoat_roughness = m.clearcoat_roughness;
+  mp.sheen_color = m.sheen_color;
+  mp.sheen_roughness = m.sheen_roughness;
+  mp.iridescence = m.iridescence;
+  mp.iridescence_ior = m.iridescence_ior;
+  mp.iridescence_thickness = m.iridescence_thickness_max;
+  mp.diffuse_transmission = m.diffuse_transmission;
+  mp.diffuse_transmission_color = m.diffuse_transmission_color;
   return whitted_params(mp);
 }
 
@@ -77,13 +102,17 @@ struct Tracer {
     for (const Light& light : scene.lights) {
       LightSample ls;
       if (!sample_light(light, si.p, ls)) continue;
-      if (dot(ls.wi, si.ng) <= 0) continue;  // light below the geometric surface
       const float ndotl = dot(mp.ns, ls.wi);
-      if (ndotl <= 0) continue;
+      const bool from_back = dot(ls.wi, si.ng) <= 0;  // light below the geometric surface
+      if (from_back != (ndotl <= 0) || (from_back && !(max_component(w.kdt) > 0))) continue;
       ++counts.shadow;
       const float transmittance =
           shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
       if (!(transmittance > 0)) continue;
+      if (from_back) {
+        radiance += ls.irradiance * w.kdt * (transmittance * -ndotl / kPi);
+        continue;
+      }
       const Vec3f h = normalize(v + ls.wi);
       const float ndoth = std::max(0.0f, dot(mp.ns, h));
       const float spec = (w.exponent + 8) / (8 * kPi) * std::pow(ndoth, w.exponent);
@@ -105,7 +134,25 @@ struct Tracer {
       ++counts.reflection;
       radiance += w.kr * trace(refl, reflect_differential(si, rd, v, n, r), depth + 1, 0, rweight, nullptr);
     }
+    radiance += transmitted(ray, rd, si, mp, w, depth, weight * a);
     return radiance * a + behind * (1 - a);
+  }
+
+  // The ideal transmission: refracted by Snell's law into a volume (total internal reflection
+  // sends it back as a mirror ray), straight through a thin wall.
+  Vec3f transmitted(const Ray& ray, const RayDifferential& rd, const SurfaceInteraction& si,
+                    const MaterialPoint& mp, const WhittedParams& w, int depth, Vec3f weight) {
+    const Vec3f tweight = weight * w.kt;
+    if (depth >= cfg.max_depth || !(max_component(tweight) >= cfg.min_reflectance)) return {};
+    const Vec3f v = normalize(-ray.dir);
+    Vec3f dir = -v;
+    if (w.ior != 1 && !refract(v, mp.ns, si.back_face ? 1 / w.ior : w.ior, dir)) dir = reflect(-v, mp.ns);
+    if ((dot(dir, si.ng) < 0) != (dot(dir, mp.ns) < 0)) return {};
+    Ray next;
+    next.org = spawn_origin(si, dir);
+    next.dir = dir;
+    ++counts.reflection;
+    return w.kt * trace(next, rd, depth + 1, 0, tweight, nullptr);
   }
 };
 

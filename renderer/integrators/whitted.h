@@ -18,6 +18,9 @@ struct WhittedParams {
   Vec3f kr;        ///< ideal mirror reflectance
   Vec3f emission;  ///< emitted radiance
   float exponent;  ///< Blinn-Phong exponent p in [1, 10000]
+  Vec3f kt;        ///< ideal transmission (refraction for a volume, straight through if thin)
+  Vec3f kdt;       ///< diffuse transmission: Lambert albedo of light from behind
+  float ior = 1;   ///< index the transmitted ray refracts into (1: straight through)
 };
 
 /// The documented mapping from glTF factors (README "Whitted material mapping"):
@@ -29,6 +32,12 @@ struct WhittedParams {
 ///        Blinn-Phong exponent, Walter et al. 2007)
 ///   kr = f0 x (1 - roughness)^2               smooth metals mirror, smooth plastics glint
 ///   emission = emissive
+/// and for the KHR extensions (c = clearcoat, t = transmission, d = diffuse transmission):
+///   f0 is mixed with the thin film's reflectance at normal incidence by the iridescence factor
+///   kd = base_color x (1 - metallic)(1 - t)(1 - d)(1 - 0.04 c) + sheenColor x E_sheen(1)
+///   ks += 0.04 c, kr += 0.04 c (1 - clearcoatRoughness)^2
+///   kt = base_color x (1 - metallic) t (1 - f0), refracting with the ior for a volume
+///   kdt = diffuseTransmissionColor x (1 - metallic)(1 - t) d
 /// Materials with `unlit` skip all of this: their radiance is base_color.
 /// The inputs are the material's values at the shaded point (factors x textures).
 WhittedParams whitted_params(const MaterialPoint& m);

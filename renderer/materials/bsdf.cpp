@@ -1,11 +1,17 @@
-// glTF metallic-roughness BRDF: evaluation, VNDF sampling and pdf.
+// The glTF BSDF: every lobe's value and density for a direction pair, lobe selection and
+// sampling.
 #include "renderer/materials/bsdf.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "renderer/materials/sheen.h"
+#include "renderer/materials/thin_film.h"
+
 namespace penumbra {
 namespace {
+
+constexpr float kCoatF0 = 0.04f;  // clear coat of index 1.5
 
 struct Local {
   Vec3f t, b, n;
@@ -13,165 +19,286 @@ struct Local {
   Vec3f to_world(Vec3f v) const { return t * v.x + b * v.y + n * v.z; }
 };
 
-Local frame_of(const GltfBrdf& b) {
+Local base_frame(const GltfBsdf& b) {
   Local f;
   f.n = b.n;
-  make_frame(b.n, f.t, f.b);
+  if (b.anisotropy > 0) {
+    f.t = b.t;
+    f.b = cross(b.n, b.t);
+  } else {
+    make_frame(b.n, f.t, f.b);
+  }
   return f;
 }
 
-float alpha_of(const GltfBrdf& b) {
-  return std::max(kMinGgxAlpha, b.roughness * b.roughness);
+Vec3f coat_normal(const GltfBsdf& b) {
+  return b.clearcoat_n.x == 0 && b.clearcoat_n.y == 0 && b.clearcoat_n.z == 0 ? b.n : b.clearcoat_n;
 }
 
-Vec3f schlick(Vec3f f0, float cos_theta) {
-  const float m = std::clamp(1 - cos_theta, 0.0f, 1.0f), m2 = m * m;
-  const float k = m2 * m2 * m;  // (1 - cos)^5
-  return f0 + (Vec3f{1, 1, 1} - f0) * k;
+GgxAlpha base_alpha(const GltfBsdf& b) {
+  const float a = std::max(kMinGgxAlpha, b.roughness * b.roughness);
+  const float s = std::clamp(b.anisotropy, 0.0f, 1.0f);
+  return {a + (1 - a) * s * s, a};
+}
+
+float coat_alpha(const GltfBsdf& b) {
+  return std::max(kMinGgxAlpha, b.clearcoat_roughness * b.clearcoat_roughness);
 }
 
 Vec3f mix(Vec3f a, Vec3f b, float t) {
   return a * (1 - t) + b * t;
 }
 
-/// Density of the specular lobe's wi (local): D_v(h) / (4 v.h) = G1(v) D(h) / (4 n.v).
-float specular_pdf(Vec3f v, Vec3f h, float alpha) {
-  if (!(v.z > 0)) return 0;
-  return smith_g1(v, alpha) * ggx_d(h, alpha) / (4 * v.z);
+// The isotropic GGX values that depend on cosines only, as a local vector.
+Vec3f polar(float cos_theta) {
+  const float c = std::clamp(cos_theta, -1.0f, 1.0f);
+  return {std::sqrt(std::max(0.0f, 1 - c * c)), 0, c};
 }
 
-}  // namespace
-
-void make_frame(Vec3f n, Vec3f& t, Vec3f& b) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float c = n.x * n.y * a;
-  t = {1 + sign * n.x * n.x * a, sign * c, -sign * n.x};
-  b = {c, sign + n.y * n.y * a, -n.y};
+// The dielectric Fresnel of the base at cos, RGB once iridescence mixes in its thin film.
+Vec3f dielectric_fresnel_rgb(const GltfBsdf& b, float cos_theta) {
+  const float f = dielectric_fresnel(b, cos_theta);
+  if (!(b.iridescence > 0)) return {f, f, f};
+  const Vec3f film =
+      iridescence_fresnel(1, b.iridescence_ior, cos_theta, b.iridescence_thickness, {b.f0, b.f0, b.f0}) *
+      b.specular;
+  return mix({f, f, f}, film, b.iridescence);
 }
 
-Vec3f sample_cosine_hemisphere(Vec2f u) {
-  const float r = std::sqrt(u.x), phi = 2 * kPi * u.y;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1 - u.x))};
+Vec3f metal_fresnel(const GltfBsdf& b, float cos_theta) {
+  const Vec3f f = schlick(b.base_color, cos_theta);
+  if (!(b.iridescence > 0)) return f;
+  return mix(f, iridescence_fresnel(1, b.iridescence_ior, cos_theta, b.iridescence_thickness, b.base_color),
+             b.iridescence);
 }
 
-float ggx_d(Vec3f h, float alpha) {
-  if (!(h.z > 0)) return 0;
-  const float a2 = alpha * alpha;
-  const float d = h.z * h.z * (a2 - 1) + 1;
-  return a2 / (kPi * d * d);
+float coat_attenuation(const GltfBsdf& b, float cos_theta) {
+  return 1 - b.clearcoat * schlick(kCoatF0, std::fabs(cos_theta));
 }
 
-float smith_g1(Vec3f v, float alpha) {
-  if (!(v.z > 0)) return 0;
-  const float a2 = alpha * alpha;
-  // G1 = 2 n.v / (n.v + sqrt(a^2 + (1 - a^2) (n.v)^2))
-  return 2 * v.z / (v.z + std::sqrt(a2 + (1 - a2) * v.z * v.z));
-}
+// Probabilities of choosing each lobe at wo, summing to 1 (every present lobe >= 5%).
+enum Lobe { kCoat, kSheen, kSpecular, kDiffuse, kDiffuseTransmission, kRefraction, kLobes };
+struct LobeChoice {
+  float p[kLobes] = {};
+};
 
-float smith_visibility(float n_dot_l, float n_dot_v, float alpha) {
-  const float a2 = alpha * alpha;
-  const float gv = n_dot_l * std::sqrt(n_dot_v * n_dot_v * (1 - a2) + a2);
-  const float gl = n_dot_v * std::sqrt(n_dot_l * n_dot_l * (1 - a2) + a2);
-  const float s = gv + gl;
-  return s > 0 ? 0.5f / s : 0.0f;
-}
-
-Vec3f sample_ggx_vndf(Vec3f v, float alpha, Vec2f u) {
-  // Heitz 2018, listing 1: stretch the view, sample the projected hemisphere, unstretch.
-  const Vec3f vh = normalize(Vec3f{alpha * v.x, alpha * v.y, v.z});
-  const float len2 = vh.x * vh.x + vh.y * vh.y;
-  const Vec3f t1 = len2 > 0 ? Vec3f{-vh.y, vh.x, 0} / std::sqrt(len2) : Vec3f{1, 0, 0};
-  const Vec3f t2 = cross(vh, t1);
-  const float r = std::sqrt(u.x), phi = 2 * kPi * u.y;
-  const float p1 = r * std::cos(phi);
-  float p2 = r * std::sin(phi);
-  const float s = 0.5f * (1 + vh.z);
-  p2 = (1 - s) * std::sqrt(std::max(0.0f, 1 - p1 * p1)) + s * p2;
-  const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1 - p1 * p1 - p2 * p2));
-  return normalize(Vec3f{alpha * nh.x, alpha * nh.y, std::max(1e-6f, nh.z)});
-}
-
-float dielectric_fresnel(const GltfBrdf& b, float cos_theta) {
-  return b.specular * schlick(Vec3f{b.f0, b.f0, b.f0}, cos_theta).x;
-}
-
-float specular_probability(const GltfBrdf& b) {
-  const float sf0 = b.specular * b.f0;
-  const float spec = luminance(mix(Vec3f{sf0, sf0, sf0}, b.base_color, b.metallic));
-  const float diff = (1 - b.metallic) * (1 - b.transmission) * (1 - sf0) * luminance(b.base_color);
-  if (!(diff > 0)) return 1;
-  if (!(spec > 0)) return 0;
-  return std::clamp(spec / (spec + diff), 0.1f, 0.9f);  // never starve either lobe
-}
-
-namespace {
-// Everything about one direction pair in one shading frame: the diffuse and specular terms and
-// (if pdf is not null) the sampling density, so estimators that need f and pdf together
-// (next-event estimation with MIS) build the frame and the half vector once.
-void eval_pair(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular, float* pdf) {
-  diffuse = specular = {0, 0, 0};
-  if (pdf) *pdf = 0;
-  const Local f = frame_of(b);
-  const Vec3f v = f.to_local(wo), l = f.to_local(wi);
-  if (!(v.z > 0) || !(l.z > 0)) return;
-  const Vec3f h = normalize(v + l);
-  const float alpha = alpha_of(b);
-  const float v_dot_h = std::max(0.0f, dot(v, h));
-  const float dv = ggx_d(h, alpha) * smith_visibility(l.z, v.z, alpha);
-  const float fd = dielectric_fresnel(b, v_dot_h);
-  const Vec3f f_dielectric{fd, fd, fd};
-  const Vec3f f_metal = schlick(b.base_color, v_dot_h);
-  diffuse = b.base_color * ((1 - fd) * (1 - b.metallic) * (1 - b.transmission) / kPi);
-  specular = mix(f_dielectric, f_metal, b.metallic) * dv;
-  if (pdf) {
-    const float ps = specular_probability(b);
-    *pdf = ps * specular_pdf(v, h, alpha) + (1 - ps) * l.z / kPi;
+LobeChoice choose(const GltfBsdf& b, float cos_v, float cos_coat) {
+  LobeChoice c;
+  const float coat = b.clearcoat > 0 ? b.clearcoat * schlick(kCoatF0, std::max(0.0f, cos_coat)) : 0.0f;
+  const float rest = 1 - coat;
+  const float sheen_max = max_component(b.sheen_color);
+  const float sheen = sheen_max > 0 ? sheen_max * sheen_albedo(cos_v, b.sheen_roughness) : 0.0f;
+  const float below = rest * (1 - sheen);
+  const float fd = max_component(dielectric_fresnel_rgb(b, cos_v));
+  const float dielectric = (1 - b.metallic) * (1 - fd);
+  c.p[kCoat] = coat;
+  c.p[kSheen] = rest * sheen;
+  c.p[kSpecular] = below * ((1 - b.metallic) * fd + b.metallic * luminance(b.base_color));
+  c.p[kDiffuse] =
+      below * dielectric * (1 - b.transmission) * (1 - b.diffuse_transmission) * luminance(b.base_color);
+  c.p[kDiffuseTransmission] = below * dielectric * (1 - b.transmission) * b.diffuse_transmission *
+                              luminance(b.diffuse_transmission_color);
+  c.p[kRefraction] = b.volume ? below * dielectric * b.transmission * luminance(b.base_color) : 0.0f;
+  float sum = 0;
+  for (float& p : c.p) sum += p = std::max(p, 0.0f);
+  if (!(sum > 0)) {  // a black BSDF: sample the specular lobe, whose value is then 0
+    c.p[kSpecular] = 1;
+    return c;
   }
-}
-}  // namespace
-
-void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular) {
-  eval_pair(b, wo, wi, diffuse, specular, nullptr);
-}
-
-Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
-  Vec3f diffuse, specular;
-  eval_pair(b, wo, wi, diffuse, specular, nullptr);
-  return diffuse + specular;
+  float total = 0;
+  for (float& p : c.p) total += p = p > 0 ? std::max(p / sum, 0.05f) : 0.0f;
+  for (float& p : c.p) p /= total;
+  return c;
 }
 
-Vec3f brdf_eval_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi, float& pdf) {
-  Vec3f diffuse, specular;
-  eval_pair(b, wo, wi, diffuse, specular, &pdf);
-  return diffuse + specular;
-}
-
-float brdf_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi) {
-  Vec3f diffuse, specular;
+// Every term for one direction pair: diffuse and the rest, and (if pdf is not null) the density.
+struct PairEval {
+  Vec3f diffuse, other;
   float pdf = 0;
-  eval_pair(b, wo, wi, diffuse, specular, &pdf);
-  return pdf;
+};
+
+// The coat lobe (value and density) at world directions wo, wi.
+void eval_coat(const GltfBsdf& b, Vec3f wo, Vec3f wi, Vec3f nc, Vec3f& value, float& pdf) {
+  const float cv = dot(nc, wo), cl = dot(nc, wi);
+  if (!(cv > 0) || !(cl > 0)) return;
+  const Vec3f h = normalize(wo + wi);
+  const float a = coat_alpha(b), ch = dot(nc, h);
+  const float d = ggx_d(polar(ch), a);
+  const float g2 = smith_g2(polar(cv), polar(cl), GgxAlpha{a, a});
+  const float f = b.clearcoat * schlick(kCoatF0, std::max(0.0f, dot(wo, h)));
+  value = Vec3f{f, f, f} * (d * g2 / (4 * cv * cl));
+  pdf = smith_g1(polar(cv), a) * d / (4 * cv);
 }
 
-bool brdf_sample(const GltfBrdf& b, Vec3f wo, float u1, Vec2f u, BrdfSample& out) {
-  out = BrdfSample{};
-  const Local f = frame_of(b);
-  const Vec3f v = f.to_local(wo);
-  if (!(v.z > 0)) return false;
-  Vec3f l;
-  if (u1 < specular_probability(b)) {
-    const Vec3f h = sample_ggx_vndf(v, alpha_of(b), u);
-    l = reflect(-v, h);
-  } else {
-    l = sample_cosine_hemisphere(u);
+// The base's reflection terms (local v, l above the surface).
+void eval_base_reflection(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice& c, PairEval& e) {
+  const Vec3f h = normalize(v + l);
+  const GgxAlpha a = base_alpha(b);
+  const float vh = std::max(0.0f, dot(v, h));
+  const float dv = ggx_d(h, a) * smith_g2(v, l, a) / (4 * v.z * l.z);
+  const Vec3f fd = dielectric_fresnel_rgb(b, vh);
+  e.other = mix(fd, metal_fresnel(b, vh), b.metallic) * dv;
+  e.diffuse = b.base_color * ((1 - max_component(fd)) * (1 - b.metallic) * (1 - b.transmission) *
+                              (1 - b.diffuse_transmission) / kPi);
+  e.pdf += c.p[kSpecular] * smith_g1(v, a) * ggx_d(h, a) / (4 * v.z) + c.p[kDiffuse] * l.z / kPi;
+}
+
+// The base's transmission terms (local v above, l below the surface).
+void eval_base_transmission(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice& c, PairEval& e) {
+  const float dielectric = 1 - b.metallic;
+  if (b.diffuse_transmission > 0) {
+    const float tv = 1 - dielectric_fresnel(b, v.z), tl = 1 - dielectric_fresnel(b, -l.z);
+    e.diffuse = b.diffuse_transmission_color *
+                (dielectric * (1 - b.transmission) * b.diffuse_transmission * tv * tl / kPi);
+    e.pdf += c.p[kDiffuseTransmission] * -l.z / kPi;
   }
-  if (!(l.z > 0)) return false;
-  out.wi = normalize(f.to_world(l));
-  const Vec3f value = brdf_eval_pdf(b, wo, out.wi, out.pdf);
-  if (!(out.pdf > 0) || !std::isfinite(out.pdf)) return false;
-  out.weight = value * (std::max(0.0f, dot(out.wi, b.n)) / out.pdf);
+  if (!b.volume || !(b.transmission > 0) || b.eta == 1) return;
+  // Generalised half vector of refraction, on the side of the normal.
+  Vec3f h = v + l * b.eta;
+  if (!(dot(h, h) > 0)) return;
+  h = normalize(h);
+  if (h.z < 0) h = -h;
+  const float vh = dot(v, h), lh = dot(l, h);
+  if (!(vh > 0) || !(lh < 0)) return;  // back-facing microfacet
+  const GgxAlpha a = base_alpha(b);
+  const float denom = (lh + vh / b.eta) * (lh + vh / b.eta);
+  const float d = ggx_d(h, a);
+  const float f = dielectric_fresnel(b, vh);
+  const float ft =
+      d * (1 - f) * smith_g2(v, l, a) * std::fabs(lh * vh / (denom * v.z * l.z)) / (b.eta * b.eta);
+  e.other = b.base_color * (dielectric * b.transmission * ft);
+  e.pdf += c.p[kRefraction] * smith_g1(v, a) * vh * d / v.z * std::fabs(lh) / denom;
+}
+
+PairEval eval_pair(const GltfBsdf& b, Vec3f wo, Vec3f wi) {
+  PairEval e;
+  const Local f = base_frame(b);
+  const Vec3f v = f.to_local(wo), l = f.to_local(wi);
+  if (!(v.z > 0) || l.z == 0) return e;
+  const Vec3f nc = coat_normal(b);
+  const LobeChoice c = choose(b, v.z, dot(nc, wo));
+  if (l.z > 0)
+    eval_base_reflection(b, v, l, c, e);
+  else
+    eval_base_transmission(b, v, l, c, e);
+  // Sheen over the base, with its albedo scaling.
+  const float sheen_max = max_component(b.sheen_color);
+  if (sheen_max > 0) {
+    const float ev = sheen_albedo(v.z, b.sheen_roughness),
+                el = sheen_albedo(std::fabs(l.z), b.sheen_roughness);
+    const float scale = 1 - sheen_max * std::max(ev, el);
+    e.diffuse = e.diffuse * scale;
+    e.other = e.other * scale;
+    if (l.z > 0) {
+      e.other += b.sheen_color * sheen_brdf(v, l, b.sheen_roughness);
+      e.pdf += c.p[kSheen] * l.z / kPi;
+    }
+  }
+  // The clear coat over everything.
+  if (b.clearcoat > 0) {
+    const float att = coat_attenuation(b, dot(nc, wo)) * coat_attenuation(b, dot(nc, wi));
+    e.diffuse = e.diffuse * att;
+    e.other = e.other * att;
+    Vec3f coat;
+    float pdf = 0;
+    eval_coat(b, wo, wi, nc, coat, pdf);
+    e.other += coat;
+    e.pdf += c.p[kCoat] * pdf;
+  }
+  return e;
+}
+
+// A direction from lobe `lobe` in world space; false if it fails (total internal reflection,
+// below the horizon of a reflection lobe).
+bool sample_lobe(const GltfBsdf& b, int lobe, Vec3f wo, Vec2f u, Vec3f& wi) {
+  const Local f = base_frame(b);
+  const Vec3f v = f.to_local(wo);
+  Vec3f l;
+  switch (lobe) {
+    case kCoat: {
+      Local cf;
+      cf.n = coat_normal(b);
+      make_frame(cf.n, cf.t, cf.b);
+      const Vec3f vc = cf.to_local(wo);
+      if (!(vc.z > 0)) return false;
+      const Vec3f h = sample_ggx_vndf(vc, coat_alpha(b), u);
+      const Vec3f lc = reflect(-vc, h);
+      if (!(lc.z > 0)) return false;
+      wi = normalize(cf.to_world(lc));
+      return true;
+    }
+    case kSheen:
+    case kDiffuse:
+      l = sample_cosine_hemisphere(u);
+      break;
+    case kDiffuseTransmission:
+      l = sample_cosine_hemisphere(u);
+      l.z = -l.z;
+      break;
+    case kSpecular:
+      l = reflect(-v, sample_ggx_vndf(v, base_alpha(b), u));
+      break;
+    case kRefraction: {
+      const Vec3f h = sample_ggx_vndf(v, base_alpha(b), u);
+      if (!refract(v, h, b.eta, l)) return false;
+      break;
+    }
+    default:
+      return false;
+  }
+  if (l.z == 0 || ((lobe == kSpecular || lobe == kSheen || lobe == kDiffuse) && !(l.z > 0))) return false;
+  if ((lobe == kDiffuseTransmission || lobe == kRefraction) && !(l.z < 0)) return false;
+  wi = normalize(f.to_world(l));
   return true;
+}
+
+}  // namespace
+
+float dielectric_fresnel(const GltfBsdf& b, float cos_theta) {
+  return b.specular * (b.volume ? fresnel_dielectric(cos_theta, b.eta) : schlick(b.f0, cos_theta));
+}
+
+void bsdf_eval_parts(const GltfBsdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular) {
+  const PairEval e = eval_pair(b, wo, wi);
+  diffuse = e.diffuse;
+  specular = e.other;
+}
+
+Vec3f bsdf_eval(const GltfBsdf& b, Vec3f wo, Vec3f wi) {
+  const PairEval e = eval_pair(b, wo, wi);
+  return e.diffuse + e.other;
+}
+
+Vec3f bsdf_eval_pdf(const GltfBsdf& b, Vec3f wo, Vec3f wi, float& pdf) {
+  const PairEval e = eval_pair(b, wo, wi);
+  pdf = e.pdf;
+  return e.diffuse + e.other;
+}
+
+float bsdf_pdf(const GltfBsdf& b, Vec3f wo, Vec3f wi) {
+  return eval_pair(b, wo, wi).pdf;
+}
+
+bool bsdf_sample(const GltfBsdf& b, Vec3f wo, float u1, Vec2f u, BsdfSample& out) {
+  out = BsdfSample{};
+  const float cos_v = dot(b.n, wo);
+  if (!(cos_v > 0)) return false;
+  const LobeChoice c = choose(b, cos_v, dot(coat_normal(b), wo));
+  int lobe = kLobes - 1;
+  float acc = 0;
+  for (int k = 0; k < kLobes; ++k) {
+    acc += c.p[k];
+    if (u1 < acc && c.p[k] > 0) {
+      lobe = k;
+      break;
+    }
+  }
+  while (lobe > 0 && !(c.p[lobe] > 0)) --lobe;  // rounding left u1 past the last lobe
+  if (!sample_lobe(b, lobe, wo, u, out.wi)) return false;
+  const Vec3f value = bsdf_eval_pdf(b, wo, out.wi, out.pdf);
+  if (!(out.pdf > 0) || !std::isfinite(out.pdf)) return false;
+  out.weight = value * (std::fabs(dot(out.wi, b.n)) / out.pdf);
+  return is_finite(out.weight);
 }
 
 }  // namespace penumbra

@@ -1,77 +1,93 @@
-// The glTF 2.0 metallic-roughness BRDF (glTF specification, Appendix B): evaluation, density
-// and sampling of its diffuse and GGX specular lobes in world-space directions.
+// The glTF 2.0 BSDF: the metallic-roughness BRDF of the core specification (Appendix B) with the
+// layers and lobes of the ratified KHR material extensions, evaluated, sampled and given a
+// density in world-space directions.
 #pragma once
 
-// The glTF 2.0 metallic-roughness BRDF (glTF specification, Appendix B): Trowbridge-Reitz (GGX)
-// distribution with alpha = roughness^2, height-correlated Smith visibility, Schlick Fresnel,
-// Lambert diffuse under the dielectric's Fresnel layer, and the dielectric/metal mix by
-// `metallic`:
-//   f = (1 - m)(1 - t)(1 - s F(f0)) c / pi + [(1 - m) s F(f0) + m F(c)] D V
-// with f0 = 0.04 for the core model (KHR_materials_ior: ((ior - 1)/(ior + 1))^2), s the
-// KHR_materials_specular factor (1 by default) and t the KHR_materials_transmission factor (0 by
-// default; the transmitted part is a delta lobe the integrator handles, see path.h).
-// Sampling picks the diffuse or the specular lobe, the specular one by its distribution of
-// visible normals (Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018);
-// pdf() is the combined density of both, so estimators may use any of the three functions.
-// Directions are unit vectors in world space; the shading frame comes from the normal.
+// The model, from the outside in (the Khronos extension specifications' layering, made
+// reciprocal by applying each layer's Fresnel attenuation on both directions):
+//
+//   f = coat + A_c(v) A_c(l) [ sheen + S(v, l) base ]
+//
+// - coat (KHR_materials_clearcoat): c F_c(v.h_c) D_c V_c, an isotropic GGX layer of index 1.5
+//   (f0 = 0.04) with its own normal; A_c(w) = 1 - c F_c(|n_c.w|).
+// - sheen (KHR_materials_sheen): sheenColor D_charlie V_sheen (sheen.h); the layers below are
+//   scaled by S = 1 - max(sheenColor) max(E(|n.v|), E(|n.l|)), E the sheen's directional albedo.
+// - base, reflection (l above the surface):
+//     [(1 - m) F_d + m F_m] D V  +  (1 - m)(1 - t)(1 - d)(1 - max F_d) c / pi
+//   with anisotropic GGX (KHR_materials_anisotropy: alpha_t = mix(alpha, 1, A^2) along the
+//   anisotropy direction, alpha_b = alpha = roughness^2), F_d = s Schlick(f0) and F_m =
+//   Schlick(c), each mixed with the thin-film Fresnel by the iridescence factor
+//   (KHR_materials_iridescence, thin_film.h).
+// - base, transmission (l below the surface):
+//     (1 - m)(1 - t) d c_d / pi (1 - F_d(|n.v|))(1 - F_d(|n.l|))       diffuse transmission
+//   + (1 - m) t c (1 - F) D G2 |v.h||l.h| / (|n.v||n.l| (l.h + v.h/eta)^2 eta^2)
+//                                                  rough refraction (Walter et al., EGSR 2007)
+//   The refraction lobe exists only for a volume (KHR_materials_volume); then the dielectric F
+//   of both lobes is the exact Fresnel of the relative index eta, so light inside meets total
+//   internal reflection. Without a volume, transmission is the integrator's thin delta lobe
+//   straight through and here only removes the diffuse share t (see path.h).
+//
+// Reciprocal except for the refraction lobe, which carries radiance's 1/eta^2. Sampling picks
+// one lobe by its estimated albedo at wo (every present lobe at least 5% of the time); pdf() is
+// the density of the whole mixture, so estimators may combine the three functions freely.
 
-#include "renderer/core/math.h"
+#include "renderer/materials/microfacet.h"
 
 namespace penumbra {
 
-/// A BRDF at one point. Requires a unit shading normal n.
-struct GltfBrdf {
+/// A BSDF at one point. Requires a unit shading normal n (on the side of wo), and a unit
+/// tangent t perpendicular to it when anisotropy > 0.
+struct GltfBsdf {
   Vec3f base_color{1, 1, 1};
   float metallic = 1;
   float roughness = 1;
   Vec3f n{0, 0, 1};
   float f0 = 0.04f;        ///< dielectric reflectance at normal incidence
   float specular = 1;      ///< KHR_materials_specular factor: scales the dielectric Fresnel
-  float transmission = 0;  ///< KHR_materials_transmission: share of the diffuse base removed
+  float transmission = 0;  ///< KHR_materials_transmission: share of the diffuse base transmitted
+  bool volume = false;     ///< transmission refracts into a volume (the rough lobe above)
+  float eta = 1.5f;        ///< relative index behind the surface over in front (volume lobe)
+  Vec3f t{1, 0, 0};        ///< anisotropy direction (unit, perpendicular to n)
+  float anisotropy = 0;    ///< KHR_materials_anisotropy strength in [0, 1]
+  float iridescence = 0;   ///< KHR_materials_iridescence factor in [0, 1]
+  float iridescence_ior = 1.3f;
+  float iridescence_thickness = 400;  ///< nanometres
+  Vec3f sheen_color{0, 0, 0};         ///< KHR_materials_sheen colour (black: no sheen)
+  float sheen_roughness = 0;
+  float clearcoat = 0;  ///< KHR_materials_clearcoat factor in [0, 1]
+  float clearcoat_roughness = 0;
+  Vec3f clearcoat_n{0, 0, 0};                 ///< unit coat normal; zero: the shading normal n
+  float diffuse_transmission = 0;             ///< KHR_materials_diffuse_transmission factor
+  Vec3f diffuse_transmission_color{1, 1, 1};  ///< its colour
 };
 
-/// Fresnel reflectance of the dielectric layer at cos(theta) = cos_theta: s Schlick(f0).
-float dielectric_fresnel(const GltfBrdf& b, float cos_theta);
+/// Fresnel reflectance of the dielectric layer at cos(theta) = cos_theta: s Schlick(f0), or
+/// for a volume s times the exact Fresnel of eta.
+float dielectric_fresnel(const GltfBsdf& b, float cos_theta);
 
-/// Smallest alpha used: roughness 0 would make D a Dirac delta (below 1e-3 the lobe is
-/// narrower than float directions resolve anyway).
-inline constexpr float kMinGgxAlpha = 1e-3f;
+/// True if the BSDF scatters light to the far side of the surface (diffuse transmission or
+/// the volume's refraction lobe).
+inline bool has_transmission_lobes(const GltfBsdf& b) {
+  return b.metallic < 1 && (b.diffuse_transmission > 0 || (b.volume && b.transmission > 0));
+}
 
-/// f(wo, wi), zero unless both directions are above the shading surface. Reciprocal.
-Vec3f brdf_eval(const GltfBrdf& b, Vec3f wo, Vec3f wi);
-/// The diffuse and specular terms of brdf_eval (their sum), for light-group AOVs.
-void brdf_eval_parts(const GltfBrdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular);
-/// brdf_eval and brdf_pdf together, sharing the frame and half vector (pdf is set).
-Vec3f brdf_eval_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi, float& pdf);
-/// Solid-angle density with which brdf_sample() produces wi (both lobes combined).
-float brdf_pdf(const GltfBrdf& b, Vec3f wo, Vec3f wi);
+/// f(wo, wi) for wi on either side of the surface; zero if wo is below it.
+Vec3f bsdf_eval(const GltfBsdf& b, Vec3f wo, Vec3f wi);
+/// The diffuse (reflected and transmitted) and the other terms of bsdf_eval (their sum), for
+/// light-group AOVs.
+void bsdf_eval_parts(const GltfBsdf& b, Vec3f wo, Vec3f wi, Vec3f& diffuse, Vec3f& specular);
+/// bsdf_eval and bsdf_pdf together, sharing the frames and half vectors (pdf is set).
+Vec3f bsdf_eval_pdf(const GltfBsdf& b, Vec3f wo, Vec3f wi, float& pdf);
+/// Solid-angle density with which bsdf_sample() produces wi (all lobes combined).
+float bsdf_pdf(const GltfBsdf& b, Vec3f wo, Vec3f wi);
 
-struct BrdfSample {
+struct BsdfSample {
   Vec3f wi;
-  Vec3f weight;  ///< f cos(theta_i) / pdf (0 when the sample fails)
+  Vec3f weight;  ///< f |cos(theta_i)| / pdf (0 when the sample fails)
   float pdf = 0;
 };
 /// Samples wi from u1 (lobe choice) and u (direction), both uniform in [0, 1).
-/// Returns false (and a zero weight) if wo is below the surface or the sample is.
-bool brdf_sample(const GltfBrdf& b, Vec3f wo, float u1, Vec2f u, BrdfSample& out);
-
-/// Probability of choosing the specular lobe: its share of the Fresnel-at-normal-incidence
-/// reflectance, (1 - m) s f0 + m c against (1 - m)(1 - t)(1 - s f0) c (luminances).
-float specular_probability(const GltfBrdf& b);
-
-/// The GGX pieces, in the local frame where the normal is +z (exposed for tests).
-float ggx_d(Vec3f h, float alpha);
-float smith_g1(Vec3f v, float alpha);
-/// Height-correlated visibility V = G2 / (4 |n.l| |n.v|) (Heitz 2014, eq. 99).
-float smith_visibility(float n_dot_l, float n_dot_v, float alpha);
-/// A visible normal for view direction v (local, v.z > 0) from u in [0,1)^2.
-Vec3f sample_ggx_vndf(Vec3f v, float alpha, Vec2f u);
-
-/// An orthonormal basis (t, b, n) around unit n (Duff et al., "Building an Orthonormal Basis,
-/// Revisited", JCGT 6(1), 2017).
-void make_frame(Vec3f n, Vec3f& t, Vec3f& b);
-
-/// Cosine-weighted direction in the local frame (+z up) from u in [0,1)^2 (Malley's method).
-Vec3f sample_cosine_hemisphere(Vec2f u);
+/// Returns false (and a zero weight) if wo is below the surface or the sample fails.
+bool bsdf_sample(const GltfBsdf& b, Vec3f wo, float u1, Vec2f u, BsdfSample& out);
 
 }  // namespace penumbra

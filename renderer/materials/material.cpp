@@ -2,6 +2,7 @@
 // coverage.
 #include "renderer/materials/material.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace penumbra {
@@ -178,6 +179,111 @@ Vec3f eval_emission(const Scene& scene, const SurfaceInteraction& si) {
   return emissive * coverage(mat, si, eval_texture(scene, mat.base_color_tex, si).w);
 }
 
+namespace {
+
+// The surface's tangent frame as authored (t, b) around shading normal n; false without
+// tangents. si.ns was flipped for back faces, so the tangent and bitangent flip with it (as the
+// Khronos sample viewer does).
+bool tangent_frame(const SurfaceInteraction& si, Vec3f n, Vec3f& t, Vec3f& b) {
+  if (si.tangent.w == 0) return false;
+  const float side = si.back_face ? -1.0f : 1.0f;
+  t = Vec3f{si.tangent.x, si.tangent.y, si.tangent.z} * side;
+  t = t - n * dot(n, t);
+  if (!(dot(t, t) > 0)) return false;
+  t = normalize(t);
+  b = cross(n, t) * (si.tangent.w * side);
+  return true;
+}
+
+// Normal n perturbed by tangent-space normal map `ref` (X and Y scaled by `scale`); n where
+// there is no map, no tangent frame, or the result faces away from the geometric normal.
+Vec3f normal_mapped(const Scene& scene, const SurfaceInteraction& si, const TextureRef& ref, float scale,
+                    Vec3f n) {
+  Vec3f t, b;
+  if (ref.texture < 0 || !tangent_frame(si, n, t, b)) return n;
+  const Vec4f tn = eval_texture(scene, ref, si);
+  const Vec3f m{(tn.x * 2 - 1) * scale, (tn.y * 2 - 1) * scale, tn.z * 2 - 1};
+  const Vec3f out = normalize(t * m.x + b * m.y + n * m.z);
+  return is_finite(out) && dot(out, si.ng) > 0 ? out : n;
+}
+
+float texture_channel(const Scene& scene, const TextureRef& ref, const SurfaceInteraction& si, int c) {
+  if (ref.texture < 0) return 1;
+  const Vec4f v = eval_texture(scene, ref, si);
+  return c == 0 ? v.x : (c == 1 ? v.y : (c == 2 ? v.z : v.w));
+}
+
+Vec3f texture_rgb(const Scene& scene, const TextureRef& ref, const SurfaceInteraction& si) {
+  if (ref.texture < 0) return {1, 1, 1};
+  const Vec4f v = eval_texture(scene, ref, si);
+  return {v.x, v.y, v.z};
+}
+
+// The anisotropy strength and direction (KHR_materials_anisotropy): the texture's RG direction
+// in tangent space rotated by the material's rotation, strength x texture B.
+void eval_anisotropy(const Scene& scene, const Material& mat, const SurfaceInteraction& si,
+                     MaterialPoint& mp) {
+  Vec2f dir{1, 0};
+  float strength = mat.anisotropy;
+  if (mat.anisotropy_tex.texture >= 0) {
+    const Vec4f a = eval_texture(scene, mat.anisotropy_tex, si);
+    const Vec2f d{a.x * 2 - 1, a.y * 2 - 1};
+    const float len = std::sqrt(d.x * d.x + d.y * d.y);
+    if (len > 0) dir = {d.x / len, d.y / len};
+    strength *= a.z;
+  }
+  const float c = std::cos(mat.anisotropy_rotation), s = std::sin(mat.anisotropy_rotation);
+  const Vec2f r{c * dir.x - s * dir.y, s * dir.x + c * dir.y};
+  Vec3f t, b;
+  if (!tangent_frame(si, mp.ns, t, b)) make_frame(mp.ns, t, b);
+  const Vec3f a = t * r.x + b * r.y;
+  const Vec3f at = a - mp.ns * dot(mp.ns, a);
+  if (!(dot(at, at) > 1e-12f)) return;
+  mp.tangent = normalize(at);
+  mp.anisotropy = std::clamp(strength, 0.0f, 1.0f);
+}
+
+// The KHR extensions' layers and lobes at si (after the base normal is known).
+void eval_extensions(const Scene& scene, const Material& mat, const SurfaceInteraction& si,
+                     MaterialPoint& mp) {
+  mp.ior = mat.ior;
+  mp.volume = mat.volume && mat.transmission > 0;
+  if (mp.volume && std::isfinite(mat.attenuation_distance) && mat.attenuation_distance > 0)
+    for (int c = 0; c < 3; ++c)
+      mp.sigma_a[c] = -std::log(std::max(mat.attenuation_color[c], 1e-6f)) / mat.attenuation_distance;
+  mp.dispersion = mat.dispersion;
+  if (mat.clearcoat > 0) {
+    mp.clearcoat = std::clamp(mat.clearcoat * texture_channel(scene, mat.clearcoat_tex, si, 0), 0.0f, 1.0f);
+    mp.clearcoat_roughness = std::clamp(
+        mat.clearcoat_roughness * texture_channel(scene, mat.clearcoat_roughness_tex, si, 1), 0.0f, 1.0f);
+    mp.ns_coat = normal_mapped(scene, si, mat.clearcoat_normal_tex, mat.clearcoat_normal_scale, si.ns);
+  }
+  if (max_component(mat.sheen_color) > 0) {
+    mp.sheen_color = mat.sheen_color * texture_rgb(scene, mat.sheen_color_tex, si);
+    mp.sheen_roughness =
+        std::clamp(mat.sheen_roughness * texture_channel(scene, mat.sheen_roughness_tex, si, 3), 0.0f, 1.0f);
+  }
+  if (mat.anisotropy > 0) eval_anisotropy(scene, mat, si, mp);
+  if (mat.iridescence > 0) {
+    mp.iridescence =
+        std::clamp(mat.iridescence * texture_channel(scene, mat.iridescence_tex, si, 0), 0.0f, 1.0f);
+    mp.iridescence_ior = mat.iridescence_ior;
+    const float w = mat.iridescence_thickness_tex.texture >= 0
+                        ? texture_channel(scene, mat.iridescence_thickness_tex, si, 1)
+                        : 1.0f;
+    mp.iridescence_thickness =
+        mat.iridescence_thickness_min + (mat.iridescence_thickness_max - mat.iridescence_thickness_min) * w;
+  }
+  if (mat.diffuse_transmission > 0) {
+    mp.diffuse_transmission = std::clamp(
+        mat.diffuse_transmission * texture_channel(scene, mat.diffuse_transmission_tex, si, 3), 0.0f, 1.0f);
+    mp.diffuse_transmission_color =
+        mat.diffuse_transmission_color * texture_rgb(scene, mat.diffuse_transmission_color_tex, si);
+  }
+}
+
+}  // namespace
+
 MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bool with_occlusion) {
   const Material& mat = material_of(scene, si.material);
   MaterialPoint mp;
@@ -196,21 +302,50 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bo
     mp.transmission *= eval_texture(scene, mat.transmission_tex, si).x;
   if (with_occlusion && mat.occlusion_tex.texture >= 0)
     mp.occlusion = 1 + mat.occlusion_strength * (eval_texture(scene, mat.occlusion_tex, si).x - 1);
-  mp.ns = si.ns;
-  if (mat.normal_tex.texture >= 0 && si.tangent.w != 0) {
-    const Vec4f tn = eval_texture(scene, mat.normal_tex, si);
-    const Vec3f m{(tn.x * 2 - 1) * mat.normal_scale, (tn.y * 2 - 1) * mat.normal_scale, tn.z * 2 - 1};
-    // Tangent frame of the surface as authored; si.ns was flipped for back faces, so flip
-    // the tangent and bitangent with it (as the Khronos sample viewer does).
-    const float side = si.back_face ? -1.0f : 1.0f;
-    Vec3f t = Vec3f{si.tangent.x, si.tangent.y, si.tangent.z} * side;
-    t = normalize(t - si.ns * dot(si.ns, t));
-    const Vec3f b = cross(si.ns, t) * (si.tangent.w * side);
-    const Vec3f n = normalize(t * m.x + b * m.y + si.ns * m.z);
-    if (dot(t, t) > 0 && dot(n, si.ng) > 0) mp.ns = n;
-  }
+  mp.ns = normal_mapped(scene, si, mat.normal_tex, mat.normal_scale, si.ns);
+  mp.ns_coat = mp.ns;
   if (mat.procedural >= 0) apply_procedural(scene, mat, si, mp);
+  eval_extensions(scene, mat, si, mp);
   return mp;
+}
+
+float dispersion_ior(float ior, float dispersion, int channel) {
+  if (channel < 0 || channel > 2 || !(dispersion > 0) || !(ior > 1)) return ior;
+  constexpr float kLambda[3] = {610, 550, 465};
+  const float abbe = 20 / dispersion;
+  const float l = kLambda[channel];
+  return std::max(1.0f, ior + (ior - 1) / abbe * (523655 / (l * l) - 1.5168f));
+}
+
+GltfBsdf make_bsdf(const MaterialPoint& mp, bool back_face, int channel) {
+  GltfBsdf b;
+  b.base_color = mp.base_color;
+  b.metallic = mp.metallic;
+  b.roughness = mp.roughness;
+  b.n = mp.ns;
+  b.f0 = mp.f0;
+  b.specular = mp.specular;
+  b.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
+  if (mp.volume) {
+    const float ior = std::max(1.0f, dispersion_ior(mp.ior, mp.dispersion, channel));
+    b.eta = back_face ? 1 / ior : ior;
+    b.volume = ior != 1;  // index 1 does not bend light: the thin lobe passes it straight through
+  }
+  if (mp.anisotropy > 0) {
+    b.anisotropy = mp.anisotropy;
+    b.t = mp.tangent;
+  }
+  b.iridescence = mp.iridescence;
+  b.iridescence_ior = mp.iridescence_ior;
+  b.iridescence_thickness = mp.iridescence_thickness;
+  b.sheen_color = mp.sheen_color;
+  b.sheen_roughness = mp.sheen_roughness;
+  b.clearcoat = mp.clearcoat;
+  b.clearcoat_roughness = mp.clearcoat_roughness;
+  if (mp.clearcoat > 0) b.clearcoat_n = mp.ns_coat;
+  b.diffuse_transmission = mp.diffuse_transmission;
+  b.diffuse_transmission_color = mp.diffuse_transmission_color;
+  return b;
 }
 
 float eval_alpha(const Scene& scene, uint32_t instance, uint32_t prim, float u, float v) {

@@ -48,9 +48,32 @@ struct Material {
   TextureRef emissive_tex;            ///< RGB, multiplies emissive
   float ior = 1.5f;                   ///< KHR_materials_ior: dielectric f0 = ((ior-1)/(ior+1))^2
   float specular = 1;                 ///< KHR_materials_specular specularFactor
-  float transmission = 0;             ///< KHR_materials_transmission factor (thin-walled)
+  float transmission = 0;             ///< KHR_materials_transmission factor
   TextureRef transmission_tex;        ///< R multiplies transmission (linear)
-  int procedural = -1;                ///< index into Scene::procedurals (PENUMBRA_procedural), -1 = none
+  /// KHR_materials_volume with thicknessFactor > 0: the mesh bounds a volume that transmitted
+  /// light refracts into and is absorbed in; false: thin-walled.
+  bool volume = false;
+  Vec3f attenuation_color{1, 1, 1};        ///< colour white light takes after attenuation_distance
+  float attenuation_distance = kInfinity;  ///< world units; infinite: no absorption
+  float dispersion = 0;                    ///< KHR_materials_dispersion: 20 / Abbe number
+  float clearcoat = 0;                     ///< KHR_materials_clearcoat factor x texture (R)
+  float clearcoat_roughness = 0;           ///< x texture (G)
+  TextureRef clearcoat_tex, clearcoat_roughness_tex, clearcoat_normal_tex;
+  float clearcoat_normal_scale = 1;
+  Vec3f sheen_color{0, 0, 0};  ///< KHR_materials_sheen colour factor x texture (RGB)
+  float sheen_roughness = 0;   ///< x texture (A)
+  TextureRef sheen_color_tex, sheen_roughness_tex;
+  float anisotropy = 0;           ///< KHR_materials_anisotropy strength x texture (B)
+  float anisotropy_rotation = 0;  ///< radians, counter-clockwise from the tangent
+  TextureRef anisotropy_tex;      ///< RG: direction in tangent space, B: strength
+  float iridescence = 0;          ///< KHR_materials_iridescence factor x texture (R)
+  float iridescence_ior = 1.3f;
+  float iridescence_thickness_min = 100, iridescence_thickness_max = 400;  ///< nm, mixed by texture (G)
+  TextureRef iridescence_tex, iridescence_thickness_tex;
+  float diffuse_transmission = 0;             ///< KHR_materials_diffuse_transmission factor x texture (A)
+  Vec3f diffuse_transmission_color{1, 1, 1};  ///< x texture (RGB)
+  TextureRef diffuse_transmission_tex, diffuse_transmission_color_tex;
+  int procedural = -1;  ///< index into Scene::procedurals (PENUMBRA_procedural), -1 = none
 };
 
 /// A triangle mesh (one glTF primitive): in world space when its only instance is the identity

@@ -54,7 +54,7 @@ TEST_CASE(
   CHECK(ls.scene.textures.empty());
   for (const char* needle :
        {"images[0]: image data could not be read from 'missing.png'",
-        "images[1]: image data could not be read", "images[2]: not a PNG or JPEG image"}) {
+        "images[1]: image data could not be read", "images[2]: not a PNG, JPEG or WebP image"}) {
     bool found = false;
     for (const auto& w : ls.warnings) found = found || w.find(needle) != std::string::npos;
     CHECK(found);
@@ -107,4 +107,77 @@ TEST_CASE("gltf hardening: an image is charged to the budget from its header, be
   w.j["images"] = {{{"uri", "small.png"}}};
   w.write_external(dir / "scene.gltf", "scene.bin");
   CHECK(load_gltf(dir / "scene.gltf", opt).scene.textures.size() == 1);
+}
+
+namespace {
+// A 4 x 4 image of one colour written by OpenImageIO (format from the extension).
+void write_flat_image(const fs::path& file, float r, float g, float b) {
+  std::vector<unsigned char> px(4 * 4 * 3);
+  for (size_t i = 0; i < px.size(); i += 3) {
+    px[i] = (unsigned char)(r * 255);
+    px[i + 1] = (unsigned char)(g * 255);
+    px[i + 2] = (unsigned char)(b * 255);
+  }
+  auto out = OIIO::ImageOutput::create(file.string());
+  REQUIRE(out);
+  REQUIRE(out->open(file.string(), OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8)));
+  REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+  out->close();
+}
+
+// One textured triangle whose texture is `texture` over `images`.
+fs::path textured_file(const fs::path& dir, nlohmann::json images, nlohmann::json texture,
+                       std::vector<std::string> used) {
+  test::GltfWriter w;
+  const int pos = w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const std::vector<float> uv = {0, 0, 1, 0, 0, 1};
+  const int tc = w.accessor(uv.data(), 24, 5126, 3, "VEC2");
+  w.j["images"] = images;
+  w.j["textures"] = {texture};
+  w.j["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  const int m = w.mesh(pos);
+  w.j["meshes"][size_t(m)]["primitives"][0]["attributes"]["TEXCOORD_0"] = tc;
+  w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
+  w.node({{"mesh", m}});
+  w.j["extensionsUsed"] = used;
+  w.write_embedded(dir / "t.gltf");
+  return dir / "t.gltf";
+}
+}  // namespace
+
+TEST_CASE("EXT_texture_webp reads the WebP source; KHR_texture_basisu uses the fallback source or warns",
+          "[io][texture][quick]") {
+  const auto dir = test::temp_dir("texture_extensions");
+  write_flat_image(dir / "red.png", 1, 0, 0);
+  write_flat_image(dir / "blue.webp", 0, 0, 1);
+  // A KTX2 file: its 12-byte identifier and nothing a decoder could use.
+  std::ofstream(dir / "t.ktx2", std::ios::binary) << std::string("\xABKTX 20\xBB\r\n\x1A\n", 12) << "payload";
+  const nlohmann::json images = {{{"uri", "red.png"}}, {{"uri", "blue.webp"}}, {{"uri", "t.ktx2"}}};
+  auto texel = [](const LoadedScene& l) {
+    REQUIRE(l.scene.textures.size() == 1);
+    return sample_texture(l.scene.textures[0], {0.5f, 0.5f}, 0);
+  };
+  // WebP preferred over the PNG fallback.
+  LoadedScene l = load_gltf(
+      textured_file(dir, images, {{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}},
+                    {"EXT_texture_webp"}));
+  CHECK(l.warnings.empty());
+  CHECK(texel(l).z == Approx(1));
+  CHECK(texel(l).x == Approx(0));
+  // Basis Universal: the KTX2 image is not decoded, the core source is the fallback.
+  l = load_gltf(textured_file(dir, images,
+                              {{"source", 0}, {"extensions", {{"KHR_texture_basisu", {{"source", 2}}}}}},
+                              {"KHR_texture_basisu"}));
+  CHECK(l.warnings.empty());
+  CHECK(texel(l).x == Approx(1));
+  // Without a fallback: a warning naming the texture and the extension, and no texture.
+  l = load_gltf(textured_file(dir, images, {{"extensions", {{"KHR_texture_basisu", {{"source", 2}}}}}},
+                              {"KHR_texture_basisu"}));
+  CHECK(l.scene.textures.empty());
+  REQUIRE(l.warnings.size() == 1);
+  CHECK_THAT(l.warnings[0], Contains("textures[0]") && Contains("KHR_texture_basisu") && Contains("factors"));
+  // A KTX2 image used as a plain source: a warning that says what it is.
+  l = load_gltf(textured_file(dir, images, {{"source", 2}}, {}));
+  REQUIRE(l.warnings.size() == 1);
+  CHECK_THAT(l.warnings[0], Contains("images[2]") && Contains("KTX2"));
 }

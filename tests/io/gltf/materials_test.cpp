@@ -83,6 +83,16 @@ FrontView front_albedo(const std::filesystem::path& file, int width = 480) {
   return v;
 }
 
+// A file with one quad node whose primitive uses materials[0] (for the caller to write).
+GltfWriter quad_with_material() {
+  GltfWriter w;
+  const int m =
+      w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
+  w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
+  w.node({{"mesh", m}});
+  return w;
+}
+
 float lum(Vec3f c) {
   return luminance(c);
 }
@@ -226,11 +236,7 @@ TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCO
 
 TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field",
           "[io][gltf][quick]") {
-  GltfWriter w;
-  const int m =
-      w.mesh(w.positions(test::quad_positions()), w.indices(std::vector<uint8_t>{0, 1, 2, 0, 2, 3}));
-  w.j["meshes"][size_t(m)]["primitives"][0]["material"] = 0;
-  w.node({{"mesh", m}});
+  GltfWriter w = quad_with_material();
   w.j["materials"] = {{{"extensions",
                         {{"KHR_materials_ior", {{"ior", 2.0}}},
                          {"KHR_materials_specular", {{"specularFactor", 0.5}}},
@@ -255,4 +261,136 @@ TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name 
   w.j["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"] = "shiny";
   REQUIRE_THROWS_WITH(write_and_load(w, "spbad"),
                       Contains("KHR_materials_specular.specularFactor") && Contains("number"));
+}
+
+TEST_CASE(
+    "KHR material layers (clearcoat, sheen, volume, anisotropy, iridescence, dispersion, diffuse "
+    "transmission) load; bad values name the field",
+    "[io][gltf][quick]") {
+  GltfWriter w = quad_with_material();
+  w.j["materials"] = {
+      {{"extensions",
+        {{"KHR_materials_clearcoat", {{"clearcoatFactor", 0.8}, {"clearcoatRoughnessFactor", 0.2}}},
+         {"KHR_materials_sheen", {{"sheenColorFactor", {0.9, 0.5, 0.1}}, {"sheenRoughnessFactor", 0.4}}},
+         {"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+         {"KHR_materials_volume",
+          {{"thicknessFactor", 0.5}, {"attenuationDistance", 2.0}, {"attenuationColor", {0.5, 0.6, 0.7}}}},
+         {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.6}, {"anisotropyRotation", 1.25}}},
+         {"KHR_materials_iridescence",
+          {{"iridescenceFactor", 1.0},
+           {"iridescenceIor", 1.8},
+           {"iridescenceThicknessMinimum", 200},
+           {"iridescenceThicknessMaximum", 600}}},
+         {"KHR_materials_dispersion", {{"dispersion", 0.3}}},
+         {"KHR_materials_diffuse_transmission",
+          {{"diffuseTransmissionFactor", 0.25}, {"diffuseTransmissionColorFactor", {0.2, 0.4, 0.6}}}}}}}};
+  w.j["extensionsUsed"] = {"KHR_materials_clearcoat",    "KHR_materials_sheen",
+                           "KHR_materials_transmission", "KHR_materials_volume",
+                           "KHR_materials_anisotropy",   "KHR_materials_iridescence",
+                           "KHR_materials_dispersion",   "KHR_materials_diffuse_transmission"};
+  const LoadedScene loaded = write_and_load(w, "layers");
+  for (const auto& warning : loaded.warnings) CHECK(warning.find("not supported") == std::string::npos);
+  const Material& mat = loaded.scene.materials.at(0);
+  CHECK(mat.clearcoat == 0.8f);
+  CHECK(mat.clearcoat_roughness == 0.2f);
+  CHECK(mat.sheen_color.x == 0.9f);
+  CHECK(mat.sheen_color.z == 0.1f);
+  CHECK(mat.sheen_roughness == 0.4f);
+  CHECK(mat.volume);
+  CHECK(mat.attenuation_distance == 2.0f);
+  CHECK(mat.attenuation_color.y == 0.6f);
+  CHECK(mat.anisotropy == 0.6f);
+  CHECK(mat.anisotropy_rotation == 1.25f);
+  CHECK(mat.iridescence == 1.0f);
+  CHECK(mat.iridescence_ior == 1.8f);
+  CHECK(mat.iridescence_thickness_min == 200);
+  CHECK(mat.iridescence_thickness_max == 600);
+  CHECK(mat.dispersion == 0.3f);
+  CHECK(mat.diffuse_transmission == 0.25f);
+  CHECK(mat.diffuse_transmission_color.z == 0.6f);
+  // A thickness of 0 is thin-walled.
+  w.j["materials"][0]["extensions"]["KHR_materials_volume"]["thicknessFactor"] = 0.0;
+  CHECK_FALSE(write_and_load(w, "thin").scene.materials.at(0).volume);
+  auto bad = [&](const char* ext, const char* key, nlohmann::json value, const char* expect) {
+    GltfWriter b = w;
+    b.j["materials"][0]["extensions"][ext][key] = value;
+    INFO(ext << "." << key);
+    REQUIRE_THROWS_WITH(
+        write_and_load(b, "bad"),
+        Contains(std::string("materials[0].extensions.") + ext + "." + key) && Contains(expect));
+  };
+  bad("KHR_materials_clearcoat", "clearcoatFactor", 1.5, "[0, 1]");
+  bad("KHR_materials_sheen", "sheenColorFactor", {1, 2}, "3 numbers");
+  bad("KHR_materials_volume", "attenuationDistance", 0.0, "> 0");
+  bad("KHR_materials_anisotropy", "anisotropyStrength", "strong", "number");
+  bad("KHR_materials_iridescence", "iridescenceIor", 0.5, ">= 1");
+  bad("KHR_materials_dispersion", "dispersion", -1, ">= 0");
+  bad("KHR_materials_diffuse_transmission", "diffuseTransmissionFactor", 2, "[0, 1]");
+  bad("KHR_materials_clearcoat", "clearcoatTexture", 3, "texture info");
+}
+
+TEST_CASE("KHR_materials_variants: a variant picks each mapping's material; unknown names list the variants",
+          "[io][gltf][quick]") {
+  GltfWriter w = quad_with_material();
+  w.j["materials"] = {{{"name", "own"}}, {{"name", "blue"}}, {{"name", "green"}}};
+  w.j["extensions"]["KHR_materials_variants"]["variants"] = {
+      {{"name", "red"}}, {{"name", "blue"}}, {{"name", "green"}}};
+  w.j["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"] = {
+      {{"material", 1}, {"variants", {1}}}, {{"material", 2}, {"variants", {2}}}};
+  w.j["extensionsUsed"] = {"KHR_materials_variants"};
+  auto material_of_mesh = [&](const std::string& variant) {
+    GltfLoadOptions opt;
+    opt.variant = variant;
+    const LoadedScene l = write_and_load(w, "variants", opt);
+    CHECK(l.warnings.empty());
+    CHECK(l.info.variants == std::vector<std::string>{"red", "blue", "green"});
+    return l.scene.materials.at(size_t(l.scene.meshes.at(0).material)).name;
+  };
+  CHECK(material_of_mesh("") == "own");
+  CHECK(material_of_mesh("red") == "own");  // no mapping: the primitive's own material
+  CHECK(material_of_mesh("blue") == "blue");
+  CHECK(material_of_mesh("green") == "green");
+  GltfLoadOptions opt;
+  opt.variant = "purple";
+  REQUIRE_THROWS_WITH(write_and_load(w, "novariant", opt),
+                      Contains("no variant 'purple'") && Contains("'red', 'blue', 'green'"));
+  w.j["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][0]["material"] = 9;
+  opt.variant = "blue";
+  REQUIRE_THROWS_WITH(
+      write_and_load(w, "badmapping", opt),
+      Contains("meshes[0].primitives[0].extensions.KHR_materials_variants.mappings[0].material"));
+}
+
+TEST_CASE("KHR_materials_pbrSpecularGlossiness converts to metallic-roughness with a warning",
+          "[io][gltf][quick]") {
+  GltfWriter w = quad_with_material();
+  const char* ext = "KHR_materials_pbrSpecularGlossiness";
+  w.j["extensionsUsed"] = {ext};
+  // A dielectric: grey diffuse, the dielectric's 0.04 specular: metallic 0, the diffuse is the base.
+  w.j["materials"] = {{{"extensions",
+                        {{ext,
+                          {{"diffuseFactor", {0.5, 0.25, 0.125, 0.8}},
+                           {"specularFactor", {0.04, 0.04, 0.04}},
+                           {"glossinessFactor", 0.25}}}}}}};
+  LoadedScene l = write_and_load(w, "specgloss");
+  const Material& d = l.scene.materials.at(0);
+  CHECK(d.metallic == Approx(0).margin(1e-6));
+  CHECK(d.roughness == Approx(0.75));
+  CHECK(d.base_color.x == Approx(0.5).epsilon(1e-4));
+  CHECK(d.base_color.z == Approx(0.125).epsilon(1e-4));
+  CHECK(d.alpha == Approx(0.8));
+  REQUIRE(l.warnings.size() == 1);
+  CHECK_THAT(l.warnings[0], Contains("materials[0].extensions.KHR_materials_pbrSpecularGlossiness") &&
+                                Contains("converted to metallic-roughness"));
+  // A metal: black diffuse, coloured specular: metallic 1, the specular colour is the base.
+  w.j["materials"][0]["extensions"][ext] = {
+      {"diffuseFactor", {0, 0, 0, 1}}, {"specularFactor", {0.9, 0.6, 0.3}}, {"glossinessFactor", 1.0}};
+  l = write_and_load(w, "specgloss_metal");
+  const Material& m = l.scene.materials.at(0);
+  CHECK(m.metallic == Approx(1).margin(1e-3));
+  CHECK(m.roughness == Approx(0).margin(1e-6));
+  CHECK(m.base_color.x == Approx(0.9).epsilon(1e-3));
+  CHECK(m.base_color.z == Approx(0.3).epsilon(1e-3));
+  w.j["materials"][0]["extensions"][ext]["glossinessFactor"] = "glossy";
+  REQUIRE_THROWS_WITH(write_and_load(w, "specgloss_bad"), Contains("glossinessFactor") && Contains("number"));
 }
