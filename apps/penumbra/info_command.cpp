@@ -151,6 +151,9 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
               join(i.extensions_required).c_str());
   print_extension_support(i.extensions_used);
   if (!i.variants.empty()) std::printf("variants     %s (--variant NAME)\n", join(i.variants).c_str());
+  if (loaded.environment)
+    std::printf("environment  %s (EXT_lights_image_based, %dx%d map; --env replaces it)\n",
+                i.image_light.c_str(), loaded.environment->width, loaded.environment->height);
   const Bounds3f b = compute_bounds(s);
   if (!b.empty())
     std::printf("bounds       (%.4g, %.4g, %.4g) - (%.4g, %.4g, %.4g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x,

@@ -153,6 +153,8 @@ void setup_phase(RenderJob& job) {
     job.environment = make_constant_environment(*q.env_colour * a.env_intensity);
   else if (!a.env.empty())
     job.environment = load_environment(a.env, a.env_intensity, a.env_rotation, q.budget - committed);
+  else if (job.loaded.environment)  // the file's EXT_lights_image_based light
+    job.environment = *job.loaded.environment;
   if (q.path) job.area_lights = build_area_lights(scene);
   if (scene.lights.empty() && (!q.path || (job.area_lights.pmf.empty() && is_black(job.environment)))) {
     scene.lights.push_back(default_key_light(job.camera));

@@ -2,11 +2,16 @@
 """Writes a copy of a glTF (.gltf with its resources, or .glb) with one more camera node, so
 that Penumbra and Blender Cycles render exactly the same view.
 
-usage: add_camera.py IN.gltf|IN.glb OUTDIR EYE_X EYE_Y EYE_Z YFOV_RADIANS [PITCH_DEGREES]
+usage: add_camera.py IN.gltf|IN.glb OUTDIR EYE_X EYE_Y EYE_Z YFOV_RADIANS [PITCH_DEGREES] [--optional-extensions]
 The camera sits at EYE looking down -Z (glTF's camera convention) turned by PITCH about +X
-(90 looks along +Y with +Z up), with aspect 16:9."""
+(90 looks along +Y with +Z up), with aspect 16:9. --optional-extensions empties
+extensionsRequired, so that an importer without one of them loads the rest (Blender 3.4 refuses
+files that require KHR_materials_iridescence)."""
 import json, math, os, shutil, struct, sys
 
+optional = "--optional-extensions" in sys.argv
+if optional:
+    sys.argv.remove("--optional-extensions")
 src, outdir = sys.argv[1], sys.argv[2]
 eye = [float(v) for v in sys.argv[3:6]]
 yfov = float(sys.argv[6])
@@ -21,6 +26,8 @@ def add_camera(doc):
                                         "rotation": [math.sin(pitch / 2), 0, 0, math.cos(pitch / 2)]})
     scene = doc["scenes"][doc.get("scene", 0)]
     scene.setdefault("nodes", []).append(len(doc["nodes"]) - 1)
+    if optional:
+        doc.pop("extensionsRequired", None)
     return doc
 
 

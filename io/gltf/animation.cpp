@@ -15,7 +15,8 @@ namespace penumbra::gltf {
 namespace {
 
 // Channel ci of animations[ai] sampled at `time` into poses (nothing for a channel without a
-// target node or with an unsupported path, which is warned about).
+// target node or with an unsupported path, which is warned about; KHR_animation_pointer
+// channels are applied by animation_pointer.h).
 void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, std::vector<NodePose>& poses) {
   const auto& anim = ctx.model.animations[ai];
   const auto& ch = anim.channels[ci];
@@ -24,19 +25,11 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
   if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
     ctx.fail(cw + ".sampler", "sampler index " + std::to_string(ch.sampler) + " out of range (" +
                                   std::to_string(anim.samplers.size()) + " samplers)");
+  if (ch.target_path == "pointer") return;
   if (ch.target_node < 0) return;  // no target node: nothing to animate (spec allows it)
   if (size_t(ch.target_node) >= ctx.model.nodes.size())
     ctx.fail(cw + ".target.node", "node index " + std::to_string(ch.target_node) + " out of range (" +
                                       std::to_string(ctx.model.nodes.size()) + " nodes)");
-  const auto& smp = anim.samplers[size_t(ch.sampler)];
-  const std::string sw = aw + "." + idx("samplers", size_t(ch.sampler));
-  Interpolation interp = Interpolation::Linear;
-  if (smp.interpolation == "STEP")
-    interp = Interpolation::Step;
-  else if (smp.interpolation == "CUBICSPLINE")
-    interp = Interpolation::CubicSpline;
-  else if (smp.interpolation != "LINEAR" && !smp.interpolation.empty())
-    ctx.fail(sw + ".interpolation", "'" + smp.interpolation + "' is not STEP, LINEAR or CUBICSPLINE");
   const std::string& path = ch.target_path;
   size_t width = 0;
   if (path == "translation" || path == "scale")
@@ -44,38 +37,12 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
   else if (path == "rotation")
     width = 4;
   else if (path == "weights")
-    width = 0;  // from the counts below
+    width = 0;  // from the counts
   else {
     ctx.warn(cw + ".target.path", "path '" + path + "' is not supported; channel ignored");
     return;
   }
-  const auto in = read_accessor(ctx, smp.input, sw + ".input", {TINYGLTF_TYPE_SCALAR},
-                                {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
-  const auto outv = read_accessor(
-      ctx, smp.output, sw + ".output",
-      {width == 3 ? TINYGLTF_TYPE_VEC3 : (width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_SCALAR)},
-      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-       TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-      true);
-  std::vector<float> times(in.begin(), in.end()), values(outv.begin(), outv.end());
-  for (size_t k = 0; k < times.size(); ++k)
-    if (!std::isfinite(times[k]) || (k > 0 && times[k] < times[k - 1]))
-      ctx.fail(sw + ".input", "key times must be finite and non-decreasing (key " + std::to_string(k) + ")");
-  for (float v : values)
-    if (!std::isfinite(v)) ctx.fail(sw + ".output", "values must be finite");
-  const size_t per_key = interp == Interpolation::CubicSpline ? 3 : 1;
-  if (width == 0) {  // weights: one value per morph target per key
-    if (values.size() % (times.size() * per_key) != 0)
-      ctx.fail(sw + ".output", "count " + std::to_string(values.size()) + " is not a multiple of " +
-                                   std::to_string(times.size() * per_key) + " (keys x morph targets)");
-    width = values.size() / (times.size() * per_key);
-  } else if (values.size() != times.size() * per_key * width) {
-    ctx.fail(sw + ".output", "has " + std::to_string(values.size() / width) + " elements; " +
-                                 std::to_string(times.size() * per_key) + " expected for " +
-                                 std::to_string(times.size()) + " keys");
-  }
-  std::vector<double> v(width);
-  sample_track(times, values, width, interp, path == "rotation", time, v.data());
+  const std::vector<double> v = sample_animation(ctx, ai, ch.sampler, width, path == "rotation", time);
   NodePose& pose = poses[size_t(ch.target_node)];
   if (path == "translation") {
     pose.has_t = true;
@@ -93,6 +60,52 @@ void sample_channel(const GltfContext& ctx, size_t ai, size_t ci, double time, s
 }
 
 }  // namespace
+
+std::vector<double> sample_animation(const GltfContext& ctx, size_t ai, int sampler, size_t width,
+                                     bool rotation, double time) {
+  const auto& anim = ctx.model.animations[ai];
+  const auto& smp = anim.samplers[size_t(sampler)];
+  const std::string sw = idx("animations", ai) + "." + idx("samplers", size_t(sampler));
+  Interpolation interp = Interpolation::Linear;
+  if (smp.interpolation == "STEP")
+    interp = Interpolation::Step;
+  else if (smp.interpolation == "CUBICSPLINE")
+    interp = Interpolation::CubicSpline;
+  else if (smp.interpolation != "LINEAR" && !smp.interpolation.empty())
+    ctx.fail(sw + ".interpolation", "'" + smp.interpolation + "' is not STEP, LINEAR or CUBICSPLINE");
+  const int type = width == 2   ? TINYGLTF_TYPE_VEC2
+                   : width == 3 ? TINYGLTF_TYPE_VEC3
+                   : width == 4 ? TINYGLTF_TYPE_VEC4
+                                : TINYGLTF_TYPE_SCALAR;
+  const auto in = read_accessor(ctx, smp.input, sw + ".input", {TINYGLTF_TYPE_SCALAR},
+                                {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+  const auto outv = read_accessor(
+      ctx, smp.output, sw + ".output", {type},
+      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+       TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+      true);
+  std::vector<float> times(in.begin(), in.end()), values(outv.begin(), outv.end());
+  if (times.empty()) ctx.fail(sw + ".input", "has no keys");
+  for (size_t k = 0; k < times.size(); ++k)
+    if (!std::isfinite(times[k]) || (k > 0 && times[k] < times[k - 1]))
+      ctx.fail(sw + ".input", "key times must be finite and non-decreasing (key " + std::to_string(k) + ")");
+  for (float v : values)
+    if (!std::isfinite(v)) ctx.fail(sw + ".output", "values must be finite");
+  const size_t per_key = interp == Interpolation::CubicSpline ? 3 : 1;
+  if (width == 0) {  // e.g. weights: one value per morph target per key
+    if (values.size() % (times.size() * per_key) != 0)
+      ctx.fail(sw + ".output", "count " + std::to_string(values.size()) + " is not a multiple of " +
+                                   std::to_string(times.size() * per_key) + " (keys x values per key)");
+    width = values.size() / (times.size() * per_key);
+  } else if (values.size() != times.size() * per_key * width) {
+    ctx.fail(sw + ".output", "has " + std::to_string(values.size() / width) + " elements; " +
+                                 std::to_string(times.size() * per_key) + " expected for " +
+                                 std::to_string(times.size()) + " keys");
+  }
+  std::vector<double> v(width);
+  if (width > 0) sample_track(times, values, width, interp, rotation, time, v.data());
+  return v;
+}
 
 std::vector<NodePose> evaluate_animations(const GltfContext& ctx, double time) {
   std::vector<NodePose> poses(ctx.model.nodes.size());

@@ -21,6 +21,12 @@ struct NodePose {
   std::vector<double> weights;
 };
 
+/// The value of animations[a].samplers[sampler] (a valid index) at `time` seconds: `width`
+/// components per key (0: the output count over the key count), a quaternion normalised if
+/// `rotation`. Throws InputError naming the sampler for malformed keys or values.
+std::vector<double> sample_animation(const GltfContext& ctx, size_t a, int sampler, size_t width,
+                                     bool rotation, double time);
+
 /// One pose per node: every channel of every animation sampled at `time` seconds. Throws
 /// InputError naming the animation element for malformed channels or samplers.
 std::vector<NodePose> evaluate_animations(const GltfContext& ctx, double time);

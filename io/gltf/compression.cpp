@@ -111,8 +111,9 @@ void decode_meshopt_view(tinygltf::Model& model, const std::string& file, size_t
     throw InputError(file, where,
                      "decodes to " + std::to_string(decoded) +
                          " bytes, more than the bufferView's byteLength " + std::to_string(bv.byteLength));
-  const unsigned char* src = source_bytes(model, file, buffer, offset, length, where);
+  source_bytes(model, file, buffer, offset, length, where);  // the range is checked before allocating
   const int target = new_buffer(model, uint64_t(bv.byteLength), budget, where);
+  const unsigned char* src = model.buffers[size_t(buffer)].data.data() + offset;
   unsigned char* dst = model.buffers[size_t(target)].data.data();
   int rc = 0;
   if (mode == "ATTRIBUTES")
@@ -198,8 +199,10 @@ std::vector<DracoAttribute> draco_requests(const tinygltf::Model& model, const s
     if (!out.empty() && uint64_t(a.count) != points)
       throw InputError(file, aw, "count differs from the primitive's other Draco attributes");
     points = uint64_t(a.count);
-    budget.charge(points * component_bytes(a.componentType) * uint64_t(r.components) * 2, aw,
-                  "its decoded data needs");
+    uint64_t bytes = 0;
+    if (!mul_ok(points, component_bytes(a.componentType) * uint64_t(r.components) * 2, bytes))
+      throw InputError(file, aw, "count " + std::to_string(points) + " is too large");
+    budget.charge(bytes, aw, "its decoded data needs");
     out.push_back(std::move(r));
     accessors.push_back(it->second);
   }
@@ -223,13 +226,17 @@ void decode_draco_primitive(tinygltf::Model& model, const std::string& file, tin
   uint64_t points = 0;
   std::vector<DracoAttribute> attributes =
       draco_requests(model, file, prim, x, where, accessors, points, budget);
-  uint64_t faces = 0;
-  if (prim.indices >= 0) {
-    const tinygltf::Accessor& a = accessor_at(model, file, prim.indices, where + ".indices");
-    if (a.count % 3 != 0) throw InputError(file, where + ".indices", "count is not a multiple of 3");
-    faces = uint64_t(a.count) / 3;
-    budget.charge(uint64_t(a.count) * 8, where + ".indices", "its decoded data needs");
-  }
+  // Draco decodes a triangle list; the primitive declares its size by its indices accessor.
+  if (prim.indices < 0) throw InputError(file, xw, "a Draco primitive needs an indices accessor");
+  if (prim.mode != TINYGLTF_MODE_TRIANGLES)
+    throw InputError(file, where + ".mode", "a Draco primitive must be a triangle list (mode 4)");
+  const tinygltf::Accessor& ia = accessor_at(model, file, prim.indices, where + ".indices");
+  if (ia.count % 3 != 0) throw InputError(file, where + ".indices", "count is not a multiple of 3");
+  const uint64_t faces = uint64_t(ia.count) / 3;
+  uint64_t index_bytes = 0;
+  if (!mul_ok(uint64_t(ia.count), 8, index_bytes))
+    throw InputError(file, where + ".indices", "count " + std::to_string(ia.count) + " is too large");
+  budget.charge(index_bytes, where + ".indices", "its decoded data needs");
   DracoMesh mesh = decode_draco(src, bv.byteLength, points, faces, attributes);
   if (!mesh.error.empty()) throw InputError(file, xw, mesh.error);
   if (mesh.points != points && !attributes.empty())

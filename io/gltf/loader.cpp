@@ -10,8 +10,10 @@
 
 #include "io/gltf/accessors.h"
 #include "io/gltf/animation.h"
+#include "io/gltf/animation_pointer.h"
 #include "io/gltf/compression.h"
 #include "io/gltf/context.h"
+#include "io/gltf/image_light.h"
 #include "io/gltf/images.h"
 #include "io/gltf/materials.h"
 #include "io/gltf/meshes.h"
@@ -28,6 +30,8 @@ std::vector<std::string> supported_gltf_extensions() {
   for (auto& e : gltf::compression_extensions()) out.push_back(std::move(e));
   out.push_back("EXT_mesh_gpu_instancing");
   out.push_back("KHR_materials_variants");
+  out.push_back("KHR_animation_pointer");
+  out.push_back("EXT_lights_image_based");
   out.push_back("KHR_materials_pbrSpecularGlossiness");
   out.push_back("EXT_texture_webp");
   out.push_back("KHR_texture_basisu");
@@ -42,7 +46,12 @@ std::vector<std::pair<std::string, std::string>> partial_gltf_extensions() {
            "fallback source is used, else the material's factors"},
           {"KHR_materials_pbrSpecularGlossiness",
            "converted to metallic-roughness from its factors and diffuse texture; the "
-           "specular-glossiness texture is not used"}};
+           "specular-glossiness texture is not used"},
+          {"KHR_meshopt_compression",
+           "Debian 12's meshoptimizer 0.18 decodes version-0 streams only; version-1 streams and the COLOR "
+           "filter are errors"},
+          {"KHR_materials_specular",
+           "specularFactor only; specularColorFactor and the specular textures are not used"}};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {
@@ -151,6 +160,7 @@ std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions&
   std::vector<NodePose> poses;
   if (ctx.options.time) poses = evaluate_animations(ctx, *ctx.options.time);
   const std::vector<int> roots = scene_roots(ctx);
+  load_image_light(ctx, textures);
   NodeTransforms nodes = link_nodes(ctx, poses);
   if (ctx.options.time) mark_moving_nodes(ctx, nodes);
   const NodeUses uses = place_nodes(ctx, nodes, roots);
@@ -178,6 +188,9 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
   std::shared_ptr<GltfAnimation> animation;
   try {
     gltf::decompress_model(model, name, budget);
+    if (options.time && gltf::has_animation_pointers(model))
+      gltf::apply_animation_pointers(gltf::GltfContext{model, name, options, budget, out}, model,
+                                     *options.time);
     animation = gltf::convert(gltf::GltfContext{model, name, options, budget, out}, vendor);
   } catch (const std::bad_alloc&) {
     throw InputError(name, "", "out of memory while converting the scene");

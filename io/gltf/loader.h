@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "renderer/lights/environment.h"
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
@@ -54,6 +55,7 @@ struct GltfInfo {
   std::vector<std::string> extensions_used, extensions_required;
   std::vector<std::string> variants;                ///< KHR_materials_variants names, in file order
   int variant = -1;                                 ///< the variant used (index into variants), -1: none
+  std::string image_light;                          ///< the EXT_lights_image_based light used, empty: none
   std::vector<std::string> camera_instances;        ///< "name (perspective, node 3)" in scene order
   std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
@@ -70,6 +72,8 @@ struct GltfAnimation;
 struct LoadedScene {
   Scene scene;
   GltfInfo info;
+  /// The scene's EXT_lights_image_based light as the path tracer's environment; null if none.
+  std::shared_ptr<const Environment> environment;
   std::vector<std::string> warnings;  ///< each names the element it concerns
   /// Set when a time and keep_animation were asked for and the file has animations that only
   /// move placements (see pose_gltf_scene):

@@ -82,6 +82,17 @@ void charge_elements(const nlohmann::json& doc, MemoryBudget& budget) {
                 std::to_string(channels) + " channels and " + std::to_string(samplers) + " samplers need");
 }
 
+// True for a buffer that only EXT_/KHR_meshopt_compression's decoding fills (no uri, the
+// extension's fallback flag): it is never read, and decoding charges what it writes.
+bool is_meshopt_fallback(const nlohmann::json& b) {
+  if (!b.is_object() || b.contains("uri") || !b.contains("extensions") || !b["extensions"].is_object())
+    return false;
+  const auto& x = b["extensions"];
+  for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"})
+    if (x.contains(name) && x[name].is_object() && x[name].value("fallback", false) == true) return true;
+  return false;
+}
+
 // Reads the scene file. Before the whole file is read, the JSON text's parsed size is charged
 // (from the file size, or a GLB's JSON chunk length), and a GLB's binary rest.
 std::vector<unsigned char> read_scene_file(const fs::path& file, uint64_t max_file_bytes,
@@ -146,7 +157,7 @@ void resolve_external_files(const nlohmann::json& doc, const std::string& file, 
   }
   if (const auto buffers = doc.find("buffers"); buffers != doc.end())
     for (size_t i = 0; i < buffers->size(); ++i)
-      if ((*buffers)[i].contains("byteLength"))
+      if ((*buffers)[i].contains("byteLength") && !is_meshopt_fallback((*buffers)[i]))
         budget.charge((*buffers)[i]["byteLength"].get<uint64_t>(), idx("buffers", i), "its data needs");
 }
 
@@ -179,38 +190,47 @@ std::string one_line(std::string s) {
   return s;
 }
 
-// Two compression layouts tinygltf refuses, made acceptable before it parses the JSON:
+// Three layouts tinygltf refuses, made acceptable before it parses the JSON:
 // - a primitive whose indices accessor has no bufferView, which is how KHR_draco_mesh_compression
 //   primitives declare their decoded indices: such accessors are given the primitive's Draco
 //   bufferView (decompress_model() then points them at the decoded indices);
 // - a buffer without a uri other than a GLB's first, which is how EXT_/KHR_meshopt_compression
 //   declare the fallback buffer that decoding fills: such buffers become 4 zero bytes
-//   (decompress_model() gives every compressed bufferView a buffer of its own).
+//   (decompress_model() gives every compressed bufferView a buffer of its own);
+// - a KHR_animation_pointer channel, whose target has no node: tinygltf drops channels without
+//   one, so such targets get node 0 (unused: the pointer names the target).
 // Returns the rewritten JSON, or an empty string when nothing needs it.
-std::string prepare_compressed(std::string_view json) {
+std::string prepare_for_tinygltf(std::string_view json) {
   if (json.find("KHR_draco_mesh_compression") == std::string_view::npos &&
-      json.find("meshopt_compression") == std::string_view::npos)
+      json.find("meshopt_compression") == std::string_view::npos &&
+      json.find("KHR_animation_pointer") == std::string_view::npos)
     return {};
   nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
-  if (doc.is_discarded() || !doc.contains("meshes") || !doc["meshes"].is_array() ||
-      !doc.contains("accessors") || !doc["accessors"].is_array())
-    return {};
-  auto& accessors = doc["accessors"];
+  if (doc.is_discarded() || !doc.is_object()) return {};
   bool changed = false;
+  if (doc.contains("animations") && doc["animations"].is_array())
+    for (auto& a : doc["animations"]) {
+      if (!a.is_object() || !a.contains("channels") || !a["channels"].is_array()) continue;
+      for (auto& ch : a["channels"]) {
+        if (!ch.is_object() || !ch.contains("target") || !ch["target"].is_object()) continue;
+        auto& target = ch["target"];
+        if (target.value("path", "") != "pointer" || target.contains("node")) continue;
+        target["node"] = 0;
+        changed = true;
+      }
+    }
   if (doc.contains("buffers") && doc["buffers"].is_array()) {
     for (auto& b : doc["buffers"]) {
-      if (!b.is_object() || b.contains("uri") || !b.contains("extensions") || !b["extensions"].is_object())
-        continue;
-      const auto& x = b["extensions"];
-      const auto fallback = [&](const char* name) {
-        return x.contains(name) && x[name].is_object() && x[name].value("fallback", false) == true;
-      };
-      if (!fallback("EXT_meshopt_compression") && !fallback("KHR_meshopt_compression")) continue;
+      if (!is_meshopt_fallback(b)) continue;
       b["uri"] = "data:application/octet-stream;base64,AAAAAA==";
       b["byteLength"] = 4;
       changed = true;
     }
   }
+  if (!doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") ||
+      !doc["accessors"].is_array())
+    return changed ? doc.dump() : std::string();
+  auto& accessors = doc["accessors"];
   for (auto& mesh : doc["meshes"]) {
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
     for (auto& prim : mesh["primitives"]) {
@@ -287,7 +307,7 @@ void parse_gltf(const fs::path& file, const GltfLoadOptions& options, MemoryBudg
   check_document(json, name, root, options, box, budget, out.warnings, vendor);
 
   const uint64_t json_bytes = json.size();
-  if (std::string patched = prepare_compressed(json); !patched.empty()) {
+  if (std::string patched = prepare_for_tinygltf(json); !patched.empty()) {
     budget.charge(patched.size(), "JSON", "the JSON prepared for decompression needs");
     bytes = replace_json(bytes, is_glb, parse_bytes, std::move(patched));
     parse_bytes = bytes.size();

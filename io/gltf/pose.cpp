@@ -26,7 +26,7 @@ std::shared_ptr<GltfAnimation> describe_animation(const GltfContext& ctx, const 
   bool rigid = nodes.moving_skipped == 0;
   for (const auto& anim : ctx.model.animations)
     for (const auto& ch : anim.channels)
-      rigid = rigid && !(ch.target_node >= 0 && ch.target_path == "weights");
+      rigid = rigid && !(ch.target_node >= 0 && ch.target_path == "weights") && ch.target_path != "pointer";
   for (const MeshUse& use : uses.meshes) {
     const auto& node = ctx.model.nodes[size_t(use.node)];
     rigid = rigid && node.skin < 0 && !(ctx.options.flatten && is_moving(nodes, use.node));

@@ -56,21 +56,26 @@ namespace {
 // One light sample's contribution: BSDF, shadow ray, MIS weight.
 void estimate(const Scene& scene, const Accelerator& accel, const DirectLightingVertex& v,
               const DirectLightingMode& mode, const IncidentLight& l, RayCounts& counts, PathRadiance& out) {
-  // A light below the geometric surface lights it only through a transmission lobe, and the
-  // shading normal must see it on the same side.
+  // A light below the geometric surface lights it only through a transmission lobe, and then
+  // the shading normal must see it on the same side (else reflected light would leak through).
   const bool below = !(dot(l.wi, v.si.ng) > 0);
-  if (below && !has_transmission_lobes(v.brdf)) return;
-  if (below != (dot(l.wi, v.brdf.n) < 0)) return;
+  const bool transmits = has_transmission_lobes(v.brdf);
+  if (below && !transmits) return;
+  if (transmits && below != (dot(l.wi, v.brdf.n) < 0)) return;
   float pdf_b = 0;
   const Vec3f f = bsdf_eval_pdf(v.brdf, v.wo, l.wi, pdf_b);
   if (!(max_component(f) > 0)) return;
   ++counts.shadow;
   const float t = shadow_transmittance(scene, accel, shadow_ray(v.si, l.wi, l.distance), mode.hit_filter);
+  const Vec3f sigma = below ? v.sigma_below : v.sigma_above;  // the volume the shadow ray crosses
   const float w = l.delta || !mode.bsdf_mis ? 1.0f : power_heuristic(l.pdf, v.bsdf_share * pdf_b);
   if (!(t > 0 && w > 0)) return;
   const bool split = out.groups && v.vertex == 0;
   const Vec3f share = split ? diffuse_share(v.brdf, v.wo, l.wi) : Vec3f{};
-  out.add(v.beta * f * l.li * (std::fabs(dot(v.brdf.n, l.wi)) * t * w / l.pdf), v.vertex,
+  Vec3f absorbed{1, 1, 1};
+  if (max_component(sigma) > 0)
+    for (int c = 0; c < 3; ++c) absorbed[c] = std::exp(-sigma[c] * l.distance);
+  out.add(v.beta * f * l.li * absorbed * (std::fabs(dot(v.brdf.n, l.wi)) * t * w / l.pdf), v.vertex,
           split ? &share : nullptr);
 }
 

@@ -51,6 +51,8 @@ struct DirectLightingVertex {
   Vec3f beta;            ///< path throughput up to this vertex
   int vertex = 0;        ///< surface hit index along the path (0 = first)
   float bsdf_share = 1;  ///< probability that BSDF sampling here uses the BRDF (MIS weight)
+  Vec3f sigma_above{};   ///< absorption of the volume on the geometric normal's side (shadow rays)
+  Vec3f sigma_below{};   ///< and on the other side
 };
 
 /// Which estimators run, as PathConfig's LightStrategy and hit filter set them.

@@ -83,7 +83,7 @@ Lobes choose_lobes(const MaterialPoint& mp, const SurfaceInteraction& si, Vec3f 
   if (l.brdf.volume || !(l.brdf.transmission > 0)) return l;
   const float cos_o = std::fabs(dot(mp.ns, wo));
   const float fd = dielectric_fresnel(l.brdf, cos_o);
-  l.trans_weight = mp.base_color * ((1 - mp.metallic) * l.brdf.transmission * (1 - fd));
+  l.trans_weight = thin_transmission(l.brdf, cos_o);
   const float t = luminance(l.trans_weight);
   const float r = (1 - mp.metallic) * (fd + (1 - fd) * (1 - l.brdf.transmission) * luminance(mp.base_color)) +
                   mp.metallic * luminance(mp.base_color);
@@ -118,8 +118,8 @@ bool sample_bsdf(const Lobes& lobes, const SurfaceInteraction& si, const Materia
   } else {
     BsdfSample bs;
     if (!bsdf_sample(lobes.brdf, wo, (u_lobe - lobes.p_t) / lobes.p_r, u_dir, bs)) return false;
-    // The geometric surface must agree with the shading side the lobe chose.
-    const bool through = dot(bs.wi, lobes.brdf.n) < 0;
+    // The geometric surface must agree with the side the lobe chose.
+    const bool through = bs.transmitted;
     if ((dot(bs.wi, si.ng) <= 0) != through) return false;
     wi = bs.wi;
     if (through && mp.volume) seg.sigma_a = si.back_face ? Vec3f{} : mp.sigma_a;  // into or out of the volume
@@ -208,7 +208,10 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     const Vec3f wo = -seg.ray.dir;
     choose_channel(mp, samples, seg);
     const Lobes lobes = choose_lobes(mp, si, wo, seg.channel);
-    sample_direct_lighting(scene, accel, lights, {si, lobes.brdf, wo, seg.beta, vertex, lobes.p_r}, mode,
+    // Shadow rays cross the volume the ray arrived in, or through the surface the volume behind it.
+    const Vec3f behind = mp.volume ? (si.back_face ? Vec3f{} : mp.sigma_a) : seg.sigma_a;
+    sample_direct_lighting(scene, accel, lights,
+                           {si, lobes.brdf, wo, seg.beta, vertex, lobes.p_r, seg.sigma_a, behind}, mode,
                            samples, counts, path);
 
     // BSDF sampling.

@@ -95,6 +95,57 @@ Vec2f env_direction_to_uv(const Environment& env, Vec3f d) {
   return {0.5f + phi / (2 * kPi), theta / kPi};
 }
 
+namespace {
+
+// v rotated by the conjugate of unit quaternion q (x, y, z, w): v' = v + 2 u x (u x v - w v),
+// u = -(x, y, z).
+Vec3f rotate_inverse(Vec4f q, Vec3f v) {
+  const Vec3f u{-q.x, -q.y, -q.z};
+  const Vec3f t = cross(u, v) * 2;
+  return v + t * q.w + cross(u, t);
+}
+
+// The cube face and its texel for direction d (OpenGL's major-axis rule).
+Vec3f cube_lookup(const std::vector<Vec3f> (&faces)[6], int n, Vec3f d) {
+  const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  int face;
+  float sc, tc, ma;
+  if (ax >= ay && ax >= az) {
+    face = d.x > 0 ? 0 : 1;
+    sc = d.x > 0 ? -d.z : d.z;
+    tc = -d.y;
+    ma = ax;
+  } else if (ay >= az) {
+    face = d.y > 0 ? 2 : 3;
+    sc = d.x;
+    tc = d.y > 0 ? d.z : -d.z;
+    ma = ay;
+  } else {
+    face = d.z > 0 ? 4 : 5;
+    sc = d.z > 0 ? d.x : -d.x;
+    tc = -d.y;
+    ma = az;
+  }
+  const float s = 0.5f * (sc / ma + 1), t = 0.5f * (tc / ma + 1);
+  const int x = std::clamp(int(s * float(n)), 0, n - 1), y = std::clamp(int(t * float(n)), 0, n - 1);
+  return faces[face][size_t(y) * size_t(n) + size_t(x)];
+}
+
+}  // namespace
+
+std::vector<Vec3f> equirect_from_cube(const std::vector<Vec3f> (&faces)[6], int face_size, int width,
+                                      int height, Vec4f rotation) {
+  Environment frame;  // the convention's axes, unrotated
+  std::vector<Vec3f> out(size_t(width) * size_t(height));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Vec3f d =
+          env_uv_to_direction(frame, {(float(x) + 0.5f) / float(width), (float(y) + 0.5f) / float(height)});
+      out[size_t(y) * size_t(width) + size_t(x)] = cube_lookup(faces, face_size, rotate_inverse(rotation, d));
+    }
+  return out;
+}
+
 Vec3f env_uv_to_direction(const Environment& env, Vec2f uv) {
   const float phi = (uv.x - 0.5f) * 2 * kPi, theta = uv.y * kPi;
   const float st = std::sin(theta);

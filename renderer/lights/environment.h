@@ -45,6 +45,15 @@ float env_pdf(const Environment& env, Vec3f dir);
 /// black. Never allocates.
 bool env_sample(const Environment& env, Vec2f u, Vec3f& dir, Vec3f& radiance, float& pdf);
 
+/// A width x height map in this file's convention resampled from a cube map (nearest texel):
+/// six square faces of face_size texels in the order +X, -X, +Y, -Y, +Z, -Z, each row-major
+/// from its top row, oriented as OpenGL cube maps are (face +X: s along -Z, t along -Y; +Y: s
+/// along +X, t along +Z; ...). The texel for world direction d is the cube's at R^-1 d, R the
+/// unit quaternion `rotation` (x, y, z, w): the cube map turned by R. Requires face_size >= 1
+/// and each face of face_size^2 texels.
+std::vector<Vec3f> equirect_from_cube(const std::vector<Vec3f> (&faces)[6], int face_size, int width,
+                                      int height, Vec4f rotation);
+
 /// The map's (u, v) for a direction (u, v in [0, 1], v = 0 at +Y) and back, including rotation.
 Vec2f env_direction_to_uv(const Environment& env, Vec3f dir);
 Vec3f env_uv_to_direction(const Environment& env, Vec2f uv);

@@ -58,7 +58,7 @@ Vec3f polar(float cos_theta) {
 // The dielectric Fresnel of the base at cos, RGB once iridescence mixes in its thin film.
 Vec3f dielectric_fresnel_rgb(const GltfBsdf& b, float cos_theta) {
   const float f = dielectric_fresnel(b, cos_theta);
-  if (!(b.iridescence > 0)) return {f, f, f};
+  if (!(b.iridescence > 0) || f >= 1) return {f, f, f};  // total internal reflection stays total
   const Vec3f film =
       iridescence_fresnel(1, b.iridescence_ior, cos_theta, b.iridescence_thickness, {b.f0, b.f0, b.f0}) *
       b.specular;
@@ -74,6 +74,12 @@ Vec3f metal_fresnel(const GltfBsdf& b, float cos_theta) {
 
 float coat_attenuation(const GltfBsdf& b, float cos_theta) {
   return 1 - b.clearcoat * schlick(kCoatF0, std::fabs(cos_theta));
+}
+
+// The coat's attenuation of light passing it twice at the same angle (in and out).
+float sq_attenuation(const GltfBsdf& b, float cos_theta) {
+  const float a = coat_attenuation(b, cos_theta);
+  return a * a;
 }
 
 // Probabilities of choosing each lobe at wo, summing to 1 (every present lobe >= 5%).
@@ -146,10 +152,11 @@ void eval_base_reflection(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice&
 // The base's transmission terms (local v above, l below the surface).
 void eval_base_transmission(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice& c, PairEval& e) {
   const float dielectric = 1 - b.metallic;
+  const Vec3f one{1, 1, 1};
   if (b.diffuse_transmission > 0) {
-    const float tv = 1 - dielectric_fresnel(b, v.z), tl = 1 - dielectric_fresnel(b, -l.z);
-    e.diffuse = b.diffuse_transmission_color *
-                (dielectric * (1 - b.transmission) * b.diffuse_transmission * tv * tl / kPi);
+    const Vec3f tv = one - dielectric_fresnel_rgb(b, v.z), tl = one - dielectric_fresnel_rgb(b, -l.z);
+    e.diffuse = b.diffuse_transmission_color * tv * tl *
+                (dielectric * (1 - b.transmission) * b.diffuse_transmission / kPi);
     e.pdf += c.p[kDiffuseTransmission] * -l.z / kPi;
   }
   if (!b.volume || !(b.transmission > 0) || b.eta == 1) return;
@@ -163,10 +170,9 @@ void eval_base_transmission(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoic
   const GgxAlpha a = base_alpha(b);
   const float denom = (lh + vh / b.eta) * (lh + vh / b.eta);
   const float d = ggx_d(h, a);
-  const float f = dielectric_fresnel(b, vh);
-  const float ft =
-      d * (1 - f) * smith_g2(v, l, a) * std::fabs(lh * vh / (denom * v.z * l.z)) / (b.eta * b.eta);
-  e.other = b.base_color * (dielectric * b.transmission * ft);
+  const Vec3f f = dielectric_fresnel_rgb(b, vh);
+  const float ft = d * smith_g2(v, l, a) * std::fabs(lh * vh / (denom * v.z * l.z)) / (b.eta * b.eta);
+  e.other = b.base_color * (one - f) * (dielectric * b.transmission * ft);
   e.pdf += c.p[kRefraction] * smith_g1(v, a) * vh * d / v.z * std::fabs(lh) / denom;
 }
 
@@ -254,6 +260,16 @@ bool sample_lobe(const GltfBsdf& b, int lobe, Vec3f wo, Vec2f u, Vec3f& wi) {
 
 }  // namespace
 
+Vec3f thin_transmission(const GltfBsdf& b, float cos_theta) {
+  const Vec3f through = (Vec3f{1, 1, 1} - dielectric_fresnel_rgb(b, cos_theta)) * b.base_color *
+                        ((1 - b.metallic) * b.transmission);
+  float layers = 1;
+  if (b.clearcoat > 0) layers *= sq_attenuation(b, cos_theta);
+  const float sheen_max = max_component(b.sheen_color);
+  if (sheen_max > 0) layers *= 1 - sheen_max * sheen_albedo(cos_theta, b.sheen_roughness);
+  return through * layers;
+}
+
 float dielectric_fresnel(const GltfBsdf& b, float cos_theta) {
   return b.specular * (b.volume ? fresnel_dielectric(cos_theta, b.eta) : schlick(b.f0, cos_theta));
 }
@@ -295,6 +311,7 @@ bool bsdf_sample(const GltfBsdf& b, Vec3f wo, float u1, Vec2f u, BsdfSample& out
   }
   while (lobe > 0 && !(c.p[lobe] > 0)) --lobe;  // rounding left u1 past the last lobe
   if (!sample_lobe(b, lobe, wo, u, out.wi)) return false;
+  out.transmitted = lobe == kDiffuseTransmission || lobe == kRefraction;
   const Vec3f value = bsdf_eval_pdf(b, wo, out.wi, out.pdf);
   if (!(out.pdf > 0) || !std::isfinite(out.pdf)) return false;
   out.weight = value * (std::fabs(dot(out.wi, b.n)) / out.pdf);

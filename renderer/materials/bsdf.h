@@ -65,6 +65,12 @@ struct GltfBsdf {
 /// for a volume s times the exact Fresnel of eta.
 float dielectric_fresnel(const GltfBsdf& b, float cos_theta);
 
+/// Weight of the thin-walled transmission the integrator traces straight through (a delta lobe,
+/// not part of bsdf_eval) at cos(theta) = cos_theta: (1 - metallic) t (1 - F) base colour per
+/// channel (F with the thin film), times the coat's attenuation in and out and the sheen's
+/// albedo scaling, as the layers above the base attenuate it.
+Vec3f thin_transmission(const GltfBsdf& b, float cos_theta);
+
 /// True if the BSDF scatters light to the far side of the surface (diffuse transmission or
 /// the volume's refraction lobe).
 inline bool has_transmission_lobes(const GltfBsdf& b) {
@@ -85,6 +91,7 @@ struct BsdfSample {
   Vec3f wi;
   Vec3f weight;  ///< f |cos(theta_i)| / pdf (0 when the sample fails)
   float pdf = 0;
+  bool transmitted = false;  ///< a transmission lobe chose wi (to the far side of the surface)
 };
 /// Samples wi from u1 (lobe choice) and u (direction), both uniform in [0, 1).
 /// Returns false (and a zero weight) if wo is below the surface or the sample fails.

@@ -247,7 +247,7 @@ void eval_anisotropy(const Scene& scene, const Material& mat, const SurfaceInter
 void eval_extensions(const Scene& scene, const Material& mat, const SurfaceInteraction& si,
                      MaterialPoint& mp) {
   mp.ior = mat.ior;
-  mp.volume = mat.volume && mat.transmission > 0;
+  mp.volume = mat.volume && (mat.transmission > 0 || mat.diffuse_transmission > 0);
   if (mp.volume && std::isfinite(mat.attenuation_distance) && mat.attenuation_distance > 0)
     for (int c = 0; c < 3; ++c)
       mp.sigma_a[c] = -std::log(std::max(mat.attenuation_color[c], 1e-6f)) / mat.attenuation_distance;

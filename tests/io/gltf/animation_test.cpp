@@ -1,6 +1,6 @@
 // Animation at a time (io/gltf/animation.cpp): node TRS channels (LINEAR, slerp, STEP, CUBICSPLINE),
-// morph-target weights and skinning, on small generated files with hand-computed answers; the
-// corpus InterpolationTest against its own keyframes.
+// morph-target weights, skinning and KHR_animation_pointer channels, on small generated files with
+// hand-computed answers; the corpus InterpolationTest against its own keyframes.
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -172,4 +172,68 @@ TEST_CASE("animation: corpus InterpolationTest matches its keyframes and midpoin
   const float full = extent_x(load_gltf(file, at(s0)), 3);
   CHECK(extent_x(load_gltf(file, at((s0 + k1) / 2)), 3) == Approx(0.75 * full).epsilon(1e-4));
   CHECK(extent_x(load_gltf(file, at(k1)), 3) == Approx(0.5 * full).epsilon(1e-4));
+}
+
+TEST_CASE("animation: KHR_animation_pointer animates material, light, camera and node properties at --time",
+          "[io][animation][quick]") {
+  test::GltfWriter w;
+  const int mesh = w.mesh(w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  w.j["meshes"][size_t(mesh)]["primitives"][0]["material"] = 0;
+  w.j["materials"] = {
+      {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"roughnessFactor", 1.0}}},
+       {"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}}}}}}};
+  w.j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}};
+  w.j["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1.0}}};
+  const int n = w.node({{"mesh", mesh}});
+  w.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+  w.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  w.j["extensionsUsed"] = {"KHR_animation_pointer", "KHR_lights_punctual", "KHR_materials_clearcoat"};
+  REQUIRE(n == 0);  // the pointers below name nodes[0]
+  auto pointer = [&](const std::string& p, const std::vector<float>& values, const char* type, size_t width) {
+    w.channel(-1, "pointer", {0, 2}, values, type, width);
+    auto& ch = w.j["animations"][0]["channels"].back();
+    ch["target"].erase("node");
+    ch["target"]["extensions"]["KHR_animation_pointer"]["pointer"] = p;
+  };
+  pointer("/materials/0/pbrMetallicRoughness/baseColorFactor", {1, 1, 1, 1, 0, 0.5f, 1, 1}, "VEC4", 4);
+  pointer("/materials/0/pbrMetallicRoughness/roughnessFactor", {1, 0}, "SCALAR", 1);
+  pointer("/materials/0/extensions/KHR_materials_clearcoat/clearcoatFactor", {0, 1}, "SCALAR", 1);
+  pointer("/extensions/KHR_lights_punctual/lights/0/intensity", {1, 9}, "SCALAR", 1);
+  pointer("/cameras/0/perspective/yfov", {0.5f, 1.0f}, "SCALAR", 1);
+  pointer("/nodes/0/translation", {0, 0, 0, 4, 0, 0}, "VEC3", 3);
+  const auto dir = test::temp_dir("pointer");
+  w.write_embedded(dir / "p.gltf");
+  // Halfway (t = 1): every property is the mean of its two keys.
+  GltfLoadOptions opt;
+  opt.time = 1.0;
+  LoadedScene l = load_gltf(dir / "p.gltf", opt);
+  CHECK(l.warnings.empty());
+  const Material& m = l.scene.materials.at(0);
+  CHECK(m.base_color.x == Approx(0.5));
+  CHECK(m.base_color.y == Approx(0.75));
+  CHECK(m.roughness == Approx(0.5));
+  CHECK(m.clearcoat == Approx(0.5));
+  REQUIRE(l.scene.lights.size() == 1);
+  CHECK(l.scene.lights[0].intensity == Approx(5));
+  REQUIRE(l.scene.cameras.size() == 1);
+  CHECK(l.scene.cameras[0].yfov == Approx(0.75));
+  CHECK(mesh_of_node(l.scene, n).positions[0].x == Approx(2));
+  // Without a time the file's static values stand.
+  l = load_gltf(dir / "p.gltf");
+  CHECK(l.scene.materials.at(0).roughness == 1);
+  CHECK(l.scene.lights.at(0).intensity == 1);
+  // A property Penumbra does not animate is a warning; an element that does not exist an error.
+  pointer("/materials/0/doubleSided", {0, 1}, "SCALAR", 1);
+  w.write_embedded(dir / "p.gltf");
+  l = load_gltf(dir / "p.gltf", opt);
+  REQUIRE(l.warnings.size() == 1);
+  CHECK_THAT(l.warnings[0],
+             Catch::Contains("KHR_animation_pointer.pointer") && Catch::Contains("doubleSided"));
+  w.j["animations"][0]["channels"].back()["target"]["extensions"]["KHR_animation_pointer"]["pointer"] =
+      "/materials/3/pbrMetallicRoughness/metallicFactor";
+  w.write_embedded(dir / "p.gltf");
+  REQUIRE_THROWS_WITH(
+      load_gltf(dir / "p.gltf", opt),
+      Catch::Contains("animations[0].channels[6].target.extensions.KHR_animation_pointer.pointer") &&
+          Catch::Contains("'3'"));
 }

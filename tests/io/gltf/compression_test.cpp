@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
@@ -229,6 +230,17 @@ TEST_CASE("compression: a Draco-encoded mesh loads as the triangles it was made 
                         Catch::Contains("indices") && Catch::Contains("differs"));
     std::ofstream(dir / "id.gltf") << draco_gltf(stream, id + 7, points, faces);
     REQUIRE_THROWS_WITH(load_gltf(dir / "id.gltf"), Catch::Contains("no attribute with id"));
+  }
+  SECTION("a Draco primitive without indices, or not a triangle list, is an error") {
+    std::string text = draco_gltf(stream, id, points, faces);
+    const std::string no_indices = std::regex_replace(text, std::regex(R"(,"indices":1)"), "");
+    std::ofstream(dir / "noidx.gltf") << no_indices;
+    REQUIRE_THROWS_WITH(load_gltf(dir / "noidx.gltf"), Catch::Contains("needs an indices accessor"));
+    const std::string strip =
+        std::regex_replace(text, std::regex(R"("indices":1)"), R"("indices":1,"mode":5)");
+    std::ofstream(dir / "strip.gltf") << strip;
+    REQUIRE_THROWS_WITH(load_gltf(dir / "strip.gltf"),
+                        Catch::Contains("primitives[0].mode") && Catch::Contains("triangle list"));
   }
   SECTION("the decoded data is charged to the memory budget") {
     GltfLoadOptions opt;

@@ -88,3 +88,37 @@ TEST_CASE("environment: the sampling density integrates to 1 and matches the sam
   CHECK(is_black(make_map_environment(2, 1, {{0, 0, 0}, {0, 0, 0}}, 1, 0)));
   CHECK_THROWS_AS(make_map_environment(2, 2, {{1, 1, 1}}, 1, 0), std::invalid_argument);
 }
+
+TEST_CASE(
+    "environment: a cube map resampled to the map keeps each face on its axis, and turns with the "
+    "rotation",
+    "[env][quick]") {
+  // Six flat faces, each its own colour; face k has colour e_k-ish (distinct per face).
+  const Vec3f colours[6] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+  std::vector<Vec3f> faces[6];
+  for (int f = 0; f < 6; ++f) faces[f].assign(4 * 4, colours[f]);
+  const Vec3f axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const Environment env =
+      make_map_environment(64, 32, equirect_from_cube(faces, 4, 64, 32, {0, 0, 0, 1}), 1, 0);
+  for (int f = 0; f < 6; ++f) {
+    INFO("face " << f);
+    check_vec(env_eval(env, axes[f]), colours[f]);
+    // Directions 30 degrees off the axis still see the same face.
+    const Vec3f off = normalize(axes[f] + Vec3f{0.3f, 0.2f, 0.25f} * 0.5f);
+    if (dot(off, axes[f]) > 0.9f) check_vec(env_eval(env, off), colours[f]);
+  }
+  // Turned by +90 degrees about +Y (which carries +X to -Z): -Z now sees the +X face.
+  const float h = std::sqrt(0.5f);
+  const Environment turned =
+      make_map_environment(64, 32, equirect_from_cube(faces, 4, 64, 32, {0, h, 0, h}), 1, 0);
+  check_vec(env_eval(turned, {0, 0, -1}), colours[0]);
+  check_vec(env_eval(turned, {0, 1, 0}), colours[2]);  // the axis of the turn keeps its face
+  // The OpenGL face orientation: on +X, s runs along -Z and t along -Y (row 0 is the top, +Y).
+  std::vector<Vec3f> marked[6];
+  for (int f = 0; f < 6; ++f) marked[f].assign(4 * 4, Vec3f{0, 0, 0});
+  marked[0][0] = {1, 1, 1};  // +X face, top-left texel: towards +Y and +Z
+  const Environment m =
+      make_map_environment(256, 128, equirect_from_cube(marked, 4, 256, 128, {0, 0, 0, 1}), 1, 0);
+  check_vec(env_eval(m, normalize(Vec3f{1, 0.8f, 0.8f})), {1, 1, 1});
+  check_vec(env_eval(m, normalize(Vec3f{1, 0.8f, -0.8f})), {0, 0, 0});
+}

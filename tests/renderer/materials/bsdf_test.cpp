@@ -405,3 +405,38 @@ TEST_CASE(
   CHECK(refracted == 0);
   CHECK(reflected / n == Approx(1).epsilon(0.01));
 }
+
+TEST_CASE("bsdf layers: only transmission lobes send samples to the far side", "[bsdf][quick]") {
+  // An opaque clear-coated material whose coat normal leans away from the base normal: coat
+  // samples may fall below the base normal, but they are reflections.
+  GltfBsdf b;
+  b.base_color = {0.8f, 0.8f, 0.8f};
+  b.metallic = 0;
+  b.roughness = 0.5f;
+  b.clearcoat = 1;
+  b.clearcoat_roughness = 0.3f;
+  b.clearcoat_n = normalize(Vec3f{0.6f, 0, 0.8f});
+  REQUIRE_FALSE(has_transmission_lobes(b));
+  Rng rng = make_pixel_rng(4, 4, 4, 4);
+  int below_n = 0;
+  for (int i = 0; i < 20000; ++i) {
+    BsdfSample s;
+    if (!bsdf_sample(b, view_at(-0.55f), rng.next_float(), {rng.next_float(), rng.next_float()}, s)) continue;
+    CHECK_FALSE(s.transmitted);
+    below_n += s.wi.z < 0;
+  }
+  CHECK(below_n > 0);  // the case exists: coat reflections below the base normal
+  // With diffuse transmission, samples of that lobe are marked.
+  b.diffuse_transmission = 1;
+  REQUIRE(has_transmission_lobes(b));
+  int transmitted = 0;
+  for (int i = 0; i < 20000; ++i) {
+    BsdfSample s;
+    if (!bsdf_sample(b, view_at(0.2f), rng.next_float(), {rng.next_float(), rng.next_float()}, s)) continue;
+    if (s.transmitted) {
+      ++transmitted;
+      CHECK(s.wi.z < 0);
+    }
+  }
+  CHECK(transmitted > 0);
+}
