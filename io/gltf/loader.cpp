@@ -49,9 +49,7 @@ std::vector<std::pair<std::string, std::string>> partial_gltf_extensions() {
            "specular-glossiness texture is not used"},
           {"KHR_meshopt_compression",
            "Debian 12's meshoptimizer 0.18 decodes version-0 streams only; version-1 streams and the COLOR "
-           "filter are errors"},
-          {"KHR_materials_specular",
-           "specularFactor only; specularColorFactor and the specular textures are not used"}};
+           "filter are errors"}};
 }
 
 int json_nesting_depth(std::string_view json, int limit) {

@@ -116,9 +116,9 @@ void extension_number(const GltfContext& ctx, const tinygltf::Material& src, con
   out = float(x);
 }
 
-// Three numbers in [0, 1] at extensions.<ext>.<key> (absent: `out` keeps its default).
+// Three numbers at extensions.<ext>.<key>, clamped to [0, hi] (absent: `out` keeps its default).
 void extension_color(const GltfContext& ctx, const tinygltf::Material& src, const std::string& where,
-                     const char* ext, const char* key, Vec3f& out) {
+                     const char* ext, const char* key, Vec3f& out, double hi = 1) {
   auto it = src.extensions.find(ext);
   if (it == src.extensions.end()) return;
   const auto& v = it->second.Get(key);
@@ -128,7 +128,7 @@ void extension_color(const GltfContext& ctx, const tinygltf::Material& src, cons
   for (int c = 0; c < 3; ++c) {
     const auto& x = v.Get(c);
     if (!x.IsNumber()) ctx.fail(w, "must be 3 numbers");
-    out[c] = float(std::clamp(finite_or_fail(ctx, x.GetNumberAsDouble(), w), 0.0, 1.0));
+    out[c] = float(std::clamp(finite_or_fail(ctx, x.GetNumberAsDouble(), w), 0.0, hi));
   }
 }
 
@@ -179,6 +179,11 @@ void read_khr_extensions(const GltfContext& ctx, TextureCache& cache, const tiny
     ctx.fail(where + ".extensions.KHR_materials_ior.ior", "must be 0 or in [1, 1e6]");
   extension_number(ctx, src, where, "KHR_materials_specular", "specularFactor", m.specular, 0.0, 1.0,
                    "in [0, 1]");
+  extension_color(ctx, src, where, "KHR_materials_specular", "specularColorFactor", m.specular_color, 1e6);
+  m.specular_tex =
+      extension_texture(ctx, cache, src, where, "KHR_materials_specular", "specularTexture", false);
+  m.specular_color_tex =
+      extension_texture(ctx, cache, src, where, "KHR_materials_specular", "specularColorTexture", true);
   extension_number(ctx, src, where, "KHR_materials_transmission", "transmissionFactor", m.transmission, 0.0,
                    1.0, "in [0, 1]");
   if (m.transmission > 0)

@@ -16,7 +16,10 @@ WhittedParams whitted_params(const MaterialPoint& m) {
   const float d = std::clamp(m.diffuse_transmission, 0.0f, 1.0f);
   const float coat = std::clamp(m.clearcoat, 0.0f, 1.0f);
   const float d0 = m.specular * m.f0;  // 0.04 for the core glTF model
-  Vec3f f0 = Vec3f{d0, d0, d0} * (1 - metallic) + m.base_color * metallic;
+  const Vec3f dc{m.specular * std::min(m.f0 * m.specular_color.x, 1.0f),
+                 m.specular * std::min(m.f0 * m.specular_color.y, 1.0f),
+                 m.specular * std::min(m.f0 * m.specular_color.z, 1.0f)};
+  Vec3f f0 = dc * (1 - metallic) + m.base_color * metallic;
   if (m.iridescence > 0)
     f0 = f0 * (1 - m.iridescence) +
          iridescence_fresnel(1, m.iridescence_ior, 1, m.iridescence_thickness, f0) * m.iridescence;
@@ -44,6 +47,7 @@ WhittedParams whitted_params(const Material& m) {
   mp.emissive = m.emissive;
   mp.f0 = ior_to_f0(m.ior);
   mp.specular = m.specular;
+  mp.specular_color = m.specular_color;
   mp.ior = m.ior;
   mp.transmission = m.transmission;
   mp.volume = m.volume && m.transmission > 0;

@@ -58,11 +58,19 @@ Vec3f polar(float cos_theta) {
 // The dielectric Fresnel of the base at cos, RGB once iridescence mixes in its thin film.
 Vec3f dielectric_fresnel_rgb(const GltfBsdf& b, float cos_theta) {
   const float f = dielectric_fresnel(b, cos_theta);
-  if (!(b.iridescence > 0) || f >= 1) return {f, f, f};  // total internal reflection stays total
+  if (f >= b.specular) return {f, f, f};  // total internal reflection stays total
+  // KHR_materials_specular's colour: f0 per channel min(f0 c, 1) under the same f90 = s.
+  Vec3f fc{f, f, f};
+  const Vec3f c = b.specular_color;
+  if (c.x != 1 || c.y != 1 || c.z != 1)
+    for (int k = 0; k < 3; ++k)
+      fc[k] = b.volume ? std::min(f * c[k], b.specular)
+                       : b.specular * schlick(std::min(b.f0 * c[k], 1.0f), cos_theta);
+  if (!(b.iridescence > 0)) return fc;
+  const Vec3f f0 = Vec3f{std::min(b.f0 * c.x, 1.0f), std::min(b.f0 * c.y, 1.0f), std::min(b.f0 * c.z, 1.0f)};
   const Vec3f film =
-      iridescence_fresnel(1, b.iridescence_ior, cos_theta, b.iridescence_thickness, {b.f0, b.f0, b.f0}) *
-      b.specular;
-  return mix({f, f, f}, film, b.iridescence);
+      iridescence_fresnel(1, b.iridescence_ior, cos_theta, b.iridescence_thickness, f0) * b.specular;
+  return mix(fc, film, b.iridescence);
 }
 
 Vec3f metal_fresnel(const GltfBsdf& b, float cos_theta) {
@@ -123,16 +131,19 @@ struct PairEval {
   float pdf = 0;
 };
 
-// The coat lobe (value and density) at world directions wo, wi.
+// The coat lobe (value and density) at world directions wo, wi. Estimators multiply every value
+// by the shading normal's |n.l|; the coat, with its own normal, needs its own n_c.l, so its
+// microfacet value D G2 / (4 n_c.v n_c.l) is divided by |n.l| in place of n_c.l (the same when
+// the normals agree; without this a coat normal map turns grazing coat samples into fireflies).
 void eval_coat(const GltfBsdf& b, Vec3f wo, Vec3f wi, Vec3f nc, Vec3f& value, float& pdf) {
-  const float cv = dot(nc, wo), cl = dot(nc, wi);
-  if (!(cv > 0) || !(cl > 0)) return;
+  const float cv = dot(nc, wo), cl = dot(nc, wi), nl = std::fabs(dot(b.n, wi));
+  if (!(cv > 0) || !(cl > 0) || !(nl > 1e-6f)) return;
   const Vec3f h = normalize(wo + wi);
   const float a = coat_alpha(b), ch = dot(nc, h);
   const float d = ggx_d(polar(ch), a);
   const float g2 = smith_g2(polar(cv), polar(cl), GgxAlpha{a, a});
   const float f = b.clearcoat * schlick(kCoatF0, std::max(0.0f, dot(wo, h)));
-  value = Vec3f{f, f, f} * (d * g2 / (4 * cv * cl));
+  value = Vec3f{f, f, f} * (d * g2 / (4 * cv * nl));
   pdf = smith_g1(polar(cv), a) * d / (4 * cv);
 }
 

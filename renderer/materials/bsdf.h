@@ -9,13 +9,16 @@
 //   f = coat + A_c(v) A_c(l) [ sheen + S(v, l) base ]
 //
 // - coat (KHR_materials_clearcoat): c F_c(v.h_c) D_c V_c, an isotropic GGX layer of index 1.5
-//   (f0 = 0.04) with its own normal; A_c(w) = 1 - c F_c(|n_c.w|).
+//   (f0 = 0.04) with its own normal; A_c(w) = 1 - c F_c(|n_c.w|). The coat's cosine is its own
+//   normal's: its value carries n_c.l / |n.l| so that the estimators' |n.l| gives it (with a
+//   coat normal map this breaks reciprocity, as any shading normal does).
 // - sheen (KHR_materials_sheen): sheenColor D_charlie V_sheen (sheen.h); the layers below are
 //   scaled by S = 1 - max(sheenColor) max(E(|n.v|), E(|n.l|)), E the sheen's directional albedo.
 // - base, reflection (l above the surface):
 //     [(1 - m) F_d + m F_m] D V  +  (1 - m)(1 - t)(1 - d)(1 - max F_d) c / pi
 //   with anisotropic GGX (KHR_materials_anisotropy: alpha_t = mix(alpha, 1, A^2) along the
-//   anisotropy direction, alpha_b = alpha = roughness^2), F_d = s Schlick(f0) and F_m =
+//   anisotropy direction, alpha_b = alpha = roughness^2), F_d = s Schlick(min(f0 c_s, 1)) per
+//   channel (KHR_materials_specular's factor s and colour c_s) and F_m =
 //   Schlick(c), each mixed with the thin-film Fresnel by the iridescence factor
 //   (KHR_materials_iridescence, thin_film.h).
 // - base, transmission (l below the surface):
@@ -42,14 +45,15 @@ struct GltfBsdf {
   float metallic = 1;
   float roughness = 1;
   Vec3f n{0, 0, 1};
-  float f0 = 0.04f;        ///< dielectric reflectance at normal incidence
-  float specular = 1;      ///< KHR_materials_specular factor: scales the dielectric Fresnel
-  float transmission = 0;  ///< KHR_materials_transmission: share of the diffuse base transmitted
-  bool volume = false;     ///< transmission refracts into a volume (the rough lobe above)
-  float eta = 1.5f;        ///< relative index behind the surface over in front (volume lobe)
-  Vec3f t{1, 0, 0};        ///< anisotropy direction (unit, perpendicular to n)
-  float anisotropy = 0;    ///< KHR_materials_anisotropy strength in [0, 1]
-  float iridescence = 0;   ///< KHR_materials_iridescence factor in [0, 1]
+  float f0 = 0.04f;               ///< dielectric reflectance at normal incidence
+  float specular = 1;             ///< KHR_materials_specular factor: scales the dielectric Fresnel
+  Vec3f specular_color{1, 1, 1};  ///< KHR_materials_specular colour: tints the dielectric f0
+  float transmission = 0;         ///< KHR_materials_transmission: share of the diffuse base transmitted
+  bool volume = false;            ///< transmission refracts into a volume (the rough lobe above)
+  float eta = 1.5f;               ///< relative index behind the surface over in front (volume lobe)
+  Vec3f t{1, 0, 0};               ///< anisotropy direction (unit, perpendicular to n)
+  float anisotropy = 0;           ///< KHR_materials_anisotropy strength in [0, 1]
+  float iridescence = 0;          ///< KHR_materials_iridescence factor in [0, 1]
   float iridescence_ior = 1.3f;
   float iridescence_thickness = 400;  ///< nanometres
   Vec3f sheen_color{0, 0, 0};         ///< KHR_materials_sheen colour (black: no sheen)

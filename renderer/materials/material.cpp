@@ -296,7 +296,8 @@ MaterialPoint eval_material(const Scene& scene, const SurfaceInteraction& si, bo
   mp.roughness = std::clamp(mat.roughness * mr.y, 0.0f, 1.0f);
   mp.emissive = emission(scene, mat, si);
   mp.f0 = ior_to_f0(mat.ior);
-  mp.specular = mat.specular;
+  mp.specular = mat.specular * texture_channel(scene, mat.specular_tex, si, 3);
+  mp.specular_color = mat.specular_color * texture_rgb(scene, mat.specular_color_tex, si);
   mp.transmission = mat.transmission;
   if (mat.transmission > 0 && mat.transmission_tex.texture >= 0)
     mp.transmission *= eval_texture(scene, mat.transmission_tex, si).x;
@@ -325,6 +326,7 @@ GltfBsdf make_bsdf(const MaterialPoint& mp, bool back_face, int channel) {
   b.n = mp.ns;
   b.f0 = mp.f0;
   b.specular = mp.specular;
+  b.specular_color = mp.specular_color;
   b.transmission = std::clamp(mp.transmission, 0.0f, 1.0f);
   if (mp.volume) {
     const float ior = std::max(1.0f, dispersion_ior(mp.ior, mp.dispersion, channel));

@@ -19,13 +19,14 @@ struct MaterialPoint {
   float occlusion = 1;                ///< 1 + strength (texture.r - 1); ambient-only (not path traced)
   Vec3f ns;                           ///< unit shading normal after normal mapping, facing the viewer
   bool unlit = false;
-  float f0 = 0.04f;        ///< dielectric reflectance at normal incidence, from the ior
-  float ior = 1.5f;        ///< KHR_materials_ior
-  float specular = 1;      ///< KHR_materials_specular factor
-  float transmission = 0;  ///< factor x texture (R)
-  bool volume = false;     ///< transmission refracts into a volume (Material::volume)
-  Vec3f sigma_a{0, 0, 0};  ///< the volume's absorption coefficient -ln(attenuation colour) / distance
-  float dispersion = 0;    ///< KHR_materials_dispersion
+  float f0 = 0.04f;               ///< dielectric reflectance at normal incidence, from the ior
+  float ior = 1.5f;               ///< KHR_materials_ior
+  float specular = 1;             ///< KHR_materials_specular factor x texture (A)
+  Vec3f specular_color{1, 1, 1};  ///< KHR_materials_specular colour factor x texture (RGB)
+  float transmission = 0;         ///< factor x texture (R)
+  bool volume = false;            ///< transmission refracts into a volume (Material::volume)
+  Vec3f sigma_a{0, 0, 0};         ///< the volume's absorption coefficient -ln(attenuation colour) / distance
+  float dispersion = 0;           ///< KHR_materials_dispersion
   float clearcoat = 0, clearcoat_roughness = 0;
   Vec3f ns_coat;  ///< the coat's unit normal (its normal map over the unmapped shading normal)
   Vec3f sheen_color{0, 0, 0};

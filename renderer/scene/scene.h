@@ -47,9 +47,11 @@ struct Material {
   float occlusion_strength = 1;       ///< 1 + strength (R - 1)
   TextureRef emissive_tex;            ///< RGB, multiplies emissive
   float ior = 1.5f;                   ///< KHR_materials_ior: dielectric f0 = ((ior-1)/(ior+1))^2
-  float specular = 1;                 ///< KHR_materials_specular specularFactor
-  float transmission = 0;             ///< KHR_materials_transmission factor
-  TextureRef transmission_tex;        ///< R multiplies transmission (linear)
+  float specular = 1;                 ///< KHR_materials_specular specularFactor x texture (A)
+  Vec3f specular_color{1, 1, 1};      ///< specularColorFactor x texture (RGB, sRGB-decoded)
+  TextureRef specular_tex, specular_color_tex;
+  float transmission = 0;       ///< KHR_materials_transmission factor
+  TextureRef transmission_tex;  ///< R multiplies transmission (linear)
   /// KHR_materials_volume with thicknessFactor > 0: the mesh bounds a volume that transmitted
   /// light refracts into and is absorbed in; false: thin-walled.
   bool volume = false;

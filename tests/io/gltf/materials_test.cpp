@@ -237,16 +237,19 @@ TEST_CASE("corpus textures: MultiUVTest reads its emissive texture through TEXCO
 TEST_CASE("KHR_materials_ior, _specular and _transmission load; bad values name the field",
           "[io][gltf][quick]") {
   GltfWriter w = quad_with_material();
-  w.j["materials"] = {{{"extensions",
-                        {{"KHR_materials_ior", {{"ior", 2.0}}},
-                         {"KHR_materials_specular", {{"specularFactor", 0.5}}},
-                         {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}}}}}};
+  w.j["materials"] = {
+      {{"extensions",
+        {{"KHR_materials_ior", {{"ior", 2.0}}},
+         {"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {2, 0.5, 0}}}},
+         {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}}}}}};
   w.j["extensionsUsed"] = {"KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission"};
   w.j["extensionsRequired"] = {"KHR_materials_transmission"};
   const LoadedScene loaded = write_and_load(w, "extmat");
   const Material& mat = loaded.scene.materials.at(0);
   CHECK(mat.ior == 2);
   CHECK(mat.specular == 0.5f);
+  CHECK(mat.specular_color.x == 2);  // the colour factor may exceed 1
+  CHECK(mat.specular_color.y == 0.5f);
   CHECK(mat.transmission == 0.75f);
   // ior 0 is the extension's special case (f0 = 1); between 0 and 1 it is an error.
   w.j["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.0;

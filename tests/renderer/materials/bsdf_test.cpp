@@ -440,3 +440,22 @@ TEST_CASE("bsdf layers: only transmission lobes send samples to the far side", "
   }
   CHECK(transmitted > 0);
 }
+
+TEST_CASE("bsdf layers: KHR_materials_specular's colour tints the dielectric f0 per channel",
+          "[bsdf][quick]") {
+  // A black dielectric seen along its normal reflects s min(f0 c, 1) of what the white one's
+  // f0 gives there (Schlick at v.h = 1 is f0): the ratio is exact at the mirror direction.
+  GltfBsdf b;
+  b.base_color = {0, 0, 0};
+  b.metallic = 0;
+  b.roughness = 0.3f;
+  b.specular = 0.8f;
+  GltfBsdf plain = b;
+  b.specular_color = {1, 0.5f, 30};
+  const Vec3f n = view_at(0);
+  const Vec3f f = bsdf_eval(b, n, n), f1 = bsdf_eval(plain, n, n);
+  REQUIRE(f1.x > 0);
+  CHECK(f.x / f1.x == Approx(1).epsilon(1e-5));
+  CHECK(f.y / f1.y == Approx(0.5).epsilon(1e-5));
+  CHECK(f.z / f1.z == Approx(1 / 0.04).epsilon(1e-4));  // f0 c clamped to 1
+}
