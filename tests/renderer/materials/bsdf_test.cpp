@@ -316,7 +316,7 @@ TEST_CASE("bsdf layers: reciprocity, and the refraction lobe's eta^2", "[bsdf][q
 TEST_CASE("bsdf layers: sampling agrees with pdf and eval, and the pdf integrates to the accepted share",
           "[bsdf][quick]") {
   Rng rng = make_pixel_rng(5, 4, 3, 2);
-  for (int k = 0; k < 12; ++k) {
+  for (int k = 0; k < 8; ++k) {
     GltfBsdf b = random_layers(rng);
     if (k % 3 == 0) {
       b.metallic = 0;
@@ -327,7 +327,7 @@ TEST_CASE("bsdf layers: sampling agrees with pdf and eval, and the pdf integrate
     const Vec3f wo = view_at(0.2f + 0.1f * float(k));
     const double total = sphere_integral([&](Vec3f wi) { return bsdf_pdf(b, wo, wi); }, 1000, 256);
     Rng srng = make_pixel_rng(1, 2, 3, uint64_t(k));
-    const int n = 100000;
+    const int n = 60000;
     int accepted = 0;
     for (int i = 0; i < n; ++i) {
       BsdfSample s;
@@ -348,7 +348,7 @@ TEST_CASE("bsdf layers: sampling agrees with pdf and eval, and the pdf integrate
 
 TEST_CASE("bsdf layers: sampled albedo equals quadrature within 1%", "[bsdf]") {
   Rng rng = make_pixel_rng(8, 6, 4, 2);
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < 6; ++k) {
     GltfBsdf b = random_layers(rng);
     if (k % 4 == 1) {
       b.metallic = 0;
@@ -358,10 +358,10 @@ TEST_CASE("bsdf layers: sampled albedo equals quadrature within 1%", "[bsdf]") {
     }
     const Vec3f wo = view_at(0.15f * float(k));
     const double quad = sphere_integral(
-        [&](Vec3f wi) { return double(luminance(bsdf_eval(b, wo, wi))) * std::fabs(wi.z); }, 3000, 512);
+        [&](Vec3f wi) { return double(luminance(bsdf_eval(b, wo, wi))) * std::fabs(wi.z); }, 1500, 256);
     Rng srng = make_pixel_rng(2, 3, 4, uint64_t(k));
     double mc = 0;
-    const int n = 400000;
+    const int n = 200000;
     for (int i = 0; i < n; ++i) {
       BsdfSample s;
       if (bsdf_sample(b, wo, srng.next_float(), {srng.next_float(), srng.next_float()}, s))
