@@ -14,6 +14,7 @@ RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, cons
   e["scene.sha256"] = scene_sha256;
   e["scene.index"] = std::to_string(a.scene);
   e["scene.flatten"] = a.flatten ? "1" : "0";
+  e["scene.variant"] = a.variant.empty() ? "none" : a.variant;
   e["scene.time"] =
       a.time ? exact(*a.time) : (a.frame ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
   e["camera"] = a.camera.empty() ? "default '" + camera.name + "'" : a.camera;
