@@ -8,6 +8,7 @@
 #include "io/error.h"
 #include "io/gltf/loader.h"
 #include "support/gltf_writer.h"
+#include "support/image_files.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -16,21 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A 4 x 4 face of one 8-bit colour, with alpha if `alpha` >= 0.
-void write_face(const fs::path& file, const unsigned char rgb[3], int alpha) {
-  const int nc = alpha >= 0 ? 4 : 3;
-  std::vector<unsigned char> px(size_t(16 * nc));
-  for (size_t i = 0; i < px.size(); i += size_t(nc)) {
-    for (int c = 0; c < 3; ++c) px[i + size_t(c)] = rgb[c];
-    if (nc == 4) px[i + 3] = (unsigned char)alpha;
-  }
-  auto out = OIIO::ImageOutput::create(file.string());
-  REQUIRE(out);
-  REQUIRE(out->open(file.string(), OIIO::ImageSpec(4, 4, nc, OIIO::TypeDesc::UINT8)));
-  REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
-  out->close();
-}
-
 // A one-triangle file whose scene uses image-based light 0 over six faces (+X face red, the
 // others black; face 0 RGBD with alpha `alpha` if >= 0).
 fs::path ibl_file(const fs::path& dir, nlohmann::json light, int alpha = -1) {
@@ -38,7 +24,7 @@ fs::path ibl_file(const fs::path& dir, nlohmann::json light, int alpha = -1) {
   nlohmann::json images = nlohmann::json::array();
   for (int f = 0; f < 6; ++f) {
     const std::string name = "face" + std::to_string(f) + ".png";
-    write_face(dir / name, f == 0 ? red : black, f == 0 ? alpha : -1);
+    test::write_flat_image(dir / name, f == 0 ? red : black, f == 0 ? alpha : -1);
     images.push_back({{"uri", name}});
   }
   test::GltfWriter w;

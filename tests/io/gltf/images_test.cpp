@@ -11,6 +11,7 @@
 #include "io/gltf/loader.h"
 #include "support/gltf_hostile.h"
 #include "support/gltf_writer.h"
+#include "support/image_files.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -110,21 +111,6 @@ TEST_CASE("gltf hardening: an image is charged to the budget from its header, be
 }
 
 namespace {
-// A 4 x 4 image of one colour written by OpenImageIO (format from the extension).
-void write_flat_image(const fs::path& file, float r, float g, float b) {
-  std::vector<unsigned char> px(4 * 4 * 3);
-  for (size_t i = 0; i < px.size(); i += 3) {
-    px[i] = (unsigned char)(r * 255);
-    px[i + 1] = (unsigned char)(g * 255);
-    px[i + 2] = (unsigned char)(b * 255);
-  }
-  auto out = OIIO::ImageOutput::create(file.string());
-  REQUIRE(out);
-  REQUIRE(out->open(file.string(), OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8)));
-  REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
-  out->close();
-}
-
 // One textured triangle whose texture is `texture` over `images`.
 fs::path textured_file(const fs::path& dir, nlohmann::json images, nlohmann::json texture,
                        std::vector<std::string> used) {
@@ -148,8 +134,9 @@ fs::path textured_file(const fs::path& dir, nlohmann::json images, nlohmann::jso
 TEST_CASE("EXT_texture_webp reads the WebP source; KHR_texture_basisu uses the fallback source or warns",
           "[io][texture][quick]") {
   const auto dir = test::temp_dir("texture_extensions");
-  write_flat_image(dir / "red.png", 1, 0, 0);
-  write_flat_image(dir / "blue.webp", 0, 0, 1);
+  const unsigned char red[3] = {255, 0, 0}, blue[3] = {0, 0, 255};
+  test::write_flat_image(dir / "red.png", red);
+  test::write_flat_image(dir / "blue.webp", blue);
   // A KTX2 file: its 12-byte identifier and nothing a decoder could use.
   std::ofstream(dir / "t.ktx2", std::ios::binary) << std::string("\xABKTX 20\xBB\r\n\x1A\n", 12) << "payload";
   const nlohmann::json images = {{{"uri", "red.png"}}, {{"uri", "blue.webp"}}, {{"uri", "t.ktx2"}}};
