@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -367,6 +368,33 @@ void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> 
   });
 }
 
+/// Cryptomatte manifests kept in sidecar files (cryptomatte/<key>/manif_file, relative to the
+/// EXR) follow the frame: each is copied from beside the first part to beside `out`
+/// ("OUT.{name}.json") and the attribute renamed in every part's header.
+void move_crypto_sidecars(const std::filesystem::path& first, const std::filesystem::path& out,
+                          std::vector<OIIO::ImageSpec>& specs) {
+  constexpr uint64_t kMaxManifestBytes = uint64_t(1) << 30;
+  for (const OIIO::ParamValue& p : OIIO::ParamValueList(specs[0].extra_attribs)) {
+    const std::string attr = p.name().string();
+    if (attr.rfind("cryptomatte/", 0) != 0 || attr.size() < 11 ||
+        attr.compare(attr.size() - 11, 11, "/manif_file") != 0 || p.type() != OIIO::TypeDesc::STRING)
+      continue;
+    const std::string prefix = attr.substr(0, attr.size() - 10);  // "cryptomatte/<key>/"
+    const std::string layer = specs[0].get_string_attribute(prefix + "name", "manifest");
+    const std::filesystem::path source = first.parent_path() / p.get_string();
+    check_input_file(source, attr, kMaxManifestBytes);
+    std::ifstream in(source, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw InputError(source.string(), attr, "cannot be read");
+    const std::filesystem::path dest = std::filesystem::path(out).replace_extension("." + layer + ".json");
+    write_atomically(dest, [&](const std::filesystem::path& temp) {
+      write_file_checked(temp, text.data(), text.size(), dest);
+    });
+    for (auto& sp : specs)
+      if (sp.find_attribute(attr)) sp.attribute(attr, dest.filename().string());
+  }
+}
+
 }  // namespace
 
 void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
@@ -436,6 +464,7 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     statistics.apply(spec);
     if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
   }
+  move_crypto_sidecars(parts[0], out, full);
   write_frame(out, full, pixels);
 }
 

@@ -25,6 +25,16 @@ namespace penumbra {
 
 namespace {
 
+/// A crop or tile: the film is the data window inside the full display window.
+void set_frame_window(OIIO::ImageSpec& spec, const Film& film) {
+  spec.x = film.origin_x;
+  spec.y = film.origin_y;
+  spec.full_x = 0;
+  spec.full_y = 0;
+  spec.full_width = film.full_width > 0 ? film.full_width : film.width;
+  spec.full_height = film.full_height > 0 ? film.full_height : film.height;
+}
+
 void write_with_oiio(const std::filesystem::path& final_path, const std::filesystem::path& temp,
                      const OIIO::ImageSpec& spec, const void* pixels, OIIO::TypeDesc pixel_type) {
   auto out = OIIO::ImageOutput::create(final_path.string());
@@ -65,13 +75,7 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
     }
   }
   spec.alpha_channel = 3;
-  // A crop or tile: the film is the data window inside the full display window.
-  spec.x = film.origin_x;
-  spec.y = film.origin_y;
-  spec.full_x = 0;
-  spec.full_y = 0;
-  spec.full_width = film.full_width > 0 ? film.full_width : film.width;
-  spec.full_height = film.full_height > 0 ? film.full_height : film.height;
+  set_frame_window(spec, film);
   spec.attribute("compression", options.compression);
   spec.attribute("oiio:ColorSpace", "lin_rec709");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
@@ -337,8 +341,15 @@ std::string lower_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-/// The one place that turns DisplayOptions into a CPU processor (config, display, view).
-OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
+bool contains_srgb(std::string name) {
+  for (auto& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return name.find("srgb") != std::string::npos;
+}
+
+/// The one place that turns DisplayOptions into a CPU processor (config, display, view); fills
+/// `described` (if not null) with what was resolved.
+OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options,
+                                               DisplayDescription* described = nullptr) {
   const char* env = std::getenv("OCIO");
   const std::string source = !options.ocio_config.empty() ? options.ocio_config
                              : (env && *env)              ? std::string(env)
@@ -387,6 +398,26 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayOptions& options) {
     throw InputError(source, "--look",
                      "no look '" + options.look + "' (available: " + (looks.empty() ? "none" : looks) + ")");
   }
+  if (described) {
+    DisplayDescription& d = *described;
+    d.source = !options.ocio_config.empty() ? options.ocio_config
+               : (env && *env)              ? "$OCIO=" + std::string(env)
+                                            : std::string("<shipped config>");
+    const char* name = config->getName();
+    d.config = name && *name                  ? name
+               : !options.ocio_config.empty() ? options.ocio_config
+               : (env && *env)                ? std::string(env)
+                                              : std::string("penumbra-default");
+    d.display = display;
+    d.view = view;
+    d.look = options.look;
+    d.exposure = options.exposure;
+    const char* cs_name = config->getDisplayViewColorSpaceName(display.c_str(), view.c_str());
+    d.colorspace = cs_name ? cs_name : "";
+    const auto cs = config->getColorSpace(d.colorspace.c_str());
+    const bool data = cs && cs->isData();
+    d.srgb = !data && (contains_srgb(d.colorspace) || contains_srgb(display));
+  }
   try {
     if (options.look.empty())
       return config
@@ -417,7 +448,27 @@ void check_display_output(const std::filesystem::path& path, const DisplayOption
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".tif" && ext != ".tiff")
     throw InputError(path.string(), "",
                      "unsupported display image format '" + ext + "' (use .png, .jpg, .jpeg, .tif or .tiff)");
+  if (options.alpha && (ext == ".jpg" || ext == ".jpeg"))
+    throw InputError(path.string(), "",
+                     "JPEG has no alpha channel: --png-alpha needs a .png or .tif display image");
   display_processor(options);
+}
+
+DisplayDescription describe_display(const DisplayOptions& options) {
+  DisplayDescription d;
+  display_processor(options, &d);
+  return d;
+}
+
+std::vector<std::pair<std::string, std::string>> display_metadata(const DisplayDescription& d) {
+  char exposure[32];
+  std::snprintf(exposure, sizeof exposure, "%g", double(d.exposure));
+  return {{"penumbra:ocio_config", d.config},
+          {"penumbra:ocio_display", d.display},
+          {"penumbra:ocio_view", d.view},
+          {"penumbra:ocio_look", d.look.empty() ? "none" : d.look},
+          {"penumbra:ocio_colorspace", d.colorspace},
+          {"penumbra:exposure", exposure}};
 }
 
 void apply_display_transform(std::vector<float>& rgb, int width, int height, const DisplayOptions& options) {
@@ -431,22 +482,40 @@ void write_display_image(const Film& film, const std::filesystem::path& path, co
   const size_t n = size_t(film.width) * size_t(film.height);
   std::vector<float> rgb(n * 3);
   const float gain = std::exp2(options.exposure);
-  for (size_t i = 0; i < n; ++i)
+  for (size_t i = 0; i < n; ++i) {
+    const float a = options.half_beauty ? float(half(film.rgba[i * 4 + 3])) : film.rgba[i * 4 + 3];
+    // With alpha the view applies to the straight colour; over black, to the premultiplied one.
+    const float unpremultiply = options.alpha ? (a > 0 ? 1 / a : 0.0f) : 1.0f;
     for (int c = 0; c < 3; ++c) {
       const float v = film.rgba[i * 4 + size_t(c)];
-      rgb[i * 3 + size_t(c)] = (options.half_beauty ? float(half(v)) : v) * gain;
+      rgb[i * 3 + size_t(c)] = (options.half_beauty ? float(half(v)) : v) * gain * unpremultiply;
     }
-  apply_display_transform(rgb, film.width, film.height, options);
+  }
+  DisplayDescription described;
+  const auto cpu = display_processor(options, &described);
+  OCIO::PackedImageDesc desc(rgb.data(), film.width, film.height, 3);
+  cpu->apply(desc);
   const std::string ext = lower_extension(path);
   const bool sixteen = ext == ".tif" || ext == ".tiff";
-  OIIO::ImageSpec spec(film.width, film.height, 3, sixteen ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
+  const int channels = options.alpha ? 4 : 3;
+  OIIO::ImageSpec spec(film.width, film.height, channels,
+                       sixteen ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  if (options.alpha) spec.alpha_channel = 3;
+  set_frame_window(spec, film);  // PNG oFFs, TIFF XPosition / YPosition
+  if (described.srgb) spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
-  for (float& v : rgb) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+  for (const auto& [k, v] : display_metadata(described)) spec.attribute(k, v);
+  std::vector<float> pixels(n * size_t(channels));
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < channels; ++c) {
+      const float alpha = options.half_beauty ? float(half(film.rgba[i * 4 + 3])) : film.rgba[i * 4 + 3];
+      const float v = c < 3 ? rgb[i * 3 + size_t(c)] : alpha;
+      pixels[i * size_t(channels) + size_t(c)] = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    }
   write_atomically(
       path,
       [&](const std::filesystem::path& temp) {
-        write_with_oiio(path, temp, spec, rgb.data(), OIIO::TypeDesc::FLOAT);
+        write_with_oiio(path, temp, spec, pixels.data(), OIIO::TypeDesc::FLOAT);
       },
       sha256);
 }

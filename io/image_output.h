@@ -62,18 +62,43 @@ struct DisplayOptions {
   /// Round the beauty to half floats first, as a half EXR stores it: the display image of a
   /// render then equals the one made from its EXR (a merged farm frame's).
   bool half_beauty = false;
+  /// Keep the beauty's alpha: RGBA with straight (un-premultiplied) colour, the view applied to
+  /// the un-premultiplied scene-linear colour. PNG and TIFF only.
+  bool alpha = false;
 };
 
-/// Writes the beauty (over black) through the display/view transform as 8-bit RGB (16-bit for
-/// TIFF). The format follows the extension (.png, .jpg/.jpeg, .tif/.tiff). Throws InputError
-/// for a bad config/display/view and std::runtime_error for write failures.
+/// What a display image was made with, as recorded in its metadata and the EXR's.
+struct DisplayDescription {
+  std::string config;  ///< the config's name (its `name:` field), else its file, else "penumbra-default"
+  std::string source;  ///< the config's file, "$OCIO=<file>", or "<shipped config>"
+  std::string display, view, look;  ///< resolved (defaults filled in); look empty = none
+  std::string colorspace;           ///< the view's colour space
+  float exposure = 0;
+  bool srgb = false;  ///< the encoding is sRGB (the view's colour space or the display is named sRGB and
+                      ///< is not data): only then does the image carry sRGB tags
+};
+
+/// Resolves `options` against its config as write_display_image does. Throws InputError as
+/// check_display_output.
+DisplayDescription describe_display(const DisplayOptions& options);
+
+/// The metadata attributes of a display description: "penumbra:ocio_config", ..._display,
+/// ..._view, ..._look, ..._colorspace and "penumbra:exposure" (as text).
+std::vector<std::pair<std::string, std::string>> display_metadata(const DisplayDescription& d);
+
+/// Writes the beauty (over black, or with its alpha under options.alpha) through the
+/// display/view transform as 8-bit RGB(A) (16-bit for TIFF). The format follows the extension
+/// (.png, .jpg/.jpeg, .tif/.tiff). The file records display_metadata(); it is tagged sRGB only
+/// when the description says so; a crop or tile keeps its offset in the full frame (PNG oFFs,
+/// TIFF XPosition/YPosition). Throws InputError for a bad config/display/view and
+/// std::runtime_error for write failures.
 /// If `sha256` is not null it receives the SHA-256 of the file's bytes.
 void write_display_image(const Film& film, const std::filesystem::path& path, const DisplayOptions& options,
                          std::string* sha256 = nullptr);
 
 /// Checks, before any rendering, that `path` has a display-image extension (.png, .jpg,
-/// .jpeg, .tif, .tiff) and that the config, display and view resolve. Throws InputError
-/// naming the file or config and, for an unknown display or view, listing the valid ones.
+/// .jpeg, .tif, .tiff; with options.alpha not JPEG) and that the config, display and view resolve. Throws
+/// InputError naming the file or config and, for an unknown display or view, listing the valid ones.
 void check_display_output(const std::filesystem::path& path, const DisplayOptions& options);
 
 /// Writes `values` (width x height, row-major) as an 8-bit sRGB heat map (.png, .jpg, .tif):

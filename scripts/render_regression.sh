@@ -8,7 +8,7 @@
 #
 # "Identical" means: the same parts, channels, types, windows and header attributes, except
 # the timing attribute penumbra:render_seconds and the command line (which names each run's
-# output folder), and the same value in every pixel of every channel except cost.ns
+# output folder), and the same value in every pixel of every channel except cost_ns.X
 # (wall-clock nanoseconds per ray). Compared with oiiotool with zero tolerance.
 # Corpus renders (the animation time) need ../shared/corpus or PENUMBRA_CORPUS.
 set -euo pipefail
@@ -59,8 +59,8 @@ case "$mode" in
         echo "HEADER DIFFERS: $name"; diff <(header "$fa") <(header "$fb") | head -6 || true; fails=$((fails + 1)); continue
       fi
       sel=()
-      if oiiotool --info -v "$fa" | grep -q 'cost\.ns'; then  # single-part files only carry cost
-        chans=$(oiiotool --info -v "$fa" | sed -n 's/^ *channel list: //p' | head -1 | tr -d ' ' | sed 's/([a-z0-9]*)//g' | tr ',' '\n' | grep -v '^cost\.ns$' | paste -sd,)
+      if oiiotool --info -v "$fa" | grep -q 'cost_ns'; then  # single-part files only carry cost
+        chans=$(oiiotool --info -v "$fa" | sed -n 's/^ *channel list: //p' | head -1 | tr -d ' ' | sed 's/([a-z0-9]*)//g' | tr ',' '\n' | grep -v '^cost_ns\.X$' | paste -sd,)
         sel=(--ch "$chans")
       fi
       if ! oiiotool -a "$fa" "${sel[@]}" "$fb" "${sel[@]}" --fail 0 --failpercent 0 --diff >/dev/null 2>&1; then

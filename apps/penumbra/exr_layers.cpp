@@ -14,6 +14,8 @@
 
 namespace penumbra::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 std::string json_string(const std::string& v) {
@@ -29,8 +31,8 @@ std::string json_string(const std::string& v) {
   return r + "\"";
 }
 
-/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind id.object
-/// (glTF node index + 1) and id.material (material index + 1); 0 is the background.
+/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind object_id
+/// (glTF node index + 1) and material_id (material index + 1); 0 is the background.
 std::string id_manifest(const Scene& scene, const GltfInfo& info) {
   std::set<int> nodes;
   for (const auto& inst : scene.instances)
@@ -47,6 +49,31 @@ std::string id_manifest(const Scene& scene, const GltfInfo& info) {
   for (size_t m = 0; m < scene.materials.size(); ++m)
     j += (m ? ", " : "") + json_string(std::to_string(m + 1)) + ": " + json_string(scene.materials[m].name);
   return j + "}}";
+}
+
+/// Cryptomatte channels ({layer}00.R = rank 0 id, .G its coverage, .B rank 1 id, .A its coverage,
+/// then {layer}01, ...: always 32-bit float) and the cryptomatte/<key>/ attributes.
+void add_crypto_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
+  const CryptoImage& img = buffers.crypto;
+  for (size_t l = 0; l < job.request.crypto.size(); ++l) {
+    const std::string& layer = job.request.crypto[l];
+    for (int group = 0; group < img.channels / 4; ++group)
+      for (int c = 0; c < 4; ++c)
+        exr.extra.push_back({format("%s%02d.", layer.c_str(), group) + "RGBA"[c], &img.layers[l],
+                             ChannelType::Float, img.channels, group * 4 + c});
+    const std::string key = "cryptomatte/" + crypto_key(layer) + "/";
+    exr.metadata.push_back({key + "name", layer});
+    exr.metadata.push_back({key + "hash", "MurmurHash3_32"});
+    exr.metadata.push_back({key + "conversion", "uint32_to_float32"});
+    const std::string& manifest = buffers.crypto_manifests[l];
+    if (manifest.size() <= kInlineManifestBytes || job.request.out_streams) {
+      exr.metadata.push_back({key + "manifest", manifest});
+    } else {
+      const fs::path sidecar = crypto_sidecar_path(job.request.out, layer);
+      exr.metadata.push_back({key + "manif_file", sidecar.filename().string()});
+      buffers.sidecars.push_back({sidecar, manifest});
+    }
+  }
 }
 
 /// OpenEXR's standard camera attributes (row vectors, p' = p M; camera space looks down -Z):
@@ -89,11 +116,13 @@ void add_part_identity(ExrOptions& exr, const RenderJob& job) {
   std::string layers;
   for (const auto& name : job.request.aovs) layers += (layers.empty() ? "" : ",") + name;
   part.entries["aovs"] = layers;
+  if (!job.request.crypto.empty()) part.entries["crypto_depth"] = std::to_string(job.request.crypto_depth);
   exr.metadata.push_back({kSceneHashAttribute, job.scene_sha256});
   exr.metadata.push_back({kSettingsAttribute, canonical_text(part)});
 }
 
-/// The data AOVs' channels: colour albedo, float N, P, Z, UV, uint ids with their manifest.
+/// The data AOVs' channels: colour albedo, float N, P, Z, UV and the ids (whole numbers as float, which
+/// compositors read as values) with their manifest.
 void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
   const auto& aovs = job.request.aovs;
   const ChannelType colour = job.args.use_float ? ChannelType::Float : ChannelType::Half;
@@ -111,8 +140,8 @@ void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
     for (int c = 0; c < 2; ++c)
       exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
   if (aovs.count("id")) {
-    exr.extra.push_back({"id.object", &data.object_id, ChannelType::Uint});
-    exr.extra.push_back({"id.material", &data.material_id, ChannelType::Uint});
+    exr.extra.push_back({"object_id.X", &data.object_id, ChannelType::Float});
+    exr.extra.push_back({"material_id.X", &data.material_id, ChannelType::Float});
     exr.metadata.push_back({"penumbra:manifest", id_manifest(job.loaded.scene, job.loaded.info)});
   }
 }
@@ -123,9 +152,9 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
   const PathImage& image = job.path_image;
   if (aovs.count("samples")) {
     buffers.samples.assign(image.samples.begin(), image.samples.end());
-    exr.extra.push_back({"samples", &buffers.samples, ChannelType::Uint});
+    exr.extra.push_back({"samples.X", &buffers.samples, ChannelType::Float});
   }
-  if (aovs.count("variance")) exr.extra.push_back({"variance", &image.variance, ChannelType::Float});
+  if (aovs.count("variance")) exr.extra.push_back({"variance.X", &image.variance, ChannelType::Float});
   if (aovs.count("light"))
     for (int g = 0; g < kLightGroupCount; ++g)
       for (int c = 0; c < 3; ++c)
@@ -134,21 +163,72 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
                              g * 3 + c});
   if (job.request.cost_aov) {
     if (buffers.cost.counted) {
-      exr.extra.push_back({"cost.nodes", &buffers.cost.nodes});
-      exr.extra.push_back({"cost.triangles", &buffers.cost.triangles});
-      exr.extra.push_back({"cost.shapes", &buffers.cost.shapes});
+      exr.extra.push_back({"cost_nodes.X", &buffers.cost.nodes});
+      exr.extra.push_back({"cost_triangles.X", &buffers.cost.triangles});
+      exr.extra.push_back({"cost_shapes.X", &buffers.cost.shapes});
     }
-    exr.extra.push_back({"cost.ns", &buffers.cost.nanoseconds});
+    exr.extra.push_back({"cost_ns.X", &buffers.cost.nanoseconds});
   }
 }
 
 }  // namespace
+
+fs::path crypto_sidecar_path(const fs::path& exr, const std::string& layer) {
+  return fs::path(exr).replace_extension("." + layer + ".json");
+}
+
+std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
+                                               const std::string& layer) {
+  auto node_name = [&](int n) {
+    return size_t(n) < info.node_names.size() ? info.node_names[size_t(n)]
+                                              : "nodes[" + std::to_string(n) + "]";
+  };
+  std::vector<std::string> names;
+  names.reserve(scene.instances.size());
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (layer == "CryptoMaterial") {
+      const int m = instance_material(scene, inst);
+      names.push_back(m >= 0 ? scene.materials[size_t(m)].name : "default");
+    } else if (inst.node < 0) {
+      names.push_back("instances[" + std::to_string(i) + "]");
+    } else if (layer == "CryptoAsset") {
+      int root = inst.node;  // the topmost ancestor (bounded: the loader rejects cycles)
+      for (size_t step = 0; step < info.node_parents.size() && size_t(root) < info.node_parents.size() &&
+                            info.node_parents[size_t(root)] >= 0;
+           ++step)
+        root = info.node_parents[size_t(root)];
+      names.push_back(node_name(root));
+    } else {
+      names.push_back(node_name(inst.node));
+    }
+  }
+  return names;
+}
 
 void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers) {
   const IntegratorType integrator = job.request.path ? IntegratorType::Path : IntegratorType::Whitted;
   if (job.request.data_aovs)
     buffers.data = render_data_aovs(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator);
   if (job.request.cost_aov) buffers.cost = render_cost(*job.accel, job.camera, job.cfg, integrator);
+  if (job.request.crypto.empty()) return;
+  std::vector<CryptoLayerIds> layers;
+  for (const std::string& layer : job.request.crypto) {
+    CryptoLayerIds ids{layer, {}};
+    std::set<std::string> names;
+    for (const std::string& name : crypto_instance_names(job.loaded.scene, job.loaded.info, layer)) {
+      ids.instance_ids.push_back(crypto_id(name));
+      names.insert(name);
+    }
+    std::string manifest = "{";
+    for (const std::string& name : names)
+      manifest += (manifest.size() > 1 ? "," : "") + json_string(name) + ":" +
+                  json_string(crypto_hex(crypto_id(name)));
+    buffers.crypto_manifests.push_back(manifest + "}");
+    layers.push_back(std::move(ids));
+  }
+  buffers.crypto = render_cryptomatte(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator, layers,
+                                      job.request.crypto_depth);
 }
 
 ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
@@ -181,6 +261,10 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
   if (!a.reproducible) exr.float_metadata.push_back({kRenderSecondsAttribute, float(job.stats.seconds)});
   if (job.request.data_aovs) add_data_channels(exr, job, buffers.data);
   add_render_channels(exr, job, buffers);
+  add_crypto_channels(exr, job, buffers);
+  // The display transform its display image is made with.
+  if (job.request.png)
+    for (auto& kv : display_metadata(describe_display(job.request.display))) exr.metadata.push_back(kv);
   return exr;
 }
 

@@ -3,9 +3,14 @@
 // float data, uint ids), in ExrOptions for io/image_output's write_exr.
 #pragma once
 
+#include <filesystem>
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "io/gltf/loader.h"
 #include "io/image_output.h"
+#include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/cost_map.h"
 
@@ -18,7 +23,25 @@ struct LayerBuffers {
   DataAovs data;               ///< albedo, N, P, Z, UV, ids (from the beauty's camera samples)
   std::vector<float> samples;  ///< the path tracer's sample counts as floats
   CostImage cost;              ///< traversal cost of the camera rays
+  CryptoImage crypto;          ///< ranked Cryptomatte ids, one layer per request.crypto entry
+  /// Each Cryptomatte layer's manifest ({"name": "hex", ...}, names sorted).
+  std::vector<std::string> crypto_manifests;
+  /// Manifests too large for the header, written beside the EXR: (path, JSON text).
+  std::vector<std::pair<std::filesystem::path, std::string>> sidecars;
 };
+
+/// Manifests up to this size go into the EXR header; larger ones into a sidecar JSON file
+/// beside it ("OUT.CryptoObject.json"), named by the layer's manif_file attribute.
+inline constexpr size_t kInlineManifestBytes = 64 * 1024;
+
+/// The sidecar manifest path of Cryptomatte layer `layer` of the EXR `exr`.
+std::filesystem::path crypto_sidecar_path(const std::filesystem::path& exr, const std::string& layer);
+
+/// The name each scene instance has in Cryptomatte layer `layer` (CryptoObject: its glTF node's
+/// name; CryptoMaterial: its material's name, "default" for none; CryptoAsset: its root node's
+/// name), one per scene.instances entry.
+std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
+                                               const std::string& layer);
 
 /// Traces what the requested data and cost AOVs need (the beauty's own camera samples).
 void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers);

@@ -2,6 +2,7 @@
 #include "renderer/integrators/aov.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "renderer/core/parallel.h"
 #include "renderer/integrators/visibility.h"
@@ -92,6 +93,70 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
       }
   });
   return a;
+}
+
+namespace {
+
+/// Blend layers a camera sample passes through before its remaining weight counts as the last
+/// surface's (as the Whitted integrator's max_blend_layers).
+constexpr int kMaxBlendLayers = 16;
+
+}  // namespace
+
+CryptoImage render_cryptomatte(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                               const RenderConfig& config, IntegratorType integrator,
+                               const std::vector<CryptoLayerIds>& layers, int depth) {
+  CryptoImage img;
+  const PixelWindow win = render_window(config);
+  img.width = win.width();
+  img.height = win.height();
+  img.depth = depth;
+  img.channels = 4 * ((depth + 1) / 2);
+  const size_t n = size_t(img.width) * size_t(img.height);
+  img.layers.assign(layers.size(), std::vector<float>(n * size_t(img.channels), 0.0f));
+  const bool filter = scene_needs_hit_filter(scene);
+  // A sample's weight is split over the Blend layers it passes, in kSlots equal slots.
+  constexpr uint32_t kSlots = 8;
+  TileScheduler scheduler(win, config.tile_size, config.threads);
+  scheduler.for_each_tile([&](const PixelWindow& tile) {
+    // Per sample: up to kSlots (instance, weight in slots) entries; expanded into ids whose
+    // multiplicity is the weight, so rank_crypto_ids counts coverage in 1/(spp * kSlots) units.
+    std::vector<int> hit_instance;
+    std::vector<float> ids;
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        const size_t i = size_t(y - win.y0) * size_t(img.width) + size_t(x - win.x0);
+        hit_instance.clear();
+        for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
+          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
+          Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          float remaining = 1;  // of this sample's weight, not yet given to a surface
+          uint32_t given = 0;   // slots handed out
+          for (int layer = 0; layer < kMaxBlendLayers && given < kSlots; ++layer) {
+            Hit hit;
+            if (!intersect_visible(scene, accel, ray, hit, filter)) break;
+            const SurfaceInteraction si = make_interaction(scene, ray, hit);
+            const float a =
+                layer + 1 < kMaxBlendLayers ? std::clamp(eval_material(scene, si).alpha, 0.0f, 1.0f) : 1.0f;
+            // Slots up to the cumulative weight given so far, rounded to the nearest slot.
+            const float total = (1 - remaining) + remaining * a;
+            const uint32_t upto = std::min(kSlots, uint32_t(std::lround(total * float(kSlots))));
+            for (; given < upto; ++given) hit_instance.push_back(int(hit.geom_id));
+            remaining *= 1 - a;
+            if (!(remaining > 0)) break;
+            ray.tnear = std::nextafter(std::max(hit.t, ray.tnear), kInfinity);
+          }
+          for (; given < kSlots; ++given) hit_instance.push_back(-1);
+        }
+        for (size_t l = 0; l < layers.size(); ++l) {
+          ids.clear();
+          for (int inst : hit_instance)
+            ids.push_back(inst >= 0 ? layers[l].instance_ids[size_t(inst)] : 0.0f);
+          rank_crypto_ids(ids, depth, img.channels, &img.layers[l][i * size_t(img.channels)]);
+        }
+      }
+  });
+  return img;
 }
 
 }  // namespace penumbra

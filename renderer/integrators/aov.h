@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/render.h"
 
 namespace penumbra {
@@ -35,5 +36,14 @@ struct DataAovs {
 /// filter, sampler) and reduces them per pixel as above. Deterministic for any thread count.
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, IntegratorType integrator);
+
+/// Cryptomatte: traces the same camera samples and ranks each layer's instance ids per pixel
+/// (rank_crypto_ids): a sample's weight goes to the surfaces it sees, split over Blend layers
+/// by their alpha (up to 16 layers, in eighths of a sample), so the coverage is the pixel
+/// filter's weight of each name. Requires 1 <= depth and every layer's instance_ids to cover
+/// scene.instances. Deterministic for any thread count.
+CryptoImage render_cryptomatte(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                               const RenderConfig& config, IntegratorType integrator,
+                               const std::vector<CryptoLayerIds>& layers, int depth);
 
 }  // namespace penumbra
