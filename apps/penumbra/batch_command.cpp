@@ -6,6 +6,7 @@
 #include <set>
 
 #include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_command.h"
 #include "io/error.h"
 #include "io/exr_merge.h"
@@ -35,6 +36,7 @@ const std::map<std::string, std::string>& reserved_settings() {
       {"overwrite", "`penumbra batch` (overwriting is the default)"},
       {"reproducible", "nothing: batch renders are always reproducible"},
       {"quiet", "`penumbra batch -q`"},
+      {"progress", "`penumbra batch --progress`"},
       {"debug-pixel", "`penumbra render --debug-pixel`"},
       {"help", "`penumbra render --help`"},
   };
@@ -49,6 +51,7 @@ struct Target {
   bool quiet = false;
   int threads = 0;         ///< for a shot whose settings give none
   std::string max_memory;  ///< likewise
+  std::string progress;    ///< `render --progress`; empty: its default
 };
 
 /// The command line of `render` for `target` of the shot, from its keys and settings; throws
@@ -70,6 +73,7 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
     argv.insert(argv.end(), {"--tile", std::to_string(t.tile) + "/" + std::to_string(t.tiles)});
   argv.push_back("--reproducible");
   if (t.quiet) argv.push_back("-q");
+  if (!t.progress.empty() && t.progress != "auto") argv.push_back("--progress=" + t.progress);
   const auto sets = [&](const char* key) {
     for (const JobSetting& s : shot.settings)
       if (s.key == key) return true;
@@ -91,7 +95,7 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
         if (("," + v + ",").find(",cost,") != std::string::npos)
           throw InputError(
               job.file.string(), s.where,
-              "the cost layer records times (cost.ns), which differ between runs; render it with "
+              "the cost layer records times (cost_ns), which differ between runs; render it with "
               "`penumbra render --aov cost`");
     const CLI::Option* opt = render.get_option_no_throw("--" + s.key);
     if (!opt || s.key.size() < 2)
@@ -183,7 +187,7 @@ int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
   const WorkUnit& u = pj.units[n];
   const fs::path final_exr = unit_output(pj.job, u);
   if (b.skip_existing && u.tiles > 1 && complete(final_exr)) {
-    if (!b.quiet)
+    if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
       std::fprintf(stderr, "penumbra: unit %zu: frame %s is complete; skipped\n", n,
                    final_exr.string().c_str());
     return kExitOk;
@@ -240,7 +244,7 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   }
   if (!png.empty()) write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
   for (const fs::path& p : parts) fs::remove(p);
-  if (!b.quiet)
+  if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
     std::fprintf(stderr, "penumbra: merged %d stripes into %s\n", u.tiles, final_exr.string().c_str());
   return true;
 }
@@ -253,10 +257,12 @@ int merge_frames(const PreparedJob& pj, const BatchArgs& b) {
 
 int render_all(const PreparedJob& pj, const BatchArgs& b) {
   for (size_t s = 0; s < pj.job.shots.size(); ++s) {
-    if (!b.quiet) std::fprintf(stderr, "penumbra: shot %s\n", pj.job.shots[s].name.c_str());
+    if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
+      std::fprintf(stderr, "penumbra: shot %s\n", pj.job.shots[s].name.c_str());
     RenderArgs args = pj.shot_args[s];
     args.skip_existing = b.skip_existing;
-    if (const int rc = run_render(args); rc != kExitOk) return rc;
+    if (const int rc = in_shot(pj.job, pj.job.shots[s], [&] { return run_render(args); }); rc != kExitOk)
+      return rc;
   }
   return kExitOk;
 }
@@ -294,15 +300,16 @@ void check_shots(PreparedJob& pj, const BatchArgs& b, bool check_frames) {
   std::map<std::string, std::string> writer;  // every output file -> the shot writing it
   for (size_t s = 0; s < pj.job.shots.size(); ++s) {
     const JobShot& shot = pj.job.shots[s];
-    pj.shot_args.push_back(
-        shot_target_args(pj.job, shot, {std::nullopt, true, 0, 1, b.quiet, b.threads, b.max_memory}));
+    pj.shot_args.push_back(shot_target_args(
+        pj.job, shot, {std::nullopt, true, 0, 1, b.quiet, b.threads, b.max_memory, b.progress}));
     if (!check_frames) continue;
     auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
     for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
       if (u.shot == s && u.tiles > 1) {
         check_shot(
             pj.job, shot,
-            shot_target_args(pj.job, shot, {u.frame, false, 0, u.tiles, b.quiet, b.threads, b.max_memory}));
+            shot_target_args(pj.job, shot,
+                             {u.frame, false, 0, u.tiles, b.quiet, b.threads, b.max_memory, b.progress}));
         break;
       }
     for (const auto& [option, file] : outputs) {
@@ -343,8 +350,9 @@ void remove_made_folders(PreparedJob& pj) {
 RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
   const WorkUnit& u = pj.units.at(n);
   const JobShot& shot = pj.job.shots[u.shot];
-  return shot_target_args(
-      pj.job, shot, {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet, pj.threads, pj.max_memory});
+  return shot_target_args(pj.job, shot,
+                          {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet, pj.threads,
+                           pj.max_memory, pj.shot_args[u.shot].progress});
 }
 
 bool unit_complete(const PreparedJob& pj, size_t n) {

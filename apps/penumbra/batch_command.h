@@ -23,8 +23,9 @@ struct BatchArgs {
   int tiles = 1;                ///< stripes per frame for shots that give no "tiles"
   bool skip_existing = false;   ///< keep complete outputs (the farm's re-runs)
   bool quiet = false;
-  int threads = 0;         ///< `render --threads` for shots whose settings give none; 0 = none
-  std::string max_memory;  ///< `render --max-memory` for shots whose settings give none
+  std::string progress = "auto";  ///< `render --progress` for every render (auto, text, json, none)
+  int threads = 0;                ///< `render --threads` for shots whose settings give none; 0 = none
+  std::string max_memory;         ///< `render --max-memory` for shots whose settings give none
 };
 
 /// A checked job: the file, its units, and each shot's `render` flags for a whole range.

@@ -1,8 +1,12 @@
-// The scene description and accelerator statistics of `penumbra info`.
+// The scene description and accelerator statistics of `penumbra info`, as text or JSON.
 #include "apps/penumbra/info_command.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "apps/penumbra/cli_support.h"
@@ -79,29 +83,196 @@ void print_shapes(const Scene& s, const GltfInfo& i) {
   }
 }
 
-// Each used extension as supported, partially supported (with what is missing) or not supported.
-void print_extension_support(const std::vector<std::string>& used) {
+/// How far Penumbra implements an extension: "supported", "partial" (with what is missing) or
+/// "unsupported".
+struct ExtensionSupport {
+  std::string support, note;
+};
+
+ExtensionSupport extension_support(const std::string& e) {
   const std::vector<std::string> supported = supported_gltf_extensions();
   const auto partial = partial_gltf_extensions();
+  const auto p = std::find_if(partial.begin(), partial.end(), [&](const auto& x) { return x.first == e; });
+  if (p != partial.end()) return {"partial", p->second};
+  if (std::find(supported.begin(), supported.end(), e) != supported.end()) return {"supported", ""};
+  return {"unsupported", "ignored"};
+}
+
+// Each used extension as supported, partially supported (with what is missing) or not supported.
+void print_extension_support(const std::vector<std::string>& used) {
   for (const auto& e : used) {
-    const auto p = std::find_if(partial.begin(), partial.end(), [&](const auto& x) { return x.first == e; });
-    if (p != partial.end())
-      std::printf("  %-40s partially supported: %s\n", e.c_str(), p->second.c_str());
-    else if (std::find(supported.begin(), supported.end(), e) != supported.end())
+    const ExtensionSupport x = extension_support(e);
+    if (x.support == "partial")
+      std::printf("  %-40s partially supported: %s\n", e.c_str(), x.note.c_str());
+    else if (x.support == "supported")
       std::printf("  %-40s supported\n", e.c_str());
     else
       std::printf("  %-40s not supported (ignored)\n", e.c_str());
   }
 }
 
+const char* light_type_name(LightType t) {
+  return t == LightType::Point ? "point" : (t == LightType::Spot ? "spot" : "directional");
+}
+
+/// A float as the double of its shortest decimal form (0.8f -> 0.8, not 0.800000011920929), so
+/// that values read back equal those the file wrote.
+double num(float v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::strtod(std::string(buf, r.ptr).c_str(), nullptr);
+}
+
+nlohmann::ordered_json vec3(Vec3f v) {
+  return {num(v.x), num(v.y), num(v.z)};
+}
+
+/// A finite number, or null (an infinite zfar).
+nlohmann::ordered_json finite_or_null(float v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(num(v)) : nlohmann::ordered_json();
+}
+
+/// The description as one JSON document (schema: README, `penumbra info --json`).
+nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loaded, const AccelStats& st) {
+  using J = nlohmann::ordered_json;
+  const Scene& s = loaded.scene;
+  const GltfInfo& i = loaded.info;
+  J j;
+  j["schema"] = 1;
+  j["file"] = file;
+  j["asset"] = {{"version", i.version}, {"generator", i.generator}};
+  j["scenes"] = J::array();
+  for (int k = 0; k < i.scene_count; ++k)
+    j["scenes"].push_back(
+        {{"index", k}, {"name", i.scene_names[size_t(k)]}, {"rendered", k == i.scene_index}});
+  j["scene"] = i.scene_index >= 0 ? J(i.scene_index) : J();
+  j["nodes"] = i.node_count;
+  j["meshes"] = J::array();
+  for (const GltfMeshInfo& m : i.meshes)
+    j["meshes"].push_back({{"name", m.name}, {"primitives", m.primitives}, {"triangles", m.triangles}});
+  j["primitives"] = i.primitive_count;
+  j["stored"] = {{"meshes", s.meshes.size()}, {"triangles", count_stored_triangles(s)}};
+  const size_t placed = size_t(
+      std::count_if(s.instances.begin(), s.instances.end(), [](const Instance& x) { return !x.identity; }));
+  j["instances"] = {{"count", s.instances.size()},
+                    {"world_space", s.instances.size() - placed},
+                    {"placed", placed},
+                    {"triangles", count_triangles(s)}};
+  std::vector<size_t> shape_uses(s.shapes.size(), 0);
+  for (const Instance& inst : s.instances)
+    if (inst.shape >= 0) ++shape_uses[size_t(inst.shape)];
+  j["shapes"] = J::array();
+  for (size_t k = 0; k < s.shapes.size(); ++k) {
+    const SceneShape& sh = s.shapes[k];
+    j["shapes"].push_back({{"index", k},
+                           {"node", sh.node >= 0 ? J(sh.node) : J()},
+                           {"name", sh.name},
+                           {"kind", shape_kind_name(sh.shape.kind)},
+                           {"description", describe_shape(sh.shape)},
+                           {"material", sh.material >= 0 ? J(sh.material) : J()},
+                           {"instances", shape_uses[k]}});
+  }
+  j["materials"] = J::array();
+  for (size_t k = 0; k < s.materials.size(); ++k) {
+    const Material& m = s.materials[k];
+    j["materials"].push_back(
+        {{"index", k},
+         {"name", m.name},
+         {"base_color", vec3(m.base_color)},
+         {"metallic", num(m.metallic)},
+         {"roughness", num(m.roughness)},
+         {"emissive", vec3(m.emissive)},
+         {"procedural",
+          m.procedural >= 0 ? J(describe_procedural(s.procedurals[size_t(m.procedural)])) : J()}});
+  }
+  j["cameras_defined"] = i.gltf_camera_count;
+  j["cameras"] = J::array();
+  for (size_t k = 0; k < s.cameras.size(); ++k) {
+    const Camera& c = s.cameras[k];
+    const bool ortho = c.projection == Projection::Orthographic;
+    J cam = {{"index", k},
+             {"name", c.name},
+             {"type", ortho ? "orthographic" : "perspective"},
+             {"yfov", ortho ? J() : J(num(c.yfov))},
+             {"aspect", c.aspect > 0 ? J(num(c.aspect)) : J()},
+             {"znear", num(c.znear)},
+             {"zfar", finite_or_null(c.zfar)}};
+    if (ortho) {
+      cam["xmag"] = num(c.xmag);
+      cam["ymag"] = num(c.ymag);
+    }
+    cam["description"] = k < i.camera_instances.size() ? i.camera_instances[k] : std::string();
+    j["cameras"].push_back(cam);
+  }
+  j["lights_defined"] = i.gltf_light_count;
+  j["lights"] = J::array();
+  for (size_t k = 0; k < s.lights.size(); ++k) {
+    const Light& l = s.lights[k];
+    j["lights"].push_back({{"index", k},
+                           {"name", l.name},
+                           {"type", light_type_name(l.type)},
+                           {"intensity", num(l.intensity)},
+                           {"unit", l.type == LightType::Directional ? "lux" : "cd"},
+                           {"color", vec3(l.color)}});
+  }
+  j["images"] = i.image_count;
+  j["textures"] = s.textures.size();
+  j["animations"] = i.animation_count;
+  j["extensions"] = J::array();
+  std::vector<std::string> named = i.extensions_used;
+  for (const auto& e : i.extensions_required)
+    if (std::find(named.begin(), named.end(), e) == named.end()) named.push_back(e);
+  for (const auto& e : named) {
+    const ExtensionSupport x = extension_support(e);
+    const bool required = std::find(i.extensions_required.begin(), i.extensions_required.end(), e) !=
+                          i.extensions_required.end();
+    j["extensions"].push_back(
+        {{"name", e}, {"required", required}, {"support", x.support}, {"note", x.note}});
+  }
+  j["variants"] = i.variants;
+  j["environment"] = loaded.environment ? J{{"light", i.image_light},
+                                            {"width", loaded.environment->width},
+                                            {"height", loaded.environment->height}}
+                                        : J();
+  const Bounds3f b = compute_bounds(s);
+  j["bounds"] = b.empty() ? J() : J{{"min", vec3(b.lo)}, {"max", vec3(b.hi)}};
+  // Node figures are null where the structure keeps none (Embree; a grid has cells, not a tree).
+  const bool tree = st.nodes > 0 && st.name != "grid";
+  const auto figure = [](bool known, auto v) { return known ? J(v) : J(); };
+  j["accelerator"] = {{"name", st.name},
+                      {"config", st.config},
+                      {"triangles", st.triangles},
+                      {"shapes", st.shapes},
+                      {"instances", st.instances},
+                      {"build_seconds", st.build_seconds},
+                      {"bytes", st.bytes},
+                      {"nodes", figure(st.nodes > 0, st.nodes)},
+                      {"leaves", figure(tree, st.leaves)},
+                      {"empty_leaves", figure(st.nodes > 0, st.empty_leaves)},
+                      {"references", figure(st.nodes > 0, st.references)},
+                      {"avg_leaf_triangles", figure(st.nodes > 0, st.avg_leaf_prims)},
+                      {"max_leaf_triangles", figure(st.nodes > 0, st.max_leaf_prims)},
+                      {"max_depth", figure(tree, st.max_depth)},
+                      {"sah_cost", figure(st.sah_cost > 0, st.sah_cost)}};
+  j["warnings"] = loaded.warnings;
+  return j;
+}
+
 }  // namespace
 
 int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
-             const std::string& accel_name, const std::vector<std::string>& accel_params) {
+             const std::string& accel_name, const std::vector<std::string>& accel_params, bool json) {
   const AccelConfig accel_config = parse_accel(accel_name, accel_params);
   LoadedScene loaded = load_scene(file, scene_index, allow_external, flatten, default_memory_budget(), false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
+  if (json) {
+    const auto accel = make_scene_accelerator(accel_name, s, accel_config);
+    const std::string doc =
+        info_json(file, loaded, accel->stats()).dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+    std::printf("%s\n", doc.c_str());
+    return kExitOk;
+  }
   std::printf("file         %s\n", file.c_str());
   std::printf("asset        glTF %s%s%s\n", i.version.c_str(),
               i.generator.empty() ? "" : ", generator: ", i.generator.c_str());
@@ -135,8 +306,7 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
   std::printf("lights       %d defined, %zu in the scene\n", i.gltf_light_count, s.lights.size());
   for (size_t k = 0; k < s.lights.size(); ++k) {
     const auto& l = s.lights[k];
-    const char* type =
-        l.type == LightType::Point ? "point" : (l.type == LightType::Spot ? "spot" : "directional");
+    const char* type = light_type_name(l.type);
     std::printf("  [%zu] %s: %s, intensity %.4g %s\n", k, l.name.c_str(), type, l.intensity,
                 l.type == LightType::Directional ? "lux" : "cd");
   }

@@ -2,7 +2,8 @@
 // `info`, assemble farm tiles with `merge`, render job files with `batch` and submit them to Slurm with
 // `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`. This file wires the subcommands'
 // flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1 a failure outside the input
-// (I/O, memory); a render ended by a signal returns 128 + signal. Only main() exits.
+// (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a parse error
+// included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
@@ -12,6 +13,8 @@
 #include "apps/penumbra/info_command.h"
 #include "apps/penumbra/merge_command.h"
 #include "apps/penumbra/mesh_command.h"
+#include "apps/penumbra/parse_errors.h"
+#include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
 #include "apps/penumbra/submit_command.h"
@@ -26,7 +29,7 @@ struct InfoArgs {
   std::string file, accel = "embree";
   std::vector<std::string> accel_params;
   int scene = -1;
-  bool allow_external = false, flatten = false;
+  bool allow_external = false, flatten = false, json = false;
 };
 
 void add_info_options(CLI::App& info, InfoArgs& a) {
@@ -38,6 +41,9 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
   info.add_flag("--allow-external-uris", a.allow_external,
                 "let buffer URIs reach files outside the scene's folder");
   info.add_flag("--flatten", a.flatten, "as for render: no instancing");
+  info.add_flag(
+      "--json", a.json,
+      "print the description as one JSON document (the schema is in README, `penumbra info --json`)");
 }
 
 void add_merge_options(CLI::App& merge, MergeArgs& a) {
@@ -84,6 +90,7 @@ void add_batch_options(CLI::App& batch, BatchArgs& a) {
   batch.add_flag("--skip-existing", a.skip_existing,
                  "keep outputs that already are complete EXRs (frames, stripes, merged frames)");
   batch.add_flag("-q,--quiet", a.quiet, "no progress, warnings or summaries on stderr");
+  batch.add_option("--progress", a.progress, progress_option_help())->check(CLI::IsMember(progress_modes()));
   batch.add_option("--threads", a.threads, "render --threads for shots whose settings give none")
       ->check(CLI::Range(1, 1024));
   batch.add_option("--max-memory", a.max_memory, "render --max-memory for shots whose settings give none");
@@ -150,8 +157,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitInput;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version: on stdout
+    for (const std::string& message : parse_error_messages(app, e, argc, argv))
+      report("error", message.c_str(), kExitInput);
+    return kExitInput;
   }
   note_given_options(*render, argc, argv, render_args);
   try {
@@ -162,7 +171,7 @@ int main(int argc, char** argv) {
     if (*mesh) return run_mesh(mesh_args);
     if (*info)
       return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,
-                      info_args.accel, info_args.accel_params);
+                      info_args.accel, info_args.accel_params, info_args.json);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {
@@ -181,7 +190,7 @@ int main(int argc, char** argv) {
     // A failed write, sync or rename (full disk, permissions): the message names the file.
     return report("error", e.what(), kExitInternal);
   } catch (const std::exception& e) {
-    return report("internal error", e.what(), kExitInternal);
+    return report("error", (std::string("internal error: ") + e.what()).c_str(), kExitInternal);
   }
   return kExitInternal;
 }

@@ -70,11 +70,12 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
       if (state.window.x0 != win.x0 || state.window.y0 != win.y0 || state.window.x1 != win.x1 ||
           state.window.y1 != win.y1)
         throw InputError(state_file.string(), "", "its pixels cover another window than this render's");
-      if (!a.quiet)
-        std::fprintf(stderr, "resuming %s: %d passes done, %u spp reached\n", state_file.string().c_str(),
-                     state.passes, state.reached);
-    } else if (!a.quiet) {
-      std::fprintf(stderr, "no checkpoint at %s: starting from the beginning\n", state_file.string().c_str());
+      if (prints_text(job.progress, a.quiet))
+        std::fprintf(stderr, "penumbra: resuming %s: %d passes done, %u spp reached\n",
+                     state_file.string().c_str(), state.passes, state.reached);
+    } else if (prints_text(job.progress, a.quiet)) {
+      std::fprintf(stderr, "penumbra: no checkpoint at %s: starting from the beginning\n",
+                   state_file.string().c_str());
     }
   }
   auto last_checkpoint = Clock::now();

@@ -1,21 +1,103 @@
-// Progress lines and the render summary.
+// Progress lines (text and JSON), announcements and the render summary.
 #include "apps/penumbra/progress.h"
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "apps/penumbra/render_job.h"
 
 namespace penumbra::cli {
 
-ProgressReporter::ProgressReporter(bool enabled) : m_enabled(enabled), m_tty(isatty(STDERR_FILENO)) {}
+namespace {
+
+/// Seconds between two JSON progress lines of a phase (its first and last line aside).
+constexpr double kJsonInterval = 0.25;
+
+/// Seconds to the millisecond, for lines a person may read too.
+double milliseconds(double s) {
+  return std::round(s * 1000) / 1000;
+}
+
+void print_json_line(const nlohmann::ordered_json& j) {
+  const std::string line = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::fprintf(stderr, "%s\n", line.c_str());
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+const std::vector<std::string>& progress_modes() {
+  static const std::vector<std::string> modes = {"auto", "text", "json", "none"};
+  return modes;
+}
+
+std::string progress_option_help() {
+  return "progress on stderr: auto (default: a line updated in place on a terminal, one per 10% in logs), "
+         "text (one line per 10%), json (one JSON object per line for each phase: phase, fraction, elapsed, "
+         "eta, frame; no summary) or none";
+}
+
+ProgressMode progress_mode(const std::string& name, bool quiet) {
+  if (name == "text") return ProgressMode::Text;
+  if (name == "json") return ProgressMode::Json;
+  if (name == "none") return ProgressMode::None;
+  if (name != "auto" && !name.empty()) throw UsageError("--progress: unknown mode '" + name + "'");
+  return quiet ? ProgressMode::None : ProgressMode::Auto;
+}
+
+void announce(ProgressMode mode, const std::string& what) {
+  if (mode != ProgressMode::Auto && mode != ProgressMode::Text) return;
+  std::fprintf(stderr, "penumbra: %s\u2026\n", what.c_str());
+  std::fflush(stderr);
+}
+
+void print_json_warnings(const std::string& file, const std::vector<std::string>& warnings) {
+  const size_t shown = std::min<size_t>(warnings.size(), 20);
+  for (size_t i = 0; i < shown; ++i) print_json_line({{"warning", file + ": " + warnings[i]}});
+  if (warnings.size() > shown)
+    print_json_line(
+        {{"warning", file + ": ... and " + std::to_string(warnings.size() - shown) + " more warnings"}});
+}
+
+ProgressReporter::ProgressReporter(ProgressMode mode, const char* phase, std::optional<int64_t> frame)
+    : m_mode(mode),
+      m_phase(phase),
+      m_frame(frame),
+      m_tty(mode == ProgressMode::Auto && isatty(STDERR_FILENO)) {
+  if (m_mode == ProgressMode::Json) {
+    std::lock_guard lock(m_mutex);
+    print_json(0, 0);
+  }
+}
+
+void ProgressReporter::print_json(double fraction, double elapsed) {
+  m_last_fraction = std::max(m_last_fraction, fraction);
+  m_last = elapsed;
+  const double f = m_last_fraction;
+  nlohmann::ordered_json j;
+  j["phase"] = m_phase;
+  j["fraction"] = f;
+  j["elapsed"] = milliseconds(elapsed);
+  j["eta"] = f > 0 ? nlohmann::ordered_json(milliseconds(elapsed * (1 - f) / f)) : nlohmann::ordered_json();
+  j["frame"] = m_frame ? nlohmann::ordered_json(*m_frame) : nlohmann::ordered_json();
+  print_json_line(j);
+  if (f >= 1) m_done = true;
+}
 
 void ProgressReporter::operator()(int done, int total) {
-  if (!m_enabled) return;
+  if (m_mode == ProgressMode::None || total <= 0) return;
   std::lock_guard lock(m_mutex);
   const double elapsed = seconds_since(m_start);
-  const double frac = double(done) / double(total);
+  const double frac = std::clamp(double(done) / double(total), 0.0, 1.0);
+  if (m_mode == ProgressMode::Json) {
+    if (m_done || (frac < 1 && elapsed - m_last < kJsonInterval)) return;
+    print_json(frac, elapsed);
+    return;
+  }
   const int decile = int(frac * 10);
   if (m_tty) {
     if (done != total && elapsed - m_last < 0.1) return;
@@ -33,6 +115,7 @@ void ProgressReporter::operator()(int done, int total) {
 
 void ProgressReporter::finish() {
   std::lock_guard lock(m_mutex);
+  if (m_mode == ProgressMode::Json && !m_done) print_json(1, seconds_since(m_start));
   if (m_open) std::fputc('\n', stderr);
   m_open = false;
 }

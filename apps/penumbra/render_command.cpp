@@ -46,8 +46,10 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   if (q.data_aovs) b += 14 * 4;
   if (q.cost_aov) b += 3 * 4 + 3;
   if (q.aovs.count("samples")) b += 4;  // the counts as floats for the EXR
+  const uint64_t crypto = q.crypto.size() * 4 * uint64_t((q.crypto_depth + 1) / 2);  // ranked (id, coverage)
+  b += crypto * 4;
   const uint64_t channels = 4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) +
-                            (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2);
+                            (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2) + crypto;
   b += channels * 4 * (multipart ? 2 : 1);  // packed channels; --multipart also repacks them per part
   if (q.png) b += 12 + 3;
   return b;
@@ -116,14 +118,20 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
 void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   const RenderArgs& a = job.args;
   set_phase("loading the scene");
+  ProgressReporter progress(job.progress, "load", job.frame);
   const auto t0 = Clock::now();
   const double posed_s = kept ? kept->pose_s : 0;
-  if (kept)
+  if (kept) {
     job.loaded = std::move(kept->loaded);
-  else
-    job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet,
-                            job.request.time, keep, a.variant);
+  } else {
+    announce(job.progress, "loading " + a.scene_file);
+    const bool json = job.progress == ProgressMode::Json;
+    job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget,
+                            a.quiet || json, job.request.time, keep, a.variant);
+    if (json && !a.quiet) print_json_warnings(a.scene_file, job.loaded.warnings);
+  }
   job.load_s = posed_s + seconds_since(t0);
+  progress.finish();
   // No output may replace a buffer or image the scene was loaded from.
   std::vector<std::pair<std::string, fs::path>> inputs;
   for (const auto& f : job.loaded.info.source_files) inputs.push_back({"the scene's file", f});
@@ -170,16 +178,20 @@ void setup_phase(RenderJob& job) {
 
 void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   set_phase("building the acceleration structure");
+  ProgressReporter progress(job.progress, "build", job.frame);
   const auto t0 = Clock::now();
   const double moved_s = kept ? kept->update_s : 0;
   // An animated scene at a time keeps Embree's still placements apart from the instances that
   // later frames move (as a single --frame render does, so that both see the same structure).
   AccelConfig config = job.request.accel_config;
   config.embree.world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
+  if (!(kept && kept->accel))
+    announce(job.progress, "building " + job.args.accel + " (" + describe_scene_size(job.loaded.scene) + ")");
   job.accel = kept && kept->accel ? std::move(kept->accel)
                                   : make_scene_accelerator(job.args.accel, job.loaded.scene, config);
   kept.reset();
   job.build_s = moved_s + seconds_since(t0);
+  progress.finish();
 }
 
 /// Keeps the frame's scene and accelerator for the next frame, as loaded (without the default
@@ -216,7 +228,7 @@ int render_debug_pixel(RenderJob& job) {
 
 void render_phase(RenderJob& job) {
   set_phase("rendering");
-  ProgressReporter reporter(!job.args.quiet);
+  ProgressReporter reporter(job.progress, "render", job.frame);
   if (job.request.path)
     run_path_render(job, reporter);
   else
@@ -230,12 +242,16 @@ void render_phase(RenderJob& job) {
 /// their hashes.
 void write_phase(RenderJob& job) {
   const RenderRequest& q = job.request;
+  ProgressReporter progress(job.progress, "write", job.frame);
   const auto t0 = Clock::now();
   LayerBuffers buffers;
   render_layer_buffers(job, buffers);
   const ExrOptions exr = make_exr_options(job, buffers);
   set_phase("writing the outputs");
   const bool hashes = !job.args.stats_json.empty();
+  for (const auto& [sidecar, text] : buffers.sidecars)
+    write_atomically(
+        sidecar, [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), sidecar); });
   write_exr(job.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
   if (q.png) write_display_image(job.film, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
   if (q.cost_png)
@@ -243,6 +259,7 @@ void write_phase(RenderJob& job) {
                   cost_caption(buffers.cost, job.args.accel), hashes ? &job.hashes.cost_png : nullptr);
   job.write_s = seconds_since(t0);
   if (hashes) write_stats_json(job);
+  progress.finish();
 }
 
 /// One render: load, set up, build, render, write, report. `kept` is the previous frame's scene,
@@ -259,7 +276,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptS
   render_phase(job);
   write_phase(job);
   if (job.remove_state) fs::remove(fs::path(job.request.out).concat(".resume"));
-  if (!a.quiet) print_render_summary(job);
+  if (prints_text(job.progress, a.quiet)) print_render_summary(job);
   if (keep && !job.interrupted) keep_scene(job, kept);
   const RenderRequest& q = job.request;
   if (q.paths_to_stdout) {
@@ -342,6 +359,7 @@ void check_frames_distinct(const std::vector<FramePlan>& plan, const std::vector
 /// incomplete is reported and rendered again.
 bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q) {
   if (!a.skip_existing) return false;
+  const bool text = prints_text(progress_mode(a.progress, a.quiet), a.quiet);
   std::string problem;
   const std::string label = p.number ? "frame " + std::to_string(*p.number) + ": " : "";
   if (is_complete_exr(q.out, problem)) {
@@ -352,17 +370,17 @@ bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q)
     std::error_code ec;
     for (const fs::path& other : others)
       if (!fs::exists(other, ec)) {
-        if (!a.quiet)
+        if (text)
           std::fprintf(stderr, "penumbra: warning: %s%s is missing; rendering the frame again\n",
                        label.c_str(), other.string().c_str());
         return false;
       }
-    if (!a.quiet)
+    if (text)
       std::fprintf(stderr, "penumbra: %s%s is complete; skipped\n", label.c_str(), q.out.string().c_str());
     return true;
   }
   std::error_code ec;
-  if (fs::exists(q.out, ec) && !a.quiet)
+  if (fs::exists(q.out, ec) && text)
     std::fprintf(stderr, "penumbra: warning: %s%s %s; rendering it again\n", label.c_str(),
                  q.out.string().c_str(), problem.c_str());
   return false;
@@ -379,6 +397,7 @@ int run_render(const RenderArgs& a) {
   for (const FramePlan& p : plan) requests.push_back(check_render_args(p.args));
   if (a.frames) check_frames_distinct(plan, requests);
   int64_t rendered = 0, skipped = 0;
+  const bool text = prints_text(progress_mode(a.progress, a.quiet), a.quiet);
   std::optional<KeptScene> kept;
   for (size_t i = 0; i < plan.size(); ++i) {
     const FramePlan& p = plan[i];
@@ -387,14 +406,14 @@ int run_render(const RenderArgs& a) {
       continue;
     }
     const std::string reuse = reuse_kept_scene(kept, requests[i]);
-    if (a.frames && !a.quiet)
+    if (a.frames && text)
       std::fprintf(stderr, "penumbra: frame %lld (%zu of %zu) -> %s%s\n", static_cast<long long>(*p.number),
                    i + 1, plan.size(), requests[i].out.string().c_str(), reuse.c_str());
     if (const int rc = render_frame(p.args, std::move(requests[i]), kept, i + 1 < plan.size()); rc != kExitOk)
       return rc;
     ++rendered;
   }
-  if (a.frames && !a.quiet)
+  if (a.frames && text)
     std::fprintf(stderr, "penumbra: frames %s: %lld rendered, %lld skipped, %.2f s in total\n",
                  a.frames->c_str(), static_cast<long long>(rendered), static_cast<long long>(skipped),
                  seconds_since(t0));

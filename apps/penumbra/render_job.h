@@ -3,9 +3,12 @@
 // the accelerator, the images and the figures the summary and the statistics report.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_options.h"
 #include "io/gltf/loader.h"
 #include "io/render_settings.h"
@@ -21,8 +24,13 @@ struct WrittenHashes {
 };
 
 struct RenderJob {
-  explicit RenderJob(const RenderArgs& a) : args(a) {}
+  explicit RenderJob(const RenderArgs& a)
+      : args(a),
+        progress(progress_mode(a.progress, a.quiet)),
+        frame(a.frame ? std::optional<int64_t>(std::stoll(*a.frame)) : std::nullopt) {}
   const RenderArgs& args;
+  ProgressMode progress;         ///< how the phases report on stderr
+  std::optional<int64_t> frame;  ///< --frame's number (checked before), for the JSON progress lines
   RenderRequest request;
   LoadedScene loaded;
   RenderConfig cfg;

@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/exr_layers.h"
+#include "apps/penumbra/progress.h"
 #include "apps/penumbra/scene_setup.h"
 #include "io/atomic_file.h"
 
@@ -22,8 +24,19 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The AOV names --aov accepts (besides "all").
-constexpr const char* kAovNames[] = {"albedo", "N",       "P",        "Z",     "UV",
-                                     "id",     "samples", "variance", "light", "cost"};
+constexpr const char* kAovNames[] = {"albedo",
+                                     "N",
+                                     "P",
+                                     "Z",
+                                     "UV",
+                                     "id",
+                                     "samples",
+                                     "variance",
+                                     "light",
+                                     "cost",
+                                     "crypto_object",
+                                     "crypto_material",
+                                     "crypto_asset"};
 
 /// -o, --png, --cost-png and --stats-json: extensions, folders and the display transform.
 void check_output_paths(const RenderArgs& a, RenderRequest& q) {
@@ -41,6 +54,7 @@ void check_output_paths(const RenderArgs& a, RenderRequest& q) {
   q.display.look = a.look;
   q.display.exposure = a.exposure;
   q.display.half_beauty = !a.use_float;  // the display image shows what the EXR holds
+  q.display.alpha = a.png_alpha;
   if (q.png) {
     resolve_output(*q.png, "--png");
     check_display_output(*q.png, q.display);  // a typo must not cost a whole render
@@ -114,7 +128,8 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
     std::string name;
     while (std::getline(ss, name, ',')) {
       if (name == "all") {
-        q.aovs.insert({"albedo", "N", "P", "Z", "UV", "id"});
+        q.aovs.insert(
+            {"albedo", "N", "P", "Z", "UV", "id", "crypto_object", "crypto_material", "crypto_asset"});
         if (q.path) q.aovs.insert({"samples", "variance", "light"});
         continue;
       }
@@ -128,6 +143,13 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
       q.aovs.insert(name);
     }
   }
+  for (const auto& [aov, layer] : {std::pair{"crypto_object", "CryptoObject"},
+                                   {"crypto_material", "CryptoMaterial"},
+                                   {"crypto_asset", "CryptoAsset"}})
+    if (q.aovs.count(aov)) q.crypto.push_back(layer);
+  if (a.crypto_depth_given && q.crypto.empty())
+    throw UsageError("--crypto-depth needs --aov crypto_object, crypto_material or crypto_asset");
+  q.crypto_depth = a.crypto_depth;
   q.cost_aov = q.aovs.count("cost") > 0;
   q.data_aovs = q.aovs.count("albedo") || q.aovs.count("N") || q.aovs.count("P") || q.aovs.count("Z") ||
                 q.aovs.count("UV") || q.aovs.count("id");
@@ -163,6 +185,9 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   if (q.png) outputs.push_back({"--png", *q.png});
   if (q.cost_png) outputs.push_back({"--cost-png", *q.cost_png});
   if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
+  if (!q.out_streams)
+    for (const std::string& layer : q.crypto)
+      outputs.push_back({"the " + layer + " manifest", crypto_sidecar_path(q.out, layer)});
   std::vector<std::pair<std::string, fs::path>> inputs = {{"the scene file", a.scene_file}};
   if (!a.env.empty() && !q.env_colour) inputs.push_back({"--env", a.env});
   if (!a.ocio_config.empty())
@@ -283,6 +308,9 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
   render.add_option("--look", args.look,
                     "OCIO look applied before the view: High Contrast, Low Contrast, Plus 1 EV, Minus 1 EV "
                     "with the shipped config");
+  render.add_flag(
+      "--png-alpha", args.png_alpha,
+      "keep the beauty's alpha in the display image (RGBA, colour un-premultiplied; .png and .tif)");
   render.add_option(
       "--background", args.background,
       "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
@@ -336,12 +364,19 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "render stripe i of N (i/N, rows split evenly, 0 = top) for farms; `penumbra merge` assembles them");
   render.add_option("--debug-pixel", args.debug_pixel, "render only pixel x,y and print its value");
   render.add_flag("-q,--quiet", args.quiet, "no progress, warnings or summary on stderr");
+  render.add_option("--progress", args.progress, progress_option_help())
+      ->check(CLI::IsMember(progress_modes()));
   render.add_option(
       "--aov", args.aovs,
-      "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (id.object, id.material + a "
-      "name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
-      "direct/indirect); all = every one of these; cost = traversal cost of the camera rays "
-      "(cost.nodes, cost.triangles, cost.shapes, cost.ns) and a heat map");
+      "extra EXR layers, comma-separated or repeated: albedo, N, P, Z, UV, id (object_id, material_id + "
+      "a name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
+      "direct/indirect); crypto_object, crypto_material, crypto_asset = Cryptomatte mattes of node, "
+      "material and root node names; all = every one of these; cost = traversal cost of the camera rays "
+      "(cost_nodes, cost_triangles, cost_shapes, cost_ns) and a heat map");
+  render
+      .add_option("--crypto-depth", args.crypto_depth,
+                  "Cryptomatte ranks (id, coverage pairs) kept per pixel (default 6: three RGBA layers)")
+      ->check(CLI::Range(1, 16));
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }
@@ -360,6 +395,7 @@ void note_given_options(const CLI::App& render, int argc, char** argv, RenderArg
   args.depth_given = render.count("--max-depth") > 0;
   args.background_given = render.count("--background") > 0;
   args.ambient_given = render.count("--ambient") > 0;
+  args.crypto_depth_given = render.count("--crypto-depth") > 0;
 }
 
 RenderRequest check_render_args(const RenderArgs& a) {

@@ -42,13 +42,17 @@ struct RenderArgs {
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
   double time_limit = 0;
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
+  int crypto_depth = 6;  ///< Cryptomatte ranks per pixel
+  bool crypto_depth_given = false;
+  bool png_alpha = false;             ///< the display image keeps the beauty's alpha (RGBA)
   std::optional<double> time;         ///< --time, seconds
   std::optional<std::string> frame;   ///< --frame, an integer, converted with --fps
   std::optional<std::string> frames;  ///< --frames A-B[:STEP] or N, each frame as --frame
   double fps = 24;
-  bool skip_existing = false;  ///< keep a frame whose -o is already a complete EXR
-  bool overwrite = false;      ///< the default, accepted explicitly
-  bool reproducible = false;   ///< no command line or timing in the EXR: equal renders, equal files
+  bool skip_existing = false;     ///< keep a frame whose -o is already a complete EXR
+  bool overwrite = false;         ///< the default, accepted explicitly
+  bool reproducible = false;      ///< no command line or timing in the EXR: equal renders, equal files
+  std::string progress = "auto";  ///< --progress: auto, text, json or none (see progress.h)
 };
 
 /// Declares every flag of `render` on `render`, bound to `args`.
@@ -75,6 +79,9 @@ struct RenderRequest {
   uint64_t budget = 0;  ///< --max-memory in bytes
   std::set<std::string> aovs;
   bool cost_aov = false, data_aovs = false;
+  std::vector<std::string>
+      crypto;  ///< Cryptomatte layers asked for: CryptoObject, CryptoMaterial, CryptoAsset
+  int crypto_depth = 6;
   std::optional<double> time;  ///< animation time from --time or --frame / --fps
   /// Every file the run writes, named by its option, for the collision checks (also against
   /// the files the scene loads, once they are known).

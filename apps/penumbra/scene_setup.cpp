@@ -26,12 +26,19 @@ LoadedScene load_scene(const std::string& file, int scene, bool allow_external, 
   if (!quiet) {
     const size_t shown = std::min<size_t>(loaded.warnings.size(), 20);
     for (size_t i = 0; i < shown; ++i)
-      std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), loaded.warnings[i].c_str());
+      std::fprintf(stderr, "penumbra: warning: %s: %s\n", file.c_str(), loaded.warnings[i].c_str());
     if (loaded.warnings.size() > shown)
-      std::fprintf(stderr, "warning: %s: ... and %zu more warnings\n", file.c_str(),
+      std::fprintf(stderr, "penumbra: warning: %s: ... and %zu more warnings\n", file.c_str(),
                    loaded.warnings.size() - shown);
   }
   return loaded;
+}
+
+std::string describe_scene_size(const Scene& scene) {
+  const std::string triangles = human_count(count_stored_triangles(scene)) + " triangles";
+  if (scene.shapes.empty()) return triangles;
+  return triangles + ", " + std::to_string(scene.shapes.size()) +
+         (scene.shapes.size() == 1 ? " shape" : " shapes");
 }
 
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file) {

@@ -20,6 +20,10 @@ LoadedScene load_scene(const std::string& file, int scene, bool allow_external, 
                        uint64_t max_memory, bool quiet, std::optional<double> time = {},
                        bool keep_animation = false, const std::string& variant = {});
 
+/// What an acceleration structure is built over, in a few words: "4.65k triangles", "1.20M
+/// triangles, 3 shapes".
+std::string describe_scene_size(const Scene& scene);
+
 /// The camera instance `spec` names: an index as `penumbra info` lists them, or a camera name.
 /// Throws InputError listing the cameras if there is no such camera or the name is ambiguous.
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file);

@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <new>
 
+#include "io/file_checks.h"
 #include "io/gltf/accessors.h"
 #include "io/gltf/animation.h"
 #include "io/gltf/animation_pointer.h"
 #include "io/gltf/compression.h"
 #include "io/gltf/context.h"
+#include "io/gltf/file_access.h"
 #include "io/gltf/image_light.h"
 #include "io/gltf/images.h"
 #include "io/gltf/materials.h"
@@ -89,8 +91,16 @@ void describe(const tinygltf::Model& model, GltfInfo& info) {
   info.node_count = int(model.nodes.size());
   for (size_t i = 0; i < model.nodes.size(); ++i)
     info.node_names.push_back(model.nodes[i].name.empty() ? idx("nodes", i) : model.nodes[i].name);
+  info.node_parents.assign(model.nodes.size(), -1);
+  for (size_t i = 0; i < model.nodes.size(); ++i)
+    for (int c : model.nodes[i].children)
+      if (c >= 0 && size_t(c) < model.nodes.size() && size_t(c) != i) info.node_parents[size_t(c)] = int(i);
   info.mesh_count = int(model.meshes.size());
-  for (const auto& m : model.meshes) info.primitive_count += int(m.primitives.size());
+  for (size_t i = 0; i < model.meshes.size(); ++i) {
+    const auto& m = model.meshes[i];
+    info.primitive_count += int(m.primitives.size());
+    info.meshes.push_back({m.name.empty() ? idx("meshes", i) : m.name, int(m.primitives.size()), 0});
+  }
   info.gltf_camera_count = int(model.cameras.size());
   info.gltf_light_count = int(model.lights.size());
   info.image_count = int(model.images.size());
@@ -155,6 +165,9 @@ std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions&
   validate_cameras(ctx);
   validate_lights(ctx);
   const std::vector<std::vector<LocalPrimitive>> meshes = decode_meshes(ctx);
+  for (size_t m = 0; m < meshes.size(); ++m)
+    for (const LocalPrimitive& p : meshes[m])
+      if (p.usable) ctx.out.info.meshes[m].triangles += p.indices.size() / 3;
   std::vector<NodePose> poses;
   if (ctx.options.time) poses = evaluate_animations(ctx, *ctx.options.time);
   const std::vector<int> roots = scene_roots(ctx);
@@ -178,6 +191,11 @@ std::shared_ptr<GltfAnimation> convert(const GltfContext& ctx, VendorExtensions&
 
 LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options) {
   const std::string name = file.string();
+  // Another 3D format is named before its bytes reach the JSON parser.
+  const uint64_t size = check_input_file(file, "", options.max_file_bytes);
+  const std::vector<unsigned char> head =
+      gltf::read_input_file(file, "", options.max_file_bytes, kSceneSniffBytes);
+  check_gltf_file_format(file, {reinterpret_cast<const char*>(head.data()), head.size()}, size);
   gltf::MemoryBudget budget(name, options.max_memory_bytes);
   LoadedScene out;
   tinygltf::Model model;

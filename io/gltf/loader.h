@@ -45,12 +45,20 @@ struct GltfLoadOptions {
   std::string variant;
 };
 
+/// One glTF mesh as `penumbra info` lists it.
+struct GltfMeshInfo {
+  std::string name;        ///< its name, or "meshes[i]" if unnamed
+  int primitives = 0;      ///< primitives in the file, usable or not
+  uint64_t triangles = 0;  ///< triangles of its usable primitives, once (not per placement)
+};
+
 /// Descriptive facts about the file, for `penumbra info`.
 struct GltfInfo {
   std::string generator, version;
   int scene_count = 0, scene_index = -1;
   std::vector<std::string> scene_names;
   int node_count = 0, mesh_count = 0, primitive_count = 0;
+  std::vector<GltfMeshInfo> meshes;  ///< every glTF mesh, in file order
   int gltf_camera_count = 0, gltf_light_count = 0, image_count = 0, animation_count = 0;
   std::vector<std::string> extensions_used, extensions_required;
   std::vector<std::string> variants;                ///< KHR_materials_variants names, in file order
@@ -58,6 +66,7 @@ struct GltfInfo {
   std::string image_light;                          ///< the EXT_lights_image_based light used, empty: none
   std::vector<std::string> camera_instances;        ///< "name (perspective, node 3)" in scene order
   std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
+  std::vector<int> node_parents;                    ///< each node's parent node, -1 for a root
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
                                                     ///< external buffer and image file, in load order
   /// The SHA-256 of each source_files entry's bytes as the loader read them (same order).
@@ -83,9 +92,10 @@ struct LoadedScene {
   uint64_t animation_bytes = 0;  ///< what `animation` holds of the file (buffers, images), for budgets
 };
 
-/// Loads `file`. Throws InputError (file + JSON path + reason) for anything malformed or
-/// hostile; degenerate but harmless content (points/lines primitives, NaN vertices, missing
-/// images) produces a warning instead and is skipped.
+/// Loads `file`. A file in another 3D format (OBJ, FBX, USD, PLY, ...: check_gltf_file_format)
+/// is refused naming the format before it is parsed. Throws InputError (file + JSON path +
+/// reason) for anything malformed or hostile; degenerate but harmless content (points/lines primitives, NaN
+/// vertices, missing images) produces a warning instead and is skipped.
 LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options = {});
 
 /// Poses `scene`, loaded by load_gltf with a time and `animation` (LoadedScene::animation, the

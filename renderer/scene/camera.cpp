@@ -1,5 +1,8 @@
-// Camera ray generation and framing.
+// Camera ray generation and framing (the fit solved per corner of the bounds).
 #include "renderer/scene/camera.h"
+
+#include <algorithm>
+#include <cmath>
 
 namespace penumbra {
 
@@ -57,20 +60,45 @@ Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov) {
   return c;
 }
 
+Camera fit_bounds(const Camera& view, const Bounds3f& bounds, float aspect) {
+  Camera c = view;
+  Vec3f lo{-1, -1, -1}, hi{1, 1, 1};  // empty bounds: the unit sphere's box at the origin
+  if (!bounds.empty()) lo = bounds.lo, hi = bounds.hi;
+  const Vec3f centre = 0.5f * (lo + hi);
+  // The box's size, with a floor for a point: the least gap left between the eye and the
+  // nearest corner is a share of it.
+  const float size = std::max(length(hi - lo), 1e-3f * std::max(1.0f, length(centre)));
+  float max_x = 0, max_y = 0, max_z = -kInfinity, dist = 0;
+  const float tan_y = std::tan(0.5f * view.yfov), tan_x = tan_y * aspect;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3f p{(k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z};
+    const Vec3f d = p - centre;
+    const float x = std::fabs(dot(d, view.u)), y = std::fabs(dot(d, view.v)), z = dot(d, view.w);
+    max_x = std::max(max_x, x);
+    max_y = std::max(max_y, y);
+    max_z = std::max(max_z, z);
+    // Perspective: the corner at depth (dist - z) projects to x / (dist - z) <= tan_x.
+    dist = std::max(dist, z + std::max(x / tan_x, y / tan_y));
+  }
+  if (view.projection == Projection::Orthographic) {
+    c.ymag = std::max({max_y, max_x / aspect, 1e-6f * size});
+    c.xmag = c.ymag * aspect;
+    dist = max_z + size;  // in front of every corner; orthographic rays start on the image plane
+    c.znear = 0;
+  } else {
+    dist = std::max(dist, max_z + 1e-3f * size);
+    c.znear = dist * 1e-4f;
+  }
+  c.eye = centre + view.w * dist;
+  return c;
+}
+
 Camera frame_bounds(const Bounds3f& bounds, float aspect) {
   constexpr float kYfov = 0.6911f;  // 39.6 degrees, Blender's default 50 mm lens
-  Vec3f center{0, 0, 0};
-  float radius = 1;
-  if (!bounds.empty()) {
-    center = bounds.center();
-    radius = std::max(0.5f * length(bounds.extent()), 1e-6f);
-  }
-  const float half_fov = 0.5f * std::min(kYfov, 2.0f * std::atan(std::tan(0.5f * kYfov) * aspect));
-  const float dist = radius / std::sin(half_fov) * 1.05f;
+  // The frame only: fit_bounds places the eye (far from the origin too, without rounding).
   const Vec3f dir = normalize(Vec3f{0.5f, 0.4f, 1.0f});
-  Camera c = look_at(center + dir * dist, center, {0, 1, 0}, kYfov);
+  Camera c = fit_bounds(look_at(dir, {0, 0, 0}, {0, 1, 0}, kYfov), bounds, aspect);
   c.name = "auto-framed";
-  c.znear = dist * 1e-4f;
   return c;
 }
 

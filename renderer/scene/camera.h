@@ -32,9 +32,21 @@ void generate_camera_rays(const Camera& cam, int width, int height, float x, flo
 /// A camera at `eye` looking at `target` with approximate up vector `up` (right-handed frame).
 Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov);
 
+/// `view` moved so that `bounds` fits a width/height = `aspect` image tightly, as Blender's
+/// "frame selected": the view direction and frame (u, v, w), projection and yfov are kept; the
+/// eye moves along w on the line through the bounds' centre. Perspective: the eye distance is
+/// the smallest at which all 8 corners of `bounds` project inside the image, solved per corner
+/// (corner at (x, y, z) in the camera frame about the centre: distance >= z + |x| / tan_x and
+/// >= z + |y| / tan_y) and maxed, so the extreme corner touches the border of the limiting axis.
+/// Orthographic: ymag (and xmag = ymag * aspect) from the corners' extents, the eye in front of
+/// every corner. znear is set to 1e-4 of the eye distance (perspective) or 0 (orthographic).
+/// Empty bounds frame the unit sphere at the origin; a degenerate box (a point, a flat or
+/// edge-on box) stays in view at a positive distance.
+Camera fit_bounds(const Camera& view, const Bounds3f& bounds, float aspect);
+
 /// Default framing used when a scene has no camera: a perspective camera with a 39.6 degree
 /// vertical FOV looking at the bounds' centre from the front-right-above direction
-/// (0.5, 0.4, 1) so that the bounding sphere fits the image of the given aspect.
+/// (0.5, 0.4, 1), fitted to the image of the given aspect by fit_bounds().
 Camera frame_bounds(const Bounds3f& bounds, float aspect);
 
 /// The documented default key light added when a scene has no light: a white directional

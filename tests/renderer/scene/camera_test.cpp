@@ -1,4 +1,5 @@
-// Tests for renderer/camera: pixel centres, aspect, orthographic and perspective rays, framing.
+// Tests for renderer/camera: pixel centres, aspect, orthographic and perspective rays, framing
+// (the corners of the bounds projected back into the image: inside, the extreme one at the border).
 #include "renderer/scene/camera.h"
 
 #include <catch2/catch.hpp>
@@ -78,15 +79,112 @@ TEST_CASE("look_at builds a right-handed orthonormal frame", "[camera][quick]") 
   CHECK(dot(-c.w, normalize(Vec3f{-1, -2, -3})) == Approx(1));
 }
 
-TEST_CASE("frame_bounds keeps the whole bounding sphere in view", "[camera][quick]") {
-  const Bounds3f b{{-1, -2, -3}, {5, 2, 1}};
-  for (float aspect : {0.5f, 1.0f, 16.0f / 9.0f}) {
-    const Camera c = frame_bounds(b, aspect);
-    const Vec3f centre = b.center();
-    const float r = 0.5f * length(b.extent());
-    const float d = length(c.eye - centre);
-    const float half_v = 0.5f * c.yfov, half_h = std::atan(std::tan(half_v) * aspect);
-    CHECK(std::asin(r / d) <= std::min(half_v, half_h) + 1e-5f);
-    CHECK(dot(-c.w, normalize(centre - c.eye)) == Approx(1));
+namespace {
+
+/// Raster position (x right, y down, in pixels) of world point `p` under `cam` in a w x h image.
+Vec2f project(const Camera& cam, Vec3f p, int w, int h) {
+  const float aspect = float(w) / float(h);
+  const Vec3f q = p - cam.eye;
+  float sx = 0, sy = 0;
+  if (cam.projection == Projection::Orthographic) {
+    sx = dot(q, cam.u) / (cam.ymag * aspect);
+    sy = dot(q, cam.v) / cam.ymag;
+  } else {
+    const float depth = -dot(q, cam.w);
+    REQUIRE(depth > 0);  // in front of the camera
+    const float tan_y = std::tan(0.5f * cam.yfov);
+    sx = dot(q, cam.u) / depth / (tan_y * aspect);
+    sy = dot(q, cam.v) / depth / tan_y;
   }
+  return {0.5f * (sx + 1) * float(w), 0.5f * (1 - sy) * float(h)};
+}
+
+/// Every corner of `b` projects inside the w x h image, and the outermost one lies within one
+/// pixel of the border on the axis that limits the fit.
+void check_tight_fit(const Camera& cam, const Bounds3f& b, int w, int h) {
+  float reach_x = 0, reach_y = 0;  // the largest distance from the centre line, pixels
+  for (int k = 0; k < 8; ++k) {
+    const Vec3f p{(k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z};
+    const Vec2f r = project(cam, p, w, h);
+    CHECK(r.x >= -1e-3f * float(w));
+    CHECK(r.x <= float(w) * (1 + 1e-3f));
+    CHECK(r.y >= -1e-3f * float(h));
+    CHECK(r.y <= float(h) * (1 + 1e-3f));
+    reach_x = std::max(reach_x, std::fabs(r.x - 0.5f * float(w)));
+    reach_y = std::max(reach_y, std::fabs(r.y - 0.5f * float(h)));
+  }
+  const float gap_x = 0.5f * float(w) - reach_x, gap_y = 0.5f * float(h) - reach_y;
+  CHECK(std::min(gap_x, gap_y) <= 1.0f);  // the limiting axis touches the border
+  CHECK(std::min(gap_x, gap_y) >= -1e-3f * float(std::max(w, h)));
+}
+
+}  // namespace
+
+TEST_CASE("frame_bounds fits the corners of the bounds tightly, keeping the view direction",
+          "[camera][quick]") {
+  Scene sphere;  // a sphere of radius 2 at (1, -3, 0.5): its bounds are the box around it
+  Shape ball;
+  ball.radius = 2;
+  sphere.shapes.push_back({"ball", ball, -1, -1});
+  sphere.instances.push_back(make_shape_instance(0, to_affine(translate(1, -3, 0.5))));
+  const Bounds3f sphere_bounds = compute_bounds(sphere);
+  REQUIRE(sphere_bounds.lo.x == Approx(-1));
+  REQUIRE(sphere_bounds.hi.y == Approx(-1));
+  const Bounds3f cube{{0, 0, 0}, {1, 1, 1}};
+  const Bounds3f slab{{-1, -2, -3}, {5, 2, 1}};
+  for (const Bounds3f& b : {cube, sphere_bounds, slab})
+    for (auto [w, h] :
+         {std::pair{960, 540}, std::pair{400, 400}, std::pair{300, 600}, std::pair{2000, 100}}) {
+      CAPTURE(b.lo.x, b.hi.x, w, h);
+      const Camera c = frame_bounds(b, float(w) / float(h));
+      CHECK(c.name == "auto-framed");
+      CHECK(c.projection == Projection::Perspective);
+      // The view of frame_bounds: the centre from the front-right-above direction (0.5, 0.4, 1).
+      CHECK(dot(c.w, normalize(Vec3f{0.5f, 0.4f, 1.0f})) == Approx(1));
+      CHECK(dot(-c.w, normalize(b.center() - c.eye)) == Approx(1));
+      check_tight_fit(c, b, w, h);
+    }
+}
+
+TEST_CASE("fit_bounds: orthographic views get ymag from the extents", "[camera][quick]") {
+  Camera view = look_at({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 1);
+  view.projection = Projection::Orthographic;
+  const Bounds3f cube{{0, 0, 0}, {1, 1, 1}};
+  // Looking down -z at the unit cube: half-extents 0.5 x 0.5; the wide image is limited by height.
+  Camera c = fit_bounds(view, cube, 2.0f);
+  CHECK(c.ymag == Approx(0.5f));
+  CHECK(c.xmag == Approx(1.0f));
+  check_tight_fit(c, cube, 200, 100);
+  // A tall image is limited by width: ymag = 0.5 / aspect.
+  c = fit_bounds(view, cube, 0.5f);
+  CHECK(c.ymag == Approx(1.0f));
+  check_tight_fit(c, cube, 100, 200);
+  // Every corner in front of the eye, the view direction kept.
+  CHECK(c.eye.z > 1);
+  CHECK(c.w.z == Approx(1));
+  // Seen along a diagonal, the extents are the corners' projections onto u and v.
+  const Camera diagonal = fit_bounds(look_at({1, 1, 1}, {0, 0, 0}, {0, 1, 0}, 1), cube, 1.0f);
+  check_tight_fit(diagonal, cube, 256, 256);
+}
+
+TEST_CASE("fit_bounds: perspective distance solved per corner", "[camera][quick]") {
+  // Looking down -z at a cube of side 2 centred at the origin with tan(yfov/2) = 0.5 and a square
+  // image: the front corners (z = 1, |x| = |y| = 1) need distance 1 + 1 / 0.5 = 3.
+  Camera view = look_at({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 2 * std::atan(0.5f));
+  const Bounds3f box{{-1, -1, -1}, {1, 1, 1}};
+  Camera c = fit_bounds(view, box, 1.0f);
+  CHECK(c.eye.x == Approx(0).margin(1e-6));
+  CHECK(c.eye.z == Approx(3));
+  // A 2:1 image: the horizontal half-extent is tan_x = 1, the vertical limits: still 3.
+  c = fit_bounds(view, box, 2.0f);
+  CHECK(c.eye.z == Approx(3));
+  // A 1:2 image: tan_x = 0.25, so 1 + 1 / 0.25 = 5.
+  c = fit_bounds(view, box, 0.5f);
+  CHECK(c.eye.z == Approx(5));
+  // Empty bounds frame the unit sphere's box at the origin; a point stays at a positive distance.
+  c = fit_bounds(view, Bounds3f{}, 1.0f);
+  CHECK(c.eye.z == Approx(3));
+  c = fit_bounds(view, Bounds3f{{2, 2, 2}, {2, 2, 2}}, 1.0f);
+  CHECK(c.eye.z > 2);
+  CHECK(std::isfinite(c.eye.z));
 }
