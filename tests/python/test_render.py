@@ -1,0 +1,237 @@
+# Scene.render against analytic answers and against itself: the beauty's shape and dtype, the
+# data AOVs of two fronto-parallel quads whose depth, position, normal, albedo and ids are known
+# (for every integrator and accelerator), windows equal to slices of the frame, identical images
+# for 1 and 2 threads and for concurrent renders, the path tracer's layers, the settings' checks,
+# and the GIL released while a render runs.
+import math
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import penumbra
+from conftest import SCENES, quad, write_gltf
+
+W, H = 33, 25
+YFOV = 0.8
+FRONT_EDGE = 0.3  # the front quad covers x <= 0.3 at z = -1
+BACK_COLOR, FRONT_COLOR = (0.2, 0.4, 0.6), (0.9, 0.5, 0.1)
+
+
+@pytest.fixture(scope="module")
+def quads(tmp_path_factory):
+    """A camera at z = 1 looking down -Z at a back quad at z = -2 (node 1, depth 3) and, on the
+    left, a front quad at z = -1 (node 2, depth 2) up to x = 0.3; no lights."""
+    back_p, back_i = quad(-20, 20, -20, 20, -2)
+    front_p, front_i = quad(-20, FRONT_EDGE, -20, 20, -1)
+    path = write_gltf(
+        tmp_path_factory.mktemp("quads") / "quads.gltf",
+        nodes=[{"name": "camera", "camera": 0, "translation": [0, 0, 1]},
+               {"name": "back", "mesh": 0}, {"name": "front", "mesh": 1}],
+        meshes=[(back_p, back_i, 0), (front_p, front_i, 1)],
+        materials=[{"name": "back material", "pbrMetallicRoughness": {"baseColorFactor": [*BACK_COLOR, 1],
+                                                                      "metallicFactor": 0}},
+                   {"name": "front material", "pbrMetallicRoughness": {"baseColorFactor": [*FRONT_COLOR, 1],
+                                                                       "metallicFactor": 0}}],
+        cameras=[{"name": "cam", "type": "perspective",
+                  "perspective": {"yfov": YFOV, "znear": 0.01, "zfar": 100}}])
+    return penumbra.load(path)
+
+
+def column_sides():
+    """Columns whose every ray meets the front quad, and columns whose every ray misses it."""
+    tan_x = math.tan(YFOV / 2) * W / H
+    x_at = lambda raster_x: 2 * (2 * raster_x / W - 1) * tan_x  # x where the ray meets z = -1
+    front = [i for i in range(W) if x_at(i + 1) < FRONT_EDGE - 1e-3]
+    back = [i for i in range(W) if x_at(i) > FRONT_EDGE + 1e-3]
+    assert front and back and len(front) + len(back) >= W - 1
+    return front, back
+
+
+def test_beauty_shape_and_dtype(default_scene):
+    r = default_scene.render(width=40, height=24, spp=1)
+    assert r.beauty.shape == (24, 40, 4) and r.beauty.dtype == np.float32
+    assert r.rgb.shape == (24, 40, 3) and r.rgb.dtype == np.float32
+    np.testing.assert_array_equal(r.rgb, r.beauty[..., :3])
+    assert np.all(np.isfinite(r.beauty)) and r.beauty[..., :3].max() > 0
+    np.testing.assert_array_equal(r.beauty[..., 3], 1)  # the room surrounds the camera
+    assert r.stats["samples"] == 40 * 24 * 1 and r.stats["camera_rays"] == 40 * 24
+    with pytest.raises(ValueError):
+        r.beauty[0, 0, 0] = 1  # a read-only view into the result
+
+
+def test_size_follows_the_camera_aspect(default_scene):
+    r = default_scene.render(width=64, spp=1)
+    assert (r.width, r.height) == (64, round(64 / (16 / 9)))
+    assert r.camera.name == "room camera" and r.camera_index == 0 and not r.default_light
+
+
+@pytest.mark.parametrize("integrator", ["whitted", "path"])
+@pytest.mark.parametrize("accel", penumbra.accelerator_names())
+def test_data_aovs_of_two_quads_are_analytic(quads, integrator, accel):
+    r = quads.render(width=W, height=H, spp=4, integrator=integrator, accel=accel, aovs=["all"])
+    assert r.default_light  # no light, no emitter, no environment: the default key light
+    a = r.aovs
+    front, back = column_sides()
+    z, p, n = a["Z"], a["P"], a["N"]
+    assert z.shape == (H, W) and p.shape == (H, W, 3) and a["UV"].shape == (H, W, 2)
+    assert z[H // 2, W // 2] == pytest.approx(2.0, abs=1e-5)  # the centre sees the front quad
+    np.testing.assert_allclose(z[:, front], 2.0, atol=1e-5)
+    np.testing.assert_allclose(z[:, back], 3.0, atol=1e-5)
+    np.testing.assert_allclose(p[:, front, 2], -1.0, atol=1e-5)
+    np.testing.assert_allclose(p[:, back, 2], -2.0, atol=1e-5)
+    np.testing.assert_allclose(n.reshape(-1, 3), np.tile([0, 0, 1], (H * W, 1)), atol=1e-5)
+    np.testing.assert_allclose(a["albedo"][:, front], np.broadcast_to(FRONT_COLOR, (H, len(front), 3)), atol=1e-6)
+    np.testing.assert_allclose(a["albedo"][:, back], np.broadcast_to(BACK_COLOR, (H, len(back), 3)), atol=1e-6)
+    # Object id = glTF node index + 1, material id = material index + 1.
+    assert a["object_id"].dtype == np.uint32
+    assert np.all(a["object_id"][:, front] == 3) and np.all(a["object_id"][:, back] == 2)
+    assert np.all(a["material_id"][:, front] == 2) and np.all(a["material_id"][:, back] == 1)
+    assert r.id_manifest == {"object": {"2": "back", "3": "front"},
+                             "material": {"1": "back material", "2": "front material"}}
+    np.testing.assert_array_equal(r.beauty[..., 3], 1)
+
+
+def test_path_layers(quads):
+    r = quads.render(width=W, height=H, spp=8, integrator="path", aovs=["samples", "variance", "light"])
+    a = r.aovs
+    np.testing.assert_array_equal(a["samples"], 8)
+    assert a["variance"].shape == (H, W) and np.all(a["variance"] >= 0)
+    groups = ["emission", "diffuse_direct", "diffuse_indirect", "specular_direct", "specular_indirect"]
+    total = sum(a[g].astype(np.float64) for g in groups)
+    np.testing.assert_allclose(total, r.rgb, rtol=1e-4, atol=1e-6)  # the five groups sum to the beauty
+    assert "Z" not in a
+
+
+def test_window_is_a_slice_of_the_frame(default_scene):
+    full = default_scene.render(width=32, height=18, spp=2, aovs=["Z", "id"])
+    part = default_scene.render(width=32, height=18, spp=2, aovs=["Z", "id"], window=(8, 4, 24, 16))
+    assert part.beauty.shape == (12, 16, 4) and part.origin == (8, 4) and part.frame_size == (32, 18)
+    np.testing.assert_array_equal(part.beauty, full.beauty[4:16, 8:24])
+    np.testing.assert_array_equal(part.aovs["Z"], full.aovs["Z"][4:16, 8:24])
+    np.testing.assert_array_equal(part.aovs["object_id"], full.aovs["object_id"][4:16, 8:24])
+
+
+@pytest.mark.parametrize("integrator", ["whitted", "path"])
+def test_one_and_two_threads_give_identical_images(default_scene, integrator):
+    one = default_scene.render(width=48, height=27, spp=4, integrator=integrator, threads=1, aovs=["all"])
+    two = default_scene.render(width=48, height=27, spp=4, integrator=integrator, threads=2, tile_size=8,
+                               aovs=["all"])
+    np.testing.assert_array_equal(one.beauty, two.beauty)
+    assert one.aovs.keys() == two.aovs.keys()
+    for name in one.aovs:
+        np.testing.assert_array_equal(one.aovs[name], two.aovs[name], err_msg=name)
+
+
+def test_seed_changes_the_path_traced_image(default_scene):
+    a = default_scene.render(width=24, height=14, spp=2, integrator="path", seed=1)
+    b = default_scene.render(width=24, height=14, spp=2, integrator="path", seed=2)
+    assert not np.array_equal(a.beauty, b.beauty)
+
+
+def test_camera_by_name_equals_camera_by_index(default_scene):
+    by_name = default_scene.render(width=20, height=12, spp=1, camera="room camera")
+    by_index = default_scene.render(penumbra.RenderSettings(width=20, height=12, spp=1, camera=0))
+    np.testing.assert_array_equal(by_name.beauty, by_index.beauty)
+    with pytest.raises(penumbra.InputError) as e:
+        default_scene.render(width=20, height=12, camera="nope")
+    assert str(e.value) == f"{default_scene.file}: camera: no camera named 'nope' (cameras: 0 'room camera')"
+    assert e.value.element == "camera"
+    with pytest.raises(penumbra.InputError, match="camera 3 does not exist"):
+        default_scene.render(width=20, height=12, camera=3)
+
+
+def test_no_camera_frames_the_bounds_and_no_light_adds_the_key_light(tmp_path):
+    p, i = quad(-1, 1, -1, 1, 0)
+    scene = penumbra.load(write_gltf(tmp_path / "bare.gltf", [{"mesh": 0}], [(p, i, None)]))
+    r = scene.render(width=32, height=32, spp=1, aovs=["id"])
+    assert r.camera_index == -1 and r.default_light
+    assert r.aovs["object_id"][16, 16] == 1  # the framed quad fills the centre
+    assert scene.lights == []  # the default light lives only for the render
+
+
+def test_settings_are_checked_before_rendering(default_scene):
+    with pytest.raises(ValueError, match="integrator: unknown value 'foo' \\(known: whitted, path\\)"):
+        default_scene.render(integrator="foo")
+    with pytest.raises(ValueError, match="accel: unknown value 'octree'"):
+        default_scene.render(accel="octree")
+    with pytest.raises(ValueError, match="'samples' needs integrator 'path'"):
+        default_scene.render(aovs=["samples"])
+    with pytest.raises(ValueError, match="unknown AOV 'depth'"):
+        default_scene.render(aovs=["depth"])
+    with pytest.raises(ValueError, match="env_color needs integrator 'path'"):
+        default_scene.render(env_color=1.0)
+    with pytest.raises(ValueError, match="background applies to integrator 'whitted'"):
+        default_scene.render(integrator="path", background=(0.1, 0.2, 0.3))
+    with pytest.raises(ValueError, match="filter: unknown value 'lanczos'"):
+        default_scene.render(filter="lanczos")
+    with pytest.raises(ValueError, match="accel_params bvh.max_leaf_size=4: a parameter of 'bvh'"):
+        default_scene.render(accel_params=["bvh.max_leaf_size=4"])
+    with pytest.raises(ValueError):
+        default_scene.render(width=20000)
+    with pytest.raises(TypeError, match="unknown render setting 'widht'"):
+        default_scene.render(widht=10)
+    s = penumbra.RenderSettings(width=10, integrator="path")
+    assert s.width == 10 and s.copy(width=20).width == 20 and s.width == 10
+    assert s.spp == 0 and s.camera is None and s.background is None
+
+
+def test_accelerator_parameters_keep_the_image(default_scene):
+    a = default_scene.render(width=24, height=14, spp=1, accel="bvh", aovs=["Z"])
+    b = default_scene.render(width=24, height=14, spp=1, accel="bvh", accel_params=["bvh.max_leaf_size=2"],
+                             aovs=["Z"])
+    np.testing.assert_array_equal(a.aovs["Z"], b.aovs["Z"])
+
+
+def test_concurrent_renders_of_one_scene_equal_sequential_ones(default_scene):
+    settings = [dict(width=40, height=22, spp=2), dict(width=40, height=22, spp=2, integrator="path")]
+    expected = [default_scene.render(**s).beauty for s in settings]
+    results = [None, None]
+
+    def run(k):
+        results[k] = default_scene.render(**settings[k]).beauty
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for got, want in zip(results, expected):
+        np.testing.assert_array_equal(got, want)
+
+
+def test_render_releases_the_gil(default_scene):
+    """A thread that increments a counter keeps running while another thread renders. With a
+    switch interval longer than the render, a render holding the GIL would leave the counter
+    exactly where it was when the render began."""
+    counter = 0
+    stop = threading.Event()
+    seen = {}
+
+    def spin():
+        nonlocal counter
+        while not stop.is_set():
+            counter += 1
+            time.sleep(0.0005)  # without the GIL, so the render thread gets it back at once
+
+    def render():
+        before = counter
+        seen["result"] = default_scene.render(width=160, height=90, spp=16)
+        seen["during"] = counter - before
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(30)
+    try:
+        spinner = threading.Thread(target=spin)
+        spinner.start()
+        worker = threading.Thread(target=render)
+        worker.start()
+        worker.join()
+        stop.set()
+        spinner.join()
+    finally:
+        sys.setswitchinterval(old)
+    assert seen["result"].beauty.shape == (90, 160, 4)
+    assert seen["during"] > 0
