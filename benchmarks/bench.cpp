@@ -3,7 +3,8 @@
 // random), verifies every structure's answers against Embree (disagreements settled by the exact
 // brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
 // SVG chart and traversal-cost heat maps; with --marching-cubes, instead, isosurface extraction of
-// the classic CSG part in cells per second; with --noise, noise evaluations per second. See README,
+// the classic CSG part in cells per second; with --noise, noise evaluations per second. The table
+// and chart are formatted by benchmarks/report.h, the SAH column by benchmarks/sah.h. See README,
 // "Benchmarks", and benchmarks/RESULTS.md.
 #include <sys/utsname.h>
 #include <tbb/global_control.h>
@@ -25,6 +26,10 @@
 #include <thread>
 #include <vector>
 
+#include "benchmarks/chart.h"
+#include "benchmarks/machine.h"
+#include "benchmarks/report.h"
+#include "benchmarks/sah.h"
 #include "benchmarks/scenegen.h"
 #include "io/accel_params.h"
 #include "io/atomic_file.h"
@@ -48,6 +53,7 @@ using namespace penumbra;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using bench::Row;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -319,36 +325,12 @@ int run_noise(int count, int repeats) {
   return 0;
 }
 
-struct Row {
-  std::string scene, accel, kind, config;
-  uint64_t triangles = 0, shapes = 0, rays = 0, hits = 0, bytes = 0, mismatches = 0, ties = 0;
-  double evals = -1;  // SDF evaluations per ray (sphere-tracing steps); -1: not counted (Embree)
-  double build_s = 0, sah = 0;
-  std::vector<std::pair<int, double>> mrays;  // threads -> Mrays/s
-  std::vector<double> vs_embree;              // per thread count
-};
-
 std::string json_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
     if (c == '"' || c == '\\') o += '\\';
     if (static_cast<unsigned char>(c) < 0x20) continue;
     o += c;
-  }
-  return o;
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<')
-      o += "&lt;";
-    else if (c == '>')
-      o += "&gt;";
-    else if (c == '&')
-      o += "&amp;";
-    else
-      o += c;
   }
   return o;
 }
@@ -382,6 +364,7 @@ std::string machine_json() {
   field("date", date);
   field("cpu", read_field("/proc/cpuinfo", "model name"));
   field("hardware_threads", std::to_string(std::thread::hardware_concurrency()));
+  field("cores", std::to_string(bench::read_machine_info().cores));
   field("memory", read_field("/proc/meminfo", "MemTotal"));
   field("os", read_field("/etc/os-release", "PRETTY_NAME"));
   field("kernel", std::string(u.sysname) + " " + u.release + " " + u.machine);
@@ -395,78 +378,19 @@ std::string machine_json() {
   return s;
 }
 
-/// A bar chart per scene: Mrays/s per ray kind and structure for each thread count, and build
-/// time per structure. Plain SVG 1.1, no scripts or external fonts.
-std::string svg_chart(const std::vector<Row>& rows, const std::vector<int>& thread_counts) {
-  std::vector<std::string> scenes, accels, kinds;
-  auto add = [](std::vector<std::string>& v, const std::string& x) {
-    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
-  };
-  for (const auto& r : rows) {
-    add(scenes, r.scene);
-    add(accels, r.accel);
-    add(kinds, r.kind);
-  }
-  static const char* colors[] = {"#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#b07aa1"};
-  const int charts = int(thread_counts.size()) + 1, chart_w = 340, chart_h = 200, panel_h = chart_h + 90;
-  const int width = charts * (chart_w + 30) + 40, height = int(scenes.size()) * panel_h + 70;
-  std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-    << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" "
-       "fill=\"white\"/>\n";
-  o << "<text x=\"20\" y=\"22\" font-size=\"15\" font-weight=\"bold\">penumbra-bench: throughput (Mrays/s, "
-       "higher is better) "
-       "and build time (ms, lower is better)</text>\n";
-  for (size_t a = 0; a < accels.size(); ++a)  // legend
-    o << "<rect x=\"" << 20 + a * 90 << "\" y=\"34\" width=\"12\" height=\"12\" fill=\"" << colors[a % 6]
-      << "\"/><text x=\"" << 36 + a * 90 << "\" y=\"44\">" << xml_escape(accels[a]) << "</text>\n";
-  for (size_t si = 0; si < scenes.size(); ++si) {
-    const int y0 = 70 + int(si) * panel_h;
-    o << "<text x=\"20\" y=\"" << y0 + 14 << "\" font-size=\"13\" font-weight=\"bold\">"
-      << xml_escape(scenes[si]) << "</text>\n";
-    for (int c = 0; c < charts; ++c) {
-      const bool build = c == int(thread_counts.size());
-      const int x0 = 40 + c * (chart_w + 30), top = y0 + 40, base = top + chart_h;
-      // Groups: ray kinds (throughput) or a single group (build time).
-      const size_t groups = build ? 1 : kinds.size();
-      auto value = [&](size_t g, size_t a) -> double {
-        for (const auto& r : rows)
-          if (r.scene == scenes[si] && r.accel == accels[a] && (build || r.kind == kinds[g]))
-            return build ? r.build_s * 1e3 : (size_t(c) < r.mrays.size() ? r.mrays[size_t(c)].second : 0);
-        return 0;
-      };
-      double vmax = 0;
-      for (size_t g = 0; g < groups; ++g)
-        for (size_t a = 0; a < accels.size(); ++a) vmax = std::max(vmax, value(g, a));
-      if (!(vmax > 0)) vmax = 1;
-      const std::string title = build ? "build time (ms)"
-                                      : std::to_string(thread_counts[size_t(c)]) + " thread" +
-                                            (thread_counts[size_t(c)] == 1 ? "" : "s") + ", Mrays/s";
-      o << "<text x=\"" << x0 << "\" y=\"" << top - 8 << "\" font-weight=\"bold\">" << title << "</text>\n";
-      o << "<line x1=\"" << x0 << "\" y1=\"" << base << "\" x2=\"" << x0 + chart_w << "\" y2=\"" << base
-        << "\" stroke=\"black\"/>\n";
-      const double gw = double(chart_w) / double(groups), bw = gw * 0.8 / double(accels.size());
-      for (size_t g = 0; g < groups; ++g) {
-        for (size_t a = 0; a < accels.size(); ++a) {
-          const double v = value(g, a), h = v / vmax * (chart_h - 14);
-          const double x = x0 + double(g) * gw + gw * 0.1 + double(a) * bw;
-          char buf[64];
-          std::snprintf(buf, sizeof buf, v >= 100 ? "%.0f" : (v >= 10 ? "%.1f" : "%.2f"), v);
-          o << "<rect x=\"" << x << "\" y=\"" << base - h << "\" width=\"" << bw * 0.92 << "\" height=\"" << h
-            << "\" fill=\"" << colors[a % 6] << "\"><title>"
-            << xml_escape(scenes[si] + " " + accels[a] + (build ? "" : " " + kinds[g])) << ": " << buf
-            << "</title></rect>\n";
-          if (bw >= 14)
-            o << "<text x=\"" << x + bw * 0.46 << "\" y=\"" << base - h - 3
-              << "\" font-size=\"8\" text-anchor=\"middle\">" << buf << "</text>\n";
-        }
-        o << "<text x=\"" << x0 + double(g) * gw + gw / 2 << "\" y=\"" << base + 14
-          << "\" text-anchor=\"middle\">" << (build ? "build" : xml_escape(kinds[g])) << "</text>\n";
-      }
-    }
-  }
-  o << "</svg>\n";
-  return o.str();
+/// The software of a run, one line for the chart's caption: versions, OS, compiler, build type.
+std::string software_line() {
+  utsname u{};
+  uname(&u);
+  return std::string("Penumbra ") + PENUMBRA_VERSION + ", Embree " + embree_version() + ", oneTBB " +
+         TBB_runtime_version() + ", " + read_field("/etc/os-release", "PRETTY_NAME") + ", " + u.sysname +
+         " " + u.release + ", " +
+#ifdef __clang__
+         "Clang " __clang_version__
+#else
+         "GCC " __VERSION__
+#endif
+         + ", " + PENUMBRA_BUILD_TYPE + " build";
 }
 
 }  // namespace
@@ -559,25 +483,11 @@ int main(int argc, char** argv) {
     if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end())
       std::rotate(accels.begin(), it, it + 1);
     // The table, one row as soon as it is measured (long runs show progress).
-    std::printf("%-28s %-7s %-8s %9s %9s %8s %8s %9s %6s %5s %9s", "scene", "accel", "rays", "build ms",
-                "MiB", "B/tri", "SAH", "count", "wrong", "ties", "evals/ray");
-    for (int t : threads)
-      std::printf("  %4dT Mrays/s (x Embree)", t > 0 ? t : int(tbb::info::default_concurrency()));
-    std::printf("\n");
+    std::vector<int> thread_counts;  // 0 resolved to all cores
+    for (int t : threads) thread_counts.push_back(t > 0 ? t : int(tbb::info::default_concurrency()));
+    std::printf("%s%s", bench::sah_legend().c_str(), bench::table_header(thread_counts).c_str());
     auto print_row = [](const Row& r) {
-      std::printf("%-28.28s %-7s %-8s %9.2f %9.2f %8.1f %8.2f %9llu %6llu %5llu", r.scene.c_str(),
-                  r.accel.c_str(), r.kind.c_str(), r.build_s * 1e3, double(r.bytes) / (1 << 20),
-                  r.triangles ? double(r.bytes) / double(r.triangles) : 0.0, r.sah,
-                  static_cast<unsigned long long>(r.rays), static_cast<unsigned long long>(r.mismatches),
-                  static_cast<unsigned long long>(r.ties));
-      if (r.evals >= 0)
-        std::printf(" %9.2f", r.evals);
-      else
-        std::printf(" %9s", "-");
-      for (size_t i = 0; i < r.mrays.size(); ++i)
-        std::printf("  %12.2f (%5.2fx)      ", r.mrays[i].second,
-                    i < r.vs_embree.size() ? r.vs_embree[i] : 0.0);
-      std::printf("\n");
+      std::printf("%s", bench::table_row(r).c_str());
       std::fflush(stdout);
     };
     std::vector<Row> rows;
@@ -604,6 +514,12 @@ int main(int argc, char** argv) {
           times.push_back(seconds_since(t0));
         }
         const AccelStats st = accel->stats();
+        // The SAH under the benchmark's one set of constants, from this tree's node boxes.
+        const bench::StructureSah sah =
+            bench::measure_structure_sah(accel_name, views, instances, config, *accel);
+        if (!sah.cost && accel_name == "bvh")
+          std::fprintf(stderr, "penumbra-bench: %s %s: SAH n/a: %s\n", name.c_str(), accel_name.c_str(),
+                       sah.note.c_str());
         if (!heatmaps.empty()) {
           RenderConfig rc;
           rc.width = width;
@@ -619,8 +535,9 @@ int main(int argc, char** argv) {
           Row row{name, accel_name, set.kind, st.config, st.triangles, st.shapes, set.rays.size()};
           row.bytes = st.bytes;
           if (accel->counts_traversal() && st.shapes > 0) row.evals = evaluations_per_ray(*accel, set);
-          row.build_s = median(times);
-          row.sah = st.sah_cost;
+          row.build_s = bench::spread_of(times);
+          row.sah = sah.cost;
+          row.builder_sah = st.sah_cost;
           const Agreement g = check_against_embree(*accel, *embree, *exact, set, scale);
           row.mismatches = g.wrong;
           row.ties = g.ties;
@@ -628,16 +545,17 @@ int main(int argc, char** argv) {
             const int n = t > 0 ? t : int(tbb::info::default_concurrency());
             uint64_t hits = 0;
             trace_seconds(*accel, set, n, hits);  // warm-up
-            std::vector<double> secs;
-            for (int r = 0; r < repeats; ++r) secs.push_back(trace_seconds(*accel, set, n, hits));
+            std::vector<double> mrays;
+            for (int r = 0; r < repeats; ++r)
+              mrays.push_back(double(set.rays.size()) / trace_seconds(*accel, set, n, hits) / 1e6);
             row.hits = hits;
-            row.mrays.push_back({n, double(set.rays.size()) / median(secs) / 1e6});
+            row.mrays.push_back({n, bench::spread_of(mrays)});
           }
           // Ratio to Embree on the same rays (Embree is measured first, see above).
           for (const auto& e : rows)
             if (e.scene == name && e.accel == "embree" && e.kind == row.kind)
               for (size_t i = 0; i < row.mrays.size(); ++i)
-                row.vs_embree.push_back(row.mrays[i].second / e.mrays[i].second);
+                row.vs_embree.push_back(row.mrays[i].mrays.median / e.mrays[i].mrays.median);
           if (accel_name == "embree")
             for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(1.0);
           print_row(row);
@@ -653,16 +571,20 @@ int main(int argc, char** argv) {
         std::ofstream f(tmp);
         f << "scene,accel,rays,triangles,shapes,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties,evals_"
              "per_ray";
-        for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
-          f << ",mrays_" << m.first << "t,vs_embree_" << m.first << "t";
+        for (int t : thread_counts) f << ",mrays_" << t << "t,vs_embree_" << t << "t";
+        f << ",builder_sah_cost,build_s_min,build_s_max";
+        for (int t : thread_counts) f << ",mrays_min_" << t << "t,mrays_max_" << t << "t";
         f << "\n";
         for (const auto& r : rows) {
           f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.shapes << ','
-            << r.build_s << ',' << r.bytes << ',' << r.sah << ',' << r.rays << ',' << r.hits << ','
-            << r.mismatches << ',' << r.ties << ',';
+            << r.build_s.median << ',' << r.bytes << ',';
+          if (r.sah) f << *r.sah;  // empty: no SAH
+          f << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ',' << r.ties << ',';
           if (r.evals >= 0) f << r.evals;
           for (size_t i = 0; i < r.mrays.size(); ++i)
-            f << ',' << r.mrays[i].second << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+            f << ',' << r.mrays[i].mrays.median << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+          f << ',' << r.builder_sah << ',' << r.build_s.min << ',' << r.build_s.max;
+          for (const auto& m : r.mrays) f << ',' << m.mrays.min << ',' << m.mrays.max;
           f << "\n";
         }
         if (!f) throw std::runtime_error(csv + ": cannot write");
@@ -670,32 +592,46 @@ int main(int argc, char** argv) {
     if (!json.empty())
       write_atomically(json, [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp);
+        const auto per_thread = [&](const Row& r, double bench::Spread::*field) {
+          std::ostringstream o;
+          for (size_t k = 0; k < r.mrays.size(); ++k)
+            o << (k ? ", " : "") << '"' << r.mrays[k].threads << "\": " << r.mrays[k].mrays.*field;
+          return "{" + o.str() + "}";
+        };
         f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"machine\": {\n"
           << machine_json() << "  },\n"
-          << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n  \"results\": [\n";
+          << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n"
+          << "  \"sah_constants\": {\"traversal\": " << bench::kSahConstants.traversal
+          << ", \"intersection\": " << bench::kSahConstants.intersection << "},\n  \"results\": [\n";
         for (size_t i = 0; i < rows.size(); ++i) {
           const auto& r = rows[i];
           f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel
             << "\", \"config\": \"" << json_escape(r.config) << "\", \"rays\": \"" << r.kind
             << "\", \"triangles\": " << r.triangles << ", \"shapes\": " << r.shapes
             << ", \"evals_per_ray\": " << (r.evals >= 0 ? std::to_string(r.evals) : std::string("null"))
-            << ", \"build_s\": " << r.build_s << ", \"bytes\": " << r.bytes << ", \"sah_cost\": " << r.sah
-            << ", \"ray_count\": " << r.rays << ", \"mismatches\": " << r.mismatches
-            << ", \"ties\": " << r.ties << ", \"mrays\": {";
-          for (size_t k = 0; k < r.mrays.size(); ++k)
-            f << (k ? ", " : "") << '"' << r.mrays[k].first << "\": " << r.mrays[k].second;
-          f << "}}" << (i + 1 < rows.size() ? "," : "") << "\n";
+            << ", \"build_s\": " << r.build_s.median << ", \"build_s_min\": " << r.build_s.min
+            << ", \"build_s_max\": " << r.build_s.max << ", \"bytes\": " << r.bytes
+            << ", \"sah_cost\": " << (r.sah ? std::to_string(*r.sah) : std::string("null"))
+            << ", \"builder_sah_cost\": " << r.builder_sah << ", \"ray_count\": " << r.rays
+            << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties
+            << ", \"mrays\": " << per_thread(r, &bench::Spread::median)
+            << ", \"mrays_min\": " << per_thread(r, &bench::Spread::min)
+            << ", \"mrays_max\": " << per_thread(r, &bench::Spread::max) << "}"
+            << (i + 1 < rows.size() ? "," : "") << "\n";
         }
         f << "  ]\n}\n";
         if (!f) throw std::runtime_error(json + ": cannot write");
       });
     if (!svg.empty())
       write_atomically(svg, [&](const std::filesystem::path& tmp) {
-        std::vector<int> counts;
-        for (const auto& m : rows.empty() ? std::vector<std::pair<int, double>>{} : rows[0].mrays)
-          counts.push_back(m.first);
+        bench::RunSettings rs;
+        rs.width = width, rs.height = height, rs.builds = builds, rs.repeats = repeats;
+        rs.build_threads = int(tbb::info::default_concurrency());
+        rs.threads = thread_counts;
+        rs.machine = bench::describe(bench::read_machine_info());
+        rs.software = software_line();
         std::ofstream f(tmp);
-        f << svg_chart(rows, counts);
+        f << bench::bar_chart_svg(bench::results_chart(rows, rs));
         if (!f) throw std::runtime_error(svg + ": cannot write");
       });
     if (wrong > 0) {

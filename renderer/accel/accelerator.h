@@ -85,6 +85,9 @@ struct AccelStats {
   double sah_cost = 0;          ///< SAH cost of the tree with the builder's constants (0: n/a);
                                 ///< two levels: top nodes at 1 plus each instance's bottom cost
                                 ///< weighted by the area of its world box
+  double sah_node_area = 0;     ///< the SAH without constants (BVH, kD-tree; 0 with sah_leaf_area:
+                                ///< n/a): sum over interior nodes of area / root area
+  double sah_leaf_area = 0;     ///< sum over leaves of area / root area x references (not blocks)
   uint64_t bytes = 0;           ///< memory held by the structure
   double build_seconds = 0;
 };

@@ -253,6 +253,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     m_stats.max_depth = std::max(m_stats.max_depth, depth);
     const double rel = m_sah_root_area > 0 ? surface_area(b.box) / m_sah_root_area : 1.0;
     m_stats.sah_cost += rel * m_config.traversal_cost;
+    m_stats.sah_node_area += rel;
     const BvhBuildNode* kids[W];
     int n = 0;
     if (!b.child[0]) {
@@ -291,6 +292,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       m_stats.max_depth = std::max(m_stats.max_depth, depth + 1);
       const double lrel = m_sah_root_area > 0 ? surface_area(kids[i]->box) / m_sah_root_area : 1.0;
       m_stats.sah_cost += lrel * m_config.intersection_cost * count[i];
+      m_stats.sah_leaf_area += lrel * kids[i]->count;
     }
     WideNode<W>& node = bvh.nodes[idx];  // after the recursion: resize may have moved it
     Bounds3f boxes[W];
@@ -308,9 +310,11 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     if (!b.child[0]) {
       m_tally.add(b.count);
       m_stats.sah_cost += rel * m_config.intersection_cost * b.count;
+      m_stats.sah_leaf_area += rel * b.count;
       return;
     }
     m_stats.sah_cost += rel * m_config.traversal_cost;
+    m_stats.sah_node_area += rel;
     compute_stats(*b.child[0], depth + 1);
     compute_stats(*b.child[1], depth + 1);
   }

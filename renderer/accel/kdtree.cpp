@@ -453,12 +453,14 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
       const uint32_t n = uint32_t(b.tris.size());
       m_tally.add(n);
       m_stats.sah_cost += rel * m_config.intersection_cost * n;
+      m_stats.sah_leaf_area += rel * n;
       m_nodes[idx].prim_offset = uint32_t(m_leaf_prims.size());
       for (const uint32_t t : b.tris) m_leaf_prims.push_back(prims[t]);
       m_nodes[idx].flags = (n << 2) | 3u;
       return;
     }
     m_stats.sah_cost += rel * m_config.traversal_cost;
+    m_stats.sah_node_area += rel;
     const uint32_t below = uint32_t(m_nodes.size());
     m_nodes.resize(m_nodes.size() + 2);
     m_nodes[idx].split = b.split;
