@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Installs Penumbra's build and runtime dependencies from Debian 12's archive, and the tools
-# its tests run against (Blender's glTF importer, which needs NumPy; Slurm and munge for the
-# throw-away single-node cluster).
+# Installs Penumbra's build and runtime dependencies from Debian 12's archive; with --test also
+# the tools its tests run against (Blender for the glTF-import and compositor checks, with NumPy;
+# pytest for the Python API; Slurm and munge for the throw-away single-node cluster).
 # Idempotent: only packages that are missing are installed. Needs root (or sudo).
+# Usage: install-deps.sh [--test]
 set -euo pipefail
 
 PACKAGES=(
@@ -13,10 +14,13 @@ PACKAGES=(
   libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
   libdraco-dev draco libmeshoptimizer-dev gltfpack
   catch2 libcli11-dev libbenchmark-dev
-  python3 clang-format
-  blender python3-numpy
-  slurm-wlm munge
+  python3 python3-dev python3-numpy pybind11-dev help2man clang-format
 )
+case "${1:-}" in
+  --test) PACKAGES+=(blender python3-pytest slurm-wlm munge) ;;
+  "") ;;
+  *) echo "usage: install-deps.sh [--test]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do
