@@ -9,6 +9,7 @@
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/render_job.h"
+#include "io/error.h"
 #include "io/exr_merge.h"
 #include "renderer/integrators/light_groups.h"
 
@@ -262,9 +263,14 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
   if (job.request.data_aovs) add_data_channels(exr, job, buffers.data);
   add_render_channels(exr, job, buffers);
   add_crypto_channels(exr, job, buffers);
-  // The display transform its display image is made with.
-  if (job.request.png)
+  // The display transform its display image is (or, for --no-png and farm stripes, would be)
+  // made with, so that a frame's EXR is the same however it was rendered. Without a display
+  // image an unusable config is no error: the attributes are left out.
+  try {
     for (auto& kv : display_metadata(describe_display(job.request.display))) exr.metadata.push_back(kv);
+  } catch (const InputError&) {
+    if (job.request.png) throw;
+  }
   return exr;
 }
 
