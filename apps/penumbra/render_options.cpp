@@ -150,6 +150,11 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
   if (a.crypto_depth_given && q.crypto.empty())
     throw UsageError("--crypto-depth needs --aov crypto_object, crypto_material or crypto_asset");
   q.crypto_depth = a.crypto_depth;
+  const std::string& c = a.compression;
+  if (!q.crypto.empty() && !a.multipart && (c == "pxr24" || c == "dwaa" || c == "dwab"))
+    throw UsageError("--compression " + c +
+                     " is lossy for float channels and would change the Cryptomatte ids; use a lossless one "
+                     "or --multipart (which keeps data layers lossless)");
   q.cost_aov = q.aovs.count("cost") > 0;
   q.data_aovs = q.aovs.count("albedo") || q.aovs.count("N") || q.aovs.count("P") || q.aovs.count("Z") ||
                 q.aovs.count("UV") || q.aovs.count("id");

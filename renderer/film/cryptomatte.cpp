@@ -89,7 +89,6 @@ std::string crypto_key(std::string_view layer) {
 void rank_crypto_ids(std::vector<float>& ids, int depth, int channels, float* out) {
   std::fill(out, out + channels, 0.0f);
   if (ids.empty()) return;
-  const float weight = 1.0f / float(ids.size());
   // Group equal ids (by bits, so the order is total and exact), then rank the groups.
   std::sort(ids.begin(), ids.end(), [](float a, float b) { return float_bits(a) < float_bits(b); });
   std::vector<std::pair<size_t, float>> groups;  // (count, id)
@@ -103,9 +102,9 @@ void rank_crypto_ids(std::vector<float>& ids, int depth, int channels, float* ou
   std::stable_sort(groups.begin(), groups.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [count, id] : groups) {
-    if (filled == depth) break;
+    if (filled >= depth || filled * 2 + 1 >= channels) break;
     out[filled * 2] = id;
-    out[filled * 2 + 1] = float(count) * weight;
+    out[filled * 2 + 1] = float(count) / float(ids.size());  // exactly 1 when every sample agrees
     ++filled;
   }
 }

@@ -68,6 +68,8 @@ expect 0 "CryptoObject01.A \(float\)$" -- oiiotool --info -v "$work/d3.exr"
 oiiotool --info -v "$work/d3.exr" | grep -q "CryptoObject02" && fail "--crypto-depth 3 wrote a third channel group"
 expect 2 "--crypto-depth needs --aov crypto_object" -- "$penumbra" render "$d" -o "$work/x.exr" --crypto-depth 4
 expect 2 "crypto-depth" -- "$penumbra" render "$d" -o "$work/x.exr" --aov crypto_object --crypto-depth 0
+expect 2 "--compression dwaa is lossy for float channels" -- "$penumbra" render "$d" -o "$work/x.exr" --aov all --compression dwaa
+expect 0 "mpd.exr" -- "$penumbra" render "$d" -o "$work/mpd.exr" --width 32 --spp 1 --aov crypto_object --compression dwaa --multipart -q
 [ ! -e "$work/x.exr" ] || fail "a refused render left x.exr"
 
 # 3000 objects with long names: the object manifest exceeds the header's limit.
