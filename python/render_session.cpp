@@ -10,6 +10,7 @@
 #include "io/accel_params.h"
 #include "io/environment_io.h"
 #include "io/error.h"
+#include "io/id_manifest.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/scene_accel.h"
@@ -137,43 +138,6 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
   }
   if (found < 0) throw InputError(file, "camera", "no camera named '" + spec + "' (" + listing + ")");
   return found;
-}
-
-std::string json_string(const std::string& v) {
-  std::string r = "\"";
-  for (unsigned char c : v) {
-    if (c == '"' || c == '\\') {
-      r += '\\';
-      r += char(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      r += buf;
-    } else {
-      r += char(c);
-    }
-  }
-  return r + "\"";
-}
-
-/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind object_id
-/// (glTF node index + 1) and material_id (material index + 1), as the command's EXR carries it.
-std::string id_manifest(const Scene& scene, const GltfInfo& info) {
-  std::set<int> nodes;
-  for (const auto& inst : scene.instances)
-    if (inst.node >= 0) nodes.insert(inst.node);
-  std::string j = "{\"object\": {";
-  bool first = true;
-  for (int n : nodes) {
-    const std::string name =
-        size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
-    j += (first ? "" : ", ") + json_string(std::to_string(n + 1)) + ": " + json_string(name);
-    first = false;
-  }
-  j += "}, \"material\": {";
-  for (size_t m = 0; m < scene.materials.size(); ++m)
-    j += (m ? ", " : "") + json_string(std::to_string(m + 1)) + ": " + json_string(scene.materials[m].name);
-  return j + "}}";
 }
 
 /// Removes the default key light a render added, however the render ends.
@@ -347,7 +311,7 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   if (data)
     out.data = render_data_aovs(scene, accel, out.camera, cfg,
                                 path ? IntegratorType::Path : IntegratorType::Whitted);
-  if (out.aovs.count("id")) out.id_manifest = id_manifest(scene, session.loaded.info);
+  if (out.aovs.count("id")) out.id_manifest = penumbra::id_manifest(scene, session.loaded.info);
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "apps/penumbra/render_job.h"
 #include "io/error.h"
 #include "io/exr_merge.h"
+#include "io/id_manifest.h"
 #include "renderer/integrators/light_groups.h"
 
 namespace penumbra::cli {
@@ -18,39 +19,6 @@ namespace penumbra::cli {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string json_string(const std::string& v) {
-  std::string r = "\"";
-  for (unsigned char c : v) {
-    if (c == '"' || c == '\\')
-      r += '\\', r += char(c);
-    else if (c < 0x20)
-      r += format("\\u%04x", c);
-    else
-      r += char(c);
-  }
-  return r + "\"";
-}
-
-/// {"object": {"<id>": "<node name>", ...}, "material": {...}}: the names behind object_id
-/// (glTF node index + 1) and material_id (material index + 1); 0 is the background.
-std::string id_manifest(const Scene& scene, const GltfInfo& info) {
-  std::set<int> nodes;
-  for (const auto& inst : scene.instances)
-    if (inst.node >= 0) nodes.insert(inst.node);
-  std::string j = "{\"object\": {";
-  bool first = true;
-  for (int n : nodes) {
-    const std::string name =
-        size_t(n) < info.node_names.size() ? info.node_names[size_t(n)] : "nodes[" + std::to_string(n) + "]";
-    j += (first ? "" : ", ") + json_string(std::to_string(n + 1)) + ": " + json_string(name);
-    first = false;
-  }
-  j += "}, \"material\": {";
-  for (size_t m = 0; m < scene.materials.size(); ++m)
-    j += (m ? ", " : "") + json_string(std::to_string(m + 1)) + ": " + json_string(scene.materials[m].name);
-  return j + "}}";
-}
 
 /// Cryptomatte channels ({layer}00.R = rank 0 id, .G its coverage, .B rank 1 id, .A its coverage,
 /// then {layer}01, ...: always 32-bit float) and the cryptomatte/<key>/ attributes.
@@ -223,8 +191,8 @@ void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers) {
     }
     std::string manifest = "{";
     for (const std::string& name : names)
-      manifest += (manifest.size() > 1 ? "," : "") + json_string(name) + ":" +
-                  json_string(crypto_hex(crypto_id(name)));
+      manifest +=
+          (manifest.size() > 1 ? "," : "") + json_quote(name) + ":" + json_quote(crypto_hex(crypto_id(name)));
     buffers.crypto_manifests.push_back(manifest + "}");
     layers.push_back(std::move(ids));
   }
