@@ -49,6 +49,37 @@ void generate_camera_rays(const Camera& cam, int width, int height, float x, flo
   out[2] = raster_ray(cam, m, x, y + step);
 }
 
+Transform view_matrix(const Camera& cam) {
+  Transform t;
+  const Vec3f rows[3] = {cam.u, cam.v, cam.w};
+  for (int r = 0; r < 3; ++r) {
+    t.m[size_t(r)] = {rows[r].x, rows[r].y, rows[r].z, -double(dot(rows[r], cam.eye))};
+  }
+  return t;
+}
+
+Transform projection_matrix(const Camera& cam, float aspect) {
+  Transform p;
+  const double n = cam.znear, f = cam.zfar;
+  if (cam.projection == Projection::Orthographic) {
+    const double ymag = cam.ymag, xmag = cam.ymag * double(aspect);
+    p.m[0] = {1 / xmag, 0, 0, 0};
+    p.m[1] = {0, 1 / ymag, 0, 0};
+    p.m[2] = std::isfinite(f) ? std::array<double, 4>{0, 0, 2 / (n - f), (f + n) / (n - f)}
+                              : std::array<double, 4>{0, 0, -1, -(n + 1)};
+    p.m[3] = {0, 0, 0, 1};
+    return p;
+  }
+  const double near = n > 0 ? n : double(kMinZnear);
+  const double t = std::tan(0.5 * double(cam.yfov));
+  p.m[0] = {1 / (double(aspect) * t), 0, 0, 0};
+  p.m[1] = {0, 1 / t, 0, 0};
+  p.m[2] = std::isfinite(f) ? std::array<double, 4>{0, 0, (f + near) / (near - f), 2 * f * near / (near - f)}
+                            : std::array<double, 4>{0, 0, -1, -2 * near};
+  p.m[3] = {0, 0, -1, 0};
+  return p;
+}
+
 Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov) {
   Camera c;
   c.eye = eye;

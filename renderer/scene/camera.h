@@ -29,6 +29,23 @@ Ray raster_ray(const Camera& cam, const CameraRaster& raster, float x, float y);
 /// per-camera terms.
 void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step, Ray out[3]);
 
+/// The world-to-camera (view) matrix: rows u, v, w and translation -(u.eye, v.eye, w.eye), the
+/// rigid inverse [R^T  -R^T eye] of the camera's frame; camera space looks down -Z.
+Transform view_matrix(const Camera& cam);
+
+/// glTF's projection matrix (glTF 2.0, 3.10.3 "Projection Matrices") for an image of the given
+/// aspect (width / height, which replaces the file's hint, as in ray generation):
+/// perspective with a finite zfar maps depth znear..zfar to z/w = -1..1; with zfar infinite it
+/// is the infinite projection (row 3 = [0, 0, -1, -2 znear]); orthographic uses xmag = ymag *
+/// aspect, and with zfar infinite its z row is [0, 0, -1, -(znear + 1)] so that z + w is still
+/// the distance past the near plane. Clip space: -w <= x, y <= w, and z + w >= 0 in front of
+/// the near plane (z - w <= 0 before a finite far plane). znear <= 0 on a perspective camera
+/// is taken as kMinZnear.
+Transform projection_matrix(const Camera& cam, float aspect);
+
+/// The near distance projection_matrix() uses for a perspective camera without a positive znear.
+inline constexpr float kMinZnear = 1e-6f;
+
 /// A camera at `eye` looking at `target` with approximate up vector `up` (right-handed frame).
 Camera look_at(Vec3f eye, Vec3f target, Vec3f up, float yfov);
 

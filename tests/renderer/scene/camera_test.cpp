@@ -2,6 +2,7 @@
 // (the corners of the bounds projected back into the image: inside, the extreme one at the border).
 #include "renderer/scene/camera.h"
 
+#include <array>
 #include <catch2/catch.hpp>
 
 using namespace penumbra;
@@ -187,4 +188,66 @@ TEST_CASE("fit_bounds: perspective distance solved per corner", "[camera][quick]
   c = fit_bounds(view, Bounds3f{{2, 2, 2}, {2, 2, 2}}, 1.0f);
   CHECK(c.eye.z > 2);
   CHECK(std::isfinite(c.eye.z));
+}
+
+namespace {
+// Clip-space (x, y, z, w) of world point p: projection x view.
+std::array<double, 4> clip_of(const Camera& c, float aspect, Vec3f p) {
+  const Transform m = projection_matrix(c, aspect) * view_matrix(c);
+  std::array<double, 4> out{};
+  for (size_t r = 0; r < 4; ++r) out[r] = m.m[r][0] * p.x + m.m[r][1] * p.y + m.m[r][2] * p.z + m.m[r][3];
+  return out;
+}
+}  // namespace
+
+TEST_CASE("view matrix: the rigid inverse of the camera frame", "[camera][quick]") {
+  const Camera c = look_at({1, 2, 3}, {-2, 0.5f, -1}, {0, 1, 0}, 0.8f);
+  // Camera to world: columns u, v, w and the eye; its inverse is [R^T  -R^T eye].
+  Transform to_world;
+  const Vec3f cols[3] = {c.u, c.v, c.w};
+  for (size_t r = 0; r < 3; ++r)
+    to_world.m[r] = {cols[0][int(r)], cols[1][int(r)], cols[2][int(r)], c.eye[int(r)]};
+  Transform inv;
+  REQUIRE(inverse(to_world, inv));
+  const Transform v = view_matrix(c);
+  for (size_t r = 0; r < 4; ++r)
+    for (size_t k = 0; k < 4; ++k) CHECK(v.m[r][k] == Approx(inv.m[r][k]).margin(1e-6));
+  // The eye maps to the origin and the view direction to -Z.
+  const Vec3f e = transform_point(v, c.eye), f = transform_point(v, c.eye - c.w * 2);
+  CHECK(length(e) < 1e-5f);
+  CHECK(length(f - Vec3f{0, 0, -2}) < 1e-5f);
+}
+
+TEST_CASE("projection matrix: glTF's depth mapping and the ray generator's image plane", "[camera][quick]") {
+  Camera c = look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.9f);
+  c.znear = 0.5f;
+  c.zfar = 20;
+  const float aspect = 1.5f;
+  // Finite far plane: depth znear -> z/w = -1, zfar -> +1.
+  auto n = clip_of(c, aspect, {0, 0, -0.5f}), f = clip_of(c, aspect, {0, 0, -20});
+  CHECK(n[2] / n[3] == Approx(-1));
+  CHECK(f[2] / f[3] == Approx(1));
+  CHECK(n[3] == Approx(0.5));  // w = depth
+  // Infinite far plane: z + w = 2 (depth - znear), z/w -> 1 far away.
+  c.zfar = kInfinity;
+  const auto i = clip_of(c, aspect, {0, 0, -3});
+  CHECK(i[2] + i[3] == Approx(2 * (3 - 0.5)));
+  const auto far_away = clip_of(c, aspect, {0, 0, -1e6f});
+  CHECK(far_away[2] / far_away[3] == Approx(1).margin(1e-5));
+  // A point on the ray through raster (x, y) projects back to that raster position.
+  for (Vec2f r : {Vec2f{10, 20}, Vec2f{299.5f, 0.25f}, Vec2f{150, 100}}) {
+    const Ray ray = generate_camera_ray(c, 300, 200, r.x, r.y);
+    const auto q = clip_of(c, aspect, ray.org + ray.dir * 7);
+    CHECK((q[0] / q[3] + 1) * 150 == Approx(r.x).margin(1e-3));
+    CHECK((1 - q[1] / q[3]) * 100 == Approx(r.y).margin(1e-3));
+  }
+  // Orthographic: x/w in [-1, 1] over xmag = ymag * aspect, depth znear..zfar -> -1..1.
+  c.projection = Projection::Orthographic;
+  c.ymag = 2;
+  c.zfar = 10;
+  const auto o = clip_of(c, aspect, {3, -2, -10});
+  CHECK(o[0] == Approx(1));
+  CHECK(o[1] == Approx(-1));
+  CHECK(o[2] == Approx(1));
+  CHECK(clip_of(c, aspect, {0, 0, -0.5f})[2] == Approx(-1));
 }
