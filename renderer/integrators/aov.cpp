@@ -10,10 +10,8 @@
 
 namespace penumbra {
 
-DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
-                          const RenderConfig& config, IntegratorType integrator) {
+DataAovs make_data_aovs(const PixelWindow& win) {
   DataAovs a;
-  const PixelWindow win = render_window(config);
   a.width = win.width();
   a.height = win.height();
   const size_t n = size_t(a.width) * size_t(a.height);
@@ -24,72 +22,99 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
   a.depth.assign(n, kInfinity);
   a.object_id.assign(n, 0.0f);
   a.material_id.assign(n, 0.0f);
+  return a;
+}
+
+void AovPixel::clear() {
+  m_albedo = m_normal = m_position = Vec3f{};
+  m_uv = Vec2f{};
+  m_hits = 0;
+  m_depth = kInfinity;
+  m_objects.clear();
+  m_materials.clear();
+}
+
+void AovPixel::add_miss() {
+  m_objects.push_back(0);
+  m_materials.push_back(0);
+}
+
+void AovPixel::add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp,
+                       float depth) {
+  m_albedo += mp.base_color;
+  m_normal += mp.ns;
+  m_position += si.p;
+  m_uv = {m_uv.x + si.uv[0].x, m_uv.y + si.uv[0].y};
+  ++m_hits;
+  m_depth = std::min(m_depth, depth);
+  const Instance& inst = scene.instances[si.instance];
+  m_objects.push_back(inst.node >= 0 ? uint32_t(inst.node) + 1 : 0);
+  const int m = instance_material(scene, inst);
+  m_materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
+}
+
+namespace {
+// The most frequent id (ties: the smaller one).
+float majority(std::vector<uint32_t>& ids) {
+  std::sort(ids.begin(), ids.end());
+  uint32_t best = 0;
+  size_t best_count = 0;
+  for (size_t k = 0; k < ids.size();) {
+    size_t e = k;
+    while (e < ids.size() && ids[e] == ids[k]) ++e;
+    if (e - k > best_count) {
+      best = ids[k];
+      best_count = e - k;
+    }
+    k = e;
+  }
+  return float(best);
+}
+}  // namespace
+
+void AovPixel::store(DataAovs& a, size_t i, int spp) {
+  a.depth[i] = m_depth;
+  a.object_id[i] = majority(m_objects);
+  a.material_id[i] = majority(m_materials);
+  const float inv_spp = 1.0f / float(spp);
+  for (int c = 0; c < 3; ++c) a.albedo[i * 3 + size_t(c)] = m_albedo[c] * inv_spp;
+  if (m_hits > 0) {
+    const float inv = 1.0f / float(m_hits);
+    const Vec3f nn = normalize(m_normal);
+    const Vec3f pp = m_position * inv;
+    for (int c = 0; c < 3; ++c) {
+      a.normal[i * 3 + size_t(c)] = nn[c];
+      a.position[i * 3 + size_t(c)] = pp[c];
+    }
+    a.uv[i * 2] = m_uv.x * inv;
+    a.uv[i * 2 + 1] = m_uv.y * inv;
+  }
+}
+
+DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                          const RenderConfig& config, IntegratorType integrator) {
+  const PixelWindow win = render_window(config);
+  DataAovs a = make_data_aovs(win);
   const bool filter = scene_needs_hit_filter(scene);
   TileScheduler scheduler(win, config.tile_size, config.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) {
-    std::vector<uint32_t> objects, materials;
+    AovPixel pixel;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) {
         const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
-        Vec3f albedo{0, 0, 0}, normal{0, 0, 0}, position{0, 0, 0};
-        Vec2f uv{0, 0};
-        int hits = 0;
-        objects.clear();
-        materials.clear();
+        pixel.clear();
         for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
           const Vec2f p = camera_sample_position(config, integrator, x, y, s);
           const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
           Hit hit;
           if (!intersect_visible(scene, accel, ray, hit, filter)) {
-            objects.push_back(0);
-            materials.push_back(0);
+            pixel.add_miss();
             continue;
           }
           const SurfaceInteraction si = make_interaction(scene, ray, hit);
-          const MaterialPoint mp = eval_material(scene, si);
-          albedo += mp.base_color;
-          normal += mp.ns;
-          position += si.p;
-          uv = {uv.x + si.uv[0].x, uv.y + si.uv[0].y};
-          ++hits;
-          const float z = dot(si.p - camera.eye, -camera.w);
-          a.depth[i] = std::min(a.depth[i], z);
-          const Instance& inst = scene.instances[hit.geom_id];
-          objects.push_back(inst.node >= 0 ? uint32_t(inst.node) + 1 : 0);
-          const int m = instance_material(scene, inst);
-          materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
+          pixel.add_hit(scene, si, eval_material(scene, si), dot(si.p - camera.eye, -camera.w));
         }
-        // The most frequent id (ties: the smaller one).
-        auto majority = [](std::vector<uint32_t>& ids) {
-          std::sort(ids.begin(), ids.end());
-          uint32_t best = 0;
-          size_t best_count = 0;
-          for (size_t k = 0; k < ids.size();) {
-            size_t e = k;
-            while (e < ids.size() && ids[e] == ids[k]) ++e;
-            if (e - k > best_count) {
-              best = ids[k];
-              best_count = e - k;
-            }
-            k = e;
-          }
-          return float(best);
-        };
-        a.object_id[i] = majority(objects);
-        a.material_id[i] = majority(materials);
-        const float inv_spp = 1.0f / float(config.spp);
-        for (int c = 0; c < 3; ++c) a.albedo[i * 3 + size_t(c)] = albedo[c] * inv_spp;
-        if (hits > 0) {
-          const float inv = 1.0f / float(hits);
-          const Vec3f nn = normalize(normal);
-          const Vec3f pp = position * inv;
-          for (int c = 0; c < 3; ++c) {
-            a.normal[i * 3 + size_t(c)] = nn[c];
-            a.position[i * 3 + size_t(c)] = pp[c];
-          }
-          a.uv[i * 2] = uv.x * inv;
-          a.uv[i * 2 + 1] = uv.y * inv;
-        }
+        pixel.store(a, i, config.spp);
       }
   });
   return a;

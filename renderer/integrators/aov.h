@@ -32,6 +32,28 @@ struct DataAovs {
   std::vector<float> material_id;  ///< 1 per pixel (integer values)
 };
 
+/// Data AOVs covering `window`, cleared to their background values (0, and +inf for Z).
+DataAovs make_data_aovs(const PixelWindow& window);
+
+/// The per-pixel reduction above, sample by sample: what render_data_aovs and the raster
+/// integrator's AOVs share. clear() before each pixel; store() writes pixel i of the AOVs.
+class AovPixel {
+ public:
+  void clear();
+  /// A sample that sees nothing.
+  void add_miss();
+  /// A sample whose first visible surface is si (material values mp) at camera depth `depth`.
+  void add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth);
+  void store(DataAovs& aovs, size_t i, int spp);
+
+ private:
+  Vec3f m_albedo, m_normal, m_position;
+  Vec2f m_uv;
+  int m_hits = 0;
+  float m_depth = kInfinity;
+  std::vector<uint32_t> m_objects, m_materials;
+};
+
 /// Traces the camera samples of `integrator` under `config` (threads, tiles, spp, seed,
 /// filter, sampler) and reduces them per pixel as above. Deterministic for any thread count.
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,

@@ -41,11 +41,6 @@ Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float
   return r[0];
 }
 
-// Differentials one sample spacing apart (pbrt-v4: scaled by max(1/8, 1/sqrt(spp))).
-float differential_step(int spp) {
-  return std::max(0.125f, 1.0f / std::sqrt(float(spp)));
-}
-
 struct RayCounters {
   std::atomic<uint64_t> camera{0}, shadow{0}, reflection{0};
   void add(const RayCounts& c) {
@@ -73,9 +68,13 @@ TileScheduler make_scheduler(const RenderConfig& config) {
 
 }  // namespace
 
+float differential_step(int spp) {
+  return std::max(0.125f, 1.0f / std::sqrt(float(spp)));
+}
+
 Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y,
                              uint32_t s) {
-  if (integrator == IntegratorType::Whitted) return whitted_position(config, x, y, s);
+  if (integrator != IntegratorType::Path) return whitted_position(config, x, y, s);
   SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
   return filtered_position(config, x, y, st.get2d());  // the stream's first request (path_samples)
 }

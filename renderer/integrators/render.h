@@ -105,9 +105,13 @@ void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathL
                        RayCounts& counts);
 
 /// Raster position (pixel corner at integer coordinates) of camera sample `s` of pixel (x, y)
-/// exactly as `integrator` places it: the one definition the integrators, the data AOVs and
-/// the cost map share.
+/// exactly as `integrator` places it (Raster: as Whitted): the one definition the integrators,
+/// the rasteriser, the data AOVs and the cost map share.
 Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y, uint32_t s);
+
+/// The spacing in pixels of the differentials of a render with `spp` samples per pixel, the
+/// footprint textures are filtered over (pbrt-v4: max(1/8, 1/sqrt(spp))).
+float differential_step(int spp);
 
 /// The pass schedule of render_path: sample index where pass k ends (1, 2, 4, 8, 16, 32, 48,
 /// ... capped at spp).

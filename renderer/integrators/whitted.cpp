@@ -63,6 +63,39 @@ WhittedParams whitted_params(const Material& m) {
   return whitted_params(mp);
 }
 
+float ShadowRayVisibility::transmittance(const void* context, int, const SurfaceInteraction& si,
+                                         const LightSample& ls, RayCounts& counts) {
+  const auto& c = *static_cast<const ShadowRayVisibility*>(context);
+  ++counts.shadow;
+  return shadow_transmittance(c.scene, c.accel, shadow_ray(si, ls.wi, ls.distance), c.hit_filter);
+}
+
+Vec3f whitted_local(const Scene& scene, const WhittedConfig& cfg, const SurfaceInteraction& si,
+                    const MaterialPoint& mp, const WhittedParams& w, Vec3f v,
+                    const LightVisibility& visibility, RayCounts& counts) {
+  // Ambient (scaled by the occlusion texture) plus emission.
+  Vec3f radiance = w.emission + w.ka * cfg.ambient * mp.occlusion;
+  // Direct light: diffuse + Blinn-Phong specular, each light as visible as `visibility` says.
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    LightSample ls;
+    if (!sample_light(scene.lights[i], si.p, ls)) continue;
+    const float ndotl = dot(mp.ns, ls.wi);
+    const bool from_back = dot(ls.wi, si.ng) <= 0;  // light below the geometric surface
+    if (from_back != (ndotl <= 0) || (from_back && !(max_component(w.kdt) > 0))) continue;
+    const float transmittance = visibility.transmittance(visibility.context, int(i), si, ls, counts);
+    if (!(transmittance > 0)) continue;
+    if (from_back) {
+      radiance += ls.irradiance * w.kdt * (transmittance * -ndotl / kPi);
+      continue;
+    }
+    const Vec3f h = normalize(v + ls.wi);
+    const float ndoth = std::max(0.0f, dot(mp.ns, h));
+    const float spec = (w.exponent + 8) / (8 * kPi) * std::pow(ndoth, w.exponent);
+    radiance += ls.irradiance * transmittance * (w.kd * (ndotl / kPi) + w.ks * (spec * ndotl));
+  }
+  return radiance;
+}
+
 namespace {
 
 struct Tracer {
@@ -99,29 +132,8 @@ struct Tracer {
 
     const WhittedParams w = whitted_params(mp);
     const Vec3f v = normalize(-ray.dir);
-    // Ambient (scaled by the occlusion texture) plus emission.
-    Vec3f radiance = w.emission + w.ka * cfg.ambient * mp.occlusion;
-
-    // Direct light: diffuse + Blinn-Phong specular, each light behind a shadow ray.
-    for (const Light& light : scene.lights) {
-      LightSample ls;
-      if (!sample_light(light, si.p, ls)) continue;
-      const float ndotl = dot(mp.ns, ls.wi);
-      const bool from_back = dot(ls.wi, si.ng) <= 0;  // light below the geometric surface
-      if (from_back != (ndotl <= 0) || (from_back && !(max_component(w.kdt) > 0))) continue;
-      ++counts.shadow;
-      const float transmittance =
-          shadow_transmittance(scene, accel, shadow_ray(si, ls.wi, ls.distance), cfg.hit_filter);
-      if (!(transmittance > 0)) continue;
-      if (from_back) {
-        radiance += ls.irradiance * w.kdt * (transmittance * -ndotl / kPi);
-        continue;
-      }
-      const Vec3f h = normalize(v + ls.wi);
-      const float ndoth = std::max(0.0f, dot(mp.ns, h));
-      const float spec = (w.exponent + 8) / (8 * kPi) * std::pow(ndoth, w.exponent);
-      radiance += ls.irradiance * transmittance * (w.kd * (ndotl / kPi) + w.ks * (spec * ndotl));
-    }
+    const ShadowRayVisibility shadows{scene, accel, cfg.hit_filter};
+    Vec3f radiance = whitted_local(scene, cfg, si, mp, w, v, shadows.visibility(), counts);
 
     // Ideal mirror reflection, unless its weight on the pixel is below min_reflectance.
     const Vec3f rweight = weight * w.kr * a;

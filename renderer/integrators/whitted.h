@@ -5,6 +5,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/integrators/ray_counts.h"
+#include "renderer/lights/punctual.h"
 #include "renderer/materials/material.h"
 #include "renderer/scene/interaction.h"
 
@@ -55,6 +56,34 @@ struct WhittedConfig {
   bool hit_filter = true;              ///< false skips alpha/back-face filtering of hits: a speed-up,
                                        ///< valid only when scene_needs_hit_filter() is false
 };
+
+/// How much of a punctual light reaches a surface point: transmittance(context, light index,
+/// si, light sample, counts) in [0, 1] (shadow rays, shadow maps, or none). Thread-safe.
+struct LightVisibility {
+  float (*transmittance)(const void* context, int light, const SurfaceInteraction& si, const LightSample& ls,
+                         RayCounts& counts) = nullptr;
+  const void* context = nullptr;
+};
+
+/// Light visibility by a shadow ray through the accelerator (shadow_transmittance), counted as
+/// a shadow ray: what the Whitted integrator uses.
+struct ShadowRayVisibility {
+  const Scene& scene;
+  const Accelerator& accel;
+  bool hit_filter = true;  ///< as WhittedConfig::hit_filter
+  static float transmittance(const void* context, int light, const SurfaceInteraction& si,
+                             const LightSample& ls, RayCounts& counts);
+  LightVisibility visibility() const { return {&ShadowRayVisibility::transmittance, this}; }
+};
+
+/// The Whitted integrator's local terms at a surface point seen from unit direction v (towards
+/// the viewer): emission + ka Ia occlusion + sum over the scene's lights of the visible
+/// fraction of [kd/pi max(0, n.l) + ks (p+8)/(8 pi) max(0, n.h)^p max(0, n.l)] E, and the
+/// diffuse transmission of lights behind the surface (see whitted_radiance). No reflection, no
+/// transmission, no alpha: the caller composites. Never allocates, throws or logs.
+Vec3f whitted_local(const Scene& scene, const WhittedConfig& cfg, const SurfaceInteraction& si,
+                    const MaterialPoint& mp, const WhittedParams& w, Vec3f v,
+                    const LightVisibility& visibility, RayCounts& counts);
 
 /// Radiance along a camera ray (counted as one camera ray) with its differentials (for texture
 /// filtering; may be invalid), and its coverage (1 if it hit opaque geometry, 0 if it

@@ -154,6 +154,11 @@ SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hi
   return si;
 }
 
+namespace {
+// The derivatives of si's UVs and normal from those of its barycentrics (u, v) along x and y.
+void barycentric_derivatives(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by);
+}  // namespace
+
 void compute_differentials(const Scene& scene, SurfaceInteraction& si, const RayDifferential& rd) {
   if (!rd.valid) return;
   // Offsets of the auxiliary rays' hits on the tangent plane through si.p.
@@ -170,10 +175,7 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
     return;
   }
   // Barycentric derivatives: least-squares solve of dp = e1 db1 + e2 db2.
-  const Instance& inst = scene.instances[si.instance];
-  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const WorldTriangle& tri = si.tri;
-  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
   const float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2);
   const float det = a11 * a22 - a12 * a12;
@@ -182,7 +184,15 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
     const float r1 = dot(e1, dp), r2 = dot(e2, dp);
     return {(a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det};
   };
-  const Vec2f bx = solve(dpdx), by = solve(dpdy);
+  barycentric_derivatives(scene, si, solve(dpdx), solve(dpdy));
+}
+
+namespace {
+void barycentric_derivatives(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by) {
+  const Instance& inst = scene.instances[si.instance];
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const WorldTriangle& tri = si.tri;
+  const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   auto deriv2 = [&](const std::vector<Vec2f>& t, Vec2f db) -> Vec2f {
     const Vec2f d1{t[i1].x - t[i0].x, t[i1].y - t[i0].y}, d2{t[i2].x - t[i0].x, t[i2].y - t[i0].y};
     return {d1.x * db.x + d2.x * db.y, d1.y * db.x + d2.y * db.y};
@@ -203,6 +213,16 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
     si.dndx = (n1 * bx.x + n2 * bx.y) * s;
     si.dndy = (n1 * by.x + n2 * by.y) * s;
   }
+}
+}  // namespace
+
+void set_barycentric_differentials(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by) {
+  if (si.shape >= 0 || !std::isfinite(bx.x + bx.y + by.x + by.y)) return;
+  const WorldTriangle& tri = si.tri;
+  const Vec3f e1 = tri.p[1] - tri.p[0], e2 = tri.p[2] - tri.p[0];
+  si.dpdx = e1 * bx.x + e2 * bx.y;
+  si.dpdy = e1 * by.x + e2 * by.y;
+  barycentric_derivatives(scene, si, bx, by);
 }
 
 RayDifferential reflect_differential(const SurfaceInteraction& si, const RayDifferential& rd, Vec3f wo,

@@ -62,6 +62,12 @@ Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit);
 /// them zero when rd is not valid or the plane is parallel to an auxiliary ray.
 void compute_differentials(const Scene& scene, SurfaceInteraction& si, const RayDifferential& rd);
 
+/// Fills a triangle hit's derivatives from the screen-space derivatives of its barycentrics
+/// (u, v) over one differential step in x (bx) and in y (by), as a rasteriser knows them:
+/// dp = e1 du + e2 dv on the world triangle, and the UVs' and normal's derivatives likewise.
+/// Leaves shape hits and non-finite input untouched.
+void set_barycentric_differentials(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by);
+
 /// Differentials of the mirror-reflected ray (pbrt-v3 SpecularReflect): origins move by
 /// dp/dx, dp/dy; directions by the change of the view vector and of the normal. `wo` is the
 /// unit direction towards the viewer, `n` the unit normal used for reflection, `wi` the

@@ -145,7 +145,7 @@ TEST_CASE("cost map: Embree answers but does not count", "[cost][quick]") {
   TraversalCost cost;
   Hit h;
   CHECK(e->intersect_counted({{0, 0, 5}, 0, {0, 0, -1}, kInfinity}, h, cost));
-  CHECK(h.t == 5);
+  CHECK(h.t == Approx(5).epsilon(1e-6));  // Embree's t carries rounding on some CPUs
   CHECK(cost.nodes == 0);
   CHECK(cost.triangles == 0);
 }
