@@ -41,6 +41,7 @@ void validate(const RenderConfig& c) {
   check_non_negative("whitted.min_reflectance", double(c.whitted.min_reflectance));
   check_non_negative("whitted.ambient", c.whitted.ambient);
   check_non_negative("whitted.background", c.whitted.background);
+  check_range("raster.shadow_map_size", c.raster.shadow_map_size, 16, 8192);
   check_range("path.max_depth", c.path.max_depth, 0, kMaxDepth);
   check_range("path.rr_depth", c.path.rr_depth, 1, kMaxDepth);
   check_range("path.max_blend_layers", c.path.max_blend_layers, 0, kMaxSpp);

@@ -14,7 +14,22 @@
 
 namespace penumbra {
 
-enum class IntegratorType : uint8_t { Whitted, Path };
+/// Whitted: ray traced; Path: path traced; Raster: rasterised primary visibility shaded with the
+/// Whitted integrator's local terms (its camera samples are Whitted's).
+enum class IntegratorType : uint8_t { Whitted, Path, Raster };
+
+/// How the rasteriser finds whether a light reaches a surface point.
+enum class RasterShadows : uint8_t {
+  Ray,   ///< a shadow ray through the accelerator (as the Whitted integrator)
+  Map,   ///< a shadow map per light (depth maps rendered by the rasteriser)
+  None,  ///< every light reaches every point facing it
+};
+
+/// Settings of the raster integrator.
+struct RasterConfig {
+  RasterShadows shadows = RasterShadows::Ray;
+  int shadow_map_size = 2048;  ///< [16, 8192] texels on a side (point lights: per cube face)
+};
 
 /// Render settings with their defaults; validate() before use.
 struct RenderConfig {
@@ -25,7 +40,8 @@ struct RenderConfig {
   int tile_size = 32;     ///< square tile edge in pixels, [1, kMaxImageSize]
   uint64_t seed = 0;      ///< decorrelates whole renders; same seed => same image
   PixelFilter filter;     ///< box, 1 pixel wide by default; width in (0, kMaxFilterWidth]
-  WhittedConfig whitted;  ///< max_depth [0, kMaxDepth]
+  WhittedConfig whitted;  ///< max_depth [0, kMaxDepth]; also the raster integrator's shading
+  RasterConfig raster;    ///< raster integrator only
   // Path tracer only.
   PathConfig path;  ///< max_depth [0, kMaxDepth], rr_depth [1, kMaxDepth]
   SamplerType sampler = SamplerType::Sobol;

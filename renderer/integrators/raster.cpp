@@ -1,0 +1,230 @@
+// The raster integrator: visibility buffer from the rasteriser, Whitted local shading, Blend
+// compositing, and the data AOVs.
+#include "renderer/integrators/raster.h"
+
+#include <atomic>
+#include <chrono>
+#include <optional>
+
+#include "renderer/integrators/visibility.h"
+#include "renderer/raster/shadow_map.h"
+
+namespace penumbra {
+
+namespace {
+
+Ray camera_view_ray(const void* context, float x, float y) {
+  const auto& cv = *static_cast<const CameraView*>(context);
+  return generate_camera_ray(cv.camera, cv.width, cv.height, x, y);
+}
+
+Vec2f camera_sample(const void* context, int x, int y, uint32_t s) {
+  return camera_sample_position(*static_cast<const RenderConfig*>(context), IntegratorType::Raster, x, y, s);
+}
+
+/// Light visibility from shadow maps.
+struct MapVisibility {
+  const ShadowMaps& maps;
+  static float transmittance(const void* context, int light, const SurfaceInteraction& si, const LightSample&,
+                             RayCounts&) {
+    return shadow_map_visibility(static_cast<const MapVisibility*>(context)->maps, light, si.p, si.ng);
+  }
+};
+
+float fully_visible(const void*, int, const SurfaceInteraction&, const LightSample&, RayCounts&) {
+  return 1;
+}
+
+/// The surface a fragment shows along its sample's camera ray; with step > 0, a triangle's
+/// footprint over `step` pixels from the fragment's screen-space barycentric derivatives
+/// (for textured materials).
+SurfaceInteraction fragment_interaction(const Scene& scene, const CameraView& cv, const RasterFragment& f,
+                                        const Ray& ray, float step) {
+  Hit hit = f.hit;
+  const bool shape = scene.instances[hit.geom_id].shape >= 0;
+  if (!shape) hit.t = f.depth / std::max(dot(ray.dir, -cv.camera.w), 1e-30f);
+  SurfaceInteraction si = make_interaction(scene, ray, hit);
+  if (!shape && step > 0 && material_reads_footprint(material_of(scene, si.material)))
+    set_barycentric_differentials(scene, si, {f.duv_dx.x * step, f.duv_dx.y * step},
+                                  {f.duv_dy.x * step, f.duv_dy.y * step});
+  return si;
+}
+
+/// Shades every sample of a tile and writes the pixels' means into the film.
+struct Shader {
+  const Scene& scene;
+  const CameraView& cv;
+  const RenderConfig& config;
+  const LightVisibility& visibility;
+  Film& film;
+
+  Vec3f local(const RasterFragment& f, const Ray& ray, float step, float& alpha, RayCounts& counts) const {
+    SurfaceInteraction si = fragment_interaction(scene, cv, f, ray, step);
+    if (si.shape >= 0 && material_reads_footprint(material_of(scene, si.material))) {
+      Ray r[3];
+      const Vec2f& p = sample_position;
+      generate_camera_rays(cv.camera, cv.width, cv.height, p.x, p.y, step, r);
+      compute_differentials(scene, si, RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir});
+    }
+    const MaterialPoint mp = eval_material(scene, si);
+    alpha = mp.alpha;
+    if (mp.unlit) return mp.base_color;
+    const WhittedParams w = whitted_params(mp);
+    return whitted_local(scene, config.whitted, si, mp, w, normalize(-ray.dir), visibility, counts);
+  }
+
+  void tile(const RasterTile& t, RayCounts& counts) {
+    const float step = differential_step(config.spp);
+    size_t i = 0;
+    for (int y = t.pixels.y0; y < t.pixels.y1; ++y)
+      for (int x = t.pixels.x0; x < t.pixels.x1; ++x) {
+        Vec3f sum{0, 0, 0};
+        float coverage = 0;
+        for (int s = 0; s < t.spp; ++s, ++i) {
+          sample_position = t.positions[i];
+          const Ray ray =
+              generate_camera_ray(cv.camera, cv.width, cv.height, sample_position.x, sample_position.y);
+          // Front to back: each Blend layer takes its alpha of what is left, the opaque
+          // surface (or the background) the rest.
+          float remaining = 1;
+          for (uint32_t k = t.blend_begin[i]; k < t.blend_begin[i + 1] && remaining > 0; ++k) {
+            float a = 1;
+            const Vec3f l = local(t.blend[k], ray, step, a, counts);
+            if (!(a > 0)) continue;
+            sum += l * (remaining * a);
+            coverage += remaining * a;
+            remaining *= 1 - a;
+          }
+          if (!(remaining > 0)) continue;
+          if (t.opaque[i].hit.valid()) {
+            float a = 1;
+            sum += local(t.opaque[i], ray, step, a, counts) * remaining;
+            coverage += remaining;
+          } else {
+            sum += config.whitted.background * remaining;
+          }
+        }
+        const float inv = 1.0f / float(t.spp);
+        float* px = film.pixel(x - film.origin_x, y - film.origin_y);
+        px[0] = sum.x * inv;
+        px[1] = sum.y * inv;
+        px[2] = sum.z * inv;
+        px[3] = coverage * inv;
+      }
+  }
+
+  Vec2f sample_position;
+};
+
+}  // namespace
+
+void make_camera_view(const Camera& camera, int width, int height, CameraView& out) {
+  out.camera = camera;
+  out.width = width;
+  out.height = height;
+  out.view.view = view_matrix(camera);
+  out.view.projection = projection_matrix(camera, float(width) / float(height));
+  out.view.far_plane = std::isfinite(camera.zfar);
+  out.view.width = width;
+  out.view.height = height;
+  out.view.ray = &camera_view_ray;
+  out.view.ray_context = &out;
+}
+
+RasterPass camera_raster_pass(const RenderConfig& config) {
+  RasterPass pass;
+  pass.window = render_window(config);
+  pass.tile_size = config.tile_size;
+  pass.threads = config.threads;
+  pass.spp = config.spp;
+  pass.position = &camera_sample;
+  pass.position_context = &config;
+  // Whitted's jittered samples stay inside their pixel with the 1-pixel box; other filters
+  // reach half their width beyond the pixel's centre.
+  pass.margin = std::max(0.0f, 0.5f * config.filter.width - 0.5f) + 0.01f;
+  pass.cull_back_faces = true;
+  pass.blend = RasterBlend::Layers;
+  pass.max_blend_layers = config.whitted.max_blend_layers;
+  return pass;
+}
+
+Film render_raster(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                   const RenderConfig& config, RenderStats* stats, const ProgressFn& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CameraView cv;
+  make_camera_view(camera, config.width, config.height, cv);
+  const RasterPass pass = camera_raster_pass(config);
+  const PixelWindow win = pass.window;
+  Film film = make_film(win.width(), win.height());
+  film.origin_x = win.x0;
+  film.origin_y = win.y0;
+  film.full_width = config.width;
+  film.full_height = config.height;
+
+  // Light visibility: shadow rays, shadow maps or none.
+  const bool filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
+  const ShadowRayVisibility rays{scene, accel, filter};
+  ShadowMaps maps;
+  std::optional<MapVisibility> map_visibility;
+  LightVisibility visibility{&fully_visible, nullptr};
+  if (config.raster.shadows == RasterShadows::Ray) visibility = rays.visibility();
+  if (config.raster.shadows == RasterShadows::Map) {
+    maps = build_shadow_maps(scene, config.raster.shadow_map_size, config.threads);
+    map_visibility.emplace(MapVisibility{maps});
+    visibility = {&MapVisibility::transmittance, &*map_visibility};
+  }
+
+  std::atomic<uint64_t> shadow_rays{0};
+  std::atomic<int> done{0};
+  const int tiles = TileScheduler(win, config.tile_size, config.threads).tile_count();
+  rasterize(scene, cv.view, pass, [&](const RasterTile& tile) {
+    Shader shader{scene, cv, config, visibility, film, {}};
+    RayCounts counts;
+    shader.tile(tile, counts);
+    shadow_rays += counts.shadow;
+    const int d = ++done;
+    if (progress) progress(d, tiles);
+  });
+  if (stats) {
+    stats->rays = RayCounts{0, shadow_rays.load(), 0};
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats->threads = thread_count(config.threads);
+    stats->passes = 1;
+    stats->samples = uint64_t(film.width) * uint64_t(film.height) * uint64_t(config.spp);
+  }
+  return film;
+}
+
+DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const RenderConfig& config) {
+  CameraView cv;
+  make_camera_view(camera, config.width, config.height, cv);
+  const RasterPass pass = camera_raster_pass(config);
+  const PixelWindow win = pass.window;
+  DataAovs a = make_data_aovs(win);
+  rasterize(scene, cv.view, pass, [&](const RasterTile& t) {
+    AovPixel pixel;
+    size_t i = 0;
+    for (int y = t.pixels.y0; y < t.pixels.y1; ++y)
+      for (int x = t.pixels.x0; x < t.pixels.x1; ++x) {
+        pixel.clear();
+        for (int s = 0; s < t.spp; ++s, ++i) {
+          const RasterFragment* f = t.blend_begin[i] < t.blend_begin[i + 1] ? &t.blend[t.blend_begin[i]]
+                                    : t.opaque[i].hit.valid()               ? &t.opaque[i]
+                                                                            : nullptr;
+          if (!f) {
+            pixel.add_miss();
+            continue;
+          }
+          const Vec2f p = t.positions[i];
+          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          const SurfaceInteraction si =
+              fragment_interaction(scene, cv, *f, ray, 0);  // finest texels, as traced
+          pixel.add_hit(scene, si, eval_material(scene, si), f->depth);
+        }
+        pixel.store(a, size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0), config.spp);
+      }
+  });
+  return a;
+}
+
+}  // namespace penumbra

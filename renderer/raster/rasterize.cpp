@@ -1,0 +1,593 @@
+// The rasteriser: triangle setup (vertex stage, clipping, viewport), binning, tile rasterisation
+// into a per-sample z-buffer, Blend layers, and the visibility buffer handed to the shader.
+#include "renderer/raster/rasterize.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/materials/material.h"
+#include "renderer/raster/clip.h"
+#include "renderer/raster/edge.h"
+
+namespace penumbra {
+
+namespace {
+
+/// How a triangle's fragments are tested.
+enum class Kind : uint8_t { Opaque, Mask, Blend };
+
+/// A triangle after clipping and the viewport map, in screen space (100 bytes).
+struct SetupTriangle {
+  int32_t x[3], y[3];  ///< fixed-point raster vertices, ordered so that the area is positive
+  float iw[3];         ///< 1 / w of each vertex (perspective-correct interpolation)
+  float dw[3];         ///< view depth / w of each vertex
+  float bu[3], bv[3];  ///< each vertex's barycentrics (u, v) in the source triangle
+  uint32_t instance, prim;
+  int32_t px0, py0, px1, py1;  ///< pixels [px0, px1) x [py0, py1) whose samples it may cover
+  Kind kind;
+};
+
+/// A shape instance, ray-cast over its projected bounds.
+struct SetupShape {
+  uint32_t instance;
+  int32_t px0, py0, px1, py1;
+  Kind kind;
+  bool cull_back;  ///< single-sided material: back-facing hits are skipped
+};
+
+/// The fixed parts of a pass: view, planes, window, and the per-instance clip transforms.
+struct Pipeline {
+  const Scene& scene;
+  const RasterView& view;
+  const RasterPass& pass;
+  ClipPlanes planes;
+  PixelWindow win;
+};
+
+Kind material_kind(const Material& m, const RasterPass& pass) {
+  if (m.alpha_mode == AlphaMode::Mask) return Kind::Mask;
+  if (m.alpha_mode == AlphaMode::Blend) return pass.blend == RasterBlend::Layers ? Kind::Blend : Kind::Mask;
+  return Kind::Opaque;
+}
+
+// p in view space (double) from world space.
+void to_view(const Transform& v, Vec3f p, double out[3]) {
+  for (int r = 0; r < 3; ++r)
+    out[r] = v.m[size_t(r)][0] * p.x + v.m[size_t(r)][1] * p.y + v.m[size_t(r)][2] * p.z + v.m[size_t(r)][3];
+}
+
+Vec4f to_clip(const Transform& p, const double v[3]) {
+  double c[4];
+  for (int r = 0; r < 4; ++r)
+    c[r] = p.m[size_t(r)][0] * v[0] + p.m[size_t(r)][1] * v[1] + p.m[size_t(r)][2] * v[2] + p.m[size_t(r)][3];
+  return {float(c[0]), float(c[1]), float(c[2]), float(c[3])};
+}
+
+// The pixel range whose samples may reach raster interval [lo, hi] (pixels), clamped to
+// [w0, w1).
+void pixel_range(double lo, double hi, float margin, int w0, int w1, int32_t& a, int32_t& b) {
+  const double l = std::floor(lo - 1.0 - double(margin)), h = std::floor(hi + double(margin)) + 1.0;
+  a = int32_t(std::clamp(l, double(w0), double(w1)));
+  b = int32_t(std::clamp(h, double(w0), double(w1)));
+}
+
+/// Screen-space sub-triangle (a, b, c) of a clipped source triangle: viewport map, snapping,
+/// culling and bounds. Returns false when it covers no sample.
+bool setup_triangle(const Pipeline& pl, const ClipVertex* const v[3], uint32_t instance, uint32_t prim,
+                    Kind kind, bool cull, bool mirrored, SetupTriangle& t) {
+  const double w = pl.view.width, h = pl.view.height;
+  FixedPoint f[3];
+  double rx[3], ry[3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec4f& p = v[k]->p;
+    if (!(p.w > 0)) return false;
+    rx[k] = (double(p.x) / double(p.w) + 1.0) * 0.5 * w;
+    ry[k] = (1.0 - double(p.y) / double(p.w)) * 0.5 * h;
+    if (!(std::fabs(rx[k]) <= kMaxRasterCoordinate && std::fabs(ry[k]) <= kMaxRasterCoordinate)) return false;
+    f[k] = to_fixed(rx[k], ry[k]);
+  }
+  const int64_t area2 = edge_function(f[0], f[1], f[2]);
+  if (area2 == 0) return false;
+  // Counter-clockwise in world space seen from the viewer is clockwise in raster (y down) space.
+  const bool front = (area2 < 0) != mirrored;
+  if (cull && !front) return false;
+  int order[3] = {0, 1, 2};
+  if (area2 < 0) std::swap(order[1], order[2]);
+  for (int k = 0; k < 3; ++k) {
+    const ClipVertex& c = *v[order[k]];
+    t.x[k] = int32_t(f[order[k]].x);
+    t.y[k] = int32_t(f[order[k]].y);
+    t.iw[k] = 1.0f / c.p.w;
+    t.dw[k] = c.depth / c.p.w;
+    t.bu[k] = c.b[1];
+    t.bv[k] = c.b[2];
+  }
+  t.instance = instance;
+  t.prim = prim;
+  t.kind = kind;
+  const PixelWindow& win = pl.win;
+  pixel_range(std::min({rx[0], rx[1], rx[2]}), std::max({rx[0], rx[1], rx[2]}), pl.pass.margin, win.x0,
+              win.x1, t.px0, t.px1);
+  pixel_range(std::min({ry[0], ry[1], ry[2]}), std::max({ry[0], ry[1], ry[2]}), pl.pass.margin, win.y0,
+              win.y1, t.py0, t.py1);
+  return t.px0 < t.px1 && t.py0 < t.py1;
+}
+
+/// Vertex stage, clipping and setup of triangle `prim` of mesh instance `instance`; appends
+/// its screen-space triangles to `out`.
+void setup_source_triangle(const Pipeline& pl, uint32_t instance, uint32_t prim, Kind kind, bool cull,
+                           std::vector<SetupTriangle>& out, RasterStats& st) {
+  const Instance& inst = pl.scene.instances[instance];
+  const WorldTriangle wt = world_triangle(pl.scene, inst, prim);
+  ClipVertex cv[3];
+  unsigned all = ~0u, any = 0;
+  for (int k = 0; k < 3; ++k) {
+    double v[3];
+    to_view(pl.view.view, wt.p[k], v);
+    cv[k].p = to_clip(pl.view.projection, v);
+    cv[k].depth = float(-v[2]);
+    cv[k].b[k] = 1;
+    const unsigned code = clip_outcode(cv[k].p, pl.planes);
+    all &= code;
+    any |= code;
+  }
+  ++st.triangles_in;
+  if (all) {
+    ++st.culled;
+    return;
+  }
+  ClipVertex poly[kMaxClipVertices];
+  int n = 3;
+  const ClipVertex* src = cv;
+  if (any) {
+    ++st.clipped;
+    n = clip_triangle(cv, pl.planes, poly);
+    src = poly;
+  }
+  const size_t before = out.size();
+  for (int i = 1; i + 1 < n; ++i) {
+    const ClipVertex* tri[3] = {&src[0], &src[i], &src[i + 1]};
+    SetupTriangle t;
+    if (setup_triangle(pl, tri, instance, prim, kind, cull, inst.mirrored, t)) out.push_back(t);
+  }
+  if (out.size() == before) ++st.culled;
+  st.triangles_setup += out.size() - before;
+}
+
+/// Every mesh instance's triangles set up in parallel, in submission order (instance, then
+/// triangle): a triangle's index in the result is its place in the z-buffer's tie order.
+std::vector<SetupTriangle> setup_triangles(const Pipeline& pl, tbb::task_arena& arena, RasterStats& st) {
+  const Scene& scene = pl.scene;
+  // Global triangle numbering over the mesh instances, cut into batches of kBatch.
+  std::vector<uint32_t> mesh_instances;
+  std::vector<uint64_t> first;  // first global triangle of each mesh instance
+  uint64_t total = 0;
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.shape >= 0) continue;
+    mesh_instances.push_back(uint32_t(i));
+    first.push_back(total);
+    total += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  }
+  constexpr uint64_t kBatch = 8192;
+  const size_t batches = size_t((total + kBatch - 1) / kBatch);
+  std::vector<std::vector<SetupTriangle>> parts(batches);
+  std::vector<RasterStats> part_stats(batches);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), batches, [&](size_t b) {
+      const uint64_t g0 = b * kBatch, g1 = std::min(total, g0 + kBatch);
+      size_t k = size_t(std::upper_bound(first.begin(), first.end(), g0) - first.begin()) - 1;
+      std::vector<SetupTriangle>& out = parts[b];
+      out.reserve(size_t(g1 - g0));
+      for (uint64_t g = g0; g < g1;) {
+        while (k + 1 < first.size() && first[k + 1] <= g) ++k;
+        const uint32_t instance = mesh_instances[k];
+        const Instance& inst = scene.instances[instance];
+        const Material& m = material_of(scene, scene.meshes[size_t(inst.mesh)].material);
+        const Kind kind = material_kind(m, pl.pass);
+        const bool cull = pl.pass.cull_back_faces && !m.double_sided;
+        const uint64_t end = std::min(g1, k + 1 < first.size() ? first[k + 1] : total);
+        for (; g < end; ++g)
+          setup_source_triangle(pl, instance, uint32_t(g - first[k]), kind, cull, out, part_stats[b]);
+      }
+    });
+  });
+  size_t count = 0;
+  for (const auto& p : parts) count += p.size();
+  std::vector<SetupTriangle> all;
+  all.reserve(count);
+  for (size_t b = 0; b < batches; ++b) {
+    all.insert(all.end(), parts[b].begin(), parts[b].end());
+    std::vector<SetupTriangle>().swap(parts[b]);
+    st.triangles_in += part_stats[b].triangles_in;
+    st.triangles_setup += part_stats[b].triangles_setup;
+    st.clipped += part_stats[b].clipped;
+    st.culled += part_stats[b].culled;
+  }
+  return all;
+}
+
+/// Each shape instance with the pixels its world bounds project to (the whole window when
+/// the bounds reach behind the near plane).
+std::vector<SetupShape> setup_shapes(const Pipeline& pl, RasterStats& st) {
+  std::vector<SetupShape> out;
+  const Scene& scene = pl.scene;
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.shape < 0) continue;
+    const SceneShape& ss = scene.shapes[size_t(inst.shape)];
+    Bounds3f b = shape_bounds(ss.shape);
+    if (b.empty()) continue;
+    if (!inst.identity) b = transform_bounds(inst.to_world, b);
+    const Material& m = material_of(scene, ss.material);
+    SetupShape s;
+    s.instance = uint32_t(i);
+    s.kind = material_kind(m, pl.pass);
+    s.cull_back = pl.pass.cull_back_faces && !m.double_sided;
+    // A Mask (or thresholded Blend) shape is covered everywhere or nowhere.
+    if (s.kind == Kind::Mask) {
+      const float a = eval_alpha(scene, uint32_t(i), 0, 0, 0);
+      if (!(a >= (m.alpha_mode == AlphaMode::Mask ? 1.0f : 0.5f))) continue;
+      s.kind = Kind::Opaque;
+    }
+    double lo[2] = {kInfinity, kInfinity}, hi[2] = {-kInfinity, -kInfinity};
+    bool behind = false;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3f p{(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
+      double v[3];
+      to_view(pl.view.view, p, v);
+      const Vec4f q = to_clip(pl.view.projection, v);
+      if (!(q.w > 0) || (clip_outcode(q, pl.planes) & 1u)) {
+        behind = true;
+        break;
+      }
+      const double rx = (double(q.x) / q.w + 1.0) * 0.5 * pl.view.width;
+      const double ry = (1.0 - double(q.y) / q.w) * 0.5 * pl.view.height;
+      lo[0] = std::min(lo[0], rx), hi[0] = std::max(hi[0], rx);
+      lo[1] = std::min(lo[1], ry), hi[1] = std::max(hi[1], ry);
+    }
+    if (behind) {
+      s.px0 = pl.win.x0, s.px1 = pl.win.x1, s.py0 = pl.win.y0, s.py1 = pl.win.y1;
+    } else {
+      pixel_range(lo[0], hi[0], pl.pass.margin, pl.win.x0, pl.win.x1, s.px0, s.px1);
+      pixel_range(lo[1], hi[1], pl.pass.margin, pl.win.y0, pl.win.y1, s.py0, s.py1);
+    }
+    if (s.px0 < s.px1 && s.py0 < s.py1) out.push_back(s);
+  }
+  st.shapes = out.size();
+  return out;
+}
+
+/// Triangle indices per tile (compressed rows: tile t holds refs[begin[t] .. begin[t + 1])).
+struct Bins {
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<uint64_t> begin;
+  std::vector<uint32_t> refs;
+};
+
+Bins bin_triangles(const std::vector<SetupTriangle>& tris, const PixelWindow& win, int ts) {
+  Bins bins;
+  bins.tiles_x = (win.width() + ts - 1) / ts;
+  bins.tiles_y = (win.height() + ts - 1) / ts;
+  const size_t ntiles = size_t(bins.tiles_x) * size_t(bins.tiles_y);
+  bins.begin.assign(ntiles + 1, 0);
+  auto for_tiles = [&](const SetupTriangle& t, auto&& fn) {
+    const int tx0 = (t.px0 - win.x0) / ts, tx1 = (t.px1 - 1 - win.x0) / ts;
+    const int ty0 = (t.py0 - win.y0) / ts, ty1 = (t.py1 - 1 - win.y0) / ts;
+    for (int ty = ty0; ty <= ty1; ++ty)
+      for (int tx = tx0; tx <= tx1; ++tx) fn(size_t(ty) * size_t(bins.tiles_x) + size_t(tx));
+  };
+  for (const SetupTriangle& t : tris) for_tiles(t, [&](size_t k) { ++bins.begin[k + 1]; });
+  for (size_t k = 0; k < ntiles; ++k) bins.begin[k + 1] += bins.begin[k];
+  bins.refs.resize(bins.begin[ntiles]);
+  std::vector<uint64_t> fill(bins.begin.begin(), bins.begin.end() - 1);
+  for (size_t i = 0; i < tris.size(); ++i)
+    for_tiles(tris[i], [&](size_t k) { bins.refs[fill[k]++] = uint32_t(i); });
+  return bins;
+}
+
+/// A covered sample before resolution: its z-buffer key and the sub-triangle's linear
+/// barycentrics of vertices 1 and 2 (shapes: the ray parameter in l1).
+struct Candidate {
+  uint32_t sample;
+  float depth;
+  uint32_t id;  ///< submission index: a setup triangle, or triangles + shape index
+  float l1, l2;
+};
+
+bool closer(float da, uint32_t ia, float db, uint32_t ib) {
+  return da < db || (da == db && ia < ib);
+}
+
+/// One thread's tile buffers, reused from tile to tile.
+struct TileBuffers {
+  std::vector<Vec2f> positions;
+  std::vector<FixedPoint> fixed;
+  std::vector<float> depth;
+  std::vector<uint32_t> id;
+  std::vector<float> l1, l2;
+  std::vector<Candidate> blend;
+  std::vector<RasterFragment> opaque, layers;
+  std::vector<uint32_t> layer_begin;
+};
+
+constexpr uint32_t kNone = 0xffffffffu;
+
+/// Perspective-correct source barycentrics (u, v) of triangle t at linear barycentrics
+/// (1 - l1 - l2, l1, l2).
+Vec2f source_uv(const SetupTriangle& t, double l1, double l2) {
+  const double l0 = 1.0 - l1 - l2;
+  const double s = l0 * t.iw[0] + l1 * t.iw[1] + l2 * t.iw[2];
+  const double u = (l0 * t.iw[0] * t.bu[0] + l1 * t.iw[1] * t.bu[1] + l2 * t.iw[2] * t.bu[2]) / s;
+  const double v = (l0 * t.iw[0] * t.bv[0] + l1 * t.iw[1] * t.bv[1] + l2 * t.iw[2] * t.bv[2]) / s;
+  return {float(u), float(v)};
+}
+
+/// The fragment of setup triangle t at linear barycentrics (l1, l2): source barycentrics and
+/// their derivatives per pixel (the quotient rule on the perspective-correct ratio, with the
+/// linear barycentrics' constant screen gradients).
+RasterFragment triangle_fragment(const SetupTriangle& t, float depth, double l1, double l2) {
+  RasterFragment f;
+  f.depth = depth;
+  f.hit.geom_id = t.instance;
+  f.hit.prim_id = t.prim;
+  const FixedPoint v0{t.x[0], t.y[0]}, v1{t.x[1], t.y[1]}, v2{t.x[2], t.y[2]};
+  const EdgeTriangle e = make_edge_triangle(v0, v1, v2);
+  const double inv_area = kSubpixelScale / double(e.area2);  // per pixel
+  const double l0 = 1.0 - l1 - l2;
+  const double l[3] = {l0, l1, l2};
+  double s = 0, nu = 0, nv = 0, ds[2] = {0, 0}, dnu[2] = {0, 0}, dnv[2] = {0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const double dl[2] = {double(e.edge[k].a) * inv_area, double(e.edge[k].b) * inv_area};
+    const double iw = t.iw[k];
+    s += l[k] * iw;
+    nu += l[k] * iw * t.bu[k];
+    nv += l[k] * iw * t.bv[k];
+    for (int a = 0; a < 2; ++a) {
+      ds[a] += dl[a] * iw;
+      dnu[a] += dl[a] * iw * t.bu[k];
+      dnv[a] += dl[a] * iw * t.bv[k];
+    }
+  }
+  f.hit.u = float(nu / s);
+  f.hit.v = float(nv / s);
+  const double s2 = s * s;
+  f.duv_dx = {float((dnu[0] * s - nu * ds[0]) / s2), float((dnv[0] * s - nv * ds[0]) / s2)};
+  f.duv_dy = {float((dnu[1] * s - nu * ds[1]) / s2), float((dnv[1] * s - nv * ds[1]) / s2)};
+  return f;
+}
+
+/// The nearest hit of `shape` along object-space ray `ray`; with `cull_back`, the nearest seen
+/// from outside (n . d <= 0: the sign is the same in object and world space, as normals map by
+/// the inverse transpose), stepping past back-facing hits a bounded number of times.
+bool front_hit(const Shape& shape, const Ray& ray, bool cull_back, ShapeHit& hit) {
+  Ray r = ray;
+  for (int i = 0; i < 64; ++i) {
+    if (!intersect_shape(shape, r, hit)) return false;
+    if (!cull_back || dot(shape_surface(shape, r.org + r.dir * hit.t, 1e-4f).n, r.dir) <= 0) return true;
+    r.tnear = std::nextafter(std::max(hit.t, r.tnear), kInfinity);
+  }
+  return false;
+}
+
+/// Rasterises one tile: z-buffer of opaque and alpha-tested fragments, Blend candidates, then
+/// the resolved visibility buffer.
+class TileRasterizer {
+ public:
+  TileRasterizer(const Pipeline& pl, const std::vector<SetupTriangle>& tris,
+                 const std::vector<SetupShape>& shapes, const Bins& bins)
+      : m_pl(pl), m_tris(tris), m_shapes(shapes), m_bins(bins) {}
+
+  void run(const PixelWindow& tile, TileBuffers& b,
+           const std::function<void(const RasterTile&)>& shade) const {
+    const int spp = m_pl.pass.spp;
+    const size_t n = size_t(tile.width()) * size_t(tile.height()) * size_t(spp);
+    init_samples(tile, b, n);
+    const int ts = m_pl.pass.tile_size;
+    const size_t k =
+        size_t((tile.y0 - m_pl.win.y0) / ts) * size_t(m_bins.tiles_x) + size_t((tile.x0 - m_pl.win.x0) / ts);
+    for (uint64_t r = m_bins.begin[k]; r < m_bins.begin[k + 1]; ++r) raster_triangle(tile, m_bins.refs[r], b);
+    for (size_t s = 0; s < m_shapes.size(); ++s) raster_shape(tile, s, b);
+    resolve(tile, b, n);
+    RasterTile out;
+    out.pixels = tile;
+    out.spp = spp;
+    out.positions = b.positions.data();
+    out.opaque = b.opaque.data();
+    out.blend_begin = b.layer_begin.data();
+    out.blend = b.layers.data();
+    shade(out);
+  }
+
+ private:
+  void init_samples(const PixelWindow& tile, TileBuffers& b, size_t n) const {
+    const RasterPass& pass = m_pl.pass;
+    b.positions.resize(n);
+    b.fixed.resize(n);
+    b.depth.assign(n, kInfinity);
+    b.id.assign(n, kNone);
+    b.l1.resize(n);
+    b.l2.resize(n);
+    b.blend.clear();
+    size_t i = 0;
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x)
+        for (uint32_t s = 0; s < uint32_t(pass.spp); ++s, ++i) {
+          const Vec2f p = pass.position ? pass.position(pass.position_context, x, y, s)
+                                        : Vec2f{float(x) + 0.5f, float(y) + 0.5f};
+          b.positions[i] = p;
+          b.fixed[i] = to_fixed(std::clamp(double(p.x), -kMaxRasterCoordinate, kMaxRasterCoordinate),
+                                std::clamp(double(p.y), -kMaxRasterCoordinate, kMaxRasterCoordinate));
+        }
+  }
+
+  // The depth test and the fragment stage for one covered sample.
+  void fragment(size_t i, float depth, uint32_t id, float l1, float l2, Kind kind, TileBuffers& b) const {
+    if (!closer(depth, id, b.depth[i], b.id[i])) return;
+    if (kind == Kind::Blend) {
+      b.blend.push_back({uint32_t(i), depth, id, l1, l2});
+      return;
+    }
+    b.depth[i] = depth;
+    b.id[i] = id;
+    b.l1[i] = l1;
+    b.l2[i] = l2;
+  }
+
+  void raster_triangle(const PixelWindow& tile, uint32_t index, TileBuffers& b) const {
+    const SetupTriangle& t = m_tris[index];
+    const EdgeTriangle e = make_edge_triangle({t.x[0], t.y[0]}, {t.x[1], t.y[1]}, {t.x[2], t.y[2]});
+    const double inv_area = 1.0 / double(e.area2);
+    const int x0 = std::max(t.px0, tile.x0), x1 = std::min(t.px1, tile.x1);
+    const int y0 = std::max(t.py0, tile.y0), y1 = std::min(t.py1, tile.y1);
+    const int spp = m_pl.pass.spp;
+    const float mask_cut = m_pl.pass.blend == RasterBlend::Threshold ? 0.5f : 1.0f;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const size_t base = (size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0)) * size_t(spp);
+        for (int s = 0; s < spp; ++s) {
+          const size_t i = base + size_t(s);
+          int64_t ev[3];
+          if (!edge_inside(e, b.fixed[i], ev)) continue;
+          const double l1 = double(ev[1]) * inv_area, l2 = double(ev[2]) * inv_area, l0 = 1.0 - l1 - l2;
+          const double sw = l0 * t.iw[0] + l1 * t.iw[1] + l2 * t.iw[2];
+          const float depth = float((l0 * t.dw[0] + l1 * t.dw[1] + l2 * t.dw[2]) / sw);
+          if (!closer(depth, index, b.depth[i], b.id[i])) continue;
+          if (t.kind == Kind::Mask) {
+            const Vec2f uv = source_uv(t, l1, l2);
+            const Material& m =
+                material_of(m_pl.scene, instance_material(m_pl.scene, m_pl.scene.instances[t.instance]));
+            const float cut = m.alpha_mode == AlphaMode::Mask ? 1.0f : mask_cut;
+            if (!(eval_alpha(m_pl.scene, t.instance, t.prim, uv.x, uv.y) >= cut)) continue;
+          }
+          fragment(i, depth, index, float(l1), float(l2), t.kind, b);
+        }
+      }
+  }
+
+  void raster_shape(const PixelWindow& tile, size_t index, TileBuffers& b) const {
+    const SetupShape& sh = m_shapes[index];
+    const int x0 = std::max(sh.px0, tile.x0), x1 = std::min(sh.px1, tile.x1);
+    const int y0 = std::max(sh.py0, tile.y0), y1 = std::min(sh.py1, tile.y1);
+    if (x0 >= x1 || y0 >= y1) return;
+    const Scene& scene = m_pl.scene;
+    const Instance& inst = scene.instances[sh.instance];
+    const Shape& shape = scene.shapes[size_t(inst.shape)].shape;
+    const uint32_t id = uint32_t(m_tris.size() + index);
+    const int spp = m_pl.pass.spp;
+    const auto& vrow = m_pl.view.view.m[2];
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const size_t base = (size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0)) * size_t(spp);
+        for (int s = 0; s < spp; ++s) {
+          const size_t i = base + size_t(s);
+          const Vec2f p = b.positions[i];
+          const Ray world = m_pl.view.ray(m_pl.view.ray_context, p.x, p.y);
+          Ray obj = world;
+          if (!inst.identity) {
+            obj.org = apply_point(inst.to_object, world.org);
+            obj.dir = apply_vector(inst.to_object, world.dir);
+          }
+          ShapeHit hit;
+          if (!front_hit(shape, obj, sh.cull_back, hit)) continue;
+          const Vec3f q = world.org + world.dir * hit.t;
+          const float depth = float(-(vrow[0] * q.x + vrow[1] * q.y + vrow[2] * q.z + vrow[3]));
+          fragment(i, depth, id, hit.t, 0, sh.kind, b);
+        }
+      }
+  }
+
+  RasterFragment make_fragment(uint32_t id, float depth, float l1, float l2) const {
+    if (id < m_tris.size()) return triangle_fragment(m_tris[id], depth, l1, l2);
+    RasterFragment f;
+    f.depth = depth;
+    f.hit.geom_id = m_shapes[id - m_tris.size()].instance;
+    f.hit.prim_id = 0;
+    f.hit.t = l1;
+    return f;
+  }
+
+  void resolve(const PixelWindow& tile, TileBuffers& b, size_t n) const {
+    (void)tile;
+    b.opaque.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      b.opaque[i] =
+          b.id[i] == kNone ? RasterFragment{} : make_fragment(b.id[i], b.depth[i], b.l1[i], b.l2[i]);
+    // Blend layers in front of each sample's opaque fragment, front to back; past the layer
+    // limit the next one stands for the opaque surface.
+    auto& c = b.blend;
+    c.erase(std::remove_if(c.begin(), c.end(),
+                           [&](const Candidate& k) {
+                             return !closer(k.depth, k.id, b.depth[k.sample], b.id[k.sample]);
+                           }),
+            c.end());
+    std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& z) {
+      return a.sample != z.sample ? a.sample < z.sample : closer(a.depth, a.id, z.depth, z.id);
+    });
+    b.layers.clear();
+    b.layer_begin.assign(n + 1, 0);
+    const size_t limit = size_t(std::max(0, m_pl.pass.max_blend_layers));
+    for (size_t k = 0; k < c.size();) {
+      const uint32_t s = c[k].sample;
+      size_t e = k, kept = 0;
+      while (e < c.size() && c[e].sample == s) ++e;
+      for (size_t j = k; j < e; ++j) {
+        if (kept == limit) {
+          b.opaque[s] = make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2);
+          break;
+        }
+        b.layers.push_back(make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2));
+        ++kept;
+      }
+      b.layer_begin[s + 1] = uint32_t(kept);
+      k = e;
+    }
+    for (size_t i = 0; i < n; ++i) b.layer_begin[i + 1] += b.layer_begin[i];
+  }
+
+  const Pipeline& m_pl;
+  const std::vector<SetupTriangle>& m_tris;
+  const std::vector<SetupShape>& m_shapes;
+  const Bins& m_bins;
+};
+
+/// Guard band (in viewport half-extents) that holds every sample, with a pixel to spare.
+float guard_band(const RasterView& view, const RasterPass& pass) {
+  const float dim = float(std::max(1, std::min(view.width, view.height)));
+  return std::max(2.0f, 1.0f + 2.0f * (pass.margin + 2.0f) / dim);
+}
+
+}  // namespace
+
+uint64_t raster_memory_bytes(const Scene& scene, const RasterPass& pass) {
+  const uint64_t tris = count_triangles(scene);
+  const uint64_t samples =
+      uint64_t(pass.tile_size) * uint64_t(pass.tile_size) * uint64_t(std::max(1, pass.spp));
+  const uint64_t per_sample = sizeof(Vec2f) + sizeof(FixedPoint) + 16 + sizeof(RasterFragment) + 4;
+  // Setup triangles (clipping adds a few), their references (a handful of tiles each) and
+  // the batches being concatenated.
+  return tris * (2 * sizeof(SetupTriangle) + 4 * sizeof(uint32_t)) +
+         uint64_t(thread_count(pass.threads)) * samples * per_sample;
+}
+
+void rasterize(const Scene& scene, const RasterView& view, const RasterPass& pass,
+               const std::function<void(const RasterTile& tile)>& shade, RasterStats* stats) {
+  Pipeline pl{scene, view, pass, ClipPlanes{view.far_plane, guard_band(view, pass)}, pass.window};
+  RasterStats st;
+  tbb::task_arena arena(thread_count(pass.threads));
+  const std::vector<SetupTriangle> tris = setup_triangles(pl, arena, st);
+  const std::vector<SetupShape> shapes = setup_shapes(pl, st);
+  const Bins bins = bin_triangles(tris, pl.win, pass.tile_size);
+  st.bin_references = bins.refs.size();
+  const TileRasterizer raster(pl, tris, shapes, bins);
+  tbb::enumerable_thread_specific<TileBuffers> buffers;
+  TileScheduler scheduler(pl.win, pass.tile_size, pass.threads);
+  scheduler.for_each_tile([&](const PixelWindow& tile) { raster.run(tile, buffers.local(), shade); });
+  if (stats) *stats = st;
+}
+
+}  // namespace penumbra
