@@ -53,13 +53,6 @@ ClipVertex intersect(const ClipVertex& a0, const ClipVertex& b0, int k, float gu
 
 }  // namespace
 
-unsigned clip_outcode(const Vec4f& p, const ClipPlanes& planes) {
-  unsigned code = 0;
-  for (int k = 0; k < kPlanes; ++k)
-    if (plane_used(k, planes) && !(plane_value(p, k, planes.guard) >= 0)) code |= 1u << k;
-  return code;
-}
-
 int clip_triangle(const ClipVertex in[3], const ClipPlanes& planes, ClipVertex out[kMaxClipVertices]) {
   ClipVertex buf[2][kMaxClipVertices + 1];
   int n = 3;

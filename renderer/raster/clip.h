@@ -32,7 +32,12 @@ struct ClipPlanes {
 /// Which planes p lies outside of, as a bit mask (bit 0 near, 1 far, 2..5 the guard band's
 /// left, right, bottom, top). When the three vertices of a triangle share a bit, it is
 /// invisible; when none is set, it needs no clipping. NaN coordinates are outside every plane.
-unsigned clip_outcode(const Vec4f& p, const ClipPlanes& planes);
+inline unsigned clip_outcode(const Vec4f& p, const ClipPlanes& planes) {
+  const float g = planes.guard * p.w;
+  return unsigned(!(p.z + p.w >= 0)) | unsigned(planes.far && !(p.w - p.z >= 0)) << 1 |
+         unsigned(!(g + p.x >= 0)) << 2 | unsigned(!(g - p.x >= 0)) << 3 | unsigned(!(g + p.y >= 0)) << 4 |
+         unsigned(!(g - p.y >= 0)) << 5;
+}
 
 /// Clips triangle `in` against the planes (near: z + w >= 0; far: w - z >= 0; guard band:
 /// guard w -+ x >= 0 and likewise for y) and writes the convex polygon that remains to `out`

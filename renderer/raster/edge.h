@@ -22,10 +22,16 @@ struct FixedPoint {
   int64_t x = 0, y = 0;
 };
 
+/// Rounds to the nearest integer, halves away from zero (as std::llround, inline). Requires
+/// finite |v| < 2^62.
+inline int64_t round_to_int64(double v) {
+  return int64_t(v + (v >= 0 ? 0.5 : -0.5));
+}
+
 /// Snaps a raster position to the fixed-point grid (round to nearest). Requires finite
 /// |x|, |y| <= kMaxRasterCoordinate (clipping guarantees it for triangle vertices).
 inline FixedPoint to_fixed(double x, double y) {
-  return {std::llround(x * kSubpixelScale), std::llround(y * kSubpixelScale)};
+  return {round_to_int64(x * kSubpixelScale), round_to_int64(y * kSubpixelScale)};
 }
 
 /// Twice the signed area of (a, b, p): cross(b - a, p - a), exact. With raster y pointing

@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "renderer/materials/material.h"
@@ -39,7 +40,15 @@ struct SetupShape {
   bool cull_back;  ///< single-sided material: back-facing hits are skipped
 };
 
-/// The fixed parts of a pass: view, planes, window, and the per-instance clip transforms.
+/// The vertex stage's output: every mesh instance's vertices in clip space with their view
+/// depth, instance i's at [first[i], first[i] + its mesh's vertex count).
+struct Vertices {
+  std::vector<uint64_t> first;
+  std::vector<Vec4f> clip;
+  std::vector<float> depth;
+};
+
+/// The fixed parts of a pass: view, planes and window.
 struct Pipeline {
   const Scene& scene;
   const RasterView& view;
@@ -67,12 +76,31 @@ Vec4f to_clip(const Transform& p, const double v[3]) {
   return {float(c[0]), float(c[1]), float(c[2]), float(c[3])};
 }
 
-// The pixel range whose samples may reach raster interval [lo, hi] (pixels), clamped to
-// [w0, w1).
-void pixel_range(double lo, double hi, float margin, int w0, int w1, int32_t& a, int32_t& b) {
-  const double l = std::floor(lo - 1.0 - double(margin)), h = std::floor(hi + double(margin)) + 1.0;
-  a = int32_t(std::clamp(l, double(w0), double(w1)));
-  b = int32_t(std::clamp(h, double(w0), double(w1)));
+/// Where the samples of pixel x lie along an axis: in [x + lo, x + hi].
+struct SampleSpan {
+  double lo = 0, hi = 1;
+};
+
+SampleSpan sample_span(const RasterPass& pass) {
+  if (!pass.position) return {0.5, 0.5};
+  return {-double(pass.margin), 1.0 + double(pass.margin)};
+}
+
+// floor(v) for |v| < 2^31, without a library call.
+int64_t floor_int(double v) {
+  const int64_t i = int64_t(v);
+  return i - int64_t(double(i) > v);
+}
+
+// The pixels whose samples may reach raster interval [lo, hi] (pixels, widened by the
+// snapping's half unit), clamped to [w0, w1).
+void pixel_range(double lo, double hi, SampleSpan span, int w0, int w1, int32_t& a, int32_t& b) {
+  constexpr double eps = 1.0 / kSubpixelScale;
+  lo = std::clamp(lo, -kMaxRasterCoordinate, kMaxRasterCoordinate);  // also NaN-free below
+  hi = std::clamp(hi, -kMaxRasterCoordinate, kMaxRasterCoordinate);
+  const int64_t l = -floor_int(-(lo - span.hi - eps)), h = floor_int(hi - span.lo + eps) + 1;
+  a = int32_t(std::clamp<int64_t>(l, w0, w1));
+  b = int32_t(std::clamp<int64_t>(h, w0, w1));
 }
 
 /// Screen-space sub-triangle (a, b, c) of a clipped source triangle: viewport map, snapping,
@@ -85,8 +113,9 @@ bool setup_triangle(const Pipeline& pl, const ClipVertex* const v[3], uint32_t i
   for (int k = 0; k < 3; ++k) {
     const Vec4f& p = v[k]->p;
     if (!(p.w > 0)) return false;
-    rx[k] = (double(p.x) / double(p.w) + 1.0) * 0.5 * w;
-    ry[k] = (1.0 - double(p.y) / double(p.w)) * 0.5 * h;
+    const double iw = 1.0 / double(p.w);
+    rx[k] = (double(p.x) * iw + 1.0) * 0.5 * w;
+    ry[k] = (1.0 - double(p.y) * iw) * 0.5 * h;
     if (!(std::fabs(rx[k]) <= kMaxRasterCoordinate && std::fabs(ry[k]) <= kMaxRasterCoordinate)) return false;
     f[k] = to_fixed(rx[k], ry[k]);
   }
@@ -110,26 +139,38 @@ bool setup_triangle(const Pipeline& pl, const ClipVertex* const v[3], uint32_t i
   t.prim = prim;
   t.kind = kind;
   const PixelWindow& win = pl.win;
-  pixel_range(std::min({rx[0], rx[1], rx[2]}), std::max({rx[0], rx[1], rx[2]}), pl.pass.margin, win.x0,
+  pixel_range(std::min({rx[0], rx[1], rx[2]}), std::max({rx[0], rx[1], rx[2]}), sample_span(pl.pass), win.x0,
               win.x1, t.px0, t.px1);
-  pixel_range(std::min({ry[0], ry[1], ry[2]}), std::max({ry[0], ry[1], ry[2]}), pl.pass.margin, win.y0,
+  pixel_range(std::min({ry[0], ry[1], ry[2]}), std::max({ry[0], ry[1], ry[2]}), sample_span(pl.pass), win.y0,
               win.y1, t.py0, t.py1);
   return t.px0 < t.px1 && t.py0 < t.py1;
 }
 
-/// Vertex stage, clipping and setup of triangle `prim` of mesh instance `instance`; appends
-/// its screen-space triangles to `out`.
-void setup_source_triangle(const Pipeline& pl, uint32_t instance, uint32_t prim, Kind kind, bool cull,
-                           std::vector<SetupTriangle>& out, RasterStats& st) {
+/// The fan of screen-space triangles of a source triangle that needs clipping (kept apart from
+/// the common path, whose stack then holds no clipped polygon).
+void setup_clipped(const Pipeline& pl, const ClipVertex cv[3], uint32_t instance, uint32_t prim, Kind kind,
+                   bool cull, bool mirrored, std::vector<SetupTriangle>& out) {
+  ClipVertex poly[kMaxClipVertices];
+  const int n = clip_triangle(cv, pl.planes, poly);
+  for (int i = 1; i + 1 < n; ++i) {
+    const ClipVertex* tri[3] = {&poly[0], &poly[i], &poly[i + 1]};
+    SetupTriangle t;
+    if (setup_triangle(pl, tri, instance, prim, kind, cull, mirrored, t)) out.push_back(t);
+  }
+}
+
+/// Clipping and setup of triangle `prim` of mesh instance `instance`, whose vertices the vertex
+/// stage transformed; appends its screen-space triangles to `out`.
+void setup_source_triangle(const Pipeline& pl, const Vertices& vs, uint32_t instance, uint32_t prim,
+                           Kind kind, bool cull, std::vector<SetupTriangle>& out, RasterStats& st) {
   const Instance& inst = pl.scene.instances[instance];
-  const WorldTriangle wt = world_triangle(pl.scene, inst, prim);
+  const uint32_t* index = &pl.scene.meshes[size_t(inst.mesh)].indices[size_t(prim) * 3];
+  const uint64_t base = vs.first[instance];
   ClipVertex cv[3];
   unsigned all = ~0u, any = 0;
   for (int k = 0; k < 3; ++k) {
-    double v[3];
-    to_view(pl.view.view, wt.p[k], v);
-    cv[k].p = to_clip(pl.view.projection, v);
-    cv[k].depth = float(-v[2]);
+    cv[k].p = vs.clip[base + index[k]];
+    cv[k].depth = vs.depth[base + index[k]];
     cv[k].b[k] = 1;
     const unsigned code = clip_outcode(cv[k].p, pl.planes);
     all &= code;
@@ -140,29 +181,80 @@ void setup_source_triangle(const Pipeline& pl, uint32_t instance, uint32_t prim,
     ++st.culled;
     return;
   }
-  ClipVertex poly[kMaxClipVertices];
-  int n = 3;
-  const ClipVertex* src = cv;
-  if (any) {
-    ++st.clipped;
-    n = clip_triangle(cv, pl.planes, poly);
-    src = poly;
-  }
   const size_t before = out.size();
-  for (int i = 1; i + 1 < n; ++i) {
-    const ClipVertex* tri[3] = {&src[0], &src[i], &src[i + 1]};
+  if (!any) {
+    const ClipVertex* tri[3] = {&cv[0], &cv[1], &cv[2]};
     SetupTriangle t;
     if (setup_triangle(pl, tri, instance, prim, kind, cull, inst.mirrored, t)) out.push_back(t);
+  } else {
+    ++st.clipped;
+    setup_clipped(pl, cv, instance, prim, kind, cull, inst.mirrored, out);
   }
   if (out.size() == before) ++st.culled;
   st.triangles_setup += out.size() - before;
 }
 
-/// Every mesh instance's triangles set up in parallel, in submission order (instance, then
-/// triangle): a triangle's index in the result is its place in the z-buffer's tie order.
-std::vector<SetupTriangle> setup_triangles(const Pipeline& pl, tbb::task_arena& arena, RasterStats& st) {
+/// The vertex stage: each mesh instance's vertices by its model-view-projection matrix (made in
+/// double, applied in float) and their view depth, in parallel.
+Vertices transform_vertices(const Pipeline& pl, tbb::task_arena& arena) {
   const Scene& scene = pl.scene;
-  // Global triangle numbering over the mesh instances, cut into batches of kBatch.
+  Vertices vs;
+  vs.first.assign(scene.instances.size() + 1, 0);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    vs.first[i + 1] = vs.first[i] + (inst.shape >= 0 ? 0 : scene.meshes[size_t(inst.mesh)].positions.size());
+  }
+  vs.clip.resize(vs.first.back());
+  vs.depth.resize(vs.first.back());
+  constexpr size_t kChunk = 16384;
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
+      const Instance& inst = scene.instances[i];
+      if (inst.shape >= 0) return;
+      const Transform model_view = pl.view.view * to_transform(inst.to_world);
+      const Transform mvp = pl.view.projection * model_view;
+      float m[4][4], d[4];
+      for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) m[r][c] = float(mvp.m[size_t(r)][size_t(c)]);
+        d[r] = float(-model_view.m[2][size_t(r)]);
+      }
+      const std::vector<Vec3f>& pos = scene.meshes[size_t(inst.mesh)].positions;
+      tbb::parallel_for(size_t(0), pos.size(), kChunk, [&](size_t c0) {
+        const size_t c1 = std::min(pos.size(), c0 + kChunk);
+        for (size_t k = c0; k < c1; ++k) {
+          const Vec3f p = pos[k];
+          Vec4f& o = vs.clip[vs.first[i] + k];
+          o.x = m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3];
+          o.y = m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3];
+          o.z = m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3];
+          o.w = m[3][0] * p.x + m[3][1] * p.y + m[3][2] * p.z + m[3][3];
+          vs.depth[vs.first[i] + k] = d[0] * p.x + d[1] * p.y + d[2] * p.z + d[3];
+        }
+      });
+    });
+  });
+  return vs;
+}
+
+/// The setup triangles of a pass in batches of consecutive source triangles, each triangle
+/// named by a 32-bit id: its batch in the high bits, its place in the batch in the low `shift`
+/// bits. Ids grow with submission order (instance, then triangle), the z-buffer's tie order;
+/// shapes take the ids from end_id() on.
+struct SetupTriangles {
+  std::vector<std::vector<SetupTriangle>> batches;
+  int shift = 16;
+  const SetupTriangle& operator[](uint32_t id) const {
+    return batches[id >> shift][id & ((uint32_t(1) << shift) - 1)];
+  }
+  uint32_t end_id() const { return uint32_t(batches.size()) << shift; }
+  bool is_triangle(uint32_t id) const { return id < end_id(); }
+};
+
+/// Every mesh instance's triangles set up in parallel batches, in submission order.
+SetupTriangles setup_triangles(const Pipeline& pl, tbb::task_arena& arena, RasterStats& st) {
+  const Scene& scene = pl.scene;
+  const Vertices vs = transform_vertices(pl, arena);
+  // Global triangle numbering over the mesh instances, cut into batches of `batch`.
   std::vector<uint32_t> mesh_instances;
   std::vector<uint64_t> first;  // first global triangle of each mesh instance
   uint64_t total = 0;
@@ -173,16 +265,24 @@ std::vector<SetupTriangle> setup_triangles(const Pipeline& pl, tbb::task_arena& 
     first.push_back(total);
     total += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
   }
-  constexpr uint64_t kBatch = 8192;
-  const size_t batches = size_t((total + kBatch - 1) / kBatch);
-  std::vector<std::vector<SetupTriangle>> parts(batches);
+  // A batch of n source triangles makes at most 7 n setup triangles (a clipped polygon has at
+  // most 9 vertices); the ids of every batch and of the shapes fit 32 bits.
+  SetupTriangles out;
+  uint64_t batch = 8192;
+  out.shift = 16;
+  while ((((total + batch - 1) / batch + 1) << out.shift) > (uint64_t(1) << 32) - scene.instances.size()) {
+    batch *= 2;
+    ++out.shift;
+  }
+  const size_t batches = size_t((total + batch - 1) / batch);
+  out.batches.resize(batches);
   std::vector<RasterStats> part_stats(batches);
   arena.execute([&] {
     tbb::parallel_for(size_t(0), batches, [&](size_t b) {
-      const uint64_t g0 = b * kBatch, g1 = std::min(total, g0 + kBatch);
+      const uint64_t g0 = b * batch, g1 = std::min(total, g0 + batch);
       size_t k = size_t(std::upper_bound(first.begin(), first.end(), g0) - first.begin()) - 1;
-      std::vector<SetupTriangle>& out = parts[b];
-      out.reserve(size_t(g1 - g0));
+      std::vector<SetupTriangle>& part = out.batches[b];
+      part.reserve(size_t(g1 - g0));
       for (uint64_t g = g0; g < g1;) {
         while (k + 1 < first.size() && first[k + 1] <= g) ++k;
         const uint32_t instance = mesh_instances[k];
@@ -192,23 +292,17 @@ std::vector<SetupTriangle> setup_triangles(const Pipeline& pl, tbb::task_arena& 
         const bool cull = pl.pass.cull_back_faces && !m.double_sided;
         const uint64_t end = std::min(g1, k + 1 < first.size() ? first[k + 1] : total);
         for (; g < end; ++g)
-          setup_source_triangle(pl, instance, uint32_t(g - first[k]), kind, cull, out, part_stats[b]);
+          setup_source_triangle(pl, vs, instance, uint32_t(g - first[k]), kind, cull, part, part_stats[b]);
       }
     });
   });
-  size_t count = 0;
-  for (const auto& p : parts) count += p.size();
-  std::vector<SetupTriangle> all;
-  all.reserve(count);
-  for (size_t b = 0; b < batches; ++b) {
-    all.insert(all.end(), parts[b].begin(), parts[b].end());
-    std::vector<SetupTriangle>().swap(parts[b]);
-    st.triangles_in += part_stats[b].triangles_in;
-    st.triangles_setup += part_stats[b].triangles_setup;
-    st.clipped += part_stats[b].clipped;
-    st.culled += part_stats[b].culled;
+  for (const RasterStats& p : part_stats) {
+    st.triangles_in += p.triangles_in;
+    st.triangles_setup += p.triangles_setup;
+    st.clipped += p.clipped;
+    st.culled += p.culled;
   }
-  return all;
+  return out;
 }
 
 /// Each shape instance with the pixels its world bounds project to (the whole window when
@@ -253,8 +347,8 @@ std::vector<SetupShape> setup_shapes(const Pipeline& pl, RasterStats& st) {
     if (behind) {
       s.px0 = pl.win.x0, s.px1 = pl.win.x1, s.py0 = pl.win.y0, s.py1 = pl.win.y1;
     } else {
-      pixel_range(lo[0], hi[0], pl.pass.margin, pl.win.x0, pl.win.x1, s.px0, s.px1);
-      pixel_range(lo[1], hi[1], pl.pass.margin, pl.win.y0, pl.win.y1, s.py0, s.py1);
+      pixel_range(lo[0], hi[0], sample_span(pl.pass), pl.win.x0, pl.win.x1, s.px0, s.px1);
+      pixel_range(lo[1], hi[1], sample_span(pl.pass), pl.win.y0, pl.win.y1, s.py0, s.py1);
     }
     if (s.px0 < s.px1 && s.py0 < s.py1) out.push_back(s);
   }
@@ -269,7 +363,7 @@ struct Bins {
   std::vector<uint32_t> refs;
 };
 
-Bins bin_triangles(const std::vector<SetupTriangle>& tris, const PixelWindow& win, int ts) {
+Bins bin_triangles(const SetupTriangles& tris, const PixelWindow& win, int ts) {
   Bins bins;
   bins.tiles_x = (win.width() + ts - 1) / ts;
   bins.tiles_y = (win.height() + ts - 1) / ts;
@@ -281,12 +375,16 @@ Bins bin_triangles(const std::vector<SetupTriangle>& tris, const PixelWindow& wi
     for (int ty = ty0; ty <= ty1; ++ty)
       for (int tx = tx0; tx <= tx1; ++tx) fn(size_t(ty) * size_t(bins.tiles_x) + size_t(tx));
   };
-  for (const SetupTriangle& t : tris) for_tiles(t, [&](size_t k) { ++bins.begin[k + 1]; });
+  for (const auto& part : tris.batches)
+    for (const SetupTriangle& t : part) for_tiles(t, [&](size_t k) { ++bins.begin[k + 1]; });
   for (size_t k = 0; k < ntiles; ++k) bins.begin[k + 1] += bins.begin[k];
   bins.refs.resize(bins.begin[ntiles]);
   std::vector<uint64_t> fill(bins.begin.begin(), bins.begin.end() - 1);
-  for (size_t i = 0; i < tris.size(); ++i)
-    for_tiles(tris[i], [&](size_t k) { bins.refs[fill[k]++] = uint32_t(i); });
+  for (size_t b = 0; b < tris.batches.size(); ++b)
+    for (size_t i = 0; i < tris.batches[b].size(); ++i) {
+      const uint32_t id = uint32_t(b << tris.shift | i);
+      for_tiles(tris.batches[b][i], [&](size_t k) { bins.refs[fill[k]++] = id; });
+    }
   return bins;
 }
 
@@ -327,37 +425,47 @@ Vec2f source_uv(const SetupTriangle& t, double l1, double l2) {
   return {float(u), float(v)};
 }
 
+/// The screen gradients (per pixel in x and y) of a setup triangle's linear barycentrics.
+struct Gradients {
+  double dl[3][2];
+};
+
+Gradients gradients(const SetupTriangle& t) {
+  const EdgeTriangle e = make_edge_triangle({t.x[0], t.y[0]}, {t.x[1], t.y[1]}, {t.x[2], t.y[2]});
+  const double inv_area = kSubpixelScale / double(e.area2);
+  Gradients g;
+  for (int k = 0; k < 3; ++k)
+    g.dl[k][0] = double(e.edge[k].a) * inv_area, g.dl[k][1] = double(e.edge[k].b) * inv_area;
+  return g;
+}
+
 /// The fragment of setup triangle t at linear barycentrics (l1, l2): source barycentrics and
 /// their derivatives per pixel (the quotient rule on the perspective-correct ratio, with the
-/// linear barycentrics' constant screen gradients).
-RasterFragment triangle_fragment(const SetupTriangle& t, float depth, double l1, double l2) {
+/// linear barycentrics' constant screen gradients g).
+RasterFragment triangle_fragment(const SetupTriangle& t, const Gradients& g, float depth, double l1,
+                                 double l2) {
   RasterFragment f;
   f.depth = depth;
   f.hit.geom_id = t.instance;
   f.hit.prim_id = t.prim;
-  const FixedPoint v0{t.x[0], t.y[0]}, v1{t.x[1], t.y[1]}, v2{t.x[2], t.y[2]};
-  const EdgeTriangle e = make_edge_triangle(v0, v1, v2);
-  const double inv_area = kSubpixelScale / double(e.area2);  // per pixel
-  const double l0 = 1.0 - l1 - l2;
-  const double l[3] = {l0, l1, l2};
+  const double l[3] = {1.0 - l1 - l2, l1, l2};
   double s = 0, nu = 0, nv = 0, ds[2] = {0, 0}, dnu[2] = {0, 0}, dnv[2] = {0, 0};
   for (int k = 0; k < 3; ++k) {
-    const double dl[2] = {double(e.edge[k].a) * inv_area, double(e.edge[k].b) * inv_area};
-    const double iw = t.iw[k];
+    const double iw = t.iw[k], iu = iw * t.bu[k], iv = iw * t.bv[k];
     s += l[k] * iw;
-    nu += l[k] * iw * t.bu[k];
-    nv += l[k] * iw * t.bv[k];
+    nu += l[k] * iu;
+    nv += l[k] * iv;
     for (int a = 0; a < 2; ++a) {
-      ds[a] += dl[a] * iw;
-      dnu[a] += dl[a] * iw * t.bu[k];
-      dnv[a] += dl[a] * iw * t.bv[k];
+      ds[a] += g.dl[k][a] * iw;
+      dnu[a] += g.dl[k][a] * iu;
+      dnv[a] += g.dl[k][a] * iv;
     }
   }
-  f.hit.u = float(nu / s);
-  f.hit.v = float(nv / s);
-  const double s2 = s * s;
-  f.duv_dx = {float((dnu[0] * s - nu * ds[0]) / s2), float((dnv[0] * s - nv * ds[0]) / s2)};
-  f.duv_dy = {float((dnu[1] * s - nu * ds[1]) / s2), float((dnv[1] * s - nv * ds[1]) / s2)};
+  const double inv_s = 1.0 / s, inv_s2 = inv_s * inv_s;
+  f.hit.u = float(nu * inv_s);
+  f.hit.v = float(nv * inv_s);
+  f.duv_dx = {float((dnu[0] * s - nu * ds[0]) * inv_s2), float((dnv[0] * s - nv * ds[0]) * inv_s2)};
+  f.duv_dy = {float((dnu[1] * s - nu * ds[1]) * inv_s2), float((dnv[1] * s - nv * ds[1]) * inv_s2)};
   return f;
 }
 
@@ -378,8 +486,8 @@ bool front_hit(const Shape& shape, const Ray& ray, bool cull_back, ShapeHit& hit
 /// the resolved visibility buffer.
 class TileRasterizer {
  public:
-  TileRasterizer(const Pipeline& pl, const std::vector<SetupTriangle>& tris,
-                 const std::vector<SetupShape>& shapes, const Bins& bins)
+  TileRasterizer(const Pipeline& pl, const SetupTriangles& tris, const std::vector<SetupShape>& shapes,
+                 const Bins& bins)
       : m_pl(pl), m_tris(tris), m_shapes(shapes), m_bins(bins) {}
 
   void run(const PixelWindow& tile, TileBuffers& b,
@@ -477,7 +585,7 @@ class TileRasterizer {
     const Scene& scene = m_pl.scene;
     const Instance& inst = scene.instances[sh.instance];
     const Shape& shape = scene.shapes[size_t(inst.shape)].shape;
-    const uint32_t id = uint32_t(m_tris.size() + index);
+    const uint32_t id = m_tris.end_id() + uint32_t(index);
     const int spp = m_pl.pass.spp;
     const auto& vrow = m_pl.view.view.m[2];
     for (int y = y0; y < y1; ++y)
@@ -501,11 +609,16 @@ class TileRasterizer {
       }
   }
 
-  RasterFragment make_fragment(uint32_t id, float depth, float l1, float l2) const {
-    if (id < m_tris.size()) return triangle_fragment(m_tris[id], depth, l1, l2);
+  // The fragment of submission `id`; `cache` holds the gradients of the last triangle resolved.
+  RasterFragment make_fragment(uint32_t id, float depth, float l1, float l2,
+                               std::pair<uint32_t, Gradients>& cache) const {
+    if (m_tris.is_triangle(id)) {
+      if (cache.first != id) cache = {id, gradients(m_tris[id])};
+      return triangle_fragment(m_tris[id], cache.second, depth, l1, l2);
+    }
     RasterFragment f;
     f.depth = depth;
-    f.hit.geom_id = m_shapes[id - m_tris.size()].instance;
+    f.hit.geom_id = m_shapes[id - m_tris.end_id()].instance;
     f.hit.prim_id = 0;
     f.hit.t = l1;
     return f;
@@ -514,9 +627,10 @@ class TileRasterizer {
   void resolve(const PixelWindow& tile, TileBuffers& b, size_t n) const {
     (void)tile;
     b.opaque.resize(n);
+    std::pair<uint32_t, Gradients> cache{kNone, {}};
     for (size_t i = 0; i < n; ++i)
       b.opaque[i] =
-          b.id[i] == kNone ? RasterFragment{} : make_fragment(b.id[i], b.depth[i], b.l1[i], b.l2[i]);
+          b.id[i] == kNone ? RasterFragment{} : make_fragment(b.id[i], b.depth[i], b.l1[i], b.l2[i], cache);
     // Blend layers in front of each sample's opaque fragment, front to back; past the layer
     // limit the next one stands for the opaque surface.
     auto& c = b.blend;
@@ -537,10 +651,10 @@ class TileRasterizer {
       while (e < c.size() && c[e].sample == s) ++e;
       for (size_t j = k; j < e; ++j) {
         if (kept == limit) {
-          b.opaque[s] = make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2);
+          b.opaque[s] = make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2, cache);
           break;
         }
-        b.layers.push_back(make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2));
+        b.layers.push_back(make_fragment(c[j].id, c[j].depth, c[j].l1, c[j].l2, cache));
         ++kept;
       }
       b.layer_begin[s + 1] = uint32_t(kept);
@@ -550,7 +664,7 @@ class TileRasterizer {
   }
 
   const Pipeline& m_pl;
-  const std::vector<SetupTriangle>& m_tris;
+  const SetupTriangles& m_tris;
   const std::vector<SetupShape>& m_shapes;
   const Bins& m_bins;
 };
@@ -570,7 +684,7 @@ uint64_t raster_memory_bytes(const Scene& scene, const RasterPass& pass) {
   const uint64_t per_sample = sizeof(Vec2f) + sizeof(FixedPoint) + 16 + sizeof(RasterFragment) + 4;
   // Setup triangles (clipping adds a few), their references (a handful of tiles each) and
   // the batches being concatenated.
-  return tris * (2 * sizeof(SetupTriangle) + 4 * sizeof(uint32_t)) +
+  return tris * (2 * sizeof(SetupTriangle) + 4 * sizeof(uint32_t) + sizeof(Vec4f) + sizeof(float)) +
          uint64_t(thread_count(pass.threads)) * samples * per_sample;
 }
 
@@ -578,15 +692,25 @@ void rasterize(const Scene& scene, const RasterView& view, const RasterPass& pas
                const std::function<void(const RasterTile& tile)>& shade, RasterStats* stats) {
   Pipeline pl{scene, view, pass, ClipPlanes{view.far_plane, guard_band(view, pass)}, pass.window};
   RasterStats st;
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  auto t0 = Clock::now();
   tbb::task_arena arena(thread_count(pass.threads));
-  const std::vector<SetupTriangle> tris = setup_triangles(pl, arena, st);
+  const SetupTriangles tris = setup_triangles(pl, arena, st);
   const std::vector<SetupShape> shapes = setup_shapes(pl, st);
+  st.setup_seconds = since(t0);
+  t0 = Clock::now();
   const Bins bins = bin_triangles(tris, pl.win, pass.tile_size);
   st.bin_references = bins.refs.size();
+  st.bin_seconds = since(t0);
+  t0 = Clock::now();
   const TileRasterizer raster(pl, tris, shapes, bins);
   tbb::enumerable_thread_specific<TileBuffers> buffers;
   TileScheduler scheduler(pl.win, pass.tile_size, pass.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) { raster.run(tile, buffers.local(), shade); });
+  st.tile_seconds = since(t0);
   if (stats) *stats = st;
 }
 

@@ -85,6 +85,9 @@ struct RasterStats {
   uint64_t culled = 0;           ///< source triangles culled (outside a plane or back-facing)
   uint64_t bin_references = 0;   ///< (tile, triangle) pairs
   uint64_t shapes = 0;           ///< shape instances ray-cast
+  double setup_seconds = 0;      ///< vertex stage, clipping and triangle setup
+  double bin_seconds = 0;        ///< binning into tiles
+  double tile_seconds = 0;       ///< rasterising, resolving and shading the tiles
 };
 
 /// Bytes a raster pass over `scene` may hold at once beyond the caller's own buffers: setup
