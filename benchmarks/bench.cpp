@@ -3,7 +3,8 @@
 // random), verifies every structure's answers against Embree (disagreements settled by the exact
 // brute-force scan), and prints a table; optionally CSV, JSON with the machine and versions, an
 // SVG chart and traversal-cost heat maps; with --marching-cubes, instead, isosurface extraction of
-// the classic CSG part in cells per second; with --noise, noise evaluations per second. The table
+// the classic CSG part in cells per second; with --noise, noise evaluations per second; with
+// --raster, rasterised against ray-traced primary visibility in frames per second. The table
 // and chart are formatted by benchmarks/report.h, the SAH column by benchmarks/sah.h. See README,
 // "Benchmarks", and benchmarks/RESULTS.md.
 #include <sys/utsname.h>
@@ -14,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -41,6 +43,7 @@
 #include "renderer/accel/factory.h"
 #include "renderer/core/rng.h"
 #include "renderer/integrators/cost_map.h"
+#include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/procedural/noise.h"
 #include "renderer/scene/camera.h"
@@ -235,6 +238,91 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
   return load_gltf(spec, options).scene;
 }
 
+/// The median seconds of `repeats` calls of fn after one warm-up call.
+template <typename Fn>
+double median_seconds(int repeats, Fn&& fn) {
+  fn();
+  std::vector<double> t;
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = Clock::now();
+    fn();
+    t.push_back(seconds_since(t0));
+  }
+  return median(t);
+}
+
+/// --raster: frames per second of primary visibility at width x height, one sample per pixel
+/// centre: the rasteriser's visibility buffer against Embree's and the BVH's camera rays (with
+/// and without their build), and the raster preview's shaded frame (no shadows, shadow maps).
+int run_raster(const std::vector<std::string>& scenes, uint64_t seed, int width, int height,
+               const std::vector<int>& threads, int builds, int repeats) {
+  std::printf("%-22s %9s %3s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s\n", "scene", "tris", "T", "raster",
+              "preview", "+maps", "embree", "+build", "bvh", "+build", "raster", "vs", "vs");
+  std::printf("%-22s %9s %3s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s\n", "", "", "", "vis ms", "ms", "ms",
+              "ms", "ms", "ms", "ms", "fps", "embree", "+build");
+  for (const std::string& spec : scenes) {
+    std::string name;
+    const Scene scene = load_bench_scene(spec, seed, name);
+    const Camera cam = bench_camera(scene, width, height);
+    for (int t : threads) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(thread_count(t)));
+      RenderConfig cfg;
+      cfg.width = width;
+      cfg.height = height;
+      cfg.spp = 1;
+      cfg.threads = t;
+      validate(cfg);
+      CameraView cv;
+      make_camera_view(cam, width, height, cv);
+      RasterPass pass = camera_raster_pass(cfg);
+      pass.position = nullptr;  // pixel centres, as the camera rays below
+      pass.margin = 0;
+      std::atomic<uint64_t> visible{0};
+      const double vis = median_seconds(repeats, [&] {
+        visible = 0;
+        rasterize(scene, cv.view, pass, [&](const RasterTile& tile) {
+          const size_t n = size_t(tile.pixels.width()) * size_t(tile.pixels.height());
+          uint64_t v = 0;
+          for (size_t i = 0; i < n; ++i)
+            v += tile.opaque[i].hit.valid() || tile.blend_begin[i + 1] > tile.blend_begin[i];
+          visible += v;
+        });
+      });
+      double build_s[2] = {0, 0}, trace_s[2] = {0, 0};
+      uint64_t hits[2] = {0, 0};
+      std::unique_ptr<Accelerator> embree;
+      const char* names[2] = {"embree", "bvh"};
+      for (int k = 0; k < 2; ++k) {
+        std::unique_ptr<Accelerator> a;
+        std::vector<double> b;
+        for (int i = 0; i < builds; ++i) {
+          const auto t0 = Clock::now();
+          a = make_scene_accelerator(names[k], scene);
+          b.push_back(seconds_since(t0));
+        }
+        build_s[k] = median(b);
+        const std::vector<RaySet> sets = make_ray_sets(scene, *a, width, height, {"primary"});
+        trace_s[k] = median_seconds(repeats, [&] { trace_seconds(*a, sets[0], t, hits[k]); });
+        if (k == 0) embree = std::move(a);
+      }
+      cfg.raster.shadows = RasterShadows::None;
+      const double preview = median_seconds(repeats, [&] { render_raster(scene, embree.get(), cam, cfg); });
+      cfg.raster.shadows = RasterShadows::Map;
+      const double maps = median_seconds(repeats, [&] { render_raster(scene, embree.get(), cam, cfg); });
+      std::printf("%-22s %9llu %3d %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.2fx %7.2fx\n",
+                  name.c_str(), static_cast<unsigned long long>(count_triangles(scene)), thread_count(t),
+                  vis * 1e3, preview * 1e3, maps * 1e3, trace_s[0] * 1e3, (trace_s[0] + build_s[0]) * 1e3,
+                  trace_s[1] * 1e3, (trace_s[1] + build_s[1]) * 1e3, 1 / vis, trace_s[0] / vis,
+                  (trace_s[0] + build_s[0]) / vis);
+      if (visible.load() != hits[0])
+        std::printf("  (visible samples: raster %llu, embree %llu)\n",
+                    static_cast<unsigned long long>(visible.load()),
+                    static_cast<unsigned long long>(hits[0]));
+    }
+  }
+  return 0;
+}
+
 /// The classic CSG part: a sphere of radius 1.35 intersected with the cube [-1, 1]^3, minus three
 /// cylinders of radius 0.5 along X, Y and Z (the shape of the marching-cubes tests).
 SdfTree csg_part_tree() {
@@ -406,6 +494,7 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   std::vector<int> mc_resolutions;
   int noise_count = 0;
+  bool raster = false;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
@@ -441,6 +530,9 @@ int main(int argc, char** argv) {
                  "instead of the structures: evaluate 3D Perlin noise, 5-octave fBm and Worley F1 at this "
                  "many random points on one thread, --repeats times, and print evaluations per second")
       ->check(CLI::Range(1, 1000000000));
+  app.add_flag("--raster", raster,
+               "instead of the structures: frames per second of primary visibility at --width x --height, "
+               "rasterised against Embree's and the BVH's camera rays, and the shaded raster preview");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -454,6 +546,12 @@ int main(int argc, char** argv) {
       return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
     }
   if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
+  if (raster) try {
+      return run_raster(scenes, seed, width, height, threads, builds, repeats);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
+    }
   std::string command;
   for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
 

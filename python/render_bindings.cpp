@@ -30,7 +30,8 @@ const std::vector<std::string>& setting_names() {
                                                  "ambient",        "rr_depth",      "clamp_indirect",
                                                  "light_sampling", "sampler",       "env_color",
                                                  "env_map",        "env_intensity", "env_rotation",
-                                                 "time_limit",     "adaptive",      "adaptive_min_spp"};
+                                                 "time_limit",     "adaptive",      "adaptive_min_spp",
+                                                 "raster_shadows"};
   return names;
 }
 
@@ -176,7 +177,9 @@ void bind_settings(py::module_& m) {
                      "pixels; 0: from height and the camera's aspect (960 if both 0)")
       .def_readwrite("height", &RenderSettings::height, "pixels; 0: from width and the camera's aspect")
       .def_readwrite("spp", &RenderSettings::spp, "samples per pixel; 0: 4 (whitted), 64 (path)")
-      .def_readwrite("integrator", &RenderSettings::integrator, "'whitted' or 'path'")
+      .def_readwrite("integrator", &RenderSettings::integrator, "'whitted', 'path' or 'raster'")
+      .def_readwrite("raster_shadows", &RenderSettings::raster_shadows,
+                     "raster: light visibility by 'ray' (shadow rays), 'map' (shadow maps) or 'none'")
       .def_readwrite("accel", &RenderSettings::accel, "embree, bvh, kdtree, grid or brute")
       .def_readwrite("accel_params", &RenderSettings::accel_params, "['bvh.max_leaf_size=4', ...]")
       .def_readwrite("seed", &RenderSettings::seed)

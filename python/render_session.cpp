@@ -13,6 +13,7 @@
 #include "io/id_manifest.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/lights/environment.h"
 #include "renderer/scene/camera.h"
@@ -101,6 +102,9 @@ RenderConfig make_config(const RenderSettings& s, const std::set<std::string>& a
   cfg.whitted.max_depth = s.max_depth >= 0 ? s.max_depth : 5;
   cfg.whitted.background = s.background.value_or(Vec3f{0, 0, 0});
   cfg.whitted.ambient = s.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f});
+  cfg.raster.shadows = s.raster_shadows == "map"    ? RasterShadows::Map
+                       : s.raster_shadows == "none" ? RasterShadows::None
+                                                    : RasterShadows::Ray;
   cfg.path.max_depth = s.max_depth >= 0 ? s.max_depth : 12;
   cfg.path.rr_depth = s.rr_depth;
   cfg.path.clamp_indirect = s.clamp_indirect;
@@ -182,7 +186,10 @@ bool pose_session(SceneSession& session, double time) {
 }
 
 std::set<std::string> check_settings(const RenderSettings& s, const std::vector<std::string>& aov_names) {
-  check_choice("integrator", s.integrator, {"whitted", "path"});
+  check_choice("integrator", s.integrator, {"whitted", "path", "raster"});
+  check_choice("raster_shadows", s.raster_shadows, {"ray", "map", "none"});
+  if (s.integrator != "raster" && s.raster_shadows != "ray")
+    throw std::invalid_argument("raster_shadows needs integrator 'raster'");
   const bool path = is_path(s);
   if (s.width < 0 || s.width > kMaxImageSize || s.height < 0 || s.height > kMaxImageSize)
     throw std::invalid_argument("width and height must be in [1, 16384] (0: from the camera's aspect)");
@@ -303,14 +310,18 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
     }
     if (out.aovs.count("variance")) out.variance = std::move(image.variance);
     if (out.aovs.count("light")) out.groups = std::move(image.groups);
+  } else if (settings.integrator == "raster") {
+    out.film = render_raster(scene, &accel, out.camera, cfg, &out.stats);
   } else {
     out.film = render_whitted(scene, accel, out.camera, cfg, &out.stats);
   }
   bool data = false;
   for (const char* name : kDataAovNames) data |= out.aovs.count(name) > 0;
   if (data)
-    out.data = render_data_aovs(scene, accel, out.camera, cfg,
-                                path ? IntegratorType::Path : IntegratorType::Whitted);
+    out.data = settings.integrator == "raster"
+                   ? render_raster_aovs(scene, out.camera, cfg)
+                   : render_data_aovs(scene, accel, out.camera, cfg,
+                                      path ? IntegratorType::Path : IntegratorType::Whitted);
   if (out.aovs.count("id")) out.id_manifest = penumbra::id_manifest(scene, session.loaded.info);
   return out;
 }

@@ -54,7 +54,8 @@ struct RenderSettings {
   int width = 0,
       height = 0;  ///< 0 and 0: 960 wide; one 0: follows the camera's aspect hint (16:9 without one)
   int spp = 0;     ///< 0: 4 (whitted), 64 (path)
-  std::string integrator = "whitted";     ///< "whitted" or "path"
+  std::string integrator = "whitted";     ///< "whitted", "path" or "raster"
+  std::string raster_shadows = "ray";     ///< raster only: "ray", "map" or "none"
   std::string accel = "embree";           ///< an accelerator_names() entry
   std::vector<std::string> accel_params;  ///< "bvh.max_leaf_size=4", ... of `accel` only
   uint64_t seed = 0;

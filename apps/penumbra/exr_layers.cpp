@@ -13,6 +13,7 @@
 #include "io/exr_merge.h"
 #include "io/id_manifest.h"
 #include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/raster.h"
 
 namespace penumbra::cli {
 
@@ -176,9 +177,13 @@ std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInf
 }
 
 void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers) {
-  const IntegratorType integrator = job.request.path ? IntegratorType::Path : IntegratorType::Whitted;
+  const IntegratorType integrator = job.request.path     ? IntegratorType::Path
+                                    : job.request.raster ? IntegratorType::Raster
+                                                         : IntegratorType::Whitted;
   if (job.request.data_aovs)
-    buffers.data = render_data_aovs(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator);
+    buffers.data = job.request.raster
+                       ? render_raster_aovs(job.loaded.scene, job.camera, job.cfg)
+                       : render_data_aovs(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator);
   if (job.request.cost_aov) buffers.cost = render_cost(*job.accel, job.camera, job.cfg, integrator);
   if (job.request.crypto.empty()) return;
   std::vector<CryptoLayerIds> layers;

@@ -22,7 +22,9 @@
 #include "io/frame_outputs.h"
 #include "io/hash.h"
 #include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/raster/shadow_map.h"
 
 namespace penumbra::cli {
 
@@ -64,9 +66,14 @@ uint64_t charge_image_budget(const RenderJob& job) {
   const uint64_t image =
       uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
   const Scene& scene = job.loaded.scene;
-  const uint64_t scene_bytes = scene_memory_bytes(scene) +
-                               count_stored_triangles(scene) * kAccelBytesPerTriangle +
-                               job.loaded.animation_bytes;
+  uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle +
+                         job.loaded.animation_bytes;
+  if (job.request.raster) {
+    // The rasteriser's setup triangles and tile buffers, and the shadow maps.
+    scene_bytes += raster_memory_bytes(scene, camera_raster_pass(cfg));
+    if (cfg.raster.shadows == RasterShadows::Map)
+      scene_bytes += shadow_map_bytes(scene, cfg.raster.shadow_map_size);
+  }
   if (image > budget || scene_bytes > budget - image)
     throw UsageError("image " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " (" +
                      job.args.integrator + (job.request.aovs.empty() ? "" : ", with AOVs") + ") needs " +
@@ -106,7 +113,7 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
   if (moved_instances == 0)
     return " (animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused)";
   const auto t1 = Clock::now();
-  const bool moved = kept->accel->update_instances(instance_views(kept->loaded.scene));
+  const bool moved = kept->accel && kept->accel->update_instances(instance_views(kept->loaded.scene));
   if (!moved) kept->accel.reset();
   kept->update_s = seconds_since(t1);
   return moved ? " (animated scene: loaded scene reused, instances moved, top level rebuilt)"
@@ -176,7 +183,20 @@ void setup_phase(RenderJob& job) {
                                 !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
 }
 
+/// Whether the render queries an acceleration structure: every integrator does but the raster
+/// one without shadow rays, Cryptomatte or the cost layer (those trace the camera samples).
+bool needs_accelerator(const RenderJob& job) {
+  const RenderRequest& q = job.request;
+  return !q.raster || job.cfg.raster.shadows == RasterShadows::Ray || q.cost_aov || !q.crypto.empty() ||
+         !job.args.debug_pixel.empty();
+}
+
 void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
+  if (!needs_accelerator(job)) {
+    if (kept) job.build_s = kept->update_s;
+    kept.reset();
+    return;
+  }
   set_phase("building the acceleration structure");
   ProgressReporter progress(job.progress, "build", job.frame);
   const auto t0 = Clock::now();
@@ -214,11 +234,19 @@ int render_debug_pixel(RenderJob& job) {
                      std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
   float rgba[4];
   RayCounts counts;
-  if (q.path)
+  if (q.path) {
     render_path_pixel(job.loaded.scene, *job.accel, job.path_lights(), job.camera, cfg, q.debug_x, q.debug_y,
                       rgba, counts);
-  else
+  } else if (q.raster) {
+    RenderConfig one = cfg;
+    one.window = {q.debug_x, q.debug_y, q.debug_x + 1, q.debug_y + 1};
+    RenderStats st;
+    const Film f = render_raster(job.loaded.scene, job.accel.get(), job.camera, one, &st);
+    for (int c = 0; c < 4; ++c) rgba[c] = f.rgba[size_t(c)];
+    counts = st.rays;
+  } else {
     render_whitted_pixel(job.loaded.scene, *job.accel, job.camera, cfg, q.debug_x, q.debug_y, rgba, counts);
+  }
   std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, %s %llu)\n",
               q.debug_x, q.debug_y, rgba[0], rgba[1], rgba[2], rgba[3],
               static_cast<unsigned long long>(counts.camera), static_cast<unsigned long long>(counts.shadow),
@@ -231,6 +259,9 @@ void render_phase(RenderJob& job) {
   ProgressReporter reporter(job.progress, "render", job.frame);
   if (job.request.path)
     run_path_render(job, reporter);
+  else if (job.request.raster)
+    job.film = render_raster(job.loaded.scene, job.accel.get(), job.camera, job.cfg, &job.stats,
+                             [&](int d, int t) { reporter(d, t); });
   else
     job.film = render_whitted(job.loaded.scene, *job.accel, job.camera, job.cfg, &job.stats,
                               [&](int d, int t) { reporter(d, t); });

@@ -39,7 +39,12 @@ RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, cons
     e["env.rotation"] = exact(a.env_rotation);
   } else {
     const auto& w = cfg.whitted;
-    e["whitted.max_depth"] = std::to_string(w.max_depth);
+    if (a.integrator == "raster") {
+      e["raster.shadows"] = a.raster_shadows;
+      if (a.raster_shadows == "map") e["raster.shadow_map_size"] = std::to_string(cfg.raster.shadow_map_size);
+    } else {
+      e["whitted.max_depth"] = std::to_string(w.max_depth);
+    }
     e["whitted.background"] =
         exact(w.background.x) + "," + exact(w.background.y) + "," + exact(w.background.z);
     e["whitted.ambient"] = exact(w.ambient.x) + "," + exact(w.ambient.y) + "," + exact(w.ambient.z);

@@ -68,6 +68,14 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
   q.background = parse_colour(a.background, "--background");
   q.ambient = parse_colour(a.ambient, "--ambient");
   q.path = a.integrator == "path";
+  q.raster = a.integrator == "raster";
+  if (!q.raster && (a.raster_shadows_given || a.shadow_map_size_given))
+    throw UsageError(std::string(a.raster_shadows_given ? "--raster-shadows" : "--shadow-map-size") +
+                     " needs --integrator raster");
+  if (q.raster && a.depth_given)
+    throw UsageError("--max-depth does not apply to --integrator raster (local shading: no reflected rays)");
+  if (a.shadow_map_size_given && a.raster_shadows != "map")
+    throw UsageError("--shadow-map-size needs --raster-shadows map");
   if (q.path && (a.background_given || a.ambient_given))
     throw UsageError(
         std::string(a.background_given ? "--background" : "--ambient") +
@@ -228,10 +236,19 @@ void add_sampling_options(CLI::App& render, RenderArgs& args) {
   render.add_option("--height", args.height, "image height in pixels (default: width / camera aspect)")
       ->check(CLI::Range(1, 16384));
   render
-      .add_option("--integrator", args.integrator,
-                  "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast) or path "
-                  "(physically based path tracer)")
-      ->check(CLI::IsMember({"whitted", "path"}));
+      .add_option(
+          "--integrator", args.integrator,
+          "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast), path "
+          "(physically based path tracer) or raster (rasterised preview with Whitted's local shading)")
+      ->check(CLI::IsMember({"whitted", "path", "raster"}));
+  render
+      .add_option("--raster-shadows", args.raster_shadows,
+                  "raster: light visibility by shadow rays (ray, default), shadow maps (map) or none")
+      ->check(CLI::IsMember({"ray", "map", "none"}));
+  render
+      .add_option("--shadow-map-size", args.shadow_map_size,
+                  "raster: shadow map texels on a side (default 2048; point lights: per cube face)")
+      ->check(CLI::Range(16, 8192));
   render
       .add_option("--spp", args.spp,
                   "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")
@@ -400,6 +417,8 @@ void note_given_options(const CLI::App& render, int argc, char** argv, RenderArg
   args.depth_given = render.count("--max-depth") > 0;
   args.background_given = render.count("--background") > 0;
   args.ambient_given = render.count("--ambient") > 0;
+  args.raster_shadows_given = render.count("--raster-shadows") > 0;
+  args.shadow_map_size_given = render.count("--shadow-map-size") > 0;
   args.crypto_depth_given = render.count("--crypto-depth") > 0;
 }
 
@@ -436,6 +455,10 @@ RenderConfig make_render_config(const RenderArgs& a, const RenderRequest& q, flo
   cfg.whitted.max_depth = a.depth_given ? a.max_depth : 5;
   cfg.whitted.background = q.background;
   cfg.whitted.ambient = q.ambient;
+  cfg.raster.shadows = a.raster_shadows == "map"    ? RasterShadows::Map
+                       : a.raster_shadows == "none" ? RasterShadows::None
+                                                    : RasterShadows::Ray;
+  cfg.raster.shadow_map_size = a.shadow_map_size;
   cfg.path.max_depth = a.depth_given ? a.max_depth : 12;
   cfg.path.rr_depth = a.rr_depth;
   cfg.path.clamp_indirect = a.clamp_indirect;

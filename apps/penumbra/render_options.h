@@ -41,7 +41,10 @@ struct RenderArgs {
   int rr_depth = 3, adaptive_min_spp = 16;
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
   double time_limit = 0;
+  std::string raster_shadows = "ray";  ///< --raster-shadows: ray, map or none
+  int shadow_map_size = 2048;
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
+  bool raster_shadows_given = false, shadow_map_size_given = false;
   int crypto_depth = 6;  ///< Cryptomatte ranks per pixel
   bool crypto_depth_given = false;
   bool png_alpha = false;             ///< the display image keeps the beauty's alpha (RGBA)
@@ -63,7 +66,8 @@ void note_given_options(const CLI::App& render, int argc, char** argv, RenderArg
 
 /// The checked values of a render request, everything that can be known before loading.
 struct RenderRequest {
-  bool path = false;  ///< --integrator path
+  bool path = false;    ///< --integrator path
+  bool raster = false;  ///< --integrator raster
   std::filesystem::path out;
   std::optional<std::filesystem::path> png, cost_png;
   bool out_streams = false;     ///< -o is a device or FIFO (no resume state beside it)

@@ -148,7 +148,7 @@ RasterPass camera_raster_pass(const RenderConfig& config) {
   return pass;
 }
 
-Film render_raster(const Scene& scene, const Accelerator& accel, const Camera& camera,
+Film render_raster(const Scene& scene, const Accelerator* accel, const Camera& camera,
                    const RenderConfig& config, RenderStats* stats, const ProgressFn& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   CameraView cv;
@@ -163,11 +163,14 @@ Film render_raster(const Scene& scene, const Accelerator& accel, const Camera& c
 
   // Light visibility: shadow rays, shadow maps or none.
   const bool filter = config.whitted.hit_filter && scene_needs_hit_filter(scene);
-  const ShadowRayVisibility rays{scene, accel, filter};
+  std::optional<ShadowRayVisibility> rays;
   ShadowMaps maps;
   std::optional<MapVisibility> map_visibility;
   LightVisibility visibility{&fully_visible, nullptr};
-  if (config.raster.shadows == RasterShadows::Ray) visibility = rays.visibility();
+  if (config.raster.shadows == RasterShadows::Ray) {
+    rays.emplace(ShadowRayVisibility{scene, *accel, filter});
+    visibility = rays->visibility();
+  }
   if (config.raster.shadows == RasterShadows::Map) {
     maps = build_shadow_maps(scene, config.raster.shadow_map_size, config.threads);
     map_visibility.emplace(MapVisibility{maps});

@@ -29,11 +29,11 @@ RasterPass camera_raster_pass(const RenderConfig& config);
 
 /// Renders the scene with the raster integrator. Requires a config that passes validate();
 /// `accel` (built by make_scene_accelerator over the scene) answers the shadow rays of
-/// RasterShadows::Ray and is not used otherwise. Each pixel is the plain mean of its samples'
-/// composited radiance (RGBA, premultiplied; background = whitted.background with alpha 0),
+/// RasterShadows::Ray, must be non-null then and is not used otherwise. Each pixel is the plain mean of its
+/// samples' composited radiance (RGBA, premultiplied; background = whitted.background with alpha 0),
 /// bit-identical for any thread count or tile size. stats->rays counts shadow rays; the
 /// camera samples are rasterised, not traced.
-Film render_raster(const Scene& scene, const Accelerator& accel, const Camera& camera,
+Film render_raster(const Scene& scene, const Accelerator* accel, const Camera& camera,
                    const RenderConfig& config, RenderStats* stats = nullptr, const ProgressFn& progress = {});
 
 /// The data AOVs of render_data_aovs from the rasterised samples (the first visible surface of

@@ -68,7 +68,7 @@ def test_size_follows_the_camera_aspect(default_scene):
     assert r.camera.name == "room camera" and r.camera_index == 0 and not r.default_light
 
 
-@pytest.mark.parametrize("integrator", ["whitted", "path"])
+@pytest.mark.parametrize("integrator", ["whitted", "path", "raster"])
 @pytest.mark.parametrize("accel", penumbra.accelerator_names())
 def test_data_aovs_of_two_quads_are_analytic(quads, integrator, accel):
     r = quads.render(width=W, height=H, spp=4, integrator=integrator, accel=accel, aovs=["all"])
@@ -114,7 +114,7 @@ def test_window_is_a_slice_of_the_frame(default_scene):
     np.testing.assert_array_equal(part.aovs["object_id"], full.aovs["object_id"][4:16, 8:24])
 
 
-@pytest.mark.parametrize("integrator", ["whitted", "path"])
+@pytest.mark.parametrize("integrator", ["whitted", "path", "raster"])
 def test_one_and_two_threads_give_identical_images(default_scene, integrator):
     one = default_scene.render(width=48, height=27, spp=4, integrator=integrator, threads=1, aovs=["all"])
     two = default_scene.render(width=48, height=27, spp=4, integrator=integrator, threads=2, tile_size=8,
@@ -123,6 +123,18 @@ def test_one_and_two_threads_give_identical_images(default_scene, integrator):
     assert one.aovs.keys() == two.aovs.keys()
     for name in one.aovs:
         np.testing.assert_array_equal(one.aovs[name], two.aovs[name], err_msg=name)
+
+
+@pytest.mark.parametrize("shadows", ["ray", "map", "none"])
+def test_raster_preview_shadows(default_scene, shadows):
+    r = default_scene.render(width=48, height=27, spp=1, integrator="raster", raster_shadows=shadows)
+    lit = default_scene.render(width=48, height=27, spp=1, integrator="raster", raster_shadows="none")
+    np.testing.assert_array_equal(r.beauty[..., 3], lit.beauty[..., 3])  # the same coverage
+    assert np.all(r.rgb <= lit.rgb + 1e-6)  # shadows only take light away
+    if shadows != "none":
+        assert np.sum(r.rgb < lit.rgb - 1e-3) > 20  # and they do
+    with pytest.raises(ValueError, match="raster_shadows needs integrator 'raster'"):
+        default_scene.render(width=8, height=8, raster_shadows="map")
 
 
 def test_seed_changes_the_path_traced_image(default_scene):
@@ -153,7 +165,7 @@ def test_no_camera_frames_the_bounds_and_no_light_adds_the_key_light(tmp_path):
 
 
 def test_settings_are_checked_before_rendering(default_scene):
-    with pytest.raises(ValueError, match="integrator: unknown value 'foo' \\(known: whitted, path\\)"):
+    with pytest.raises(ValueError, match="integrator: unknown value 'foo' \\(known: whitted, path, raster\\)"):
         default_scene.render(integrator="foo")
     with pytest.raises(ValueError, match="accel: unknown value 'octree'"):
         default_scene.render(accel="octree")

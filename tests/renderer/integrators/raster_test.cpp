@@ -121,7 +121,7 @@ TEST_CASE("raster: MIP level from screen-space UV derivatives", "[raster][quick]
     RenderConfig cfg = small_render_config(64, 64, spp, 16);
     cfg.raster.shadows = RasterShadows::None;
     const float lod = std::log2(4.0f * differential_step(spp));
-    const Film f = render_raster(s, *accel, cam, cfg);
+    const Film f = render_raster(s, accel.get(), cam, cfg);
     const float* p = f.pixel(20, 30);
     CHECK(p[0] == Approx(lod / 8).margin(1e-3));
     CHECK(p[2] == Approx(1 - lod / 8).margin(1e-3));
@@ -136,7 +136,8 @@ TEST_CASE("raster: MIP level from screen-space UV derivatives", "[raster][quick]
   const Camera persp = look_at({0, 0.3f, 4}, {0, 0, 0}, {0, 1, 0}, 0.7f);
   RenderConfig cfg = small_render_config(64, 64, 1, 16);
   cfg.raster.shadows = RasterShadows::None;
-  const Film r = render_raster(tilted, *accel2, persp, cfg), w = render_whitted(tilted, *accel2, persp, cfg);
+  const Film r = render_raster(tilted, accel2.get(), persp, cfg),
+             w = render_whitted(tilted, *accel2, persp, cfg);
   const DataAovs t = render_data_aovs(tilted, *accel2, persp, cfg, IntegratorType::Raster);
   const std::vector<bool> mask = interior_mask(t);
   int compared = 0, far_above_near = 0;
@@ -160,7 +161,7 @@ TEST_CASE("raster: local shading equals the Whitted integrator without reflectio
   if (s.lights.empty()) s.lights.push_back(default_key_light(cam));
   cfg.whitted.max_depth = 0;
   const auto accel = make_scene_accelerator("embree", s);
-  const Film r = render_raster(s, *accel, cam, cfg);
+  const Film r = render_raster(s, accel.get(), cam, cfg);
   const Film w = render_whitted(s, *accel, cam, cfg);
   const std::vector<bool> mask = interior_mask(render_data_aovs(s, *accel, cam, cfg, IntegratorType::Raster));
   int compared = 0, close = 0;
@@ -197,12 +198,12 @@ TEST_CASE("raster: shadow maps agree with shadow rays", "[raster]") {
   const auto accel = make_scene_accelerator("embree", s);
   RenderConfig cfg = small_render_config(120, 90, 1, 16);
   cfg.raster.shadows = RasterShadows::Ray;
-  const Film ray = render_raster(s, *accel, cam, cfg);
+  const Film ray = render_raster(s, accel.get(), cam, cfg);
   cfg.raster.shadows = RasterShadows::Map;
   cfg.raster.shadow_map_size = 1024;
-  const Film map = render_raster(s, *accel, cam, cfg);
+  const Film map = render_raster(s, accel.get(), cam, cfg);
   cfg.raster.shadows = RasterShadows::None;
-  const Film none = render_raster(s, *accel, cam, cfg);
+  const Film none = render_raster(s, accel.get(), cam, cfg);
   int pixels = 0, agree = 0, shadowed = 0;
   for (int y = 0; y < 90; ++y)
     for (int x = 0; x < 120; ++x) {

@@ -146,7 +146,7 @@ TEST_CASE("raster: the z-buffer does not depend on triangle order", "[raster][qu
   const RenderConfig cfg = unshadowed(96, 80, 4);
   const auto accel = make_scene_accelerator("brute", s);
   const auto accel2 = make_scene_accelerator("brute", shuffled);
-  const Film a = render_raster(s, *accel, cam, cfg), b = render_raster(shuffled, *accel2, cam, cfg);
+  const Film a = render_raster(s, accel.get(), cam, cfg), b = render_raster(shuffled, accel2.get(), cam, cfg);
   CHECK(same_film(a, b));
   const DataAovs za = render_raster_aovs(s, cam, cfg), zb = render_raster_aovs(shuffled, cam, cfg);
   CHECK(za.depth == zb.depth);
@@ -172,16 +172,16 @@ TEST_CASE("raster: the same image for any thread count and tile size", "[raster]
   RenderConfig cfg = small_render_config(70, 50, 4, 8);
   cfg.filter = make_filter(FilterType::Gaussian, 3);
   cfg.threads = 1;
-  const Film one = render_raster(s, *accel, cam, cfg);
+  const Film one = render_raster(s, accel.get(), cam, cfg);
   cfg.threads = 2;
   cfg.tile_size = 13;
-  const Film two = render_raster(s, *accel, cam, cfg);
+  const Film two = render_raster(s, accel.get(), cam, cfg);
   CHECK(same_film(one, two));
   cfg.tile_size = 64;
-  CHECK(same_film(one, render_raster(s, *accel, cam, cfg)));
+  CHECK(same_film(one, render_raster(s, accel.get(), cam, cfg)));
   // A crop is the same pixels as the whole frame.
   cfg.window = {10, 5, 41, 33};
-  const Film crop = render_raster(s, *accel, cam, cfg);
+  const Film crop = render_raster(s, accel.get(), cam, cfg);
   bool same = true;
   for (int y = 5; y < 33; ++y)
     for (int x = 10; x < 41; ++x)
@@ -207,7 +207,7 @@ TEST_CASE("raster: Mask is alpha-tested, Blend composited front to back, as the 
   cam.ymag = 2;
   const RenderConfig cfg = unshadowed(16, 16, 1);
   const auto accel = make_scene_accelerator("brute", s);
-  const Film r = render_raster(s, *accel, cam, cfg);
+  const Film r = render_raster(s, accel.get(), cam, cfg);
   const Film w = render_whitted(s, *accel, cam, cfg);
   // Left half: a quarter red over blue; right half: blue; the Mask quad is invisible.
   const float* left = r.pixel(3, 12);
@@ -220,7 +220,7 @@ TEST_CASE("raster: Mask is alpha-tested, Blend composited front to back, as the 
   // Layers beyond the limit: the first one past it counts as opaque.
   RenderConfig one_layer = cfg;
   one_layer.whitted.max_blend_layers = 0;
-  CHECK(render_raster(s, *accel, cam, one_layer).pixel(3, 12)[0] == Approx(1));
+  CHECK(render_raster(s, accel.get(), cam, one_layer).pixel(3, 12)[0] == Approx(1));
 }
 
 TEST_CASE("raster: back faces of single-sided materials are culled, also under mirroring",
@@ -251,7 +251,7 @@ TEST_CASE("raster: back faces of single-sided materials are culled, also under m
   CHECK(at(28, 4).hit.valid());        // two-sided
   CHECK(at(28, 16).hit.geom_id == 2);  // the mirrored quad in front, at x in [0, 4]
   const auto accel = make_scene_accelerator("brute", s);
-  const Film w = render_whitted(s, *accel, cam, cfg), f = render_raster(s, *accel, cam, cfg);
+  const Film w = render_whitted(s, *accel, cam, cfg), f = render_raster(s, accel.get(), cam, cfg);
   for (size_t i = 0; i < w.rgba.size(); ++i) CHECK(f.rgba[i] == Approx(w.rgba[i]).margin(1e-6));
 }
 
