@@ -411,9 +411,12 @@ struct TileBuffers {
   std::vector<Candidate> blend;
   std::vector<RasterFragment> opaque, layers;
   std::vector<uint32_t> layer_begin;
+  std::vector<float> block_max;  ///< per kBlock x kBlock pixels: a bound on its samples' depths
 };
 
 constexpr uint32_t kNone = 0xffffffffu;
+/// Pixels on a side of the blocks of hierarchical z and edge rejection.
+constexpr int kBlock = 8;
 
 /// Perspective-correct source barycentrics (u, v) of triangle t at linear barycentrics
 /// (1 - l1 - l2, l1, l2).
@@ -521,6 +524,9 @@ class TileRasterizer {
     b.l1.resize(n);
     b.l2.resize(n);
     b.blend.clear();
+    b.block_max.assign(
+        size_t((tile.width() + kBlock - 1) / kBlock) * size_t((tile.height() + kBlock - 1) / kBlock),
+        kInfinity);
     size_t i = 0;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x)
@@ -533,29 +539,78 @@ class TileRasterizer {
         }
   }
 
-  // The depth test and the fragment stage for one covered sample.
-  void fragment(size_t i, float depth, uint32_t id, float l1, float l2, Kind kind, TileBuffers& b) const {
-    if (!closer(depth, id, b.depth[i], b.id[i])) return;
+  // The depth test and the fragment stage for one covered sample; true if it was written to
+  // the z-buffer (a Blend fragment is kept aside instead).
+  bool fragment(size_t i, float depth, uint32_t id, float l1, float l2, Kind kind, TileBuffers& b) const {
+    if (!closer(depth, id, b.depth[i], b.id[i])) return false;
     if (kind == Kind::Blend) {
       b.blend.push_back({uint32_t(i), depth, id, l1, l2});
-      return;
+      return false;
     }
     b.depth[i] = depth;
     b.id[i] = id;
     b.l1[i] = l1;
     b.l2[i] = l2;
+    return true;
   }
 
+  // One triangle over the tile, block by block: a block is skipped when the triangle lies
+  // behind every sample in it (hierarchical z: the block's bound on its samples' depth) or
+  // wholly outside one of its edges; a triangle that writes every sample of a block lowers its
+  // bound (Greene, Kass and Miller, "Hierarchical Z-Buffer Visibility", SIGGRAPH 1993). Both
+  // tests are conservative: the buffer is the one a plain loop gives.
   void raster_triangle(const PixelWindow& tile, uint32_t index, TileBuffers& b) const {
     const SetupTriangle& t = m_tris[index];
     const EdgeTriangle e = make_edge_triangle({t.x[0], t.y[0]}, {t.x[1], t.y[1]}, {t.x[2], t.y[2]});
-    const double inv_area = 1.0 / double(e.area2);
     const int x0 = std::max(t.px0, tile.x0), x1 = std::min(t.px1, tile.x1);
     const int y0 = std::max(t.py0, tile.y0), y1 = std::min(t.py1, tile.y1);
+    float zmin = kInfinity, zmax = 0;
+    for (int k = 0; k < 3; ++k) {
+      const float z = t.dw[k] / t.iw[k];
+      zmin = std::min(zmin, z);
+      zmax = std::max(zmax, z);
+    }
+    zmin *= 1 - 1e-5f;  // the fragments' depths carry rounding
+    zmax *= 1 + 1e-5f;
+    const int bw = (tile.width() + kBlock - 1) / kBlock;
+    for (int by = (y0 - tile.y0) / kBlock; by * kBlock + tile.y0 < y1; ++by)
+      for (int bx = (x0 - tile.x0) / kBlock; bx * kBlock + tile.x0 < x1; ++bx) {
+        float& bound = b.block_max[size_t(by) * size_t(bw) + size_t(bx)];
+        if (zmin > bound) continue;
+        PixelWindow blk{tile.x0 + bx * kBlock, tile.y0 + by * kBlock, 0, 0};
+        blk.x1 = std::min(blk.x0 + kBlock, tile.x1);
+        blk.y1 = std::min(blk.y0 + kBlock, tile.y1);
+        const PixelWindow r{std::max(blk.x0, x0), std::max(blk.y0, y0), std::min(blk.x1, x1),
+                            std::min(blk.y1, y1)};
+        if (outside_an_edge(e, r)) continue;
+        const int written = raster_block(t, e, index, tile, r, b);
+        if (t.kind == Kind::Opaque && written == blk.width() * blk.height() * m_pl.pass.spp)
+          bound = std::min(bound, zmax);
+      }
+  }
+
+  // Whether every sample the pixels of r may hold lies outside one of e's edges.
+  bool outside_an_edge(const EdgeTriangle& e, const PixelWindow& r) const {
+    const SampleSpan span = sample_span(m_pl.pass);
+    const int64_t xs[2] = {int64_t(std::floor((r.x0 + span.lo) * kSubpixelScale)),
+                           int64_t(std::ceil((r.x1 - 1 + span.hi) * kSubpixelScale))};
+    const int64_t ys[2] = {int64_t(std::floor((r.y0 + span.lo) * kSubpixelScale)),
+                           int64_t(std::ceil((r.y1 - 1 + span.hi) * kSubpixelScale))};
+    for (const EdgeEquation& q : e.edge)
+      if (q.c + q.a * xs[q.a > 0] + q.b * ys[q.b > 0] < q.threshold) return true;
+    return false;
+  }
+
+  // The samples of the pixels of r that t covers through the depth test and the fragment
+  // stage; returns how many were written to the z-buffer.
+  int raster_block(const SetupTriangle& t, const EdgeTriangle& e, uint32_t index, const PixelWindow& tile,
+                   const PixelWindow& r, TileBuffers& b) const {
+    const double inv_area = 1.0 / double(e.area2);
     const int spp = m_pl.pass.spp;
     const float mask_cut = m_pl.pass.blend == RasterBlend::Threshold ? 0.5f : 1.0f;
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) {
+    int written = 0;
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x) {
         const size_t base = (size_t(y - tile.y0) * size_t(tile.width()) + size_t(x - tile.x0)) * size_t(spp);
         for (int s = 0; s < spp; ++s) {
           const size_t i = base + size_t(s);
@@ -572,9 +627,10 @@ class TileRasterizer {
             const float cut = m.alpha_mode == AlphaMode::Mask ? 1.0f : mask_cut;
             if (!(eval_alpha(m_pl.scene, t.instance, t.prim, uv.x, uv.y) >= cut)) continue;
           }
-          fragment(i, depth, index, float(l1), float(l2), t.kind, b);
+          written += fragment(i, depth, index, float(l1), float(l2), t.kind, b);
         }
       }
+    return written;
   }
 
   void raster_shape(const PixelWindow& tile, size_t index, TileBuffers& b) const {
