@@ -136,12 +136,15 @@ void print_render_summary(const RenderJob& job) {
                                       ? std::string()
                                       : format(" and %zu shapes (%llu placed)", scene.shapes.size(),
                                                static_cast<unsigned long long>(count_shape_instances(scene)));
+  const std::string depth_text =
+      job.request.raster ? "shadows " + a.raster_shadows
+                         : "max-depth " + std::to_string(path ? cfg.path.max_depth : cfg.whitted.max_depth);
   std::fprintf(
       stderr,
       "penumbra render %s\n"
       "  scene    %zu meshes%s in %zu instances, %s triangles (%s stored), %zu materials, %zu lights%s\n"
       "  camera   %s (%s)\n"
-      "  image    %dx%d, %s, %s max-depth %d, filter %s %.3g px, %d threads, accel %s\n"
+      "  image    %dx%d, %s, %s %s, filter %s %.3g px, %d threads, accel %s\n"
       "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
       "  rays     camera %s  shadow %s  %s %s  total %s  (%.2f Mrays/s)\n"
       "  memory   peak %.1f MiB\n",
@@ -150,9 +153,9 @@ void print_render_summary(const RenderJob& job) {
       scene.materials.size(), scene.lights.size(), job.default_light ? " (default key light)" : "",
       job.camera.name.c_str(),
       job.camera.projection == Projection::Perspective ? "perspective" : "orthographic", cfg.width,
-      cfg.height, spp_text.c_str(), a.integrator.c_str(), path ? cfg.path.max_depth : cfg.whitted.max_depth,
-      filter_name(cfg.filter.type), double(cfg.filter.width), stats.threads, a.accel.c_str(), job.load_s,
-      job.build_s, stats.seconds, job.write_s, human_count(stats.rays.camera).c_str(),
+      cfg.height, spp_text.c_str(), a.integrator.c_str(), depth_text.c_str(), filter_name(cfg.filter.type),
+      double(cfg.filter.width), stats.threads, job.accel ? a.accel.c_str() : "none (nothing traced)",
+      job.load_s, job.build_s, stats.seconds, job.write_s, human_count(stats.rays.camera).c_str(),
       human_count(stats.rays.shadow).c_str(), path ? "bounce" : "reflection",
       human_count(stats.rays.reflection).c_str(), human_count(total).c_str(),
       stats.seconds > 0 ? double(total) / stats.seconds / 1e6 : 0.0, peak_memory_mib());

@@ -247,7 +247,7 @@ void add_sampling_options(CLI::App& render, RenderArgs& args) {
       ->check(CLI::IsMember({"ray", "map", "none"}));
   render
       .add_option("--shadow-map-size", args.shadow_map_size,
-                  "raster: shadow map texels on a side (default 2048; point lights: per cube face)")
+                  "raster: shadow map texels on a side (default 1024; point lights: per cube face)")
       ->check(CLI::Range(16, 8192));
   render
       .add_option("--spp", args.spp,

@@ -42,7 +42,7 @@ struct RenderArgs {
   float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
   double time_limit = 0;
   std::string raster_shadows = "ray";  ///< --raster-shadows: ray, map or none
-  int shadow_map_size = 2048;
+  int shadow_map_size = 1024;
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
   bool raster_shadows_given = false, shadow_map_size_given = false;
   int crypto_depth = 6;  ///< Cryptomatte ranks per pixel

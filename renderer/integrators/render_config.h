@@ -28,7 +28,7 @@ enum class RasterShadows : uint8_t {
 /// Settings of the raster integrator.
 struct RasterConfig {
   RasterShadows shadows = RasterShadows::Ray;
-  int shadow_map_size = 2048;  ///< [16, 8192] texels on a side (point lights: per cube face)
+  int shadow_map_size = 1024;  ///< [16, 8192] texels on a side (point lights: per cube face)
 };
 
 /// Render settings with their defaults; validate() before use.

@@ -59,7 +59,8 @@ struct Pipeline {
 
 Kind material_kind(const Material& m, const RasterPass& pass) {
   if (m.alpha_mode == AlphaMode::Mask) return Kind::Mask;
-  if (m.alpha_mode == AlphaMode::Blend) return pass.blend == RasterBlend::Layers ? Kind::Blend : Kind::Mask;
+  if (m.alpha_mode == AlphaMode::Blend)
+    return pass.blend == RasterBlend::Layers && !pass.depth_only ? Kind::Blend : Kind::Mask;
   return Kind::Opaque;
 }
 
@@ -607,7 +608,7 @@ class TileRasterizer {
                    const PixelWindow& r, TileBuffers& b) const {
     const double inv_area = 1.0 / double(e.area2);
     const int spp = m_pl.pass.spp;
-    const float mask_cut = m_pl.pass.blend == RasterBlend::Threshold ? 0.5f : 1.0f;
+    const float mask_cut = m_pl.pass.blend == RasterBlend::Threshold || m_pl.pass.depth_only ? 0.5f : 1.0f;
     int written = 0;
     for (int y = r.y0; y < r.y1; ++y)
       for (int x = r.x0; x < r.x1; ++x) {
@@ -684,6 +685,17 @@ class TileRasterizer {
     (void)tile;
     b.opaque.resize(n);
     std::pair<uint32_t, Gradients> cache{kNone, {}};
+    if (m_pl.pass.depth_only) {
+      for (size_t i = 0; i < n; ++i) {
+        b.opaque[i] = RasterFragment{};
+        if (b.id[i] == kNone) continue;
+        b.opaque[i].depth = b.depth[i];
+        b.opaque[i].hit.geom_id = m_tris.is_triangle(b.id[i]) ? m_tris[b.id[i]].instance
+                                                              : m_shapes[b.id[i] - m_tris.end_id()].instance;
+      }
+      b.layer_begin.assign(n + 1, 0);
+      return;
+    }
     for (size_t i = 0; i < n; ++i)
       b.opaque[i] =
           b.id[i] == kNone ? RasterFragment{} : make_fragment(b.id[i], b.depth[i], b.l1[i], b.l2[i], cache);

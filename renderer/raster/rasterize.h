@@ -50,6 +50,8 @@ struct RasterPass {
   float margin = 0;             ///< >= 0, see `position`
   bool cull_back_faces = true;  ///< drop the back faces of single-sided materials
   RasterBlend blend = RasterBlend::Layers;
+  bool depth_only = false;    ///< fragments carry only depth and ids (no barycentrics or derivatives),
+                              ///< Blend surfaces as Threshold: the passes of shadow maps
   int max_blend_layers = 16;  ///< Layers: at most this many per sample (>= 0); the next
                               ///< Blend surface, if any, counts as opaque
 };

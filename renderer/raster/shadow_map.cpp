@@ -76,6 +76,7 @@ void render_face(const Scene& scene, ShadowFace& face, int threads) {
   pass.spp = 1;
   pass.cull_back_faces = false;
   pass.blend = RasterBlend::Threshold;
+  pass.depth_only = true;
   rasterize(scene, view, pass, [&](const RasterTile& t) {
     size_t i = 0;
     for (int y = t.pixels.y0; y < t.pixels.y1; ++y)
@@ -113,6 +114,7 @@ ShadowMaps build_shadow_maps(const Scene& scene, int size, int threads) {
       ShadowFace f;
       f.view = c;
       f.size = size;
+      f.tan_half = c.projection == Projection::Orthographic ? 0.0f : std::tan(0.5f * c.yfov);
       m.faces.push_back(std::move(f));
     }
     m.cube = m.faces.size() == 6;
@@ -129,7 +131,7 @@ float shadow_map_visibility(const ShadowMaps& maps, int light, Vec3f p, Vec3f ng
   const ShadowFace& f = m.faces[m.cube ? size_t(cube_face(p - m.faces[0].view.eye)) : 0];
   const Camera& c = f.view;
   const bool ortho = c.projection == Projection::Orthographic;
-  const float tan_half = ortho ? 0.0f : std::tan(0.5f * c.yfov);
+  const float tan_half = f.tan_half;
   // World size of one texel at p's depth, and the cosine between the surface and the light.
   const float depth0 = dot(p - c.eye, -c.w);
   const float texel = 2.0f * (ortho ? c.ymag : tan_half * std::max(depth0, 0.0f)) / float(f.size);

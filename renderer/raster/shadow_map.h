@@ -20,6 +20,7 @@ namespace penumbra {
 struct ShadowFace {
   Camera view;
   int size = 0;
+  float tan_half = 0;        ///< perspective: tan(view.yfov / 2); 0 for an orthographic face
   std::vector<float> depth;  ///< size x size, row-major, top row first
 };
 
