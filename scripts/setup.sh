@@ -32,12 +32,10 @@ case "$mode" in
     # The same suite again under AddressSanitizer + UndefinedBehaviorSanitizer (build type
     # Sanitize), including every hostile corpus file through the CLI. Left out here, as they
     # run in the Release suite above: the accelerator cross-check over all corpus models (11
-    # minutes instrumented) and the raster integrator's cross-check over the same models (its
-    # code runs instrumented in the shipped-scene cross-check), the two Slurm tests (4 minutes
-    # instrumented: they drive slurmctld, slurmd and munge around the same commands the other
-    # CLI tests run), the Blender compositor check (Blender's time; Penumbra's side of it runs
-    # in cli.cryptomatte), the install and package tests (a consumer project and a .deb:
-    # packaging, not code paths) and the Python
+    # minutes instrumented), the two Slurm tests (4 minutes instrumented: they drive slurmctld,
+    # slurmd and munge around the same commands the other CLI tests run), the Blender compositor
+    # check (Blender's time; Penumbra's side of it runs in cli.cryptomatte), the install and
+    # package tests (a consumer project and a .deb: packaging, not code paths) and the Python
     # tests (an instrumented module cannot load into Debian's uninstrumented python3).
     # SANITIZE=0 skips this stage.
     if [ "${SANITIZE:-1}" != 0 ]; then
@@ -45,7 +43,7 @@ case "$mode" in
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize
       cmake --build "$SAN_DIR" -j "$JOBS"
       ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cross-check: id and Z agree with the ray tracer on every valid corpus model|cli.slurm_farm|cli.slurm_cluster|cli.compositor|install\.|python\."
+        -E "cross-check: every valid corpus model|cli.slurm_farm|cli.slurm_cluster|cli.compositor|install\.|python\."
     fi
     ;;
 esac
