@@ -278,15 +278,19 @@ int run_raster(const std::vector<std::string>& scenes, uint64_t seed, int width,
       pass.position = nullptr;  // pixel centres, as the camera rays below
       pass.margin = 0;
       std::atomic<uint64_t> visible{0};
+      RasterStats rs;
       const double vis = median_seconds(repeats, [&] {
         visible = 0;
-        rasterize(scene, cv.view, pass, [&](const RasterTile& tile) {
-          const size_t n = size_t(tile.pixels.width()) * size_t(tile.pixels.height());
-          uint64_t v = 0;
-          for (size_t i = 0; i < n; ++i)
-            v += tile.opaque[i].hit.valid() || tile.blend_begin[i + 1] > tile.blend_begin[i];
-          visible += v;
-        });
+        rasterize(
+            scene, cv.view, pass,
+            [&](const RasterTile& tile) {
+              const size_t n = size_t(tile.pixels.width()) * size_t(tile.pixels.height());
+              uint64_t v = 0;
+              for (size_t i = 0; i < n; ++i)
+                v += tile.opaque[i].hit.valid() || tile.blend_begin[i + 1] > tile.blend_begin[i];
+              visible += v;
+            },
+            &rs);
       });
       double build_s[2] = {0, 0}, trace_s[2] = {0, 0};
       uint64_t hits[2] = {0, 0};
@@ -314,6 +318,13 @@ int run_raster(const std::vector<std::string>& scenes, uint64_t seed, int width,
                   vis * 1e3, preview * 1e3, maps * 1e3, trace_s[0] * 1e3, (trace_s[0] + build_s[0]) * 1e3,
                   trace_s[1] * 1e3, (trace_s[1] + build_s[1]) * 1e3, 1 / vis, trace_s[0] / vis,
                   (trace_s[0] + build_s[0]) / vis);
+      std::printf(
+          "  raster phases (last pass): set-up %.1f ms, binning %.1f ms, tiles %.1f ms; %llu of %llu "
+          "triangles set up, %llu bin references\n",
+          rs.setup_seconds * 1e3, rs.bin_seconds * 1e3, rs.tile_seconds * 1e3,
+          static_cast<unsigned long long>(rs.triangles_setup),
+          static_cast<unsigned long long>(rs.triangles_in),
+          static_cast<unsigned long long>(rs.bin_references));
       if (visible.load() != hits[0])
         std::printf("  (visible samples: raster %llu, embree %llu)\n",
                     static_cast<unsigned long long>(visible.load()),
