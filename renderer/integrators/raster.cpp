@@ -15,7 +15,7 @@ namespace {
 
 Ray camera_view_ray(const void* context, float x, float y) {
   const auto& cv = *static_cast<const CameraView*>(context);
-  return generate_camera_ray(cv.camera, cv.width, cv.height, x, y);
+  return raster_ray(cv.camera, cv.raster, x, y);
 }
 
 Vec2f camera_sample(const void* context, int x, int y, uint32_t s) {
@@ -58,13 +58,14 @@ struct Shader {
   const LightVisibility& visibility;
   Film& film;
 
-  Vec3f local(const RasterFragment& f, const Ray& ray, float step, float& alpha, RayCounts& counts) const {
+  // The local radiance of fragment f seen by the camera ray through raster position p.
+  Vec3f local(const RasterFragment& f, Vec2f p, const Ray& ray, float step, float& alpha,
+              RayCounts& counts) const {
     SurfaceInteraction si = fragment_interaction(scene, cv, f, ray, step);
     if (si.shape >= 0 && material_reads_footprint(material_of(scene, si.material))) {
-      Ray r[3];
-      const Vec2f& p = sample_position;
-      generate_camera_rays(cv.camera, cv.width, cv.height, p.x, p.y, step, r);
-      compute_differentials(scene, si, RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir});
+      const Ray rx = raster_ray(cv.camera, cv.raster, p.x + step, p.y);
+      const Ray ry = raster_ray(cv.camera, cv.raster, p.x, p.y + step);
+      compute_differentials(scene, si, RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir});
     }
     const MaterialPoint mp = eval_material(scene, si);
     alpha = mp.alpha;
@@ -81,15 +82,14 @@ struct Shader {
         Vec3f sum{0, 0, 0};
         float coverage = 0;
         for (int s = 0; s < t.spp; ++s, ++i) {
-          sample_position = t.positions[i];
-          const Ray ray =
-              generate_camera_ray(cv.camera, cv.width, cv.height, sample_position.x, sample_position.y);
+          const Vec2f p = t.positions[i];
+          const Ray ray = raster_ray(cv.camera, cv.raster, p.x, p.y);
           // Front to back: each Blend layer takes its alpha of what is left, the opaque
           // surface (or the background) the rest.
           float remaining = 1;
           for (uint32_t k = t.blend_begin[i]; k < t.blend_begin[i + 1] && remaining > 0; ++k) {
             float a = 1;
-            const Vec3f l = local(t.blend[k], ray, step, a, counts);
+            const Vec3f l = local(t.blend[k], p, ray, step, a, counts);
             if (!(a > 0)) continue;
             sum += l * (remaining * a);
             coverage += remaining * a;
@@ -98,7 +98,7 @@ struct Shader {
           if (!(remaining > 0)) continue;
           if (t.opaque[i].hit.valid()) {
             float a = 1;
-            sum += local(t.opaque[i], ray, step, a, counts) * remaining;
+            sum += local(t.opaque[i], p, ray, step, a, counts) * remaining;
             coverage += remaining;
           } else {
             sum += config.whitted.background * remaining;
@@ -112,8 +112,6 @@ struct Shader {
         px[3] = coverage * inv;
       }
   }
-
-  Vec2f sample_position;
 };
 
 }  // namespace
@@ -122,6 +120,7 @@ void make_camera_view(const Camera& camera, int width, int height, CameraView& o
   out.camera = camera;
   out.width = width;
   out.height = height;
+  out.raster = camera_raster(camera, width, height);
   out.view.view = view_matrix(camera);
   out.view.projection = projection_matrix(camera, float(width) / float(height));
   out.view.far_plane = std::isfinite(camera.zfar);
@@ -181,7 +180,7 @@ Film render_raster(const Scene& scene, const Accelerator* accel, const Camera& c
   std::atomic<int> done{0};
   const int tiles = TileScheduler(win, config.tile_size, config.threads).tile_count();
   rasterize(scene, cv.view, pass, [&](const RasterTile& tile) {
-    Shader shader{scene, cv, config, visibility, film, {}};
+    Shader shader{scene, cv, config, visibility, film};
     RayCounts counts;
     shader.tile(tile, counts);
     shadow_rays += counts.shadow;
@@ -219,7 +218,7 @@ DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const Rend
             continue;
           }
           const Vec2f p = t.positions[i];
-          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          const Ray ray = raster_ray(camera, cv.raster, p.x, p.y);
           const SurfaceInteraction si =
               fragment_interaction(scene, cv, *f, ray, 0);  // finest texels, as traced
           pixel.add_hit(scene, si, eval_material(scene, si), f->depth);

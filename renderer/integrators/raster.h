@@ -13,11 +13,13 @@
 namespace penumbra {
 
 /// The camera as a raster view for a width x height image: view_matrix(), projection_matrix()
-/// with the image's aspect, far clipping when zfar is finite, and generate_camera_ray() for
-/// shapes. `camera` must outlive the view (its ray function reads it).
+/// with the image's aspect, far clipping when zfar is finite, and the camera's rays (raster_ray,
+/// bit for bit generate_camera_ray's) for shapes. view.ray_context points at the CameraView
+/// itself: it must stay where make_camera_view() filled it in.
 struct CameraView {
   Camera camera;
   int width = 0, height = 0;
+  CameraRaster raster;  ///< the camera's per-image terms
   RasterView view;
 };
 void make_camera_view(const Camera& camera, int width, int height, CameraView& out);
