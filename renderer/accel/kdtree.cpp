@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "renderer/accel/clip.h"
 #include "renderer/accel/common.h"
 #include "renderer/accel/stats.h"
 
@@ -80,66 +81,6 @@ struct BuildNode {
   int axis = -1;  // -1 for a leaf
 };
 
-/// Bounds of the part of triangle t inside `box` (Sutherland-Hodgman clipping in double),
-/// rounded outward to float and intersected with `box`; for a shape, its bounds intersected
-/// with `box`. Empty if nothing is inside.
-Bounds3f clip_triangle(const PrimitiveRecord& t, const Bounds3f& box) {
-  if (is_shape(t)) {
-    const Bounds3f o{max(t.a, box.lo), min(t.b, box.hi)};
-    return o.empty() ? Bounds3f{} : o;
-  }
-  struct P {
-    double v[3];
-  };
-  P poly[16], tmp[16];
-  int n = 3;
-  for (int k = 0; k < 3; ++k) {
-    poly[0].v[k] = t.a[k];
-    poly[1].v[k] = t.b[k];
-    poly[2].v[k] = t.c[k];
-  }
-  for (int k = 0; k < 3 && n > 0; ++k) {
-    for (int side = 0; side < 2 && n > 0; ++side) {
-      // Keep points with s * (x - plane) >= 0: s = +1 for the lower face, -1 for the upper.
-      const double plane = side == 0 ? box.lo[k] : box.hi[k];
-      const double s = side == 0 ? 1.0 : -1.0;
-      int m = 0;
-      for (int i = 0; i < n; ++i) {
-        const P& a = poly[i];
-        const P& b = poly[(i + 1) % n];
-        const double da = s * (a.v[k] - plane), db = s * (b.v[k] - plane);
-        if (da >= 0) tmp[m++] = a;
-        if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
-          const double f = da / (da - db);
-          P c;
-          for (int j = 0; j < 3; ++j) c.v[j] = a.v[j] + f * (b.v[j] - a.v[j]);
-          c.v[k] = plane;
-          tmp[m++] = c;
-        }
-      }
-      n = m;
-      std::copy(tmp, tmp + m, poly);
-    }
-  }
-  Bounds3f out;
-  if (n == 0) return out;
-  double lo[3] = {poly[0].v[0], poly[0].v[1], poly[0].v[2]}, hi[3] = {lo[0], lo[1], lo[2]};
-  for (int i = 1; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], poly[i].v[k]);
-      hi[k] = std::max(hi[k], poly[i].v[k]);
-    }
-  for (int k = 0; k < 3; ++k) {
-    float l = float(lo[k]), h = float(hi[k]);
-    if (double(l) > lo[k]) l = std::nextafter(l, -kInfinity);
-    if (double(h) < hi[k]) h = std::nextafter(h, kInfinity);
-    out.lo[k] = std::max(l, box.lo[k]);
-    out.hi[k] = std::min(h, box.hi[k]);
-    if (out.lo[k] > out.hi[k]) return Bounds3f{};
-  }
-  return out;
-}
-
 class Builder {
  public:
   Builder(const KdTreeConfig& c, const std::vector<PrimitiveRecord>& tris, int max_depth)
@@ -186,7 +127,8 @@ class Builder {
         nr += first;
       } else if (first) {
         // Straddling triangle: clip it to each child box (perfect splits, sec. 4.3).
-        const Bounds3f lb = clip_triangle(m_tris[e.tri], lbox), rb = clip_triangle(m_tris[e.tri], rbox);
+        const Bounds3f lb = clip_primitive_bounds(m_tris[e.tri], lbox),
+                       rb = clip_primitive_bounds(m_tris[e.tri], rbox);
         if (!lb.empty()) {
           add_events(left_new, e.tri, lb);
           ++nl;
@@ -280,27 +222,6 @@ class Builder {
   const std::vector<PrimitiveRecord>& m_tris;
   int m_max_depth;
   tbb::enumerable_thread_specific<std::vector<uint8_t>> m_classes;
-};
-
-/// The triangles a ray tested last (Amanatides & Woo 1987, "mailboxing"; a small per-ray ring
-/// as in Havran's thesis, sec. 1.11): a triangle clipped into several leaves along the ray is
-/// tested once. Skipping the repeat never changes an answer: the test depends only on the ray
-/// and its far limit, which only shrinks, so a triangle that missed misses again and one that
-/// hit is already the closest hit or behind it. Shapes are always tested.
-struct Mailbox {
-  static constexpr int kSize = 8;
-  uint64_t keys[kSize] = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
-  int next = 0;
-  /// True if `rec` was tested before; records it otherwise.
-  bool seen(const PrimitiveRecord& rec) {
-    if (is_shape(rec)) return false;
-    const uint64_t key = (uint64_t(rec.geom_id) << 32) | rec.prim_id;
-    for (const uint64_t k : keys)
-      if (k == key) return true;
-    keys[next] = key;
-    next = (next + 1) & (kSize - 1);
-    return false;
-  }
 };
 
 // ---- The accelerator ----------------------------------------------------------------------------
