@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -25,6 +26,8 @@ struct Writer {
   json j;
   std::vector<uint8_t> bin;
   std::string file;
+  /// A polyhedron's solid -> the glTF mesh written for it.
+  std::map<const SolidMesh*, int> polyhedron_meshes;
 
   int accessor(const void* data, size_t bytes, int component_type, size_t count, const char* type, int target,
                const json& minmax = nullptr) {
@@ -48,6 +51,27 @@ struct Writer {
     return int(j["accessors"].size()) - 1;
   }
 };
+
+/// The glTF mesh holding a polyhedron's triangles (its welded, outward-wound mesh; one
+/// TRIANGLES primitive, placed by no node), written once per solid.
+int polyhedron_mesh(Writer& wr, const SolidMesh& solid) {
+  if (const auto it = wr.polyhedron_meshes.find(&solid); it != wr.polyhedron_meshes.end()) return it->second;
+  if (solid.positions.empty() || solid.indices.size() < 3)
+    throw InputError(wr.file, "shapes", "a polyhedron CSG node without triangles");
+  Bounds3f b;
+  for (const Vec3f& p : solid.positions) b = merge(b, p);
+  const json minmax = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
+  const int positions = wr.accessor(solid.positions.data(), solid.positions.size() * 12, kFloat,
+                                    solid.positions.size(), "VEC3", kArrayBuffer, minmax);
+  const int indices = wr.accessor(solid.indices.data(), solid.indices.size() * 4, kUint32,
+                                  solid.indices.size(), "SCALAR", kElementArrayBuffer);
+  wr.j["meshes"].push_back(
+      {{"name", "polyhedron"},
+       {"primitives", {{{"attributes", {{"POSITION", positions}}}, {"indices", indices}, {"mode", 4}}}}});
+  const int mesh = int(wr.j["meshes"].size()) - 1;
+  wr.polyhedron_meshes[&solid] = mesh;
+  return mesh;
+}
 
 /// Column-major 4x4 matrix of the frame (u, v, w) at `origin`.
 json frame_matrix(Vec3f u, Vec3f v, Vec3f w, Vec3f origin) {
@@ -194,8 +218,9 @@ void displacement_json(const SdfDisplacement& d, json& j) {
 
 /// CSG node `index` of `tree` as a PENUMBRA_shapes CSG object (the inverse of the loader's
 /// reading): its type and fields, a matrix placing its frame unless that is the identity, and
-/// its operands as children.
-json csg_json(const SdfTree& tree, int index, const std::string& file, int depth = 1) {
+/// its operands as children. A polyhedron's triangles become a glTF mesh it names.
+json csg_json(const SdfTree& tree, int index, Writer& wr, int depth = 1) {
+  const std::string& file = wr.file;
   if (depth > kMaxSdfDepth)
     throw InputError(file, "shapes", "a CSG tree deeper than " + std::to_string(kMaxSdfDepth) + " levels");
   const SdfNode& n = tree.nodes[size_t(index)];
@@ -208,6 +233,7 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
                                        "torus",
                                        "halfSpace",
                                        "convexPolyhedron",
+                                       "polyhedron",
                                        "union",
                                        "intersection",
                                        "subtraction",
@@ -247,6 +273,12 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
         j["planes"].push_back({p.x, p.y, p.z, p.w});
       }
       break;
+    case SdfKind::Polyhedron:
+      if (n.polyhedron < 0 || size_t(n.polyhedron) >= tree.polyhedra.size())
+        throw InputError(file, "shapes",
+                         "a polyhedron node's mesh " + std::to_string(n.polyhedron) + " out of range");
+      j["mesh"] = polyhedron_mesh(wr, tree.polyhedra[size_t(n.polyhedron)]);
+      break;
     case SdfKind::Displace:
       if (n.displacement < 0 || size_t(n.displacement) >= tree.displacements.size())
         throw InputError(file, "shapes",
@@ -257,8 +289,8 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
       break;
   }
   if (is_operator(n.kind)) {
-    j["children"] = json::array({csg_json(tree, n.a, file, depth + 1)});
-    if (!is_unary(n.kind)) j["children"].push_back(csg_json(tree, n.b, file, depth + 1));
+    j["children"] = json::array({csg_json(tree, n.a, wr, depth + 1)});
+    if (!is_unary(n.kind)) j["children"].push_back(csg_json(tree, n.b, wr, depth + 1));
     if (n.kind >= SdfKind::SmoothUnion && n.kind <= SdfKind::SmoothSubtraction) j["radius"] = n.radius;
   }
   if (!is_identity(n.to_local)) {
@@ -271,7 +303,8 @@ json csg_json(const SdfTree& tree, int index, const std::string& file, int depth
 }
 
 /// The PENUMBRA_shapes object of a scene shape.
-json shape_json(const SceneShape& ss, size_t material_count, const std::string& file) {
+json shape_json(const SceneShape& ss, size_t material_count, Writer& wr) {
+  const std::string& file = wr.file;
   const Shape& s = ss.shape;
   json j = {{"type", shape_kind_name(s.kind)}};
   switch (s.kind) {
@@ -291,7 +324,7 @@ json shape_json(const SceneShape& ss, size_t material_count, const std::string& 
       break;
     case ShapeKind::Implicit:
       if (s.sdf.root < 0) throw InputError(file, "shapes", ss.name + ": an implicit shape without a tree");
-      j["csg"] = csg_json(s.sdf, s.sdf.root, file);
+      j["csg"] = csg_json(s.sdf, s.sdf.root, wr);
       j["maxSteps"] = s.trace.max_steps;
       j["epsilon"] = s.trace.relative_epsilon;
       break;
@@ -307,7 +340,7 @@ void write_shape_instance(Writer& wr, const Scene& scene, const Instance& inst, 
                      "shape " + std::to_string(inst.shape) + " out of range");
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   json node = {{"name", ss.name.empty() ? "shapes[" + std::to_string(inst.shape) + "]" : ss.name}};
-  node["extensions"]["PENUMBRA_shapes"] = shape_json(ss, scene.materials.size(), wr.file);
+  node["extensions"]["PENUMBRA_shapes"] = shape_json(ss, scene.materials.size(), wr);
   if (!inst.identity) node["matrix"] = affine_matrix(inst.to_world);
   add_root(wr, node);
 }

@@ -1,7 +1,8 @@
 // The PENUMBRA_shapes extension: each node's extension object read by kind (analytic shapes;
 // implicit shapes with their CSG trees: primitives, operators folded into binary nodes, noise
-// displacement, node transforms), then each shape placed by its node's world transform and
-// instancing copies.
+// displacement, node transforms, polyhedra named by mesh), the polyhedra's solids built from
+// their meshes' triangles, then each shape placed by its node's world transform and instancing
+// copies.
 #include "io/gltf/shapes.h"
 
 #include <tiny_gltf.h>
@@ -10,9 +11,11 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <span>
 
+#include "io/gltf/accessors.h"
 #include "io/gltf/json_reader.h"
 #include "io/gltf/meshes.h"
 #include "io/gltf/procedural.h"
@@ -56,6 +59,7 @@ constexpr CsgType kCsgTypes[] = {
     {"torus", SdfKind::Torus, {"majorRadius", "minorRadius"}},
     {"halfSpace", SdfKind::HalfSpace, {"normal", "offset"}},
     {"convexPolyhedron", SdfKind::ConvexPolyhedron, {"planes"}},
+    {"polyhedron", SdfKind::Polyhedron, {"mesh"}},
     {"union", SdfKind::Union, {"children"}},
     {"intersection", SdfKind::Intersection, {"children"}},
     {"subtraction", SdfKind::Subtraction, {"children"}},
@@ -69,10 +73,11 @@ constexpr CsgType kCsgTypes[] = {
       "gain", "distortion"}},
 };
 constexpr const char* kCsgCommonKeys[] = {"type", "translation", "rotation", "scale", "matrix"};
-constexpr const char* kCsgKeys[] = {
-    "type",        "translation", "rotation", "scale",     "matrix",     "radius",   "size",      "height",
-    "majorRadius", "minorRadius", "normal",   "offset",    "planes",     "children", "amplitude", "frequency",
-    "seed",        "noise",       "detail",   "roughness", "lacunarity", "gain",     "distortion"};
+constexpr const char* kCsgKeys[] = {"type",       "translation", "rotation",   "scale",       "matrix",
+                                    "radius",     "size",        "height",     "majorRadius", "minorRadius",
+                                    "normal",     "offset",      "planes",     "children",    "amplitude",
+                                    "frequency",  "seed",        "noise",      "detail",      "roughness",
+                                    "lacunarity", "gain",        "distortion", "mesh"};
 
 // Limit of a displace node's |amplitude| and frequency.
 constexpr float kMaxDisplacement = 1e6f;
@@ -132,12 +137,26 @@ bool may_be_unbounded(const SdfTree& tree, int index, int depth) {
   }
 }
 
+// The checks of a complete implicit shape: its inside bounded and not empty, its bounds and
+// Lipschitz bound within the float range. `cw` is the JSON path of its csg member.
+void check_implicit(const Shape& shape, const std::string& file, const std::string& cw) {
+  const Bounds3f& b = shape.sdf_bounds;
+  if (b.empty())
+    throw InputError(
+        file, cw,
+        may_be_unbounded(shape.sdf, shape.sdf.root, 0)
+            ? "the shape's inside is unbounded (intersect half-spaces and complements with a finite shape)"
+            : "the shape's inside is empty (the parts it intersects do not overlap)");
+  if (!is_finite(b.lo) || !is_finite(b.hi) || !(std::isfinite(shape.lipschitz) && shape.lipschitz > 0))
+    throw InputError(file, cw, "the transforms scale the shape beyond the 32-bit float range");
+}
+
 // Reads extension objects into NodeShapes, one at a time; `m_tree` holds the CSG tree of the
-// implicit shape being read.
+// implicit shape being read, `m_pending` its polyhedron nodes.
 class ShapeReader : public JsonReader {
  public:
-  ShapeReader(const std::string& file, size_t materials, MemoryBudget& budget)
-      : JsonReader(file), m_materials(materials), m_budget(budget) {}
+  ShapeReader(const std::string& file, size_t materials, size_t meshes, MemoryBudget& budget)
+      : JsonReader(file), m_file(file), m_materials(materials), m_meshes(meshes), m_budget(budget) {}
   NodeShape read(const json& ext, int node, const std::string& where);
 
  private:
@@ -149,12 +168,15 @@ class ShapeReader : public JsonReader {
   SdfNode csg_primitive(const json& j, const std::string& where, SdfKind kind);
   void csg_planes(const json& j, const std::string& where, SdfNode& node);
   int csg_displacement(const json& j, const std::string& where);
+  int csg_polyhedron(const json& j, const std::string& where);
   Affine3f csg_transform(const json& j, const std::string& where) const;
   int add_node(const SdfNode& node, const std::string& where);
 
-  size_t m_materials;
+  const std::string& m_file;
+  size_t m_materials, m_meshes;
   MemoryBudget& m_budget;
   SdfTree m_tree;
+  std::vector<PendingPolyhedron> m_pending;
 };
 
 int ShapeReader::material(const json& ext, const std::string& where) const {
@@ -185,6 +207,9 @@ NodeShape ShapeReader::read(const json& ext, int node, const std::string& where)
   out.material = material(ext, where);
   if (spec->kind == ShapeKind::Implicit) {
     out.shape = implicit(ext, where);
+    if (!m_pending.empty()) out.csg = where + ".csg";
+    out.polyhedra = std::move(m_pending);
+    m_pending.clear();
   } else {
     out.shape.kind = spec->kind;
     analytic(ext, where, out.shape);
@@ -227,19 +252,21 @@ Shape ShapeReader::implicit(const json& ext, const std::string& where) {
     if (!(trace.relative_epsilon < 0.1f)) fail(where + ".epsilon", "must be < 0.1 (got " + shown(*e) + ")");
   }
   m_tree = SdfTree{};
+  m_pending.clear();
   m_tree.root = csg_node(*csg, cw, 1);
   m_tree.nodes.shrink_to_fit();
   m_tree.planes.shrink_to_fit();
   m_tree.displacements.shrink_to_fit();
+  m_tree.polyhedra.shrink_to_fit();
+  if (!m_pending.empty()) {  // completed and checked once the polyhedra are built
+    Shape shape;
+    shape.kind = ShapeKind::Implicit;
+    shape.sdf = std::move(m_tree);
+    shape.trace = trace;
+    return shape;
+  }
   Shape shape = make_implicit_shape(std::move(m_tree), trace);
-  const Bounds3f& b = shape.sdf_bounds;
-  if (b.empty())
-    fail(cw,
-         may_be_unbounded(shape.sdf, shape.sdf.root, 0)
-             ? "the shape's inside is unbounded (intersect half-spaces and complements with a finite shape)"
-             : "the shape's inside is empty (the parts it intersects do not overlap)");
-  if (!is_finite(b.lo) || !is_finite(b.hi) || !(std::isfinite(shape.lipschitz) && shape.lipschitz > 0))
-    fail(cw, "the transforms scale the shape beyond the 32-bit float range");
+  check_implicit(shape, m_file, cw);
   return shape;
 }
 
@@ -362,10 +389,31 @@ SdfNode ShapeReader::csg_primitive(const json& j, const std::string& where, SdfK
     case SdfKind::ConvexPolyhedron:
       csg_planes(j, where, n);
       break;
+    case SdfKind::Polyhedron:
+      n.polyhedron = csg_polyhedron(j, where);
+      break;
     default:
       break;
   }
   return n;
+}
+
+// A polyhedron node's mesh index, checked against the meshes; its (empty) entry in
+// SdfTree::polyhedra, filled by place_shapes. Returns the entry's index.
+int ShapeReader::csg_polyhedron(const json& j, const std::string& where) {
+  const std::string mw = where + ".mesh";
+  const json* m = find(j, "mesh");
+  if (!m) fail(mw, "is required (the index of the glTF mesh whose triangles bound the solid)");
+  if (!m->is_number_integer()) fail(mw, "must be an integer mesh index (got " + shown(*m) + ")");
+  if (!m->is_number_unsigned()) fail(mw, "index " + shown(*m) + " is negative");
+  const uint64_t u = m->get<uint64_t>();
+  if (u >= m_meshes)
+    fail(mw, "mesh " + std::to_string(u) + " out of range (" + std::to_string(m_meshes) + " meshes)");
+  m_budget.charge(sizeof(SolidMesh) + sizeof(PendingPolyhedron) + mw.size(), where, "its polyhedron needs");
+  m_tree.polyhedra.emplace_back();
+  const int index = int(m_tree.polyhedra.size()) - 1;
+  m_pending.push_back({index, int(u), mw});
+  return index;
 }
 
 void ShapeReader::csg_planes(const json& j, const std::string& where, SdfNode& node) {
@@ -447,6 +495,157 @@ Affine3f ShapeReader::csg_transform(const json& j, const std::string& where) con
   return to_local;
 }
 
+// Bytes building a solid holds beyond what it keeps, per triangle (the welded copy, the edge list
+// for the closedness check, areas, the BVH order and centroids) and per node-budget unit (a node
+// and, at worst, a polygon fragment with 16 vertices of the splitting pool).
+constexpr uint64_t kSolidBuildBytesPerTriangle = 128;
+constexpr uint64_t kSolidBuildBytesPerNode = sizeof(SolidBspNode) + 64 + 16 * 24;
+
+const char* mode_name(int mode) {
+  static const char* const kNames[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
+                                       "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
+  return mode >= 0 && mode <= 6 ? kNames[mode] : "invalid";
+}
+
+// The sizes of glTF mesh `mesh`'s primitives read from their accessors' counts, before any is
+// decoded: each must be TRIANGLES with a POSITION attribute. `where` (the polyhedron's "mesh"
+// member) and `name` ("mesh 3") name errors.
+struct MeshSizes {
+  uint64_t vertices = 0, indices = 0;
+};
+MeshSizes mesh_sizes(const GltfContext& ctx, int mesh, const std::string& where, const std::string& name) {
+  const auto& primitives = ctx.model.meshes[size_t(mesh)].primitives;
+  if (primitives.empty()) ctx.fail(where, name + " has no primitives");
+  const auto count = [&](int accessor) {
+    return accessor >= 0 && size_t(accessor) < ctx.model.accessors.size()
+               ? uint64_t(ctx.model.accessors[size_t(accessor)].count)
+               : uint64_t(0);
+  };
+  MeshSizes sizes;
+  for (size_t pi = 0; pi < primitives.size(); ++pi) {
+    const auto& prim = primitives[pi];
+    const std::string pn = name + "'s " + idx("primitives", pi);
+    if (prim.mode != TINYGLTF_MODE_TRIANGLES)
+      ctx.fail(where, pn + " has mode " + std::to_string(prim.mode) + " (" + mode_name(prim.mode) +
+                          "); a polyhedron needs TRIANGLES (mode 4) primitives");
+    const auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) ctx.fail(where, pn + " has no POSITION attribute");
+    const uint64_t nv = count(pos->second), ni = prim.indices >= 0 ? count(prim.indices) : nv;
+    if (ni % 3) ctx.fail(where, pn + " has " + std::to_string(ni) + " indices, not a multiple of 3");
+    sizes.vertices += nv;
+    sizes.indices += ni;
+    if (sizes.indices / 3 > kMaxPolyhedronTriangles)
+      ctx.fail(where, name + " has more than " + std::to_string(kMaxPolyhedronTriangles) +
+                          " triangles (the most a polyhedron may have)");
+    if (sizes.vertices >= 0xffffffffu) ctx.fail(where, name + " has too many vertices");
+  }
+  return sizes;
+}
+
+// The triangles of glTF mesh `mesh`'s primitives (checked by mesh_sizes), vertices numbered
+// across the primitives in order.
+void mesh_triangles(const GltfContext& ctx, int mesh, const std::string& where, const std::string& name,
+                    std::vector<Vec3f>& positions, std::vector<uint32_t>& indices) {
+  const auto& used = ctx.model.extensionsUsed;
+  const bool quantized = std::find(used.begin(), used.end(), "KHR_mesh_quantization") != used.end();
+  const auto& primitives = ctx.model.meshes[size_t(mesh)].primitives;
+  for (size_t pi = 0; pi < primitives.size(); ++pi) {
+    const auto& prim = primitives[pi];
+    const std::string pw = idx("meshes", size_t(mesh)) + "." + idx("primitives", pi);
+    const int pos = prim.attributes.at("POSITION");
+    const std::vector<double> xyz =
+        quantized ? read_accessor(ctx, pos, pw + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                                  {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                                  true, true)
+                  : read_accessor(ctx, pos, pw + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3},
+                                  {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    const size_t nv = xyz.size() / 3, base = positions.size();
+    std::vector<uint32_t> local;
+    if (prim.indices >= 0) {
+      local = read_indices(ctx, prim.indices, pw + ".indices");
+    } else {
+      local.resize(nv);
+      for (size_t i = 0; i < nv; ++i) local[i] = uint32_t(i);
+    }
+    for (size_t i = 0; i < nv; ++i)
+      positions.push_back({float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])});
+    for (const uint32_t i : local) {
+      if (i >= nv)
+        ctx.fail(where, name + "'s " + idx("primitives", pi) + " has index " + std::to_string(i) +
+                            " >= its vertex count " + std::to_string(nv));
+      indices.push_back(uint32_t(base) + i);
+    }
+  }
+}
+
+// The solid of glTF mesh `mesh` for the polyhedron node whose "mesh" member is `where`. What
+// decoding, the triangles and the build hold is charged first, from the accessors' counts
+// (decoding then charges its part again, in the room given back for it), then exchanged for
+// what the solid keeps.
+SolidMesh build_polyhedron(const GltfContext& ctx, int mesh, const std::string& where) {
+  const std::string name = "mesh " + std::to_string(mesh);
+  const uint64_t before = ctx.budget.used();
+  const MeshSizes sizes = mesh_sizes(ctx, mesh, where, name);
+  const uint64_t triangles = sizes.indices / 3;
+  const uint64_t decoding = sizes.vertices * 3 * 8 + sizes.indices * 8;
+  ctx.charge(decoding + sizes.vertices * sizeof(Vec3f) + sizes.indices * sizeof(uint32_t) +
+                 triangles * kSolidBuildBytesPerTriangle,
+             where, name + "'s " + std::to_string(triangles) + " triangles need");
+  ctx.budget.release(decoding);
+  std::vector<Vec3f> positions;
+  std::vector<uint32_t> indices;
+  positions.reserve(size_t(sizes.vertices));
+  indices.reserve(size_t(sizes.indices));
+  mesh_triangles(ctx, mesh, where, name, positions, indices);
+  SolidBspConfig config;
+  config.max_classifications = kMaxPolyhedronClassifications;
+  const uint64_t automatic = 8 * triangles + 1024;
+  const uint64_t affordable = (ctx.budget.limit() - ctx.budget.used()) / kSolidBuildBytesPerNode;
+  const bool by_memory = affordable < automatic;
+  config.max_nodes = std::max<uint64_t>(1, std::min(automatic, affordable));
+  SolidMesh solid;
+  try {
+    solid = build_solid_mesh(positions, indices, config);
+  } catch (const SolidMeshError& e) {
+    if (e.over_budget() && by_memory && e.reason().find("max_classifications") == std::string::npos)
+      ctx.fail(where, name + "'s solid BSP needs more than the " + format_bytes(ctx.budget.limit()) +
+                          " budget allows with the rest of the scene (" + e.reason() + ")");
+    ctx.fail(where, name + " " + e.reason());
+  }
+  ctx.budget.release(ctx.budget.used() - before);
+  ctx.charge(solid_mesh_bytes(solid), where, name + "'s solid needs");
+  if (solid.bsp.flipped)
+    ctx.warn(where,
+             name + " winds inwards (its signed volume is negative); its triangles are taken reversed");
+  return solid;
+}
+
+// Builds the polyhedra of every shape that has some (a mesh once, then copied), and completes and
+// checks those shapes.
+void build_polyhedra(const GltfContext& ctx, std::vector<NodeShape>& shapes) {
+  std::map<int, std::pair<size_t, int>> built;  // mesh -> (shape, polyhedron) holding its solid
+  for (size_t si = 0; si < shapes.size(); ++si) {
+    NodeShape& s = shapes[si];
+    if (s.polyhedra.empty()) continue;
+    for (const PendingPolyhedron& p : s.polyhedra) {
+      SolidMesh& slot = s.shape.sdf.polyhedra[size_t(p.index)];
+      const auto it = built.find(p.mesh);
+      if (it == built.end()) {
+        slot = build_polyhedron(ctx, p.mesh, p.where);
+        built[p.mesh] = {si, p.index};
+      } else {
+        slot = shapes[it->second.first].shape.sdf.polyhedra[size_t(it->second.second)];
+        ctx.charge(solid_mesh_bytes(slot), p.where, "mesh " + std::to_string(p.mesh) + "'s solid needs");
+      }
+    }
+    s.polyhedra.clear();
+    s.shape = make_implicit_shape(std::move(s.shape.sdf), s.shape.trace);
+    check_implicit(s.shape, ctx.file, s.csg);
+  }
+}
+
 // One shape placed by its node: the SceneShape, then an instance per placement (never marked
 // the identity on a moving node). Returns how many placements were left out.
 uint64_t place_shape(const GltfContext& ctx, NodeShape& from, const Transform& world, bool moving) {
@@ -500,7 +699,9 @@ std::vector<NodeShape> read_node_shapes(const json& doc, const std::string& file
   const auto nodes = doc.find("nodes");
   if (nodes == doc.end() || !nodes->is_array()) return out;
   const auto materials = doc.find("materials");
-  ShapeReader reader(file, materials != doc.end() && materials->is_array() ? materials->size() : 0, budget);
+  const auto meshes = doc.find("meshes");
+  ShapeReader reader(file, materials != doc.end() && materials->is_array() ? materials->size() : 0,
+                     meshes != doc.end() && meshes->is_array() ? meshes->size() : 0, budget);
   for (size_t i = 0; i < nodes->size(); ++i) {
     const json& node = (*nodes)[i];
     const auto extensions = node.find("extensions");
@@ -514,6 +715,7 @@ std::vector<NodeShape> read_node_shapes(const json& doc, const std::string& file
 
 void place_shapes(const GltfContext& ctx, std::vector<NodeShape>& shapes, NodeTransforms& nodes,
                   const std::vector<int>& shape_nodes) {
+  build_polyhedra(ctx, shapes);
   for (const int node : shape_nodes) {
     const auto it = std::lower_bound(shapes.begin(), shapes.end(), node,
                                      [](const NodeShape& s, int n) { return s.node < n; });

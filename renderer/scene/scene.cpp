@@ -97,8 +97,10 @@ uint64_t scene_memory_bytes(const Scene& scene) {
     total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
              bytes(m.colors) + bytes(m.indices);
   total += bytes(scene.shapes);
-  for (const SceneShape& s : scene.shapes)
+  for (const SceneShape& s : scene.shapes) {
     total += bytes(s.shape.sdf.nodes) + bytes(s.shape.sdf.planes) + bytes(s.shape.sdf.displacements);
+    for (const SolidMesh& solid : s.shape.sdf.polyhedra) total += solid_mesh_bytes(solid);
+  }
   for (const Texture& t : scene.textures)
     for (const MipLevel& level : t.levels) total += bytes(level.texels);
   total += bytes(scene.procedurals);

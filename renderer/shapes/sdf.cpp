@@ -67,6 +67,10 @@ float primitive(const SdfTree& tree, const SdfNode& n, Vec3f p) {
       }
       return d;
     }
+    case SdfKind::Polyhedron:
+      return size_t(n.polyhedron) < tree.polyhedra.size()
+                 ? solid_mesh_signed_distance(tree.polyhedra[size_t(n.polyhedron)], p)
+                 : kInfinity;
     default:
       return kInfinity;
   }
@@ -150,6 +154,10 @@ Vec3f primitive_gradient(const SdfTree& tree, const SdfNode& n, Vec3f p) {
       }
       return g;
     }
+    case SdfKind::Polyhedron:
+      return size_t(n.polyhedron) < tree.polyhedra.size()
+                 ? solid_mesh_gradient(tree.polyhedra[size_t(n.polyhedron)], p)
+                 : Vec3f{0, 1, 0};
     default: {  // Cone
       const float h = 1e-4f * std::max({n.size.y, n.radius, 1e-6f});
       const Vec3f dx{h, 0, 0}, dy{0, h, 0}, dz{0, 0, h};

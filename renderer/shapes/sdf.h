@@ -12,6 +12,7 @@
 #include "renderer/core/geometry.h"
 #include "renderer/core/math.h"
 #include "renderer/procedural/noise.h"
+#include "renderer/shapes/solid_bsp.h"
 
 namespace penumbra {
 
@@ -26,6 +27,8 @@ enum class SdfKind : uint8_t {
   Torus,               ///< major radius = size.x in the XZ plane, minor radius = radius
   HalfSpace,           ///< dot(normal, p) - offset <= 0 inside; normal is unit
   ConvexPolyhedron,    ///< intersection of half-spaces planes[first_plane, first_plane + plane_count)
+  Polyhedron,          ///< the closed mesh SdfTree::polyhedra[polyhedron], concave or not: the exact
+                       ///< distance to its triangles, negated inside its solid BSP
   Union,               ///< min(a, b)
   Intersection,        ///< max(a, b)
   Subtraction,         ///< a minus b: max(a, -b)
@@ -62,6 +65,7 @@ struct SdfNode {
   int first_plane = 0, plane_count = 0;  ///< ConvexPolyhedron: range in SdfTree::planes
   int a = -1, b = -1;                    ///< operator children (unary operators use a only)
   int displacement = -1;                 ///< Displace: index into SdfTree::displacements
+  int polyhedron = -1;                   ///< Polyhedron: index into SdfTree::polyhedra
   /// Maps the parent's frame (the tree's frame at the root) into this node's local frame.
   Affine3f to_local;
 };
@@ -71,6 +75,7 @@ struct SdfTree {
   std::vector<SdfNode> nodes;
   std::vector<Vec4f> planes;                   ///< (unit normal, offset) of ConvexPolyhedron faces
   std::vector<SdfDisplacement> displacements;  ///< the noise of Displace nodes
+  std::vector<SolidMesh> polyhedra;            ///< the meshes of Polyhedron nodes (build_solid_mesh)
   int root = -1;
 };
 
@@ -92,7 +97,8 @@ float sdf_eval(const SdfTree& tree, int node, Vec3f p);
 float sdf_lipschitz(const SdfTree& tree);
 
 /// Unit outward normal at `p` from the analytic gradient: each primitive's closed-form gradient
-/// (the cone's by central differences), chained through the node transforms (L^T g), the active
+/// (the cone's by central differences; a polyhedron's from its closest point, see
+/// solid_mesh_gradient), chained through the node transforms (L^T g), the active
 /// operand of min / max operators, the blend weights of smooth ones and, for Displace, the
 /// child's gradient plus amplitude x frequency x the noise's analytic gradient. Zero where the gradient
 /// vanishes or is not finite (a sphere's centre).

@@ -202,6 +202,12 @@ TreeBox primitive_box(const SdfTree& tree, const SdfNode& n, float delta) {
                                       tree.planes.begin() + n.first_plane + n.plane_count);
       return polyhedron_box(planes, d);
     }
+    case SdfKind::Polyhedron: {  // the mesh's box: every point with f <= d lies within d of it
+      if (size_t(n.polyhedron) >= tree.polyhedra.size()) return {Bounds3f{}, false};
+      const Bounds3f& b = tree.polyhedra[size_t(n.polyhedron)].bounds;
+      if (b.empty()) return {b, false};
+      return {Bounds3f{b.lo - Vec3f{d, d, d}, b.hi + Vec3f{d, d, d}}, false};
+    }
     default:  // HalfSpace
       return unbounded_box();
   }

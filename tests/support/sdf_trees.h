@@ -120,4 +120,149 @@ inline SdfTree displaced_sphere(float r, float amplitude, float frequency,
   return t;
 }
 
+/// An indexed triangle mesh for the solid-BSP and polyhedron tests.
+struct TriMesh {
+  std::vector<Vec3f> positions;
+  std::vector<uint32_t> indices;
+  /// Two triangles a b c, a c d (counter-clockwise seen from the side they face).
+  void quad(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+    indices.insert(indices.end(), {a, b, c, a, c, d});
+  }
+  /// Every triangle's winding reversed.
+  TriMesh flipped() const {
+    TriMesh m = *this;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) std::swap(m.indices[t + 1], m.indices[t + 2]);
+    return m;
+  }
+  /// `other` appended (its indices offset).
+  void append(const TriMesh& other) {
+    const uint32_t base = uint32_t(positions.size());
+    positions.insert(positions.end(), other.positions.begin(), other.positions.end());
+    for (uint32_t i : other.indices) indices.push_back(base + i);
+  }
+};
+
+/// The box [lo, hi]: vertex i at (i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z),
+/// 12 outward triangles, the faces in the order -x, +x, -y, +y, -z, +z (two triangles each).
+inline TriMesh box_mesh(Vec3f lo, Vec3f hi) {
+  TriMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  m.quad(0, 4, 6, 2);
+  m.quad(1, 3, 7, 5);
+  m.quad(0, 1, 5, 4);
+  m.quad(2, 6, 7, 3);
+  m.quad(0, 2, 3, 1);
+  m.quad(4, 5, 7, 6);
+  return m;
+}
+
+/// The same box with 4 vertices of its own per face (24, as glTF files split them for normals).
+inline TriMesh split_box_mesh(Vec3f lo, Vec3f hi) {
+  const TriMesh shared = box_mesh(lo, hi);
+  TriMesh m;
+  for (size_t t = 0; t < shared.indices.size(); t += 6) {
+    const uint32_t base = uint32_t(m.positions.size());
+    for (size_t k : {0, 1, 2, 5}) m.positions.push_back(shared.positions[shared.indices[t + k]]);
+    m.quad(base, base + 1, base + 2, base + 3);
+  }
+  return m;
+}
+
+/// The simple polygon `outline` (counter-clockwise seen from +z, star-shaped around `centre`)
+/// extruded from z0 to z1, its caps fanned from the centre.
+inline TriMesh prism_mesh(const std::vector<Vec2f>& outline, Vec2f centre, float z0, float z1) {
+  TriMesh m;
+  const uint32_t n = uint32_t(outline.size());
+  for (float z : {z0, z1})
+    for (const Vec2f& p : outline) m.positions.push_back({p.x, p.y, z});
+  m.positions.push_back({centre.x, centre.y, z0});
+  m.positions.push_back({centre.x, centre.y, z1});
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t j = (i + 1) % n;
+    m.quad(i, j, n + j, n + i);
+    m.indices.insert(m.indices.end(), {2 * n + 1, n + i, n + j, 2 * n, j, i});
+  }
+  return m;
+}
+
+/// An L-shaped prism: the cube [-1, 1]^3 without the notch x > 0, y > 0.
+inline TriMesh l_prism_mesh() {
+  return prism_mesh({{-1, -1}, {1, -1}, {1, 0}, {0, 0}, {0, 1}, {-1, 1}}, {-0.5f, -0.5f}, -1, 1);
+}
+
+/// A five-pointed star (outer radius 1, inner 0.4) extruded over z in [-0.5, 0.5].
+inline TriMesh star_prism_mesh() {
+  std::vector<Vec2f> outline;
+  for (int k = 0; k < 10; ++k) {
+    const float a = 0.3f + float(k) * kPi / 5, r = k % 2 ? 0.4f : 1.0f;
+    outline.push_back({r * std::cos(a), r * std::sin(a)});
+  }
+  return prism_mesh(outline, {0, 0}, -0.5f, 0.5f);
+}
+
+/// A unit icosphere subdivided `level` times (shared vertices, outward); with `spike` > 1 its 12
+/// original vertices are pushed out to that radius, a star-shaped concave polyhedron.
+inline TriMesh icosphere_mesh(int level, float spike = 1) {
+  const float t = (1 + std::sqrt(5.0f)) / 2;
+  TriMesh m;
+  m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (auto& p : m.positions) p = normalize(p);
+  m.indices = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+               4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+               6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
+  for (int l = 0; l < level; ++l) {
+    std::vector<std::pair<std::pair<uint32_t, uint32_t>, uint32_t>> mids;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      const std::pair<uint32_t, uint32_t> key{std::min(a, b), std::max(a, b)};
+      for (const auto& [k, v] : mids)
+        if (k == key) return v;
+      m.positions.push_back(normalize((m.positions[a] + m.positions[b]) * 0.5f));
+      mids.push_back({key, uint32_t(m.positions.size() - 1)});
+      return uint32_t(m.positions.size() - 1);
+    };
+    std::vector<uint32_t> g;
+    for (size_t i = 0; i < m.indices.size(); i += 3) {
+      const uint32_t a = m.indices[i], b = m.indices[i + 1], c = m.indices[i + 2];
+      const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      g.insert(g.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    m.indices.swap(g);
+  }
+  for (int i = 0; i < 12; ++i) m.positions[size_t(i)] = m.positions[size_t(i)] * spike;
+  return m;
+}
+
+/// A torus-like ring around +Y: major radius R, minor radius r, nu x nv quads (outward).
+inline TriMesh ring_mesh(float major, float minor, int nu, int nv) {
+  TriMesh m;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const float u = 2 * kPi * float(i) / float(nu), v = 2 * kPi * float(j) / float(nv);
+      const float a = major + minor * std::cos(v);
+      m.positions.push_back({a * std::cos(u), minor * std::sin(v), a * std::sin(u)});
+    }
+  const auto at = [&](int i, int j) { return uint32_t((i % nu) * nv + j % nv); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) m.quad(at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
+  return m;
+}
+
+/// The box [-1, 1]^3 with the cavity [-0.5, 0.5]^3 (an inner box wound inwards).
+inline TriMesh hollow_box_mesh() {
+  TriMesh m = box_mesh({-1, -1, -1}, {1, 1, 1});
+  m.append(box_mesh({-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}).flipped());
+  return m;
+}
+
+/// A Polyhedron node over `mesh` (built with build_solid_mesh, appended to t.polyhedra).
+inline SdfNode sdf_polyhedron(SdfTree& t, const TriMesh& mesh) {
+  t.polyhedra.push_back(build_solid_mesh(mesh.positions, mesh.indices));
+  SdfNode n;
+  n.kind = SdfKind::Polyhedron;
+  n.polyhedron = int(t.polyhedra.size()) - 1;
+  return n;
+}
+
 }  // namespace penumbra::test

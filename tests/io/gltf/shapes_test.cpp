@@ -6,19 +6,24 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <random>
 
 #include "io/error.h"
 #include "io/gltf/loader.h"
+#include "io/gltf_writer.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/scene_builder.h"
+#include "support/sdf_trees.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
 using Catch::Matchers::Contains;
+using Catch::Matchers::EndsWith;
 using penumbra::test::GltfWriter;
 using json = nlohmann::json;
 
@@ -855,4 +860,266 @@ TEST_CASE("shapes: bad displace fields are errors naming the node and the field"
   CHECK_THAT(error_of(implicit(none)), Contains(kCsg + ".children: must hold exactly 1 CSG node (got 2)"));
   CHECK_THAT(error_of(implicit(displace({{"type", "halfSpace"}}, 0.1))),
              Contains(kCsg + ": the shape's inside is unbounded"));
+}
+
+namespace {
+
+// Polyhedron CSG nodes: glTF meshes of test::TriMesh (sdf_trees.h), one TRIANGLES primitive each
+// unless split.
+
+// Adds `m` as a mesh (FLOAT positions, UNSIGNED_INT indices, `mode`); returns the mesh index.
+int add_tri_mesh(GltfWriter& w, const test::TriMesh& m, int mode = 4) {
+  std::vector<float> xyz;
+  for (const Vec3f& p : m.positions) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+  return w.mesh(w.positions(xyz), w.indices(m.indices), mode);
+}
+
+json polyhedron(int mesh) {
+  return {{"type", "polyhedron"}, {"mesh", mesh}};
+}
+
+// A file whose node 0 is the implicit shape of `csg`, with the meshes `meshes` (indices 0, 1, ...).
+GltfWriter polyhedron_file(json csg, const std::vector<test::TriMesh>& meshes) {
+  GltfWriter w = shape_file(implicit(std::move(csg)));
+  for (const test::TriMesh& m : meshes) add_tri_mesh(w, m);
+  return w;
+}
+
+std::string load_error(GltfWriter& w, GltfLoadOptions opt = {}) {
+  try {
+    test::write_and_load(w, next_name(), opt);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const test::TriMesh kCube = test::box_mesh({-1, -1, -1}, {1, 1, 1});
+
+}  // namespace
+
+TEST_CASE("shapes: polyhedron CSG nodes are the solids of their meshes' triangles",
+          "[io][gltf][shapes][polyhedron][quick]") {
+  const SdfTree box = test::single_shape(test::sdf_primitive(SdfKind::Box, {1, 1, 1}));
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(-2.5f, 2.5f);
+  SECTION("alone: the 24-vertex cube of a typical glTF file, welded") {
+    GltfWriter w = polyhedron_file(polyhedron(0), {test::split_box_mesh({-1, -1, -1}, {1, 1, 1})});
+    const LoadedScene l = test::write_and_load(w, next_name());
+    REQUIRE(l.scene.shapes.size() == 1);
+    CHECK(l.warnings.empty());
+    const Shape& s = l.scene.shapes[0].shape;
+    REQUIRE(s.sdf.polyhedra.size() == 1);
+    CHECK(node_of(s.sdf, SdfKind::Polyhedron).polyhedron == 0);
+    CHECK(s.sdf.polyhedra[0].positions.size() == 8);
+    CHECK(s.lipschitz == Approx(1));
+    test::check_vec(s.sdf_bounds.lo, {-1, -1, -1});
+    test::check_vec(s.sdf_bounds.hi, {1, 1, 1});
+    for (int i = 0; i < 500; ++i) {
+      const Vec3f p{u(rng), u(rng), u(rng)};
+      REQUIRE(sdf_eval(s.sdf, p) == Approx(sdf_eval(box, p)).margin(1e-5));
+    }
+    ShapeHit hit;
+    Ray r;
+    r.org = {0, 0, -5};
+    r.dir = {0, 0, 1};
+    REQUIRE(intersect_shape(s, r, hit));
+    CHECK(hit.t == Approx(4).margin(1e-4));
+  }
+  SECTION("an operand: a cube mesh minus a sphere, as the analytic CSG") {
+    const json ball = sphere(1.25f, {0.3f, 0.2f, 0.1f});
+    GltfWriter w = polyhedron_file(op("subtraction", {polyhedron(0), ball}), {kCube});
+    const Shape s = test::write_and_load(w, next_name()).scene.shapes.at(0).shape;
+    const SdfTree analytic = tree_of(op("subtraction", {{{"type", "box"}, {"size", {2, 2, 2}}}, ball}));
+    for (int i = 0; i < 500; ++i) {
+      const Vec3f p{u(rng), u(rng), u(rng)};
+      REQUIRE(sdf_eval(s.sdf, p) == Approx(sdf_eval(analytic, p)).margin(1e-5));
+    }
+  }
+  SECTION("several TRIANGLES primitives, with and without indices, make one mesh") {
+    // The cube's first three faces indexed, the other three as a triangle soup.
+    GltfWriter w = shape_file(implicit(polyhedron(0)));
+    std::vector<float> first, soup;
+    for (const Vec3f& p : kCube.positions) first.insert(first.end(), {p.x, p.y, p.z});
+    const std::vector<uint32_t> indexed(kCube.indices.begin(), kCube.indices.begin() + 18);
+    for (size_t k = 18; k < kCube.indices.size(); ++k) {
+      const Vec3f p = kCube.positions[kCube.indices[k]];
+      soup.insert(soup.end(), {p.x, p.y, p.z});
+    }
+    w.mesh(w.positions(first), w.indices(indexed));
+    w.j["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", w.positions(soup)}}}});
+    const Shape s = test::write_and_load(w, next_name()).scene.shapes.at(0).shape;
+    CHECK(s.sdf.polyhedra.at(0).positions.size() == 8);
+    CHECK(sdf_eval(s.sdf, {0, 0, 0}) == Approx(-1));
+    CHECK(sdf_eval(s.sdf, {0, 0, 3}) == Approx(2));
+  }
+  SECTION("a mesh used twice is built once and copied; an inward mesh is reversed with a warning") {
+    json moved = polyhedron(0);
+    moved["translation"] = {3, 0, 0};
+    GltfWriter w = polyhedron_file(op("union", {polyhedron(0), moved}), {kCube.flipped()});
+    const LoadedScene l = test::write_and_load(w, next_name());
+    const Shape& s = l.scene.shapes.at(0).shape;
+    REQUIRE(s.sdf.polyhedra.size() == 2);
+    CHECK(s.sdf.polyhedra[0].indices == s.sdf.polyhedra[1].indices);
+    CHECK(sdf_eval(s.sdf, {0, 0, 0}) == Approx(-1));
+    CHECK(sdf_eval(s.sdf, {3, 0, 0}) == Approx(-1));
+    CHECK(sdf_eval(s.sdf, {1.5f, 0, 0}) == Approx(0.5f));
+    REQUIRE(l.warnings.size() == 1);
+    CHECK(l.warnings[0] == kCsg +
+                               ".children[0].mesh: mesh 0 winds inwards (its signed volume is negative); its "
+                               "triangles are taken reversed");
+  }
+  SECTION("the node's transform places the mesh's frame") {
+    json p = polyhedron(0);
+    p["translation"] = {2, 0, 0};
+    p["scale"] = {2, 2, 2};
+    GltfWriter w = polyhedron_file(p, {kCube});
+    const Shape shape = test::write_and_load(w, next_name()).scene.shapes.at(0).shape;
+    // Values pass through transforms: a bound whose Lipschitz constant is 1 / the scale.
+    CHECK(sdf_eval(shape.sdf, {2, 0, 0}) == Approx(-1));
+    CHECK(sdf_eval(shape.sdf, {7, 0, 0}) == Approx(1.5));
+    CHECK(sdf_eval(shape.sdf, {2, 0, 5}) == Approx(1.5));
+    CHECK(shape.lipschitz == Approx(0.5));
+    test::check_vec(shape.sdf_bounds.lo, {0, -2, -2}, 1e-5f);
+    test::check_vec(shape.sdf_bounds.hi, {4, 2, 2}, 1e-5f);
+  }
+}
+
+TEST_CASE("shapes: bad polyhedron nodes and meshes are errors naming the node's mesh member",
+          "[io][gltf][shapes][polyhedron][hostile][quick]") {
+  const std::string mesh = kCsg + ".mesh: ";
+  SECTION("the mesh index: missing, of another type, negative, out of range") {
+    CHECK_THAT(error_of(implicit({{"type", "polyhedron"}})),
+               Contains("scene.gltf: " + mesh +
+                        "is required (the index of the glTF mesh whose triangles bound the solid)"));
+    CHECK_THAT(error_of(implicit({{"type", "polyhedron"}, {"mesh", "0"}})),
+               Contains(mesh + "must be an integer mesh index (got \"0\")"));
+    CHECK_THAT(error_of(implicit({{"type", "polyhedron"}, {"mesh", -1}})),
+               Contains(mesh + "index -1 is negative"));
+    CHECK_THAT(error_of(implicit(polyhedron(0))), Contains(mesh + "mesh 0 out of range (0 meshes)"));
+    GltfWriter w = polyhedron_file(polyhedron(3), {kCube});
+    CHECK_THAT(load_error(w), Contains(mesh + "mesh 3 out of range (1 meshes)"));
+    CHECK_THAT(error_of(implicit({{"type", "polyhedron"}, {"mesh", 0}, {"radius", 1}})),
+               Contains(kCsg + ".radius: does not apply to a \"polyhedron\" CSG node"));
+  }
+  SECTION("an open mesh, as the second operand") {
+    test::TriMesh open = kCube;
+    open.indices.erase(open.indices.begin(), open.indices.begin() + 3);
+    GltfWriter w = polyhedron_file(op("subtraction", {polyhedron(0), polyhedron(1)}), {kCube, open});
+    CHECK_THAT(load_error(w),
+               EndsWith("scene.gltf: nodes[0].extensions.PENUMBRA_shapes.csg.children[1].mesh: mesh 1 "
+                        "is not closed: edge (0, 4) is used by 1 triangle"));
+  }
+  SECTION("inconsistent winding, non-manifold edges, no volume") {
+    test::TriMesh bad = kCube;
+    std::swap(bad.indices[1], bad.indices[2]);
+    GltfWriter w = polyhedron_file(polyhedron(0), {bad});
+    CHECK_THAT(load_error(w),
+               EndsWith(mesh + "mesh 0 is not consistently oriented: edge (0, 4) is used by 2 triangles in "
+                               "the same direction (4 -> 0)"));
+    test::TriMesh two = test::box_mesh({0, 0, 0}, {1, 1, 1});
+    two.append(test::box_mesh({1, 1, 0}, {2, 2, 1}));
+    GltfWriter w2 = polyhedron_file(polyhedron(0), {two});
+    CHECK_THAT(load_error(w2), Contains(mesh + "mesh 0 is not closed: edge (3, 7) is used by 4 triangles"));
+    const test::TriMesh sheet{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2, 0, 2, 1}};
+    GltfWriter w3 = polyhedron_file(polyhedron(0), {sheet});
+    CHECK_THAT(load_error(w3), EndsWith(mesh + "mesh 0 encloses no volume (signed volume 0)"));
+  }
+  SECTION("a non-finite vertex") {
+    test::TriMesh bad = kCube;
+    bad.positions[3].y = std::numeric_limits<float>::quiet_NaN();
+    GltfWriter w = polyhedron_file(polyhedron(0), {bad});
+    CHECK_THAT(load_error(w), EndsWith(mesh + "mesh 0 has a non-finite vertex 3 (1, nan, -1)"));
+  }
+  SECTION("primitives other than TRIANGLES, or without POSITION") {
+    for (int mode : {1, 5}) {
+      GltfWriter w = shape_file(implicit(polyhedron(0)));
+      add_tri_mesh(w, kCube, mode);
+      CHECK_THAT(load_error(w), EndsWith(mesh + "mesh 0's primitives[0] has mode " + std::to_string(mode) +
+                                         (mode == 1 ? " (LINES)" : " (TRIANGLE_STRIP)") +
+                                         "; a polyhedron needs TRIANGLES (mode 4) primitives"));
+    }
+    GltfWriter w = polyhedron_file(polyhedron(0), {kCube});
+    w.j["meshes"][0]["primitives"].push_back({{"attributes", json::object()}});
+    CHECK_THAT(load_error(w), EndsWith(mesh + "mesh 0's primitives[1] has no POSITION attribute"));
+  }
+  SECTION("more than kMaxPolyhedronTriangles triangles") {
+    // Positions from an accessor without a bufferView (all zeros), not indexed.
+    GltfWriter w = shape_file(implicit(polyhedron(0)));
+    w.j["accessors"].push_back({{"componentType", 5126}, {"count", 3 * 65537}, {"type", "VEC3"}});
+    w.j["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}});
+    CHECK_THAT(load_error(w),
+               EndsWith(mesh + "mesh 0 has more than 65536 triangles (the most a polyhedron may have)"));
+  }
+  SECTION("the shape's inside is checked once the solids are built") {
+    GltfWriter w = polyhedron_file(op("intersection", {polyhedron(0), sphere(1, {5, 0, 0})}), {kCube});
+    CHECK_THAT(load_error(w),
+               EndsWith(kCsg + ": the shape's inside is empty (the parts it intersects do not overlap)"));
+  }
+}
+
+TEST_CASE("shapes: a polyhedron's solid is charged to the memory budget",
+          "[io][gltf][shapes][polyhedron][hostile]") {
+  // The same file but for the CSG (a ring mesh's polyhedron, or a sphere with the mesh unused),
+  // its buffer external so that the end of the load is its peak.
+  const test::TriMesh ring = test::ring_mesh(1, 0.35f, 48, 24);
+  const auto file = [&](bool use_mesh) {
+    GltfWriter w = polyhedron_file(use_mesh ? polyhedron(0) : sphere(1), {ring});
+    const auto dir = test::temp_dir(next_name());
+    w.write_external(dir / "scene.gltf", "scene.bin");
+    return dir / "scene.gltf";
+  };
+  const auto with_mesh = file(true), without = file(false);
+  const auto loads = [](const std::filesystem::path& path, uint64_t budget, std::string* error) {
+    GltfLoadOptions opt;
+    opt.max_memory_bytes = budget;
+    try {
+      load_gltf(path, opt);
+      return true;
+    } catch (const InputError& e) {
+      if (error) *error = e.what();
+      return false;
+    }
+  };
+  const auto smallest = [&](const std::filesystem::path& path) {
+    uint64_t lo = 1, hi = 1ull << 30;
+    REQUIRE(loads(path, hi, nullptr));
+    while (hi - lo > 1) {
+      const uint64_t mid = lo + (hi - lo) / 2;
+      (loads(path, mid, nullptr) ? hi : lo) = mid;
+    }
+    return hi;
+  };
+  const uint64_t plain = smallest(without), solid = smallest(with_mesh);
+  const SolidMesh expected = build_solid_mesh(ring.positions, ring.indices);
+  CHECK(solid >= plain + solid_mesh_bytes(expected));
+  std::string error;
+  REQUIRE_FALSE(loads(with_mesh, plain, &error));
+  CHECK_THAT(error, Contains(kCsg + ".mesh: mesh 0's") && Contains("over the"));
+}
+
+TEST_CASE("shapes: polyhedra come back through write_gltf", "[io][gltf][shapes][polyhedron][quick]") {
+  json moved = polyhedron(0);
+  moved["translation"] = {0.5f, 0, 0};
+  GltfWriter w = polyhedron_file(op("subtraction", {polyhedron(0), moved}), {test::l_prism_mesh()});
+  w.node({{"extensions", {{"PENUMBRA_shapes", implicit(polyhedron(0))}}}});
+  const LoadedScene first = test::write_and_load(w, next_name());
+  REQUIRE(first.scene.shapes.size() == 2);
+  const auto dir = test::temp_dir(next_name());
+  write_gltf(first.scene, dir / "again.gltf");
+  const LoadedScene second = load_gltf(dir / "again.gltf");
+  REQUIRE(second.scene.shapes.size() == 2);
+  CHECK(second.warnings.empty());
+  std::mt19937 rng(32);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  for (size_t k = 0; k < 2; ++k) {
+    const SdfTree& a = first.scene.shapes[k].shape.sdf;
+    const SdfTree& b = second.scene.shapes[k].shape.sdf;
+    REQUIRE(b.polyhedra.size() == a.polyhedra.size());
+    CHECK(b.polyhedra[0].positions.size() == a.polyhedra[0].positions.size());
+    for (int i = 0; i < 300; ++i) {
+      const Vec3f p{u(rng), u(rng), u(rng)};
+      REQUIRE(sdf_eval(b, p) == sdf_eval(a, p));
+    }
+  }
 }

@@ -81,7 +81,10 @@ TEST_CASE("gather_primitives: mesh order, ids, and non-finite triangles dropped"
   const std::vector<uint32_t> bi{0, 1, 2, 2, 1, 0};
   Shape sphere;
   sphere.radius = 2;
-  const Shape unbounded = make_implicit_shape(SdfTree{{SdfNode{SdfKind::HalfSpace}}, {}, {}, 0});
+  SdfTree half_space;
+  half_space.nodes = {SdfNode{SdfKind::HalfSpace}};
+  half_space.root = 0;
+  const Shape unbounded = make_implicit_shape(half_space);
   const std::vector<GeometryView> views{{a, ai}, {{}, {}, &unbounded}, {b, bi}, {{}, {}, &sphere}};
   std::vector<Shape> shapes;
   const std::vector<PrimitiveRecord> tris = gather_primitives(views, shapes);

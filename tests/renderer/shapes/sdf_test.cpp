@@ -495,3 +495,125 @@ TEST_CASE("sdf: grazing rays hit displaced spheres of zero and tiny amplitude as
     }
   }
 }
+
+namespace {
+
+void test_vec_near(Vec3f a, Vec3f b, float eps = 1e-5f) {
+  CHECK(a.x == Approx(b.x).margin(eps));
+  CHECK(a.y == Approx(b.y).margin(eps));
+  CHECK(a.z == Approx(b.z).margin(eps));
+}
+
+}  // namespace
+
+TEST_CASE("sdf: a polyhedron of a cube mesh gives the box's exact signed distance",
+          "[shapes][sdf][polyhedron][quick]") {
+  SdfTree t;
+  t.root = add_node(t, sdf_polyhedron(t, box_mesh({-1, -1, -1}, {1, 1, 1})));
+  // Faces, edges, corners and the inside, against the closed form.
+  CHECK(sdf_eval(t, {3, 0, 0}) == Approx(2));
+  CHECK(sdf_eval(t, {0, 0, -4}) == Approx(3));
+  CHECK(sdf_eval(t, {2, 2, 0}) == Approx(std::sqrt(2.0f)));
+  CHECK(sdf_eval(t, {2, 2, 2}) == Approx(std::sqrt(3.0f)));
+  CHECK(sdf_eval(t, {0.5f, 0, 0}) == Approx(-0.5f));
+  CHECK(sdf_eval(t, {0, 0, 0}) == Approx(-1));
+  CHECK(sdf_eval(t, {0, 0.25f, 0.9f}) == Approx(-0.1f));
+  CHECK(sdf_lipschitz(t) == Approx(1));
+  const Bounds3f b = sdf_tree_bounds(t);
+  test_vec_near(b.lo, {-1, -1, -1});
+  test_vec_near(b.hi, {1, 1, 1});
+  // Everywhere, for the shared, the split (24-vertex) and the inward-wound mesh, moved and turned.
+  const SdfTree box = single_shape(sdf_primitive(SdfKind::Box, {1, 1, 1}));
+  SdfTree split, inward, moved, moved_box = box;
+  split.root = add_node(split, sdf_polyhedron(split, split_box_mesh({-1, -1, -1}, {1, 1, 1})));
+  inward.root = add_node(inward, sdf_polyhedron(inward, box_mesh({-1, -1, -1}, {1, 1, 1}).flipped()));
+  SdfNode m = sdf_polyhedron(moved, box_mesh({-1, -1, -1}, {1, 1, 1}));
+  Affine3f turn = moved_by({0.5f, -1, 2});
+  const float c = std::cos(0.4f), s = std::sin(0.4f);
+  turn.m[0][0] = c, turn.m[0][1] = -s, turn.m[1][0] = s, turn.m[1][1] = c;
+  m.to_local = turn;
+  moved.root = add_node(moved, m);
+  moved_box.nodes[0].to_local = turn;
+  std::mt19937 rng(21);
+  int gradients = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3f p = random_point(rng, 3);
+    const float expected = sdf_eval(box, p);
+    REQUIRE(sdf_eval(t, p) == Approx(expected).margin(1e-5));
+    REQUIRE(sdf_eval(split, p) == Approx(expected).margin(1e-5));
+    REQUIRE(sdf_eval(inward, p) == Approx(expected).margin(1e-5));
+    REQUIRE(sdf_eval(moved, p) == Approx(sdf_eval(moved_box, p)).margin(1e-5));
+    // The gradient where the box's is unique (central differences at two steps agree).
+    const Vec3f n1 = sdf_normal(box, p, 1e-3f), n2 = sdf_normal(box, p, 2e-3f);
+    if (!(dot(n1, n2) > 0.99999f)) continue;
+    REQUIRE(dot(sdf_gradient_normal(t, p), sdf_gradient_normal(box, p)) > 0.999f);
+    ++gradients;
+  }
+  CHECK(gradients > 4000);
+}
+
+TEST_CASE("sdf: polyhedra of concave meshes are Lipschitz 1", "[shapes][sdf][polyhedron][quick]") {
+  std::mt19937 rng(22);
+  for (const TriMesh& mesh : {l_prism_mesh(), ring_mesh(1, 0.35f, 24, 12), icosphere_mesh(1, 1.8f)}) {
+    SdfTree t;
+    SdfNode n = sdf_polyhedron(t, mesh);
+    n.to_local = moved_by({0.2f, 0.1f, -0.3f});
+    t.root = add_node(t, n);
+    REQUIRE(sdf_lipschitz(t) == Approx(1));
+    int inside = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3f x = random_point(rng, 2.2f), y = x + random_point(rng, 0.3f);
+      const float fx = sdf_eval(t, x);
+      inside += fx < 0;
+      REQUIRE(std::abs(fx - sdf_eval(t, y)) <= length(x - y) + 1e-5f);
+    }
+    CHECK(inside > 100);
+  }
+}
+
+TEST_CASE("sdf: sphere tracing a cube mesh minus a sphere agrees with the analytic CSG",
+          "[shapes][sdf][polyhedron][quick]") {
+  const auto cube_minus_sphere = [](bool mesh) {
+    SdfTree t;
+    const int cube = add_node(t, mesh ? sdf_polyhedron(t, box_mesh({-1, -1, -1}, {1, 1, 1}))
+                                      : sdf_primitive(SdfKind::Box, {1, 1, 1}));
+    SdfNode ball = sdf_primitive(SdfKind::Sphere, {1.25f, 0, 0});
+    ball.to_local = moved_by({0.3f, 0.2f, 0.1f});
+    t.root = add_node(t, sdf_operator(SdfKind::Subtraction, cube, add_node(t, ball)));
+    return make_implicit_shape(t);
+  };
+  const Shape mesh = cube_minus_sphere(true), analytic = cube_minus_sphere(false);
+  CHECK(mesh.lipschitz == analytic.lipschitz);
+  test_vec_near(mesh.sdf_bounds.lo, analytic.sdf_bounds.lo);
+  test_vec_near(mesh.sdf_bounds.hi, analytic.sdf_bounds.hi);
+  std::mt19937 rng(23);
+  std::normal_distribution<float> g;
+  int hits = 0, misses = 0, disagreements = 0, normals = 0;
+  for (int i = 0; i < 2000; ++i) {
+    Ray r;
+    r.org = normalize(Vec3f{g(rng), g(rng), g(rng)}) * 5;
+    r.dir = random_point(rng, 1.3f) - r.org;
+    ShapeHit hm, ha;
+    const bool a = intersect_shape(analytic, r, ha), m = intersect_shape(mesh, r, hm);
+    if (a != m) {
+      ++disagreements;
+      continue;
+    }
+    if (!a) {
+      ++misses;
+      continue;
+    }
+    ++hits;
+    REQUIRE(hm.t * length(r.dir) == Approx(ha.t * length(r.dir)).margin(1e-3));
+    const Vec3f p = r.org + r.dir * ha.t;
+    const Vec3f n1 = sdf_normal(analytic.sdf, p, 1e-3f), n2 = sdf_normal(analytic.sdf, p, 2e-3f);
+    if (!(dot(n1, n2) > 0.9999f)) continue;  // an edge of the cube or of the cut
+    CHECK(dot(shape_surface(mesh, r.org + r.dir * hm.t, 1e-3f).n, shape_surface(analytic, p, 1e-3f).n) >
+          0.99f);
+    ++normals;
+  }
+  CHECK(disagreements <= 2);  // rays grazing an edge within the tracing tolerance
+  CHECK(hits > 800);
+  CHECK(misses > 100);
+  CHECK(normals > 600);
+}
