@@ -146,7 +146,8 @@ StructureSah measure_structure_sah(std::string_view name, std::span<const Geomet
     out.note = "Embree does not expose its nodes";
     return out;
   }
-  if (name != "bvh" && name != "kdtree") {
+  const bool reports_terms = name == "kdtree" || name == "octree" || name == "bsp";
+  if (name != "bvh" && !reports_terms) {
     out.note = std::string(name) + " is not a tree";
     return out;
   }
@@ -155,12 +156,12 @@ StructureSah measure_structure_sah(std::string_view name, std::span<const Geomet
     out.note = "two-level build (placed instances): the top level is not visible";
     return out;
   }
-  if (name == "kdtree") {
+  if (reports_terms) {
     const AccelStats st = built.stats();
     if (st.sah_node_area + st.sah_leaf_area > 0)
       out.terms = SahTerms{st.sah_node_area, st.sah_leaf_area};
     else
-      out.note = "the kD-tree reports no SAH terms";
+      out.note = "the " + std::string(name) + " reports no SAH terms";
     if (out.terms) out.cost = sah_cost(*out.terms, constants);
     return out;
   }

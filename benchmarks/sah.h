@@ -57,8 +57,9 @@ struct StructureSah {
 ///    and settings (its shape never depends on scheduling), at the width `built` reports; used only
 ///    if those terms under the builder's own constants and leaf blocks give its
 ///    AccelStats::sah_cost (relative 1e-6), so the figure is the measured tree's.
-///  - "kdtree": the constant-free terms its statistics report (AccelStats::sah_node_area and
-///    sah_leaf_area, summed over its nodes as it flattens them).
+///  - "kdtree", "octree", "bsp": the constant-free terms their statistics report
+///    (AccelStats::sah_node_area and sah_leaf_area, summed over their nodes as they flatten
+///    them; the BSP's areas are those of its convex cells).
 ///  - "embree" (no access to its nodes), "grid", "brute" (no tree): n/a.
 ///  - Two-level builds (some instance not the identity): n/a (the top level is not visible).
 /// Throws what make_accelerator throws for these inputs.

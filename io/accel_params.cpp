@@ -53,6 +53,9 @@ std::vector<AccelParamInfo> accel_param_keys() {
       {"kdtree.intersection_cost", num(d.kdtree.intersection_cost), "K_I, > 0"},
       {"kdtree.empty_bonus", num(d.kdtree.empty_bonus), "cost reduction for an empty side, [0, 1)"},
       {"kdtree.max_depth", std::to_string(d.kdtree.max_depth), "[0, 64]; 0 = 8 + 1.3 log2 N"},
+      {"octree.max_leaf_prims", std::to_string(d.octree.max_leaf_prims),
+       "a node with more primitives is subdivided, [1, 1024]"},
+      {"octree.max_depth", std::to_string(d.octree.max_depth), "depth limit (root = 0), [1, 20]"},
       {"grid.lambda", num(d.grid.lambda), "cells per triangle of the finest grids, (0, 64]"},
       {"grid.coarse_lambda", num(d.grid.coarse_lambda),
        "cells per triangle of grids with sub-grids, (0, 64]"},
@@ -99,6 +102,10 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.kdtree.empty_bonus = parse_value<float>(key, value);
   else if (key == "kdtree.max_depth")
     c.kdtree.max_depth = parse_value<int>(key, value);
+  else if (key == "octree.max_leaf_prims")
+    c.octree.max_leaf_prims = parse_value<int>(key, value);
+  else if (key == "octree.max_depth")
+    c.octree.max_depth = parse_value<int>(key, value);
   else if (key == "grid.lambda")
     c.grid.lambda = parse_value<float>(key, value);
   else if (key == "grid.coarse_lambda")

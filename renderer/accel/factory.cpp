@@ -11,7 +11,7 @@
 namespace penumbra {
 
 std::vector<std::string> accelerator_names() {
-  return {"embree", "bvh", "kdtree", "grid", "brute"};
+  return {"embree", "bvh", "kdtree", "grid", "octree", "brute"};
 }
 
 namespace {
@@ -30,6 +30,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   if (name == "bvh") return make_bvh_accelerator(meshes, config.bvh);
   if (name == "kdtree") return make_kdtree_accelerator(meshes, config.kdtree);
   if (name == "grid") return make_grid_accelerator(meshes, config.grid);
+  if (name == "octree") return make_octree_accelerator(meshes, config.octree);
   if (name == "brute") return make_brute_accelerator(meshes);
   throw_unknown(name);
 }

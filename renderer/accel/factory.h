@@ -1,5 +1,5 @@
 // Choosing an acceleration structure by name: the one place that maps "embree", "bvh",
-// "kdtree", "grid" and "brute" to their builders, with each builder's configuration.
+// "kdtree", "grid", "octree" and "brute" to their builders, with each builder's configuration.
 #pragma once
 
 #include <memory>
@@ -13,6 +13,7 @@
 #include "renderer/accel/embree.h"
 #include "renderer/accel/grid.h"
 #include "renderer/accel/kdtree.h"
+#include "renderer/accel/octree.h"
 
 namespace penumbra {
 
@@ -22,6 +23,7 @@ struct AccelConfig {
   BvhConfig bvh;
   KdTreeConfig kdtree;
   GridConfig grid;
+  OctreeConfig octree;
 };
 
 /// Names accepted by make_accelerator, default ("embree") first.

@@ -318,6 +318,24 @@ inline std::vector<Ray> camera_rays(const Bounds3f& b, int n) {
   return rays;
 }
 
+/// Axis-parallel rays on the lines x, y in {lo, lo + step, ...} along +z and -z (and the other
+/// two axes): they run through vertices, along edges and inside the planes of walls.
+inline std::vector<Ray> lattice_rays(float lo, float hi, float step) {
+  std::vector<Ray> rays;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float a = lo; a <= hi; a += step)
+      for (float b = lo; b <= hi; b += step)
+        for (float sign : {1.0f, -1.0f}) {
+          Vec3f o, d;
+          o[axis] = sign > 0 ? lo - 1 : hi + 1;
+          o[(axis + 1) % 3] = a;
+          o[(axis + 2) % 3] = b;
+          d[axis] = sign;
+          rays.push_back({o, 0, d, kInfinity});
+        }
+  return rays;
+}
+
 /// Rays with origins in (a box around) `b` and uniform directions; every fourth is a segment.
 inline std::vector<Ray> random_rays(const Bounds3f& b, int n, std::mt19937& rng) {
   const Bounds3f g = grown(b, 0.25f);

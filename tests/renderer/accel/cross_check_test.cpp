@@ -30,24 +30,6 @@ std::vector<Vec3f> light_positions(const Scene& s) {
   return out;
 }
 
-/// Axis-parallel rays on the lines x, y in {lo, lo + step, ...} along +z and -z (and the other
-/// two axes): they run through vertices, along edges and inside the planes of walls.
-std::vector<Ray> lattice_rays(float lo, float hi, float step) {
-  std::vector<Ray> rays;
-  for (int axis = 0; axis < 3; ++axis)
-    for (float a = lo; a <= hi; a += step)
-      for (float b = lo; b <= hi; b += step)
-        for (float sign : {1.0f, -1.0f}) {
-          Vec3f o, d;
-          o[axis] = sign > 0 ? lo - 1 : hi + 1;
-          o[(axis + 1) % 3] = a;
-          o[(axis + 2) % 3] = b;
-          d[axis] = sign;
-          rays.push_back({o, 0, d, kInfinity});
-        }
-  return rays;
-}
-
 }  // namespace
 
 // ---- Synthetic scenes ---------------------------------------------------------------------------

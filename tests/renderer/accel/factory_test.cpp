@@ -41,9 +41,9 @@ TEST_CASE("empty scenes build and miss", "[accel][quick]") {
   CHECK_THROWS_AS(make_accelerator("octree-of-dreams", {}), std::invalid_argument);
 }
 
-TEST_CASE("the factory knows five back ends, embree first, and refuses bad configurations",
-          "[accel][quick]") {
-  CHECK(accelerator_names() == std::vector<std::string>{"embree", "bvh", "kdtree", "grid", "brute"});
+TEST_CASE("the factory knows its back ends, embree first, and refuses bad configurations", "[accel][quick]") {
+  CHECK(accelerator_names() ==
+        std::vector<std::string>{"embree", "bvh", "kdtree", "grid", "octree", "brute"});
   AccelConfig bad_bvh;
   bad_bvh.bvh.max_leaf_size = 0;
   CHECK_THROWS_AS(make_accelerator("bvh", {}, bad_bvh), std::invalid_argument);
@@ -53,6 +53,10 @@ TEST_CASE("the factory knows five back ends, embree first, and refuses bad confi
   AccelConfig bad_grid;
   bad_grid.grid.lambda = 0;
   CHECK_THROWS_AS(make_accelerator("grid", {}, bad_grid), std::invalid_argument);
+  AccelConfig bad_octree;
+  bad_octree.octree.max_depth = 21;
+  CHECK_THROWS_WITH(make_accelerator("octree", {}, bad_octree),
+                    Catch::Contains("octree: max_depth must be in [1, 20], got 21"));
   AccelConfig bad_embree;
   bad_embree.embree.quality = 3;
   CHECK_THROWS_WITH(make_accelerator("embree", {}, bad_embree), Catch::Contains("embree: quality"));

@@ -1,0 +1,394 @@
+// Octree. Regular 8-way subdivision of the scene box at each node's centre, each primitive
+// referenced by the children its part inside the node meets (Sutherland-Hodgman clipping, as the
+// kD-tree's perfect splits). Traversal: J. Revelles, C. Urena and M. Lastra, "An Efficient
+// Parametric Algorithm for Octree Traversal", WSCG 2000: a child's t-interval is its parent's
+// intersected, per axis, with the half-line before or after the mid-plane parameter
+// tm_k = (mid_k - o_k) * (1 / d_k); children are visited in order of entry. Node layout after
+// the kD-tree's (renderer/accel/kdtree.cpp).
+#include "renderer/accel/octree.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "renderer/accel/clip.h"
+#include "renderer/accel/common.h"
+#include "renderer/accel/stats.h"
+
+namespace penumbra {
+namespace {
+
+constexpr int kMaxLeafPrimsLimit = 1024;
+constexpr int kMaxDepthLimit = 20;
+constexpr uint32_t kInterior = ~0u;  // OctNode::count of an interior node
+// Each interior node on the path pushes at most 7 children; interior nodes lie above max_depth.
+constexpr int kStackSize = 7 * kMaxDepthLimit + 1;
+// An axis narrower than this many rounding bands is not split (see splits()).
+constexpr float kMinSplitBands = 4;
+// The SAH constants of the statistics: the kD-tree's defaults (K_T, K_I of Wald & Havran 2006).
+constexpr double kTraversalCost = 15;
+constexpr double kIntersectionCost = 20;
+
+/// Flattened node, 8 bytes. The eight children of an interior node are adjacent (64 bytes), in
+/// child order c = x + 2 y + 4 z, where a set bit means the upper half along that axis.
+struct OctNode {
+  uint32_t index;  // 4 bytes: interior: index of child 0; leaf: first of its records
+  uint32_t count;  // 4 bytes: leaf: number of records (0: an empty leaf); interior: kInterior
+  bool leaf() const { return count != kInterior; }
+};
+static_assert(sizeof(OctNode) == 8, "OctNode must stay 8 bytes");
+
+// ---- Subdivision, shared by build and traversal ------------------------------------------------
+
+/// The centre of [lo, hi] along one axis, as build and traversal both compute it: the halves
+/// summed (no overflow at huge coordinates), clamped into [lo, hi].
+inline float centre(float lo, float hi) {
+  return std::clamp(0.5f * lo + 0.5f * hi, lo, hi);
+}
+
+/// An axis is split only if its centre lies strictly inside it and it is wider than
+/// kMinSplitBands rounding bands (children are widened by one band on each side: a narrower
+/// axis would give children as wide as their parent). Along an axis that is not split (a flat
+/// box, one a float wide, or one within rounding of a point) the lower children span the whole
+/// axis and the upper children are empty leaves.
+inline bool splits(float lo, float mid, float hi, float band) {
+  return lo < mid && mid < hi && hi - lo > kMinSplitBands * band;
+}
+
+/// Whether some axis of `box` is split (else its one child would be the box itself).
+inline bool splits_any(const Bounds3f& box, float band) {
+  for (int k = 0; k < 3; ++k)
+    if (splits(box.lo[k], centre(box.lo[k], box.hi[k]), box.hi[k], band)) return true;
+  return false;
+}
+
+/// Child c's range along one axis of a node spanning [lo, hi] with centre `mid`, where `upper`
+/// is bit k of c; empty (lo > hi) for an upper child along an axis that is not split.
+inline void child_range(float lo, float mid, float hi, float band, bool upper, float& child_lo,
+                        float& child_hi) {
+  if (!splits(lo, mid, hi, band)) {
+    child_lo = upper ? kInfinity : lo;
+    child_hi = upper ? -kInfinity : hi;
+  } else {
+    child_lo = upper ? mid : lo;
+    child_hi = upper ? hi : mid;
+  }
+}
+
+/// The box of child c of `box` (bit k of c: the upper half along axis k); empty for an upper
+/// child along an axis that is not split.
+Bounds3f child_box(const Bounds3f& box, float band, int c) {
+  Bounds3f b;
+  for (int k = 0; k < 3; ++k) {
+    child_range(box.lo[k], centre(box.lo[k], box.hi[k]), box.hi[k], band, (c >> k) & 1, b.lo[k], b.hi[k]);
+    if (b.lo[k] > b.hi[k]) return Bounds3f{};
+  }
+  return b;
+}
+
+// ---- Build ------------------------------------------------------------------------------------
+
+struct BuildNode {
+  std::array<std::unique_ptr<BuildNode>, 8> children;  // interior only
+  std::vector<uint32_t> prims;                         // leaf only, ascending
+  bool leaf = true;
+};
+
+class Builder {
+ public:
+  Builder(const OctreeConfig& c, const std::vector<PrimitiveRecord>& prims, float band)
+      : m_config(c), m_prims(prims), m_band(band) {
+    m_bounds.reserve(prims.size());
+    for (const PrimitiveRecord& p : prims) m_bounds.push_back(primitive_bounds(p));
+  }
+
+  /// The subtree over primitives `ids` (ascending) in `box` at `depth`. Its shape depends on
+  /// the input alone, never on scheduling.
+  std::unique_ptr<BuildNode> build(std::vector<uint32_t> ids, const Bounds3f& box, int depth) const {
+    auto node = std::make_unique<BuildNode>();
+    const size_t n = ids.size();
+    if (n <= size_t(m_config.max_leaf_prims) || depth >= m_config.max_depth || !splits_any(box, m_band)) {
+      node->prims = std::move(ids);
+      return node;
+    }
+    // Phase 1: each child references the primitives whose part inside its box, widened by the
+    // rounding band, is not empty.
+    const Vec3f band{m_band, m_band, m_band};
+    std::array<Bounds3f, 8> boxes, wide;
+    for (int c = 0; c < 8; ++c) {
+      boxes[c] = child_box(box, m_band, c);
+      if (!boxes[c].empty()) wide[c] = {boxes[c].lo - band, boxes[c].hi + band};
+    }
+    std::array<std::vector<uint32_t>, 8> kids;
+    for (const uint32_t id : ids)
+      for (int c = 0; c < 8; ++c)
+        if (!boxes[c].empty() && references(id, wide[c])) kids[c].push_back(id);
+    // Phase 2: no progress (every child holds all of the primitives or none, and more than one
+    // holds them all): a leaf. One full child is kept: it cuts off empty space.
+    int full = 0;
+    bool separated = false;
+    for (int c = 0; c < 8; ++c) {
+      full += kids[c].size() == n;
+      separated = separated || (!kids[c].empty() && kids[c].size() < n);
+    }
+    if (!separated && full != 1) {
+      node->prims = std::move(ids);
+      return node;
+    }
+    // Phase 3: recurse; large nodes build their children in parallel.
+    std::vector<uint32_t>().swap(ids);
+    node->leaf = false;
+    const auto make_child = [&](int c) {
+      node->children[c] = build(std::move(kids[c]), boxes[c], depth + 1);
+    };
+    if (n >= m_config.parallel_threshold) {
+      tbb::parallel_for(0, 8, make_child);
+    } else {
+      for (int c = 0; c < 8; ++c) make_child(c);
+    }
+    return node;
+  }
+
+ private:
+  /// Whether clip_primitive_bounds(primitive id, box) is not empty. The bounding-box tests
+  /// settle the cases clipping would (disjoint: nothing kept; contained: nothing clipped).
+  bool references(uint32_t id, const Bounds3f& box) const {
+    const Bounds3f& b = m_bounds[id];
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      if (b.hi[k] < box.lo[k] || b.lo[k] > box.hi[k]) return false;
+      inside = inside && b.lo[k] >= box.lo[k] && b.hi[k] <= box.hi[k];
+    }
+    return inside || !clip_primitive_bounds(m_prims[id], box).empty();
+  }
+
+  const OctreeConfig& m_config;
+  const std::vector<PrimitiveRecord>& m_prims;
+  std::vector<Bounds3f> m_bounds;  // primitive_bounds of each primitive
+  float m_band;                    // child boxes are widened by this before clipping
+};
+
+// ---- The accelerator ----------------------------------------------------------------------------
+
+class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
+  friend class TraversalAccelerator<OctreeAccelerator>;
+
+ public:
+  OctreeAccelerator(std::span<const GeometryView> views, const OctreeConfig& config) : m_config(config) {
+    validate(config);
+    const BuildTimer timer;
+    const std::vector<PrimitiveRecord> prims = gather_primitives(views, m_shapes);
+    m_input_triangles = count_input_triangles(views);
+    if (prims.size() >= kInterior) throw std::runtime_error("octree: too many primitives (max 2^32 - 2)");
+    if (!prims.empty()) {
+      for (const PrimitiveRecord& p : prims) m_bounds = merge(m_bounds, primitive_bounds(p));
+      m_band = rounding_band(m_bounds);
+      m_clip = widen_for_rounding(m_bounds);
+      m_root_area = surface_area(m_bounds);
+      std::vector<uint32_t> all(prims.size());
+      std::iota(all.begin(), all.end(), 0u);
+      const Builder builder(m_config, prims, m_band);
+      const auto root = builder.build(std::move(all), m_bounds, 0);
+      m_nodes.emplace_back();
+      flatten(*root, 0, m_bounds, 0, prims);
+      if (m_nodes.size() >= kInterior || m_leaf_prims.size() >= kInterior)
+        throw std::runtime_error("octree: tree too large (2^32 - 1 or more nodes or references)");
+      m_tally.fill(m_stats);
+    }
+    m_build_seconds = timer.seconds();
+  }
+
+  Bounds3f bounds() const override { return m_bounds; }
+
+  AccelStats stats() const override {
+    AccelStats s = make_stats(
+        m_stats, "octree",
+        "max_leaf_prims " + std::to_string(m_config.max_leaf_prims) + ", max_depth " +
+            std::to_string(m_config.max_depth),
+        m_input_triangles, m_nodes.size() * sizeof(OctNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
+        m_build_seconds);
+    s.nodes = m_nodes.size();
+    s.shapes = m_shapes.size();
+    return s;
+  }
+
+ private:
+  /// A node to visit: its index, the part [t0, t1] of the ray that may lie in it, and its box
+  /// (plain arrays: the traversal stack is never initialised as a whole).
+  struct Todo {
+    uint32_t node;
+    float t0, t1;
+    float lo[3], hi[3];
+  };
+
+  /// Front-to-back traversal with early exit: a node whose interval starts beyond `best`
+  /// (narrowed by closest-hit visitors) is skipped. `visit(w, rec)` returns true to stop
+  /// (any-hit). Returns true iff a visitor stopped it. Occlusion queries (AnyHit) take the same
+  /// order.
+  template <typename Visit, typename Counter, bool AnyHit>
+  bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
+                std::bool_constant<AnyHit>) const {
+    const WatertightRay w = prepare_watertight(ray);
+    if (!w.valid || m_nodes.empty()) return false;
+    const RayBoxQuery q = prepare_box_query(ray);
+    float t0 = w.tnear, t1 = ray.tfar;
+    if (!intersect_box(m_clip.lo, m_clip.hi, q, t0, t1)) return false;
+    Todo todo[kStackSize];
+    int sp = 0;
+    Todo cur{0,
+             t0,
+             t1,
+             {m_bounds.lo.x, m_bounds.lo.y, m_bounds.lo.z},
+             {m_bounds.hi.x, m_bounds.hi.y, m_bounds.hi.z}};
+    Mailbox mailbox;
+    for (;;) {
+      if (!(best < cur.t0)) {
+        const OctNode& node = m_nodes[cur.node];
+        counter.node();
+        if (node.leaf()) {
+          const PrimitiveRecord* recs = m_leaf_prims.data() + node.index;
+          for (uint32_t i = 0; i < node.count; ++i)
+            if (!mailbox.seen(recs[i]) && visit(w, recs[i])) return true;
+        } else {
+          Todo kids[8];
+          const int n = children(node, cur, q, best, kids);
+          if (n > 0) {
+            for (int i = n - 1; i >= 1; --i) todo[sp++] = kids[i];
+            cur = kids[0];
+            continue;
+          }
+        }
+      }
+      if (sp == 0) return false;
+      cur = todo[--sp];
+    }
+  }
+
+  /// The children of interior node `node` (interval and box in `cur`) that may hold part of the
+  /// ray before `best`, written to `out` in order of entry distance (ties in child order);
+  /// returns their number. Empty leaves are left out.
+  ///
+  /// Per axis k, the near side of the mid plane (below it for d_k > 0, above for d_k < 0) gets
+  /// (-inf, tm_k] and the far side [tm_k, +inf), tm_k padded outward by kSlabPad as
+  /// intersect_box pads; a child's interval is the node's intersected with its sides' along all
+  /// three axes (Revelles et al. 2000). Conservative rules keep every hit brute force reports:
+  /// an origin within the rounding band of the plane gives both sides (-inf, inf); a ray
+  /// parallel to the plane (1/d_k infinite, as in intersect_box) gives the origin's side
+  /// (-inf, inf) and the other nothing.
+  int children(const OctNode& node, const Todo& cur, const RayBoxQuery& q, float best, Todo* out) const {
+    float start[3][2], end[3][2], mid[3];
+    for (int k = 0; k < 3; ++k) {
+      const float lo = cur.lo[k], hi = cur.hi[k];
+      mid[k] = centre(lo, hi);
+      int only = -1;  // the one side the ray can be in, or -1 for both
+      float t_exit = kInfinity, t_enter = -kInfinity;
+      const float delta = mid[k] - q.org[k];
+      const float tm = delta * q.inv_dir[k];
+      if (!splits(lo, mid[k], hi, m_band)) {
+        only = 0;  // the lower children span the whole axis
+      } else if (std::fabs(delta) <= m_band) {
+        only = -1;  // the origin lies on the plane, within rounding
+      } else if (std::isinf(q.inv_dir[k]) || std::isnan(tm)) {
+        only = delta < 0 ? 1 : 0;  // parallel to the plane: the origin's side
+      } else {
+        t_exit = tm > 0 ? tm * kSlabPad : tm * (2.0f - kSlabPad);   // the near side's end, padded up
+        t_enter = tm > 0 ? tm * (2.0f - kSlabPad) : tm * kSlabPad;  // the far side's start, padded down
+      }
+      const int near = q.dir_neg[k];  // the upper side first for a negative direction
+      if (only >= 0) {
+        start[k][only] = -kInfinity;
+        end[k][only] = kInfinity;
+        start[k][1 - only] = kInfinity;
+        end[k][1 - only] = -kInfinity;
+      } else {
+        start[k][near] = -kInfinity;
+        end[k][near] = t_exit;
+        start[k][1 - near] = t_enter;
+        end[k][1 - near] = kInfinity;
+      }
+    }
+    int n = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (m_nodes[node.index + c].count == 0) continue;  // an empty leaf
+      float s = cur.t0, e = cur.t1;
+      for (int k = 0; k < 3; ++k) {
+        const int side = (c >> k) & 1;
+        s = std::max(s, start[k][side]);
+        e = std::min(e, end[k][side]);
+      }
+      if (s > e || best < s) continue;
+      // Insertion by entry distance, after the children entered at the same distance.
+      int i = n++;
+      for (; i > 0 && out[i - 1].t0 > s; --i) out[i] = out[i - 1];
+      out[i].node = node.index + uint32_t(c);
+      out[i].t0 = s;
+      out[i].t1 = e;
+      for (int k = 0; k < 3; ++k)
+        child_range(cur.lo[k], mid[k], cur.hi[k], m_band, (c >> k) & 1, out[i].lo[k], out[i].hi[k]);
+    }
+    return n;
+  }
+
+  /// Writes build node `b` (box `box`, at `depth`) into m_nodes[idx] (already allocated), an
+  /// interior node's eight children as a block after every node written so far, and a leaf's
+  /// records contiguously into m_leaf_prims; gathers the statistics on the way. The SAH cost
+  /// counts K_T = 15 per interior node and K_I = 20 per reference, each weighted by the node's
+  /// area over the root's.
+  void flatten(const BuildNode& b, uint32_t idx, const Bounds3f& box, uint64_t depth,
+               const std::vector<PrimitiveRecord>& prims) {
+    m_stats.max_depth = std::max(m_stats.max_depth, depth);
+    const double rel = m_root_area > 0 ? surface_area(box) / m_root_area : 1.0;
+    if (b.leaf) {
+      const uint32_t n = uint32_t(b.prims.size());
+      m_tally.add(n);
+      m_stats.sah_cost += rel * kIntersectionCost * n;
+      m_stats.sah_leaf_area += rel * n;
+      m_nodes[idx] = {uint32_t(m_leaf_prims.size()), n};
+      for (const uint32_t p : b.prims) m_leaf_prims.push_back(prims[p]);
+      return;
+    }
+    m_stats.sah_cost += rel * kTraversalCost;
+    m_stats.sah_node_area += rel;
+    const uint32_t first = uint32_t(m_nodes.size());
+    m_nodes.resize(m_nodes.size() + 8);
+    m_nodes[idx] = {first, kInterior};
+    for (int c = 0; c < 8; ++c)
+      flatten(*b.children[c], first + uint32_t(c), child_box(box, m_band, c), depth + 1, prims);
+  }
+
+  OctreeConfig m_config;
+  std::vector<OctNode> m_nodes;               // node 0 is the root; children in blocks of 8, depth first
+  std::vector<PrimitiveRecord> m_leaf_prims;  // each leaf's records, contiguous, in leaf order
+  Bounds3f m_bounds;                          // exact bounds of the primitives: the root's box
+  Bounds3f m_clip;                            // m_bounds widened by m_band, for clipping rays
+  float m_band = 0;                           // rounding band: origins this close to a mid plane
+                                              // count as on it; child boxes are widened by it
+  uint64_t m_input_triangles = 0;
+  double m_root_area = 0;
+  LeafTally m_tally;
+  AccelStats m_stats;
+  double m_build_seconds = 0;
+};
+
+}  // namespace
+
+void validate(const OctreeConfig& c) {
+  if (c.max_leaf_prims < 1 || c.max_leaf_prims > kMaxLeafPrimsLimit)
+    throw std::invalid_argument("octree: max_leaf_prims must be in [1, 1024], got " +
+                                std::to_string(c.max_leaf_prims));
+  if (c.max_depth < 1 || c.max_depth > kMaxDepthLimit)
+    throw std::invalid_argument("octree: max_depth must be in [1, 20], got " + std::to_string(c.max_depth));
+}
+
+std::unique_ptr<Accelerator> make_octree_accelerator(std::span<const GeometryView> views,
+                                                     const OctreeConfig& config) {
+  return std::make_unique<OctreeAccelerator>(views, config);
+}
+
+}  // namespace penumbra
