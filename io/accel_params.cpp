@@ -49,6 +49,9 @@ std::vector<AccelParamInfo> accel_param_keys() {
        "[0, 1] (0: off)"},
       {"bvh.spatial_budget", num(d.bvh.spatial_budget),
        "references spatial splits may add, per triangle, [0, 4]"},
+      {"bvh.refit_max_growth", num(d.bvh.refit_max_growth),
+       "--frames: refit while the SAH cost is within this factor of the last build's, 0 or [1, 1000]; 0 = "
+       "always rebuild"},
       {"kdtree.traversal_cost", num(d.kdtree.traversal_cost), "K_T, > 0"},
       {"kdtree.intersection_cost", num(d.kdtree.intersection_cost), "K_I, > 0"},
       {"kdtree.empty_bonus", num(d.kdtree.empty_bonus), "cost reduction for an empty side, [0, 1)"},
@@ -94,6 +97,8 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.bvh.spatial_alpha = parse_value<float>(key, value);
   else if (key == "bvh.spatial_budget")
     c.bvh.spatial_budget = parse_value<float>(key, value);
+  else if (key == "bvh.refit_max_growth")
+    c.bvh.refit_max_growth = parse_value<float>(key, value);
   else if (key == "kdtree.traversal_cost")
     c.kdtree.traversal_cost = parse_value<float>(key, value);
   else if (key == "kdtree.intersection_cost")

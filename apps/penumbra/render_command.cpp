@@ -88,10 +88,15 @@ uint64_t charge_image_budget(const RenderJob& job) {
 /// the next frame's time with its accelerator's instances moved (reuse_kept_scene). The
 /// accelerator's views point into the scene's vectors, whose storage moves with them.
 struct KeptScene {
-  LoadedScene loaded;
+  LoadedScene loaded;                  ///< empty when `reload`
   std::unique_ptr<Accelerator> accel;  ///< null: built anew for the next frame
-  double pose_s = 0;                   ///< seconds spent posing the scene for the next frame
-  double update_s = 0;                 ///< seconds spent moving the accelerator's instances
+  double built_sah = 0;                ///< the accelerator's SAH cost when last built
+  /// The next frame loads its scene anew (its animation moves vertices: skins, morph targets)
+  /// and `accel` is refitted to it or built anew (refit_or_rebuild_scene's policy).
+  bool reload = false;
+  const char* update = "reused";  ///< what became of `accel`: "reused" or "instances moved"
+  double pose_s = 0;              ///< seconds spent posing the scene for the next frame
+  double update_s = 0;            ///< seconds spent moving the accelerator's instances
 };
 
 /// Readies the kept scene for the frame of `q`: a static scene as it is; an animated one posed
@@ -102,12 +107,19 @@ struct KeptScene {
 /// would.
 std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest& q) {
   if (!kept) return "";
+  if (kept->reload)
+    return " (animated vertices: scene loaded anew, acceleration structure refitted or rebuilt)";
   if (!kept->loaded.animation) return " (static scene: loaded scene and acceleration structure reused)";
   const auto t0 = Clock::now();
   uint64_t moved_instances = 0;
   if (!q.time || !pose_gltf_scene(*kept->loaded.animation, *q.time, kept->loaded.scene, &moved_instances)) {
-    kept.reset();
-    return "";
+    if (!q.time || !kept->accel) {
+      kept.reset();
+      return "";
+    }
+    // Posing moves only placements: the frame loads the file, and the structure is refitted.
+    kept->reload = true;
+    return " (animated vertices: scene loaded anew, acceleration structure refitted or rebuilt)";
   }
   kept->pose_s = seconds_since(t0);
   if (moved_instances == 0)
@@ -115,6 +127,7 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
   const auto t1 = Clock::now();
   const bool moved = kept->accel && kept->accel->update_instances(instance_views(kept->loaded.scene));
   if (!moved) kept->accel.reset();
+  kept->update = "instances moved";
   kept->update_s = seconds_since(t1);
   return moved ? " (animated scene: loaded scene reused, instances moved, top level rebuilt)"
                : " (animated scene: loaded scene reused, instances moved, acceleration structure rebuilt)";
@@ -127,8 +140,10 @@ void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   set_phase("loading the scene");
   ProgressReporter progress(job.progress, "load", job.frame);
   const auto t0 = Clock::now();
-  const double posed_s = kept ? kept->pose_s : 0;
-  if (kept) {
+  if (kept && kept->reload) kept->loaded = LoadedScene{};
+  const bool reuse = kept && !kept->reload;
+  const double posed_s = reuse ? kept->pose_s : 0;
+  if (reuse) {
     job.loaded = std::move(kept->loaded);
   } else {
     announce(job.progress, "loading " + a.scene_file);
@@ -205,10 +220,25 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   // later frames move (as a single --frame render does, so that both see the same structure).
   AccelConfig config = job.request.accel_config;
   config.embree.world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
-  if (!(kept && kept->accel))
+  if (kept && kept->accel && kept->reload) {
+    job.accel = std::move(kept->accel);
+    job.accel_built_sah = kept->built_sah;
+    const RefitReport r =
+        refit_or_rebuild_scene(job.accel, job.accel_built_sah, job.args.accel, job.loaded.scene, config);
+    job.accel_update = r.refitted ? "refitted" : "rebuilt";
+    char growth[64];
+    std::snprintf(growth, sizeof growth, "SAH cost %.3gx its last build's", r.growth);
+    announce(job.progress, r.refitted ? "refitted " + job.args.accel + " (" + growth + ")"
+                                      : "rebuilt " + job.args.accel + " (" + r.reason + ")");
+  } else if (kept && kept->accel) {
+    job.accel = std::move(kept->accel);
+    job.accel_built_sah = kept->built_sah;
+    job.accel_update = kept->update;
+  } else {
     announce(job.progress, "building " + job.args.accel + " (" + describe_scene_size(job.loaded.scene) + ")");
-  job.accel = kept && kept->accel ? std::move(kept->accel)
-                                  : make_scene_accelerator(job.args.accel, job.loaded.scene, config);
+    job.accel = make_scene_accelerator(job.args.accel, job.loaded.scene, config);
+    job.accel_built_sah = job.accel->stats().sah_cost;
+  }
   kept.reset();
   job.build_s = moved_s + seconds_since(t0);
   progress.finish();
@@ -218,11 +248,21 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
 /// light setup_phase added): a scene without animations, or one loaded at a time with what
 /// posing it needs (LoadedScene::animation).
 void keep_scene(RenderJob& job, std::optional<KeptScene>& kept) {
-  if (job.loaded.info.animation_count != 0 && !job.loaded.animation) return;
+  if (job.loaded.info.animation_count != 0 && !job.loaded.animation) {
+    // Posing cannot move what this animation moves: the next frame loads the file at its time,
+    // and this frame's structure is refitted to it.
+    if (!job.accel || !job.request.time) return;
+    kept.emplace();
+    kept->reload = true;
+    kept->accel = std::move(job.accel);
+    kept->built_sah = job.accel_built_sah;
+    return;
+  }
   if (job.default_light) job.loaded.scene.lights.pop_back();
   kept.emplace();
   kept->loaded = std::move(job.loaded);
   kept->accel = std::move(job.accel);
+  kept->built_sah = job.accel_built_sah;
 }
 
 /// --debug-pixel: one pixel exactly as the full render would compute it, printed on stdout.

@@ -41,6 +41,10 @@ struct RenderJob {
   RenderSettings settings;     ///< what decides the pixels (path renders and windows only)
   std::string scene_sha256;    ///< over every file the scene loaded (path renders and windows)
   std::unique_ptr<Accelerator> accel;
+  double accel_built_sah = 0;  ///< the accelerator's SAH cost when last built (the refit policy's base)
+  /// How this frame's accelerator came to be: "built", "reused" or "instances moved" (from the
+  /// previous frame), "refitted" or "rebuilt" (the previous frame's, to moved vertices).
+  std::string accel_update = "built";
   double load_s = 0, build_s = 0, write_s = 0;
   RenderStats stats;
   Film film;

@@ -34,6 +34,7 @@ std::string stats_json_text(const RenderJob& job) {
   j["interrupted"] = job.interrupted != 0;
   j["threads"] = stats.threads;
   j["accelerator"] = a.accel;
+  j["accelerator_update"] = job.accel_update;
   j["seconds"] = {
       {"load", job.load_s}, {"build", job.build_s}, {"render", stats.seconds}, {"write", job.write_s}};
   j["rays"] = {{"camera", stats.rays.camera},

@@ -185,6 +185,28 @@ class Accelerator {
     (void)instances;
     return false;
   }
+  /// Refitting for animation: moves a single-level build to `views`, the same views with new
+  /// vertex positions (and shapes with new parameters), keeping the tree and recomputing its
+  /// boxes bottom-up (stats() then reports the refitted tree's SAH cost). `views` must have
+  /// the build's count, and each view its kind and triangle count; no triangle may have a
+  /// non-finite vertex then or at the build. Answers equal those of any correct structure
+  /// over `views` (a refitted tree only traverses more). Returns false, with the accelerator
+  /// unchanged, when it cannot (another layout, or a back end that does not refit: the
+  /// default); the caller then builds anew. Not thread-safe: no query may run during the call.
+  virtual bool refit(std::span<const GeometryView> views) {
+    (void)views;
+    return false;
+  }
+  /// refit() for a build over instances: every mesh's structure refitted to `meshes` and the
+  /// instances moved to `instances` (as update_instances() does). Returns false under the
+  /// conditions of both; the structure may then be partly refitted and must be discarded (built
+  /// anew).
+  virtual bool refit_instances(std::span<const GeometryView> meshes,
+                               std::span<const InstanceView> instances) {
+    (void)meshes;
+    (void)instances;
+    return false;
+  }
 };
 
 }  // namespace penumbra

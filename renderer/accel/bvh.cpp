@@ -121,8 +121,44 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       for (const PrimitiveRecord& r : tris)
         if (is_shape(r)) m_ids.shape_geom[r.prim_id & ~kShapeBit] = r.geom_id;
     }
+    m_view_prims.reserve(meshes.size());
+    for (const GeometryView& v : meshes)
+      m_view_prims.push_back(v.shape ? kShapeBit : uint32_t(v.indices.size() / 3));
+    m_complete = tris.size() == m_input_triangles + count_input_shapes(meshes);
     if (!tris.empty()) build(std::move(tris));
     m_build_seconds = timer.seconds();
+  }
+
+  /// Keeps the tree and its leaves' order; copies the views' new primitives into the leaves and
+  /// recomputes every box bottom-up (a primitive cut by spatial splits gets its whole box in each
+  /// leaf that holds it, which still contains its parts) and the SAH statistics.
+  bool refit(std::span<const GeometryView> views) override {
+    if (!m_complete || views.size() != m_view_prims.size()) return false;
+    std::vector<uint32_t> start(views.size());  // index of view g's first record
+    uint32_t n = 0;
+    for (size_t g = 0; g < views.size(); ++g) {
+      const uint32_t prims = views[g].shape ? kShapeBit : uint32_t(views[g].indices.size() / 3);
+      if (prims != m_view_prims[g]) return false;
+      start[g] = n;
+      n += views[g].shape ? 1 : prims;
+    }
+    std::vector<Shape> shapes;
+    const std::vector<PrimitiveRecord> fresh = gather_primitives(views, shapes);
+    if (fresh.size() != n) return false;  // a primitive without finite bounds now
+    const auto record = [&](uint32_t geom, uint32_t prim) -> const PrimitiveRecord& {
+      return fresh[start[geom] + ((prim & kShapeBit) ? 0 : prim)];
+    };
+    m_shapes = std::move(shapes);
+    m_stats.sah_cost = m_stats.sah_node_area = m_stats.sah_leaf_area = 0;
+    if (m_width == 2) {
+      for (PrimitiveRecord& r : m_tris) r = record(r.geom_id, r.prim_id);
+      refit_binary();
+    } else if (m_width == 4) {
+      m_bounds = refit_wide(m_wide4, record);
+    } else {
+      m_bounds = refit_wide(m_wide8, record);
+    }
+    return true;
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -304,6 +340,113 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     }
   }
 
+  /// Refits the binary nodes: children follow their parent in depth-first order, so one
+  /// backward pass sees every child before its parent. Then recomputes the SAH statistics.
+  void refit_binary() {
+    if (m_nodes.empty()) return;
+    std::vector<Bounds3f> exact(m_nodes.size());
+    for (size_t i = m_nodes.size(); i-- > 0;) {
+      const BvhNode& node = m_nodes[i];
+      Bounds3f b;
+      if (node.count == 0) {
+        b = merge(exact[i + 1], exact[node.offset]);
+      } else {
+        for (uint32_t k = node.offset, e = node.offset + node.count; k < e; ++k)
+          b = merge(b, primitive_bounds(m_tris[k]));
+      }
+      exact[i] = b;
+      const Bounds3f w = widen_for_rounding(b);
+      m_nodes[i].lo = w.lo;
+      m_nodes[i].hi = w.hi;
+    }
+    m_bounds = exact[0];
+    m_sah_root_area = surface_area(m_bounds);
+    for (size_t i = 0; i < m_nodes.size(); ++i) {
+      const double rel = m_sah_root_area > 0 ? surface_area(exact[i]) / m_sah_root_area : 1.0;
+      const uint32_t count = m_nodes[i].count;
+      add_sah(rel, count == 0, count, count);
+    }
+  }
+
+  /// Adds one node to the SAH statistics: an interior node, or a leaf of `prims` primitives
+  /// charged `units` intersection costs (blocks in the wide layouts).
+  void add_sah(double rel, bool interior, uint32_t prims, uint32_t units) {
+    if (interior) {
+      m_stats.sah_cost += rel * m_config.traversal_cost;
+      m_stats.sah_node_area += rel;
+      return;
+    }
+    m_stats.sah_cost += rel * m_config.intersection_cost * units;
+    m_stats.sah_leaf_area += rel * prims;
+  }
+
+  /// One node of a refitted tree for the SAH statistics: its exact area, and for a leaf its
+  /// primitives and blocks.
+  struct RefitNode {
+    double area = 0;
+    bool interior = true;
+    uint32_t prims = 0, blocks = 0;
+  };
+
+  /// Refits the wide tree: blocks rewritten from `record(geom, prim)`, child boxes recomputed
+  /// from the leaves up, and the SAH statistics as collapse() counts them. Returns the exact
+  /// bounds of the tree.
+  template <int W, typename Record>
+  Bounds3f refit_wide(WideBvh<W>& bvh, const Record& record) {
+    if (bvh.nodes.empty()) return {};
+    std::vector<RefitNode> sah;
+    const Bounds3f root = refit_wide_node(bvh, record, 0, sah);
+    m_sah_root_area = surface_area(root);
+    for (const RefitNode& r : sah)
+      add_sah(m_sah_root_area > 0 ? r.area / m_sah_root_area : 1.0, r.interior, r.prims, r.blocks);
+    return root;
+  }
+
+  /// Refits wide node `idx` and its subtree; returns its exact bounds.
+  template <int W, typename Record>
+  Bounds3f refit_wide_node(WideBvh<W>& bvh, const Record& record, uint32_t idx, std::vector<RefitNode>& sah) {
+    Bounds3f boxes[W];
+    int n = 0;
+    for (; n < W && slot_used(bvh.nodes[idx], n); ++n) {
+      const uint32_t child = bvh.nodes[idx].child[n], blocks = bvh.nodes[idx].count[n];
+      if (blocks == 0) {
+        boxes[n] = refit_wide_node(bvh, record, child, sah);
+        continue;
+      }
+      RefitNode leaf{0, false, 0, blocks};
+      for (uint32_t k = child; k < child + blocks; ++k) {
+        TriangleBlock4& blk = bvh.blocks[k];
+        for (int l = 0; l < 4; ++l) {
+          if (blk.id[l] == kEmptyLane) continue;
+          ++leaf.prims;
+          if (blk.id[l] & kShapeBit) {
+            boxes[n] = merge(boxes[n], shape_bounds(m_shapes[blk.id[l] & ~kShapeBit]));
+            continue;
+          }
+          const PrimitiveRecord old = m_ids.record(blk, l);
+          const PrimitiveRecord& r = record(old.geom_id, old.prim_id);
+          const Vec3f v[3] = {r.a, r.b, r.c};
+          for (int c = 0; c < 3; ++c)
+            for (int a = 0; a < 3; ++a) blk.v[c][a][l] = v[c][a];
+          boxes[n] = merge(boxes[n], primitive_bounds(r));
+        }
+      }
+      leaf.area = surface_area(boxes[n]);
+      sah.push_back(leaf);
+    }
+    Bounds3f all, widened[W];
+    for (int i = 0; i < n; ++i) {
+      all = merge(all, boxes[i]);
+      widened[i] = widen_for_rounding(boxes[i]);
+    }
+    set_child_boxes(bvh.nodes[idx], widened, n);  // children and counts stay
+    sah.push_back({surface_area(all), true, 0, 0});
+    return all;
+  }
+
+  static bool slot_used(const Node4& node, int i) { return node.lo[0][i] <= node.hi[0][i]; }
+  static bool slot_used(const QuantizedNode8& node, int i) { return (node.valid >> i) & 1; }
+
   void compute_stats(const BvhBuildNode& b, uint64_t depth) {
     m_stats.max_depth = std::max(m_stats.max_depth, depth);
     const double rel = m_sah_root_area > 0 ? surface_area(b.box) / m_sah_root_area : 1.0;
@@ -333,6 +476,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   LeafTally m_tally;
   AccelStats m_stats;
   double m_build_seconds = 0;
+  std::vector<uint32_t> m_view_prims;  // per view: its triangle count, or kShapeBit for a shape
+  bool m_complete = false;             // the build kept every primitive (none non-finite)
 };
 
 }  // namespace
@@ -354,6 +499,9 @@ void validate(const BvhConfig& c) {
   if (!(c.spatial_budget >= 0 && c.spatial_budget <= 4))
     throw std::invalid_argument("bvh: spatial_budget must be in [0, 4], got " +
                                 format_number(c.spatial_budget));
+  if (!(c.refit_max_growth == 0 || (c.refit_max_growth >= 1 && c.refit_max_growth <= 1000)))
+    throw std::invalid_argument("bvh: refit_max_growth must be 0 or in [1, 1000], got " +
+                                format_number(c.refit_max_growth));
 }
 
 std::unique_ptr<Accelerator> make_bvh_accelerator(std::span<const GeometryView> meshes,

@@ -30,6 +30,10 @@ struct BvhConfig {
   float spatial_alpha = 0.0f;
   /// [0, 4]: references that spatial splits may add, as a fraction of the primitive count.
   float spatial_budget = 1.0f;
+  /// 0 or [1, 1000]: the rebuild policy of animation (refit_or_rebuild in accel/factory.h): a
+  /// BVH refitted to moved geometry is kept while its SAH cost stays within this factor of its
+  /// cost when last built, and built anew past it; 0 never refits.
+  float refit_max_growth = 1.5f;
 };
 
 /// Throws std::invalid_argument naming the field if a value is out of range.

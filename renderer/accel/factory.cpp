@@ -7,6 +7,7 @@
 #include "renderer/accel/brute.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/instances.h"
+#include "renderer/accel/stats.h"
 
 namespace penumbra {
 
@@ -35,24 +36,64 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   throw_unknown(name);
 }
 
+namespace {
+
+bool all_identity(std::span<const InstanceView> instances) {
+  return std::all_of(instances.begin(), instances.end(),
+                     [](const InstanceView& i) { return is_identity(i.to_world); });
+}
+
+/// The views of a flattened scene: each instance's mesh, in instance order.
+std::vector<GeometryView> flattened_views(std::span<const GeometryView> meshes,
+                                          std::span<const InstanceView> instances) {
+  std::vector<GeometryView> views;
+  views.reserve(instances.size());
+  for (const auto& i : instances) views.push_back(meshes[i.mesh]);
+  return views;
+}
+
+}  // namespace
+
 std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               std::span<const InstanceView> instances,
                                               const AccelConfig& config) {
   validate_instances(instances, meshes.size());
   if (name == "embree") return make_embree_accelerator(meshes, instances, config.embree);
   // A flattened scene (every placement the identity) is one level: geom_id = instance index.
-  if (std::all_of(instances.begin(), instances.end(),
-                  [](const InstanceView& i) { return is_identity(i.to_world); })) {
-    std::vector<GeometryView> views;
-    views.reserve(instances.size());
-    for (const auto& i : instances) views.push_back(meshes[i.mesh]);
-    return make_accelerator(name, views, config);
-  }
+  if (all_identity(instances)) return make_accelerator(name, flattened_views(meshes, instances), config);
   const auto names = accelerator_names();
   if (std::find(names.begin(), names.end(), name) == names.end()) throw_unknown(name);
   return make_two_level_accelerator(
       [&](std::span<const GeometryView> level) { return make_accelerator(name, level, config); }, meshes,
       instances);
+}
+
+RefitReport refit_or_rebuild(std::unique_ptr<Accelerator>& accel, double& built_sah, std::string_view name,
+                             std::span<const GeometryView> meshes, std::span<const InstanceView> instances,
+                             const AccelConfig& config) {
+  RefitReport report;
+  validate_instances(instances, meshes.size());
+  if (name != "bvh")
+    report.reason = "the " + std::string(name) + " back end does not refit";
+  else if (config.bvh.refit_max_growth == 0)
+    report.reason = "refitting is off (bvh.refit_max_growth=0)";
+  else if (!accel || !(all_identity(instances) ? accel->refit(flattened_views(meshes, instances))
+                                               : accel->refit_instances(meshes, instances)))
+    report.reason = "the geometry's layout changed";
+  if (report.reason.empty()) {
+    const double sah = accel->stats().sah_cost;
+    report.growth = built_sah > 0 ? sah / built_sah : 1.0;
+    if (report.growth <= config.bvh.refit_max_growth) {
+      report.refitted = true;
+      return report;
+    }
+    report.reason = "its SAH cost grew " + format_number(report.growth) + "x, past bvh.refit_max_growth " +
+                    format_number(config.bvh.refit_max_growth);
+  }
+  accel.reset();  // the old structure's memory is freed before the new one is built
+  accel = make_accelerator(name, meshes, instances, config);
+  built_sah = accel->stats().sah_cost;
+  return report;
 }
 
 }  // namespace penumbra

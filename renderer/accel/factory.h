@@ -46,4 +46,22 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
                                               std::span<const InstanceView> instances,
                                               const AccelConfig& config = {});
 
+/// What refit_or_rebuild() did to a structure.
+struct RefitReport {
+  bool refitted = false;  ///< false: built anew
+  double growth = 0;      ///< the refitted SAH cost over the last build's (0: not refitted)
+  std::string reason;     ///< why it was built anew (empty when refitted)
+};
+
+/// The rebuild policy of animation. `accel` was made by make_accelerator(name, ...) over an
+/// earlier pose of the same meshes and instances (same counts, meshes, kinds and triangle
+/// counts), and `built_sah` is its SAH cost when it was last built (stats().sah_cost). Refits it
+/// to the new pose when the back end can (the BVH, alone or under instances) and
+/// config.bvh.refit_max_growth is not 0, and keeps it while its SAH cost is at most that factor
+/// of `built_sah`; otherwise builds it anew (updating `built_sah`). The answers are those of a
+/// fresh build either way. Throws as make_accelerator does.
+RefitReport refit_or_rebuild(std::unique_ptr<Accelerator>& accel, double& built_sah, std::string_view name,
+                             std::span<const GeometryView> meshes, std::span<const InstanceView> instances,
+                             const AccelConfig& config = {});
+
 }  // namespace penumbra

@@ -39,6 +39,7 @@ class TwoLevelAccelerator final : public Accelerator {
         if (copy < 0) {
           copy = int(m_shapes.size());
           m_shapes.push_back(*shape);
+          m_shape_mesh.push_back(inst.mesh);
         }
         const Bounds3f b = shape_bounds(*shape);
         if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) continue;  // never hit
@@ -51,6 +52,7 @@ class TwoLevelAccelerator final : public Accelerator {
       if (object < 0) {
         object = int(m_levels.size());
         m_levels.push_back(build(meshes.subspan(inst.mesh, 1)));
+        m_level_mesh.push_back(inst.mesh);
       }
       m_items.push_back({uint32_t(object), uint32_t(i), to_object,
                          transform_bounds(inst.to_world, m_levels[size_t(object)]->bounds())});
@@ -58,6 +60,7 @@ class TwoLevelAccelerator final : public Accelerator {
     }
     if (!world.empty() || m_levels.empty()) {  // an empty world level still names the back end
       m_levels.push_back(build(world));
+      m_level_mesh.push_back(kWorld);
       m_items.push_back({uint32_t(m_levels.size() - 1), kWorld, Affine3f{}, m_levels.back()->bounds()});
     }
     for (const auto& level : m_levels) m_stats_bottom.push_back(level->stats());
@@ -121,6 +124,33 @@ class TwoLevelAccelerator final : public Accelerator {
     build_top();
     m_build_seconds = timer.seconds();
     return true;
+  }
+
+  /// Refits every bottom level to its mesh's new views (the world level to the identity
+  /// instances' views), copies the placed shapes anew, then moves the instances as
+  /// update_instances() does. A bottom level that cannot refit leaves the levels before it
+  /// refitted: the caller discards the structure on false, as the interface says.
+  bool refit_instances(std::span<const GeometryView> meshes,
+                       std::span<const InstanceView> instances) override {
+    if (!m_layout.matches(instances)) return false;
+    for (const uint32_t mesh : m_shape_mesh) {
+      if (mesh >= meshes.size() || !meshes[mesh].shape) return false;
+      const Bounds3f b = shape_bounds(*meshes[mesh].shape);
+      if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) return false;
+    }
+    std::vector<GeometryView> world;
+    for (const uint32_t id : m_world_ids) world.push_back(meshes[instances[id].mesh]);
+    for (size_t l = 0; l < m_levels.size(); ++l) {
+      const uint32_t mesh = m_level_mesh[l];
+      if (mesh != kWorld && (mesh >= meshes.size() || meshes[mesh].shape)) return false;
+      if (!(mesh == kWorld ? m_levels[l]->refit(world) : m_levels[l]->refit(meshes.subspan(mesh, 1))))
+        return false;
+      m_stats_bottom[l] = m_levels[l]->stats();
+    }
+    for (size_t k = 0; k < m_shapes.size(); ++k) m_shapes[k] = *meshes[m_shape_mesh[k]].shape;
+    for (Item& item : m_items)
+      if (item.instance == kWorld) item.box = m_levels[item.level]->bounds();
+    return update_instances(instances);
   }
 
   AccelStats stats() const override {
@@ -283,6 +313,8 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<std::unique_ptr<Accelerator>> m_levels;  // bottom levels: per mesh, then world
   std::vector<Shape> m_shapes;                         // the placed shapes, one copy per view
   std::vector<uint32_t> m_world_ids;                   // world level's geom_id -> instance index
+  std::vector<uint32_t> m_level_mesh;                  // each bottom level's mesh, or kWorld
+  std::vector<uint32_t> m_shape_mesh;                  // each placed shape's mesh (view)
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<BvhNode> m_nodes;                        // top level, depth first
   std::vector<AccelStats> m_stats_bottom;

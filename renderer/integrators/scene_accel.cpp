@@ -26,4 +26,9 @@ std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const
   return make_accelerator(name, mesh_views(scene), instance_views(scene), config);
 }
 
+RefitReport refit_or_rebuild_scene(std::unique_ptr<Accelerator>& accel, double& built_sah,
+                                   std::string_view name, const Scene& scene, const AccelConfig& config) {
+  return refit_or_rebuild(accel, built_sah, name, mesh_views(scene), instance_views(scene), config);
+}
+
 }  // namespace penumbra

@@ -24,4 +24,9 @@ std::vector<InstanceView> instance_views(const Scene& scene);
 std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
                                                     const AccelConfig& config = {});
 
+/// refit_or_rebuild(accel, built_sah, name, mesh_views(scene), instance_views(scene), config):
+/// the structure of an earlier pose of `scene` refitted to this one, or built anew.
+RefitReport refit_or_rebuild_scene(std::unique_ptr<Accelerator>& accel, double& built_sah,
+                                   std::string_view name, const Scene& scene, const AccelConfig& config = {});
+
 }  // namespace penumbra

@@ -4,8 +4,8 @@
 # equal a separate --frame render of it (compared with idiff: the EXR metadata records each
 # command line, so the files differ in that attribute), with the loaded scene reused and its
 # instances moved (the frame's line says so), also with the camera animated too, with
-# Penumbra's own BVH, with only the camera animated (the structure kept as it is), and on the
-# shipped fly-through; --skip-existing keeps complete frames
+# Penumbra's own BVH, with only the camera animated (the structure kept as it is), with
+# vertices animated by a morph target (the BVH refitted), and on the shipped fly-through; --skip-existing keeps complete frames
 # untouched and renders again exactly the missing and the truncated ones; a scene without
 # animations is loaded once and gives the same frames; a --tile stripe is skipped like a frame;
 # bad ranges and patterns exit 2 before anything is written.
@@ -118,6 +118,48 @@ for n in 1 3; do
   expect 0 "os.$n.exr" -- "$bin" render "$work/camera-only.gltf" --frame "$n" -o "$work/os.$n.exr" "${common[@]}"
   expect 0 "PASS" -- idiff -a "$work/o.000$n.exr" "$work/os.$n.exr"
 done
+
+# Vertices animated (a morph target lifts the cube's top face): posing cannot move vertices, so
+# each later frame loads the file at its time and refits the previous frame's BVH to it (built
+# anew when refitting is off, and by the back ends that do not refit); every frame's pixels
+# equal its --frame render, whose BVH is built from scratch.
+python3 - "$scene" "$work/morph.gltf" <<'PY'
+import base64, json, struct, sys
+g = json.load(open(sys.argv[1]))
+blob = base64.b64decode(g["buffers"][0]["uri"].split(",", 1)[1])
+blob += b"\0" * (-len(blob) % 4)
+lift = [(0.0, 0.7 if y > 0 else 0.0, 0.0) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
+d_off = len(blob)
+blob += b"".join(struct.pack("<3f", *d) for d in lift)
+w_off = len(blob)
+blob += struct.pack("<2f", 0.0, 1.0)
+g["buffers"][0] = {"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}
+g["bufferViews"] += [{"buffer": 0, "byteOffset": d_off, "byteLength": 96}, {"buffer": 0, "byteOffset": w_off, "byteLength": 8}]
+n = len(g["accessors"])
+g["accessors"] += [{"bufferView": len(g["bufferViews"]) - 2, "componentType": 5126, "count": 8, "type": "VEC3",
+                    "min": [0, 0, 0], "max": [0, 0.7, 0]},
+                   {"bufferView": len(g["bufferViews"]) - 1, "componentType": 5126, "count": 2, "type": "SCALAR"}]
+g["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": n}]
+g["meshes"][0]["weights"] = [0.0]
+g["nodes"][0]["translation"] = [0, -0.3, 0]
+g["animations"] = [{"samplers": [{"input": 2, "output": n + 1, "interpolation": "LINEAR"}],
+                    "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]
+json.dump(g, open(sys.argv[2], "w"))
+PY
+morph="$work/morph.gltf"
+expect 0 "frame 2 \(2 of 3\) -> .*v.0002.exr \(animated vertices: scene loaded anew, acceleration structure refitted or rebuilt\)" -- "$bin" render "$morph" --frames 1-3 -o "$work/v.####.exr" --accel bvh --stats-json "$work/v.####.json" "${common[@]}"
+[ "$(grep -c 'refitted bvh (SAH cost [0-9.]*x its last build' "$work/err")" = 2 ] || fail "frames 2 and 3 did not refit the BVH"
+grep -q '"accelerator_update": "refitted"' "$work/v.0003.json" || fail "frame 3's statistics do not say the BVH was refitted"
+grep -q '"accelerator_update": "built"' "$work/v.0001.json" || fail "frame 1's statistics do not say the BVH was built"
+for n in 1 2 3; do
+  expect 0 "vs.$n.exr" -- "$bin" render "$morph" --frame "$n" -o "$work/vs.$n.exr" --accel bvh "${common[@]}"
+  expect 0 "PASS" -- idiff -a "$work/v.000$n.exr" "$work/vs.$n.exr"
+done
+idiff -a "$work/v.0001.exr" "$work/v.0003.exr" >/dev/null 2>&1 && fail "the morph target did not change the pixels"
+expect 0 "rebuilt bvh \(refitting is off \(bvh.refit_max_growth=0\)\)" -- "$bin" render "$morph" --frames 1-2 -o "$work/r.####.exr" --accel bvh --accel-param bvh.refit_max_growth=0 "${common[@]}"
+expect 0 "PASS" -- idiff -a "$work/r.0002.exr" "$work/vs.2.exr"
+expect 0 "rebuilt kdtree \(the kdtree back end does not refit\)" -- "$bin" render "$morph" --frames 1-2 -o "$work/k.####.exr" --accel kdtree "${common[@]}"
+expect 2 "refit_max_growth must be 0 or in \[1, 1000\], got 0.5" -- "$bin" render "$morph" --frames 1-2 -o "$work/k.####.exr" --accel bvh --accel-param bvh.refit_max_growth=0.5 "${common[@]}"
 
 # A scene without animations is loaded and built once; its frames equal a --frame render.
 python3 -c 'import json,sys; g=json.load(open(sys.argv[1])); del g["animations"]; json.dump(g, open(sys.argv[2], "w"))' "$scene" "$work/static.gltf"

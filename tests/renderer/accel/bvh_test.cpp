@@ -11,6 +11,7 @@
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/scene.h"
 #include "support/cross_check.h"
+#include "support/sdf_trees.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -377,4 +378,133 @@ TEST_CASE("bvh: configuration is validated", "[accel][bvh][quick]") {
     CHECK_THROWS_WITH(validate(c), Catch::Contains("spatial_budget must be in [0, 4]"));
   }
   CHECK_NOTHROW(validate(BvhConfig{}));
+}
+
+namespace {
+
+/// `s`'s vertices moved: every vertex displaced by a smooth field (a twist about Y and a wave)
+/// of strength k, so triangles move, rotate and stretch.
+Soup deformed(const Soup& s, float k) {
+  Soup out = s;
+  for (auto& mesh : out.positions)
+    for (Vec3f& p : mesh) {
+      const float a = k * p.y, c = std::cos(a), sn = std::sin(a);
+      p = Vec3f{c * p.x - sn * p.z, p.y + 0.3f * k * std::sin(3 * p.x), sn * p.x + c * p.z};
+    }
+  return out;
+}
+
+/// A sphere, a plane and a shape: the scene the refit tests move.
+Soup refit_scene() {
+  Soup s = icosphere(3, 1, {0, 0.5f, 0});
+  s.add_plane(1, -1.0f, -2.0f, 2.0f, 8);
+  Soup small = icosphere(1, 0.3f, {1.5f, 1, 0.5f});
+  s.add(small.positions[0], small.indices[0]);
+  return s;
+}
+
+/// Every BVH layout the refit tests cover: each width, and spatial splits.
+std::vector<std::pair<std::string, BvhConfig>> refit_configs() {
+  std::vector<std::pair<std::string, BvhConfig>> out;
+  std::vector<int> widths = wide_widths();
+  widths.push_back(2);
+  for (int width : widths) {
+    BvhConfig c;
+    c.width = width;
+    out.push_back({"width " + std::to_string(width), c});
+    c.spatial_alpha = 1e-5f;
+    out.push_back({"width " + std::to_string(width) + ", spatial splits", c});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("bvh: a refitted tree answers exactly as brute force over the moved vertices",
+          "[accel][bvh][refit]") {
+  const Soup rest = refit_scene();
+  const Shape ball = analytic_shape(ShapeKind::Sphere, 0.4f);
+  for (const auto& [what, config] : refit_configs()) {
+    std::vector<GeometryView> views = rest.views();
+    views.push_back({{}, {}, &ball});
+    const auto bvh = make_bvh_accelerator(views, config);
+    for (float k : {0.2f, 0.8f, 1.6f}) {
+      const Soup moved = deformed(rest, k);
+      const Shape ball2 = analytic_shape(ShapeKind::Sphere, 0.4f + k);
+      std::vector<GeometryView> next = moved.views();
+      next.push_back({{}, {}, &ball2});
+      REQUIRE(bvh->refit(next));
+      const auto brute = make_accelerator("brute", next);
+      const Bounds3f b = brute->bounds();
+      CHECK(bvh->bounds().lo == b.lo);
+      CHECK(bvh->bounds().hi == b.hi);
+      const Reference ref = reference(*brute, all_rays(*brute, next, b, lights_around(b), 1, 17));
+      const auto r = cross_check(*bvh, ref, next, length(b.extent()), true, 0.0f);
+      INFO(summary("bvh " + what + " refitted, twist " + std::to_string(k), r));
+      CHECK(r.failures() == 0);
+      // The tree kept its shape: leaves and references are the build's.
+      const AccelStats s = bvh->stats();
+      CHECK(s.references == make_bvh_accelerator(views, config)->stats().references);
+      CHECK(s.sah_cost > 0);
+    }
+  }
+}
+
+TEST_CASE("bvh: refitting to a translated copy keeps the SAH cost; stretching raises it",
+          "[accel][bvh][refit]") {
+  const Soup rest = refit_scene();
+  for (const auto& [what, config] : refit_configs()) {
+    INFO(what);
+    const std::vector<GeometryView> views = rest.views();
+    const auto bvh = make_bvh_accelerator(views, config);
+    const double built = bvh->stats().sah_cost;
+    // A translation by a power of two moves every box exactly; the SAH is relative to the root.
+    Soup shifted = rest;
+    for (auto& mesh : shifted.positions)
+      for (Vec3f& p : mesh) p = p + Vec3f{4, -8, 2};
+    REQUIRE(bvh->refit(shifted.views()));
+    if (config.spatial_alpha > 0)  // refitted leaves bound whole triangles, not their split parts
+      CHECK(bvh->stats().sah_cost >= built * (1 - 1e-5));
+    else
+      CHECK(bvh->stats().sah_cost == Approx(built).epsilon(1e-5));
+    // Scrambling the vertices among themselves (same layout) stretches every triangle across
+    // the scene: the refitted tree's cost grows many times over.
+    Soup scrambled = rest;
+    std::mt19937 rng(5);
+    for (auto& mesh : scrambled.positions) std::shuffle(mesh.begin(), mesh.end(), rng);
+    REQUIRE(bvh->refit(scrambled.views()));
+    CHECK(bvh->stats().sah_cost > 4 * built);
+  }
+}
+
+TEST_CASE("bvh: refit refuses another layout and non-finite vertices, and stays as it was",
+          "[accel][bvh][refit][quick]") {
+  const Soup rest = refit_scene();
+  const std::vector<GeometryView> views = rest.views();
+  for (const auto& [what, config] : refit_configs()) {
+    INFO(what);
+    const auto bvh = make_bvh_accelerator(views, config);
+    const Bounds3f before = bvh->bounds();
+    CHECK_FALSE(bvh->refit(std::span(views).first(2)));  // a view fewer
+    Soup fewer = rest;
+    fewer.indices[1].resize(fewer.indices[1].size() - 3);  // a triangle fewer
+    CHECK_FALSE(bvh->refit(fewer.views()));
+    Soup nan = rest;
+    nan.positions[0][3].x = std::numeric_limits<float>::quiet_NaN();
+    CHECK_FALSE(bvh->refit(nan.views()));
+    const Shape ball = analytic_shape(ShapeKind::Sphere, 1);
+    std::vector<GeometryView> kinds = views;
+    kinds[2] = {{}, {}, &ball};  // a mesh became a shape
+    CHECK_FALSE(bvh->refit(kinds));
+    CHECK(bvh->bounds().lo == before.lo);
+    CHECK(bvh->bounds().hi == before.hi);
+  }
+  // A build that dropped a non-finite triangle cannot refit (its leaves lack that triangle).
+  Soup nan = rest;
+  nan.positions[0][3].x = std::numeric_limits<float>::infinity();
+  const auto bvh = make_bvh_accelerator(nan.views());
+  CHECK_FALSE(bvh->refit(rest.views()));
+  // The other back ends do not refit.
+  for (const std::string name : {"kdtree", "grid", "brute", "embree"})
+    CHECK_FALSE(make_accelerator(name, views)->refit(views));
 }

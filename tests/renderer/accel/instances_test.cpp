@@ -217,3 +217,112 @@ TEST_CASE("instances: update_instances moves the placements and answers as a fre
     CHECK_FALSE(a->update_instances(moved));
   }
 }
+
+TEST_CASE("instances: refit_instances moves vertices and placements and answers as a fresh build does",
+          "[accel][instances][refit]") {
+  Soup s;
+  Soup sphere = icosphere(2, 1, {0, 0, 0});
+  s.add(sphere.positions[0], sphere.indices[0]);  // mesh 0: sphere, placed three times
+  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);           // mesh 1: a plane, in world space
+  const Shape ball = analytic_shape(ShapeKind::Sphere, 0.4f);
+  const auto frame = [&](int f, Soup& moved, Shape& shape) {
+    const float k = 0.25f * float(f);
+    moved = s;
+    for (Vec3f& p : moved.positions[0]) p = p * (1 + k * p.y);  // the sphere bulges upwards
+    for (Vec3f& p : moved.positions[1]) p.y = k * p.x * p.z;    // the plane bends
+    shape = analytic_shape(ShapeKind::Sphere, 0.4f + k);
+    std::vector<GeometryView> meshes = moved.views();
+    meshes.push_back({{}, {}, &shape});
+    std::vector<InstanceView> inst = {{0, placement({k + 0.5f, 0, 0}, {0, 1, 0}, k, {1, 1, 1})},
+                                      {0, placement({3, 1, -k}, {1, 0, 0}, 0.5, {0.5f, 1, 2})},
+                                      {1, Affine3f{}},
+                                      {2, placement({-2, k, 0}, {0, 0, 1}, 0, {1, 2, 1})}};
+    return std::pair{meshes, inst};
+  };
+  Soup m0;
+  Shape b0;
+  const auto [meshes0, inst0] = frame(0, m0, b0);
+  const auto bvh = make_accelerator("bvh", meshes0, inst0);
+  for (int f = 1; f <= 3; ++f) {
+    INFO("frame " << f);
+    Soup mf;
+    Shape bf;
+    const auto [meshes, inst] = frame(f, mf, bf);
+    REQUIRE(bvh->refit_instances(meshes, inst));
+    const auto fresh = make_accelerator("brute", meshes, inst);
+    CHECK(bvh->bounds().lo == fresh->bounds().lo);
+    CHECK(bvh->bounds().hi == fresh->bounds().hi);
+    std::mt19937 ray_rng(200 + f);
+    int hits = 0;
+    for (const Ray& r : random_rays(fresh->bounds(), 4000, ray_rng)) {
+      Hit a, b;
+      const bool ha = bvh->intersect(r, a), hb = fresh->intersect(r, b);
+      INFO(describe(r) << ": refitted " << describe(a) << ", brute force " << describe(b));
+      REQUIRE(ha == hb);
+      REQUIRE(bvh->occluded(r) == fresh->occluded(r));
+      if (!ha) continue;
+      ++hits;
+      REQUIRE(a.t == b.t);
+      REQUIRE(a.geom_id == b.geom_id);
+    }
+    CHECK(hits > 400);
+  }
+  // Another instance layout is refused.
+  Soup mf;
+  Shape bf;
+  auto [meshes, inst] = frame(4, mf, bf);
+  inst[2].to_world = placement({0, 1, 0}, {0, 1, 0}, 0, {1, 1, 1});  // the identity became a placement
+  CHECK_FALSE(bvh->refit_instances(meshes, inst));
+}
+
+TEST_CASE("refit_or_rebuild: refits the BVH while its SAH cost holds, rebuilds past the threshold",
+          "[accel][instances][refit][quick]") {
+  Soup s = icosphere(2, 1, {0, 0, 0});
+  s.add_plane(1, -1.0f, -2.0f, 2.0f, 6);
+  const std::vector<InstanceView> inst = {{0, Affine3f{}}, {1, Affine3f{}}};
+  std::unique_ptr<Accelerator> accel = make_accelerator("bvh", s.views(), inst);
+  double built = accel->stats().sah_cost;
+  const Accelerator* first = accel.get();
+  // A small motion: refitted in place.
+  Soup moved = s;
+  for (Vec3f& p : moved.positions[0]) p = p + Vec3f{0.1f, 0, 0};
+  RefitReport r = refit_or_rebuild(accel, built, "bvh", moved.views(), inst);
+  CHECK(r.refitted);
+  CHECK(r.reason.empty());
+  CHECK(r.growth == Approx(1).epsilon(0.05));
+  CHECK(accel.get() == first);
+  // Vertices scrambled among themselves: the cost explodes, the structure is built anew.
+  Soup scrambled = s;
+  std::mt19937 rng(3);
+  std::shuffle(scrambled.positions[0].begin(), scrambled.positions[0].end(), rng);
+  r = refit_or_rebuild(accel, built, "bvh", scrambled.views(), inst);
+  CHECK_FALSE(r.refitted);
+  CHECK(r.growth > 1.5);
+  CHECK_THAT(r.reason, Catch::Contains("SAH cost grew") && Catch::Contains("bvh.refit_max_growth 1.5"));
+  CHECK(built == Approx(accel->stats().sah_cost));
+  // Either way the answers are brute force's.
+  const auto brute = make_accelerator("brute", scrambled.views(), inst);
+  std::mt19937 ray_rng(9);
+  for (const Ray& ray : random_rays(brute->bounds(), 2000, ray_rng)) {
+    Hit a, b;
+    REQUIRE(accel->intersect(ray, a) == brute->intersect(ray, b));
+    if (a.valid()) REQUIRE(a.t == b.t);
+  }
+  // Refitting off, another back end, another layout: built anew, saying why.
+  AccelConfig off;
+  off.bvh.refit_max_growth = 0;
+  CHECK_THAT(refit_or_rebuild(accel, built, "bvh", s.views(), inst, off).reason,
+             Catch::Contains("refitting is off"));
+  std::unique_ptr<Accelerator> kd = make_accelerator("kdtree", s.views(), inst);
+  double kd_sah = 0;
+  r = refit_or_rebuild(kd, kd_sah, "kdtree", moved.views(), inst);
+  CHECK_FALSE(r.refitted);
+  CHECK_THAT(r.reason, Catch::Contains("the kdtree back end does not refit"));
+  const std::vector<InstanceView> one = {{0, Affine3f{}}};
+  CHECK_THAT(refit_or_rebuild(accel, built, "bvh", s.views(), one).reason, Catch::Contains("layout changed"));
+  // Bad configuration values are errors.
+  AccelConfig bad;
+  bad.bvh.refit_max_growth = 0.5f;
+  CHECK_THROWS_WITH(make_accelerator("bvh", s.views(), bad),
+                    Catch::Contains("refit_max_growth must be 0 or in [1, 1000], got 0.5"));
+}
