@@ -22,6 +22,8 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -492,6 +494,298 @@ std::string software_line() {
          + ", " + PENUMBRA_BUILD_TYPE + " build";
 }
 
+/// Work per ray (nodes or cells visited, triangles and shapes tested) over closest-hit queries.
+struct CostDistribution {
+  double mean = 0, median = 0, p99 = 0, max = 0;
+};
+
+CostDistribution per_ray_cost(const Accelerator& a, const std::vector<RaySet>& sets) {
+  std::vector<uint64_t> c;
+  for (const RaySet& set : sets)
+    for (const Ray& r : set.rays) {
+      TraversalCost k;
+      Hit h;
+      a.intersect_counted(r, h, k);
+      c.push_back(k.nodes + k.triangles + k.shapes);
+    }
+  CostDistribution d;
+  if (c.empty()) return d;
+  std::sort(c.begin(), c.end());
+  double sum = 0;
+  for (uint64_t v : c) sum += double(v);
+  d.mean = sum / double(c.size());
+  d.median = double(c[c.size() / 2]);
+  d.p99 = double(c[std::min(c.size() - 1, size_t(0.99 * double(c.size())))]);
+  d.max = double(c.back());
+  return d;
+}
+
+/// One structure on one scene in the trade-off table.
+struct TradeoffRow {
+  std::string scene, accel;
+  uint64_t triangles = 0, bytes = 0, references = 0, wrong = 0, ties = 0;
+  bench::Spread build[2];                ///< seconds with 1 thread and with every core
+  std::optional<CostDistribution> cost;  ///< nullopt: the back end does not count
+  double mrays[2] = {0, 0};              ///< primary, random; 1 thread
+};
+
+/// Builds `name` over `scene` `builds` times with `threads` threads; the spread of the seconds.
+bench::Spread timed_builds(const std::string& name, const Scene& scene, const AccelConfig& config, int builds,
+                           int threads, std::unique_ptr<Accelerator>& last) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+  std::vector<double> s;
+  for (int i = 0; i < builds; ++i) {
+    last.reset();
+    const auto t0 = Clock::now();
+    last = make_scene_accelerator(name, scene, config);
+    s.push_back(seconds_since(t0));
+  }
+  return bench::spread_of(s);
+}
+
+/// --tradeoffs: the course's table of spatial structures, measured: per scene and structure the
+/// memory, the build time with 1 thread and with every core, the distribution of work per ray
+/// (closest hits of the primary and random rays) and the throughput of one thread, with every
+/// answer checked against Embree as the main table checks it.
+std::vector<TradeoffRow> measure_tradeoffs(const std::vector<std::string>& scenes, uint64_t seed,
+                                           const std::vector<std::string>& accels, const AccelConfig& config,
+                                           int width, int height, int builds, int repeats) {
+  std::vector<TradeoffRow> rows;
+  const int all = int(tbb::info::default_concurrency());
+  for (const std::string& spec : scenes) {
+    std::string name;
+    const Scene scene = load_bench_scene(spec, seed, name);
+    const auto embree = make_scene_accelerator("embree", scene, config);
+    const auto exact = make_scene_accelerator("brute", scene, config);
+    const std::vector<RaySet> sets = make_ray_sets(scene, *embree, width, height, {"primary", "random"});
+    const float scale = length(compute_bounds(scene).extent());
+    for (const std::string& accel : accels) {
+      TradeoffRow row{name, accel};
+      row.triangles = count_triangles(scene);
+      std::unique_ptr<Accelerator> a;
+      row.build[0] = timed_builds(accel, scene, config, builds, 1, a);
+      row.build[1] = timed_builds(accel, scene, config, builds, all, a);
+      const AccelStats st = a->stats();
+      row.bytes = st.bytes;
+      row.references = st.references;
+      if (a->counts_traversal()) row.cost = per_ray_cost(*a, sets);
+      for (int k = 0; k < 2; ++k) {
+        uint64_t hits = 0;
+        std::vector<double> s;
+        for (int r = 0; r < repeats; ++r) s.push_back(trace_seconds(*a, sets[size_t(k)], 1, hits));
+        row.mrays[k] = double(sets[size_t(k)].rays.size()) / median(s) / 1e6;
+        const Agreement g = check_against_embree(*a, *embree, *exact, sets[size_t(k)], scale);
+        row.wrong += g.wrong;
+        row.ties += g.ties;
+      }
+      std::printf(
+          "%-16s %-7s %9llu %9.1f %6.1f %5.2f %9.1f %9.1f %5.2f %7.0f %7.0f %8.0f %7.2f %7.2f %5llu\n",
+          row.scene.c_str(), row.accel.c_str(), static_cast<unsigned long long>(row.triangles),
+          double(row.bytes) / 1048576.0, row.triangles ? double(row.bytes) / double(row.triangles) : 0.0,
+          row.triangles ? double(row.references) / double(row.triangles) : 0.0, row.build[0].median * 1e3,
+          row.build[1].median * 1e3,
+          row.build[1].median > 0 ? row.build[0].median / row.build[1].median : 0.0,
+          row.cost ? row.cost->median : -1.0, row.cost ? row.cost->p99 : -1.0,
+          row.cost ? row.cost->max : -1.0, row.mrays[0], row.mrays[1],
+          static_cast<unsigned long long>(row.wrong));
+      std::fflush(stdout);
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+/// The trade-off table's chart: one row of panels per scene (memory per triangle, build time
+/// with 1 thread and every core, work per ray at the median and the 99th percentile, one
+/// thread's throughput), one bar per structure.
+bench::BarChart tradeoff_chart(const std::vector<TradeoffRow>& rows, const std::vector<std::string>& accels,
+                               const std::string& caption) {
+  bench::BarChart chart;
+  chart.title = "Spatial structures: memory, build, work per ray, throughput";
+  chart.series = accels;
+  chart.caption = {caption};
+  const auto value = [](double v) { return std::optional<bench::Spread>(bench::Spread{v, v, v}); };
+  for (const TradeoffRow& first : rows) {
+    if (!chart.row_labels.empty() && chart.row_labels.back() == first.scene) continue;
+    chart.row_labels.push_back(first.scene);
+    bench::BarPanel mem{"memory", "", "memory", "bytes/triangle", {"bytes"}, {}};
+    bench::BarPanel build{"build", "threads", "build", "ms", {"1", "all"}, {}};
+    bench::BarPanel cost{"work per ray", "percentile", "nodes + tests", "per ray", {"median", "99th"}, {}};
+    bench::BarPanel speed{"1 thread", "rays", "throughput", "Mrays/s", {"primary", "random"}, {}};
+    mem.values.assign(1, std::vector<std::optional<bench::Spread>>(accels.size()));
+    build.values.assign(2, std::vector<std::optional<bench::Spread>>(accels.size()));
+    cost.values.assign(2, std::vector<std::optional<bench::Spread>>(accels.size()));
+    speed.values.assign(2, std::vector<std::optional<bench::Spread>>(accels.size()));
+    for (const TradeoffRow& r : rows) {
+      if (r.scene != first.scene) continue;
+      const size_t s = size_t(std::find(accels.begin(), accels.end(), r.accel) - accels.begin());
+      mem.values[0][s] = value(r.triangles ? double(r.bytes) / double(r.triangles) : 0.0);
+      for (int k = 0; k < 2; ++k) {
+        bench::Spread b = r.build[k];
+        b.min *= 1e3, b.median *= 1e3, b.max *= 1e3;
+        build.values[size_t(k)][s] = b;
+        speed.values[size_t(k)][s] = value(r.mrays[k]);
+      }
+      if (r.cost) {
+        cost.values[0][s] = value(r.cost->median);
+        cost.values[1][s] = value(r.cost->p99);
+      }
+    }
+    chart.rows.push_back({mem, build, cost, speed});
+  }
+  return chart;
+}
+
+int run_tradeoffs(const std::vector<std::string>& scenes, uint64_t seed,
+                  const std::vector<std::string>& accels, const AccelConfig& config, int width, int height,
+                  int builds, int repeats, const std::string& csv, const std::string& svg,
+                  const std::string& command) {
+  std::printf("%-16s %-7s %9s %9s %6s %5s %9s %9s %5s %7s %7s %8s %7s %7s %5s\n", "scene", "accel", "tris",
+              "MiB", "B/tri", "refs", "build 1T", "build", "x", "work", "work", "work", "prim", "rand",
+              "wrong");
+  std::printf("%-16s %-7s %9s %9s %6s %5s %9s %9s %5s %7s %7s %8s %7s %7s %5s\n", "", "", "", "", "", "/tri",
+              "ms", "all ms", "", "median", "p99", "max", "Mr/s", "Mr/s", "");
+  const std::vector<TradeoffRow> rows =
+      measure_tradeoffs(scenes, seed, accels, config, width, height, builds, repeats);
+  uint64_t wrong = 0;
+  for (const TradeoffRow& r : rows) wrong += r.wrong;
+  if (!csv.empty())
+    write_atomically(csv, [&](const std::filesystem::path& tmp) {
+      std::ofstream f(tmp);
+      f << "scene,accel,triangles,bytes,references,build_1t_s,build_all_s,work_mean,work_median,work_p99,"
+           "work_max,mrays_primary_1t,mrays_random_1t,wrong,ties\n";
+      for (const TradeoffRow& r : rows) {
+        f << r.scene << ',' << r.accel << ',' << r.triangles << ',' << r.bytes << ',' << r.references << ','
+          << r.build[0].median << ',' << r.build[1].median << ',';
+        if (r.cost)
+          f << r.cost->mean << ',' << r.cost->median << ',' << r.cost->p99 << ',' << r.cost->max << ',';
+        else
+          f << ",,,,";
+        f << r.mrays[0] << ',' << r.mrays[1] << ',' << r.wrong << ',' << r.ties << '\n';
+      }
+      if (!f) throw std::runtime_error(csv + ": cannot write");
+    });
+  if (!svg.empty())
+    write_atomically(svg, [&](const std::filesystem::path& tmp) {
+      std::ofstream f(tmp);
+      f << bench::bar_chart_svg(tradeoff_chart(
+          rows, accels,
+          command + " -- " + bench::describe(bench::read_machine_info()) + "; " + software_line()));
+      if (!f) throw std::runtime_error(svg + ": cannot write");
+    });
+  std::printf(
+      "work = nodes or cells visited + triangles and shapes tested per closest-hit ray (primary and "
+      "random rays); builds: median of %d; throughput: median of %d passes, 1 thread\n",
+      builds, repeats);
+  if (wrong > 0)
+    std::fprintf(stderr, "penumbra-bench: %llu wrong answers\n", static_cast<unsigned long long>(wrong));
+  return wrong > 0 ? 1 : 0;
+}
+
+/// The end of a glTF file's animations: the largest "max" of the animation samplers' input
+/// accessors (the spec requires it). 0 for a file without animations.
+double animation_end(const std::string& file) {
+  std::ifstream in(file);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  double end = 0;
+  if (j.is_discarded() || !j.contains("animations")) return end;
+  for (const auto& a : j["animations"])
+    for (const auto& s : a.value("samplers", nlohmann::json::array())) {
+      const auto& acc = j["accessors"][s["input"].get<size_t>()];
+      if (acc.contains("max")) end = std::max(end, acc["max"][0].get<double>());
+    }
+  return end;
+}
+
+/// Mean work per closest-hit ray of `rays` (nodes + triangles + shapes).
+double mean_work(const Accelerator& a, const std::vector<Ray>& rays) {
+  TraversalCost k;
+  for (const Ray& r : rays) {
+    Hit h;
+    a.intersect_counted(r, h, k);
+  }
+  return rays.empty() ? 0.0 : double(k.nodes + k.triangles + k.shapes) / double(rays.size());
+}
+
+/// --refit FILE: the BVH over an animated file's frames, each frame loaded at its time: a
+/// fresh build per frame, a refit of the first frame's tree (never rebuilt) and the rebuild
+/// policy (refit_or_rebuild with the configured bvh.refit_max_growth); per frame the update
+/// time, the SAH cost and the mean work of the camera's primary rays (a fixed camera framing
+/// the first frame). Prints a row every 24 frames and the totals; --csv writes every frame.
+int run_refit(const std::string& file, int frames, const AccelConfig& config, int width, int height,
+              int threads, const std::string& csv) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(thread_count(threads)));
+  const double end = animation_end(file);
+  if (!(end > 0)) throw std::invalid_argument(file + ": no animation to refit over");
+  const auto load = [&](int f) {
+    GltfLoadOptions o;
+    o.time = end * double(f) / double(frames);
+    return load_gltf(file, o).scene;
+  };
+  Scene scene = load(0);
+  const Camera cam = frame_bounds(compute_bounds(scene), float(width) / float(height));
+  std::vector<Ray> rays;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      rays.push_back(generate_camera_ray(cam, width, height, x + 0.5f, y + 0.5f));
+  AccelConfig never = config;
+  never.bvh.refit_max_growth = 1000;
+  std::unique_ptr<Accelerator> refitted = make_scene_accelerator("bvh", scene, config);
+  std::unique_ptr<Accelerator> policy = make_scene_accelerator("bvh", scene, config);
+  double refitted_sah = refitted->stats().sah_cost, policy_sah = policy->stats().sah_cost;
+  const double first_sah = refitted_sah;
+  std::ostringstream out;
+  out << "frame,time_s,rebuild_s,refit_s,policy_s,policy_rebuilt,sah_rebuild,sah_refit,sah_policy,work_"
+         "rebuild,"
+         "work_refit,work_policy\n";
+  double total[3] = {0, 0, 0}, work[3] = {0, 0, 0};
+  int rebuilds = 0;
+  std::printf("%s: %d frames over %.3f s, %llu triangles, %dx%d primary rays, %d threads\n", file.c_str(),
+              frames, end, static_cast<unsigned long long>(count_triangles(scene)), width, height,
+              thread_count(threads));
+  std::printf("%6s %10s %10s %10s %9s %9s %9s %9s %9s %9s\n", "frame", "build ms", "refit ms", "policy ms",
+              "SAH new", "refit", "policy", "work new", "refit", "policy");
+  for (int f = 1; f <= frames; ++f) {
+    scene = load(f);
+    auto t0 = Clock::now();
+    const auto fresh = make_scene_accelerator("bvh", scene, config);
+    const double rebuild_s = seconds_since(t0);
+    t0 = Clock::now();
+    const RefitReport r1 = refit_or_rebuild_scene(refitted, refitted_sah, "bvh", scene, never);
+    const double refit_s = seconds_since(t0);
+    if (!r1.refitted) throw std::runtime_error(file + ": frame " + std::to_string(f) + ": " + r1.reason);
+    t0 = Clock::now();
+    const RefitReport r2 = refit_or_rebuild_scene(policy, policy_sah, "bvh", scene, config);
+    const double policy_s = seconds_since(t0);
+    rebuilds += !r2.refitted;
+    const double sah[3] = {fresh->stats().sah_cost, refitted->stats().sah_cost, policy->stats().sah_cost};
+    const double w[3] = {mean_work(*fresh, rays), mean_work(*refitted, rays), mean_work(*policy, rays)};
+    const double s[3] = {rebuild_s, refit_s, policy_s};
+    for (int k = 0; k < 3; ++k) total[k] += s[k], work[k] += w[k];
+    out << f << ',' << end * f / frames << ',' << rebuild_s << ',' << refit_s << ',' << policy_s << ','
+        << !r2.refitted << ',' << sah[0] << ',' << sah[1] << ',' << sah[2] << ',' << w[0] << ',' << w[1]
+        << ',' << w[2] << '\n';
+    if (f % 24 == 0 || f == frames)
+      std::printf("%6d %10.2f %10.2f %10.2f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f\n", f, rebuild_s * 1e3,
+                  refit_s * 1e3, policy_s * 1e3, sah[0], sah[1], sah[2], w[0], w[1], w[2]);
+    std::fflush(stdout);
+  }
+  std::printf(
+      "total: rebuild every frame %.3f s, refit %.3f s (%.1fx faster), policy %.3f s with %d rebuilds "
+      "(bvh.refit_max_growth %g); mean work per ray: rebuilt %.1f, refitted %.1f (%.2fx), policy %.1f "
+      "(%.2fx); SAH of frame 0's build %.1f\n",
+      total[0], total[1], total[1] > 0 ? total[0] / total[1] : 0.0, total[2], rebuilds,
+      double(config.bvh.refit_max_growth), work[0] / frames, work[1] / frames, work[1] / work[0],
+      work[2] / frames, work[2] / work[0], first_sah);
+  if (!csv.empty())
+    write_atomically(csv, [&](const std::filesystem::path& tmp) {
+      std::ofstream f(tmp);
+      f << out.str();
+      if (!f) throw std::runtime_error(csv + ": cannot write");
+    });
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -505,7 +799,9 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   std::vector<int> mc_resolutions;
   int noise_count = 0;
-  bool raster = false;
+  bool raster = false, tradeoffs = false;
+  std::string refit_file;
+  int refit_frames = 240;
   app.add_option("scenes", scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
@@ -541,6 +837,15 @@ int main(int argc, char** argv) {
                  "instead of the structures: evaluate 3D Perlin noise, 5-octave fBm and Worley F1 at this "
                  "many random points on one thread, --repeats times, and print evaluations per second")
       ->check(CLI::Range(1, 1000000000));
+  app.add_flag("--tradeoffs", tradeoffs,
+               "instead of the main table: per scene and structure the memory, the build time with 1 thread "
+               "and every core, the work per ray (median, 99th percentile, max of nodes + tests) and one "
+               "thread's throughput on primary and random rays");
+  app.add_option("--refit", refit_file,
+                 "instead of the structures: an animated glTF file's frames with the BVH rebuilt, refitted "
+                 "and under the rebuild policy (bvh.refit_max_growth): update times, SAH and work per ray");
+  app.add_option("--refit-frames", refit_frames, "frames spanning the animation for --refit (default 240)")
+      ->check(CLI::Range(1, 100000));
   app.add_flag("--raster", raster,
                "instead of the structures: frames per second of primary visibility at --width x --height, "
                "rasterised against Embree's and the BVH's camera rays, and the shaded raster preview");
@@ -557,6 +862,18 @@ int main(int argc, char** argv) {
       return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
     }
   if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
+  if (!refit_file.empty() || tradeoffs) try {
+      AccelConfig config;
+      for (const auto& p : params) apply_accel_param(config, p);
+      if (!refit_file.empty())
+        return run_refit(refit_file, refit_frames, config, width, height, threads[0], csv);
+      std::string command;
+      for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
+      return run_tradeoffs(scenes, seed, accels, config, width, height, builds, repeats, csv, svg, command);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
+    }
   if (raster) try {
       return run_raster(scenes, seed, width, height, threads, builds, repeats);
     } catch (const std::exception& e) {
