@@ -59,6 +59,15 @@ std::vector<AccelParamInfo> accel_param_keys() {
       {"octree.max_leaf_prims", std::to_string(d.octree.max_leaf_prims),
        "a node with more primitives is subdivided, [1, 1024]"},
       {"octree.max_depth", std::to_string(d.octree.max_depth), "depth limit (root = 0), [1, 20]"},
+      {"bsp.traversal_cost", num(d.bsp.traversal_cost), "K_T, > 0"},
+      {"bsp.intersection_cost", num(d.bsp.intersection_cost), "K_I, > 0"},
+      {"bsp.empty_bonus", num(d.bsp.empty_bonus), "cost reduction for an empty side, [0, 1)"},
+      {"bsp.max_depth", std::to_string(d.bsp.max_depth), "[0, 64]; 0 = 8 + 1.3 log2 N"},
+      {"bsp.bins", std::to_string(d.bsp.bins), "positions per direction, [2, 64]"},
+      {"bsp.triangle_planes", std::to_string(d.bsp.triangle_planes),
+       "directions from the node's largest triangles, [0, 16]"},
+      {"bsp.fixed_directions", d.bsp.fixed_directions ? "1" : "0",
+       "1: the 10 diagonal directions are candidates; 0: axes and triangle planes only"},
       {"grid.lambda", num(d.grid.lambda), "cells per triangle of the finest grids, (0, 64]"},
       {"grid.coarse_lambda", num(d.grid.coarse_lambda),
        "cells per triangle of grids with sub-grids, (0, 64]"},
@@ -111,7 +120,25 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.octree.max_leaf_prims = parse_value<int>(key, value);
   else if (key == "octree.max_depth")
     c.octree.max_depth = parse_value<int>(key, value);
-  else if (key == "grid.lambda")
+  else if (key == "bsp.traversal_cost")
+    c.bsp.traversal_cost = parse_value<float>(key, value);
+  else if (key == "bsp.intersection_cost")
+    c.bsp.intersection_cost = parse_value<float>(key, value);
+  else if (key == "bsp.empty_bonus")
+    c.bsp.empty_bonus = parse_value<float>(key, value);
+  else if (key == "bsp.max_depth")
+    c.bsp.max_depth = parse_value<int>(key, value);
+  else if (key == "bsp.bins")
+    c.bsp.bins = parse_value<int>(key, value);
+  else if (key == "bsp.triangle_planes")
+    c.bsp.triangle_planes = parse_value<int>(key, value);
+  else if (key == "bsp.fixed_directions") {
+    const int v = parse_value<int>(key, value);
+    if (v != 0 && v != 1)
+      throw std::invalid_argument("--accel-param bsp.fixed_directions: must be 0 or 1, got '" +
+                                  std::string(value) + "'");
+    c.bsp.fixed_directions = v == 1;
+  } else if (key == "grid.lambda")
     c.grid.lambda = parse_value<float>(key, value);
   else if (key == "grid.coarse_lambda")
     c.grid.coarse_lambda = parse_value<float>(key, value);

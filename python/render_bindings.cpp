@@ -180,7 +180,7 @@ void bind_settings(py::module_& m) {
       .def_readwrite("integrator", &RenderSettings::integrator, "'whitted', 'path' or 'raster'")
       .def_readwrite("raster_shadows", &RenderSettings::raster_shadows,
                      "raster: light visibility by 'ray' (shadow rays), 'map' (shadow maps) or 'none'")
-      .def_readwrite("accel", &RenderSettings::accel, "embree, bvh, kdtree, grid or brute")
+      .def_readwrite("accel", &RenderSettings::accel, "embree, bvh, kdtree, grid, octree, bsp or brute")
       .def_readwrite("accel_params", &RenderSettings::accel_params, "['bvh.max_leaf_size=4', ...]")
       .def_readwrite("seed", &RenderSettings::seed)
       .def_readwrite("threads", &RenderSettings::threads, "0: every hardware thread")

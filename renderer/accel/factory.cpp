@@ -12,7 +12,7 @@
 namespace penumbra {
 
 std::vector<std::string> accelerator_names() {
-  return {"embree", "bvh", "kdtree", "grid", "octree", "brute"};
+  return {"embree", "bvh", "kdtree", "grid", "octree", "bsp", "brute"};
 }
 
 namespace {
@@ -32,6 +32,7 @@ std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<c
   if (name == "kdtree") return make_kdtree_accelerator(meshes, config.kdtree);
   if (name == "grid") return make_grid_accelerator(meshes, config.grid);
   if (name == "octree") return make_octree_accelerator(meshes, config.octree);
+  if (name == "bsp") return make_bsp_accelerator(meshes, config.bsp);
   if (name == "brute") return make_brute_accelerator(meshes);
   throw_unknown(name);
 }

@@ -1,5 +1,5 @@
 // Choosing an acceleration structure by name: the one place that maps "embree", "bvh",
-// "kdtree", "grid", "octree" and "brute" to their builders, with each builder's configuration.
+// "kdtree", "grid", "octree", "bsp" and "brute" to their builders, with each builder's configuration.
 #pragma once
 
 #include <memory>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/accel/bsp.h"
 #include "renderer/accel/bvh.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/grid.h"
@@ -24,6 +25,7 @@ struct AccelConfig {
   KdTreeConfig kdtree;
   GridConfig grid;
   OctreeConfig octree;
+  BspConfig bsp;
 };
 
 /// Names accepted by make_accelerator, default ("embree") first.

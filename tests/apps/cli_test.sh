@@ -82,7 +82,7 @@ if command -v oiiotool >/dev/null; then
   expect 0 "64 x +[0-9]+, 3 channel, uint8 png" -- oiiotool --info "$work/cost-grid.cost.png"
 fi
 expect 0 "resolution [0-9]+x[0-9]+x[0-9]+" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=2
-expect 2 "unknown accelerator 'octree' \(known: embree, bvh, kdtree, grid, brute\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --accel octree
+expect 2 "unknown accelerator 'quadtree' \(known: embree, bvh, kdtree, grid, octree, bsp, brute\)" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --accel quadtree
 expect 2 "unknown key 'grid.lamda'" -- "$bin" render "$src/scenes/default.gltf" -o "$work/a.exr" --accel grid --accel-param grid.lamda=2
 expect 2 "lambda must be in" -- "$bin" info "$src/scenes/default.gltf" --accel grid --accel-param grid.lambda=-1
 expect 2 "'2x' is not a valid" -- "$bin" info "$src/scenes/default.gltf" --accel-param bvh.bin_count=2x

@@ -167,8 +167,8 @@ def test_no_camera_frames_the_bounds_and_no_light_adds_the_key_light(tmp_path):
 def test_settings_are_checked_before_rendering(default_scene):
     with pytest.raises(ValueError, match="integrator: unknown value 'foo' \\(known: whitted, path, raster\\)"):
         default_scene.render(integrator="foo")
-    with pytest.raises(ValueError, match="accel: unknown value 'octree'"):
-        default_scene.render(accel="octree")
+    with pytest.raises(ValueError, match="accel: unknown value 'quadtree'"):
+        default_scene.render(accel="quadtree")
     with pytest.raises(ValueError, match="'samples' needs integrator 'path'"):
         default_scene.render(aovs=["samples"])
     with pytest.raises(ValueError, match="unknown AOV 'depth'"):

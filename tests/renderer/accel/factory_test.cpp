@@ -43,7 +43,7 @@ TEST_CASE("empty scenes build and miss", "[accel][quick]") {
 
 TEST_CASE("the factory knows its back ends, embree first, and refuses bad configurations", "[accel][quick]") {
   CHECK(accelerator_names() ==
-        std::vector<std::string>{"embree", "bvh", "kdtree", "grid", "octree", "brute"});
+        std::vector<std::string>{"embree", "bvh", "kdtree", "grid", "octree", "bsp", "brute"});
   AccelConfig bad_bvh;
   bad_bvh.bvh.max_leaf_size = 0;
   CHECK_THROWS_AS(make_accelerator("bvh", {}, bad_bvh), std::invalid_argument);
@@ -57,6 +57,10 @@ TEST_CASE("the factory knows its back ends, embree first, and refuses bad config
   bad_octree.octree.max_depth = 21;
   CHECK_THROWS_WITH(make_accelerator("octree", {}, bad_octree),
                     Catch::Contains("octree: max_depth must be in [1, 20], got 21"));
+  AccelConfig bad_bsp;
+  bad_bsp.bsp.bins = 1;
+  CHECK_THROWS_WITH(make_accelerator("bsp", {}, bad_bsp),
+                    Catch::Contains("bsp: bins must be in [2, 64], got 1"));
   AccelConfig bad_embree;
   bad_embree.embree.quality = 3;
   CHECK_THROWS_WITH(make_accelerator("embree", {}, bad_embree), Catch::Contains("embree: quality"));
