@@ -3,7 +3,7 @@
 # build) and, for the Stanford models, node/npm (benchmarks/fetch_models.sh is called).
 #   benchmarks/run_suite.sh [OUT_DIR]       (default: build/bench-results)
 # Writes, per part, a table (.txt), CSV, JSON and SVG chart, and the cost heat maps, to OUT_DIR.
-# Takes about 20 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
+# Takes about 45 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
 # ../shared/corpus); corpus models are skipped when it is absent.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -52,4 +52,21 @@ run collapse-flat gen:stadium:50000 gen:slivers:100000 --accel grid --accel-para
 # 4. Scaling: build time and memory against N (2 threads).
 run scaling gen:terrain:500000 gen:terrain:1000000 gen:terrain:2000000 \
   --accel embree,bvh,kdtree,grid --rays random,primary --threads 0 --builds 3 --repeats 3
+# 5. The course's table of spatial structures (RESULTS.md, "The course's trade-offs, measured"):
+# memory, build with 1 thread and every core, work per ray and throughput for every structure,
+# and the flat uniform grid (grid.max_depth=1) on the same scenes.
+run tradeoffs "$dragon" "$bunny" gen:stadium:50000 gen:slivers:100000 gen:soup:100000 gen:terrain:1000000 \
+  --tradeoffs --accel embree,bvh,kdtree,grid,octree,bsp --builds 1 --repeats 3 --width 256 --height 144
+run tradeoffs-flat-grid "$dragon" "$bunny" gen:stadium:50000 gen:slivers:100000 gen:soup:100000 \
+  gen:terrain:1000000 --tradeoffs --accel grid --accel-param grid.max_depth=1 --builds 1 --repeats 1 \
+  --width 256 --height 144
+# 6. Refit against rebuild: the BVH over 240 frames of a skinned corpus model.
+brainstem="$corpus/extensions/BrainStem/glTF-Draco/BrainStem.gltf"
+if [[ -f "$brainstem" ]]; then
+  echo "== refit: penumbra-bench --refit $brainstem" >&2
+  "$bench" --refit "$brainstem" --refit-frames 240 --width 256 --height 144 --threads 1 --csv "$out/refit.csv" |
+    tee "$out/refit.txt"
+else
+  echo "run_suite: $brainstem not found: refit skipped" >&2
+fi
 echo "$out"
