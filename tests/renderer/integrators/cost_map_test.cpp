@@ -66,7 +66,7 @@ TEST_CASE("cost map: matches intersect_counted per ray, the same for 1 and 2 thr
   cfg.width = 24;
   cfg.height = 16;
   cfg.spp = 1;
-  for (const char* name : {"bvh", "kdtree", "grid"}) {
+  for (const char* name : {"bvh", "kdtree", "grid", "octree", "bsp"}) {
     INFO(name);
     const auto a = make_accelerator(name, views);
     REQUIRE(a->counts_traversal());
