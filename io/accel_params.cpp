@@ -59,6 +59,8 @@ std::vector<AccelParamInfo> accel_param_keys() {
       {"octree.max_leaf_prims", std::to_string(d.octree.max_leaf_prims),
        "a node with more primitives is subdivided, [1, 1024]"},
       {"octree.max_depth", std::to_string(d.octree.max_depth), "depth limit (root = 0), [1, 20]"},
+      {"octree.reference_budget", num(d.octree.reference_budget),
+       "extra references splits may add, x the primitive count, [0, 64]"},
       {"bsp.traversal_cost", num(d.bsp.traversal_cost), "K_T, > 0"},
       {"bsp.intersection_cost", num(d.bsp.intersection_cost), "K_I, > 0"},
       {"bsp.empty_bonus", num(d.bsp.empty_bonus), "cost reduction for an empty side, [0, 1)"},
@@ -120,6 +122,8 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     c.octree.max_leaf_prims = parse_value<int>(key, value);
   else if (key == "octree.max_depth")
     c.octree.max_depth = parse_value<int>(key, value);
+  else if (key == "octree.reference_budget")
+    c.octree.reference_budget = parse_value<float>(key, value);
   else if (key == "bsp.traversal_cost")
     c.bsp.traversal_cost = parse_value<float>(key, value);
   else if (key == "bsp.intersection_cost")

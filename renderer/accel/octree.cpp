@@ -110,7 +110,8 @@ class Builder {
 
   /// The subtree over primitives `ids` (ascending) in `box` at `depth`. Its shape depends on
   /// the input alone, never on scheduling.
-  std::unique_ptr<BuildNode> build(std::vector<uint32_t> ids, const Bounds3f& box, int depth) const {
+  std::unique_ptr<BuildNode> build(std::vector<uint32_t> ids, const Bounds3f& box, int depth,
+                                   double budget) const {
     auto node = std::make_unique<BuildNode>();
     const size_t n = ids.size();
     if (n <= size_t(m_config.max_leaf_prims) || depth >= m_config.max_depth || !splits_any(box, m_band)) {
@@ -141,11 +142,23 @@ class Builder {
       node->prims = std::move(ids);
       return node;
     }
+    // The reference budget: the references this split adds beyond the node's own must fit in
+    // what the node was given; what is left passes to the children in proportion to their
+    // counts (so the tree never depends on scheduling).
+    size_t total = 0;
+    for (const auto& k : kids) total += k.size();
+    const double extra = double(total) - double(n);
+    if (extra > budget) {
+      node->prims = std::move(ids);
+      return node;
+    }
+    const double left = budget - std::max(extra, 0.0);
     // Phase 3: recurse; large nodes build their children in parallel.
     std::vector<uint32_t>().swap(ids);
     node->leaf = false;
     const auto make_child = [&](int c) {
-      node->children[c] = build(std::move(kids[c]), boxes[c], depth + 1);
+      const double share = total > 0 ? left * double(kids[c].size()) / double(total) : 0.0;
+      node->children[c] = build(std::move(kids[c]), boxes[c], depth + 1, share);
     };
     if (n >= m_config.parallel_threshold) {
       tbb::parallel_for(0, 8, make_child);
@@ -194,7 +207,8 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
       std::vector<uint32_t> all(prims.size());
       std::iota(all.begin(), all.end(), 0u);
       const Builder builder(m_config, prims, m_band);
-      const auto root = builder.build(std::move(all), m_bounds, 0);
+      const double budget = double(m_config.reference_budget) * double(prims.size());
+      const auto root = builder.build(std::move(all), m_bounds, 0, budget);
       m_nodes.emplace_back();
       flatten(*root, 0, m_bounds, 0, prims);
       if (m_nodes.size() >= kInterior || m_leaf_prims.size() >= kInterior)
@@ -210,7 +224,8 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
     AccelStats s = make_stats(
         m_stats, "octree",
         "max_leaf_prims " + std::to_string(m_config.max_leaf_prims) + ", max_depth " +
-            std::to_string(m_config.max_depth),
+            std::to_string(m_config.max_depth) + ", reference_budget " +
+            format_number(m_config.reference_budget),
         m_input_triangles, m_nodes.size() * sizeof(OctNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
         m_build_seconds);
     s.nodes = m_nodes.size();
@@ -384,6 +399,9 @@ void validate(const OctreeConfig& c) {
                                 std::to_string(c.max_leaf_prims));
   if (c.max_depth < 1 || c.max_depth > kMaxDepthLimit)
     throw std::invalid_argument("octree: max_depth must be in [1, 20], got " + std::to_string(c.max_depth));
+  if (!(c.reference_budget >= 0 && c.reference_budget <= 64))
+    throw std::invalid_argument("octree: reference_budget must be in [0, 64], got " +
+                                format_number(c.reference_budget));
 }
 
 std::unique_ptr<Accelerator> make_octree_accelerator(std::span<const GeometryView> views,

@@ -19,6 +19,7 @@ namespace penumbra {
 /// |--------------------|---------|-----------|------------------------------------------------------|
 /// | max_leaf_prims     | 8       | [1, 1024] | a node with more primitives is subdivided            |
 /// | max_depth          | 10      | [1, 20]   | nodes at this depth are leaves (root = depth 0)      |
+/// | reference_budget   | 4       | [0, 64]   | extra references splits may add, x the primitive count |
 /// | parallel_threshold | 8192    | any       | nodes with more primitives build children in parallel |
 ///
 /// A node is also a leaf when subdividing it makes no progress: every child would hold either
@@ -31,8 +32,14 @@ namespace penumbra {
 /// meeting along a mesh edge makes the tree follow that edge down to max_depth (2^depth leaves
 /// along it).
 struct OctreeConfig {
-  int max_leaf_prims = 8;            ///< [1, 1024]: a node with more primitives is subdivided
-  int max_depth = 10;                ///< [1, 20]: depth limit (root = 0)
+  int max_leaf_prims = 8;  ///< [1, 1024]: a node with more primitives is subdivided
+  int max_depth = 10;      ///< [1, 20]: depth limit (root = 0)
+  /// [0, 64]: references that splits may add beyond one per primitive, as a multiple of the
+  /// primitive count. The root holds the whole budget; a split must fit its added references
+  /// in its node's share and passes the rest to its children in proportion to their counts
+  /// (a node that cannot split stays a leaf). Bounds memory at (1 + budget) references per
+  /// primitive where slivers would otherwise be copied into every cell they cross.
+  float reference_budget = 4.0f;
   size_t parallel_threshold = 8192;  ///< nodes with more primitives build their children in parallel
 };
 

@@ -30,6 +30,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
                          "bvh.refit_max_growth=2",
                          "octree.max_leaf_prims=4",
                          "octree.max_depth=6",
+                         "octree.reference_budget=2",
                          "bsp.traversal_cost=3",
                          "bsp.intersection_cost=40",
                          "bsp.empty_bonus=0.1",
@@ -60,6 +61,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.bvh.refit_max_growth == 2);
   CHECK(c.octree.max_leaf_prims == 4);
   CHECK(c.octree.max_depth == 6);
+  CHECK(c.octree.reference_budget == 2);
   CHECK(c.bsp.traversal_cost == 3);
   CHECK(c.bsp.intersection_cost == 40);
   CHECK(c.bsp.empty_bonus == 0.1f);
@@ -67,7 +69,7 @@ TEST_CASE("accel params: each key sets its field", "[io][quick]") {
   CHECK(c.bsp.bins == 16);
   CHECK(c.bsp.triangle_planes == 0);
   CHECK_FALSE(c.bsp.fixed_directions);
-  CHECK(accel_param_keys().size() == 29);
+  CHECK(accel_param_keys().size() == 30);
 }
 
 TEST_CASE("accel params: unknown keys and malformed values are refused", "[io][quick]") {

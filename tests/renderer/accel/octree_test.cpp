@@ -145,7 +145,7 @@ TEST_CASE("octree: analytic statistics of a two-triangle tree", "[accel][octree]
   const auto oct = make_octree_accelerator(std::span(&view, 1), octree_config(1, 10));
   const AccelStats s = oct->stats();
   CHECK(s.name == "octree");
-  CHECK(s.config == "max_leaf_prims 1, max_depth 10");
+  CHECK(s.config == "max_leaf_prims 1, max_depth 10, reference_budget 4");
   CHECK(s.triangles == 2);
   CHECK(s.shapes == 0);
   CHECK(s.nodes == 9);
@@ -161,7 +161,8 @@ TEST_CASE("octree: analytic statistics of a two-triangle tree", "[accel][octree]
   CHECK(s.sah_leaf_area == Approx(0.5));
   CHECK(s.bytes == 9 * 8 + 2 * 44);
   CHECK(s.build_seconds >= 0);
-  CHECK(make_octree_accelerator(std::span(&view, 1))->stats().config == "max_leaf_prims 8, max_depth 10");
+  CHECK(make_octree_accelerator(std::span(&view, 1))->stats().config ==
+        "max_leaf_prims 8, max_depth 10, reference_budget 4");
   // Two primitives fit a leaf of 2: the root is the only node.
   const AccelStats s2 = make_octree_accelerator(std::span(&view, 1), octree_config(2, 10))->stats();
   CHECK(s2.nodes == 1);
@@ -257,6 +258,36 @@ TEST_CASE("octree: slivers spanning a box make no progress: a small tree, not 8^
   for (float x = 0.25f; x < 4; x += 0.25f)
     onto.push_back({{x, 0.7f + 0.004f * x, 2}, 0, {0, 0, -1}, kInfinity});
   check_against_brute("slivers along a line", std::span(&line, 1), 1, 10, onto);
+}
+
+TEST_CASE("octree: the reference budget bounds the copies of crossing slivers", "[accel][octree]") {
+  // Slivers in random directions across the box: each crosses many cells at every depth, and
+  // partial overlaps let the no-progress rule subdivide on. The budget caps the references.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0, 10);
+  std::vector<Vec3f> pos;
+  std::vector<uint32_t> idx;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
+    idx.insert(idx.end(), {uint32_t(pos.size()), uint32_t(pos.size() + 1), uint32_t(pos.size() + 2)});
+    pos.insert(pos.end(), {a, b, b + Vec3f{0.01f, 0, 0.01f}});
+  }
+  const GeometryView view{pos, idx};
+  for (float budget : {0.0f, 1.0f, 4.0f}) {
+    OctreeConfig c;
+    c.reference_budget = budget;
+    const AccelStats s = make_octree_accelerator(std::span(&view, 1), c)->stats();
+    INFO("budget " << budget << ": " << s.references << " references");
+    CHECK(double(s.references) <= (1 + double(budget)) * 2000 * 1.0001);
+    if (budget == 0) CHECK(s.references == 2000);  // a split that copies anything is refused
+  }
+  OctreeConfig open;
+  open.reference_budget = 64;
+  const AccelStats wide = make_octree_accelerator(std::span(&view, 1), open)->stats();
+  CHECK(wide.references > 5 * 2000);  // without the default budget the copies do multiply
+  OctreeConfig tight;
+  tight.reference_budget = 1;
+  check_against_brute("crossing slivers, budget 1", std::span(&view, 1), 1, 12, {}, {tight});
 }
 
 TEST_CASE("octree: a long diagonal sliver is clipped to the children it crosses", "[accel][octree]") {
@@ -485,6 +516,9 @@ TEST_CASE("octree: configuration is validated", "[accel][octree][quick]") {
   CHECK_THROWS_WITH(validate(c), "octree: max_leaf_prims must be in [1, 1024], got 0");
   c.max_leaf_prims = 1025;
   CHECK_THROWS_WITH(validate(c), Catch::Contains("max_leaf_prims") && Catch::Contains("1025"));
+  OctreeConfig b;
+  b.reference_budget = -1;
+  CHECK_THROWS_WITH(validate(b), Catch::Contains("octree: reference_budget must be in [0, 64], got -1"));
   c = {};
   c.max_depth = 0;
   CHECK_THROWS_WITH(validate(c), Catch::Contains("max_depth") && Catch::Contains("got 0"));
