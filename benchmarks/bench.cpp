@@ -543,7 +543,7 @@ bench::Spread timed_builds(const std::string& name, const Scene& scene, const Ac
   return bench::spread_of(s);
 }
 
-/// --tradeoffs: the course's table of spatial structures, measured: per scene and structure the
+/// --tradeoffs: per scene and structure the
 /// memory, the build time with 1 thread and with every core, the distribution of work per ray
 /// (closest hits of the primary and random rays) and the throughput of one thread, with every
 /// answer checked against Embree as the main table checks it.

@@ -52,7 +52,7 @@ run collapse-flat gen:stadium:50000 gen:slivers:100000 --accel grid --accel-para
 # 4. Scaling: build time and memory against N (2 threads).
 run scaling gen:terrain:500000 gen:terrain:1000000 gen:terrain:2000000 \
   --accel embree,bvh,kdtree,grid --rays random,primary --threads 0 --builds 3 --repeats 3
-# 5. The course's table of spatial structures (RESULTS.md, "The course's trade-offs, measured"):
+# 5. Spatial structures side by side (RESULTS.md, "Spatial structures: memory, build, work per ray, refit"):
 # memory, build with 1 thread and every core, work per ray and throughput for every structure,
 # and the flat uniform grid (grid.max_depth=1) on the same scenes.
 run tradeoffs "$dragon" "$bunny" gen:stadium:50000 gen:slivers:100000 gen:soup:100000 gen:terrain:1000000 \
