@@ -683,17 +683,22 @@ int run_tradeoffs(const std::vector<std::string>& scenes, uint64_t seed,
 }
 
 /// The end of a glTF file's animations: the largest "max" of the animation samplers' input
-/// accessors (the spec requires it). 0 for a file without animations.
+/// accessors (the spec requires it). 0 for a file without animations, or whose JSON cannot be
+/// read so (a GLB, or members of other types).
 double animation_end(const std::string& file) {
   std::ifstream in(file);
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   double end = 0;
-  if (j.is_discarded() || !j.contains("animations")) return end;
-  for (const auto& a : j["animations"])
-    for (const auto& s : a.value("samplers", nlohmann::json::array())) {
-      const auto& acc = j["accessors"][s["input"].get<size_t>()];
-      if (acc.contains("max")) end = std::max(end, acc["max"][0].get<double>());
-    }
+  if (j.is_discarded() || !j.is_object() || !j.contains("animations")) return end;
+  try {
+    for (const auto& a : j.at("animations"))
+      for (const auto& s : a.value("samplers", nlohmann::json::array())) {
+        const auto& acc = j.at("accessors").at(s.at("input").get<size_t>());
+        if (acc.contains("max")) end = std::max(end, acc.at("max").at(0).get<double>());
+      }
+  } catch (const nlohmann::json::exception&) {
+    return 0;
+  }
   return end;
 }
 
@@ -715,14 +720,17 @@ double mean_work(const Accelerator& a, const std::vector<Ray>& rays) {
 int run_refit(const std::string& file, int frames, const AccelConfig& config, int width, int height,
               int threads, const std::string& csv) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(thread_count(threads)));
+  Scene scene = load_gltf(file).scene;  // the loader's checks and errors come first
   const double end = animation_end(file);
-  if (!(end > 0)) throw std::invalid_argument(file + ": no animation to refit over");
+  if (!(end > 0))
+    throw std::invalid_argument(file +
+                                ": no animation to refit over (--refit needs a .gltf file with animations)");
   const auto load = [&](int f) {
     GltfLoadOptions o;
     o.time = end * double(f) / double(frames);
     return load_gltf(file, o).scene;
   };
-  Scene scene = load(0);
+  scene = load(0);
   const Camera cam = frame_bounds(compute_bounds(scene), float(width) / float(height));
   std::vector<Ray> rays;
   for (int y = 0; y < height; ++y)
@@ -872,7 +880,9 @@ int main(int argc, char** argv) {
       return run_tradeoffs(scenes, seed, accels, config, width, height, builds, repeats, csv, svg, command);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
+      const bool input =
+          dynamic_cast<const std::invalid_argument*>(&e) || dynamic_cast<const InputError*>(&e);
+      return input ? 2 : 1;
     }
   if (raster) try {
       return run_raster(scenes, seed, width, height, threads, builds, repeats);
