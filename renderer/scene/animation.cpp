@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "renderer/core/quaternion.h"
+
 namespace penumbra {
 
 namespace {
@@ -15,24 +17,10 @@ void normalise4(double* q) {
     q[0] = q[1] = q[2] = 0, q[3] = 1;
 }
 
-// Spherical linear interpolation along the shorter arc (Shoemake 1985).
-void slerp(const float* a, const float* b, double s, double* out) {
-  double qa[4] = {a[0], a[1], a[2], a[3]}, qb[4] = {b[0], b[1], b[2], b[3]};
-  normalise4(qa);
-  normalise4(qb);
-  double d = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
-  if (d < 0) {
-    for (double& v : qb) v = -v;
-    d = -d;
-  }
-  double wa = 1 - s, wb = s;
-  if (d < 0.9995) {
-    const double theta = std::acos(std::min(d, 1.0)), sin_theta = std::sin(theta);
-    wa = std::sin((1 - s) * theta) / sin_theta;
-    wb = std::sin(s * theta) / sin_theta;
-  }
-  for (int i = 0; i < 4; ++i) out[i] = wa * qa[i] + wb * qb[i];
-  normalise4(out);
+// Spherical linear interpolation of two keys along the shorter arc (core/quaternion.h).
+void slerp_keys(const float* a, const float* b, double s, double* out) {
+  const Quat q = slerp(Quat{a[0], a[1], a[2], a[3]}, Quat{b[0], b[1], b[2], b[3]}, s);
+  out[0] = q.x, out[1] = q.y, out[2] = q.z, out[3] = q.w;
 }
 }  // namespace
 
@@ -58,7 +46,7 @@ void sample_track(std::span<const float> times, std::span<const float> values, s
     case Interpolation::Step:
       return copy(key_value(i));
     case Interpolation::Linear:
-      if (rotation) return slerp(key_value(i), key_value(j), s, out);
+      if (rotation) return slerp_keys(key_value(i), key_value(j), s, out);
       for (size_t c = 0; c < width; ++c) out[c] = (1 - s) * key_value(i)[c] + s * key_value(j)[c];
       return;
     case Interpolation::CubicSpline: {

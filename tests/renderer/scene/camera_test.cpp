@@ -5,7 +5,10 @@
 #include <array>
 #include <catch2/catch.hpp>
 
+#include "support/camera_checks.h"
+
 using namespace penumbra;
+using namespace penumbra::test;
 
 TEST_CASE("perspective: centre ray looks down -w, edges span the field of view", "[camera][quick]") {
   Camera cam;                      // at the origin looking down -z
@@ -79,47 +82,6 @@ TEST_CASE("look_at builds a right-handed orthonormal frame", "[camera][quick]") 
   CHECK(uxv.z == Approx(c.w.z));
   CHECK(dot(-c.w, normalize(Vec3f{-1, -2, -3})) == Approx(1));
 }
-
-namespace {
-
-/// Raster position (x right, y down, in pixels) of world point `p` under `cam` in a w x h image.
-Vec2f project(const Camera& cam, Vec3f p, int w, int h) {
-  const float aspect = float(w) / float(h);
-  const Vec3f q = p - cam.eye;
-  float sx = 0, sy = 0;
-  if (cam.projection == Projection::Orthographic) {
-    sx = dot(q, cam.u) / (cam.ymag * aspect);
-    sy = dot(q, cam.v) / cam.ymag;
-  } else {
-    const float depth = -dot(q, cam.w);
-    REQUIRE(depth > 0);  // in front of the camera
-    const float tan_y = std::tan(0.5f * cam.yfov);
-    sx = dot(q, cam.u) / depth / (tan_y * aspect);
-    sy = dot(q, cam.v) / depth / tan_y;
-  }
-  return {0.5f * (sx + 1) * float(w), 0.5f * (1 - sy) * float(h)};
-}
-
-/// Every corner of `b` projects inside the w x h image, and the outermost one lies within one
-/// pixel of the border on the axis that limits the fit.
-void check_tight_fit(const Camera& cam, const Bounds3f& b, int w, int h) {
-  float reach_x = 0, reach_y = 0;  // the largest distance from the centre line, pixels
-  for (int k = 0; k < 8; ++k) {
-    const Vec3f p{(k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z};
-    const Vec2f r = project(cam, p, w, h);
-    CHECK(r.x >= -1e-3f * float(w));
-    CHECK(r.x <= float(w) * (1 + 1e-3f));
-    CHECK(r.y >= -1e-3f * float(h));
-    CHECK(r.y <= float(h) * (1 + 1e-3f));
-    reach_x = std::max(reach_x, std::fabs(r.x - 0.5f * float(w)));
-    reach_y = std::max(reach_y, std::fabs(r.y - 0.5f * float(h)));
-  }
-  const float gap_x = 0.5f * float(w) - reach_x, gap_y = 0.5f * float(h) - reach_y;
-  CHECK(std::min(gap_x, gap_y) <= 1.0f);  // the limiting axis touches the border
-  CHECK(std::min(gap_x, gap_y) >= -1e-3f * float(std::max(w, h)));
-}
-
-}  // namespace
 
 TEST_CASE("frame_bounds fits the corners of the bounds tightly, keeping the view direction",
           "[camera][quick]") {
