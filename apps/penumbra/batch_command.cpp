@@ -39,6 +39,8 @@ const std::map<std::string, std::string>& reserved_settings() {
       {"progress", "`penumbra batch --progress`"},
       {"debug-pixel", "`penumbra render --debug-pixel`"},
       {"help", "`penumbra render --help`"},
+      {"contact-sheet", "`penumbra render --contact-sheet` (a job's frames render as separate units)"},
+      {"contact-sheet-columns", "`penumbra render --contact-sheet-columns`"},
   };
   return m;
 }
@@ -85,6 +87,9 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
     const auto reserved = reserved_settings().find(s.key);
     if (reserved != reserved_settings().end())
       throw InputError(job.file.string(), s.where, "is set by " + reserved->second + ", not in settings");
+    if (s.key == "turntable" && !shot.frames)
+      throw InputError(job.file.string(), s.where,
+                       "a turntable renders the shot's \"frames\" (e.g. \"0-35\" for 36 frames per turn)");
     // Batch renders are reproducible: nothing that depends on the clock.
     if (s.key == "time-limit")
       throw InputError(job.file.string(), s.where,

@@ -8,10 +8,12 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra::cli {
 
@@ -132,8 +134,97 @@ nlohmann::ordered_json finite_or_null(float v) {
   return std::isfinite(v) ? nlohmann::ordered_json(num(v)) : nlohmann::ordered_json();
 }
 
+/// The camera render would use, for the image size it would render.
+struct View {
+  Camera camera;
+  std::string source;  ///< what placed it, in words
+  int width = 0, height = 0;
+  Transform view, projection;
+};
+
+View resolve_view(const InfoArgs& a, const Scene& s) {
+  const long long frame = a.frame.empty() ? 0 : parse_integer(a.frame, -(1ll << 40), 1ll << 40, "--frame");
+  if (!a.frame.empty() && a.cam.turntable.empty())
+    throw UsageError("info: --frame picks a --turntable frame");
+  const CameraRig rig = check_camera_args(a.cam, frame);
+  const int index = base_camera_index(s, a.camera, a.cam, a.file);
+  View v;
+  std::tie(v.width, v.height) = image_size(a.width, a.height, aspect_hint(s, index));
+  v.camera = choose_camera(rig, s, index, v.width, v.height);
+  const std::string lens =
+      index >= 0 ? "camera " + std::to_string(index) + " '" + s.cameras[size_t(index)].name + "'"
+                 : std::string("the default lens");
+  switch (rig.placement) {
+    case CameraPlacement::Base:
+      v.source = index >= 0 ? lens : "auto-framed on the bounds";
+      break;
+    case CameraPlacement::LookAt:
+      v.source = "--look-at, " + lens;
+      break;
+    case CameraPlacement::Orbit:
+      v.source = (rig.turntable_frames > 0 ? "--turntable frame " + std::to_string(rig.turntable_frame) +
+                                                 " of " + std::to_string(rig.turntable_frames)
+                                           : std::string("--orbit")) +
+                 ", " + lens;
+      break;
+    case CameraPlacement::Euler:
+      v.source = "--euler, " + lens;
+      break;
+  }
+  v.view = view_matrix(v.camera);
+  v.projection = projection_matrix(v.camera, float(v.width) / float(v.height));
+  return v;
+}
+
+nlohmann::ordered_json matrix_json(const Transform& t) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (const auto& row : t.m) rows.push_back({row[0], row[1], row[2], row[3]});
+  return rows;
+}
+
+nlohmann::ordered_json view_json(const View& v) {
+  using J = nlohmann::ordered_json;
+  const Camera& c = v.camera;
+  const bool ortho = c.projection == Projection::Orthographic;
+  return J{{"source", v.source},
+           {"width", v.width},
+           {"height", v.height},
+           {"type", ortho ? "orthographic" : "perspective"},
+           {"yfov", ortho ? J() : J(num(c.yfov))},
+           {"ymag", ortho ? J(num(c.ymag)) : J()},
+           {"znear", num(c.znear)},
+           {"zfar", finite_or_null(c.zfar)},
+           {"eye", vec3(c.eye)},
+           {"u", vec3(c.u)},
+           {"v", vec3(c.v)},
+           {"w", vec3(c.w)},
+           {"view_matrix", matrix_json(v.view)},
+           {"projection_matrix", matrix_json(v.projection)}};
+}
+
+void print_matrix(const char* title, const Transform& t) {
+  std::printf("  %s\n", title);
+  for (const auto& row : t.m)
+    std::printf("    [%12.6g %12.6g %12.6g %12.6g ]\n", row[0], row[1], row[2], row[3]);
+}
+
+void print_view(const View& v) {
+  const Camera& c = v.camera;
+  std::printf("view         %s, %dx%d\n", v.source.c_str(), v.width, v.height);
+  if (c.projection == Projection::Orthographic)
+    std::printf("  lens       orthographic, height %.6g", 2 * double(c.ymag));
+  else
+    std::printf("  lens       perspective, vertical fov %.6g degrees", double(c.yfov) * 180 / M_PI);
+  std::printf(", near %.6g, far %.6g\n", double(c.znear), double(c.zfar));
+  std::printf("  eye        (%.6g, %.6g, %.6g), looking along (%.6g, %.6g, %.6g), up (%.6g, %.6g, %.6g)\n",
+              c.eye.x, c.eye.y, c.eye.z, -c.w.x, -c.w.y, -c.w.z, c.v.x, c.v.y, c.v.z);
+  print_matrix("view matrix (world to camera, camera looks down -Z)", v.view);
+  print_matrix("projection matrix (glTF: clip space, depth -1..1 from near to far)", v.projection);
+}
+
 /// The description as one JSON document (schema: README, `penumbra info --json`).
-nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loaded, const AccelStats& st) {
+nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loaded, const View& view,
+                                 const AccelStats& st) {
   using J = nlohmann::ordered_json;
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
@@ -255,21 +346,47 @@ nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loa
                       {"max_depth", figure(tree, st.max_depth)},
                       {"sah_cost", figure(st.sah_cost > 0, st.sah_cost)}};
   j["warnings"] = loaded.warnings;
+  j["view"] = view_json(view);
   return j;
 }
 
 }  // namespace
 
-int run_info(const std::string& file, int scene_index, bool allow_external, bool flatten,
-             const std::string& accel_name, const std::vector<std::string>& accel_params, bool json) {
-  const AccelConfig accel_config = parse_accel(accel_name, accel_params);
-  LoadedScene loaded = load_scene(file, scene_index, allow_external, flatten, default_memory_budget(), false);
+void add_info_options(CLI::App& info, InfoArgs& a) {
+  info.add_option("scene", a.file, "glTF scene (.gltf or .glb)")->required();
+  info.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
+  info.add_option(
+      "--accel", a.accel,
+      "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, octree, "
+      "bsp, brute");
+  info.add_option("--accel-param", a.accel_params, accel_param_help())->type_name("KEY=VALUE");
+  info.add_flag("--allow-external-uris", a.allow_external,
+                "let buffer URIs reach files outside the scene's folder");
+  info.add_flag("--flatten", a.flatten, "as for render: no instancing");
+  info.add_flag(
+      "--json", a.json,
+      "print the description as one JSON document (the schema is in README, `penumbra info --json`)");
+  info.add_option("--camera", a.camera, "as for render: the camera the view section describes");
+  info.add_option("--width", a.width, "as for render: the image width the view is described for")
+      ->check(CLI::Range(1, 16384));
+  info.add_option("--height", a.height, "as for render: the image height")->check(CLI::Range(1, 16384));
+  info.add_option("--frame", a.frame, "the --turntable frame the view section describes (default 0)");
+  add_camera_options(info, a.cam);
+}
+
+int run_info(const InfoArgs& a) {
+  const std::string& file = a.file;
+  const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
+  check_camera_args(a.cam);  // bad camera flags fail before the scene loads
+  LoadedScene loaded = load_scene(file, a.scene, a.allow_external, a.flatten, default_memory_budget(), false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
-  if (json) {
+  const View view = resolve_view(a, s);
+  const std::string& accel_name = a.accel;
+  if (a.json) {
     const auto accel = make_scene_accelerator(accel_name, s, accel_config);
-    const std::string doc =
-        info_json(file, loaded, accel->stats()).dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+    const std::string doc = info_json(file, loaded, view, accel->stats())
+                                .dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
     std::printf("%s\n", doc.c_str());
     return kExitOk;
   }
@@ -330,6 +447,7 @@ int run_info(const std::string& file, int scene_index, bool allow_external, bool
                 b.hi.y, b.hi.z);
   else
     std::printf("bounds       empty\n");
+  print_view(view);
   auto accel = make_scene_accelerator(accel_name, s, accel_config);
   const AccelStats st = accel->stats();
   std::printf("accelerator  %s%s%s%s\n", st.name.c_str(), st.config.empty() ? "" : " (", st.config.c_str(),

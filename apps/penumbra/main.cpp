@@ -25,27 +25,6 @@ using namespace penumbra::cli;
 
 namespace {
 
-struct InfoArgs {
-  std::string file, accel = "embree";
-  std::vector<std::string> accel_params;
-  int scene = -1;
-  bool allow_external = false, flatten = false, json = false;
-};
-
-void add_info_options(CLI::App& info, InfoArgs& a) {
-  info.add_option("scene", a.file, "glTF scene (.gltf or .glb)")->required();
-  info.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
-  info.add_option("--accel", a.accel,
-                  "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, brute");
-  info.add_option("--accel-param", a.accel_params, accel_param_help())->type_name("KEY=VALUE");
-  info.add_flag("--allow-external-uris", a.allow_external,
-                "let buffer URIs reach files outside the scene's folder");
-  info.add_flag("--flatten", a.flatten, "as for render: no instancing");
-  info.add_flag(
-      "--json", a.json,
-      "print the description as one JSON document (the schema is in README, `penumbra info --json`)");
-}
-
 void add_merge_options(CLI::App& merge, MergeArgs& a) {
   merge.add_option("parts", a.parts, "part EXRs (together covering the frame once)")->required();
   merge.add_option("-o,--output", a.output, "full-frame EXR (written atomically)")->required();
@@ -169,9 +148,7 @@ int main(int argc, char** argv) {
     if (*batch) return run_batch(batch_args);
     if (*submit) return run_submit_slurm(submit_args);
     if (*mesh) return run_mesh(mesh_args);
-    if (*info)
-      return run_info(info_args.file, info_args.scene, info_args.allow_external, info_args.flatten,
-                      info_args.accel, info_args.accel_params, info_args.json);
+    if (*info) return run_info(info_args);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {

@@ -17,6 +17,7 @@
 #include "apps/penumbra/scene_setup.h"
 #include "apps/penumbra/stats_json.h"
 #include "io/atomic_file.h"
+#include "io/contact_sheet.h"
 #include "io/environment_io.h"
 #include "io/file_checks.h"
 #include "io/frame_outputs.h"
@@ -94,6 +95,8 @@ struct KeptScene {
   /// The next frame loads its scene anew (its animation moves vertices: skins, morph targets)
   /// and `accel` is refitted to it or built anew (refit_or_rebuild_scene's policy).
   bool reload = false;
+  /// Every frame poses the scene alike (a turntable's frames turn only the camera): reused as is.
+  bool same_pose = false;
   const char* update = "reused";  ///< what became of `accel`: "reused" or "instances moved"
   double pose_s = 0;              ///< seconds spent posing the scene for the next frame
   double update_s = 0;            ///< seconds spent moving the accelerator's instances
@@ -107,6 +110,7 @@ struct KeptScene {
 /// would.
 std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest& q) {
   if (!kept) return "";
+  if (kept->same_pose) return " (turntable: loaded scene and acceleration structure reused)";
   if (kept->reload)
     return " (animated vertices: scene loaded anew, acceleration structure refitted or rebuilt)";
   if (!kept->loaded.animation) return " (static scene: loaded scene and acceleration structure reused)";
@@ -166,18 +170,14 @@ void setup_phase(RenderJob& job) {
   const RenderArgs& a = job.args;
   const RenderRequest& q = job.request;
   Scene& scene = job.loaded.scene;
-  const int cam =
-      a.camera.empty() ? (scene.cameras.empty() ? -1 : 0) : find_camera(scene, a.camera, a.scene_file);
-  const float hint =
-      cam >= 0 && scene.cameras[size_t(cam)].aspect > 0 ? scene.cameras[size_t(cam)].aspect : 16.0f / 9.0f;
-  job.cfg = make_render_config(a, q, hint);
+  const int cam = base_camera_index(scene, a.camera, a.cam, a.scene_file);
+  job.cfg = make_render_config(a, q, aspect_hint(scene, cam));
   RenderConfig& cfg = job.cfg;
   validate(cfg);  // the library's own range checks, after the command line's named ones
   const uint64_t committed = charge_image_budget(job);
   if (!cfg.window.empty() && q.cost_aov)
     throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
-  job.camera = cam >= 0 ? scene.cameras[size_t(cam)]
-                        : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
+  job.camera = choose_camera(q.rig, scene, cam, cfg.width, cfg.height);
   // The path tracer's lights: emissive triangles and the environment.
   if (q.env_colour)
     job.environment = make_constant_environment(*q.env_colour * a.env_intensity);
@@ -248,7 +248,8 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
 /// light setup_phase added): a scene without animations, or one loaded at a time with what
 /// posing it needs (LoadedScene::animation).
 void keep_scene(RenderJob& job, std::optional<KeptScene>& kept) {
-  if (job.loaded.info.animation_count != 0 && !job.loaded.animation) {
+  const bool same_pose = !job.args.cam.turntable.empty();
+  if (job.loaded.info.animation_count != 0 && !job.loaded.animation && !same_pose) {
     // Posing cannot move what this animation moves: the next frame loads the file at its time,
     // and this frame's structure is refitted to it.
     if (!job.accel || !job.request.time) return;
@@ -263,6 +264,7 @@ void keep_scene(RenderJob& job, std::optional<KeptScene>& kept) {
   kept->loaded = std::move(job.loaded);
   kept->accel = std::move(job.accel);
   kept->built_sah = job.accel_built_sah;
+  kept->same_pose = same_pose;
 }
 
 /// --debug-pixel: one pixel exactly as the full render would compute it, printed on stdout.
@@ -413,6 +415,14 @@ std::vector<FramePlan> plan_frames(const RenderArgs& a) {
   return plan;
 }
 
+/// The flags with --turntable N alone given the turntable's frames 0..N-1 as --frames.
+RenderArgs with_turntable_frames(const RenderArgs& a) {
+  RenderArgs r = a;
+  if (!a.cam.turntable.empty() && !a.frames && !a.frame)
+    r.frames = "0-" + std::to_string(turntable_frames(a.cam) - 1);
+  return r;
+}
+
 /// No file may be written by two frames (patterns of different options can meet).
 void check_frames_distinct(const std::vector<FramePlan>& plan, const std::vector<RenderRequest>& requests) {
   std::map<std::string, int64_t> writer;
@@ -424,6 +434,26 @@ void check_frames_distinct(const std::vector<FramePlan>& plan, const std::vector
         throw UsageError(option + " " + file.string() + " would be written by frames " +
                          std::to_string(it->second) + " and " + std::to_string(*plan[i].number));
     }
+}
+
+/// --contact-sheet: needs a frame range whose frames all write a display image, and a sheet
+/// path of its own in a display format.
+void check_contact_sheet(const RenderArgs& a, const std::vector<RenderRequest>& requests) {
+  if (a.contact_sheet.empty()) {
+    if (a.contact_sheet_columns > 0) throw UsageError("--contact-sheet-columns needs --contact-sheet");
+    return;
+  }
+  if (!a.frames) throw UsageError("--contact-sheet tiles the frames of --frames or --turntable");
+  if (has_frame_pattern(a.contact_sheet))
+    throw UsageError("--contact-sheet is one image for every frame: no '#' in " + a.contact_sheet);
+  std::vector<std::pair<std::string, fs::path>> outputs = {{"--contact-sheet", a.contact_sheet}};
+  for (const RenderRequest& q : requests) {
+    if (!q.png) throw UsageError("--contact-sheet tiles the frames' display images: not with --no-png");
+    outputs.insert(outputs.end(), q.outputs.begin(), q.outputs.end());
+  }
+  check_display_output(a.contact_sheet, requests.front().display);
+  resolve_output(a.contact_sheet, "--contact-sheet");
+  check_distinct_files(outputs, {{"the scene file", a.scene_file}});
 }
 
 /// With --skip-existing: true when the frame's EXR is complete; a file that is there but
@@ -459,14 +489,20 @@ bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q)
 
 }  // namespace
 
-int run_render(const RenderArgs& a) {
+int run_render(const RenderArgs& typed) {
   const auto t0 = Clock::now();
+  const RenderArgs a = with_turntable_frames(typed);
   const std::vector<FramePlan> plan = plan_frames(a);
   // Every frame's flags and outputs are checked before the first frame loads.
   std::vector<RenderRequest> requests;
   requests.reserve(plan.size());
   for (const FramePlan& p : plan) requests.push_back(check_render_args(p.args));
   if (a.frames) check_frames_distinct(plan, requests);
+  check_contact_sheet(a, requests);
+  std::vector<fs::path> sheet_cells;
+  for (const RenderRequest& q : requests)
+    if (q.png) sheet_cells.push_back(*q.png);
+  const bool paths_to_stdout = requests.front().paths_to_stdout;
   int64_t rendered = 0, skipped = 0;
   const bool text = prints_text(progress_mode(a.progress, a.quiet), a.quiet);
   std::optional<KeptScene> kept;
@@ -488,10 +524,19 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "penumbra: frames %s: %lld rendered, %lld skipped, %.2f s in total\n",
                  a.frames->c_str(), static_cast<long long>(rendered), static_cast<long long>(skipped),
                  seconds_since(t0));
+  if (!a.contact_sheet.empty()) {
+    set_phase("writing the contact sheet");
+    write_contact_sheet(sheet_cells, a.contact_sheet_columns, a.contact_sheet, memory_budget(a.max_memory));
+    if (text)
+      std::fprintf(stderr, "penumbra: contact sheet of %zu frames -> %s\n", sheet_cells.size(),
+                   a.contact_sheet.c_str());
+    if (paths_to_stdout) std::printf("%s\n", a.contact_sheet.c_str());
+  }
   return kExitOk;
 }
 
-std::vector<std::pair<std::string, fs::path>> check_render(const RenderArgs& a) {
+std::vector<std::pair<std::string, fs::path>> check_render(const RenderArgs& typed) {
+  const RenderArgs a = with_turntable_frames(typed);
   const std::vector<FramePlan> plan = plan_frames(a);
   std::vector<RenderRequest> requests;
   std::vector<std::pair<std::string, fs::path>> outputs;
@@ -500,6 +545,8 @@ std::vector<std::pair<std::string, fs::path>> check_render(const RenderArgs& a) 
     outputs.insert(outputs.end(), requests.back().outputs.begin(), requests.back().outputs.end());
   }
   if (a.frames) check_frames_distinct(plan, requests);
+  check_contact_sheet(a, requests);
+  if (!a.contact_sheet.empty()) outputs.push_back({"--contact-sheet", a.contact_sheet});
   return outputs;
 }
 

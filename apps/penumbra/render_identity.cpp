@@ -15,9 +15,18 @@ RenderSettings pixel_settings(const RenderArgs& a, const RenderConfig& cfg, cons
   e["scene.index"] = std::to_string(a.scene);
   e["scene.flatten"] = a.flatten ? "1" : "0";
   e["scene.variant"] = a.variant.empty() ? "none" : a.variant;
-  e["scene.time"] =
-      a.time ? exact(*a.time) : (a.frame ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
+  const bool frame_is_time = a.frame && a.cam.turntable.empty();  // a turntable's frame turns the camera
+  e["scene.time"] = a.time
+                        ? exact(*a.time)
+                        : (frame_is_time ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
   e["camera"] = a.camera.empty() ? "default '" + camera.name + "'" : a.camera;
+  // The camera as rendered, whichever flags or file placed it.
+  const auto vec = [](Vec3f v) { return exact(v.x) + "," + exact(v.y) + "," + exact(v.z); };
+  e["camera.frame"] = vec(camera.eye) + " u " + vec(camera.u) + " v " + vec(camera.v) + " w " + vec(camera.w);
+  e["camera.lens"] =
+      (camera.projection == Projection::Orthographic ? "orthographic ymag " + exact(camera.ymag)
+                                                     : "perspective yfov " + exact(camera.yfov)) +
+      " near " + exact(camera.znear) + " far " + exact(camera.zfar);
   e["image"] = std::to_string(cfg.width) + "x" + std::to_string(cfg.height);
   e["integrator"] = a.integrator;
   e["seed"] = std::to_string(cfg.seed);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <tuple>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/exr_layers.h"
@@ -304,7 +305,8 @@ void add_scene_options(CLI::App& render, RenderArgs& args) {
                     "primitives' own materials)");
   render.add_option("--camera", args.camera,
                     "camera instance: index as listed by `penumbra info`, or name (default 0; none in the "
-                    "file: frame the bounds)");
+                    "file: frame the bounds); with --look-at, --orbit, --euler or --turntable it lends only "
+                    "its lens");
   render.add_option(
       "--accel", args.accel,
       "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
@@ -350,6 +352,13 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       ->excludes(time_opt)
       ->excludes(frame_opt);
   render.add_option("--fps", args.fps, "frames per second for --frame and --frames (default 24)");
+  render.add_option("--contact-sheet", args.contact_sheet,
+                    "after --frames or --turntable, tile every frame's display image in order into this "
+                    "image (.png, .jpg, .tif), left to right and top to bottom");
+  render
+      .add_option("--contact-sheet-columns", args.contact_sheet_columns,
+                  "columns of the contact sheet (default: the fewest that keep it no taller than wide)")
+      ->check(CLI::Range(1, 4096));
   auto* skip_opt = render.add_flag("--skip-existing", args.skip_existing,
                                    "keep a frame whose -o already is a complete, readable EXR; render it "
                                    "again (with a warning) when the file is truncated or unreadable");
@@ -409,6 +418,7 @@ void add_render_options(CLI::App& render, RenderArgs& args) {
   add_sampling_options(render, args);
   add_scene_options(render, args);
   add_output_options(render, args);
+  add_camera_options(render, args.cam);
 }
 
 void note_given_options(const CLI::App& render, int argc, char** argv, RenderArgs& args) {
@@ -432,21 +442,17 @@ RenderRequest check_render_args(const RenderArgs& a) {
   q.time = a.time;
   if (q.time && !std::isfinite(*q.time)) throw UsageError("--time must be a finite number of seconds");
   if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
-  if (a.frame) q.time = double(parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame")) / a.fps;
+  const long long frame = a.frame ? parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame") : 0;
+  // A turntable's frames turn the camera; the scene stays at --time or its static pose.
+  if (a.frame && a.cam.turntable.empty()) q.time = double(frame) / a.fps;
+  q.rig = check_camera_args(a.cam, frame);
   q.budget = memory_budget(a.max_memory);
   return q;
 }
 
 RenderConfig make_render_config(const RenderArgs& a, const RenderRequest& q, float hint) {
   RenderConfig cfg;
-  cfg.width = a.width;
-  cfg.height = a.height;
-  if (!cfg.width && !cfg.height) cfg.width = 960;
-  if (!cfg.height) cfg.height = std::max(1, int(std::lround(cfg.width / hint)));
-  if (!cfg.width) cfg.width = std::max(1, int(std::lround(cfg.height * hint)));
-  if (cfg.width > 16384 || cfg.height > 16384)
-    throw UsageError("image size " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) +
-                     " exceeds 16384 per side");
+  std::tie(cfg.width, cfg.height) = image_size(a.width, a.height, hint);
   cfg.window = parse_window(a, cfg.width, cfg.height);
   cfg.spp = a.spp_given ? a.spp : (q.path ? 64 : 4);
   cfg.threads = a.threads;

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "apps/penumbra/camera_options.h"
 #include "io/image_output.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
@@ -56,6 +57,9 @@ struct RenderArgs {
   bool overwrite = false;         ///< the default, accepted explicitly
   bool reproducible = false;      ///< no command line or timing in the EXR: equal renders, equal files
   std::string progress = "auto";  ///< --progress: auto, text, json or none (see progress.h)
+  std::string contact_sheet;      ///< --contact-sheet: the frames' display images tiled into one
+  int contact_sheet_columns = 0;  ///< 0: as many as keep the sheet no taller than wide
+  CameraArgs cam;                 ///< --look-at, --orbit, --turntable, --fov, ... (camera_options.h)
 };
 
 /// Declares every flag of `render` on `render`, bound to `args`.
@@ -86,7 +90,8 @@ struct RenderRequest {
   std::vector<std::string>
       crypto;  ///< Cryptomatte layers asked for: CryptoObject, CryptoMaterial, CryptoAsset
   int crypto_depth = 6;
-  std::optional<double> time;  ///< animation time from --time or --frame / --fps
+  std::optional<double> time;  ///< animation time from --time or --frame / --fps (not a turntable's frame)
+  CameraRig rig;               ///< the camera flags, checked; for a turntable at this frame
   /// Every file the run writes, named by its option, for the collision checks (also against
   /// the files the scene loads, once they are known).
   std::vector<std::pair<std::string, std::filesystem::path>> outputs;
