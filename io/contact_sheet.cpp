@@ -54,16 +54,32 @@ ContactSheetLayout contact_sheet_layout(size_t images, int columns, int cell_wid
   return l;
 }
 
+void check_contact_sheet_size(size_t images, int columns, int cell_width, int cell_height, int channels,
+                              const std::filesystem::path& out, uint64_t max_bytes) {
+  const ContactSheetLayout l = contact_sheet_layout(images, columns, cell_width, cell_height);
+  const uint64_t bytes = uint64_t(l.width()) * uint64_t(l.height()) * uint64_t(channels);
+  if (l.width() > kMaxSheetSide || l.height() > kMaxSheetSide || bytes > max_bytes)
+    throw InputError(out.string(), "contact sheet",
+                     "a " + std::to_string(l.width()) + "x" + std::to_string(l.height()) + " sheet of " +
+                         std::to_string(images) +
+                         " frames exceeds 65536 pixels a side or the memory budget (--max-memory)");
+}
+
+void check_contact_sheet_size(const std::filesystem::path& first, size_t images, int columns,
+                              const std::filesystem::path& out, uint64_t max_bytes) {
+  auto in = OIIO::ImageInput::open(first.string());
+  if (!in) throw InputError(first.string(), "contact sheet", "cannot read the image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  check_contact_sheet_size(images, columns, spec.width, spec.height, spec.nchannels, out, max_bytes);
+}
+
 void write_contact_sheet(const std::vector<std::filesystem::path>& images, int columns,
                          const std::filesystem::path& out, uint64_t max_bytes) {
   if (images.empty()) throw InputError(out.string(), "contact sheet", "no images to tile");
   const Cell first = read_cell(images[0], max_bytes);
+  check_contact_sheet_size(images.size(), columns, first.width, first.height, first.channels, out, max_bytes);
   const ContactSheetLayout l = contact_sheet_layout(images.size(), columns, first.width, first.height);
   const uint64_t bytes = uint64_t(l.width()) * uint64_t(l.height()) * uint64_t(first.channels);
-  if (l.width() > kMaxSheetSide || l.height() > kMaxSheetSide || bytes > max_bytes)
-    throw InputError(out.string(), "contact sheet",
-                     "a " + std::to_string(l.width()) + "x" + std::to_string(l.height()) +
-                         " sheet exceeds 65536 pixels a side or the memory budget (--max-memory)");
   const size_t nc = size_t(first.channels);
   std::vector<uint8_t> sheet(size_t(bytes), 0);
   for (size_t k = 0; k < images.size(); ++k) {

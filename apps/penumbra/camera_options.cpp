@@ -1,6 +1,7 @@
 // The camera flags: declaration, parsing and the checks that need no scene.
 #include "apps/penumbra/camera_options.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -12,7 +13,7 @@ namespace penumbra::cli {
 namespace {
 
 /// Most turntable frames per turn.
-constexpr long long kMaxTurntableFrames = 100000;
+constexpr long long kMaxTurntableFrames = 36000;
 
 constexpr double kDegree = M_PI / 180;
 
@@ -51,7 +52,10 @@ Vec3f parse_point(const std::string& text, const std::string& option, const std:
   } catch (const UsageError&) {
     throw UsageError(option + ": " + what + " '" + text + "' is not X,Y,Z (three finite numbers)");
   }
-  return {float(v[0]), float(v[1]), float(v[2])};
+  const Vec3f p{float(v[0]), float(v[1]), float(v[2])};
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    throw UsageError(option + ": " + what + " '" + text + "' is out of single-precision range");
+  return p;
 }
 
 /// The placement flags: --look-at, --orbit, --euler and --position.
@@ -68,10 +72,15 @@ void check_placement(const CameraArgs& a, CameraRig& rig) {
     rig.target = parse_point(a.look_at[1], "--look-at", "target");
     if (a.look_at.size() == 3)
       rig.up = parse_point(a.look_at[2], "--look-at", "up vector (give the scene file before --look-at)");
-    const Vec3f view = rig.target - rig.eye;
+    // Directions scaled by their largest component first, so that no square overflows.
+    const auto direction = [](Vec3f d) {
+      const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+      return m > 0 && std::isfinite(m) ? normalize(d / m) : Vec3f{};
+    };
+    const Vec3f view = direction(rig.target - rig.eye), up = direction(rig.up);
     if (!(length(view) > 0)) throw UsageError("--look-at: the eye and the target are the same point");
-    if (!(length(rig.up) > 0)) throw UsageError("--look-at: the up vector is zero");
-    if (!(length(cross(normalize(view), normalize(rig.up))) > 1e-6f))
+    if (!(length(up) > 0)) throw UsageError("--look-at: the up vector is zero");
+    if (!(length(cross(view, up)) > 1e-6f))
       throw UsageError("--look-at: the up vector is parallel to the view direction");
   }
   if (!a.orbit.empty()) {
@@ -79,10 +88,10 @@ void check_placement(const CameraArgs& a, CameraRig& rig) {
     rig.placement = CameraPlacement::Orbit;
     rig.azimuth = v[0] * kDegree;
     if (std::fabs(v[1]) > 90)
-      throw UsageError("--orbit: elevation " + a.orbit + " is outside [-90, 90] degrees");
+      throw UsageError("--orbit: elevation " + exact(v[1]) + " is outside [-90, 90] degrees");
     rig.elevation = v[1] * kDegree;
     if (v.size() == 3) {
-      if (!(v[2] > 0)) throw UsageError("--orbit: the distance must be > 0");
+      if (!(v[2] > 0 && v[2] < 1e30)) throw UsageError("--orbit: the distance must be > 0 (and below 1e30)");
       rig.distance = v[2];
     }
   }
@@ -144,7 +153,8 @@ void check_lens(const CameraArgs& a, CameraRig& rig) {
     rig.ortho_fit = true;
   } else if (!a.ortho.empty()) {
     rig.ortho_height = parse_number(a.ortho, "--ortho", "height");
-    if (!(*rig.ortho_height > 0)) throw UsageError("--ortho: the height must be > 0 (or 'fit')");
+    if (!(*rig.ortho_height > 0 && *rig.ortho_height < 1e30))
+      throw UsageError("--ortho: the height must be > 0 (and below 1e30), or 'fit'");
   }
   if (!a.near.empty()) {
     rig.znear = parse_number(a.near, "--near", "distance");
@@ -157,6 +167,9 @@ void check_lens(const CameraArgs& a, CameraRig& rig) {
     if (!(*rig.zfar > 0)) throw UsageError("--far: must be > 0 (or inf)");
   }
   if (rig.znear && rig.zfar && !(*rig.zfar > *rig.znear)) throw UsageError("--far must be beyond --near");
+  const bool never_framed = !a.look_at.empty() || (!a.orbit.empty() && rig.distance) || !a.position.empty();
+  if (rig.ortho_fit && never_framed)
+    throw UsageError("--ortho fit frames the bounds: not with --look-at, an --orbit distance or --position");
 }
 
 }  // namespace
@@ -255,7 +268,9 @@ Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int wi
   try {
     return rig_camera(rig, base, compute_bounds(scene), float(width) / float(height));
   } catch (const std::invalid_argument& e) {
-    throw UsageError(std::string("camera: ") + e.what());
+    // What only the scene decides: the framed near plane against --far, single-precision limits.
+    throw UsageError(
+        std::string("camera (--near, --far, --fov, --focal-length, --ortho or the placement): ") + e.what());
   }
 }
 

@@ -144,8 +144,6 @@ struct View {
 
 View resolve_view(const InfoArgs& a, const Scene& s) {
   const long long frame = a.frame.empty() ? 0 : parse_integer(a.frame, -(1ll << 40), 1ll << 40, "--frame");
-  if (!a.frame.empty() && a.cam.turntable.empty())
-    throw UsageError("info: --frame picks a --turntable frame");
   const CameraRig rig = check_camera_args(a.cam, frame);
   const int index = base_camera_index(s, a.camera, a.cam, a.file);
   View v;
@@ -377,7 +375,10 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
 int run_info(const InfoArgs& a) {
   const std::string& file = a.file;
   const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
-  check_camera_args(a.cam);  // bad camera flags fail before the scene loads
+  // Bad camera flags fail before the scene loads.
+  if (!a.frame.empty() && a.cam.turntable.empty())
+    throw UsageError("info: --frame picks a --turntable frame");
+  check_camera_args(a.cam);
   LoadedScene loaded = load_scene(file, a.scene, a.allow_external, a.flatten, default_memory_budget(), false);
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;

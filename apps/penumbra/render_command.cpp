@@ -418,8 +418,13 @@ std::vector<FramePlan> plan_frames(const RenderArgs& a) {
 /// The flags with --turntable N alone given the turntable's frames 0..N-1 as --frames.
 RenderArgs with_turntable_frames(const RenderArgs& a) {
   RenderArgs r = a;
-  if (!a.cam.turntable.empty() && !a.frames && !a.frame)
-    r.frames = "0-" + std::to_string(turntable_frames(a.cam) - 1);
+  if (!a.cam.turntable.empty() && !a.frames && !a.frame) {
+    const int n = turntable_frames(a.cam);
+    if (!has_frame_pattern(a.output))
+      throw UsageError("--turntable " + std::to_string(n) + " renders " + std::to_string(n) +
+                       " frames: -o needs a run of '#' for the frame number (e.g. turn.####.exr)");
+    r.frames = "0-" + std::to_string(n - 1);
+  }
   return r;
 }
 
@@ -444,6 +449,7 @@ void check_contact_sheet(const RenderArgs& a, const std::vector<RenderRequest>& 
     return;
   }
   if (!a.frames) throw UsageError("--contact-sheet tiles the frames of --frames or --turntable");
+  if (!a.debug_pixel.empty()) throw UsageError("--contact-sheet tiles whole frames: not with --debug-pixel");
   if (has_frame_pattern(a.contact_sheet))
     throw UsageError("--contact-sheet is one image for every frame: no '#' in " + a.contact_sheet);
   std::vector<std::pair<std::string, fs::path>> outputs = {{"--contact-sheet", a.contact_sheet}};
@@ -454,6 +460,10 @@ void check_contact_sheet(const RenderArgs& a, const std::vector<RenderRequest>& 
   check_display_output(a.contact_sheet, requests.front().display);
   resolve_output(a.contact_sheet, "--contact-sheet");
   check_distinct_files(outputs, {{"the scene file", a.scene_file}});
+  // The sheet's size, where the flags fix the image's (else after the first frame).
+  if (a.width > 0 && a.height > 0)
+    check_contact_sheet_size(requests.size(), a.contact_sheet_columns, a.width, a.height, a.png_alpha ? 4 : 3,
+                             a.contact_sheet, memory_budget(a.max_memory));
 }
 
 /// With --skip-existing: true when the frame's EXR is complete; a file that is there but
@@ -519,6 +529,9 @@ int run_render(const RenderArgs& typed) {
     if (const int rc = render_frame(p.args, std::move(requests[i]), kept, i + 1 < plan.size()); rc != kExitOk)
       return rc;
     ++rendered;
+    if (!a.contact_sheet.empty() && rendered + skipped == 1)  // the sheet's size, before the other frames
+      check_contact_sheet_size(sheet_cells[i], sheet_cells.size(), a.contact_sheet_columns, a.contact_sheet,
+                               memory_budget(a.max_memory));
   }
   if (a.frames && text)
     std::fprintf(stderr, "penumbra: frames %s: %lld rendered, %lld skipped, %.2f s in total\n",

@@ -340,16 +340,15 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "whitted: background radiance r,g,b or grey (default 0); background alpha stays 0 (path: use --env)");
   render.add_option("--ambient", args.ambient, "whitted: ambient intensity Ia, r,g,b or grey (default 0.05)");
   render.add_option("--seed", args.seed, "sampler seed, an integer in [0, 2^64 - 1] (default 0)");
-  auto* time_opt = render.add_option("--time", args.time,
-                                     "animation time in seconds: animations (node TRS, skins, morph weights) "
-                                     "are evaluated there (default: the file's static pose)");
-  auto* frame_opt =
-      render.add_option("--frame", args.frame, "animation frame N, at time N / --fps")->excludes(time_opt);
+  render.add_option("--time", args.time,
+                    "animation time in seconds: animations (node TRS, skins, morph weights) "
+                    "are evaluated there (default: the file's static pose)");
+  // --time with --frame or --frames is refused by check_render_args (a turntable's frames allow it).
+  auto* frame_opt = render.add_option("--frame", args.frame, "animation frame N, at time N / --fps");
   render
       .add_option("--frames", args.frames,
                   "render frames A to B inclusive (A-B, A-B:STEP or N), each at time N / --fps; every "
                   "output path needs a run of '#' for the frame number (#### -> 0012)")
-      ->excludes(time_opt)
       ->excludes(frame_opt);
   render.add_option("--fps", args.fps, "frames per second for --frame and --frames (default 24)");
   render.add_option("--contact-sheet", args.contact_sheet,
@@ -442,6 +441,10 @@ RenderRequest check_render_args(const RenderArgs& a) {
   q.time = a.time;
   if (q.time && !std::isfinite(*q.time)) throw UsageError("--time must be a finite number of seconds");
   if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
+  if (a.time && (a.frame || a.frames) && a.cam.turntable.empty())
+    throw UsageError(
+        "--time excludes --frame and --frames (which set the time), except with --turntable, whose "
+        "frames turn the camera");
   const long long frame = a.frame ? parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame") : 0;
   // A turntable's frames turn the camera; the scene stays at --time or its static pose.
   if (a.frame && a.cam.turntable.empty()) q.time = double(frame) / a.fps;

@@ -6,7 +6,8 @@
 // Euler angles here are yaw, pitch, roll applied intrinsically in the order Y, X', Z'':
 // R = Ry(yaw) * Rx(pitch) * Rz(roll), right-handed, in radians. For a camera that looks down
 // -Z with +Y up (glTF's convention) positive yaw turns it left (towards -X), positive pitch
-// tilts it up and positive roll turns the image counter-clockwise about the view direction.
+// tilts it up and positive roll turns it counter-clockwise about its view direction as seen from
+// behind it (its up vector leans towards -X), so the picture's content turns clockwise.
 #pragma once
 
 #include "renderer/core/math.h"

@@ -2,6 +2,7 @@
 // overrides and tight framing.
 #include "renderer/scene/camera_rig.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -33,16 +34,21 @@ std::string degrees(double radians) {
   return number(radians * 180 / M_PI);
 }
 
+/// d / |d|, scaled by its largest component first so that no square overflows; zero for a zero
+/// or non-finite d.
+Vec3f unit_direction(Vec3f d) {
+  const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  return m > 0 && std::isfinite(m) ? normalize(d / m) : Vec3f{};
+}
+
 void check_look_at(const CameraRig& r) {
   if (!finite3(r.eye) || !finite3(r.target) || !finite3(r.up))
     fail("look-at: eye, target and up must be finite");
-  const Vec3f view = r.target - r.eye;
-  const float len = length(view);
-  if (!(len > 0)) fail("look-at: the eye and the target are the same point (no view direction)");
-  const float up = length(r.up);
-  if (!(up > 0)) fail("look-at: the up vector is zero");
+  const Vec3f view = unit_direction(r.target - r.eye), up = unit_direction(r.up);
+  if (!(length(view) > 0)) fail("look-at: the eye and the target are the same point (no view direction)");
+  if (!(length(up) > 0)) fail("look-at: the up vector is zero");
   // |sin| of the angle between up and the view direction.
-  if (!(length(cross(view / len, r.up / up)) > 1e-6f))
+  if (!(length(cross(view, up)) > 1e-6f))
     fail("look-at: the up vector is parallel to the view direction (no image orientation)");
 }
 
@@ -63,6 +69,25 @@ void check_lens(const CameraRig& r) {
   if (r.zfar && !(*r.zfar > 0)) fail("far clip distance " + number(*r.zfar) + ": must be > 0 (or infinite)");
   if (r.znear && r.zfar && !(*r.zfar > *r.znear))
     fail("far clip distance " + number(*r.zfar) + " is not beyond the near one " + number(*r.znear));
+}
+
+/// The finished camera in single precision: finite, a field of view whose tangent is finite
+/// and positive, a positive orthographic height.
+void check_result(const Camera& c) {
+  const float reach = std::max({std::fabs(c.eye.x), std::fabs(c.eye.y), std::fabs(c.eye.z), c.znear});
+  if (!(reach < kMaxCameraReach))
+    fail("the camera lies " + number(reach) + " scene units out, beyond " + number(kMaxCameraReach) +
+         " (a distance too large, or a field of view too small for the framing)");
+  if (!finite3(c.u) || !finite3(c.v) || !finite3(c.w))
+    fail("the camera's axes are out of single-precision range (values too large or too small)");
+  if (c.projection == Projection::Orthographic) {
+    if (!(std::isfinite(c.ymag) && c.ymag > 0 && std::isfinite(c.xmag) && c.xmag > 0))
+      fail("orthographic height " + number(2.0 * c.ymag) + " is out of single-precision range");
+  } else {
+    const float t = std::tan(0.5f * c.yfov);
+    if (!(c.yfov > 0 && c.yfov < float(M_PI) && std::isfinite(t) && t > 0 && std::isnormal(t)))
+      fail("field of view " + degrees(c.yfov) + " degrees is outside (0, 180) in single precision");
+  }
 }
 
 /// The bounds fit_bounds frames (its unit box for empty bounds) and their centre.
@@ -204,6 +229,7 @@ Camera rig_camera(const CameraRig& r, const Camera* base, const Bounds3f& bounds
   }
   if (r.znear) c.znear = float(*r.znear);
   if (r.zfar) c.zfar = float(*r.zfar);
+  check_result(c);
   if (!(c.zfar > c.znear))
     fail("the far clip distance " + number(c.zfar) + " is not beyond the near one " + number(c.znear));
   return c;

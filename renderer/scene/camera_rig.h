@@ -20,6 +20,11 @@
 
 namespace penumbra {
 
+/// The farthest a rig's eye (each coordinate) and near plane may lie from the origin: ray
+/// origins and distances stay well inside what single-precision ray kernels (Embree's among
+/// them, 1.8e19) accept.
+inline constexpr float kMaxCameraReach = 1e18f;
+
 /// How the rig places the camera.
 enum class CameraPlacement {
   Base,    ///< the base camera's pose (a file camera), or the default framing without one
@@ -67,7 +72,9 @@ bool rig_frames_bounds(const CameraRig& rig, bool has_base_camera);
 /// pose comes from the placement, the lens from the rig where it sets one and from the base
 /// otherwise; a framed turntable keeps one distance for the whole turn, the largest the tight
 /// fit needs at any of its frames. The clip planes are the rig's when set. Throws as
-/// check_rig(), and std::invalid_argument when a given far plane is not beyond the near plane.
+/// check_rig(), and std::invalid_argument when the camera leaves single precision (an eye,
+/// field of view or height that overflows or vanishes as a float, an eye or near plane past
+/// kMaxCameraReach) or the far plane is not beyond the near plane.
 Camera rig_camera(const CameraRig& rig, const Camera* base, const Bounds3f& bounds, float aspect);
 
 /// `cam` turned to orientation `q`: u, v, w are the rotated +X, +Y, +Z axes; eye and lens kept.

@@ -109,7 +109,11 @@ expect 0 "t.0002.exr" -- "$bin" render "$sphere" --turntable 3 --turntable-eleva
   -o "$work/t.####.exr" --no-png
 [ -e "$work/t.0003.exr" ] && fail "--turntable 3 rendered frame 3" || ok
 check "elevation 90: the sphere fills the frame's centre" "float('$(stat_avg "$work/t.0001.exr" A 1x1+16+16)') == 1"
-expect 2 "--frames needs a run of '#'" -- "$bin" render "$sphere" --turntable 3 -o "$work/t.exr"
+expect 2 "--turntable 3 renders 3 frames: -o needs a run of '#'" -- "$bin" render "$sphere" --turntable 3 -o "$work/t.exr"
+# The turntable's frames keep the scene at --time (which --frames excludes otherwise).
+expect 0 "tt_time.0001.exr" -- "$bin" render "$sphere" --turntable 2 --time 0.5 --width 16 --height 16 --spp 1 \
+  -o "$work/tt_time.####.exr" --no-png
+expect 2 "--time excludes --frame and --frames" -- "$bin" render "$sphere" --frames 1-2 --time 0.5 -o "$work/x.####.exr"
 
 # Tight framing: the silhouette of a box touches the border within one pixel on the limiting
 # axis, and nothing is cut on the other (alpha read back as an 8-bit PGM).
@@ -179,8 +183,15 @@ refused "--sensor needs --focal-length" --sensor 24
 refused "--focal-length: must be > 0" --focal-length 0
 refused "--ortho: the height must be > 0" --ortho=-1
 refused "--ortho is an orthographic camera" --ortho 2 --fov 30
-refused "fitted orthographic height needs a framed camera" --look-at 0,0,4 0,0,0 --ortho fit
-refused "--turntable: .*\[1, 100000\]" --turntable 0
+refused "--ortho fit frames the bounds" --look-at 0,0,4 0,0,0 --ortho fit
+refused "--ortho fit frames the bounds" --orbit 0,0,3 --ortho fit
+refused "--look-at: eye '1e39,0,0' is out of single-precision range" --look-at 1e39,0,0 0,0,0
+refused "--ortho: the height must be > 0 \(and below 1e30\)" --ortho 1e39
+refused "field of view .* outside \(0, 180\) in single precision" --fov 179.99999999
+refused "field of view .* outside \(0, 180\) in single precision" --focal-length 1e-30
+refused "the camera lies .* scene units out, beyond 1e\+18" --orbit 0,0 --fov 1e-30
+refused "the camera lies .* scene units out" --look-at 1e20,0,0 0,0,0
+refused "--turntable: .*\[1, 36000\]" --turntable 0
 refused "--turntable: '-3' is not an integer" --turntable=-3
 refused "--turntable-elevation needs --turntable" --turntable-elevation 10
 refused "--orbit: elevation" --orbit 0,91
@@ -195,6 +206,17 @@ refused "--contact-sheet tiles the frames" --contact-sheet "$work/s.png"
 out=bad.##.exr refused "--contact-sheet tiles the frames' display images" --turntable 2 --no-png --contact-sheet "$work/s.png"
 out=bad.##.exr refused "--contact-sheet is one image for every frame" --turntable 2 --contact-sheet "$work/s.##.png"
 out=bad.##.exr refused "unsupported display image format" --turntable 2 --contact-sheet "$work/s.exr"
+out=bad.##.exr refused "--contact-sheet tiles whole frames: not with --debug-pixel" --turntable 2 --contact-sheet "$work/s.png" --debug-pixel 1,1
+# A sheet too large for its limits is refused before any frame renders when the size is given,
+# else right after the first frame.
+expect 2 "sheet of 100 frames exceeds 65536 pixels" -- "$bin" render "$sphere" --frames 0-99 --width 16384 --height 16384 \
+  -o "$work/bad.###.exr" --contact-sheet "$work/s.png"
+ls "$work"/bad* >/dev/null 2>&1 && fail "the refused sheet left $(ls "$work"/bad*)" || ok
+rm -f "$work"/big*
+# 60 frames of 64 x 36: the frame's buffers fit 250 KiB, the 398 x 382 RGB sheet does not.
+expect 2 "sheet of 60 frames exceeds .* memory budget" -- "$bin" render "$sphere" --turntable 60 --width 64 \
+  --max-memory 250K -o "$work/big.####.exr" --contact-sheet "$work/big.png" -q
+[ -e "$work/big.0000.exr" ] && [ ! -e "$work/big.0001.exr" ] && [ ! -e "$work/big.png" ] && ok || fail "the oversized sheet was refused at the wrong time: $(ls "$work"/big* 2>&1)"
 out=bad.##.exr refused "--contact-sheet.*the same file" --turntable 2 --png "$work/bad.##.png" --contact-sheet "$work/bad.01.png"
 expect 2 "up vector is zero" -- "$bin" info "$sphere" --look-at 0,0,4 0,0,0 0,0,0
 expect 2 "--frame picks a --turntable frame" -- "$bin" info "$sphere" --frame 3

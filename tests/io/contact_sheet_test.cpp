@@ -118,3 +118,23 @@ TEST_CASE("contact sheet: mismatched images, no images and oversized sheets are 
   CHECK(fs::exists(sheet));
   fs::remove_all(dir);
 }
+
+TEST_CASE("contact sheet size checks: sides and bytes, from numbers or the first image",
+          "[io][contact_sheet]") {
+  // 40 cells of 4096 x 16 fit one column (722 tall, 4100 wide); 20 columns are 20 x 4098 wide.
+  CHECK_NOTHROW(check_contact_sheet_size(40, 0, 4096, 16, 3, "s.png", uint64_t(1) << 32));
+  CHECK_THROWS_WITH(check_contact_sheet_size(40, 20, 4096, 16, 3, "s.png", uint64_t(1) << 32),
+                    Catch::Contains("s.png") && Catch::Contains("65536"));
+  // Bytes: 2 cells of 8 x 8 RGBA in one row need 22 x 12 x 4.
+  CHECK_NOTHROW(check_contact_sheet_size(2, 0, 8, 8, 4, "s.png", 22 * 12 * 4));
+  CHECK_THROWS_WITH(check_contact_sheet_size(2, 0, 8, 8, 4, "s.png", 22 * 12 * 4 - 1),
+                    Catch::Contains("budget"));
+  const fs::path dir = test::temp_dir("contact-sheet-size");
+  const fs::path a = write_cell(dir, 1, 8, 8);
+  CHECK_NOTHROW(check_contact_sheet_size(a, 2, 0, dir / "s.png", 22 * 12 * 3));
+  CHECK_THROWS_WITH(check_contact_sheet_size(a, 2, 0, dir / "s.png", 22 * 12 * 3 - 1),
+                    Catch::Contains("budget"));
+  CHECK_THROWS_WITH(check_contact_sheet_size(dir / "none.png", 2, 0, dir / "s.png", 1 << 20),
+                    Catch::Contains("none.png"));
+  fs::remove_all(dir);
+}

@@ -587,3 +587,23 @@ TEST_CASE("rig: check_rig's documented checks on values and fitted orthographic 
   fit.ortho_fit = true;
   CHECK_THROWS_AS(check_rig(fit), std::invalid_argument);
 }
+
+TEST_CASE("rig: cameras that leave single precision are refused", "[camera][rig][quick]") {
+  const Bounds3f box{{-1, -1, -1}, {1, 1, 1}};
+  CameraRig tiny_fov = orbit(0, 0);
+  tiny_fov.yfov = 1e-30;  // framing puts the eye ~1e30 out
+  CHECK_THROWS_WITH(rig_camera(tiny_fov, nullptr, box, 1.5f), Catch::Contains("scene units out"));
+  CameraRig rounds_to_pi = orbit(0, 0);
+  rounds_to_pi.yfov = M_PI - 1e-9;  // below pi as a double, pi or more as a float
+  CHECK_NOTHROW(check_rig(rounds_to_pi));
+  CHECK_THROWS_WITH(rig_camera(rounds_to_pi, nullptr, box, 1.5f), Catch::Contains("in single precision"));
+  CameraRig huge_height = orbit(0, 0);
+  huge_height.ortho_height = 1e39;  // finite as a double, infinite as a float
+  CHECK_THROWS_WITH(rig_camera(huge_height, nullptr, box, 1.5f), Catch::Contains("single-precision"));
+  CameraRig far_eye = look({1e20f, 0, 0}, {0, 0, 0}, {0, 1, 0});
+  CHECK_NOTHROW(check_rig(far_eye));  // the directions are scaled before they are normalised
+  CHECK_THROWS_WITH(rig_camera(far_eye, nullptr, box, 1.5f), Catch::Contains("scene units out"));
+  // Just inside the reach, the camera is made.
+  CameraRig near_limit = look({1e17f, 0, 0}, {0, 0, 0}, {0, 1, 0});
+  CHECK(rig_camera(near_limit, nullptr, box, 1.5f).eye.x == 1e17f);
+}
