@@ -266,7 +266,11 @@ float aspect_hint(const Scene& scene, int index) {
 Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height) {
   const Camera* base = index >= 0 ? &scene.cameras[size_t(index)] : nullptr;
   try {
-    return rig_camera(rig, base, compute_bounds(scene), float(width) / float(height));
+    // The bounds only where the rig uses them: framing, or an orbit's centre.
+    const bool uses_bounds =
+        rig.placement == CameraPlacement::Orbit || rig_frames_bounds(rig, base != nullptr);
+    return rig_camera(rig, base, uses_bounds ? compute_bounds(scene) : Bounds3f{},
+                      float(width) / float(height));
   } catch (const std::invalid_argument& e) {
     // What only the scene decides: the framed near plane against --far, single-precision limits.
     throw UsageError(

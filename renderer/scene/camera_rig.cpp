@@ -195,8 +195,9 @@ Camera rig_camera(const CameraRig& r, const Camera* base, const Bounds3f& bounds
   switch (r.placement) {
     case CameraPlacement::Base:
       if (!base) {
-        // frame_bounds' view direction, fitted with the rig's lens.
-        const Camera f = look_at(normalize(Vec3f{0.5f, 0.4f, 1.0f}), {0, 0, 0}, {0, 1, 0}, c.yfov);
+        // frame_bounds' view direction (its frame does not depend on the bounds), fitted with the
+        // rig's lens.
+        const Camera f = frame_bounds(Bounds3f{}, aspect);
         c.u = f.u, c.v = f.v, c.w = f.w;
         c = fit_keeping_height(c, r, bounds, aspect);
       }

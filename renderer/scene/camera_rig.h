@@ -74,7 +74,8 @@ bool rig_frames_bounds(const CameraRig& rig, bool has_base_camera);
 /// fit needs at any of its frames. The clip planes are the rig's when set. Throws as
 /// check_rig(), and std::invalid_argument when the camera leaves single precision (an eye,
 /// field of view or height that overflows or vanishes as a float, an eye or near plane past
-/// kMaxCameraReach) or the far plane is not beyond the near plane.
+/// kMaxCameraReach) or the far plane is not beyond the near plane. `bounds` are read only where the rig
+/// frames them (rig_frames_bounds) or orbits their centre.
 Camera rig_camera(const CameraRig& rig, const Camera* base, const Bounds3f& bounds, float aspect);
 
 /// `cam` turned to orientation `q`: u, v, w are the rotated +X, +Y, +Z axes; eye and lens kept.
