@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <climits>
 #include <map>
 #include <string>
 
@@ -49,8 +50,31 @@ void apply_keywords(py::object& settings, const py::kwargs& kw) {
   }
 }
 
-/// A copy of `settings` (None: the defaults) with the keywords applied.
+/// The name of `v`'s type, for TypeError messages.
+std::string type_name(const py::handle& v) {
+  return py::str(py::type::handle_of(v).attr("__name__"));
+}
+
+/// True for Python ints and other integer types (those with __index__, such as NumPy's).
+bool is_integer(const py::handle& v) {
+  return PyIndex_Check(v.ptr());
+}
+
+/// The integer `v` (is_integer) if it lies in [lo, INT_MAX], else ValueError naming `what`.
+int int_in_range(const py::handle& v, int lo, const std::string& what) {
+  const auto i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
+  if (!i) throw py::error_already_set();
+  if (i < py::int_(lo) || i > py::int_(INT_MAX))
+    throw py::value_error(what + " " + std::string(py::repr(i)) + " is out of range [" + std::to_string(lo) +
+                          ", " + std::to_string(INT_MAX) + "]");
+  return i.cast<int>();
+}
+
+/// A copy of `settings` (None: the defaults) with the keywords applied. TypeError unless
+/// `settings` is None or a RenderSettings.
 RenderSettings settings_from(const py::object& settings, const py::kwargs& kw) {
+  if (!settings.is_none() && !py::isinstance<RenderSettings>(settings))
+    throw py::type_error("settings must be a penumbra.RenderSettings or None, not " + type_name(settings));
   py::object s = settings.is_none() ? py::cast(RenderSettings{}) : py::cast(settings.cast<RenderSettings>());
   apply_keywords(s, kw);
   return s.cast<RenderSettings>();
@@ -196,14 +220,15 @@ void bind_settings(py::module_& m) {
           [](RenderSettings& r, const py::object& v) {
             if (v.is_none()) {
               r.camera.clear();
-            } else if (py::isinstance<py::int_>(v)) {
-              const long long i = v.cast<long long>();
-              if (i < 0) throw py::value_error("camera index must be >= 0");
-              r.camera = std::to_string(i);
+            } else if (is_integer(v)) {
+              r.camera = std::to_string(int_in_range(v, 0, "camera index"));
+            } else if (py::isinstance<py::str>(v)) {
+              const std::string name = v.cast<std::string>();
+              if (name.empty()) throw py::value_error("camera name must not be empty (None: the default)");
+              r.camera = name;
             } else {
-              r.camera = v.cast<std::string>();
-              if (r.camera.empty())
-                throw py::value_error("camera name must not be empty (None: the default)");
+              throw py::type_error("camera must be None, an index (int) or a name (str), not " +
+                                   type_name(v));
             }
           },
           "index into Scene.cameras or a camera name; None: the first camera, else a view framing the bounds")
@@ -222,8 +247,18 @@ void bind_settings(py::module_& m) {
               r.window = {};
               return;
             }
-            const auto w = v.cast<std::vector<int>>();
-            if (w.size() != 4 || w[0] < 0 || w[1] < 0 || w[2] <= w[0] || w[3] <= w[1])
+            const char* expected = "window must be None or (x0, y0, x1, y1)";
+            if (!py::isinstance<py::sequence>(v) || py::isinstance<py::str>(v))
+              throw py::type_error(std::string(expected) + ", not " + type_name(v));
+            const auto items = v.cast<py::sequence>();
+            if (items.size() != 4) throw py::value_error(std::string(expected) + " (4 values)");
+            std::vector<int> w;
+            for (const py::object item : items) {
+              if (!is_integer(item))
+                throw py::type_error(std::string(expected) + " of ints, not " + type_name(item));
+              w.push_back(int_in_range(item, 0, "window value"));
+            }
+            if (w[2] <= w[0] || w[3] <= w[1])
               throw py::value_error(
                   "window must be None or (x0, y0, x1, y1) with 0 <= x0 < x1, 0 <= y0 < y1");
             r.window = {w[0], w[1], w[2], w[3]};

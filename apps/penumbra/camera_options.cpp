@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
@@ -17,45 +18,68 @@ constexpr long long kMaxTurntableFrames = 36000;
 
 constexpr double kDegree = M_PI / 180;
 
-/// A finite number, all of `text`; throws UsageError naming `option` and `what`.
-double parse_number(const std::string& text, const std::string& option, const std::string& what) {
-  double v = 0;
+/// The largest magnitude a camera number may have: the largest finite float.
+constexpr double kMaxSingle = std::numeric_limits<float>::max();
+
+/// The largest azimuth or Euler angle, in degrees.
+constexpr double kMaxAngleDegrees = 1e6;
+
+/// True when all of `text` is a finite number, then stored in `v`.
+bool read_number(const std::string& text, double& v) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, v);
-  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+  return !text.empty() && ec == std::errc() && ptr == end && std::isfinite(v);
+}
+
+/// A finite number within single precision, all of `text`; throws UsageError naming `option` and
+/// `what`.
+double parse_number(const std::string& text, const std::string& option, const std::string& what) {
+  double v = 0;
+  if (!read_number(text, v))
     throw UsageError(option + ": " + what + " '" + text + "' is not a finite number");
+  if (!(std::fabs(v) <= kMaxSingle))
+    throw UsageError(option + ": " + what + " '" + text + "' is out of single-precision range");
   return v;
 }
 
-/// Comma-separated finite numbers, between `lo` and `hi` of them.
-std::vector<double> parse_list(const std::string& text, const std::string& option, size_t lo, size_t hi,
-                               const std::string& expected) {
-  std::vector<double> v;
+/// The comma-separated items of `text`.
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
   size_t start = 0;
   while (true) {
     const size_t comma = text.find(',', start);
-    const std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    v.push_back(parse_number(item, option, "value"));
-    if (comma == std::string::npos) break;
+    items.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return items;
     start = comma + 1;
   }
+}
+
+/// Comma-separated finite numbers within single precision, between `lo` and `hi` of them.
+std::vector<double> parse_list(const std::string& text, const std::string& option, size_t lo, size_t hi,
+                               const std::string& expected) {
+  std::vector<double> v;
+  for (const std::string& item : split_list(text)) v.push_back(parse_number(item, option, "value"));
   if (v.size() < lo || v.size() > hi)
     throw UsageError(option + ": expected " + expected + ", got '" + text + "'");
   return v;
 }
 
+/// An angle of `option` in degrees, checked to lie within kMaxAngleDegrees.
+double check_angle(double degrees, const std::string& option, const std::string& what) {
+  if (!(std::fabs(degrees) <= kMaxAngleDegrees))
+    throw UsageError(option + ": " + what + " " + exact(degrees) + " is outside [-1e6, 1e6] degrees");
+  return degrees;
+}
+
 Vec3f parse_point(const std::string& text, const std::string& option, const std::string& what) {
-  std::vector<double> v;
-  try {
-    v = parse_list(text, option, 3, 3, what + " as X,Y,Z");
-  } catch (const UsageError&) {
+  const std::vector<std::string> items = split_list(text);
+  double v[3] = {};
+  if (items.size() != 3 || !read_number(items[0], v[0]) || !read_number(items[1], v[1]) ||
+      !read_number(items[2], v[2]))
     throw UsageError(option + ": " + what + " '" + text + "' is not X,Y,Z (three finite numbers)");
-  }
-  const Vec3f p{float(v[0]), float(v[1]), float(v[2])};
-  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+  if (!(std::fabs(v[0]) <= kMaxSingle && std::fabs(v[1]) <= kMaxSingle && std::fabs(v[2]) <= kMaxSingle))
     throw UsageError(option + ": " + what + " '" + text + "' is out of single-precision range");
-  return p;
+  return {float(v[0]), float(v[1]), float(v[2])};
 }
 
 /// The placement flags: --look-at, --orbit, --euler and --position.
@@ -86,7 +110,7 @@ void check_placement(const CameraArgs& a, CameraRig& rig) {
   if (!a.orbit.empty()) {
     const std::vector<double> v = parse_list(a.orbit, "--orbit", 2, 3, "AZ,EL[,DIST] (degrees, scene units)");
     rig.placement = CameraPlacement::Orbit;
-    rig.azimuth = v[0] * kDegree;
+    rig.azimuth = check_angle(v[0], "--orbit", "azimuth") * kDegree;
     if (std::fabs(v[1]) > 90)
       throw UsageError("--orbit: elevation " + exact(v[1]) + " is outside [-90, 90] degrees");
     rig.elevation = v[1] * kDegree;
@@ -98,7 +122,9 @@ void check_placement(const CameraArgs& a, CameraRig& rig) {
   if (!a.euler.empty()) {
     const std::vector<double> v = parse_list(a.euler, "--euler", 3, 3, "YAW,PITCH,ROLL (degrees)");
     rig.placement = CameraPlacement::Euler;
-    rig.euler = {v[0] * kDegree, v[1] * kDegree, v[2] * kDegree};
+    rig.euler = {check_angle(v[0], "--euler", "yaw") * kDegree,
+                 check_angle(v[1], "--euler", "pitch") * kDegree,
+                 check_angle(v[2], "--euler", "roll") * kDegree};
     if (!a.position.empty()) {
       rig.eye = parse_point(a.position, "--position", "position");
       rig.has_eye = true;
@@ -218,6 +244,13 @@ void add_camera_options(CLI::App& app, CameraArgs& a) {
   app.add_option("--far", a.far, "far clip distance along the view axis, or inf")
       ->type_name("D")
       ->group(group);
+  // An empty value would read as a flag not given.
+  for (const char* name :
+       {"--look-at", "--orbit", "--euler", "--position", "--turntable", "--turntable-elevation", "--fov",
+        "--focal-length", "--sensor", "--ortho", "--near", "--far"})
+    app.get_option(name)->check([](const std::string& value) {
+      return value.empty() ? std::string("the value is empty") : std::string();
+    });
 }
 
 bool places_camera(const CameraArgs& a) {

@@ -58,6 +58,10 @@ int run_mesh(const MeshArgs& a) {
   if (a.resolution < 1 || a.resolution > kMaxMarchingCubesResolution)
     throw UsageError("--resolution " + std::to_string(a.resolution) + ": outside [1, " +
                      std::to_string(kMaxMarchingCubesResolution) + "]");
+  if (a.node && a.node->empty())
+    throw UsageError(
+        "--node: the value is empty (give a node index or name, or leave --node out for every "
+        "implicit shape)");
   std::vector<std::pair<std::string, fs::path>> outputs{{"-o", out}};
   if (ext == ".gltf")
     outputs.push_back({"the buffer beside -o", out.parent_path() / (out.stem().string() + ".bin")});
@@ -73,7 +77,7 @@ int run_mesh(const MeshArgs& a) {
   check_distinct_files(outputs, inputs);
   ShapeMeshConfig config;
   config.resolution = a.resolution;
-  if (!a.node.empty()) config.node = find_node(loaded.info, a.node, a.scene_file);
+  if (a.node) config.node = find_node(loaded.info, *a.node, a.scene_file);
   if (!places_implicit_shape(loaded.scene, config.node))
     throw UsageError(a.scene_file + ": " +
                      (config.node < 0 ? std::string("the scene places no implicit shape")

@@ -32,24 +32,31 @@ double finite_or_fail(const GltfContext& ctx, double v, const std::string& where
 }
 
 // KHR_texture_transform: uv' = T R S uv (spec: offset, rotation counter-clockwise, scale) into
-// ref.m; its texCoord, if present, replaces `texcoord`.
+// ref.m; its texCoord, if present, replaces `texcoord`. A member of the wrong type is an error
+// naming it.
 void read_texture_transform(const GltfContext& ctx, const tinygltf::Value& x, const std::string& where,
                             TextureRef& ref, int& texcoord) {
   const std::string xw = where + ".extensions.KHR_texture_transform";
   double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
   auto read_pair = [&](const char* key, double* v) {
     const auto& a = x.Get(key);
-    if (!a.IsArray()) return;
-    if (a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
-      ctx.fail(xw + "." + key, "must be 2 numbers");
+    if (a.Type() == tinygltf::NULL_TYPE) return;
+    if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
+      ctx.fail(xw + "." + key, "must be an array of 2 numbers");
     v[0] = a.Get(0).GetNumberAsDouble();
     v[1] = a.Get(1).GetNumberAsDouble();
   };
   read_pair("offset", off);
   read_pair("scale", sc);
-  if (x.Get("rotation").IsNumber()) rot = x.Get("rotation").GetNumberAsDouble();
+  if (const auto& r = x.Get("rotation"); r.Type() != tinygltf::NULL_TYPE) {
+    if (!r.IsNumber()) ctx.fail(xw + ".rotation", "must be a number");
+    rot = r.GetNumberAsDouble();
+  }
   if (!std::isfinite(off[0] + off[1] + sc[0] + sc[1] + rot)) ctx.fail(xw, "values must be finite");
-  if (x.Get("texCoord").IsNumber()) texcoord = x.Get("texCoord").GetNumberAsInt();
+  if (const auto& t = x.Get("texCoord"); t.Type() != tinygltf::NULL_TYPE) {
+    if (!t.IsInt() || t.Get<int>() < 0) ctx.fail(xw + ".texCoord", "must be a non-negative integer");
+    texcoord = t.Get<int>();
+  }
   const double c = std::cos(rot), sn = std::sin(rot);
   ref.m[0][0] = float(sc[0] * c);
   ref.m[0][1] = float(sc[1] * sn);

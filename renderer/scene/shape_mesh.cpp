@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace penumbra {
 
@@ -17,6 +18,10 @@ std::invalid_argument too_large(const SceneShape& s, int resolution, uint64_t ne
   return std::invalid_argument(s.name + ": meshing at resolution " + std::to_string(resolution) + " needs " +
                                std::to_string(needed) + " bytes, more than the " + std::to_string(left) +
                                " bytes left of the memory budget");
+}
+
+uint64_t saturating_add(uint64_t a, uint64_t b) {
+  return b > UINT64_MAX - a ? UINT64_MAX : a + b;
 }
 
 // The instance's mesh of the shape, moved into the world (remembering the shape's frame).
@@ -41,7 +46,11 @@ Mesh place(IsosurfaceMesh&& iso, const SceneShape& s, const Instance& inst) {
 }  // namespace
 
 ShapeMeshes mesh_implicit_shapes(const Scene& scene, const ShapeMeshConfig& config) {
-  // Every selected shape's grid and mesh estimate fits, before anything is allocated.
+  // Before anything is allocated: every selected shape's grid and mesh estimate fits, and so do
+  // the mesh estimates of all placements together with the largest grid (grids are freed after
+  // each placement, meshes are kept).
+  std::vector<uint64_t> shape_bytes(scene.shapes.size()), shape_placements(scene.shapes.size());
+  uint64_t meshes = 0, largest_work = 0;
   for (const Instance& inst : scene.instances) {
     if (!selected(inst, config)) continue;
     const SceneShape& s = scene.shapes[size_t(inst.shape)];
@@ -50,6 +59,22 @@ ShapeMeshes mesh_implicit_shapes(const Scene& scene, const ShapeMeshConfig& conf
       throw std::invalid_argument(s.name + ": the implicit shape is unbounded and cannot be meshed");
     const uint64_t bytes = marching_cubes_bytes(s.shape.sdf_bounds, config.resolution, config.marching_cubes);
     if (bytes > config.max_bytes) throw too_large(s, config.resolution, bytes, config.max_bytes);
+    const uint64_t work =
+        marching_cubes_work_bytes(s.shape.sdf_bounds, config.resolution, config.marching_cubes);
+    largest_work = std::max(largest_work, work);
+    meshes = saturating_add(meshes, bytes - work);
+    shape_bytes[size_t(inst.shape)] = saturating_add(shape_bytes[size_t(inst.shape)], bytes - work);
+    ++shape_placements[size_t(inst.shape)];
+  }
+  const uint64_t total = saturating_add(meshes, largest_work);
+  if (total > config.max_bytes) {
+    const size_t most =
+        size_t(std::max_element(shape_bytes.begin(), shape_bytes.end()) - shape_bytes.begin());
+    throw std::invalid_argument(scene.shapes[most].name + ": meshing its " +
+                                std::to_string(shape_placements[most]) + " placements at resolution " +
+                                std::to_string(config.resolution) + " needs " + std::to_string(total) +
+                                " bytes with every selected shape, more than the " +
+                                std::to_string(config.max_bytes) + " bytes left of the memory budget");
   }
   ShapeMeshes out;
   out.scene.materials = scene.materials;

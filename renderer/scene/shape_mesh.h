@@ -15,8 +15,8 @@ struct ShapeMeshConfig {
   int resolution = 128;  ///< cells along the longest axis of each shape's sdf_bounds, in [1, 4096]
   int node = -1;         ///< only the instances of this glTF node; -1 = every instance
   /// Bytes the grids and meshes may take in all: each shape's working memory and mesh estimate
-  /// (marching_cubes_bytes) is checked before anything is meshed, each exact mesh before it is
-  /// allocated.
+  /// (marching_cubes_bytes), and the mesh estimates of all placements with the largest working
+  /// memory, are checked before anything is meshed, each exact mesh before it is allocated.
   uint64_t max_bytes = UINT64_MAX;
   MarchingCubesConfig marching_cubes;  ///< max_output_bytes is set from max_bytes
 };
@@ -31,8 +31,9 @@ struct ShapeMeshes {
 /// by to_world, normals by its inverse transpose, triangles reversed under a mirroring map so
 /// they stay counter-clockwise seen from outside; the mesh takes the shape's material and name
 /// and the instance's node. The scene's materials are copied unchanged. Throws
-/// std::invalid_argument for a bad resolution, an implicit shape without bounds, or a shape
-/// whose grid or mesh does not fit max_bytes (naming the shape and the bytes it needs).
+/// std::invalid_argument for a bad resolution, an implicit shape without bounds, a shape whose
+/// grid or mesh does not fit max_bytes, or placements whose meshes do not fit it together (naming
+/// the shape, for those the one with the most mesh bytes, and the bytes needed).
 ShapeMeshes mesh_implicit_shapes(const Scene& scene, const ShapeMeshConfig& config);
 
 }  // namespace penumbra

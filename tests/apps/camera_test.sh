@@ -186,7 +186,21 @@ refused "--ortho is an orthographic camera" --ortho 2 --fov 30
 refused "--ortho fit frames the bounds" --look-at 0,0,4 0,0,0 --ortho fit
 refused "--ortho fit frames the bounds" --orbit 0,0,3 --ortho fit
 refused "--look-at: eye '1e39,0,0' is out of single-precision range" --look-at 1e39,0,0 0,0,0
-refused "--ortho: the height must be > 0 \(and below 1e30\)" --ortho 1e39
+refused "--ortho: height .1e39. is out of single-precision range" --ortho 1e39
+refused "--orbit: value '1e39' is out of single-precision range" --orbit 1e39,0
+refused "--orbit: azimuth 1.*e\+30 is outside \[-1e6, 1e6\] degrees" --orbit 1e30,0
+refused "--euler: roll 10000000 is outside \[-1e6, 1e6\] degrees" --euler 0,0,1e7
+refused "--position: position '0,0,1e39' is out of single-precision range" --euler 0,0,0 --position 0,0,1e39
+refused "--focal-length: focal length '1e39' is out of single-precision range" --focal-length 1e39
+refused "--sensor: sensor size '1e39' is out of single-precision range" --focal-length 50 --sensor 1e39
+refused "--near: distance '1e39' is out of single-precision range" --near 1e39
+refused "--far: distance '1e39' is out of single-precision range" --far 1e39
+# A flag given an empty value is refused, not read as a flag left out.
+for flag in --orbit --euler --position --turntable --turntable-elevation --fov --focal-length --sensor --ortho \
+  --near --far; do
+  refused "$flag: the value is empty" "$flag" ''
+done
+refused "--look-at: the value is empty" --look-at '' 0,0,0
 refused "field of view .* outside \(0, 180\) in single precision" --fov 179.99999999
 refused "field of view .* outside \(0, 180\) in single precision" --focal-length 1e-30
 refused "the camera lies .* scene units out, beyond 1e\+18" --orbit 0,0 --fov 1e-30
@@ -219,6 +233,8 @@ expect 2 "sheet of 60 frames exceeds .* memory budget" -- "$bin" render "$sphere
 [ -e "$work/big.0000.exr" ] && [ ! -e "$work/big.0001.exr" ] && [ ! -e "$work/big.png" ] && ok || fail "the oversized sheet was refused at the wrong time: $(ls "$work"/big* 2>&1)"
 out=bad.##.exr refused "--contact-sheet.*the same file" --turntable 2 --png "$work/bad.##.png" --contact-sheet "$work/bad.01.png"
 expect 2 "up vector is zero" -- "$bin" info "$sphere" --look-at 0,0,4 0,0,0 0,0,0
+expect 2 "--orbit: value '1e39' is out of single-precision range" -- "$bin" info "$sphere" --orbit 1e39,0
+expect 2 "--orbit: the value is empty" -- "$bin" info "$sphere" --orbit ''
 expect 2 "--frame picks a --turntable frame" -- "$bin" info "$sphere" --frame 3
 
 echo "camera: $passes passed, $fails failed"

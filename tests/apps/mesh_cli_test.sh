@@ -2,7 +2,8 @@
 # End-to-end test of `penumbra mesh`: a scene with implicit shapes (PENUMBRA_shapes) meshed to
 # .glb and .gltf, read back by `penumbra info` (and Blender when installed); a displaced sphere
 # meshed to its relief; an unknown node, a node without an implicit shape, bad resolutions and
-# outputs, and a resolution over the memory budget exit 2 before writing anything.
+# outputs, an empty --node, a resolution over the memory budget and a million instanced placements
+# over it exit 2 before writing anything.
 # Usage: mesh_cli_test.sh PENUMBRA SRC WORK
 set -u
 bin="$1"; src="$2"; work="$3"
@@ -114,6 +115,29 @@ expect 2 "must be a .glb or .gltf" -- "$bin" mesh "$scene" --resolution 8 -o "$w
 expect 2 "does not exist" -- "$bin" mesh "$scene" --resolution 8 -o "$work/nodir/x.glb"
 expect 2 "would overwrite" -- "$bin" mesh "$scene" --resolution 8 -o "$scene"
 expect 2 "ball: meshing at resolution 2000 needs [0-9]+ bytes, more than the [0-9]+ bytes left" -- "$bin" mesh "$scene" --node ball --resolution 2000 --max-memory 64M -o "$work/x.glb"
+# One implicit sphere placed a million times (EXT_mesh_gpu_instancing): the meshes of all
+# placements together are over the budget, refused before any is meshed.
+python3 - "$work" <<'PY'
+import array, json, sys
+n = 1000000
+t = array.array("f")
+for i in range(n):
+    t.extend((3.0 * (i % 100), 3.0 * (i // 100 % 100), 3.0 * (i // 10000)))
+open(sys.argv[1] + "/swarm.bin", "wb").write(t.tobytes())
+json.dump({"asset": {"version": "2.0"}, "extensionsUsed": ["PENUMBRA_shapes", "EXT_mesh_gpu_instancing"],
+           "buffers": [{"uri": "swarm.bin", "byteLength": 12 * n}],
+           "bufferViews": [{"buffer": 0, "byteLength": 12 * n}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": n, "type": "VEC3"}],
+           "scenes": [{"nodes": [0]}], "scene": 0,
+           "nodes": [{"name": "swarm", "extensions": {
+               "PENUMBRA_shapes": {"type": "implicit", "csg": {"type": "sphere", "radius": 1}},
+               "EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 0}}}}]},
+          open(sys.argv[1] + "/swarm.gltf", "w"))
+PY
+expect 2 "swarm: meshing its 1000000 placements at resolution 64 needs [0-9]+ bytes .*more than the [0-9]+ bytes left" -- \
+  "$bin" mesh "$work/swarm.gltf" --resolution 64 --max-memory 2G -o "$work/x.glb"
+absent "$work/x.glb"
+expect 2 "--node: the value is empty" -- "$bin" mesh "$scene" --node '' --resolution 8 -o "$work/x.glb"
 expect 2 "spheres.gltf: the scene places no implicit shape" -- "$bin" mesh "$src/scenes/spheres.gltf" --resolution 8 -o "$work/x.glb"
 expect 2 "default.gltf: the scene places no implicit shape" -- "$bin" mesh "$src/scenes/default.gltf" --resolution 8 -o "$work/x.glb"
 expect 2 "missing.gltf" -- "$bin" mesh "$work/missing.gltf" --resolution 8 -o "$work/x.glb"

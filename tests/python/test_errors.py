@@ -76,3 +76,30 @@ def test_warnings_are_scene_warnings(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         penumbra.load(path, quiet=True)
+
+
+def test_settings_of_the_wrong_type_or_out_of_range_name_the_setting(default_scene, tmp_path):
+    with pytest.raises(ValueError, match=r"camera index 1180591620717411303424 is out of range \[0, 2147483647\]"):
+        penumbra.RenderSettings(camera=2**70)
+    with pytest.raises(ValueError, match=r"camera index -1 is out of range"):
+        default_scene.render(camera=-1)
+    with pytest.raises(TypeError, match=r"camera must be None, an index \(int\) or a name \(str\), not float"):
+        penumbra.RenderSettings(camera=0.5)
+    with pytest.raises(ValueError, match="camera name must not be empty"):
+        penumbra.RenderSettings(camera="")
+    with pytest.raises(ValueError, match=r"window value 1180591620717411303424 is out of range"):
+        penumbra.RenderSettings(window=(0, 2**70, 0, 10))
+    with pytest.raises(TypeError, match=r"window must be None or \(x0, y0, x1, y1\), not int"):
+        penumbra.RenderSettings(window=5)
+    with pytest.raises(TypeError, match=r"window must be None or \(x0, y0, x1, y1\) of ints, not float"):
+        penumbra.RenderSettings(window=(0, 0, 1.5, 1))
+    with pytest.raises(ValueError, match=r"window must be None or \(x0, y0, x1, y1\) \(4 values\)"):
+        penumbra.RenderSettings(window=(0, 0, 1))
+    with pytest.raises(TypeError, match="settings must be a penumbra.RenderSettings or None, not int"):
+        default_scene.render(settings=5)
+    with pytest.raises(TypeError, match="settings must be a penumbra.RenderSettings or None, not str"):
+        default_scene.render_to_file(tmp_path / "x.exr", settings="fast")
+    assert not (tmp_path / "x.exr").exists()
+    # In range, the values are kept.
+    s = penumbra.RenderSettings(camera=2147483647, window=[1, 2, 3, 4])
+    assert s.camera == 2147483647 and s.window == (1, 2, 3, 4)

@@ -15,6 +15,7 @@
 #include "renderer/materials/material.h"
 #include "support/gltf_load.h"
 #include "support/gltf_writer.h"
+#include "support/image_files.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -174,6 +175,59 @@ TEST_CASE("corpus textures: TextureTransformTest offsets, rotation and scale rea
   // Scale 1.5 at the same uv.
   const Vec3f scaled = v.at(0.0f - 0.5f + uv.x, -0.55f + 0.5f - uv.y);
   CHECK(close(scaled, texel(4, {1.5f * uv.x, 1.5f * uv.y})));
+}
+
+TEST_CASE("KHR_texture_transform: members of the wrong type are errors naming the member",
+          "[io][gltf][texture][quick]") {
+  const auto dir = test::temp_dir("texture_transform");
+  const unsigned char grey[3] = {128, 128, 128};
+  test::write_flat_image(dir / "grey.png", grey);
+  GltfWriter w = quad_with_material();
+  w.j["images"] = {{{"uri", "grey.png"}}};
+  w.j["textures"] = {{{"source", 0}}};
+  w.j["extensionsUsed"] = {"KHR_texture_transform"};
+  auto load_with = [&](const nlohmann::json& transform) {
+    w.j["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorTexture", {{"index", 0}, {"extensions", {{"KHR_texture_transform", transform}}}}}}}}};
+    w.write_embedded(dir / "scene.gltf");
+    return load_gltf(dir / "scene.gltf");
+  };
+  const LoadedScene good =
+      load_with({{"offset", {0.5, 0.25}}, {"rotation", 0.0}, {"scale", {2, 3}}, {"texCoord", 1}});
+  const TextureRef& ref = good.scene.materials.at(0).base_color_tex;
+  CHECK(ref.texture == 0);
+  CHECK(ref.texcoord == 1);
+  CHECK(ref.m[0][0] == 2);
+  CHECK(ref.m[1][1] == 3);
+  CHECK(ref.m[0][2] == 0.5f);
+  CHECK(ref.m[1][2] == 0.25f);
+  const std::string xw =
+      "materials[0].pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform";
+  auto bad = [&](const char* key, const nlohmann::json& value, const char* expect) {
+    INFO(key << " = " << value.dump());
+    REQUIRE_THROWS_WITH(load_with({{key, value}}), Contains(xw + "." + key + ": " + expect));
+  };
+  bad("scale", "x", "must be an array of 2 numbers");
+  bad("scale", {1, "x"}, "must be an array of 2 numbers");
+  bad("offset", 0.5, "must be an array of 2 numbers");
+  bad("offset", {{"u", 0.5}}, "must be an array of 2 numbers");
+  bad("rotation", "90deg", "must be a number");
+  bad("rotation", {0.5}, "must be a number");
+  bad("texCoord", "1", "must be a non-negative integer");
+  bad("texCoord", 0.5, "must be a non-negative integer");
+  // The texture infos of material extensions are read the same way.
+  w.j["materials"] = {
+      {{"extensions",
+        {{"KHR_materials_clearcoat",
+          {{"clearcoatFactor", 1.0},
+           {"clearcoatTexture",
+            {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"texCoord", "1"}}}}}}}}}}}}};
+  w.j["extensionsUsed"] = {"KHR_texture_transform", "KHR_materials_clearcoat"};
+  w.write_embedded(dir / "scene.gltf");
+  REQUIRE_THROWS_WITH(load_gltf(dir / "scene.gltf"),
+                      Contains("materials[0].extensions.KHR_materials_clearcoat.clearcoatTexture.extensions."
+                               "KHR_texture_transform.texCoord: must be a non-negative integer"));
 }
 
 TEST_CASE("corpus textures: VertexColorTest multiplies COLOR_0 so the hidden X marks stay hidden",
