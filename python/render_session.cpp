@@ -268,6 +268,13 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   validate(out.config);
   const RenderConfig& cfg = out.config;
   out.camera = chosen ? *chosen : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
+  try {
+    validate_camera(out.camera, cfg.width, cfg.height);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(session.file,
+                     out.camera_index >= 0 ? "cameras[" + std::to_string(out.camera_index) + "]" : "the view",
+                     e.what());
+  }
 
   // Phase: lights: the environment, the emissive triangles, the default key light.
   Environment own_env;

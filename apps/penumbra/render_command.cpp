@@ -19,6 +19,7 @@
 #include "io/atomic_file.h"
 #include "io/contact_sheet.h"
 #include "io/environment_io.h"
+#include "io/error.h"
 #include "io/file_checks.h"
 #include "io/frame_outputs.h"
 #include "io/hash.h"
@@ -178,6 +179,11 @@ void setup_phase(RenderJob& job) {
   if (!cfg.window.empty() && q.cost_aov)
     throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
   job.camera = choose_camera(q.rig, scene, cam, cfg.width, cfg.height);
+  try {
+    validate_camera(job.camera, cfg.width, cfg.height);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(a.scene_file, cam >= 0 ? "cameras[" + std::to_string(cam) + "]" : "the view", e.what());
+  }
   // The path tracer's lights: emissive triangles and the environment.
   if (q.env_colour)
     job.environment = make_constant_environment(*q.env_colour * a.env_intensity);

@@ -184,6 +184,22 @@ void attach_shape(RTCScene scene, const Shape* shape, unsigned id) {
   throw_if_error("attaching a shape");
 }
 
+/// The largest origin or direction coordinate handed to Embree, object-space rays included:
+/// under Embree's FLT_LARGE (1.8e18) with room for the rounding of its instance transforms.
+constexpr double kEmbreeRayLimit = 1e18;
+
+/// A query's ray as handed to Embree, and how Embree's t maps back to the query's.
+struct TraceRay {
+  struct Units {
+    double start = 0;  ///< where Embree's ray starts, in its own (unit-direction) t
+    double scale = 1;  ///< query t per Embree t
+    float query_t(float t) const { return start == 0 && scale == 1 ? t : float((start + double(t)) * scale); }
+  };
+  Ray ray;
+  Units units;
+  bool ok = true;  ///< false: the ray cannot be traced (it misses)
+};
+
 class EmbreeAccelerator final : public Accelerator {
  public:
   /// Identity instances become triangle (or user) geometries of the top scene; every other
@@ -228,6 +244,7 @@ class EmbreeAccelerator final : public Accelerator {
         attach_triangles(m_scene, GeometryView{}, id);
         continue;
       }
+      note_inverse(inverse_map);
       RTCScene& object = objects[inst.mesh];
       if (!object) {
         object = new_scene();
@@ -266,7 +283,7 @@ class EmbreeAccelerator final : public Accelerator {
 
   bool intersect(const Ray& ray, Hit& hit, const HitFilter& filter) const override {
     FilterContext ctx(*this, ray, filter);
-    return closest(ray, hit, ctx.rtc);
+    return closest(ray, hit, ctx.rtc, &ctx.units);
   }
 
   bool occluded(const Ray& ray) const override {
@@ -277,7 +294,7 @@ class EmbreeAccelerator final : public Accelerator {
 
   bool occluded(const Ray& ray, const HitFilter& filter) const override {
     FilterContext ctx(*this, ray, filter);
-    return any_hit(ray, ctx.rtc);
+    return any_hit(ray, ctx.rtc, &ctx.units);
   }
 
   Bounds3f bounds() const override { return m_bounds; }
@@ -295,6 +312,13 @@ class EmbreeAccelerator final : public Accelerator {
       rtcCommitGeometry(geom);
     }
     throw_if_error("moving the instances");
+    m_inverse_scale = 1;
+    m_inverse_offset = 0;
+    for (size_t i = 0; i < instances.size(); ++i) {
+      Affine3f inverse_map;
+      if (m_layout.kinds[i] == InstanceKind::Placed && inverse(instances[i].to_world, inverse_map))
+        note_inverse(inverse_map);
+    }
     rtcCommitScene(m_scene);
     throw_if_error("rebuilding the top level (rtcCommitScene)");
     read_bounds();
@@ -327,6 +351,7 @@ class EmbreeAccelerator final : public Accelerator {
     const EmbreeAccelerator* self;
     const Ray* ray;  // the query's world-space ray (Embree passes instanced hits the object-space one)
     const HitFilter* filter;
+    TraceRay::Units units;  // how Embree's t maps to the query's (set by closest / any_hit)
 
     FilterContext(const EmbreeAccelerator& s, const Ray& r, const HitFilter& f)
         : self(&s), ray(&r), filter(&f) {
@@ -339,7 +364,7 @@ class EmbreeAccelerator final : public Accelerator {
       for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         Hit h;
-        h.t = RTCRayN_tfar(args->ray, args->N, i);
+        h.t = c.units.query_t(RTCRayN_tfar(args->ray, args->N, i));
         h.u = RTCHitN_u(args->hit, args->N, i);
         h.v = RTCHitN_v(args->hit, args->N, i);
         h.geom_id = c.self->instance_of(RTCHitN_geomID(args->hit, args->N, i),
@@ -358,16 +383,19 @@ class EmbreeAccelerator final : public Accelerator {
                                               : inst_id;
   }
 
-  bool closest(const Ray& ray, Hit& hit, RTCIntersectContext& ctx) const {
+  bool closest(const Ray& ray, Hit& hit, RTCIntersectContext& ctx, TraceRay::Units* units = nullptr) const {
     hit = Hit{};
     if (!is_valid_query(ray)) return false;
+    const TraceRay trace = traceable(ray);
+    if (!trace.ok) return false;
+    if (units) *units = trace.units;
     RTCRayHit rh;
-    fill_ray(ray, rh.ray);
+    fill_ray(trace.ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m_scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    hit.t = rh.ray.tfar;
+    hit.t = trace.units.query_t(rh.ray.tfar);
     hit.u = rh.hit.u;
     hit.v = rh.hit.v;
     hit.geom_id = instance_of(rh.hit.geomID, rh.hit.instID[0]);
@@ -375,10 +403,13 @@ class EmbreeAccelerator final : public Accelerator {
     return true;
   }
 
-  bool any_hit(const Ray& ray, RTCIntersectContext& ctx) const {
+  bool any_hit(const Ray& ray, RTCIntersectContext& ctx, TraceRay::Units* units = nullptr) const {
     if (!is_valid_query(ray)) return false;
+    const TraceRay trace = traceable(ray);
+    if (!trace.ok) return false;
+    if (units) *units = trace.units;
     RTCRay r;
-    fill_ray(ray, r);
+    fill_ray(trace.ray, r);
     rtcOccluded1(m_scene, &ctx, &r);
     return r.tfar < 0;  // Embree sets tfar = -inf on occlusion
   }
@@ -420,6 +451,70 @@ class EmbreeAccelerator final : public Accelerator {
     attach_shape(scene, m_shapes.back().get(), id);
   }
 
+  /// Adds a placed instance's world-to-object map to the reach of Embree's instanced rays.
+  void note_inverse(const Affine3f& to_object) {
+    for (int r = 0; r < 3; ++r) {
+      double row = 0;
+      for (int c = 0; c < 3; ++c) row += std::fabs(double(to_object.m[size_t(r)][size_t(c)]));
+      m_inverse_scale = std::max(m_inverse_scale, row);
+      m_inverse_offset = std::max(m_inverse_offset, std::fabs(double(to_object.m[size_t(r)][3])));
+    }
+  }
+
+  /// True when every object-space version of `r` (each instance's to_object applied to it, and
+  /// the world ray itself) has origin and direction coordinates within kEmbreeRayLimit.
+  bool embree_safe(const Ray& r) const {
+    const double org = max_component(abs(r.org)), dir = max_component(abs(r.dir));
+    return m_inverse_scale * org + m_inverse_offset <= kEmbreeRayLimit &&
+           m_inverse_scale * dir <= kEmbreeRayLimit;
+  }
+
+  /// `ray` as Embree may be given it. Embree asserts (and aborts the process) when a ray it
+  /// traverses, an instance's object-space ray included, has a coordinate beyond 1.8e18
+  /// (FLT_LARGE): an origin far from the scene, or an instance scaled by 1e-16, gets there.
+  /// Every ordinary ray is passed as it is; one that would not be is restarted where it enters
+  /// the scene's bounds with a unit direction (t mapped back by `units`), and one that still
+  /// would not be (or that misses the bounds) is not traced: it misses.
+  TraceRay traceable(const Ray& ray) const {
+    TraceRay out;
+    out.ray = ray;
+    if (embree_safe(ray)) return out;
+    out.ok = false;
+    if (m_bounds.empty()) return out;
+    const double len = std::sqrt(double(ray.dir.x) * ray.dir.x + double(ray.dir.y) * ray.dir.y +
+                                 double(ray.dir.z) * ray.dir.z);
+    if (!(len > 0) || !std::isfinite(len)) return out;
+    // The unit ray's interval inside the bounds (slabs in double precision).
+    double t0 = std::max(double(ray.tnear), 0.0) * len, t1 = double(ray.tfar) * len;
+    for (int k = 0; k < 3; ++k) {
+      const double o = ray.org[k], d = ray.dir[k] / len;
+      const double lo = m_bounds.lo[k], hi = m_bounds.hi[k];
+      if (d == 0) {
+        if (o < lo || o > hi) return out;
+        continue;
+      }
+      double a = (lo - o) / d, b = (hi - o) / d;
+      if (a > b) std::swap(a, b);
+      t0 = std::max(t0, a);
+      t1 = std::min(t1, b);
+    }
+    if (!(t0 <= t1)) return out;
+    // Start a little before the entry, so that a surface on the bounds is still in range.
+    const double start = std::max(std::max(double(ray.tnear), 0.0) * len, t0 - 1e-3 * (t1 - t0) - 1e-30);
+    Ray r;
+    for (int k = 0; k < 3; ++k) {
+      r.dir[k] = float(ray.dir[k] / len);
+      r.org[k] = float(ray.org[k] + r.dir[k] * start);
+    }
+    r.tnear = float(std::max(double(ray.tnear) * len - start, 0.0));
+    r.tfar = std::isinf(ray.tfar) ? ray.tfar : float(double(ray.tfar) * len - start);
+    if (!embree_safe(r) || !(r.tnear <= r.tfar)) return out;
+    out.ray = r;
+    out.units = {start, 1 / len};
+    out.ok = true;
+    return out;
+  }
+
   static void fill_ray(const Ray& in, RTCRay& r) {
     r.org_x = in.org.x;
     r.org_y = in.org.y;
@@ -456,6 +551,8 @@ class EmbreeAccelerator final : public Accelerator {
   std::vector<std::unique_ptr<Shape>> m_shapes;   // the user geometries' shapes (stable addresses)
   InstanceLayout m_layout;                        // every instance's mesh and kind, as built
   Bounds3f m_bounds;
+  double m_inverse_scale = 1;   // largest row sum of |to_object| over placed instances (1: the world)
+  double m_inverse_offset = 0;  // largest |translation| of a placed instance's to_object
   uint64_t m_triangles = 0;
   uint64_t m_instances = 0;
   uint64_t m_bytes = 0;

@@ -167,6 +167,11 @@ Transform to_transform(const Affine3f& a) {
 }
 
 bool inverse(const Affine3f& a, Affine3f& out) {
+  // The determinant of the linear part in single precision, as single-precision kernels
+  // (Embree's instances) compute it before dividing by it: it must be a normal float.
+  const Vec3f c0{a.m[0][0], a.m[1][0], a.m[2][0]}, c1{a.m[0][1], a.m[1][1], a.m[2][1]},
+      c2{a.m[0][2], a.m[1][2], a.m[2][2]};
+  if (!std::isnormal(dot(c0, cross(c1, c2)))) return false;
   Transform inv;
   if (!inverse(to_transform(a), inv)) return false;
   const Affine3f r = to_affine(inv);

@@ -172,7 +172,10 @@ bool is_identity(const Affine3f& a);
 /// The top three rows of an affine Transform, rounded to float.
 Affine3f to_affine(const Transform& t);
 Transform to_transform(const Affine3f& a);
-/// Inverse computed in double and rounded; false (out untouched) if singular or not finite.
+/// Inverse computed in double and rounded; false (out untouched) if singular, not finite, or
+/// not invertible in single precision: the determinant of the linear part, computed in float,
+/// must be a normal number (a scale of 1e-13 on every axis is not), as single-precision
+/// kernels such as Embree's instancing divide by it.
 bool inverse(const Affine3f& a, Affine3f& out);
 /// The box holding the image of `b` under `a` (its eight corners mapped); empty stays empty.
 Bounds3f transform_bounds(const Affine3f& a, const Bounds3f& b);

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
 
 namespace penumbra {
 
@@ -35,6 +38,48 @@ Ray raster_ray(const Camera& cam, const CameraRaster& m, float x, float y) {
   ray.tnear = cam.znear * len;
   ray.tfar = cam.zfar * len;
   return ray;
+}
+
+void validate_camera(const Camera& cam, int width, int height) {
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("camera: " + what + " (rays beyond single-precision range)");
+  };
+  const auto shown = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
+  if (width < 1 || height < 1) fail("an image of " + std::to_string(width) + " x " + std::to_string(height));
+  if (!is_finite(cam.eye) || !is_finite(cam.u) || !is_finite(cam.v) || !is_finite(cam.w))
+    fail("the eye or the axes are not finite");
+  if (!(std::isfinite(cam.znear) && cam.znear >= 0 && cam.znear < kMaxCameraReach))
+    fail("near clip distance " + shown(cam.znear) + " is not within [0, " + shown(kMaxCameraReach) + ")");
+  if (!(cam.zfar > cam.znear)) fail("far clip distance " + shown(cam.zfar) + " is not beyond the near one");
+  // The largest origin coordinate of any ray: the eye, plus the image plane's half-extents
+  // along u and v for an orthographic camera (computed in double: the sum must not round).
+  double half_w = 0, half_h = 0;
+  if (cam.projection == Projection::Orthographic) {
+    half_h = cam.ymag;
+    half_w = double(cam.ymag) * double(width) / double(height);
+    if (!(std::isfinite(half_h) && half_h > 0 && double(float(half_w)) > 0 && std::isfinite(float(half_w))))
+      fail("orthographic height " + shown(2.0 * half_h) + " for a " + std::to_string(width) + " x " +
+           std::to_string(height) + " image");
+  } else {
+    const float t = std::tan(0.5f * cam.yfov);
+    const float tx = t * float(width) / float(height);
+    if (!(cam.yfov > 0 && cam.yfov < float(M_PI) && std::isfinite(t) && std::isnormal(t) && t > 0 &&
+          std::isfinite(tx) && std::isnormal(tx)))
+      fail("field of view " + shown(double(cam.yfov) * 180 / M_PI) + " degrees for a " +
+           std::to_string(width) + " x " + std::to_string(height) + " image");
+  }
+  double reach = 0;
+  for (int k = 0; k < 3; ++k)
+    reach = std::max(reach, std::fabs(double(cam.eye[k])) + std::fabs(double(cam.u[k])) * half_w +
+                                std::fabs(double(cam.v[k])) * half_h);
+  if (!(reach < double(kMaxCameraReach)))
+    fail(std::string(cam.projection == Projection::Orthographic ? "the image plane reaches "
+                                                                : "the eye lies ") +
+         shown(reach) + " scene units out, beyond " + shown(kMaxCameraReach));
 }
 
 Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y) {

@@ -8,6 +8,20 @@
 
 namespace penumbra {
 
+/// The farthest a camera's ray origins (each coordinate) and clip distances may lie from the
+/// origin: they stay well inside what single-precision ray kernels (Embree's among them,
+/// 1.8e19) accept.
+inline constexpr float kMaxCameraReach = 1e18f;
+
+/// Throws std::invalid_argument, saying what is out of range, unless every ray that
+/// generate_camera_ray gives for a width x height image (each >= 1) is one every back end can
+/// trace: finite axes; every ray origin within kMaxCameraReach on each axis (the eye, and for an
+/// orthographic camera the image plane's corners, ymag high and ymag * width / height wide);
+/// a finite znear >= 0 and a zfar > znear (or infinite); a perspective field of view strictly
+/// inside (0, 180) degrees whose tangent is finite. Every front end calls it on the camera it
+/// renders with.
+void validate_camera(const Camera& cam, int width, int height);
+
 /// Ray through raster position (x, y) of a width x height image; x to the right, y down,
 /// pixel (i, j) covers [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5).
 /// Perspective: origin at the eye, unit direction through the image plane; tnear/tfar are

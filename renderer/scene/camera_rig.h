@@ -20,11 +20,6 @@
 
 namespace penumbra {
 
-/// The farthest a rig's eye (each coordinate) and near plane may lie from the origin: ray
-/// origins and distances stay well inside what single-precision ray kernels (Embree's among
-/// them, 1.8e19) accept.
-inline constexpr float kMaxCameraReach = 1e18f;
-
 /// How the rig places the camera.
 enum class CameraPlacement {
   Base,    ///< the base camera's pose (a file camera), or the default framing without one

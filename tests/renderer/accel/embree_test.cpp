@@ -87,3 +87,29 @@ TEST_CASE("embree: empty scenes miss, invalid settings are refused", "[accel][em
   CHECK_NOTHROW(validate(EmbreeConfig{false, 2}));
   CHECK_FALSE(embree_version().empty());
 }
+
+TEST_CASE("embree: rays whose object-space versions leave Embree's range are restarted, not aborted",
+          "[accel][embree][quick]") {
+  // A sphere of radius 1e10 scaled by 1e-10 (radius 1 in the world) seen from 1e12 away: the
+  // object-space origin (1e22) is beyond Embree's 1.8e18, which its traversal asserts.
+  Shape sphere;
+  sphere.radius = 1e10f;
+  const std::vector<GeometryView> views{{{}, {}, &sphere}};
+  const std::vector<InstanceView> instances{{0, to_affine(scale(1e-10, 1e-10, 1e-10))}};
+  const auto embree = make_accelerator("embree", views, instances);
+  Hit h;
+  REQUIRE(embree->intersect({{0, 0, 1e12f}, 0, {0, 0, -1}, kInfinity}, h));
+  CHECK(h.t == Approx(1e12f - 1).epsilon(1e-6));
+  CHECK(embree->occluded({{0, 0, 1e12f}, 0, {0, 0, -1}, kInfinity}));
+  CHECK_FALSE(embree->occluded({{0, 0, 1e12f}, 0, {0, 0, -1}, 1e11f}));          // ends before the sphere
+  CHECK_FALSE(embree->intersect({{0, 3, 1e12f}, 0, {0, 0, -1}, kInfinity}, h));  // passes beside it
+  // An unnormalised direction: t stays in the query's units.
+  REQUIRE(embree->intersect({{0, 0, 1e12f}, 0, {0, 0, -4}, kInfinity}, h));
+  CHECK(h.t == Approx((1e12f - 1) / 4).epsilon(1e-6));
+  // An ordinary ray near the sphere is passed unchanged and agrees with brute force.
+  const auto brute = make_accelerator("brute", views, instances);
+  Hit b;
+  REQUIRE(embree->intersect({{0, 0, 5}, 0, {0, 0, -1}, kInfinity}, h));
+  REQUIRE(brute->intersect({{0, 0, 5}, 0, {0, 0, -1}, kInfinity}, b));
+  CHECK(h.t == Approx(b.t).epsilon(1e-6));
+}

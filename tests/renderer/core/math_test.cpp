@@ -113,3 +113,16 @@ TEST_CASE("determinant sign detects mirroring", "[math][quick]") {
   REQUIRE(determinant3x3(scale(-1, 1, 1)) == -1);
   REQUIRE(determinant3x3(scale(2, 3, 4)) == 24);
 }
+
+TEST_CASE("inverse refuses maps single-precision kernels cannot invert", "[math][quick]") {
+  Affine3f out;
+  // A scale of 1e-12 on every axis has a determinant of 1e-36, a normal float: invertible.
+  REQUIRE(inverse(to_affine(scale(1e-12, 1e-12, 1e-12)), out));
+  CHECK(out.m[0][0] == Approx(1e12f));
+  // 1e-13 gives 1e-39 (subnormal) and 1e-16 gives 0 in float: refused, as singular maps are.
+  CHECK_FALSE(inverse(to_affine(scale(1e-13, 1e-13, 1e-13)), out));
+  CHECK_FALSE(inverse(to_affine(scale(1e-16, 1e-16, 1e-16)), out));
+  CHECK_FALSE(inverse(to_affine(scale(1, 1, 0)), out));
+  // One tiny axis with large others is fine while the determinant stays normal.
+  CHECK(inverse(to_affine(scale(1e-20, 1e10, 1e10)), out));
+}

@@ -4,6 +4,8 @@
 
 #include <array>
 #include <catch2/catch.hpp>
+#include <limits>
+#include <stdexcept>
 
 #include "support/camera_checks.h"
 
@@ -212,4 +214,31 @@ TEST_CASE("projection matrix: glTF's depth mapping and the ray generator's image
   CHECK(o[1] == Approx(-1));
   CHECK(o[2] == Approx(1));
   CHECK(clip_of(c, aspect, {0, 0, -0.5f})[2] == Approx(-1));
+}
+
+TEST_CASE("validate_camera refuses cameras whose rays leave single precision", "[camera][quick]") {
+  Camera c;  // perspective at the origin
+  CHECK_NOTHROW(validate_camera(c, 64, 32));
+  Camera far = c;
+  far.eye = {0, 0, 2e18f};
+  CHECK_THROWS_WITH(validate_camera(far, 64, 32), Catch::Matchers::Contains("the eye lies"));
+  Camera ortho = c;
+  ortho.projection = Projection::Orthographic;
+  ortho.ymag = 4e17f;  // 4e17 high, 8e17 wide for a 2:1 image: inside 1e18 ...
+  CHECK_NOTHROW(validate_camera(ortho, 64, 64));
+  // ... but the image plane of a 4:1 image reaches 1.6e18.
+  CHECK_THROWS_WITH(validate_camera(ortho, 128, 32), Catch::Matchers::Contains("image plane reaches"));
+  ortho.ymag = 1e19f;
+  CHECK_THROWS_AS(validate_camera(ortho, 16, 16), std::invalid_argument);
+  Camera narrow = c;
+  narrow.yfov = 1e-38f;  // tan(fov/2) subnormal
+  CHECK_THROWS_WITH(validate_camera(narrow, 16, 16), Catch::Matchers::Contains("field of view"));
+  Camera clip = c;
+  clip.znear = -1;
+  CHECK_THROWS_WITH(validate_camera(clip, 16, 16), Catch::Matchers::Contains("near clip"));
+  clip.znear = 2, clip.zfar = 1;
+  CHECK_THROWS_WITH(validate_camera(clip, 16, 16), Catch::Matchers::Contains("far clip"));
+  Camera nan = c;
+  nan.u.x = std::numeric_limits<float>::quiet_NaN();
+  CHECK_THROWS_WITH(validate_camera(nan, 16, 16), Catch::Matchers::Contains("not finite"));
 }
