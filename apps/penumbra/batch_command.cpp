@@ -1,11 +1,14 @@
 // `penumbra batch`: job settings as `render` flags, the up-front checks, and the four modes.
 #include "apps/penumbra/batch_command.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <set>
 
 #include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/exr_layers.h"
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_command.h"
 #include "io/error.h"
@@ -168,7 +171,7 @@ std::vector<std::pair<std::string, fs::path>> check_shot(const Job& job, const J
 std::vector<size_t> first_stripes(const PreparedJob& pj) {
   std::vector<size_t> out;
   for (size_t n = 0; n < pj.units.size(); ++n)
-    if (pj.units[n].tiles > 1 && pj.units[n].tile == 0) out.push_back(n);
+    if (const WorkUnit u = pj.units[n]; u.tiles > 1 && u.tile == 0) out.push_back(n);
   return out;
 }
 
@@ -179,7 +182,7 @@ bool complete(const fs::path& exr) {
 
 int list_units(const PreparedJob& pj) {
   for (size_t n = 0; n < pj.units.size(); ++n) {
-    const WorkUnit& u = pj.units[n];
+    const WorkUnit u = pj.units[n];
     const std::string frame = u.frame ? std::to_string(*u.frame) : "-";
     const std::string tile = u.tiles > 1 ? std::to_string(u.tile) + "/" + std::to_string(u.tiles) : "-";
     std::printf("%zu\t%s\t%s\t%s\t%s\n", n, pj.job.shots[u.shot].name.c_str(), frame.c_str(), tile.c_str(),
@@ -189,7 +192,7 @@ int list_units(const PreparedJob& pj) {
 }
 
 int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
-  const WorkUnit& u = pj.units[n];
+  const WorkUnit u = pj.units[n];
   const fs::path final_exr = unit_output(pj.job, u);
   if (b.skip_existing && u.tiles > 1 && complete(final_exr)) {
     if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
@@ -208,7 +211,7 @@ int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
 /// Merges tiled frame `first` (its first stripe's unit) and writes its display image; false
 /// when a stripe is missing (reported).
 bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
-  const WorkUnit& u = pj.units[first];
+  const WorkUnit u = pj.units[first];
   const JobShot& shot = pj.job.shots[u.shot];
   const fs::path final_exr = unit_output(pj.job, u);
   const fs::path png =
@@ -276,7 +279,8 @@ int render_all(const PreparedJob& pj, const BatchArgs& b) {
 /// returns those it made, parents first.
 std::vector<fs::path> create_output_folders(const PreparedJob& pj) {
   std::set<fs::path> folders;
-  for (const WorkUnit& u : pj.units) {
+  for (size_t n = 0; n < pj.units.size(); ++n) {
+    const WorkUnit u = pj.units[n];
     const JobShot& shot = pj.job.shots[u.shot];
     for (const std::string* pattern : {&shot.output, &shot.png, &shot.stats_json})
       if (!pattern->empty())
@@ -299,44 +303,177 @@ std::vector<fs::path> create_output_folders(const PreparedJob& pj) {
   return made;
 }
 
-/// Maps every shot's settings onto `render`'s flags into pj.shot_args and, with `check_frames`,
-/// checks every frame's outputs, one stripe of each tiled shot and that no two shots write one file.
-void check_shots(PreparedJob& pj, const BatchArgs& b, bool check_frames) {
-  std::map<std::string, std::string> writer;  // every output file -> the shot writing it
+/// The files unit `n` writes, each with what writes it: a frame's EXR (or a stripe) and its
+/// resume state and Cryptomatte sidecars; a whole frame's (or, for the first stripe, the merged
+/// frame's) display image, statistics and cost image. `crypto` are the shot's Cryptomatte layers.
+template <typename F>
+void unit_files(const PreparedJob& pj, size_t n, const std::vector<std::vector<std::string>>& crypto, F&& f) {
+  const WorkUnit u = pj.units[n];
+  const JobShot& shot = pj.job.shots[u.shot];
+  const auto at = [&](const std::string& pattern) {
+    return u.frame ? substitute_frame(pattern, *u.frame) : pattern;
+  };
+  const std::string out = at(shot.output);
+  const fs::path exr = u.tiles > 1 ? tile_part_path(out, u.tile, u.tiles) : fs::path(out);
+  f(exr.string());
+  f(exr.string() + ".resume");
+  for (const std::string& layer : crypto[u.shot]) f(crypto_sidecar_path(exr, layer).string());
+  if (u.tile > 0) return;
+  if (u.tiles > 1) f(out);
+  if (!shot.png.empty()) f(at(shot.png));
+  if (!shot.stats_json.empty() && u.tiles == 1) f(at(shot.stats_json));
+  if (const std::string& cost = pj.shot_args[u.shot].cost_png; !cost.empty() && u.tiles == 1) f(at(cost));
+}
+
+/// Throws InputError unless `file` lies in `root` (both absolute and lexically normal, `root`
+/// without a trailing separator): a comparison of their text, as neither holds "..".
+void check_in_root(const PreparedJob& pj, size_t n, const fs::path& root, const std::string& file) {
+  const std::string& r = root.native();
+  const bool inside =
+      r == "/" || (file.size() > r.size() + 1 && file.compare(0, r.size(), r) == 0 && file[r.size()] == '/');
+  if (!inside)
+    throw InputError(pj.job.file.string(), pj.job.shots[pj.units[n].shot].where,
+                     file + " is outside the output root " + root.string() +
+                         " (a job writes inside its own folder unless `--output-root DIR` allows another; "
+                         "the job's \"output_root\" can only narrow it)");
+}
+
+/// The output root: --output-root (else the job file's folder), narrowed by the job's own.
+fs::path output_root(const PreparedJob& pj, const BatchArgs& b) {
+  const auto folder = [](fs::path p) {
+    p = p.lexically_normal();
+    return p.has_filename() ? p : p.parent_path();
+  };
+  fs::path root = folder(b.output_root.empty() ? pj.job.file.parent_path() : fs::absolute(b.output_root));
+  if (!pj.job.output_root.empty()) {
+    const fs::path narrowed = folder(pj.job.output_root);
+    const fs::path rel = narrowed.lexically_relative(root);
+    if (rel.empty() || *rel.begin() == "..")
+      throw InputError(
+          pj.job.file.string(), "output_root",
+          narrowed.string() + " is outside " + root.string() +
+              (b.output_root.empty() ? ", the job file's folder (`--output-root DIR` allows more)"
+                                     : ", the --output-root"));
+    root = narrowed;
+  }
+  return root;
+}
+
+/// `p` with its symbolic links resolved (as far as it exists), without a trailing separator.
+fs::path resolved(const fs::path& p) {
+  std::error_code ec;
+  fs::path real = fs::weakly_canonical(p, ec);
+  if (ec) return p;
+  real = real.lexically_normal();
+  return real.has_filename() || real == real.root_path() ? real : real.parent_path();
+}
+
+/// Every file every unit writes lies in the output root, its folder too once symbolic links are
+/// resolved (checked before any folder is made).
+void check_output_root(const PreparedJob& pj, const BatchArgs& b,
+                       const std::vector<std::vector<std::string>>& crypto) {
+  const fs::path root = output_root(pj, b), real_root = resolved(root);
+  std::set<fs::path> folders;  // each folder's links resolved once (the first 4096 folders)
+  for (size_t n = 0; n < pj.units.size(); ++n)
+    unit_files(pj, n, crypto, [&](const std::string& file) {
+      check_in_root(pj, n, root, file);
+      const fs::path folder = fs::path(file).parent_path();
+      if (folders.size() < 4096 && folders.insert(folder).second)
+        check_in_root(pj, n, real_root, (resolved(folder) / "x").string());
+    });
+}
+
+/// No two units (nor two outputs of one unit) write the same file: a hash of each path,
+/// sorted, and the writers of a repeated hash looked up again, so that memory grows by 8 bytes
+/// per file.
+void check_unit_files(const PreparedJob& pj, const std::vector<std::vector<std::string>>& crypto) {
+  std::vector<uint64_t> hashes;
+  for (size_t n = 0; n < pj.units.size(); ++n)
+    unit_files(pj, n, crypto,
+               [&](const std::string& file) { hashes.push_back(std::hash<std::string>{}(file)); });
+  std::sort(hashes.begin(), hashes.end());
+  std::set<uint64_t> repeated;
+  for (size_t i = 1; i < hashes.size(); ++i)
+    if (hashes[i] == hashes[i - 1]) repeated.insert(hashes[i]);
+  if (repeated.empty()) return;
+  std::map<std::string, size_t> writer;  // only the files whose hash repeats
+  for (size_t n = 0; n < pj.units.size(); ++n)
+    unit_files(pj, n, crypto, [&](const std::string& file) {
+      if (!repeated.count(std::hash<std::string>{}(file))) return;
+      const auto [it, fresh] = writer.emplace(file, n);
+      if (fresh) return;
+      const WorkUnit u = pj.units[n], v = pj.units[it->second];
+      const auto name = [&](const WorkUnit& w, size_t i) {
+        return pj.job.shots[w.shot].where + " (unit " + std::to_string(i) +
+               (w.frame ? ", frame " + std::to_string(*w.frame) : "") +
+               (w.tiles > 1 ? ", stripe " + std::to_string(w.tile) + "/" + std::to_string(w.tiles) : "") +
+               ")";
+      };
+      throw InputError(pj.job.file.string(), pj.job.shots[u.shot].where,
+                       file + " would be written by " + name(v, it->second) + " and by " + name(u, n));
+    });
+}
+
+/// Stripes must not outnumber the rows of a frame whose height the settings give.
+void check_stripes(const PreparedJob& pj, size_t s) {
+  const RenderArgs& args = pj.shot_args[s];
+  const size_t first = pj.units.first_of_shot(s), count = pj.units.units_of_shot(s);
+  for (size_t n = first; n < first + count; ++n) {
+    const WorkUnit u = pj.units[n];
+    if (u.tiles <= 1) continue;
+    if (args.height > 0 && u.tiles > args.height)
+      throw InputError(pj.job.file.string(), pj.job.shots[s].where + ".tiles",
+                       std::to_string(u.tiles) + " stripes of a frame " + std::to_string(args.height) +
+                           " rows high: at most one stripe per row");
+    return;  // every tiled frame of the shot has the same split
+  }
+}
+
+/// Checks the first and last frame's flags and outputs as `render` would, one stripe of
+/// each tiled shot, the stripes against the rows, and every file the units write (check_unit_files).
+void check_shots(PreparedJob& pj, const BatchArgs& b) {
+  std::vector<std::vector<std::string>> crypto(pj.job.shots.size());
   for (size_t s = 0; s < pj.job.shots.size(); ++s) {
     const JobShot& shot = pj.job.shots[s];
-    pj.shot_args.push_back(shot_target_args(
-        pj.job, shot, {std::nullopt, true, 0, 1, b.quiet, b.threads, b.max_memory, b.progress}));
-    if (!check_frames) continue;
-    auto outputs = check_shot(pj.job, shot, pj.shot_args.back());
-    for (const WorkUnit& u : pj.units)  // one stripe of each tiled shot: its split of the rows
-      if (u.shot == s && u.tiles > 1) {
+    check_stripes(pj, s);
+    // The range's patterns ('#' in every output), then its first and last frame in full.
+    in_shot(pj.job, shot, [&] { return check_frame_patterns(pj.shot_args.back()); });
+    const size_t first = pj.units.first_of_shot(s), last = first + pj.units.units_of_shot(s) - 1;
+    for (const size_t n : {first, last}) {
+      const WorkUnit u = pj.units[n];
+      const RenderArgs args = shot_target_args(
+          pj.job, shot, {u.frame, false, 0, 1, b.quiet, b.threads, b.max_memory, b.progress});
+      check_shot(pj.job, shot, args);
+      crypto[s] = in_shot(pj.job, shot, [&] { return check_render_args(args).crypto; });
+    }
+    for (size_t n = first; n <= last; ++n)  // one stripe of each tiled shot: its split of the rows
+      if (const WorkUnit u = pj.units[n]; u.tiles > 1) {
         check_shot(
             pj.job, shot,
             shot_target_args(pj.job, shot,
                              {u.frame, false, 0, u.tiles, b.quiet, b.threads, b.max_memory, b.progress}));
         break;
       }
-    for (const auto& [option, file] : outputs) {
-      const auto [it, fresh] = writer.emplace(fs::absolute(file).lexically_normal().string(), shot.where);
-      if (!fresh && it->second != shot.where)
-        throw InputError(pj.job.file.string(), shot.where,
-                         file.string() + " is also written by " + it->second);
-    }
   }
+  check_unit_files(pj, crypto);
 }
 
 }  // namespace
 
-PreparedJob prepare_job(const BatchArgs& b, bool create_folders, bool check_frames) {
+PreparedJob prepare_job(const BatchArgs& b, bool create_folders) {
   PreparedJob pj;
   pj.job = read_job_file(b.job_file);
-  pj.units = job_units(pj.job, b.tiles);
+  pj.units = JobUnits(pj.job, b.tiles);
   pj.threads = b.threads;
   pj.max_memory = b.max_memory;
+  for (const JobShot& shot : pj.job.shots)  // every shot's settings as `render`'s flags
+    pj.shot_args.push_back(shot_target_args(
+        pj.job, shot, {std::nullopt, true, 0, 1, b.quiet, b.threads, b.max_memory, b.progress}));
+  // Nothing is made outside the output root (Cryptomatte sidecars lie beside their EXR).
+  check_output_root(pj, b, std::vector<std::vector<std::string>>(pj.job.shots.size()));
   if (create_folders) pj.made_folders = create_output_folders(pj);
   try {
-    check_shots(pj, b, check_frames);
+    check_shots(pj, b);
   } catch (...) {
     remove_made_folders(pj);  // a refused job leaves nothing behind
     throw;
@@ -353,7 +490,7 @@ void remove_made_folders(PreparedJob& pj) {
 }
 
 RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
-  const WorkUnit& u = pj.units.at(n);
+  const WorkUnit u = pj.units.at(n);
   const JobShot& shot = pj.job.shots[u.shot];
   return shot_target_args(pj.job, shot,
                           {u.frame, false, u.tile, u.tiles, pj.shot_args[u.shot].quiet, pj.threads,
@@ -361,14 +498,13 @@ RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
 }
 
 bool unit_complete(const PreparedJob& pj, size_t n) {
-  const WorkUnit& u = pj.units.at(n);
+  const WorkUnit u = pj.units.at(n);
   const fs::path final_exr = unit_output(pj.job, u);
   return complete(final_exr) || (u.tiles > 1 && complete(tile_part_path(final_exr, u.tile, u.tiles)));
 }
 
 int run_batch(const BatchArgs& b) {
-  // A farm task checks its own unit (as `render` does) rather than every frame of the job.
-  PreparedJob pj = prepare_job(b, true, !b.unit);
+  PreparedJob pj = prepare_job(b, true);
   if (b.list) {
     remove_made_folders(pj);  // listing writes nothing
     return list_units(pj);

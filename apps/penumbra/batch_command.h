@@ -26,26 +26,28 @@ struct BatchArgs {
   std::string progress = "auto";  ///< `render --progress` for every render (auto, text, json, none)
   int threads = 0;                ///< `render --threads` for shots whose settings give none; 0 = none
   std::string max_memory;         ///< `render --max-memory` for shots whose settings give none
+  std::string output_root;        ///< the folder every output must be in; empty: the job file's
 };
 
 /// A checked job: the file, its units, and each shot's `render` flags for a whole range.
 struct PreparedJob {
   Job job;
-  std::vector<WorkUnit> units;
+  JobUnits units;
   std::vector<RenderArgs> shot_args;  ///< per shot: every frame, whole, into its outputs
   int threads = 0;                    ///< BatchArgs' defaults
   std::string max_memory;
   std::vector<std::filesystem::path> made_folders;  ///< output folders prepare_job created, parents first
 };
 
-/// Reads the job, maps every shot's settings onto `render`'s flags and checks them as `render`
-/// would (every frame's outputs, a tiled frame's stripes), and that no two shots write one
-/// file. `args` gives the job file, the default stripes, the default threads and memory and
-/// quiet. With `create_folders` the folders the outputs go into are made first (a farm's output
-/// tree need not exist). Without `check_frames` only the settings are mapped and parsed, not every
-/// frame's outputs (a farm task checks its own unit when it renders). Throws InputError naming
-/// the job file, the shot and the key.
-PreparedJob prepare_job(const BatchArgs& args, bool create_folders, bool check_frames);
+/// Reads the job, maps every shot's settings onto `render`'s flags and checks them as `render` would (a
+/// shot's first and last frame in full, a tiled frame's stripes, no more stripes than the rows where the
+/// settings give the height), that every file the units write lies in the output root
+/// (BatchArgs::output_root, or the job file's folder; the job's "output_root" narrows it) and that no two
+/// units write one file (frames, stripes, display images, statistics, resume states, Cryptomatte sidecars).
+/// With `create_folders` the folders the outputs go into are made (after the root check: a farm's output tree
+/// need not exist). Throws InputError naming the job file, the shot and the key; a refused job leaves no
+/// folder behind.
+PreparedJob prepare_job(const BatchArgs& args, bool create_folders);
 
 /// Removes the folders prepare_job created while they are still empty (after a check that
 /// writes nothing: --list, --dry-run).

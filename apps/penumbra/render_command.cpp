@@ -400,21 +400,27 @@ FramePlan plan_frame(const RenderArgs& a, int64_t number) {
   return p;
 }
 
+/// A frame range's outputs must each hold a `#` so that no two frames write one file; without
+/// a range, a `#` needs --frame.
+void check_patterns(const RenderArgs& a) {
+  for (const auto& [option, member] : patterned_outputs()) {
+    if (!a.frames && has_frame_pattern(a.*member) && !a.frame)
+      throw UsageError(std::string("'#' in ") + option + " needs --frame or --frames");
+    if (a.frames && !(a.*member).empty() && !has_frame_pattern(a.*member))
+      throw UsageError(std::string("--frames needs a run of '#' in ") + option +
+                       " (e.g. out.####.exr): " + "otherwise every frame writes " + a.*member);
+  }
+}
+
 /// The frames to render: one without --frames (`#` then needs --frame), else every frame of
 /// the range, whose outputs must each hold a `#` so that no two frames write one file.
 std::vector<FramePlan> plan_frames(const RenderArgs& a) {
+  check_patterns(a);
   if (!a.frames) {
-    for (const auto& [option, member] : patterned_outputs())
-      if (has_frame_pattern(a.*member) && !a.frame)
-        throw UsageError(std::string("'#' in ") + option + " needs --frame or --frames");
     if (!a.frame) return {{std::nullopt, a}};
     return {plan_frame(a, parse_integer(*a.frame, -kMaxFrameNumber, kMaxFrameNumber, "--frame"))};
   }
   const FrameRange range = parse_frame_range(*a.frames);
-  for (const auto& [option, member] : patterned_outputs())
-    if (!(a.*member).empty() && !has_frame_pattern(a.*member))
-      throw UsageError(std::string("--frames needs a run of '#' in ") + option +
-                       " (e.g. out.####.exr): " + "otherwise every frame writes " + a.*member);
   std::vector<FramePlan> plan;
   plan.reserve(size_t(range.count()));
   for (int64_t f = range.first; f <= range.last; f += range.step) plan.push_back(plan_frame(a, f));
@@ -567,6 +573,13 @@ std::vector<std::pair<std::string, fs::path>> check_render(const RenderArgs& typ
   check_contact_sheet(a, requests);
   if (!a.contact_sheet.empty()) outputs.push_back({"--contact-sheet", a.contact_sheet});
   return outputs;
+}
+
+int check_frame_patterns(const RenderArgs& typed) {
+  const RenderArgs a = with_turntable_frames(typed);
+  check_patterns(a);
+  if (a.frames) parse_frame_range(*a.frames);
+  return 0;
 }
 
 }  // namespace penumbra::cli

@@ -21,4 +21,9 @@ int run_render(const RenderArgs& args);
 /// Throws UsageError / InputError as run_render does.
 std::vector<std::pair<std::string, std::filesystem::path>> check_render(const RenderArgs& args);
 
+/// The frame patterns of `args` without planning its frames: a --frames range (or a
+/// turntable's) needs a run of '#' in every output path; a '#' without a range needs --frame.
+/// Throws UsageError. Returns 0.
+int check_frame_patterns(const RenderArgs& args);
+
 }  // namespace penumbra::cli

@@ -19,6 +19,7 @@
 #include "io/atomic_file.h"
 #include "io/error.h"
 #include "io/exr_merge.h"
+#include "io/job_file.h"
 
 namespace penumbra::cli {
 
@@ -29,8 +30,20 @@ namespace {
 /// Memory a task asks for beyond the render's budget: the program, its libraries and thread stacks.
 constexpr uint64_t kTaskOverheadMiB = 512;
 
-/// `s` in single quotes for sh.
+/// Throws UsageError when `text`, which goes into a generated script (`what` names it), holds a
+/// control character: a newline would end a comment or a directive line and start a command
+/// or an `#SBATCH` line of its own. Every other byte (quotes, `$`, backquotes, non-UTF-8) is
+/// safe in a comment and inside single quotes. Returns `text`.
+const std::string& script_text(const std::string& text, const char* what) {
+  if (const auto bad = control_character(text))
+    throw UsageError(std::string(what) + " '" + printable(text) + "' contains the control character 0x" +
+                     *bad + ": it cannot go into a generated script");
+  return text;
+}
+
+/// `s` in single quotes for sh (after script_text()).
 std::string quoted(const std::string& s) {
+  script_text(s, "a script argument");
   std::string q = "'";
   for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
@@ -83,6 +96,8 @@ std::string batch_options(const SubmitArgs& a) {
   if (a.tiles > 1) o += " --tiles " + std::to_string(a.tiles);
   if (a.threads > 0) o += " --threads " + std::to_string(a.threads);
   if (!a.max_memory.empty()) o += " --max-memory " + quoted(a.max_memory);
+  if (!a.output_root.empty())
+    o += " --output-root " + quoted(fs::absolute(a.output_root).lexically_normal().string());
   return o;
 }
 
@@ -130,7 +145,7 @@ std::string render_script(const PreparedJob& pj, const SubmitArgs& a, const Reso
                           const std::vector<size_t>& pending, const std::string& exe) {
   std::string s = sbatch_header(r, r.cpus, a);
   s += "#SBATCH --array=" + array_spec(pending) + "\n";
-  s += "# One work unit of " + pj.job.file.string() +
+  s += "# One work unit of " + script_text(pj.job.file.string(), "the job file") +
        " per array task (`penumbra batch --list` prints them).\n";
   s += "# A failed unit is run again up to " + std::to_string(a.retries) +
        " times; bad input (exit 2) and a cancel or interrupt (130, 143: Slurm requeues what it preempts) are "
@@ -153,7 +168,8 @@ std::string merge_script(const PreparedJob& pj, const SubmitArgs& a, const Resou
                          const std::string& exe) {
   std::string s = sbatch_header(r, 1, a);
   s += "#SBATCH --kill-on-invalid-dep=yes\n";  // a failed array leaves no merge job waiting forever
-  s += "# Assembles every tiled frame of " + pj.job.file.string() + " from its stripes.\n";
+  s += "# Assembles every tiled frame of " + script_text(pj.job.file.string(), "the job file") +
+       " from its stripes.\n";
   s += "exec " + quoted(exe) + " batch " + quoted(pj.job.file.string()) + " --merge --skip-existing" +
        batch_options(a) + "\n";
   return s;
@@ -231,8 +247,9 @@ int run_submit_slurm(const SubmitArgs& a) {
   b.tiles = a.tiles;
   b.threads = a.threads;
   b.max_memory = a.max_memory;
+  b.output_root = a.output_root;
   b.quiet = true;
-  PreparedJob pj = prepare_job(b, true, true);  // the checks need the output folders
+  PreparedJob pj = prepare_job(b, true);  // the checks need the output folders
   Resources r;
   try {
     r = task_resources(pj);
@@ -244,9 +261,9 @@ int run_submit_slurm(const SubmitArgs& a) {
   bool merge_needed = false;
   for (size_t n = 0; n < pj.units.size(); ++n) {
     if (!unit_complete(pj, n)) pending.push_back(n);
-    if (pj.units[n].tiles > 1) {
+    if (const WorkUnit u = pj.units[n]; u.tiles > 1 && u.tile == 0 && !merge_needed) {
       std::string problem;
-      merge_needed = merge_needed || !is_complete_exr(unit_output(pj.job, pj.units[n]), problem);
+      merge_needed = !is_complete_exr(unit_output(pj.job, u), problem);
     }
   }
   if (pending.empty() && !merge_needed) {
@@ -256,7 +273,8 @@ int run_submit_slurm(const SubmitArgs& a) {
   }
   const fs::path dir =
       a.scripts.empty() ? fs::path(pj.job.file).replace_extension(".slurm") : fs::absolute(a.scripts);
-  const std::string exe = fs::read_symlink("/proc/self/exe").string();
+  script_text(dir.string(), "--scripts");
+  const std::string exe = script_text(fs::read_symlink("/proc/self/exe").string(), "the penumbra executable");
   const std::string render = pending.empty() ? "" : render_script(pj, a, r, pending, exe);
   const std::string merge = merge_needed ? merge_script(pj, a, r, exe) : "";
   const std::string render_name = job_name(pj.job.file, "render"),

@@ -163,7 +163,7 @@ refused "$at\.settings\.float: is an on/off flag" "{$shot, \"settings\": {\"floa
 refused "$at\.settings\.spp: takes a value, not true or false" "{$shot, \"settings\": {\"spp\": true}}"
 refused "$at\.settings.*--spp: .*0" "{$shot, \"settings\": {\"spp\": 0}}"
 refused "$at\.settings.*--integrator: foo" "{$shot, \"settings\": {\"integrator\": \"foo\"}}"
-refused "shots\[1\] \(sh2\): .*out/a.exr is also written by $at" "{$shot}" \
+refused "shots\[1\] \(sh2\): .*out/a.exr would be written by $at" "{$shot}" \
   '{"name": "sh2", "scene": "scene.gltf", "output": "out/a.exr"}'
 refused "$at: .*needs a run of '#' in -o" '{"name": "sh1", "scene": "scene.gltf", "output": "out/a.exr", "frames": "1-3"}'
 refused "$at\.scene: .*missing\.gltf: file not found" '{"name": "sh1", "scene": "missing.gltf", "output": "out/a.exr"}'

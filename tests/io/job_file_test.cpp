@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 #include <fstream>
+#include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -349,4 +351,69 @@ TEST_CASE("read_job_file refuses a missing scene, naming the job file, the shot 
     CHECK_THAT(message, Contains((d.dir / scene).string()));
     CHECK_THAT(message, Contains((d.dir / "job.json").string()));  // which job file, on a farm
   }
+}
+
+TEST_CASE("JobUnits computes every unit job_units lists, tile_frames with any steps included", "[io][job]") {
+  // Shots with frame ranges and tiled ranges of co-prime, shared and unrelated steps and
+  // offsets (negative frames too), against the listed units one by one.
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    Job job;
+    job.file = "/tmp/units.json";
+    const int shots = 1 + int(rng() % 4);
+    for (int s = 0; s < shots; ++s) {
+      JobShot shot;
+      shot.name = "s" + std::to_string(s);
+      shot.where = "shots[" + std::to_string(s) + "]";
+      shot.output = "/tmp/s" + std::to_string(s) + ".####.exr";
+      if (rng() % 5 != 0) {
+        const int64_t first = int64_t(rng() % 41) - 20, step = 1 + int64_t(rng() % 6);
+        shot.frames = FrameRange{first, first + int64_t(rng() % 60) * step + int64_t(rng() % step), step};
+        if (rng() % 2) {
+          const int64_t tf = int64_t(rng() % 61) - 30, ts = 1 + int64_t(rng() % 9);
+          shot.tile_frames = FrameRange{tf, tf + int64_t(rng() % 50), ts};
+        }
+      }
+      shot.tiles = int(rng() % 4);  // 0: the default
+      job.shots.push_back(shot);
+    }
+    const int default_tiles = 1 + int(rng() % 3);
+    const std::vector<WorkUnit> listed = job_units(job, default_tiles);
+    const JobUnits lazy(job, default_tiles);
+    REQUIRE(lazy.size() == listed.size());
+    for (size_t n = 0; n < listed.size(); ++n) {
+      const WorkUnit u = lazy[n];
+      INFO("trial " << trial << ", unit " << n);
+      REQUIRE(u.shot == listed[n].shot);
+      REQUIRE(u.frame == listed[n].frame);
+      REQUIRE(u.tile == listed[n].tile);
+      REQUIRE(u.tiles == listed[n].tiles);
+    }
+    CHECK_THROWS_AS(lazy.at(listed.size()), std::out_of_range);
+  }
+}
+
+TEST_CASE("JobUnits of a job at the unit limit answers any unit without listing them", "[io][job]") {
+  Job job;
+  job.file = "/tmp/big.json";
+  JobShot shot;
+  shot.name = "big";
+  shot.where = "shots[0] (big)";
+  shot.output = "/tmp/big.#######.exr";
+  shot.frames = FrameRange{1, 500000, 1};
+  shot.tile_frames = FrameRange{2, 1000000, 2};  // every even frame in 3 stripes
+  shot.tiles = 3;
+  job.shots.push_back(shot);
+  const JobUnits units(job, 1);
+  // 250000 untiled frames + 250000 tiled frames x 3 stripes.
+  REQUIRE(units.size() == 1000000);
+  const WorkUnit last = units[units.size() - 1];
+  CHECK(*last.frame == 500000);
+  CHECK((last.tile == 2 && last.tiles == 3));
+  const WorkUnit u = units[4];  // frame 1 (0), frame 2 (1, 2, 3), frame 3 (4)
+  CHECK(*u.frame == 3);
+  CHECK(u.tiles == 1);
+  shot.frames = FrameRange{1, 500001, 1};
+  job.shots[0] = shot;
+  CHECK_THROWS_WITH(JobUnits(job, 1), Contains("more than " + std::to_string(kMaxJobUnits)));
 }
