@@ -59,7 +59,8 @@ case "$mode" in
         echo "HEADER DIFFERS: $name"; diff <(header "$fa") <(header "$fb") | head -6 || true; fails=$((fails + 1)); continue
       fi
       sel=()
-      if oiiotool --info -v "$fa" | grep -q 'cost_ns'; then  # single-part files only carry cost
+      # grep reads all of oiiotool's output: with -q it stops early, and pipefail would fail the test.
+      if oiiotool --info -v "$fa" | grep 'cost_ns' >/dev/null; then  # single-part files only carry cost
         chans=$(oiiotool --info -v "$fa" | sed -n 's/^ *channel list: //p' | head -1 | tr -d ' ' | sed 's/([a-z0-9]*)//g' | tr ',' '\n' | grep -v '^cost_ns\.X$' | paste -sd,)
         sel=(--ch "$chans")
       fi
