@@ -18,9 +18,9 @@ if [[ "$target" =~ ^[0-9]+$ ]]; then
 fi
 seconds="${2:-300}"
 case "$target" in
-  gltf_loader | checkpoint | exr_merge) targets=("$target") ;;
-  all) targets=(gltf_loader checkpoint exr_merge) ;;
-  *) echo "usage: scripts/fuzz.sh [gltf_loader|checkpoint|exr_merge|all] [SECONDS]" >&2; exit 2 ;;
+  gltf_loader | checkpoint | exr_merge | job_file) targets=("$target") ;;
+  all) targets=(gltf_loader checkpoint exr_merge job_file) ;;
+  *) echo "usage: scripts/fuzz.sh [gltf_loader|checkpoint|exr_merge|job_file|all] [SECONDS]" >&2; exit 2 ;;
 esac
 bash scripts/install-deps.sh
 if ! command -v clang++ >/dev/null; then
@@ -42,6 +42,13 @@ for t in "${targets[@]}"; do
       seeds+=(scenes)
       max_len=65536
       extra=()
+      ;;
+    job_file)
+      rm -rf "build-fuzz/seeds/$t"
+      PENUMBRA_FUZZ_WRITE_SEEDS="build-fuzz/seeds/$t" "$bin"
+      seeds+=("build-fuzz/seeds/$t")
+      max_len=16384
+      extra=(-malloc_limit_mb=512)
       ;;
     checkpoint | exr_merge)
       rm -rf "build-fuzz/seeds/$t"
