@@ -30,20 +30,26 @@ case "$mode" in
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
     # The same suite again under AddressSanitizer + UndefinedBehaviorSanitizer (build type
-    # Sanitize), including every hostile corpus file through the CLI. Left out here, as they
-    # run in the Release suite above: the accelerator cross-check over all corpus models (11
-    # minutes instrumented), the two Slurm tests (4 minutes instrumented: they drive slurmctld,
-    # slurmd and munge around the same commands the other CLI tests run), the Blender compositor
-    # check (Blender's time; Penumbra's side of it runs in cli.cryptomatte), the install and
-    # package tests (a consumer project and a .deb: packaging, not code paths) and the Python
-    # tests (an instrumented module cannot load into Debian's uninstrumented python3).
+    # Sanitize): the unit tests, every hostile corpus file and hostile job file through the CLI,
+    # and the command-line scripts. Each slow check runs once, in the stage where it tells the
+    # most: these run in the Release suite above only, and their targets are not built here:
+    # - the accelerator cross-check over all corpus models (11 minutes instrumented) and the one
+    #   of huge and tiny coordinates;
+    # - the end-to-end, frame-range, extension and ray-limit scripts (hundreds of renders of the
+    #   shipped scenes through paths the unit tests and the other scripts also take here);
+    # - the two Slurm tests (they drive slurmctld, slurmd and munge around the same commands the
+    #   other CLI tests run), the Blender compositor check (Penumbra's side of it runs in
+    #   cli.cryptomatte), the install and package tests (packaging, not code paths);
+    # - the Python tests (an instrumented module cannot load into Debian's uninstrumented
+    #   python3), the benchmark's smoke runs and tests (measurement code), and the format and
+    #   OCIO-config checks (the same in any build).
     # SANITIZE=0 skips this stage.
     if [ "${SANITIZE:-1}" != 0 ]; then
       SAN_DIR="${SAN_BUILD_DIR:-build-sanitize}"
-      cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize
-      cmake --build "$SAN_DIR" -j "$JOBS"
+      cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
+      cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests
       ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cli.slurm_farm|cli.slurm_cluster|cli.compositor|install\.|python\."
+        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|install\.|python\.|bench\.|bench_tests_NOT_BUILT|format\.|ocio\."
     fi
     ;;
 esac
