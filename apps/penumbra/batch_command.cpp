@@ -6,6 +6,8 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/exr_layers.h"
@@ -217,6 +219,12 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   const fs::path png =
       shot.png.empty() ? fs::path() : fs::path(substitute_frame(shot.png, u.frame.value_or(0)));
   const RenderRequest q = check_render_args(pj.shot_args[u.shot]);
+  // The merged frame's files as a whole-frame render of it would write them: none may be an
+  // input (the scene, --env, the OCIO config) or the same file as another of them.
+  check_shot(pj.job, shot,
+             shot_target_args(
+                 pj.job, shot,
+                 {u.frame, false, 0, 1, true, pj.threads, pj.max_memory, pj.shot_args[u.shot].progress}));
   std::error_code ec;
   if (b.skip_existing && complete(final_exr)) {
     if (!png.empty() && !fs::exists(png, ec))  // the merge ended before its display image
@@ -303,9 +311,10 @@ std::vector<fs::path> create_output_folders(const PreparedJob& pj) {
   return made;
 }
 
-/// The files unit `n` writes, each with what writes it: a frame's EXR (or a stripe) and its
-/// resume state and Cryptomatte sidecars; a whole frame's (or, for the first stripe, the merged
-/// frame's) display image, statistics and cost image. `crypto` are the shot's Cryptomatte layers.
+/// The files unit `n` writes: a frame's EXR (or a stripe) and its resume state and Cryptomatte
+/// sidecars; a whole frame's display image and statistics, or for the first stripe the merged
+/// frame, its display image and sidecars (the merge's). `crypto` are the shots' Cryptomatte
+/// layers. (The cost image is not among them: the cost layer is refused in jobs.)
 template <typename F>
 void unit_files(const PreparedJob& pj, size_t n, const std::vector<std::vector<std::string>>& crypto, F&& f) {
   const WorkUnit u = pj.units[n];
@@ -322,75 +331,126 @@ void unit_files(const PreparedJob& pj, size_t n, const std::vector<std::vector<s
   if (u.tiles > 1) f(out);
   if (!shot.png.empty()) f(at(shot.png));
   if (!shot.stats_json.empty() && u.tiles == 1) f(at(shot.stats_json));
-  if (const std::string& cost = pj.shot_args[u.shot].cost_png; !cost.empty() && u.tiles == 1) f(at(cost));
+  if (u.tiles > 1)
+    for (const std::string& layer : crypto[u.shot]) f(crypto_sidecar_path(out, layer).string());
 }
 
-/// Throws InputError unless `file` lies in `root` (both absolute and lexically normal, `root`
-/// without a trailing separator): a comparison of their text, as neither holds "..".
-void check_in_root(const PreparedJob& pj, size_t n, const fs::path& root, const std::string& file) {
-  const std::string& r = root.native();
+/// Throws InputError unless `real` (absolute, lexically normal, links resolved) lies in
+/// `real_root` (likewise, without a trailing separator); `file` is how the job names it.
+void check_in_root(const PreparedJob& pj, size_t n, const fs::path& root, const std::string& real_root,
+                   const std::string& file, const std::string& real) {
+  const std::string& r = real_root;
   const bool inside =
-      r == "/" || (file.size() > r.size() + 1 && file.compare(0, r.size(), r) == 0 && file[r.size()] == '/');
+      r == "/" || (real.size() > r.size() + 1 && real.compare(0, r.size(), r) == 0 && real[r.size()] == '/');
   if (!inside)
     throw InputError(pj.job.file.string(), pj.job.shots[pj.units[n].shot].where,
-                     file + " is outside the output root " + root.string() +
+                     file + (real == file ? "" : " (" + real + ")") + " is outside the output root " +
+                         root.string() +
                          " (a job writes inside its own folder unless `--output-root DIR` allows another; "
                          "the job's \"output_root\" can only narrow it)");
 }
 
-/// The output root: --output-root (else the job file's folder), narrowed by the job's own.
-fs::path output_root(const PreparedJob& pj, const BatchArgs& b) {
-  const auto folder = [](fs::path p) {
-    p = p.lexically_normal();
-    return p.has_filename() ? p : p.parent_path();
+/// `p` lexically normal without a trailing separator.
+fs::path folder_path(fs::path p) {
+  p = p.lexically_normal();
+  return p.has_filename() || p == p.root_path() ? p : p.parent_path();
+}
+
+/// `p` with its symbolic links resolved as far as it exists (folder_path form); throws
+/// InputError naming the job file when they cannot be (a folder that cannot be read).
+fs::path resolved(const PreparedJob& pj, const fs::path& p) {
+  std::error_code ec;
+  const fs::path real = fs::weakly_canonical(p, ec);
+  if (ec) throw InputError(pj.job.file.string(), "", "cannot resolve " + p.string() + ": " + ec.message());
+  return folder_path(real);
+}
+
+/// `file`, a symbolic link, followed to what a write through it replaces (its target, through
+/// chains of links, dangling ones included), its folders resolved.
+fs::path resolved_link(const PreparedJob& pj, const fs::path& file) {
+  fs::path target = file;
+  for (int hops = 0; hops < 40; ++hops) {
+    std::error_code ec;
+    if (!fs::is_symlink(target, ec)) return resolved(pj, target);
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec)
+      throw InputError(pj.job.file.string(), "",
+                       "cannot read the link " + target.string() + ": " + ec.message());
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  throw InputError(pj.job.file.string(), "", file.string() + ": too many levels of symbolic links");
+}
+
+/// Where files would really be written: each folder's links resolved once, and a file that is
+/// itself a symbolic link (writes follow it) resolved to its target.
+class RealPaths {
+ public:
+  explicit RealPaths(const PreparedJob& pj) : m_pj(pj) {}
+  std::string operator()(const std::string& file) {
+    const fs::path p(file);
+    const std::string dir = p.parent_path().native();
+    auto it = m_folders.find(dir);
+    if (it == m_folders.end()) it = m_folders.emplace(dir, scan(p.parent_path())).first;
+    const std::string name = p.filename().native();
+    if (it->second.links.count(name)) return resolved_link(m_pj, p).native();
+    return it->second.real == "/" ? "/" + name : it->second.real + "/" + name;
+  }
+
+ private:
+  struct Folder {
+    std::string real;                       ///< the folder, links resolved
+    std::unordered_set<std::string> links;  ///< its entries that are symbolic links
   };
-  fs::path root = folder(b.output_root.empty() ? pj.job.file.parent_path() : fs::absolute(b.output_root));
+  Folder scan(const fs::path& dir) const {
+    Folder f{resolved(m_pj, dir).native(), {}};
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      if (std::error_code lec; it->is_symlink(lec)) f.links.insert(it->path().filename().native());
+    return f;
+  }
+  const PreparedJob& m_pj;
+  std::unordered_map<std::string, Folder> m_folders;
+};
+
+/// Every file every unit writes lies in the output root once links are resolved (in its
+/// folders and in the file itself): the root is --output-root or the job file's folder, the
+/// job's "output_root" may only narrow it. Checked before any folder is made.
+void check_output_root(const PreparedJob& pj, const BatchArgs& b,
+                       const std::vector<std::vector<std::string>>& crypto) {
+  fs::path root =
+      folder_path(b.output_root.empty() ? pj.job.file.parent_path() : fs::absolute(b.output_root));
+  std::string real_root = resolved(pj, root).native();
   if (!pj.job.output_root.empty()) {
-    const fs::path narrowed = folder(pj.job.output_root);
-    const fs::path rel = narrowed.lexically_relative(root);
-    if (rel.empty() || *rel.begin() == "..")
+    const fs::path narrowed = folder_path(pj.job.output_root);
+    const std::string real = resolved(pj, narrowed).native();
+    const bool inside = real_root == "/" || real == real_root ||
+                        (real.compare(0, real_root.size(), real_root) == 0 &&
+                         real.size() > real_root.size() && real[real_root.size()] == '/');
+    if (!inside)
       throw InputError(
           pj.job.file.string(), "output_root",
-          narrowed.string() + " is outside " + root.string() +
+          narrowed.string() + (real == narrowed.native() ? "" : " (" + real + ")") + " is outside " +
+              root.string() +
               (b.output_root.empty() ? ", the job file's folder (`--output-root DIR` allows more)"
                                      : ", the --output-root"));
     root = narrowed;
+    real_root = real;
   }
-  return root;
-}
-
-/// `p` with its symbolic links resolved (as far as it exists), without a trailing separator.
-fs::path resolved(const fs::path& p) {
-  std::error_code ec;
-  fs::path real = fs::weakly_canonical(p, ec);
-  if (ec) return p;
-  real = real.lexically_normal();
-  return real.has_filename() || real == real.root_path() ? real : real.parent_path();
-}
-
-/// Every file every unit writes lies in the output root, its folder too once symbolic links are
-/// resolved (checked before any folder is made).
-void check_output_root(const PreparedJob& pj, const BatchArgs& b,
-                       const std::vector<std::vector<std::string>>& crypto) {
-  const fs::path root = output_root(pj, b), real_root = resolved(root);
-  std::set<fs::path> folders;  // each folder's links resolved once (the first 4096 folders)
+  RealPaths real(pj);
   for (size_t n = 0; n < pj.units.size(); ++n)
-    unit_files(pj, n, crypto, [&](const std::string& file) {
-      check_in_root(pj, n, root, file);
-      const fs::path folder = fs::path(file).parent_path();
-      if (folders.size() < 4096 && folders.insert(folder).second)
-        check_in_root(pj, n, real_root, (resolved(folder) / "x").string());
-    });
+    unit_files(pj, n, crypto,
+               [&](const std::string& file) { check_in_root(pj, n, root, real_root, file, real(file)); });
 }
 
 /// No two units (nor two outputs of one unit) write the same file: a hash of each path,
 /// sorted, and the writers of a repeated hash looked up again, so that memory grows by 8 bytes
 /// per file.
 void check_unit_files(const PreparedJob& pj, const std::vector<std::vector<std::string>>& crypto) {
+  RealPaths real(pj);  // a link to another unit's file is that file
   std::vector<uint64_t> hashes;
   for (size_t n = 0; n < pj.units.size(); ++n)
     unit_files(pj, n, crypto,
-               [&](const std::string& file) { hashes.push_back(std::hash<std::string>{}(file)); });
+               [&](const std::string& file) { hashes.push_back(std::hash<std::string>{}(real(file))); });
   std::sort(hashes.begin(), hashes.end());
   std::set<uint64_t> repeated;
   for (size_t i = 1; i < hashes.size(); ++i)
@@ -399,8 +459,9 @@ void check_unit_files(const PreparedJob& pj, const std::vector<std::vector<std::
   std::map<std::string, size_t> writer;  // only the files whose hash repeats
   for (size_t n = 0; n < pj.units.size(); ++n)
     unit_files(pj, n, crypto, [&](const std::string& file) {
-      if (!repeated.count(std::hash<std::string>{}(file))) return;
-      const auto [it, fresh] = writer.emplace(file, n);
+      const std::string path = real(file);
+      if (!repeated.count(std::hash<std::string>{}(path))) return;
+      const auto [it, fresh] = writer.emplace(path, n);
       if (fresh) return;
       const WorkUnit u = pj.units[n], v = pj.units[it->second];
       const auto name = [&](const WorkUnit& w, size_t i) {
@@ -437,7 +498,7 @@ void check_shots(PreparedJob& pj, const BatchArgs& b) {
     const JobShot& shot = pj.job.shots[s];
     check_stripes(pj, s);
     // The range's patterns ('#' in every output), then its first and last frame in full.
-    in_shot(pj.job, shot, [&] { return check_frame_patterns(pj.shot_args.back()); });
+    in_shot(pj.job, shot, [&] { return check_frame_patterns(pj.shot_args[s]); });
     const size_t first = pj.units.first_of_shot(s), last = first + pj.units.units_of_shot(s) - 1;
     for (const size_t n : {first, last}) {
       const WorkUnit u = pj.units[n];

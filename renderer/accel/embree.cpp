@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <chrono>
 #include <cstring>
 #include <memory>
@@ -389,13 +390,14 @@ class EmbreeAccelerator final : public Accelerator {
     const TraceRay trace = traceable(ray);
     if (!trace.ok) return false;
     if (units) *units = trace.units;
+    assert(embree_safe(trace.ray));  // what Embree's traversal asserts, checked here first
     RTCRayHit rh;
     fill_ray(trace.ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m_scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    hit.t = trace.units.query_t(rh.ray.tfar);
+    hit.t = std::min(trace.units.query_t(rh.ray.tfar), ray.tfar);
     hit.u = rh.hit.u;
     hit.v = rh.hit.v;
     hit.geom_id = instance_of(rh.hit.geomID, rh.hit.instID[0]);
@@ -408,6 +410,7 @@ class EmbreeAccelerator final : public Accelerator {
     const TraceRay trace = traceable(ray);
     if (!trace.ok) return false;
     if (units) *units = trace.units;
+    assert(embree_safe(trace.ray));
     RTCRay r;
     fill_ray(trace.ray, r);
     rtcOccluded1(m_scene, &ctx, &r);
@@ -499,15 +502,20 @@ class EmbreeAccelerator final : public Accelerator {
       t1 = std::min(t1, b);
     }
     if (!(t0 <= t1)) return out;
-    // Start a little before the entry, so that a surface on the bounds is still in range.
-    const double start = std::max(std::max(double(ray.tnear), 0.0) * len, t0 - 1e-3 * (t1 - t0) - 1e-30);
+    // Start a little before the entry, so that a surface on the bounds is still in range: by a
+    // share of the path through the bounds, and by more than the rounding of the new origin.
+    const double extent = std::max(max_component(abs(m_bounds.lo)), max_component(abs(m_bounds.hi)));
+    const double margin = std::max(1e-3 * (t1 - t0), 1e-5 * extent);
+    const double start = std::max(std::max(double(ray.tnear), 0.0) * len, t0 - margin);
     Ray r;
     for (int k = 0; k < 3; ++k) {
       r.dir[k] = float(ray.dir[k] / len);
       r.org[k] = float(ray.org[k] + r.dir[k] * start);
     }
     r.tnear = float(std::max(double(ray.tnear) * len - start, 0.0));
-    r.tfar = std::isinf(ray.tfar) ? ray.tfar : float(double(ray.tfar) * len - start);
+    // Rounded down, so that no hit lies beyond the query's tfar.
+    r.tfar =
+        std::isinf(ray.tfar) ? ray.tfar : std::nextafter(float(double(ray.tfar) * len - start), -kInfinity);
     if (!embree_safe(r) || !(r.tnear <= r.tfar)) return out;
     out.ray = r;
     out.units = {start, 1 / len};

@@ -10,7 +10,7 @@ namespace penumbra {
 
 /// The farthest a camera's ray origins (each coordinate) and clip distances may lie from the
 /// origin: they stay well inside what single-precision ray kernels (Embree's among them,
-/// 1.8e19) accept.
+/// 1.8e18) accept.
 inline constexpr float kMaxCameraReach = 1e18f;
 
 /// Throws std::invalid_argument, saying what is out of range, unless every ray that

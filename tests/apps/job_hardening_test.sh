@@ -151,5 +151,32 @@ printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "link/a.exr"}]
 expect 2 "outside the output root" -- "$bin" batch "$work/jobs/link.json"
 [ -e "$work/elsewhere/a.exr" ] && fail "a job wrote through a link out of its root"
 
+# Links: a file that is itself a link out of the root, an "output_root" that is a link out of
+# it, a link among more than 4096 frame folders, and a root named through a link (accepted).
+mkdir -p "$work/jobs/out"
+ln -s "$work/elsewhere/target.exr" "$work/jobs/out/a.exr"
+printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "out/a.exr"}]}\n' >"$work/jobs/filelink.json"
+expect 2 "out/a.exr \($work/elsewhere/target.exr\) is outside the output root" -- "$bin" batch "$work/jobs/filelink.json" --list
+ln -s "$work/elsewhere" "$work/jobs/rootlink"
+printf '{"output_root": "rootlink", "shots": [{"name": "a", "scene": "scene.gltf", "output": "rootlink/a.exr"}]}\n' >"$work/jobs/rootlink.json"
+expect 2 "output_root: $work/jobs/rootlink \($work/elsewhere\) is outside $work/jobs" -- "$bin" batch "$work/jobs/rootlink.json" --list
+ln -s "$work/elsewhere" "$work/jobs/f4500"
+printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "f####/x.exr", "frames": "0-5000"}]}\n' >"$work/jobs/many.json"
+expect 2 "f4500/x.exr \($work/elsewhere/x.exr\) is outside the output root" -- "$bin" batch "$work/jobs/many.json" --list
+[ -e "$work/jobs/f0000" ] && fail "a refused job left its frame folders"
+ln -s "$work" "$work.alias"
+expect 0 "elsewhere/a.exr" -- "$bin" batch "$work/jobs/up.json" --list --output-root "$work.alias"
+rm -f "$work.alias"
+# A frame that is a link to another frame: the two units write one file.
+mkdir -p "$work/jobs/seq"
+ln -s "$work/jobs/seq/f.0001.exr" "$work/jobs/seq/f.0002.exr"
+printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "seq/f.####.exr", "frames": "1-2"}]}\n' >"$work/jobs/seq.json"
+expect 2 "seq/f.0002.exr would be written by shots\[0\] \(a\) \(unit 0, frame 1\) and by shots\[0\] \(a\) \(unit 1, frame 2\)" -- \
+  "$bin" batch "$work/jobs/seq.json" --list
+# Each shot's own frame patterns are checked (the first shot's here, not only the last one's).
+printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "p/a.exr", "frames": "1-2"},
+                   {"name": "b", "scene": "scene.gltf", "output": "p/b.####.exr", "frames": "1-2"}]}\n' >"$work/jobs/patterns.json"
+expect 2 "shots\[0\] \(a\): --frames needs a run of '#' in -o" -- "$bin" batch "$work/jobs/patterns.json" --list
+
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]
