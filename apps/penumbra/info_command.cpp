@@ -355,8 +355,7 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
   info.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
   info.add_option(
       "--accel", a.accel,
-      "acceleration structure to build and describe: embree (default), bvh, kdtree, grid, octree, "
-      "bsp, brute");
+      "acceleration structure to build and describe: " + accelerator_list() + " (embree by default)");
   info.add_option("--accel-param", a.accel_params, accel_param_help())->type_name("KEY=VALUE");
   info.add_flag("--allow-external-uris", a.allow_external,
                 "let buffer URIs reach files outside the scene's folder");

@@ -307,9 +307,10 @@ void add_scene_options(CLI::App& render, RenderArgs& args) {
                     "camera instance: index as listed by `penumbra info`, or name (default 0; none in the "
                     "file: frame the bounds); with --look-at, --orbit, --euler or --turntable it lends only "
                     "its lens");
-  render.add_option(
-      "--accel", args.accel,
-      "acceleration structure: embree (default), bvh, kdtree, grid or brute (a linear scan: tests only)");
+  render.add_option("--accel", args.accel,
+                    "acceleration structure: " + accelerator_list() +
+                        " (embree by default; brute is a linear "
+                        "scan, for tests)");
   render.add_option("--accel-param", args.accel_params, accel_param_help())->type_name("KEY=VALUE");
 }
 

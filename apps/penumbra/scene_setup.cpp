@@ -8,6 +8,7 @@
 #include "io/accel_params.h"
 #include "io/error.h"
 #include "renderer/accel/embree.h"
+#include "renderer/accel/factory.h"
 
 namespace penumbra::cli {
 
@@ -85,6 +86,14 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
   validate(config.kdtree);
   validate(config.grid);
   return config;
+}
+
+std::string accelerator_list() {
+  const std::vector<std::string> names = accelerator_names();
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return list;
 }
 
 std::string accel_param_help() {

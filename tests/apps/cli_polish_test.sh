@@ -41,6 +41,13 @@ expect 0 "^penumbra [0-9]+\.[0-9]+" -- "$bin" --version
 [ ! -s "$work/err" ] && ok || fail "--version wrote to stderr"
 expect 0 "Usage: .*render \[OPTIONS\] scene" -- "$bin" render --help
 [ ! -s "$work/err" ] && ok || fail "render --help wrote to stderr"
+# Every structure the factory builds is named by the help of each command that takes --accel.
+for cmd in render info; do
+  "$bin" $cmd --help >"$work/help.txt" 2>&1
+  for accel in embree bvh kdtree grid octree bsp brute; do
+    grep -A3 -- "--accel " "$work/help.txt" | grep -q "$accel" && ok || fail "$cmd --help does not name $accel"
+  done
+done
 expect 0 "Usage: .*info" -- "$bin" info --help
 for args in "render" "render $d" "render $d -o $work/a.exr --spp 0" "render $d -o $work/a.exr --width abc" \
             "render $d -o $work/a.exr --frame 1 --time 2" "render $d -o $work/a.exr --crop 1 2" \
