@@ -53,6 +53,11 @@ void add_mesh_options(CLI::App& mesh, MeshArgs& a) {
   mesh.add_flag("-q,--quiet", a.quiet, "no warnings or summary");
 }
 
+/// A CLI11 check refusing an empty value (which would read as the option not given).
+std::string non_empty(const std::string& value) {
+  return value.empty() ? "the value is empty" : "";
+}
+
 void add_batch_options(CLI::App& batch, BatchArgs& a) {
   batch.add_option("job", a.job_file, "job file (.json): the shots to render")->required();
   auto* list = batch.add_flag(
@@ -73,8 +78,10 @@ void add_batch_options(CLI::App& batch, BatchArgs& a) {
   batch.add_option("--threads", a.threads, "render --threads for shots whose settings give none")
       ->check(CLI::Range(1, 1024));
   batch.add_option("--max-memory", a.max_memory, "render --max-memory for shots whose settings give none");
-  batch.add_option("--output-root", a.output_root,
-                   "folder every file of the job must be written in (default: the job file's folder)");
+  batch
+      .add_option("--output-root", a.output_root,
+                  "folder every file of the job must be written in (default: the job file's folder)")
+      ->check(non_empty);
 }
 
 void add_submit_slurm_options(CLI::App& slurm, SubmitArgs& a) {
@@ -90,8 +97,10 @@ void add_submit_slurm_options(CLI::App& slurm, SubmitArgs& a) {
   slurm.add_option("--max-memory", a.max_memory, "memory budget for shots whose settings give none, e.g. 4G");
   slurm.add_option("--retries", a.retries, "runs of a failed unit after the first, per task (default 2)")
       ->check(CLI::Range(0, 100));
-  slurm.add_option("--output-root", a.output_root,
-                   "folder every file of the job must be written in (default: the job file's folder)");
+  slurm
+      .add_option("--output-root", a.output_root,
+                  "folder every file of the job must be written in (default: the job file's folder)")
+      ->check(non_empty);
   slurm.add_option("--scripts", a.scripts,
                    "folder for the scripts and logs (default: JOB.slurm beside the job)");
   slurm.add_option("--time", a.time_limit,

@@ -140,6 +140,8 @@ expect 0 "elsewhere/a.exr" -- "$bin" batch "$work/jobs/up.json" --list --output-
 expect 2 "outside the output root" -- "$bin" submit slurm "$work/jobs/up.json" --dry-run --threads 1 --max-memory 256M
 expect 0 "--output-root '$work'" -- "$bin" submit slurm "$work/jobs/up.json" --dry-run --threads 1 --max-memory 256M \
   --output-root "$work"
+expect 2 "--output-root: the value is empty" -- "$bin" batch "$work/jobs/up.json" --list --output-root ""
+expect 2 "--output-root: the value is empty" -- "$bin" submit slurm "$work/jobs/up.json" --dry-run --output-root ""
 printf '{"shots": [{"name": "a", "scene": "scene.gltf", "output": "/tmp/penumbra-abs.exr"}]}\n' >"$work/jobs/abs.json"
 expect 2 "/tmp/penumbra-abs.exr is outside the output root" -- "$bin" batch "$work/jobs/abs.json" --list
 printf '{"output_root": "renders", "shots": [{"name": "a", "scene": "scene.gltf", "output": "other/a.exr"}]}\n' >"$work/jobs/narrow.json"
