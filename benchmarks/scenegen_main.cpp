@@ -7,9 +7,9 @@
 #include <filesystem>
 
 #include "benchmarks/scenegen.h"
-#include "io/error.h"
-#include "io/gltf_writer.h"
-#include "io/ply_loader.h"
+#include "io/files/error.h"
+#include "io/gltf/gltf_writer.h"
+#include "io/mesh/ply_loader.h"
 
 using namespace penumbra;
 

@@ -1,7 +1,7 @@
 # Installation: `cmake --install build --prefix P` puts the commands in P/bin, the libraries
-# penumbra_renderer, penumbra_io and penumbra_draco in P/lib with their headers in
-# P/include/penumbra/{renderer,io}/, the CMake package Penumbra (Penumbra::renderer,
-# Penumbra::io) in P/lib/cmake/Penumbra, the shipped OCIO config in P/share/penumbra/ocio and
+# penumbra_renderer, penumbra_io, penumbra_render and penumbra_draco in P/lib with their headers
+# in P/include/penumbra/{renderer,io,render}/, the CMake package Penumbra (Penumbra::renderer,
+# Penumbra::io, Penumbra::render) in P/lib/cmake/Penumbra, the shipped OCIO config in P/share/penumbra/ocio and
 # the man pages (generated from --help by help2man) in P/share/man/man1. Packaging: Packaging.cmake.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -17,16 +17,17 @@ install(TARGETS penumbra penumbra-bench RUNTIME DESTINATION ${CMAKE_INSTALL_BIND
 # consumers no compile flags.
 set_target_properties(penumbra_renderer PROPERTIES EXPORT_NAME renderer)
 set_target_properties(penumbra_io PROPERTIES EXPORT_NAME io)
+set_target_properties(penumbra_render PROPERTIES EXPORT_NAME render)
 set_target_properties(penumbra_draco PROPERTIES EXPORT_NAME draco)
 set_target_properties(penumbra_warnings PROPERTIES EXPORT_NAME warnings)
 set_target_properties(penumbra_arch PROPERTIES EXPORT_NAME arch)
-install(TARGETS penumbra_renderer penumbra_io penumbra_draco penumbra_warnings penumbra_arch
+install(TARGETS penumbra_renderer penumbra_io penumbra_render penumbra_draco penumbra_warnings penumbra_arch
         EXPORT PenumbraTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # Headers keep their source paths: #include "renderer/core/math.h", "io/gltf/loader.h".
-foreach(_penumbra_dir renderer io)
+foreach(_penumbra_dir renderer io render)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${_penumbra_dir}/
           DESTINATION include/penumbra/${_penumbra_dir}
           FILES_MATCHING PATTERN "*.h" PATTERN "*.inl")
@@ -43,7 +44,7 @@ install(FILES ${PROJECT_BINARY_DIR}/PenumbraConfig.cmake ${PROJECT_BINARY_DIR}/P
         DESTINATION ${PENUMBRA_INSTALL_CMAKEDIR})
 
 # The shipped OpenColorIO config (the binaries also embed it; this copy is for $OCIO and other tools).
-install(FILES ${PROJECT_SOURCE_DIR}/io/ocio/config.ocio DESTINATION ${CMAKE_INSTALL_DATADIR}/penumbra/ocio)
+install(FILES ${PROJECT_SOURCE_DIR}/io/image/ocio/config.ocio DESTINATION ${CMAKE_INSTALL_DATADIR}/penumbra/ocio)
 
 # Man pages from --help, each command's subcommands' --help included as sections
 # (ManInclude.cmake writes them), rebuilt whenever the executable is.

@@ -19,9 +19,9 @@
 #include <iterator>
 #include <string>
 
-#include "io/checkpoint.h"
-#include "io/error.h"
-#include "io/hash.h"
+#include "io/farm/checkpoint.h"
+#include "io/files/error.h"
+#include "io/files/hash.h"
 #include "renderer/integrators/light_groups.h"
 
 namespace fs = std::filesystem;

@@ -18,10 +18,10 @@
 #include <iterator>
 #include <string>
 
-#include "io/error.h"
-#include "io/exr_merge.h"
-#include "io/image_output.h"
-#include "io/render_settings.h"
+#include "io/farm/render_settings.h"
+#include "io/files/error.h"
+#include "io/image/exr_merge.h"
+#include "io/image/image_output.h"
 
 namespace fs = std::filesystem;
 

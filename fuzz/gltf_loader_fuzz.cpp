@@ -10,7 +10,7 @@
 #include <fstream>
 #include <string>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 
 namespace fs = std::filesystem;

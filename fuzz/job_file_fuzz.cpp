@@ -12,8 +12,8 @@
 #include <fstream>
 #include <string>
 
-#include "io/error.h"
-#include "io/job_file.h"
+#include "io/farm/job_file.h"
+#include "io/files/error.h"
 
 namespace fs = std::filesystem;
 

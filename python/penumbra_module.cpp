@@ -7,7 +7,7 @@
 
 #include <exception>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "python/bindings.h"
 #include "renderer/accel/factory.h"
 

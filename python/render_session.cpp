@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "io/accel_params.h"
-#include "io/environment_io.h"
-#include "io/error.h"
-#include "io/id_manifest.h"
+#include "io/files/error.h"
+#include "io/gltf/id_manifest.h"
+#include "io/image/environment_io.h"
+#include "render/accel_params.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"

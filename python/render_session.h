@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "io/gltf/loader.h"
-#include "io/image_output.h"
+#include "io/image/image_output.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"

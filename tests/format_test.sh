@@ -7,7 +7,7 @@ cd "$src" || exit 1
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   mapfile -t files < <(git ls-files '*.h' '*.cpp')
 else
-  mapfile -t files < <(find apps benchmarks fuzz io renderer tests -name '*.h' -o -name '*.cpp')
+  mapfile -t files < <(find apps benchmarks fuzz io render renderer tests -name '*.h' -o -name '*.cpp')
 fi
 bad=0
 for f in "${files[@]}"; do

@@ -13,9 +13,9 @@
 #include "apps/penumbra/exr_layers.h"
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_command.h"
-#include "io/error.h"
-#include "io/exr_merge.h"
-#include "io/image_output.h"
+#include "io/files/error.h"
+#include "io/image/exr_merge.h"
+#include "io/image/image_output.h"
 
 namespace penumbra::cli {
 

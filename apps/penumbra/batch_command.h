@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "apps/penumbra/render_options.h"
-#include "io/job_file.h"
+#include "io/farm/job_file.h"
 
 namespace penumbra::cli {
 

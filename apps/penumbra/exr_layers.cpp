@@ -9,9 +9,9 @@
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/render_job.h"
-#include "io/error.h"
-#include "io/exr_merge.h"
-#include "io/id_manifest.h"
+#include "io/files/error.h"
+#include "io/gltf/id_manifest.h"
+#include "io/image/exr_merge.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "io/gltf/loader.h"
-#include "io/image_output.h"
+#include "io/image/image_output.h"
 #include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/cost_map.h"

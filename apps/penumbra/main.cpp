@@ -18,7 +18,7 @@
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
 #include "apps/penumbra/submit_command.h"
-#include "io/error.h"
+#include "io/files/error.h"
 
 using namespace penumbra;
 using namespace penumbra::cli;

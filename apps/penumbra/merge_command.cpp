@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "apps/penumbra/cli_support.h"
-#include "io/atomic_file.h"
-#include "io/exr_merge.h"
+#include "io/files/atomic_file.h"
+#include "io/image/exr_merge.h"
 
 namespace penumbra::cli {
 

@@ -8,8 +8,8 @@
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/path_render.h"
 #include "apps/penumbra/scene_setup.h"
-#include "io/atomic_file.h"
-#include "io/gltf_writer.h"
+#include "io/files/atomic_file.h"
+#include "io/gltf/gltf_writer.h"
 #include "renderer/scene/shape_mesh.h"
 
 namespace penumbra::cli {

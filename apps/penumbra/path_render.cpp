@@ -8,10 +8,10 @@
 
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_job.h"
-#include "io/atomic_file.h"
-#include "io/checkpoint.h"
-#include "io/error.h"
-#include "io/image_output.h"
+#include "io/farm/checkpoint.h"
+#include "io/files/atomic_file.h"
+#include "io/files/error.h"
+#include "io/image/image_output.h"
 
 namespace penumbra::cli {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "apps/penumbra/render_options.h"
-#include "io/render_settings.h"
+#include "io/farm/render_settings.h"
 #include "renderer/scene/camera.h"
 
 namespace penumbra::cli {

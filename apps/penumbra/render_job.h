@@ -10,8 +10,8 @@
 
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/render_options.h"
+#include "io/farm/render_settings.h"
 #include "io/gltf/loader.h"
-#include "io/render_settings.h"
 #include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"
 #include "renderer/lights/environment.h"

@@ -16,7 +16,7 @@
 #include "apps/penumbra/exr_layers.h"
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/scene_setup.h"
-#include "io/atomic_file.h"
+#include "io/files/atomic_file.h"
 
 namespace penumbra::cli {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "apps/penumbra/camera_options.h"
-#include "io/image_output.h"
+#include "io/image/image_output.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 

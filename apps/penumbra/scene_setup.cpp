@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "apps/penumbra/cli_support.h"
-#include "io/accel_params.h"
-#include "io/error.h"
+#include "io/files/error.h"
+#include "render/accel_params.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 

@@ -5,7 +5,7 @@
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/render_job.h"
-#include "io/atomic_file.h"
+#include "io/files/atomic_file.h"
 
 namespace penumbra::cli {
 

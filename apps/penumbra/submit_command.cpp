@@ -16,10 +16,10 @@
 
 #include "apps/penumbra/batch_command.h"
 #include "apps/penumbra/cli_support.h"
-#include "io/atomic_file.h"
-#include "io/error.h"
-#include "io/exr_merge.h"
-#include "io/job_file.h"
+#include "io/farm/job_file.h"
+#include "io/files/atomic_file.h"
+#include "io/files/error.h"
+#include "io/image/exr_merge.h"
 
 namespace penumbra::cli {
 

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "io/error.h"
-#include "io/file_checks.h"
+#include "io/files/error.h"
+#include "io/files/file_checks.h"
 #include "io/gltf/loader.h"
 
 namespace tinygltf {

@@ -12,9 +12,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "io/error.h"
-#include "io/file_checks.h"
-#include "io/hash.h"
+#include "io/files/error.h"
+#include "io/files/file_checks.h"
+#include "io/files/hash.h"
 
 namespace penumbra::gltf {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <initializer_list>
 
-#include "io/error.h"
+#include "io/files/error.h"
 
 namespace penumbra::gltf {
 

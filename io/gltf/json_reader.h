@@ -10,7 +10,7 @@
 #include <span>
 #include <string>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "renderer/core/math.h"
 
 namespace penumbra::gltf {

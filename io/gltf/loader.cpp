@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <new>
 
-#include "io/file_checks.h"
+#include "io/files/file_checks.h"
 #include "io/gltf/accessors.h"
 #include "io/gltf/animation.h"
 #include "io/gltf/animation_pointer.h"

@@ -8,12 +8,12 @@
 #include <new>
 #include <nlohmann/json.hpp>
 
-#include "io/file_checks.h"
+#include "io/files/file_checks.h"
+#include "io/files/hash.h"
 #include "io/gltf/file_access.h"
 #include "io/gltf/images.h"
 #include "io/gltf/json_checks.h"
 #include "io/gltf/meshes.h"
-#include "io/hash.h"
 
 namespace penumbra::gltf {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "benchmarks/scenegen.h"
-#include "io/accel_params.h"
+#include "render/accel_params.h"
 #include "renderer/integrators/scene_accel.h"
 
 using namespace penumbra;

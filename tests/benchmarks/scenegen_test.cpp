@@ -5,8 +5,8 @@
 #include <catch2/catch.hpp>
 #include <cstring>
 
+#include "io/gltf/gltf_writer.h"
 #include "io/gltf/loader.h"
-#include "io/gltf_writer.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/cross_check.h"
 #include "support/test_util.h"

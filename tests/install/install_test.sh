@@ -38,7 +38,7 @@ for f in bin/penumbra bin/penumbra-bench share/penumbra/ocio/config.ocio \
   check "$f installed" test -s "$p/$f"
 done
 check "bin/penumbra is executable" test -x "$p/bin/penumbra"
-check "the installed OCIO config is the shipped one" cmp -s "$src/io/ocio/config.ocio" "$p/share/penumbra/ocio/config.ocio"
+check "the installed OCIO config is the shipped one" cmp -s "$src/io/image/ocio/config.ocio" "$p/share/penumbra/ocio/config.ocio"
 missing=0
 while IFS= read -r h; do
   [ -f "$p/include/penumbra/$h" ] || { echo "FAIL: header include/penumbra/$h not installed"; missing=$((missing + 1)); }

@@ -6,7 +6,7 @@
 #include <exception>
 
 #include "io/gltf/loader.h"
-#include "io/image_output.h"
+#include "io/image/image_output.h"
 #include "renderer/integrators/render.h"
 #include "renderer/scene/camera.h"
 #include "renderer/scene/scene.h"

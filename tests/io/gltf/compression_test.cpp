@@ -9,7 +9,7 @@
 #include <fstream>
 #include <regex>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 #include "support/test_util.h"
 

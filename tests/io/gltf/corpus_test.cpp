@@ -5,7 +5,7 @@
 // loads with warnings, never anything else.
 #include <catch2/catch.hpp>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"

@@ -9,9 +9,9 @@
 #include <cstring>
 #include <fstream>
 
-#include "io/error.h"
+#include "io/files/error.h"
+#include "io/files/hash.h"
 #include "io/gltf/loader.h"
-#include "io/hash.h"
 #include "support/gltf_hostile.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"

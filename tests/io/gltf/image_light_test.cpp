@@ -5,7 +5,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 #include "support/gltf_writer.h"
 #include "support/image_files.h"

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 #include "support/gltf_hostile.h"
 #include "support/gltf_writer.h"

@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "support/gltf_load.h"
 #include "support/gltf_writer.h"
 #include "support/test_util.h"

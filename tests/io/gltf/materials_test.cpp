@@ -8,7 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include "io/gltf/loader.h"
-#include "io/image_output.h"
+#include "io/image/image_output.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"

@@ -6,9 +6,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "io/error.h"
+#include "io/files/error.h"
+#include "io/gltf/gltf_writer.h"
 #include "io/gltf/loader.h"
-#include "io/gltf_writer.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
 #include "support/gltf_load.h"

@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "io/error.h"
+#include "io/files/error.h"
 #include "io/gltf/loader.h"
 #include "support/gltf_writer.h"
 #include "support/scene_builder.h"

@@ -5,9 +5,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "io/error.h"
+#include "io/files/error.h"
+#include "io/gltf/gltf_writer.h"
 #include "io/gltf/loader.h"
-#include "io/gltf_writer.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"

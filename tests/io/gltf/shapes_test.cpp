@@ -9,9 +9,9 @@
 #include <limits>
 #include <random>
 
-#include "io/error.h"
+#include "io/files/error.h"
+#include "io/gltf/gltf_writer.h"
 #include "io/gltf/loader.h"
-#include "io/gltf_writer.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
