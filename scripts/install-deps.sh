@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs Penumbra's build and runtime dependencies from Debian 12's archive; with --test also
 # the tools its tests run against (Blender for the glTF-import and compositor checks, with NumPy;
-# pytest for the Python API; Slurm and munge for the throw-away single-node cluster).
+# pytest for the Python API; Slurm and munge for the throw-away single-node cluster; mkdocs and
+# Chromium to build the documentation site and look at it headless).
 # Idempotent: only packages that are missing are installed. Needs root (or sudo).
 # Usage: install-deps.sh [--test]
 set -euo pipefail
@@ -17,7 +18,7 @@ PACKAGES=(
   python3 python3-dev python3-numpy pybind11-dev help2man clang-format
 )
 case "${1:-}" in
-  --test) PACKAGES+=(blender python3-pytest slurm-wlm munge) ;;
+  --test) PACKAGES+=(blender python3-pytest slurm-wlm munge mkdocs chromium) ;;
   "") ;;
   *) echo "usage: install-deps.sh [--test]" >&2; exit 2 ;;
 esac

@@ -16,7 +16,7 @@ esac
 BUILD_DIR="${BUILD_DIR:-build}"
 JOBS="${JOBS:-$(nproc)}"
 
-# The test suite also needs Blender, pytest, Slurm and munge; a render needs none of them.
+# The test suite also needs Blender, pytest, Slurm, munge, mkdocs and Chromium; a render needs none of them.
 if [ "$mode" = test ]; then bash scripts/install-deps.sh --test; else bash scripts/install-deps.sh; fi
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build "$BUILD_DIR" -j "$JOBS"
