@@ -41,6 +41,7 @@
 #include "io/image/image_output.h"
 #include "io/mesh/ply_loader.h"
 #include "render/accel_params.h"
+#include "render/session.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 #include "renderer/core/rng.h"
@@ -253,6 +254,27 @@ double median_seconds(int repeats, Fn&& fn) {
   return median(t);
 }
 
+/// The shaded raster preview of `loaded` as `penumbra render --integrator raster` renders it,
+/// through the render session (its default key light included when the scene has no light):
+/// `shadows` "none" or "map", `cfg`'s size and threads, the bench camera; the median seconds.
+double preview_seconds(LoadedScene& loaded, const Accelerator* accel, const Camera& cam,
+                       const RenderConfig& cfg, const char* shadows, int repeats) {
+  RenderSpec spec;
+  spec.integrator = "raster";
+  spec.raster_shadows = shadows;
+  spec.width = cfg.width;
+  spec.height = cfg.height;
+  spec.spp = cfg.spp;
+  spec.threads = cfg.threads;
+  PrepareOptions o;
+  o.camera_index = -1;
+  o.place = [&](const Scene&, int, int, int) { return cam; };
+  const PreparedRender prepared = prepare_render(loaded, spec, o);
+  const double s = median_seconds(repeats, [&] { render_image(loaded.scene, accel, prepared); });
+  finish_render(loaded, prepared);
+  return s;
+}
+
 /// --raster: frames per second of primary visibility at width x height, one sample per pixel
 /// centre: the rasteriser's visibility buffer against Embree's and the BVH's camera rays (with
 /// and without their build), and the raster preview's shaded frame (no shadows, shadow maps).
@@ -264,7 +286,9 @@ int run_raster(const std::vector<std::string>& scenes, uint64_t seed, int width,
               "ms", "ms", "ms", "ms", "fps", "embree", "+build");
   for (const std::string& spec : scenes) {
     std::string name;
-    const Scene scene = load_bench_scene(spec, seed, name);
+    LoadedScene loaded;  // the render session's form of a scene, for the shaded preview
+    loaded.scene = load_bench_scene(spec, seed, name);
+    const Scene& scene = loaded.scene;
     const Camera cam = bench_camera(scene, width, height);
     for (int t : threads) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(thread_count(t)));
@@ -311,10 +335,8 @@ int run_raster(const std::vector<std::string>& scenes, uint64_t seed, int width,
         trace_s[k] = median_seconds(repeats, [&] { trace_seconds(*a, sets[0], t, hits[k]); });
         if (k == 0) embree = std::move(a);
       }
-      cfg.raster.shadows = RasterShadows::None;
-      const double preview = median_seconds(repeats, [&] { render_raster(scene, embree.get(), cam, cfg); });
-      cfg.raster.shadows = RasterShadows::Map;
-      const double maps = median_seconds(repeats, [&] { render_raster(scene, embree.get(), cam, cfg); });
+      const double preview = preview_seconds(loaded, embree.get(), cam, cfg, "none", repeats);
+      const double maps = preview_seconds(loaded, embree.get(), cam, cfg, "map", repeats);
       std::printf("%-22s %9llu %3d %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.2fx %7.2fx\n",
                   name.c_str(), static_cast<unsigned long long>(count_triangles(scene)), thread_count(t),
                   vis * 1e3, preview * 1e3, maps * 1e3, trace_s[0] * 1e3, (trace_s[0] + build_s[0]) * 1e3,
@@ -814,7 +836,9 @@ int main(int argc, char** argv) {
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
   app.add_option("--seed", seed, "seed of the generated scenes (default 1)");
-  app.add_option("--accel", accels, "structures to measure, comma separated (default embree,bvh,kdtree,grid)")
+  app.add_option("--accel", accels,
+                 "structures to measure, comma separated: " + accelerator_list() +
+                     " (default embree,bvh,kdtree,grid)")
       ->delimiter(',');
   app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
   app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
@@ -873,6 +897,7 @@ int main(int argc, char** argv) {
   if (!refit_file.empty() || tradeoffs) try {
       AccelConfig config;
       for (const auto& p : params) apply_accel_param(config, p);
+      validate(config);
       if (!refit_file.empty())
         return run_refit(refit_file, refit_frames, config, width, height, threads[0], csv);
       std::string command;
@@ -910,6 +935,7 @@ int main(int argc, char** argv) {
                                     "' (known: primary, shadow, diffuse, random)");
     AccelConfig config;
     for (const auto& p : params) apply_accel_param(config, p);
+    validate(config);  // every structure's parameters, as the render session checks them
     for (const auto& a : accels) {
       const auto names = accelerator_names();
       if (std::find(names.begin(), names.end(), a) == names.end())

@@ -11,6 +11,8 @@
 #include <climits>
 #include <map>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include "python/bindings.h"
 #include "renderer/integrators/light_groups.h"
@@ -21,18 +23,17 @@ namespace {
 
 using ResultPtr = std::shared_ptr<RenderOutput>;
 
-/// The attribute names of RenderSettings, in the order its repr lists them.
+/// The attribute names of RenderSettings, in the order its repr lists them: every field of the
+/// spec's table (render/spec.h), then the settings that are not plain numbers or text.
 const std::vector<std::string>& setting_names() {
-  static const std::vector<std::string> names = {"width",          "height",        "spp",
-                                                 "integrator",     "accel",         "accel_params",
-                                                 "seed",           "threads",       "tile_size",
-                                                 "camera",         "filter",        "filter_width",
-                                                 "max_depth",      "window",        "background",
-                                                 "ambient",        "rr_depth",      "clamp_indirect",
-                                                 "light_sampling", "sampler",       "env_color",
-                                                 "env_map",        "env_intensity", "env_rotation",
-                                                 "time_limit",     "adaptive",      "adaptive_min_spp",
-                                                 "raster_shadows"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const SpecField& f : spec_fields()) n.push_back(f.name);
+    for (const char* other :
+         {"camera", "window", "accel_params", "background", "ambient", "env_color", "env_map"})
+      n.push_back(other);
+    return n;
+  }();
   return names;
 }
 
@@ -197,18 +198,7 @@ void bind_settings(py::module_& m) {
      apply_keywords(o, kw);
      return o.cast<RenderSettings>();
    }))
-      .def_readwrite("width", &RenderSettings::width,
-                     "pixels; 0: from height and the camera's aspect (960 if both 0)")
-      .def_readwrite("height", &RenderSettings::height, "pixels; 0: from width and the camera's aspect")
-      .def_readwrite("spp", &RenderSettings::spp, "samples per pixel; 0: 4 (whitted), 64 (path)")
-      .def_readwrite("integrator", &RenderSettings::integrator, "'whitted', 'path' or 'raster'")
-      .def_readwrite("raster_shadows", &RenderSettings::raster_shadows,
-                     "raster: light visibility by 'ray' (shadow rays), 'map' (shadow maps) or 'none'")
-      .def_readwrite("accel", &RenderSettings::accel, "embree, bvh, kdtree, grid, octree, bsp or brute")
       .def_readwrite("accel_params", &RenderSettings::accel_params, "['bvh.max_leaf_size=4', ...]")
-      .def_readwrite("seed", &RenderSettings::seed)
-      .def_readwrite("threads", &RenderSettings::threads, "0: every hardware thread")
-      .def_readwrite("tile_size", &RenderSettings::tile_size)
       .def_property(
           "camera",
           [](const RenderSettings& r) -> py::object {
@@ -232,10 +222,6 @@ void bind_settings(py::module_& m) {
             }
           },
           "index into Scene.cameras or a camera name; None: the first camera, else a view framing the bounds")
-      .def_readwrite("filter", &RenderSettings::filter,
-                     "box, tent, gaussian, blackman-harris; '': box (whitted), blackman-harris (path)")
-      .def_readwrite("filter_width", &RenderSettings::filter_width, "pixels; 0: the filter's default")
-      .def_readwrite("max_depth", &RenderSettings::max_depth, "-1: 5 (whitted), 12 (path)")
       .def_property(
           "window",
           [](const RenderSettings& r) -> py::object {
@@ -272,20 +258,11 @@ void bind_settings(py::module_& m) {
           "ambient", [](const RenderSettings& r) { return colour_to(r.ambient); },
           [](RenderSettings& r, const py::object& v) { r.ambient = colour_from(v, "ambient"); },
           "whitted: ambient intensity (None: 0.05)")
-      .def_readwrite("rr_depth", &RenderSettings::rr_depth, "path: Russian roulette from this bounce")
-      .def_readwrite("clamp_indirect", &RenderSettings::clamp_indirect, "path: 0 = off")
-      .def_readwrite("light_sampling", &RenderSettings::light_sampling, "path: mis, bsdf or light")
-      .def_readwrite("sampler", &RenderSettings::sampler, "path: sobol or independent")
       .def_property(
           "env_color", [](const RenderSettings& r) { return colour_to(r.env_color); },
           [](RenderSettings& r, const py::object& v) { r.env_color = colour_from(v, "env_color"); },
           "path: constant environment radiance (None: env_map, else the file's image light, else black)")
       .def_readwrite("env_map", &RenderSettings::env_map, "path: equirectangular map file")
-      .def_readwrite("env_intensity", &RenderSettings::env_intensity)
-      .def_readwrite("env_rotation", &RenderSettings::env_rotation, "degrees about +Y")
-      .def_readwrite("time_limit", &RenderSettings::time_limit, "path: seconds, 0 = none")
-      .def_readwrite("adaptive", &RenderSettings::adaptive, "path: adaptive sampling threshold, 0 = off")
-      .def_readwrite("adaptive_min_spp", &RenderSettings::adaptive_min_spp)
       .def(
           "copy",
           [](const RenderSettings& r, const py::kwargs& kw) {
@@ -303,6 +280,16 @@ void bind_settings(py::module_& m) {
         }
         return r + ")";
       });
+  // Every field of the spec's table, named as the table names it.
+  for (const SpecField& f : spec_fields())
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_cvref_t<decltype(RenderSettings{}.*member)>;
+          s.def_property(
+              f.name, [member](const RenderSettings& r) { return r.*member; },
+              [member](RenderSettings& r, T v) { r.*member = v; }, f.help.c_str());
+        },
+        f.member);
 }
 
 void bind_result(py::module_& m) {

@@ -16,6 +16,8 @@
 
 #include "io/gltf/loader.h"
 #include "io/image/image_output.h"
+#include "render/session.h"
+#include "render/spec.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"
@@ -26,69 +28,27 @@ namespace penumbra::python {
 /// without --max-memory.
 uint64_t default_memory_budget();
 
-/// A loaded glTF scene as a Python Scene holds it. Every access holds `mutex`: a render adds the
-/// default key light to scene.lights for its duration, pose() moves instances, cameras and
-/// lights, and the kept accelerator is built and replaced under it.
-struct SceneSession {
-  std::string file;  ///< as given to load (the name InputError messages carry)
-  LoadedScene loaded;
-  bool loaded_at_time = false;  ///< GltfLoadOptions::time was set
-  std::mutex mutex;
-  std::unique_ptr<Accelerator> accel;     ///< the last render's structure, or null
-  std::string accel_key;                  ///< the name and parameters `accel` was built with
-  std::optional<AreaLights> area_lights;  ///< the emissive triangles, once a path render needed them
-};
+/// A loaded glTF scene as a Python Scene holds it: the render session's (render/session.h).
+/// Every access holds `mutex`: a render adds the default key light to scene.lights for its
+/// duration, pose() moves instances, cameras and lights, and the kept structure is built and
+/// replaced under it.
+using SceneSession = Session;
 
 /// load_gltf(file, options) into a new session. Throws what load_gltf throws.
 std::shared_ptr<SceneSession> load_session(const std::string& file, const GltfLoadOptions& options);
 
 /// pose_gltf_scene at `time` seconds (call with the session locked). False, with the scene
 /// unchanged, when the scene was not loaded with a time and keep_animation or its animation
-/// changes more than placements. Keeps the accelerator when only cameras and lights move,
+/// changes more than placements. Keeps the structure when only cameras and lights move,
 /// moves its instances where the back end can, and drops it otherwise.
 bool pose_session(SceneSession& session, double time);
 
-/// The settings of one render, named as the Python API names them, with `penumbra render`'s
-/// defaults. Checked by check_settings.
-struct RenderSettings {
-  int width = 0,
-      height = 0;  ///< 0 and 0: 960 wide; one 0: follows the camera's aspect hint (16:9 without one)
-  int spp = 0;     ///< 0: 4 (whitted), 64 (path)
-  std::string integrator = "whitted";     ///< "whitted", "path" or "raster"
-  std::string raster_shadows = "ray";     ///< raster only: "ray", "map" or "none"
-  std::string accel = "embree";           ///< an accelerator_names() entry
-  std::vector<std::string> accel_params;  ///< "bvh.max_leaf_size=4", ... of `accel` only
-  uint64_t seed = 0;
-  int threads = 0;  ///< 0: every hardware thread
-  int tile_size = 32;
-  std::string camera;  ///< index (digits only) or name; empty: the first camera, else framing the bounds
-  std::string filter;  ///< box, tent, gaussian, blackman-harris; empty: box (whitted), blackman-harris (path)
-  float filter_width = 0;  ///< pixels; 0: the filter's default width
-  int max_depth = -1;      ///< -1: 5 mirror bounces (whitted), 12 bounces (path)
-  PixelWindow window;      ///< (x0, y0, x1, y1) of the frame; all zero: the whole frame
-  // Whitted only (unset: the CLI's defaults, black background and 0.05 ambient).
-  std::optional<Vec3f> background, ambient;
-  // Path tracer only.
-  int rr_depth = 3;
-  float clamp_indirect = 0;
-  std::string light_sampling = "mis";         ///< mis, bsdf, light
-  std::string sampler = "sobol";              ///< sobol, independent
-  std::optional<Vec3f> env_color;             ///< constant environment radiance
-  std::string env_map;                        ///< equirectangular map file (.exr, .hdr)
-  float env_intensity = 1, env_rotation = 0;  ///< the map's multiplier and turn about +Y (degrees)
-  double time_limit = 0;                      ///< seconds; 0: none
-  float adaptive = 0;                         ///< adaptive sampling threshold; 0: off
-  int adaptive_min_spp = 16;
-};
+/// The settings of one render: the library's spec (render/spec.h), whose fields the Python API
+/// names as they are; `aovs` is passed to render_session separately.
+using RenderSettings = RenderSpec;
 
-/// AOV names a render accepts: the data AOVs (aov.h) and the path tracer's layers.
-inline constexpr const char* kDataAovNames[] = {"albedo", "N", "P", "Z", "UV", "id"};
-inline constexpr const char* kPathAovNames[] = {"samples", "variance", "light"};
-
-/// Checks the settings and the AOV names ("all": every AOV of the integrator) as `penumbra
-/// render` checks its flags, before any work; returns the AOV set. Throws std::invalid_argument
-/// naming the setting and, for a name outside a list, the valid names.
-std::set<std::string> check_settings(const RenderSettings& settings, const std::vector<std::string>& aovs);
+/// AOV names a render accepts from Python: the data AOVs (aov.h) and the path tracer's layers.
+const std::vector<std::string>& python_aov_names();
 
 /// One render with everything its outputs need.
 struct RenderOutput {
@@ -109,13 +69,10 @@ struct RenderOutput {
   RenderStats stats;
 };
 
-/// Renders `session`'s scene (locking it) as `penumbra render` does: camera by index or
-/// name (InputError listing the cameras otherwise), size from the camera's aspect hint, the
-/// environment (env_color, env_map, else the file's image-based light), the emissive
-/// triangles, the default key light for an unlit scene, the accelerator (kept for the next
-/// render with the same name and parameters), then the beauty and the requested AOVs from the
-/// same camera samples. Throws std::invalid_argument for settings outside their ranges and
-/// InputError for a bad camera or environment map.
+/// Renders `session`'s scene through the render session (render_scene) with `settings` and the
+/// layers `aovs` names ("all": every layer of python_aov_names() the integrator has). Throws
+/// std::invalid_argument for settings outside their ranges and InputError for a bad camera or
+/// environment map.
 RenderOutput render_session(SceneSession& session, const RenderSettings& settings,
                             const std::vector<std::string>& aovs);
 

@@ -1,6 +1,7 @@
 // Parsing "key=value" accelerator parameters into AccelConfig.
 #include "render/accel_params.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -160,6 +161,46 @@ void apply_accel_param(AccelConfig& c, std::string_view kv) {
     throw std::invalid_argument("--accel-param: unknown key '" + std::string(key) + "' (known: " + known +
                                 ")");
   }
+}
+
+}  // namespace penumbra
+
+namespace penumbra {
+
+void validate(const AccelConfig& config) {
+  validate(config.embree);
+  validate(config.bvh);
+  validate(config.kdtree);
+  validate(config.grid);
+  validate(config.octree);
+  validate(config.bsp);
+}
+
+AccelConfig accel_config(const std::string& name, const std::vector<std::string>& params) {
+  const std::vector<std::string> names = accelerator_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string known;
+    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("accel: unknown value '" + name + "' (known: " + known + ")");
+  }
+  AccelConfig config;
+  for (const auto& p : params) {
+    apply_accel_param(config, p);
+    const std::string prefix = p.substr(0, p.find('.'));
+    if (prefix != name)
+      throw std::invalid_argument("accel_params " + p + ": a parameter of '" + prefix + "', but accel is '" +
+                                  name + "'");
+  }
+  validate(config);
+  return config;
+}
+
+std::string accelerator_list() {
+  const std::vector<std::string> names = accelerator_names();
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return list;
 }
 
 }  // namespace penumbra

@@ -22,3 +22,20 @@ std::vector<AccelParamInfo> accel_param_keys();
 void apply_accel_param(AccelConfig& config, std::string_view key_value);
 
 }  // namespace penumbra
+
+namespace penumbra {
+
+/// Checks every structure's build parameters (Embree, BVH, kD-tree, grid, octree, BSP), each
+/// with its own validate(). Throws std::invalid_argument naming the parameter.
+void validate(const AccelConfig& config);
+
+/// The structure `name`'s configuration from "key=value" parameters, each of which must belong
+/// to `name` ("bvh.max_leaf_size=4" with accel "bvh"), validated. Throws std::invalid_argument:
+/// "accel: unknown value 'x' (known: ...)", "accel_params P: a parameter of 'a', but accel is
+/// 'b'", or what apply_accel_param and validate throw.
+AccelConfig accel_config(const std::string& name, const std::vector<std::string>& params);
+
+/// Every structure the factory builds, for help texts: "embree, bvh, ..., bsp or brute".
+std::string accelerator_list();
+
+}  // namespace penumbra

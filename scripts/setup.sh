@@ -42,14 +42,14 @@ case "$mode" in
     #   cli.cryptomatte), the install and package tests (packaging, not code paths);
     # - the Python tests (an instrumented module cannot load into Debian's uninstrumented
     #   python3), the benchmark's smoke runs and tests (measurement code), and the format and
-    #   OCIO-config checks (the same in any build).
+    #   OCIO-config checks and the documentation site (the same in any build).
     # SANITIZE=0 skips this stage.
     if [ "${SANITIZE:-1}" != 0 ]; then
       SAN_DIR="${SAN_BUILD_DIR:-build-sanitize}"
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
-      cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests
+      cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests render_tests
       ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\."
+        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\."
     fi
     ;;
 esac

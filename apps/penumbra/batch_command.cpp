@@ -206,7 +206,7 @@ int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
   args.skip_existing = b.skip_existing;
   // An unfinished render of this unit (cancelled, preempted) continues from its resume state.
   std::error_code ec;
-  args.resume = args.integrator == "path" && fs::exists(fs::path(args.output).concat(".resume"), ec);
+  args.resume = args.spec.integrator == "path" && fs::exists(fs::path(args.output).concat(".resume"), ec);
   return in_shot(pj.job, pj.job.shots[u.shot], [&] { return run_render(args); });
 }
 
@@ -482,9 +482,9 @@ void check_stripes(const PreparedJob& pj, size_t s) {
   for (size_t n = first; n < first + count; ++n) {
     const WorkUnit u = pj.units[n];
     if (u.tiles <= 1) continue;
-    if (args.height > 0 && u.tiles > args.height)
+    if (args.spec.height > 0 && u.tiles > args.spec.height)
       throw InputError(pj.job.file.string(), pj.job.shots[s].where + ".tiles",
-                       std::to_string(u.tiles) + " stripes of a frame " + std::to_string(args.height) +
+                       std::to_string(u.tiles) + " stripes of a frame " + std::to_string(args.spec.height) +
                            " rows high: at most one stripe per row");
     return;  // every tiled frame of the shot has the same split
   }

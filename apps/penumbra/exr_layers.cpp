@@ -24,7 +24,7 @@ namespace {
 /// Cryptomatte channels ({layer}00.R = rank 0 id, .G its coverage, .B rank 1 id, .A its coverage,
 /// then {layer}01, ...: always 32-bit float) and the cryptomatte/<key>/ attributes.
 void add_crypto_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
-  const CryptoImage& img = buffers.crypto;
+  const CryptoImage& img = buffers.layers.crypto;
   for (size_t l = 0; l < job.request.crypto.size(); ++l) {
     const std::string& layer = job.request.crypto[l];
     for (int group = 0; group < img.channels / 4; ++group)
@@ -35,7 +35,7 @@ void add_crypto_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
     exr.metadata.push_back({key + "name", layer});
     exr.metadata.push_back({key + "hash", "MurmurHash3_32"});
     exr.metadata.push_back({key + "conversion", "uint32_to_float32"});
-    const std::string& manifest = buffers.crypto_manifests[l];
+    const std::string& manifest = buffers.layers.crypto_manifests[l];
     if (manifest.size() <= kInlineManifestBytes || job.request.out_streams) {
       exr.metadata.push_back({key + "manifest", manifest});
     } else {
@@ -80,8 +80,8 @@ void add_camera_metadata(ExrOptions& exr, const Camera& cam, int width, int heig
 
 /// Crops and tiles carry their render's identity: merge accepts only parts of one render.
 void add_part_identity(ExrOptions& exr, const RenderJob& job) {
-  RenderSettings part = job.settings;
-  part.entries["spp"] = std::to_string(job.cfg.spp);
+  RenderSettings part = job.prepared.identity;
+  part.entries["spp"] = std::to_string(job.prepared.config.spp);
   part.entries["complete"] = job.frame_complete ? "1" : "0";  // all requested samples taken
   std::string layers;
   for (const auto& name : job.request.aovs) layers += (layers.empty() ? "" : ",") + name;
@@ -93,7 +93,8 @@ void add_part_identity(ExrOptions& exr, const RenderJob& job) {
 
 /// The data AOVs' channels: colour albedo, float N, P, Z, UV and the ids (whole numbers as float, which
 /// compositors read as values) with their manifest.
-void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
+void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data,
+                       const std::string& job_manifest) {
   const auto& aovs = job.request.aovs;
   const ChannelType colour = job.args.use_float ? ChannelType::Float : ChannelType::Half;
   if (aovs.count("albedo"))
@@ -112,14 +113,14 @@ void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data) {
   if (aovs.count("id")) {
     exr.extra.push_back({"object_id.X", &data.object_id, ChannelType::Float});
     exr.extra.push_back({"material_id.X", &data.material_id, ChannelType::Float});
-    exr.metadata.push_back({"penumbra:manifest", id_manifest(job.loaded.scene, job.loaded.info)});
+    exr.metadata.push_back({"penumbra:manifest", job_manifest});
   }
 }
 
 /// The path tracer's layers (sample counts, variance, light groups) and the cost layers.
 void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
   const auto& aovs = job.request.aovs;
-  const PathImage& image = job.path_image;
+  const RenderImage& image = job.image;
   if (aovs.count("samples")) {
     buffers.samples.assign(image.samples.begin(), image.samples.end());
     exr.extra.push_back({"samples.X", &buffers.samples, ChannelType::Float});
@@ -132,12 +133,12 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
                              job.args.use_float ? ChannelType::Float : ChannelType::Half, kLightGroupChannels,
                              g * 3 + c});
   if (job.request.cost_aov) {
-    if (buffers.cost.counted) {
-      exr.extra.push_back({"cost_nodes.X", &buffers.cost.nodes});
-      exr.extra.push_back({"cost_triangles.X", &buffers.cost.triangles});
-      exr.extra.push_back({"cost_shapes.X", &buffers.cost.shapes});
+    if (buffers.layers.cost.counted) {
+      exr.extra.push_back({"cost_nodes.X", &buffers.layers.cost.nodes});
+      exr.extra.push_back({"cost_triangles.X", &buffers.layers.cost.triangles});
+      exr.extra.push_back({"cost_shapes.X", &buffers.layers.cost.shapes});
     }
-    exr.extra.push_back({"cost_ns.X", &buffers.cost.nanoseconds});
+    exr.extra.push_back({"cost_ns.X", &buffers.layers.cost.nanoseconds});
   }
 }
 
@@ -147,83 +148,25 @@ fs::path crypto_sidecar_path(const fs::path& exr, const std::string& layer) {
   return fs::path(exr).replace_extension("." + layer + ".json");
 }
 
-std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
-                                               const std::string& layer) {
-  auto node_name = [&](int n) {
-    return size_t(n) < info.node_names.size() ? info.node_names[size_t(n)]
-                                              : "nodes[" + std::to_string(n) + "]";
-  };
-  std::vector<std::string> names;
-  names.reserve(scene.instances.size());
-  for (size_t i = 0; i < scene.instances.size(); ++i) {
-    const Instance& inst = scene.instances[i];
-    if (layer == "CryptoMaterial") {
-      const int m = instance_material(scene, inst);
-      names.push_back(m >= 0 ? scene.materials[size_t(m)].name : "default");
-    } else if (inst.node < 0) {
-      names.push_back("instances[" + std::to_string(i) + "]");
-    } else if (layer == "CryptoAsset") {
-      int root = inst.node;  // the topmost ancestor (bounded: the loader rejects cycles)
-      for (size_t step = 0; step < info.node_parents.size() && size_t(root) < info.node_parents.size() &&
-                            info.node_parents[size_t(root)] >= 0;
-           ++step)
-        root = info.node_parents[size_t(root)];
-      names.push_back(node_name(root));
-    } else {
-      names.push_back(node_name(inst.node));
-    }
-  }
-  return names;
-}
-
-void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers) {
-  const IntegratorType integrator = job.request.path     ? IntegratorType::Path
-                                    : job.request.raster ? IntegratorType::Raster
-                                                         : IntegratorType::Whitted;
-  if (job.request.data_aovs)
-    buffers.data = job.request.raster
-                       ? render_raster_aovs(job.loaded.scene, job.camera, job.cfg)
-                       : render_data_aovs(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator);
-  if (job.request.cost_aov) buffers.cost = render_cost(*job.accel, job.camera, job.cfg, integrator);
-  if (job.request.crypto.empty()) return;
-  std::vector<CryptoLayerIds> layers;
-  for (const std::string& layer : job.request.crypto) {
-    CryptoLayerIds ids{layer, {}};
-    std::set<std::string> names;
-    for (const std::string& name : crypto_instance_names(job.loaded.scene, job.loaded.info, layer)) {
-      ids.instance_ids.push_back(crypto_id(name));
-      names.insert(name);
-    }
-    std::string manifest = "{";
-    for (const std::string& name : names)
-      manifest +=
-          (manifest.size() > 1 ? "," : "") + json_quote(name) + ":" + json_quote(crypto_hex(crypto_id(name)));
-    buffers.crypto_manifests.push_back(manifest + "}");
-    layers.push_back(std::move(ids));
-  }
-  buffers.crypto = render_cryptomatte(job.loaded.scene, *job.accel, job.camera, job.cfg, integrator, layers,
-                                      job.request.crypto_depth);
-}
-
 ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
   const RenderArgs& a = job.args;
-  const RenderConfig& cfg = job.cfg;
+  const RenderConfig& cfg = job.prepared.config;
   ExrOptions exr;
   exr.half = !a.use_float;
   exr.compression = a.compression;
   exr.multipart = a.multipart;
   exr.metadata = {{"penumbra:scene", a.scene_file},
-                  {"penumbra:camera", job.camera.name},
+                  {"penumbra:camera", job.prepared.camera.name},
                   {"penumbra:spp", std::to_string(cfg.spp)},
-                  {"penumbra:integrator", a.integrator},
+                  {"penumbra:integrator", a.spec.integrator},
                   {"penumbra:filter",
                    std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)}};
   if (job.request.path) {
     exr.metadata.push_back(
-        {kMeanSppAttribute,
-         format_mean_spp(job.stats.samples, uint64_t(job.film.width) * uint64_t(job.film.height))});
-    exr.metadata.push_back({kSamplesAttribute, std::to_string(job.stats.samples)});
-    exr.metadata.push_back({kPassesAttribute, std::to_string(job.stats.image_passes)});
+        {kMeanSppAttribute, format_mean_spp(job.image.stats.samples, uint64_t(job.image.film.width) *
+                                                                         uint64_t(job.image.film.height))});
+    exr.metadata.push_back({kSamplesAttribute, std::to_string(job.image.stats.samples)});
+    exr.metadata.push_back({kPassesAttribute, std::to_string(job.image.stats.image_passes)});
   }
   add_part_identity(exr, job);
   if (!a.reproducible) exr.metadata.push_back({"penumbra:command_line", a.command_line});
@@ -231,9 +174,10 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
   // files carry it empty.
   if (a.reproducible) exr.metadata.push_back({"DateTime", ""});
   exr.metadata.push_back({"penumbra:version", PENUMBRA_VERSION});
-  add_camera_metadata(exr, job.camera, cfg.width, cfg.height);
-  if (!a.reproducible) exr.float_metadata.push_back({kRenderSecondsAttribute, float(job.stats.seconds)});
-  if (job.request.data_aovs) add_data_channels(exr, job, buffers.data);
+  add_camera_metadata(exr, job.prepared.camera, cfg.width, cfg.height);
+  if (!a.reproducible)
+    exr.float_metadata.push_back({kRenderSecondsAttribute, float(job.image.stats.seconds)});
+  if (job.request.data_aovs) add_data_channels(exr, job, buffers.layers.data, buffers.layers.id_manifest);
   add_render_channels(exr, job, buffers);
   add_crypto_channels(exr, job, buffers);
   // The display transform its display image is (or, for --no-png and farm stripes, would be)

@@ -10,6 +10,7 @@
 
 #include "io/gltf/loader.h"
 #include "io/image/image_output.h"
+#include "render/session.h"
 #include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/cost_map.h"
@@ -20,12 +21,8 @@ struct RenderJob;
 
 /// The per-pixel layers an EXR points into; must outlive the ExrOptions made from it.
 struct LayerBuffers {
-  DataAovs data;               ///< albedo, N, P, Z, UV, ids (from the beauty's camera samples)
+  RenderLayers layers;         ///< the render session's layers (data AOVs, Cryptomatte, cost)
   std::vector<float> samples;  ///< the path tracer's sample counts as floats
-  CostImage cost;              ///< traversal cost of the camera rays
-  CryptoImage crypto;          ///< ranked Cryptomatte ids, one layer per request.crypto entry
-  /// Each Cryptomatte layer's manifest ({"name": "hex", ...}, names sorted).
-  std::vector<std::string> crypto_manifests;
   /// Manifests too large for the header, written beside the EXR: (path, JSON text).
   std::vector<std::pair<std::filesystem::path, std::string>> sidecars;
 };
@@ -37,17 +34,8 @@ inline constexpr size_t kInlineManifestBytes = 64 * 1024;
 /// The sidecar manifest path of Cryptomatte layer `layer` of the EXR `exr`.
 std::filesystem::path crypto_sidecar_path(const std::filesystem::path& exr, const std::string& layer);
 
-/// The name each scene instance has in Cryptomatte layer `layer` (CryptoObject: its glTF node's
-/// name; CryptoMaterial: its material's name, "default" for none; CryptoAsset: its root node's
-/// name), one per scene.instances entry.
-std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
-                                               const std::string& layer);
-
-/// Traces what the requested data and cost AOVs need (the beauty's own camera samples).
-void render_layer_buffers(const RenderJob& job, LayerBuffers& buffers);
-
 /// The beauty's EXR options: compression, part layout, every metadata attribute, and one channel
-/// per requested AOV, pointing into `buffers` and job.path_image.
+/// per requested AOV, pointing into `buffers` and job.image.
 ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers);
 
 }  // namespace penumbra::cli

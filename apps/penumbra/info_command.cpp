@@ -220,7 +220,7 @@ void print_view(const View& v) {
   print_matrix("projection matrix (glTF: clip space, depth -1..1 from near to far)", v.projection);
 }
 
-/// The description as one JSON document (schema: README, `penumbra info --json`).
+/// The description as one JSON document (schema: docs/reference/formats.md).
 nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loaded, const View& view,
                                  const AccelStats& st) {
   using J = nlohmann::ordered_json;
@@ -360,9 +360,9 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
   info.add_flag("--allow-external-uris", a.allow_external,
                 "let buffer URIs reach files outside the scene's folder");
   info.add_flag("--flatten", a.flatten, "as for render: no instancing");
-  info.add_flag(
-      "--json", a.json,
-      "print the description as one JSON document (the schema is in README, `penumbra info --json`)");
+  info.add_flag("--json", a.json,
+                "print the description as one JSON document (the schema is in the reference, "
+                "docs/reference/formats.md)");
   info.add_option("--camera", a.camera, "as for render: the camera the view section describes");
   info.add_option("--width", a.width, "as for render: the image width the view is described for")
       ->check(CLI::Range(1, 16384));

@@ -38,8 +38,8 @@ extern "C" void on_signal(int sig) {
 
 /// The resume state's settings: the render's own, plus the window its pixels cover.
 RenderSettings state_settings(const RenderJob& job) {
-  RenderSettings s = job.settings;
-  const PixelWindow win = render_window(job.cfg);
+  RenderSettings s = job.prepared.identity;
+  const PixelWindow win = render_window(job.prepared.config);
   s.entries["window"] = std::to_string(win.x0) + "," + std::to_string(win.y0) + "-" + std::to_string(win.x1) +
                         "," + std::to_string(win.y1);
   return s;
@@ -66,7 +66,7 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
   if (a.resume) {
     if (fs::exists(state_file)) {
       state = read_checkpoint(state_file, fingerprint);
-      const PixelWindow win = render_window(job.cfg);
+      const PixelWindow win = render_window(job.prepared.config);
       if (state.window.x0 != win.x0 || state.window.y0 != win.y0 || state.window.x1 != win.x1 ||
           state.window.y1 != win.y1)
         throw InputError(state_file.string(), "", "its pixels cover another window than this render's");
@@ -86,17 +86,18 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
     cp.compression = a.compression;
     cp.metadata = {{"penumbra:scene", a.scene_file},
                    {"penumbra:checkpoint", "passes " + std::to_string(st.passes)}};
-    write_exr(resolve_path_image(st, job.cfg).film, out, cp);
+    write_exr(resolve_path_image(st, job.prepared.config).film, out, cp);
     write_checkpoint(state_file, st, fingerprint);
     last_checkpoint = Clock::now();
   };
-  job.cfg.stop = &g_stop;
+  RenderHooks hooks;
+  hooks.progress = [&](int d, int t) { progress(d, t); };
+  hooks.resume = &state;
+  hooks.after_pass = after_pass;
+  hooks.stop = &g_stop;
   g_graceful = true;
-  job.path_image = render_path(
-      job.loaded.scene, *job.accel, job.path_lights(), job.camera, job.cfg, &job.stats,
-      [&](int d, int t) { progress(d, t); }, &state, after_pass);
+  job.image = render_image(job.loaded.scene, job.structure.accel.get(), job.prepared, hooks);
   g_graceful = false;
-  job.film = std::move(job.path_image.film);
   // A signal during the last pass still ends the run with 128 + signal, the image complete.
   if (g_stop.load()) job.interrupted = g_signal.load();
   job.frame_complete = state.complete;

@@ -13,7 +13,7 @@ class ProgressReporter;
 /// closed pipe becomes a write error). Call once before loading.
 void install_signal_handlers();
 
-/// Renders job.cfg with the path tracer into job.film / job.path_image / job.stats, resuming from
+/// Renders job.prepared with the path tracer (render_image) into job.image, resuming from
 /// and checkpointing to `OUT.exr.resume` as the flags ask. Sets job.interrupted to the signal
 /// that ended it (0 if none) and job.frame_complete. Throws InputError for a resume state that
 /// is damaged or belongs to another render (nothing is written then).

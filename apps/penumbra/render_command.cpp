@@ -61,8 +61,7 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
 
 /// Charges the scene, the accelerator and every image buffer to the budget; returns the bytes
 /// taken. Throws UsageError (exit 2) naming the image when they do not fit.
-uint64_t charge_image_budget(const RenderJob& job) {
-  const RenderConfig& cfg = job.cfg;
+uint64_t charge_image_budget(const RenderJob& job, const RenderConfig& cfg) {
   const uint64_t budget = job.request.budget;
   const PixelWindow w = render_window(cfg);
   const uint64_t image =
@@ -78,8 +77,8 @@ uint64_t charge_image_budget(const RenderJob& job) {
   }
   if (image > budget || scene_bytes > budget - image)
     throw UsageError("image " + std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " (" +
-                     job.args.integrator + (job.request.aovs.empty() ? "" : ", with AOVs") + ") needs " +
-                     format_bytes(image) + " for the film and output buffers, over the " +
+                     job.request.spec.integrator + (job.request.aovs.empty() ? "" : ", with AOVs") +
+                     ") needs " + format_bytes(image) + " for the film and output buffers, over the " +
                      format_bytes(budget) + " budget with the rest of the scene (" +
                      format_bytes(scene_bytes) + ") (--max-memory)");
   return image + scene_bytes;
@@ -90,17 +89,17 @@ uint64_t charge_image_budget(const RenderJob& job) {
 /// the next frame's time with its accelerator's instances moved (reuse_kept_scene). The
 /// accelerator's views point into the scene's vectors, whose storage moves with them.
 struct KeptScene {
-  LoadedScene loaded;                  ///< empty when `reload`
-  std::unique_ptr<Accelerator> accel;  ///< null: built anew for the next frame
-  double built_sah = 0;                ///< the accelerator's SAH cost when last built
+  LoadedScene loaded;  ///< empty when `reload`
+  /// The structure (null accel: built anew for the next frame); its update says what became of
+  /// it: "reused" or "instances moved".
+  Structure structure;
   /// The next frame loads its scene anew (its animation moves vertices: skins, morph targets)
-  /// and `accel` is refitted to it or built anew (refit_or_rebuild_scene's policy).
+  /// and the structure is refitted to it or built anew (refit_or_rebuild_scene's policy).
   bool reload = false;
   /// Every frame poses the scene alike (a turntable's frames turn only the camera): reused as is.
   bool same_pose = false;
-  const char* update = "reused";  ///< what became of `accel`: "reused" or "instances moved"
-  double pose_s = 0;              ///< seconds spent posing the scene for the next frame
-  double update_s = 0;            ///< seconds spent moving the accelerator's instances
+  double pose_s = 0;    ///< seconds spent posing the scene for the next frame
+  double update_s = 0;  ///< seconds spent moving the accelerator's instances
 };
 
 /// Readies the kept scene for the frame of `q`: a static scene as it is; an animated one posed
@@ -118,7 +117,7 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
   const auto t0 = Clock::now();
   uint64_t moved_instances = 0;
   if (!q.time || !pose_gltf_scene(*kept->loaded.animation, *q.time, kept->loaded.scene, &moved_instances)) {
-    if (!q.time || !kept->accel) {
+    if (!q.time || !kept->structure.accel) {
       kept.reset();
       return "";
     }
@@ -130,9 +129,10 @@ std::string reuse_kept_scene(std::optional<KeptScene>& kept, const RenderRequest
   if (moved_instances == 0)
     return " (animated scene: loaded scene reused, cameras and lights moved, acceleration structure reused)";
   const auto t1 = Clock::now();
-  const bool moved = kept->accel && kept->accel->update_instances(instance_views(kept->loaded.scene));
-  if (!moved) kept->accel.reset();
-  kept->update = "instances moved";
+  Structure& s = kept->structure;
+  const bool moved = s.accel && s.accel->update_instances(instance_views(kept->loaded.scene));
+  if (!moved) s = Structure{};
+  s.update = "instances moved";
   kept->update_s = seconds_since(t1);
   return moved ? " (animated scene: loaded scene reused, instances moved, top level rebuilt)"
                : " (animated scene: loaded scene reused, instances moved, acceleration structure rebuilt)";
@@ -165,55 +165,36 @@ void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   check_distinct_files(job.request.outputs, inputs);
 }
 
-/// Camera and resolution (the image aspect follows the camera's hint unless both are given),
-/// the budget, the path tracer's lights, the default light, and the render's identity.
+/// The render session's prepare phase: camera and resolution (the image aspect follows the
+/// camera's hint unless both are given), the --crop or --tile window, the budget, the lights,
+/// the default light and the render's identity.
 void setup_phase(RenderJob& job) {
   const RenderArgs& a = job.args;
   const RenderRequest& q = job.request;
   Scene& scene = job.loaded.scene;
   const int cam = base_camera_index(scene, a.camera, a.cam, a.scene_file);
-  job.cfg = make_render_config(a, q, aspect_hint(scene, cam));
-  RenderConfig& cfg = job.cfg;
-  validate(cfg);  // the library's own range checks, after the command line's named ones
-  const uint64_t committed = charge_image_budget(job);
-  if (!cfg.window.empty() && q.cost_aov)
+  RenderSpec spec = q.spec;
+  const auto [width, height] = image_size(spec.width, spec.height, aspect_hint(scene, cam));
+  spec.window = parse_window(a, width, height);
+  if (!spec.window.empty() && q.cost_aov)
     throw UsageError("--aov cost renders the whole frame; not with --crop or --tile");
-  job.camera = choose_camera(q.rig, scene, cam, cfg.width, cfg.height);
-  try {
-    validate_camera(job.camera, cfg.width, cfg.height);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(a.scene_file, cam >= 0 ? "cameras[" + std::to_string(cam) + "]" : "the view", e.what());
-  }
-  // The path tracer's lights: emissive triangles and the environment.
-  if (q.env_colour)
-    job.environment = make_constant_environment(*q.env_colour * a.env_intensity);
-  else if (!a.env.empty())
-    job.environment = load_environment(a.env, a.env_intensity, a.env_rotation, q.budget - committed);
-  else if (job.loaded.environment)  // the file's EXT_lights_image_based light
-    job.environment = *job.loaded.environment;
-  if (q.path) job.area_lights = build_area_lights(scene);
-  if (scene.lights.empty() && (!q.path || (job.area_lights.pmf.empty() && is_black(job.environment)))) {
-    scene.lights.push_back(default_key_light(job.camera));
-    job.default_light = true;
-  }
   // What this render is, for its resume state and the EXR's metadata (which `merge` checks
   // tiles by): the content of every file it loaded and every setting that decides its pixels.
   // The bytes as the loader read them, not the files as they are now.
   job.scene_sha256 = sha256_of_set(job.loaded.info.source_files, job.loaded.info.source_sha256);
-  job.settings = pixel_settings(a, cfg, job.camera, job.scene_sha256,
-                                !a.env.empty() && !q.env_colour ? sha256_file(a.env) : "");
+  PrepareOptions o;
+  o.scene_file = a.scene_file;
+  o.camera_index = cam;
+  o.place = [&](const Scene& sc, int index, int w, int h) { return choose_camera(q.rig, sc, index, w, h); };
+  o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
+  o.identity = scene_identity(a, q, job.scene_sha256);
+  job.prepared = prepare_render(job.loaded, spec, o);
 }
 
-/// Whether the render queries an acceleration structure: every integrator does but the raster
-/// one without shadow rays, Cryptomatte or the cost layer (those trace the camera samples).
-bool needs_accelerator(const RenderJob& job) {
-  const RenderRequest& q = job.request;
-  return !q.raster || job.cfg.raster.shadows == RasterShadows::Ray || q.cost_aov || !q.crypto.empty() ||
-         !job.args.debug_pixel.empty();
-}
-
+/// The render session's structure phase: the kept frame's structure reused, refitted or
+/// rebuilt, else one built anew.
 void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
-  if (!needs_accelerator(job)) {
+  if (!needs_structure(job.prepared.spec, !job.args.debug_pixel.empty())) {
     if (kept) job.build_s = kept->update_s;
     kept.reset();
     return;
@@ -224,27 +205,18 @@ void build_phase(RenderJob& job, std::optional<KeptScene>& kept) {
   const double moved_s = kept ? kept->update_s : 0;
   // An animated scene at a time keeps Embree's still placements apart from the instances that
   // later frames move (as a single --frame render does, so that both see the same structure).
-  AccelConfig config = job.request.accel_config;
-  config.embree.world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
-  if (kept && kept->accel && kept->reload) {
-    job.accel = std::move(kept->accel);
-    job.accel_built_sah = kept->built_sah;
-    const RefitReport r =
-        refit_or_rebuild_scene(job.accel, job.accel_built_sah, job.args.accel, job.loaded.scene, config);
-    job.accel_update = r.refitted ? "refitted" : "rebuilt";
-    char growth[64];
-    std::snprintf(growth, sizeof growth, "SAH cost %.3gx its last build's", r.growth);
-    announce(job.progress, r.refitted ? "refitted " + job.args.accel + " (" + growth + ")"
-                                      : "rebuilt " + job.args.accel + " (" + r.reason + ")");
-  } else if (kept && kept->accel) {
-    job.accel = std::move(kept->accel);
-    job.accel_built_sah = kept->built_sah;
-    job.accel_update = kept->update;
-  } else {
-    announce(job.progress, "building " + job.args.accel + " (" + describe_scene_size(job.loaded.scene) + ")");
-    job.accel = make_scene_accelerator(job.args.accel, job.loaded.scene, config);
-    job.accel_built_sah = job.accel->stats().sah_cost;
-  }
+  const bool world_apart = job.loaded.info.animation_count != 0 && job.request.time.has_value();
+  const std::string& name = job.prepared.spec.accel;
+  Structure previous;
+  const bool moved_vertices = kept && kept->reload;
+  if (kept && kept->structure.accel)
+    previous = std::move(kept->structure);
+  else
+    announce(job.progress, "building " + name + " (" + describe_scene_size(job.loaded.scene) + ")");
+  job.structure =
+      build_structure(job.loaded.scene, job.prepared.spec, world_apart, std::move(previous), moved_vertices);
+  if (job.structure.update == "refitted" || job.structure.update == "rebuilt")
+    announce(job.progress, job.structure.update + " " + name + " (" + job.structure.reason + ")");
   kept.reset();
   job.build_s = moved_s + seconds_since(t0);
   progress.finish();
@@ -258,43 +230,30 @@ void keep_scene(RenderJob& job, std::optional<KeptScene>& kept) {
   if (job.loaded.info.animation_count != 0 && !job.loaded.animation && !same_pose) {
     // Posing cannot move what this animation moves: the next frame loads the file at its time,
     // and this frame's structure is refitted to it.
-    if (!job.accel || !job.request.time) return;
+    if (!job.structure.accel || !job.request.time) return;
     kept.emplace();
     kept->reload = true;
-    kept->accel = std::move(job.accel);
-    kept->built_sah = job.accel_built_sah;
+    kept->structure = std::move(job.structure);
     return;
   }
-  if (job.default_light) job.loaded.scene.lights.pop_back();
+  finish_render(job.loaded, job.prepared);
   kept.emplace();
   kept->loaded = std::move(job.loaded);
-  kept->accel = std::move(job.accel);
-  kept->built_sah = job.accel_built_sah;
+  kept->structure = std::move(job.structure);
+  kept->structure.update = "reused";
   kept->same_pose = same_pose;
 }
 
 /// --debug-pixel: one pixel exactly as the full render would compute it, printed on stdout.
 int render_debug_pixel(RenderJob& job) {
   const RenderRequest& q = job.request;
-  const RenderConfig& cfg = job.cfg;
+  const RenderConfig& cfg = job.prepared.config;
   if (q.debug_x < 0 || q.debug_y < 0 || q.debug_x >= cfg.width || q.debug_y >= cfg.height)
     throw UsageError("--debug-pixel " + job.args.debug_pixel + " is outside the " +
                      std::to_string(cfg.width) + "x" + std::to_string(cfg.height) + " image");
   float rgba[4];
   RayCounts counts;
-  if (q.path) {
-    render_path_pixel(job.loaded.scene, *job.accel, job.path_lights(), job.camera, cfg, q.debug_x, q.debug_y,
-                      rgba, counts);
-  } else if (q.raster) {
-    RenderConfig one = cfg;
-    one.window = {q.debug_x, q.debug_y, q.debug_x + 1, q.debug_y + 1};
-    RenderStats st;
-    const Film f = render_raster(job.loaded.scene, job.accel.get(), job.camera, one, &st);
-    for (int c = 0; c < 4; ++c) rgba[c] = f.rgba[size_t(c)];
-    counts = st.rays;
-  } else {
-    render_whitted_pixel(job.loaded.scene, *job.accel, job.camera, cfg, q.debug_x, q.debug_y, rgba, counts);
-  }
+  render_pixel(job.loaded.scene, job.structure.accel.get(), job.prepared, q.debug_x, q.debug_y, rgba, counts);
   std::printf("pixel %d,%d: R %.6g G %.6g B %.6g A %.6g (rays: camera %llu, shadow %llu, %s %llu)\n",
               q.debug_x, q.debug_y, rgba[0], rgba[1], rgba[2], rgba[3],
               static_cast<unsigned long long>(counts.camera), static_cast<unsigned long long>(counts.shadow),
@@ -302,19 +261,21 @@ int render_debug_pixel(RenderJob& job) {
   return kExitOk;
 }
 
+/// The render session's image phase: the path tracer with its signals, checkpoints and resume
+/// (path_render.h), else the integrator at once.
 void render_phase(RenderJob& job) {
   set_phase("rendering");
   ProgressReporter reporter(job.progress, "render", job.frame);
-  if (job.request.path)
+  if (job.request.path) {
     run_path_render(job, reporter);
-  else if (job.request.raster)
-    job.film = render_raster(job.loaded.scene, job.accel.get(), job.camera, job.cfg, &job.stats,
-                             [&](int d, int t) { reporter(d, t); });
-  else
-    job.film = render_whitted(job.loaded.scene, *job.accel, job.camera, job.cfg, &job.stats,
-                              [&](int d, int t) { reporter(d, t); });
+  } else {
+    RenderHooks hooks;
+    hooks.progress = [&](int d, int t) { reporter(d, t); };
+    job.image = render_image(job.loaded.scene, job.structure.accel.get(), job.prepared, hooks);
+  }
   reporter.finish();
-  job.mean_spp = double(job.stats.samples) / (double(job.film.width) * double(job.film.height));
+  job.mean_spp =
+      double(job.image.stats.samples) / (double(job.image.film.width) * double(job.image.film.height));
 }
 
 /// The EXR with its layers, the display image, the heat map, then the statistics that record
@@ -324,18 +285,19 @@ void write_phase(RenderJob& job) {
   ProgressReporter progress(job.progress, "write", job.frame);
   const auto t0 = Clock::now();
   LayerBuffers buffers;
-  render_layer_buffers(job, buffers);
+  buffers.layers = render_layers(job.loaded, job.structure.accel.get(), job.prepared);
   const ExrOptions exr = make_exr_options(job, buffers);
   set_phase("writing the outputs");
   const bool hashes = !job.args.stats_json.empty();
   for (const auto& [sidecar, text] : buffers.sidecars)
     write_atomically(
         sidecar, [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), sidecar); });
-  write_exr(job.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
-  if (q.png) write_display_image(job.film, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
+  write_exr(job.image.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
+  if (q.png) write_display_image(job.image.film, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
   if (q.cost_png)
-    write_heatmap(total_cost(buffers.cost), job.cfg.width, job.cfg.height, *q.cost_png,
-                  cost_caption(buffers.cost, job.args.accel), hashes ? &job.hashes.cost_png : nullptr);
+    write_heatmap(total_cost(buffers.layers.cost), job.prepared.config.width, job.prepared.config.height,
+                  *q.cost_png, cost_caption(buffers.layers.cost, job.args.spec.accel),
+                  hashes ? &job.hashes.cost_png : nullptr);
   job.write_s = seconds_since(t0);
   if (hashes) write_stats_json(job);
   progress.finish();
@@ -372,7 +334,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptS
         stderr,
         "penumbra: interrupted by signal %d after %d passes (%.2f spp): the image holds the finished passes; "
         "continue with the same command and --resume\n",
-        job.interrupted, job.stats.passes, job.mean_spp);
+        job.interrupted, job.image.stats.passes, job.mean_spp);
   return 128 + job.interrupted;
 }
 
@@ -473,9 +435,9 @@ void check_contact_sheet(const RenderArgs& a, const std::vector<RenderRequest>& 
   resolve_output(a.contact_sheet, "--contact-sheet");
   check_distinct_files(outputs, {{"the scene file", a.scene_file}});
   // The sheet's size, where the flags fix the image's (else after the first frame).
-  if (a.width > 0 && a.height > 0)
-    check_contact_sheet_size(requests.size(), a.contact_sheet_columns, a.width, a.height, a.png_alpha ? 4 : 3,
-                             a.contact_sheet, memory_budget(a.max_memory));
+  if (a.spec.width > 0 && a.spec.height > 0)
+    check_contact_sheet_size(requests.size(), a.contact_sheet_columns, a.spec.width, a.spec.height,
+                             a.png_alpha ? 4 : 3, a.contact_sheet, memory_budget(a.max_memory));
 }
 
 /// With --skip-existing: true when the frame's EXR is complete; a file that is there but

@@ -1,20 +1,20 @@
-// What a render is, in canonical form: the content hash of its scene and every setting that
-// decides its pixels. The resume state records it (with the window) and crops and tiles carry it
+// The scene part of a render's identity as the command's flags describe it. The identity itself
+// (every setting that decides the pixels) is the render spec's: render_identity in
+// render/spec.h. The resume state records it (with the window) and crops and tiles carry it
 // (with the sample target and layers), so state or parts of another render are recognised.
 #pragma once
 
 #include <string>
 
 #include "apps/penumbra/render_options.h"
-#include "io/farm/render_settings.h"
-#include "renderer/scene/camera.h"
+#include "render/spec.h"
 
 namespace penumbra::cli {
 
-/// Everything that decides the pixels of a render except its window and sample target: the
-/// scene (content hash, scene index, flattening, pose), camera, image size and every sampling
-/// and integrator setting; `env_sha256` is the --env map's hash (empty for a colour or none).
-RenderSettings pixel_settings(const RenderArgs& args, const RenderConfig& cfg, const Camera& camera,
-                              const std::string& scene_sha256, const std::string& env_sha256);
+/// The scene's content hash `scene_sha256`, scene index, flattening, variant, pose (--time, or
+/// --frame at --fps unless a turntable's frame turns only the camera) and --camera as given (the
+/// session adds the environment map's hash once it has read the map).
+SceneIdentity scene_identity(const RenderArgs& args, const RenderRequest& request,
+                             const std::string& scene_sha256);
 
 }  // namespace penumbra::cli

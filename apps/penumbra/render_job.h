@@ -1,6 +1,7 @@
 // One `penumbra render` run as it moves through its phases (check, load, set up, build,
 // render, write, report): the request, the scene and its lights, the renderer's configuration,
-// the accelerator, the images and the figures the summary and the statistics report.
+// the render session's phases' values (prepared render, structure, image) and the figures the
+// summary and the statistics report.
 #pragma once
 
 #include <cstdint>
@@ -12,9 +13,8 @@
 #include "apps/penumbra/render_options.h"
 #include "io/farm/render_settings.h"
 #include "io/gltf/loader.h"
+#include "render/session.h"
 #include "renderer/integrators/render.h"
-#include "renderer/lights/area.h"
-#include "renderer/lights/environment.h"
 
 namespace penumbra::cli {
 
@@ -33,29 +33,16 @@ struct RenderJob {
   std::optional<int64_t> frame;  ///< --frame's number (checked before), for the JSON progress lines
   RenderRequest request;
   LoadedScene loaded;
-  RenderConfig cfg;
-  Camera camera;
-  Environment environment;
-  AreaLights area_lights;
-  bool default_light = false;  ///< the scene had no light: the default key light was added
-  RenderSettings settings;     ///< what decides the pixels (path renders and windows only)
-  std::string scene_sha256;    ///< over every file the scene loaded (path renders and windows)
-  std::unique_ptr<Accelerator> accel;
-  double accel_built_sah = 0;  ///< the accelerator's SAH cost when last built (the refit policy's base)
-  /// How this frame's accelerator came to be: "built", "reused" or "instances moved" (from the
-  /// previous frame), "refitted" or "rebuilt" (the previous frame's, to moved vertices).
-  std::string accel_update = "built";
+  PreparedRender prepared;   ///< the session's prepared render: settings resolved, camera, lights, identity
+  std::string scene_sha256;  ///< over every file the scene loaded
+  Structure structure;       ///< the acceleration structure and how this frame's came to be
   double load_s = 0, build_s = 0, write_s = 0;
-  RenderStats stats;
-  Film film;
-  PathImage path_image;  ///< path tracer only; its film is moved into `film`
-  int interrupted = 0;   ///< the signal that ended a path render early, or 0
+  RenderImage image;    ///< the beauty, the path tracer's layers and the statistics
+  int interrupted = 0;  ///< the signal that ended a path render early, or 0
   bool frame_complete = true;
   bool remove_state = false;  ///< a completed --checkpoint/--resume render: drop OUT.exr.resume once written
   double mean_spp = 0;
   WrittenHashes hashes;
-
-  PathLights path_lights() const { return {&area_lights, &environment}; }
 };
 
 }  // namespace penumbra::cli

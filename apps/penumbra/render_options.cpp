@@ -11,33 +11,21 @@
 #include <cstdlib>
 #include <sstream>
 #include <tuple>
+#include <type_traits>
+#include <variant>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/exr_layers.h"
 #include "apps/penumbra/progress.h"
 #include "apps/penumbra/scene_setup.h"
 #include "io/files/atomic_file.h"
+#include "render/session.h"
 
 namespace penumbra::cli {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-/// The AOV names --aov accepts (besides "all").
-constexpr const char* kAovNames[] = {"albedo",
-                                     "N",
-                                     "P",
-                                     "Z",
-                                     "UV",
-                                     "id",
-                                     "samples",
-                                     "variance",
-                                     "light",
-                                     "cost",
-                                     "crypto_object",
-                                     "crypto_material",
-                                     "crypto_asset"};
 
 /// -o, --png, --cost-png and --stats-json: extensions, folders and the display transform.
 void check_output_paths(const RenderArgs& a, RenderRequest& q) {
@@ -68,14 +56,14 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
     throw UsageError("--exposure must be finite and within [-64, 64]");
   q.background = parse_colour(a.background, "--background");
   q.ambient = parse_colour(a.ambient, "--ambient");
-  q.path = a.integrator == "path";
-  q.raster = a.integrator == "raster";
+  q.path = a.spec.integrator == "path";
+  q.raster = a.spec.integrator == "raster";
   if (!q.raster && (a.raster_shadows_given || a.shadow_map_size_given))
     throw UsageError(std::string(a.raster_shadows_given ? "--raster-shadows" : "--shadow-map-size") +
                      " needs --integrator raster");
   if (q.raster && a.depth_given)
     throw UsageError("--max-depth does not apply to --integrator raster (local shading: no reflected rays)");
-  if (a.shadow_map_size_given && a.raster_shadows != "map")
+  if (a.shadow_map_size_given && a.spec.raster_shadows != "map")
     throw UsageError("--shadow-map-size needs --raster-shadows map");
   if (q.path && (a.background_given || a.ambient_given))
     throw UsageError(
@@ -83,32 +71,32 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
         " applies to --integrator whitted; the path tracer is lit by the scene's lights and --env");
   if (!q.path) {
     for (const auto& [given, name] : {std::pair{!a.env.empty(), "--env"},
-                                      {a.time_limit > 0, "--time-limit"},
-                                      {a.adaptive > 0, "--adaptive"},
-                                      {a.clamp_indirect > 0, "--clamp-indirect"},
-                                      {a.light_sampling != "mis", "--light-sampling"},
-                                      {a.sampler != "sobol", "--sampler"},
+                                      {a.spec.time_limit > 0, "--time-limit"},
+                                      {a.spec.adaptive > 0, "--adaptive"},
+                                      {a.spec.clamp_indirect > 0, "--clamp-indirect"},
+                                      {a.spec.light_sampling != "mis", "--light-sampling"},
+                                      {a.spec.sampler != "sobol", "--sampler"},
                                       {a.checkpoint > 0, "--checkpoint"},
                                       {a.resume, "--resume"}})
       if (given) throw UsageError(std::string(name) + " needs --integrator path");
   }
-  if (!std::isfinite(a.clamp_indirect) || a.clamp_indirect < 0)
+  if (!std::isfinite(a.spec.clamp_indirect) || a.spec.clamp_indirect < 0)
     throw UsageError("--clamp-indirect must be finite and >= 0 (0 = off)");
-  if (!std::isfinite(a.adaptive) || a.adaptive < 0)
+  if (!std::isfinite(a.spec.adaptive) || a.spec.adaptive < 0)
     throw UsageError("--adaptive must be finite and >= 0 (0 = off)");
-  if (!std::isfinite(a.time_limit) || a.time_limit < 0)
+  if (!std::isfinite(a.spec.time_limit) || a.spec.time_limit < 0)
     throw UsageError("--time-limit must be a finite number of seconds >= 0");
   if (!std::isfinite(a.checkpoint) || a.checkpoint < 0)
     throw UsageError("--checkpoint must be a finite number of seconds >= 0");
-  if (!std::isfinite(a.env_intensity) || a.env_intensity < 0)
+  if (!std::isfinite(a.spec.env_intensity) || a.spec.env_intensity < 0)
     throw UsageError("--env-intensity must be finite and >= 0");
-  if (!std::isfinite(a.env_rotation)) throw UsageError("--env-rotation must be finite");
+  if (!std::isfinite(a.spec.env_rotation)) throw UsageError("--env-rotation must be finite");
   q.filter_type = q.path ? FilterType::BlackmanHarris : FilterType::Box;
-  if (!a.filter.empty() && !parse_filter_type(a.filter, q.filter_type))
-    throw UsageError("--filter: unknown filter '" + a.filter +
+  if (!a.spec.filter.empty() && !parse_filter_type(a.spec.filter, q.filter_type))
+    throw UsageError("--filter: unknown filter '" + a.spec.filter +
                      "' (known: box, tent, gaussian, blackman-harris)");
-  q.filter_width = a.filter_width > 0 ? a.filter_width : default_filter_width(q.filter_type);
-  if (!std::isfinite(a.filter_width) || a.filter_width < 0 || q.filter_width > 16)
+  q.filter_width = a.spec.filter_width > 0 ? a.spec.filter_width : default_filter_width(q.filter_type);
+  if (!std::isfinite(a.spec.filter_width) || a.spec.filter_width < 0 || q.filter_width > 16)
     throw UsageError("--filter-width must be in (0, 16] pixels");
 }
 
@@ -122,7 +110,7 @@ void check_scalar_flags(const RenderArgs& a, RenderRequest& q) {
     q.debug_x = int(parse_integer(x, INT_MIN, INT_MAX, "--debug-pixel x"));
     q.debug_y = int(parse_integer(y, INT_MIN, INT_MAX, "--debug-pixel y"));
   }
-  q.accel_config = parse_accel(a.accel, a.accel_params);
+  q.accel_config = parse_accel(a.spec.accel, a.accel_params);
   const char* end = a.seed.data() + a.seed.size();
   if (const auto r = std::from_chars(a.seed.data(), end, q.seed);
       a.seed.empty() || a.seed[0] == '-' || a.seed[0] == '+' || r.ec != std::errc() || r.ptr != end)
@@ -132,41 +120,33 @@ void check_scalar_flags(const RenderArgs& a, RenderRequest& q) {
 /// --aov NAME[,NAME...] (repeatable); "all" = every compositing AOV of the integrator; and the
 /// heat map path of --aov cost.
 void check_aovs(const RenderArgs& a, RenderRequest& q) {
+  std::vector<std::string> names;
   for (const auto& item : a.aovs) {
     std::stringstream ss(item);
     std::string name;
-    while (std::getline(ss, name, ',')) {
-      if (name == "all") {
-        q.aovs.insert(
-            {"albedo", "N", "P", "Z", "UV", "id", "crypto_object", "crypto_material", "crypto_asset"});
-        if (q.path) q.aovs.insert({"samples", "variance", "light"});
-        continue;
-      }
-      if (std::find(std::begin(kAovNames), std::end(kAovNames), name) == std::end(kAovNames)) {
-        std::string known;
-        for (const char* k : kAovNames) known += (known.empty() ? "" : ", ") + std::string(k);
-        throw UsageError("--aov: unknown AOV '" + name + "' (known: " + known + ", all)");
-      }
-      if (!q.path && (name == "samples" || name == "variance" || name == "light"))
-        throw UsageError("--aov " + name + " needs --integrator path");
-      q.aovs.insert(name);
-    }
+    while (std::getline(ss, name, ',')) names.push_back(name);
   }
-  for (const auto& [aov, layer] : {std::pair{"crypto_object", "CryptoObject"},
-                                   {"crypto_material", "CryptoMaterial"},
-                                   {"crypto_asset", "CryptoAsset"}})
-    if (q.aovs.count(aov)) q.crypto.push_back(layer);
+  for (const std::string& name : names) {
+    try {
+      check_aovs({name}, "path");
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--aov: ") + e.what());
+    }
+    if (!q.path && (name == "samples" || name == "variance" || name == "light"))
+      throw UsageError("--aov " + name + " needs --integrator path");
+  }
+  q.aovs = check_aovs(names, a.spec.integrator);
+  q.crypto = crypto_layers(q.aovs);
   if (a.crypto_depth_given && q.crypto.empty())
     throw UsageError("--crypto-depth needs --aov crypto_object, crypto_material or crypto_asset");
-  q.crypto_depth = a.crypto_depth;
+  q.crypto_depth = a.spec.crypto_depth;
   const std::string& c = a.compression;
   if (!q.crypto.empty() && !a.multipart && (c == "pxr24" || c == "dwaa" || c == "dwab"))
     throw UsageError("--compression " + c +
                      " is lossy for float channels and would change the Cryptomatte ids; use a lossless one "
                      "or --multipart (which keeps data layers lossless)");
   q.cost_aov = q.aovs.count("cost") > 0;
-  q.data_aovs = q.aovs.count("albedo") || q.aovs.count("N") || q.aovs.count("P") || q.aovs.count("Z") ||
-                q.aovs.count("UV") || q.aovs.count("id");
+  q.data_aovs = wants_data_aovs(q.aovs);
   if (q.cost_aov) {
     if (!a.no_png) {
       q.cost_png = a.cost_png.empty() ? fs::path(q.out).replace_extension(".cost.png") : fs::path(a.cost_png);
@@ -219,9 +199,57 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
     }
 }
 
+/// The render spec of the checked flags, validated by the library as every front end's is.
+RenderSpec render_spec(const RenderArgs& a, const RenderRequest& q) {
+  RenderSpec spec = a.spec;
+  spec.camera = a.camera;
+  spec.seed = q.seed;
+  if (a.background_given) spec.background = q.background;
+  if (a.ambient_given) spec.ambient = q.ambient;
+  if (q.env_colour)
+    spec.env_color = q.env_colour;
+  else
+    spec.env_map = a.env;
+  spec.accel_params = a.accel_params;
+  spec.aovs = q.aovs;
+  try {
+    validate(spec);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("render settings: ") + e.what());
+  }
+  return spec;
+}
+
 }  // namespace
 
 namespace {
+
+/// The flags hand-declared below, with their own parsing and messages (not from spec_fields()).
+bool hand_declared(const SpecField& f) {
+  return std::string(f.name) == "seed";
+}
+
+/// One flag per field of the render spec's table (render/spec.h): --name-with-dashes bound to
+/// the field, with its help; integer ranges and the choices of string fields checked by the
+/// parser, except the structure's and the filter's names, which check_render_args checks with
+/// the valid names listed.
+void add_spec_options(CLI::App& render, RenderSpec& spec) {
+  for (const SpecField& f : spec_fields()) {
+    if (hand_declared(f)) continue;
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_cvref_t<decltype(spec.*member)>;
+          CLI::Option* o = render.add_option(flag_name(f), spec.*member, f.help);
+          if constexpr (std::is_integral_v<T>) {
+            if (f.lo != 0 || f.hi != 0) o->check(CLI::Range(T(f.lo), T(f.hi)));
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            const std::string name = f.name;
+            if (!f.choices.empty() && name != "accel" && name != "filter") o->check(CLI::IsMember(f.choices));
+          }
+        },
+        f.member);
+  }
+}
 
 /// The scene file, the outputs' paths, the image size and every integrator and sampling flag.
 void add_sampling_options(CLI::App& render, RenderArgs& args) {
@@ -230,74 +258,14 @@ void add_sampling_options(CLI::App& render, RenderArgs& args) {
   render.add_option("--png", args.png,
                     "display image path (.png/.jpg/.tif); default: the EXR path with .png");
   render.add_flag("--no-png", args.no_png, "write only the EXR");
-  render
-      .add_option("--width", args.width,
-                  "image width in pixels (default 960, or from --height and the camera aspect)")
-      ->check(CLI::Range(1, 16384));
-  render.add_option("--height", args.height, "image height in pixels (default: width / camera aspect)")
-      ->check(CLI::Range(1, 16384));
-  render
-      .add_option(
-          "--integrator", args.integrator,
-          "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast), path "
-          "(physically based path tracer) or raster (rasterised preview with Whitted's local shading)")
-      ->check(CLI::IsMember({"whitted", "path", "raster"}));
-  render
-      .add_option("--raster-shadows", args.raster_shadows,
-                  "raster: light visibility by shadow rays (ray, default), shadow maps (map) or none")
-      ->check(CLI::IsMember({"ray", "map", "none"}));
-  render
-      .add_option("--shadow-map-size", args.shadow_map_size,
-                  "raster: shadow map texels on a side (default 1024; point lights: per cube face)")
-      ->check(CLI::Range(16, 8192));
-  render
-      .add_option("--spp", args.spp,
-                  "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)")
-      ->check(CLI::Range(1, 65536));
-  render
-      .add_option("--max-depth", args.max_depth,
-                  "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only "
-                  "(default 12)")
-      ->check(CLI::Range(0, 64));
-  render.add_option("--rr-depth", args.rr_depth, "path: Russian roulette from this bounce on (default 3)")
-      ->check(CLI::Range(1, 64));
-  render.add_option("--clamp-indirect", args.clamp_indirect,
-                    "path: clamp each indirect sample's largest channel to this radiance; biased, trades "
-                    "fireflies for energy (default 0 = off)");
-  render
-      .add_option("--light-sampling", args.light_sampling,
-                  "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single "
-                  "techniques are for validation")
-      ->check(CLI::IsMember({"mis", "bsdf", "light"}));
-  render
-      .add_option("--sampler", args.sampler, "path: sobol (Owen-scrambled, default) or independent (PCG32)")
-      ->check(CLI::IsMember({"sobol", "independent"}));
+  add_spec_options(render, args.spec);
   render.add_option("--env", args.env,
                     "path: environment light: a radiance r,g,b or grey, or an equirectangular map (.exr, "
                     ".hdr, any float image OpenImageIO reads)");
-  render.add_option("--env-intensity", args.env_intensity, "path: multiplies --env (default 1)");
-  render.add_option("--env-rotation", args.env_rotation,
-                    "path: turns the --env map about +Y, degrees (default 0)");
-  render.add_option("--time-limit", args.time_limit,
-                    "path: stop after the pass that would run past this many seconds (default 0 = none)");
-  render.add_option("--adaptive", args.adaptive,
-                    "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is "
-                    "below it (default 0 = off)");
-  render
-      .add_option("--adaptive-min-spp", args.adaptive_min_spp,
-                  "path: samples every pixel takes before --adaptive may stop it (default 16)")
-      ->check(CLI::Range(2, 65536));
-  render.add_option("--filter", args.filter,
-                    "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, "
-                    "blackman-harris for path)");
-  render.add_option("--filter-width", args.filter_width,
-                    "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)");
 }
 
 /// Threads, scene and camera choice, and the acceleration structure.
 void add_scene_options(CLI::App& render, RenderArgs& args) {
-  render.add_option("--threads", args.threads, "worker threads (default 0 = all cores)")
-      ->check(CLI::Range(0, 1024));
   render.add_option("--scene", args.scene, "glTF scene index (default: the file's default scene)")
       ->check(CLI::Range(0, 1 << 30));
   render.add_option("--variant", args.variant,
@@ -307,10 +275,6 @@ void add_scene_options(CLI::App& render, RenderArgs& args) {
                     "camera instance: index as listed by `penumbra info`, or name (default 0; none in the "
                     "file: frame the bounds); with --look-at, --orbit, --euler or --turntable it lends only "
                     "its lens");
-  render.add_option("--accel", args.accel,
-                    "acceleration structure: " + accelerator_list() +
-                        " (embree by default; brute is a linear "
-                        "scan, for tests)");
   render.add_option("--accel-param", args.accel_params, accel_param_help())->type_name("KEY=VALUE");
 }
 
@@ -404,10 +368,6 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "direct/indirect); crypto_object, crypto_material, crypto_asset = Cryptomatte mattes of node, "
       "material and root node names; all = every one of these; cost = traversal cost of the camera rays "
       "(cost_nodes, cost_triangles, cost_shapes, cost_ns) and a heat map");
-  render
-      .add_option("--crypto-depth", args.crypto_depth,
-                  "Cryptomatte ranks (id, coverage pairs) kept per pixel (default 6: three RGBA layers)")
-      ->check(CLI::Range(1, 16));
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }
@@ -451,36 +411,8 @@ RenderRequest check_render_args(const RenderArgs& a) {
   if (a.frame && a.cam.turntable.empty()) q.time = double(frame) / a.fps;
   q.rig = check_camera_args(a.cam, frame);
   q.budget = memory_budget(a.max_memory);
+  q.spec = render_spec(a, q);
   return q;
-}
-
-RenderConfig make_render_config(const RenderArgs& a, const RenderRequest& q, float hint) {
-  RenderConfig cfg;
-  std::tie(cfg.width, cfg.height) = image_size(a.width, a.height, hint);
-  cfg.window = parse_window(a, cfg.width, cfg.height);
-  cfg.spp = a.spp_given ? a.spp : (q.path ? 64 : 4);
-  cfg.threads = a.threads;
-  cfg.seed = q.seed;
-  cfg.filter = make_filter(q.filter_type, q.filter_width);
-  cfg.whitted.max_depth = a.depth_given ? a.max_depth : 5;
-  cfg.whitted.background = q.background;
-  cfg.whitted.ambient = q.ambient;
-  cfg.raster.shadows = a.raster_shadows == "map"    ? RasterShadows::Map
-                       : a.raster_shadows == "none" ? RasterShadows::None
-                                                    : RasterShadows::Ray;
-  cfg.raster.shadow_map_size = a.shadow_map_size;
-  cfg.path.max_depth = a.depth_given ? a.max_depth : 12;
-  cfg.path.rr_depth = a.rr_depth;
-  cfg.path.clamp_indirect = a.clamp_indirect;
-  cfg.path.strategy = a.light_sampling == "bsdf"    ? LightStrategy::Bsdf
-                      : a.light_sampling == "light" ? LightStrategy::Light
-                                                    : LightStrategy::Mis;
-  cfg.sampler = a.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
-  cfg.time_limit = a.time_limit;
-  cfg.adaptive_threshold = a.adaptive;
-  cfg.adaptive_min_spp = a.adaptive_min_spp;
-  cfg.light_groups = q.aovs.count("light") > 0;
-  return cfg;
 }
 
 PixelWindow parse_window(const RenderArgs& a, int width, int height) {

@@ -1,7 +1,7 @@
 // `penumbra render`'s flags and their validation: RenderArgs holds what was typed; check_render_args
 // turns it, before anything is loaded, into a RenderRequest of checked values (outputs resolved
-// and distinct, display transform found, integrator options consistent, AOVs known), so a typo
-// never costs a render. make_render_config maps the request onto the renderer's RenderConfig.
+// and distinct, display transform found, integrator options consistent, AOVs known) with the
+// render spec (render/spec.h) the render session renders, so a typo never costs a render.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -14,6 +14,7 @@
 
 #include "apps/penumbra/camera_options.h"
 #include "io/image/image_output.h"
+#include "render/spec.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/render.h"
 
@@ -24,13 +25,14 @@ struct RenderArgs {
   std::string scene_file, output, png;
   bool multipart = false;
   bool no_png = false, use_float = false, quiet = false, allow_external = false, flatten = false;
-  int width = 0, height = 0, spp = 4, max_depth = 5, threads = 0, scene = -1;
+  int scene = -1;
+  RenderSpec spec;         ///< every flag of the render spec's table (render/spec.h), as typed
   std::string camera;      ///< index or name; empty = the first camera, or framing
   std::string variant;     ///< KHR_materials_variants name; empty = the primitives' own materials
   std::string seed = "0";  ///< parsed as an unsigned 64-bit integer
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
-  std::string accel = "embree", max_memory, debug_pixel, cost_png;
+  std::string max_memory, debug_pixel, cost_png;
   std::vector<std::string> accel_params, aovs;
   std::string command_line, look;
   std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
@@ -38,15 +40,9 @@ struct RenderArgs {
   double checkpoint = 0;          ///< seconds between checkpoints; 0 = none
   std::string stats_json;
   bool resume = false;
-  std::string integrator = "whitted", light_sampling = "mis", sampler = "sobol", filter, env;
-  int rr_depth = 3, adaptive_min_spp = 16;
-  float clamp_indirect = 0, env_intensity = 1, env_rotation = 0, filter_width = 0, adaptive = 0;
-  double time_limit = 0;
-  std::string raster_shadows = "ray";  ///< --raster-shadows: ray, map or none
-  int shadow_map_size = 1024;
+  std::string env;  ///< --env: a radiance r,g,b or grey, or a map file
   bool spp_given = false, depth_given = false, background_given = false, ambient_given = false;
   bool raster_shadows_given = false, shadow_map_size_given = false;
-  int crypto_depth = 6;  ///< Cryptomatte ranks per pixel
   bool crypto_depth_given = false;
   bool png_alpha = false;             ///< the display image keeps the beauty's alpha (RGBA)
   std::optional<double> time;         ///< --time, seconds
@@ -96,15 +92,14 @@ struct RenderRequest {
   /// the files the scene loads, once they are known).
   std::vector<std::pair<std::string, std::filesystem::path>> outputs;
   bool state_beside_output = false;  ///< the resume state path can hold a regular file
+  /// The render spec the flags describe, validated (its window is set once the image size is
+  /// known, by parse_window).
+  RenderSpec spec;
 };
 
 /// Validates every flag in the order README lists the checks. Throws UsageError or InputError
 /// (exit 2) naming the flag; writes nothing.
 RenderRequest check_render_args(const RenderArgs& args);
-
-/// The image size (one of --width/--height follows the camera's aspect `hint`), the --crop or
-/// --tile window, and every integrator setting. Throws UsageError for a window outside the image.
-RenderConfig make_render_config(const RenderArgs& args, const RenderRequest& request, float hint);
 
 /// --crop x0 x1 y0 y1 (integers: pixels; with a '.': fractions of the width or height; x1, y1
 /// exclusive) or --tile i/N (stripe i of N equal bands of rows, top first); empty if neither.

@@ -7,6 +7,7 @@
 #include "apps/penumbra/cli_support.h"
 #include "io/files/error.h"
 #include "render/accel_params.h"
+#include "render/session.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
 
@@ -43,26 +44,7 @@ std::string describe_scene_size(const Scene& scene) {
 }
 
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file) {
-  std::string known;
-  for (size_t i = 0; i < scene.cameras.size(); ++i)
-    known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + scene.cameras[i].name + "'";
-  const std::string listing = scene.cameras.empty() ? "the scene has no camera" : "cameras: " + known;
-  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
-    const unsigned long long i = spec.size() <= 9 ? std::stoull(spec) : ~0ull;
-    if (i >= scene.cameras.size())
-      throw InputError(file, "--camera", "camera " + spec + " does not exist (" + listing + ")");
-    return int(i);
-  }
-  int found = -1;
-  for (size_t i = 0; i < scene.cameras.size(); ++i) {
-    if (scene.cameras[i].name != spec) continue;
-    if (found >= 0)
-      throw InputError(file, "--camera",
-                       "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
-    found = int(i);
-  }
-  if (found < 0) throw InputError(file, "--camera", "no camera named '" + spec + "' (" + listing + ")");
-  return found;
+  return penumbra::find_camera(scene, spec, file, "--camera");
 }
 
 AccelConfig parse_accel(const std::string& name, const std::vector<std::string>& params) {
@@ -81,19 +63,8 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
       throw UsageError("--accel-param " + p + ": a parameter of '" + prefix + "', but --accel is '" + name +
                        "'");
   }
-  validate(config.embree);
-  validate(config.bvh);
-  validate(config.kdtree);
-  validate(config.grid);
+  validate(config);  // every structure's parameters, as every front end checks them
   return config;
-}
-
-std::string accelerator_list() {
-  const std::vector<std::string> names = accelerator_names();
-  std::string list;
-  for (size_t i = 0; i < names.size(); ++i)
-    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-  return list;
 }
 
 std::string accel_param_help() {

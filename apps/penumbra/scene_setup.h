@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "io/gltf/loader.h"
+#include "render/accel_params.h"
 #include "renderer/accel/factory.h"
 
 namespace penumbra::cli {
@@ -36,7 +37,7 @@ AccelConfig parse_accel(const std::string& name, const std::vector<std::string>&
 /// The help text of --accel-param: every key with its default and meaning.
 std::string accel_param_help();
 
-/// Every structure --accel accepts, from the factory's list: "embree, bvh, ..., bsp or brute".
-std::string accelerator_list();
+/// Every structure --accel accepts (render/accel_params.h).
+using penumbra::accelerator_list;
 
 }  // namespace penumbra::cli

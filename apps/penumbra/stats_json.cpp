@@ -12,7 +12,7 @@ namespace penumbra::cli {
 std::string stats_json_text(const RenderJob& job) {
   const RenderArgs& a = job.args;
   const RenderRequest& q = job.request;
-  const RenderStats& stats = job.stats;
+  const RenderStats& stats = job.image.stats;
   const Scene& scene = job.loaded.scene;
   nlohmann::ordered_json j;
   j["version"] = PENUMBRA_VERSION;
@@ -22,19 +22,19 @@ std::string stats_json_text(const RenderJob& job) {
   if (q.png) j["outputs"]["png"] = {{"path", q.png->string()}, {"sha256", job.hashes.png}};
   if (q.cost_png)
     j["outputs"]["cost_png"] = {{"path", q.cost_png->string()}, {"sha256", job.hashes.cost_png}};
-  j["integrator"] = a.integrator;
-  j["width"] = job.cfg.width;
-  j["height"] = job.cfg.height;
-  const Film& f = job.film;
+  j["integrator"] = a.spec.integrator;
+  j["width"] = job.prepared.config.width;
+  j["height"] = job.prepared.config.height;
+  const Film& f = job.image.film;
   j["window"] = {f.origin_x, f.origin_y, f.origin_x + f.width, f.origin_y + f.height};
-  j["spp"] = job.cfg.spp;
+  j["spp"] = job.prepared.config.spp;
   j["mean_spp"] = job.mean_spp;
   j["passes"] = stats.passes;
   j["time_limited"] = stats.time_limited;
   j["interrupted"] = job.interrupted != 0;
   j["threads"] = stats.threads;
-  j["accelerator"] = a.accel;
-  j["accelerator_update"] = job.accel_update;
+  j["accelerator"] = a.spec.accel;
+  j["accelerator_update"] = job.structure.update;
   j["seconds"] = {
       {"load", job.load_s}, {"build", job.build_s}, {"render", stats.seconds}, {"write", job.write_s}};
   j["rays"] = {{"camera", stats.rays.camera},

@@ -60,7 +60,7 @@ Resources task_resources(const PreparedJob& pj) {
   for (size_t s = 0; s < pj.job.shots.size(); ++s) {
     const RenderArgs& args = pj.shot_args[s];
     const std::string& where = pj.job.shots[s].where;
-    if (args.threads <= 0)
+    if (args.spec.threads <= 0)
       throw InputError(
           pj.job.file.string(), where,
           "gives no \"threads\" setting: the CPUs each task asks Slurm for (set it in the job, or "
@@ -70,7 +70,7 @@ Resources task_resources(const PreparedJob& pj) {
           pj.job.file.string(), where,
           "gives no \"max-memory\" setting: the memory each task asks Slurm for (set it in the job, "
           "or --max-memory)");
-    r.cpus = std::max(r.cpus, args.threads);
+    r.cpus = std::max(r.cpus, args.spec.threads);
     r.mem_mib = std::max(r.mem_mib, (parse_bytes(args.max_memory) + (uint64_t(1) << 20) - 1) >> 20);
   }
   r.mem_mib += kTaskOverheadMiB;

@@ -1,0 +1,299 @@
+// The render session's phases.
+#include "render/session.h"
+
+#include <set>
+#include <stdexcept>
+
+#include "io/files/error.h"
+#include "io/files/hash.h"
+#include "io/gltf/id_manifest.h"
+#include "io/image/environment_io.h"
+#include "render/accel_params.h"
+#include "renderer/integrators/raster.h"
+#include "renderer/integrators/scene_accel.h"
+
+namespace penumbra {
+
+namespace {
+
+/// Removes the default key light a render added, however the render ends.
+struct DefaultLightGuard {
+  LoadedScene& loaded;
+  const PreparedRender* prepared = nullptr;
+  ~DefaultLightGuard() {
+    if (prepared) finish_render(loaded, *prepared);
+  }
+};
+
+/// The structure's key: its name and parameters.
+std::string structure_key(const RenderSpec& spec) {
+  std::string key = spec.accel;
+  for (const auto& p : spec.accel_params) key += " " + p;
+  return key;
+}
+
+/// The environment: a constant colour, a map file, else the file's image-based light, else black.
+std::shared_ptr<const Environment> choose_environment(const LoadedScene& loaded, const RenderSpec& s,
+                                                      uint64_t budget) {
+  if (s.env_color)
+    return std::make_shared<Environment>(make_constant_environment(*s.env_color * s.env_intensity));
+  if (!s.env_map.empty())
+    return std::make_shared<Environment>(
+        load_environment(s.env_map, s.env_intensity, s.env_rotation, budget));
+  if (loaded.environment) return loaded.environment;
+  return std::make_shared<Environment>();
+}
+
+}  // namespace
+
+int find_camera(const Scene& scene, const std::string& spec, const std::string& file,
+                const std::string& element) {
+  std::string known;
+  for (size_t i = 0; i < scene.cameras.size(); ++i)
+    known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + scene.cameras[i].name + "'";
+  const std::string listing = scene.cameras.empty() ? "the scene has no camera" : "cameras: " + known;
+  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
+    const unsigned long long i = spec.size() <= 9 ? std::stoull(spec) : ~0ull;
+    if (i >= scene.cameras.size())
+      throw InputError(file, element, "camera " + spec + " does not exist (" + listing + ")");
+    return int(i);
+  }
+  int found = -1;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    if (scene.cameras[i].name != spec) continue;
+    if (found >= 0)
+      throw InputError(file, element,
+                       "camera name '" + spec + "' is ambiguous (" + listing + "); use an index");
+    found = int(i);
+  }
+  if (found < 0) throw InputError(file, element, "no camera named '" + spec + "' (" + listing + ")");
+  return found;
+}
+
+IntegratorType PreparedRender::integrator() const {
+  return spec.integrator == "path"     ? IntegratorType::Path
+         : spec.integrator == "raster" ? IntegratorType::Raster
+                                       : IntegratorType::Whitted;
+}
+
+PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& o) {
+  validate(spec);
+  PreparedRender p;
+  Scene& scene = loaded.scene;
+  p.camera_index = o.camera_index >= -1  ? o.camera_index
+                   : spec.camera.empty() ? (scene.cameras.empty() ? -1 : 0)
+                                         : find_camera(scene, spec.camera, o.scene_file);
+  const Camera* chosen = p.camera_index >= 0 ? &scene.cameras[size_t(p.camera_index)] : nullptr;
+  const float hint = chosen && chosen->aspect > 0 ? chosen->aspect : 16.0f / 9.0f;
+  p.spec = resolve(spec, hint);
+  p.config = make_render_config(p.spec);
+  validate(p.config);
+  const uint64_t env_budget = o.charge_budget ? o.charge_budget(p.config) : o.env_budget;
+  const RenderConfig& cfg = p.config;
+  p.camera = o.place  ? o.place(scene, p.camera_index, cfg.width, cfg.height)
+             : chosen ? *chosen
+                      : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
+  try {
+    validate_camera(p.camera, cfg.width, cfg.height);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(o.scene_file,
+                     p.camera_index >= 0 ? "cameras[" + std::to_string(p.camera_index) + "]" : "the view",
+                     e.what());
+  }
+  // The lights: the environment, the emissive triangles, the default key light.
+  const bool path = p.integrator() == IntegratorType::Path;
+  p.environment = choose_environment(loaded, p.spec, env_budget);
+  if (path)
+    p.area_lights = o.area_lights ? o.area_lights : std::make_shared<AreaLights>(build_area_lights(scene));
+  if (scene.lights.empty() && (!path || (p.area_lights->pmf.empty() && is_black(*p.environment)))) {
+    scene.lights.push_back(default_key_light(p.camera));
+    p.default_light = true;
+  }
+  SceneIdentity identity = o.identity;
+  if (!p.spec.env_color && !p.spec.env_map.empty()) identity.env_sha256 = sha256_file(p.spec.env_map);
+  p.identity = render_identity(p.spec, p.camera, identity);
+  return p;
+}
+
+void finish_render(LoadedScene& loaded, const PreparedRender& prepared) {
+  if (prepared.default_light && !loaded.scene.lights.empty()) loaded.scene.lights.pop_back();
+}
+
+bool needs_structure(const RenderSpec& spec, bool probe) {
+  return spec.integrator != "raster" || spec.raster_shadows == "ray" || spec.aovs.count("cost") ||
+         !crypto_layers(spec.aovs).empty() || probe;
+}
+
+Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world_apart, Structure previous,
+                          bool moved_vertices) {
+  AccelConfig config = accel_config(spec.accel, spec.accel_params);
+  config.embree.world_apart = world_apart;
+  const std::string key = structure_key(spec);
+  if (previous.accel && previous.key == key) {
+    if (!moved_vertices) return previous;
+    const RefitReport r =
+        refit_or_rebuild_scene(previous.accel, previous.built_sah, spec.accel, scene, config);
+    previous.update = r.refitted ? "refitted" : "rebuilt";
+    if (r.refitted) {
+      char growth[64];
+      std::snprintf(growth, sizeof growth, "SAH cost %.3gx its last build's", r.growth);
+      previous.reason = growth;
+    } else {
+      previous.reason = r.reason;
+    }
+    return previous;
+  }
+  previous.accel.reset();  // its memory is free before the new one is built
+  Structure s;
+  s.accel = make_scene_accelerator(spec.accel, scene, config);
+  s.key = key;
+  s.built_sah = s.accel->stats().sah_cost;
+  return s;
+}
+
+RenderImage render_image(const Scene& scene, const Accelerator* accel, const PreparedRender& p,
+                         const RenderHooks& hooks) {
+  RenderImage out;
+  RenderConfig cfg = p.config;
+  if (hooks.stop) cfg.stop = hooks.stop;
+  switch (p.integrator()) {
+    case IntegratorType::Path: {
+      PathAccumulators own;
+      PathAccumulators* state = hooks.resume ? hooks.resume : &own;
+      PathImage image = render_path(scene, *accel, p.path_lights(), p.camera, cfg, &out.stats, hooks.progress,
+                                    state, hooks.after_pass);
+      out.film = std::move(image.film);
+      out.samples = std::move(image.samples);
+      out.variance = std::move(image.variance);
+      out.groups = std::move(image.groups);
+      out.complete = state->complete;
+      break;
+    }
+    case IntegratorType::Raster:
+      out.film = render_raster(scene, accel, p.camera, cfg, &out.stats, hooks.progress);
+      break;
+    case IntegratorType::Whitted:
+      out.film = render_whitted(scene, *accel, p.camera, cfg, &out.stats, hooks.progress);
+      break;
+  }
+  return out;
+}
+
+void render_pixel(const Scene& scene, const Accelerator* accel, const PreparedRender& p, int x, int y,
+                  float rgba[4], RayCounts& counts) {
+  switch (p.integrator()) {
+    case IntegratorType::Path:
+      render_path_pixel(scene, *accel, p.path_lights(), p.camera, p.config, x, y, rgba, counts);
+      break;
+    case IntegratorType::Raster: {
+      RenderConfig one = p.config;
+      one.window = {x, y, x + 1, y + 1};
+      RenderStats st;
+      const Film f = render_raster(scene, accel, p.camera, one, &st);
+      for (int c = 0; c < 4; ++c) rgba[c] = f.rgba[size_t(c)];
+      counts = st.rays;
+      break;
+    }
+    case IntegratorType::Whitted:
+      render_whitted_pixel(scene, *accel, p.camera, p.config, x, y, rgba, counts);
+      break;
+  }
+}
+
+std::vector<std::string> crypto_layers(const std::set<std::string>& aovs) {
+  std::vector<std::string> layers;
+  for (const auto& [aov, layer] : {std::pair{"crypto_object", "CryptoObject"},
+                                   {"crypto_material", "CryptoMaterial"},
+                                   {"crypto_asset", "CryptoAsset"}})
+    if (aovs.count(aov)) layers.push_back(layer);
+  return layers;
+}
+
+bool wants_data_aovs(const std::set<std::string>& aovs) {
+  for (const char* name : {"albedo", "N", "P", "Z", "UV", "id"})
+    if (aovs.count(name)) return true;
+  return false;
+}
+
+std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
+                                               const std::string& layer) {
+  auto node_name = [&](int n) {
+    return size_t(n) < info.node_names.size() ? info.node_names[size_t(n)]
+                                              : "nodes[" + std::to_string(n) + "]";
+  };
+  std::vector<std::string> names;
+  names.reserve(scene.instances.size());
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (layer == "CryptoMaterial") {
+      const int m = instance_material(scene, inst);
+      names.push_back(m >= 0 ? scene.materials[size_t(m)].name : "default");
+    } else if (inst.node < 0) {
+      names.push_back("instances[" + std::to_string(i) + "]");
+    } else if (layer == "CryptoAsset") {
+      int root = inst.node;  // the topmost ancestor (bounded: the loader rejects cycles)
+      for (size_t step = 0; step < info.node_parents.size() && size_t(root) < info.node_parents.size() &&
+                            info.node_parents[size_t(root)] >= 0;
+           ++step)
+        root = info.node_parents[size_t(root)];
+      names.push_back(node_name(root));
+    } else {
+      names.push_back(node_name(inst.node));
+    }
+  }
+  return names;
+}
+
+RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, const PreparedRender& p) {
+  RenderLayers out;
+  const Scene& scene = loaded.scene;
+  const IntegratorType integrator = p.integrator();
+  if (wants_data_aovs(p.spec.aovs))
+    out.data = integrator == IntegratorType::Raster
+                   ? render_raster_aovs(scene, p.camera, p.config)
+                   : render_data_aovs(scene, *accel, p.camera, p.config, integrator);
+  if (p.spec.aovs.count("id")) out.id_manifest = id_manifest(scene, loaded.info);
+  if (p.spec.aovs.count("cost")) out.cost = render_cost(*accel, p.camera, p.config, integrator);
+  const std::vector<std::string> crypto = crypto_layers(p.spec.aovs);
+  if (crypto.empty()) return out;
+  std::vector<CryptoLayerIds> layers;
+  for (const std::string& layer : crypto) {
+    CryptoLayerIds ids{layer, {}};
+    std::set<std::string> names;
+    for (const std::string& name : crypto_instance_names(scene, loaded.info, layer)) {
+      ids.instance_ids.push_back(crypto_id(name));
+      names.insert(name);
+    }
+    std::string manifest = "{";
+    for (const std::string& name : names)
+      manifest +=
+          (manifest.size() > 1 ? "," : "") + json_quote(name) + ":" + json_quote(crypto_hex(crypto_id(name)));
+    out.crypto_manifests.push_back(manifest + "}");
+    layers.push_back(std::move(ids));
+  }
+  out.crypto = render_cryptomatte(scene, *accel, p.camera, p.config, integrator, layers, p.spec.crypto_depth);
+  return out;
+}
+
+RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget) {
+  validate(spec);
+  std::lock_guard<std::mutex> lock(session.mutex);
+  PrepareOptions options;
+  options.scene_file = session.file;
+  options.env_budget = env_budget;
+  options.area_lights = session.area_lights;
+  RenderResult r;
+  r.prepared = prepare_render(session.loaded, spec, options);
+  DefaultLightGuard guard{session.loaded, &r.prepared};
+  if (r.prepared.area_lights) session.area_lights = r.prepared.area_lights;
+  const Scene& scene = session.loaded.scene;
+  // An animated scene loaded at a time keeps Embree's still placements apart, as the command does.
+  const bool world_apart = session.loaded.info.animation_count != 0 && session.loaded_at_time;
+  session.structure = build_structure(scene, spec, world_apart, std::move(session.structure));
+  const Accelerator* accel = session.structure.accel.get();
+  r.image = render_image(scene, accel, r.prepared);
+  r.layers = render_layers(session.loaded, accel, r.prepared);
+  return r;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,450 @@
+// The render settings spec: its table of fields, checks, defaults and identity.
+#include "render/spec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "render/accel_params.h"
+#include "renderer/accel/factory.h"
+#include "renderer/film/filter.h"
+
+#ifndef PENUMBRA_VERSION
+#define PENUMBRA_VERSION "unknown"
+#endif
+
+namespace penumbra {
+
+namespace {
+
+constexpr double kAny = std::numeric_limits<double>::infinity();
+
+std::string join(const std::vector<std::string>& names, const char* last = ", ") {
+  std::string r;
+  for (size_t i = 0; i < names.size(); ++i)
+    r += (i == 0 ? "" : i + 1 == names.size() ? last : ", ") + names[i];
+  return r;
+}
+
+/// Shortest text that reads back to the same float or double.
+template <class T>
+std::string exact(T v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", std::numeric_limits<T>::max_digits10, double(v));
+  return buf;
+}
+
+std::string colour_text(Vec3f c) {
+  return exact(c.x) + "," + exact(c.y) + "," + exact(c.z);
+}
+
+std::vector<SpecField> make_fields() {
+  using S = RenderSpec;
+  const std::vector<std::string> filters = {"box", "tent", "gaussian", "blackman-harris"};
+  return {
+      {"width",
+       &S::width,
+       kAnyIntegrator,
+       true,
+       1,
+       16384,
+       {},
+       "image width in pixels (default 960, or from --height and the camera aspect)"},
+      {"height",
+       &S::height,
+       kAnyIntegrator,
+       true,
+       1,
+       16384,
+       {},
+       "image height in pixels (default: width / camera aspect)"},
+      {"integrator",
+       &S::integrator,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {"whitted", "path", "raster"},
+       "whitted (default: Blinn-Phong shading, shadows and mirror reflections; fast), path (physically based "
+       "path tracer) or raster (rasterised preview with Whitted's local shading)"},
+      {"raster_shadows",
+       &S::raster_shadows,
+       kRaster,
+       true,
+       0,
+       0,
+       {"ray", "map", "none"},
+       "raster: light visibility by shadow rays (ray, default), shadow maps (map) or none"},
+      {"shadow_map_size",
+       &S::shadow_map_size,
+       kRaster,
+       true,
+       16,
+       8192,
+       {},
+       "raster: shadow map texels on a side (default 1024; point lights: per cube face)"},
+      {"spp",
+       &S::spp,
+       kAnyIntegrator,
+       false,
+       1,
+       65536,
+       {},
+       "samples per pixel (default 4 for whitted, 64 for path; with --adaptive the maximum)"},
+      {"max_depth",
+       &S::max_depth,
+       kWhitted | kPath,
+       true,
+       0,
+       64,
+       {},
+       "whitted: maximum mirror bounces (default 5); path: maximum bounces, 0 = direct light only (default "
+       "12)"},
+      {"rr_depth",
+       &S::rr_depth,
+       kPath,
+       true,
+       1,
+       64,
+       {},
+       "path: Russian roulette from this bounce on (default 3)"},
+      {"clamp_indirect",
+       &S::clamp_indirect,
+       kPath,
+       true,
+       0,
+       kAny,
+       {},
+       "path: clamp each indirect sample's largest channel to this radiance; biased, trades fireflies for "
+       "energy (default 0 = off)"},
+      {"light_sampling",
+       &S::light_sampling,
+       kPath,
+       true,
+       0,
+       0,
+       {"mis", "bsdf", "light"},
+       "path: mis (default), bsdf (BSDF sampling only) or light (light sampling only); the single techniques "
+       "are for validation"},
+      {"sampler",
+       &S::sampler,
+       kPath,
+       true,
+       0,
+       0,
+       {"sobol", "independent"},
+       "path: sobol (Owen-scrambled, default) or independent (PCG32)"},
+      {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
+      {"env_rotation",
+       &S::env_rotation,
+       kPath,
+       true,
+       -kAny,
+       kAny,
+       {},
+       "path: turns the --env map about +Y, degrees (default 0)"},
+      {"time_limit",
+       &S::time_limit,
+       kPath,
+       false,
+       0,
+       kAny,
+       {},
+       "path: stop after the pass that would run past this many seconds (default 0 = none)"},
+      {"adaptive",
+       &S::adaptive,
+       kPath,
+       true,
+       0,
+       kAny,
+       {},
+       "path: adaptive sampling threshold, e.g. 0.01: a pixel stops once its error estimate is below it "
+       "(default 0 = off)"},
+      {"adaptive_min_spp",
+       &S::adaptive_min_spp,
+       kPath,
+       true,
+       2,
+       65536,
+       {},
+       "path: samples every pixel takes before --adaptive may stop it (default 16)"},
+      {"filter", &S::filter, kAnyIntegrator, true, 0, 0, filters,
+       "pixel filter: box, tent, gaussian or blackman-harris (default: box for whitted, blackman-harris for "
+       "path)"},
+      {"filter_width",
+       &S::filter_width,
+       kAnyIntegrator,
+       true,
+       0,
+       16,
+       {},
+       "pixel filter width in pixels (default: box 1, tent 2, gaussian 3, blackman-harris 1.5)"},
+      {"seed",
+       &S::seed,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "sampler seed, an integer in [0, 2^64 - 1] (default 0)"},
+      {"threads", &S::threads, kAnyIntegrator, false, 0, 1024, {}, "worker threads (default 0 = all cores)"},
+      {"tile_size",
+       &S::tile_size,
+       kAnyIntegrator,
+       false,
+       1,
+       4096,
+       {},
+       "pixels on a side of the tiles threads take (default 32; does not change pixels)"},
+      {"accel", &S::accel, kAnyIntegrator, true, 0, 0, accelerator_names(),
+       "acceleration structure: " + accelerator_list() +
+           " (default embree; brute is a linear scan, for tests)"},
+      {"crypto_depth",
+       &S::crypto_depth,
+       kAnyIntegrator,
+       false,
+       1,
+       16,
+       {},
+       "Cryptomatte ranks (id, coverage pairs) kept per pixel (default 6: three RGBA layers)"},
+  };
+}
+
+const char* integrator_names(unsigned mask) {
+  switch (mask) {
+    case kWhitted:
+      return "'whitted'";
+    case kPath:
+      return "'path'";
+    case kRaster:
+      return "'raster'";
+    case kWhitted | kPath:
+      return "'whitted' or 'path'";
+    case kWhitted | kRaster:
+      return "'whitted' or 'raster'";
+    default:
+      return "'path' or 'raster'";
+  }
+}
+
+/// Range, choices and integrator of one field. `defaults` is a default-constructed spec.
+void check_field(const RenderSpec& s, const SpecField& f, const RenderSpec& defaults) {
+  const bool is_default = field_text(s, f) == field_text(defaults, f);
+  std::visit(
+      [&](auto member) {
+        using T = std::remove_cvref_t<decltype(s.*member)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          const std::string& v = s.*member;
+          if (!f.choices.empty() && !is_default &&
+              std::find(f.choices.begin(), f.choices.end(), v) == f.choices.end())
+            throw std::invalid_argument(std::string(f.name) + ": unknown value '" + v +
+                                        "' (known: " + join(f.choices) + ")");
+        } else if (f.lo != 0 || f.hi != 0) {
+          const double v = double(s.*member);
+          if (is_default) return;
+          if (std::isinf(f.hi)) {
+            if (!std::isfinite(v) || v < f.lo)
+              throw std::invalid_argument(std::string(f.name) + " must be finite" +
+                                          (std::isinf(f.lo) ? "" : " and >= " + exact(f.lo)));
+          } else if (!(v >= f.lo && v <= f.hi)) {
+            throw std::invalid_argument(std::string(f.name) + " must be in [" + exact(f.lo) + ", " +
+                                        exact(f.hi) + "] (" + field_text(defaults, f) + ": the default)");
+          }
+        }
+      },
+      f.member);
+  if (!is_default && !(f.applies & integrator_bit(s.integrator)))
+    throw std::invalid_argument(std::string(f.name) + " needs integrator " + integrator_names(f.applies));
+}
+
+void check_colour(const char* setting, const std::optional<Vec3f>& c) {
+  if (!c) return;
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite((*c)[k]) || (*c)[k] < 0)
+      throw std::invalid_argument(std::string(setting) + " must be finite and >= 0 in every channel");
+}
+
+/// The colours and the environment: each finite and non-negative, each of its integrator.
+void check_lights(const RenderSpec& s) {
+  check_colour("background", s.background);
+  check_colour("ambient", s.ambient);
+  check_colour("env_color", s.env_color);
+  if (s.env_color && !s.env_map.empty())
+    throw std::invalid_argument("env_color and env_map exclude each other");
+  const bool path = s.integrator == "path";
+  if (path && (s.background || s.ambient))
+    throw std::invalid_argument(std::string(s.background ? "background" : "ambient") +
+                                " applies to integrator 'whitted'; the path tracer is lit by the scene's "
+                                "lights and env_color / env_map");
+  if (!path && (s.env_color || !s.env_map.empty()))
+    throw std::invalid_argument(std::string(s.env_color ? "env_color" : "env_map") +
+                                " needs integrator 'path'");
+}
+
+}  // namespace
+
+const std::vector<SpecField>& spec_fields() {
+  static const std::vector<SpecField> fields = make_fields();
+  return fields;
+}
+
+std::string flag_name(const SpecField& field) {
+  std::string f = std::string("--") + field.name;
+  std::replace(f.begin(), f.end(), '_', '-');
+  return f;
+}
+
+std::string field_text(const RenderSpec& spec, const SpecField& field) {
+  return std::visit(
+      [&](auto member) -> std::string {
+        using T = std::remove_cvref_t<decltype(spec.*member)>;
+        if constexpr (std::is_same_v<T, std::string>)
+          return spec.*member;
+        else if constexpr (std::is_floating_point_v<T>)
+          return exact(spec.*member);
+        else
+          return std::to_string(spec.*member);
+      },
+      field.member);
+}
+
+unsigned integrator_bit(const std::string& integrator) {
+  return integrator == "path" ? kPath : integrator == "raster" ? kRaster : kWhitted;
+}
+
+const std::vector<std::string>& aov_names() {
+  static const std::vector<std::string> names = {"albedo",
+                                                 "N",
+                                                 "P",
+                                                 "Z",
+                                                 "UV",
+                                                 "id",
+                                                 "samples",
+                                                 "variance",
+                                                 "light",
+                                                 "cost",
+                                                 "crypto_object",
+                                                 "crypto_material",
+                                                 "crypto_asset"};
+  return names;
+}
+
+std::set<std::string> check_aovs(const std::vector<std::string>& names, const std::string& integrator,
+                                 const std::vector<std::string>& known) {
+  const bool path = integrator == "path";
+  const auto is_path_layer = [](const std::string& n) {
+    return n == "samples" || n == "variance" || n == "light";
+  };
+  std::set<std::string> aovs;
+  for (const auto& name : names) {
+    if (name == "all") {
+      for (const auto& n : known)
+        if (n != "cost" && (path || !is_path_layer(n))) aovs.insert(n);
+      continue;
+    }
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw std::invalid_argument("unknown AOV '" + name + "' (known: " + join(known) + ", all)");
+    if (!path && is_path_layer(name)) throw std::invalid_argument("'" + name + "' needs integrator 'path'");
+    aovs.insert(name);
+  }
+  return aovs;
+}
+
+void validate(const RenderSpec& s) {
+  const RenderSpec defaults;
+  // The integrator first: every other field's check depends on it.
+  for (const SpecField& f : spec_fields())
+    if (std::string(f.name) == "integrator") check_field(s, f, defaults);
+  for (const SpecField& f : spec_fields()) check_field(s, f, defaults);
+  if (s.width < 0 || s.height < 0) throw std::invalid_argument("width and height must be >= 0");
+  check_lights(s);
+  accel_config(s.accel, s.accel_params);
+  for (const auto& name : s.aovs) check_aovs({name}, s.integrator, aov_names());
+  // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
+  RenderConfig probe = make_render_config(resolve(s, 16.0f / 9.0f));
+  probe.window = {};
+  validate(probe);
+}
+
+RenderSpec resolve(const RenderSpec& s, float hint) {
+  RenderSpec r = s;
+  const bool path = s.integrator == "path";
+  if (!r.width && !r.height) r.width = 960;
+  if (!r.height) r.height = std::max(1, int(std::lround(float(r.width) / hint)));
+  if (!r.width) r.width = std::max(1, int(std::lround(float(r.height) * hint)));
+  if (r.spp <= 0) r.spp = path ? 64 : 4;
+  FilterType type = path ? FilterType::BlackmanHarris : FilterType::Box;
+  if (!r.filter.empty()) parse_filter_type(r.filter, type);
+  r.filter = filter_name(type);
+  if (!(r.filter_width > 0)) r.filter_width = default_filter_width(type);
+  if (r.max_depth < 0) r.max_depth = path ? 12 : 5;
+  return r;
+}
+
+RenderConfig make_render_config(const RenderSpec& r) {
+  RenderConfig cfg;
+  cfg.width = r.width;
+  cfg.height = r.height;
+  cfg.window = r.window;
+  cfg.spp = r.spp;
+  cfg.threads = r.threads;
+  cfg.tile_size = r.tile_size;
+  cfg.seed = r.seed;
+  FilterType type = FilterType::Box;
+  parse_filter_type(r.filter, type);
+  cfg.filter = make_filter(type, r.filter_width);
+  cfg.whitted.max_depth = r.max_depth;
+  cfg.whitted.background = r.background.value_or(Vec3f{0, 0, 0});
+  cfg.whitted.ambient = r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f});
+  cfg.raster.shadows = r.raster_shadows == "map"    ? RasterShadows::Map
+                       : r.raster_shadows == "none" ? RasterShadows::None
+                                                    : RasterShadows::Ray;
+  cfg.raster.shadow_map_size = r.shadow_map_size;
+  cfg.path.max_depth = r.max_depth;
+  cfg.path.rr_depth = r.rr_depth;
+  cfg.path.clamp_indirect = r.clamp_indirect;
+  cfg.path.strategy = r.light_sampling == "bsdf"    ? LightStrategy::Bsdf
+                      : r.light_sampling == "light" ? LightStrategy::Light
+                                                    : LightStrategy::Mis;
+  cfg.sampler = r.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
+  cfg.time_limit = r.time_limit;
+  cfg.adaptive_threshold = r.adaptive;
+  cfg.adaptive_min_spp = r.adaptive_min_spp;
+  cfg.light_groups = r.aovs.count("light") > 0;
+  return cfg;
+}
+
+RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const SceneIdentity& scene) {
+  std::map<std::string, std::string> e;
+  e["version"] = PENUMBRA_VERSION;  // another renderer version may sample differently
+  e["scene.sha256"] = scene.sha256;
+  e["scene.index"] = std::to_string(scene.index);
+  e["scene.flatten"] = scene.flatten ? "1" : "0";
+  e["scene.variant"] = scene.variant.empty() ? "none" : scene.variant;
+  e["scene.time"] = scene.time;
+  e["camera"] = scene.camera.empty() ? "default '" + camera.name + "'" : scene.camera;
+  // The camera as rendered, whichever flags or file placed it.
+  const auto vec = [](Vec3f v) { return exact(v.x) + "," + exact(v.y) + "," + exact(v.z); };
+  e["camera.frame"] = vec(camera.eye) + " u " + vec(camera.u) + " v " + vec(camera.v) + " w " + vec(camera.w);
+  e["camera.lens"] =
+      (camera.projection == Projection::Orthographic ? "orthographic ymag " + exact(camera.ymag)
+                                                     : "perspective yfov " + exact(camera.yfov)) +
+      " near " + exact(camera.znear) + " far " + exact(camera.zfar);
+  const unsigned bit = integrator_bit(r.integrator);
+  for (const SpecField& f : spec_fields())
+    if (f.identity && (f.applies & bit)) e[f.name] = field_text(r, f);
+  for (const auto& p : r.accel_params) e["accel." + p.substr(0, p.find('='))] = p.substr(p.find('=') + 1);
+  if (bit == kPath) {
+    e["env"] = r.env_color ? colour_text(*r.env_color) : r.env_map.empty() ? "none" : r.env_map;
+    if (!scene.env_sha256.empty()) e["env.sha256"] = scene.env_sha256;
+    e["light_groups"] = r.aovs.count("light") ? "1" : "0";
+  } else {
+    e["background"] = colour_text(r.background.value_or(Vec3f{0, 0, 0}));
+    e["ambient"] = colour_text(r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f}));
+  }
+  return {e};
+}
+
+}  // namespace penumbra

@@ -1,0 +1,127 @@
+// The render session: its phases against the integrators called directly, the default key
+// light added and removed, the structure kept between renders, and the front ends' one path.
+#include "render/session.h"
+
+#include <catch2/catch.hpp>
+
+#include "io/files/error.h"
+#include "renderer/integrators/raster.h"
+#include "renderer/integrators/scene_accel.h"
+#include "support/scene_builder.h"
+#include "support/test_util.h"
+
+namespace penumbra {
+namespace {
+
+LoadedScene default_scene() {
+  return load_gltf(test::source_dir() / "scenes/default.gltf");
+}
+
+RenderSpec small(const char* integrator) {
+  RenderSpec s;
+  s.integrator = integrator;
+  s.width = 24;
+  s.height = 16;
+  s.spp = 2;
+  s.accel = "bvh";
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("session: one signature renders what each integrator renders when called directly", "[session]") {
+  LoadedScene loaded = default_scene();
+  for (const char* integrator : {"whitted", "path", "raster"}) {
+    INFO(integrator);
+    const RenderSpec spec = small(integrator);
+    PrepareOptions o;
+    o.scene_file = "default.gltf";
+    PreparedRender p = prepare_render(loaded, spec, o);
+    REQUIRE(p.config.width == 24);
+    REQUIRE(p.config.height == 16);
+    const Structure s = build_structure(loaded.scene, p.spec, false);
+    REQUIRE(s.accel);
+    CHECK(s.update == "built");
+    const RenderImage image = render_image(loaded.scene, s.accel.get(), p);
+    Film direct;
+    if (p.integrator() == IntegratorType::Path)
+      direct = render_path(loaded.scene, *s.accel, p.path_lights(), p.camera, p.config).film;
+    else if (p.integrator() == IntegratorType::Raster)
+      direct = render_raster(loaded.scene, s.accel.get(), p.camera, p.config);
+    else
+      direct = render_whitted(loaded.scene, *s.accel, p.camera, p.config);
+    CHECK(image.film.rgba == direct.rgba);
+    CHECK(image.complete);
+    finish_render(loaded, p);
+  }
+}
+
+TEST_CASE("session: the default key light lights an unlit scene for one render only", "[session]") {
+  LoadedScene loaded;  // one white quad seen by the camera that frames it, and no light
+  loaded.scene.materials.push_back(Material{});
+  test::add_quad_z(loaded.scene, -1, 1, -1, 1, 0, 0);
+  Session session;
+  session.file = "default.gltf";
+  session.loaded = std::move(loaded);
+  const RenderResult r = render_scene(session, small("whitted"), 0);
+  CHECK(r.prepared.default_light);
+  CHECK(session.loaded.scene.lights.empty());
+  // Lit by exactly the default key light: the same image as the scene with that light added.
+  Scene lit = session.loaded.scene;
+  lit.lights.push_back(default_key_light(r.prepared.camera));
+  const auto accel = make_scene_accelerator("bvh", lit);
+  CHECK(render_whitted(lit, *accel, r.prepared.camera, r.prepared.config).rgba == r.image.film.rgba);
+  const Film unlit = render_whitted(session.loaded.scene, *accel, r.prepared.camera, r.prepared.config);
+  CHECK(unlit.rgba != r.image.film.rgba);
+}
+
+TEST_CASE("session: the structure is kept while its name and parameters stay, rebuilt when they change",
+          "[session]") {
+  Session session;
+  session.file = "default.gltf";
+  session.loaded = default_scene();
+  render_scene(session, small("whitted"), 0);
+  const Accelerator* first = session.structure.accel.get();
+  REQUIRE(first);
+  render_scene(session, small("whitted"), 0);
+  CHECK(session.structure.accel.get() == first);
+  CHECK(session.structure.update == "built");
+  RenderSpec other = small("whitted");
+  other.accel_params = {"bvh.max_leaf_size=2"};
+  render_scene(session, other, 0);
+  CHECK(session.structure.key == "bvh bvh.max_leaf_size=2");
+}
+
+TEST_CASE("session: layers come from the beauty's samples and the identity from the spec", "[session]") {
+  Session session;
+  session.file = "default.gltf";
+  session.loaded = default_scene();
+  RenderSpec spec = small("path");
+  spec.aovs = {"albedo", "id", "crypto_object", "cost"};
+  const RenderResult r = render_scene(session, spec, 0);
+  const size_t pixels = 24 * 16;
+  CHECK(r.layers.data.albedo.size() == pixels * 3);
+  CHECK(r.layers.data.object_id.size() == pixels);
+  CHECK_FALSE(r.layers.id_manifest.empty());
+  REQUIRE(r.layers.crypto_manifests.size() == 1);
+  CHECK(r.layers.crypto.layers.size() == 1);
+  CHECK(r.layers.cost.nanoseconds.size() == pixels);
+  const RenderSettings again = render_identity(r.prepared.spec, r.prepared.camera, {});
+  CHECK(canonical_text(again) == canonical_text(r.prepared.identity));
+  CHECK(r.prepared.identity.entries.at("integrator") == "path");
+  CHECK(r.prepared.identity.entries.at("accel") == "bvh");
+}
+
+TEST_CASE("session: a camera that does not exist is an InputError naming the file", "[session]") {
+  LoadedScene loaded = default_scene();
+  RenderSpec spec = small("whitted");
+  spec.camera = "7";
+  PrepareOptions o;
+  o.scene_file = "default.gltf";
+  CHECK_THROWS_AS(prepare_render(loaded, spec, o), InputError);
+  spec.camera = "no such camera";
+  CHECK_THROWS_WITH(prepare_render(loaded, spec, o),
+                    Catch::Contains("default.gltf") && Catch::Contains("no camera named"));
+}
+
+}  // namespace penumbra

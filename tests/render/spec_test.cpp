@@ -1,0 +1,168 @@
+// The render spec: every field of its table checked, resolved and written into the identity.
+#include "render/spec.h"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <stdexcept>
+#include <variant>
+
+namespace penumbra {
+namespace {
+
+/// A value other than the default that the field accepts under `integrator`.
+void perturb(RenderSpec& s, const SpecField& f) {
+  std::visit(
+      [&](auto member) {
+        using T = std::remove_cvref_t<decltype(s.*member)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          if (f.name == std::string("filter")) {  // differs from both integrators' defaults
+            s.*member = "gaussian";
+            return;
+          }
+          for (const auto& c : f.choices)
+            if (c != s.*member && !(f.name == std::string("integrator"))) {
+              s.*member = c;
+              return;
+            }
+        } else if constexpr (std::is_floating_point_v<T>) {
+          s.*member = T(std::isinf(f.hi) ? std::max(f.lo, 0.0) + 0.25 : (f.lo + f.hi) / 2 + 0.125);
+        } else if (f.lo != 0 || f.hi != 0) {
+          s.*member = T(f.lo + 1 == double(s.*member) ? f.lo + 2 : f.lo + 1);
+        } else {
+          s.*member = T(s.*member + 7);
+        }
+      },
+      f.member);
+}
+
+RenderSpec with_integrator(const char* integrator) {
+  RenderSpec s;
+  s.integrator = integrator;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("spec: every field has a flag name and a help line", "[spec]") {
+  std::set<std::string> names;
+  for (const SpecField& f : spec_fields()) {
+    INFO(f.name);
+    CHECK(names.insert(f.name).second);
+    CHECK_FALSE(f.help.empty());
+    CHECK(flag_name(f).rfind("--", 0) == 0);
+    CHECK(flag_name(f).find('_') == std::string::npos);
+  }
+  CHECK(flag_name(spec_fields().front()) == "--width");
+}
+
+TEST_CASE("spec: every identity field changes the identity, the others do not", "[spec]") {
+  for (const char* integrator : {"whitted", "path", "raster"}) {
+    const RenderSpec base = with_integrator(integrator);
+    const Camera cam = frame_bounds(Bounds3f{{-1, -1, -1}, {1, 1, 1}}, 1.5f);
+    const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
+    for (const SpecField& f : spec_fields()) {
+      if (f.name == std::string("integrator") || !(f.applies & integrator_bit(integrator))) continue;
+      RenderSpec changed = base;
+      perturb(changed, f);
+      INFO(integrator << " " << f.name << " = " << field_text(changed, f));
+      REQUIRE(field_text(changed, f) != field_text(base, f));
+      REQUIRE_NOTHROW(validate(changed));
+      const RenderSettings id = render_identity(resolve(changed, 1.5f), cam, {});
+      if (f.identity)
+        CHECK(canonical_text(id) != canonical_text(reference));
+      else
+        CHECK(canonical_text(id) == canonical_text(reference));
+    }
+  }
+}
+
+TEST_CASE("spec: a field of another integrator, out of range or of no known value is refused by name",
+          "[spec]") {
+  for (const SpecField& f : spec_fields()) {
+    INFO(f.name);
+    for (const char* integrator : {"whitted", "path", "raster"}) {
+      if (f.applies & integrator_bit(integrator)) continue;
+      RenderSpec s = with_integrator(integrator);
+      perturb(s, f);
+      CHECK_THROWS_WITH(validate(s), Catch::Contains(std::string(f.name) + " needs integrator"));
+    }
+    RenderSpec s = with_integrator(f.applies & kPath ? "path" : f.applies & kWhitted ? "whitted" : "raster");
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_cvref_t<decltype(s.*member)>;
+          if constexpr (std::is_same_v<T, std::string>) {
+            if (f.choices.empty()) return;
+            s.*member = "no-such-value";
+            CHECK_THROWS_WITH(validate(s), Catch::Contains(std::string(f.name) + ": unknown value"));
+          } else if (f.lo != 0 || f.hi != 0) {
+            if (!std::isinf(f.hi)) {
+              s.*member = T(f.hi + 1);
+              CHECK_THROWS_WITH(validate(s), Catch::StartsWith(std::string(f.name) + " must be"));
+            }
+            const RenderSpec defaults;
+            if (!std::isinf(f.lo) && T(f.lo - 1) < T(f.lo) && T(f.lo - 1) != defaults.*member) {
+              s.*member = T(f.lo - 1);
+              CHECK_THROWS_WITH(validate(s), Catch::StartsWith(std::string(f.name) + " must be"));
+            }
+          }
+        },
+        f.member);
+  }
+}
+
+TEST_CASE("spec: colours, environments and the structure's parameters are checked", "[spec]") {
+  RenderSpec s = with_integrator("path");
+  s.background = Vec3f{1, 1, 1};
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("background applies to integrator 'whitted'"));
+  s = with_integrator("whitted");
+  s.env_color = Vec3f{1, 1, 1};
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("env_color needs integrator 'path'"));
+  s = with_integrator("path");
+  s.env_color = Vec3f{1, -1, 1};
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("env_color must be finite and >= 0"));
+  s = RenderSpec{};
+  s.accel = "bvh";
+  s.accel_params = {"kdtree.max_depth=4"};
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("a parameter of 'kdtree', but accel is 'bvh'"));
+  // Every structure's parameters are range-checked, the octree's and the BSP's included.
+  for (const auto& [accel, param] : {std::pair{"octree", "octree.max_depth=99"},
+                                     {"bsp", "bsp.traversal_cost=-1"},
+                                     {"kdtree", "kdtree.max_depth=9999"},
+                                     {"grid", "grid.lambda=-1"}}) {
+    s.accel = accel;
+    s.accel_params = {param};
+    INFO(param);
+    CHECK_THROWS_AS(validate(s), std::invalid_argument);
+  }
+  s = RenderSpec{};
+  s.aovs = {"samples"};
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("'samples' needs integrator 'path'"));
+  CHECK_THROWS_WITH(check_aovs({"depth"}, "path"), Catch::Contains("unknown AOV 'depth'"));
+  CHECK(check_aovs({"all"}, "whitted").count("samples") == 0);
+  CHECK(check_aovs({"all"}, "path").count("samples") == 1);
+  CHECK(check_aovs({"all"}, "path").count("cost") == 0);
+}
+
+TEST_CASE("spec: defaults resolve per integrator and follow the aspect hint", "[spec]") {
+  const RenderSpec w = resolve(with_integrator("whitted"), 2.0f);
+  CHECK(w.width == 960);
+  CHECK(w.height == 480);
+  CHECK(w.spp == 4);
+  CHECK(w.max_depth == 5);
+  CHECK(w.filter == "box");
+  CHECK(w.filter_width == 1.0f);
+  RenderSpec p = with_integrator("path");
+  p.height = 100;
+  p = resolve(p, 2.0f);
+  CHECK(p.width == 200);
+  CHECK(p.spp == 64);
+  CHECK(p.max_depth == 12);
+  CHECK(p.filter == "blackman-harris");
+  const RenderConfig cfg = make_render_config(p);
+  CHECK(cfg.width == 200);
+  CHECK(cfg.height == 100);
+  CHECK(cfg.path.max_depth == 12);
+  CHECK(cfg.filter.type == FilterType::BlackmanHarris);
+}
+
+}  // namespace penumbra
