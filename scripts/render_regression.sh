@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
 # A fixed set of renders that covers the whole output path (both integrators, every
 # accelerator, --aov all,cost, --multipart, crops, tiles and merge, an animation time, a
-# checkpoint and its resume), for checking that a change to the code changes no image.
+# checkpoint and its resume, a path render through the Python module, and a benchmark smoke
+# run's answers), for checking that a change to the code changes no image.
 #
 #   scripts/render_regression.sh render PENUMBRA OUTDIR   render the set with one binary
 #   scripts/render_regression.sh compare DIR_A DIR_B      exit 0 iff every EXR is identical
+#
+# The Python module and penumbra-bench are found beside PENUMBRA in its build tree
+# (../python, ../benchmarks); where either is missing its part is left out with a note.
+# IGNORE_ATTRS (a regular expression, default none) leaves header attributes out of the
+# comparison, e.g. IGNORE_ATTRS=penumbra:settings when the identity's form changes on purpose.
 #
 # "Identical" means: the same parts, channels, types, windows and header attributes, except
 # the timing attribute penumbra:render_seconds and the command line (which names each run's
@@ -38,6 +44,26 @@ case "$mode" in
     r "$d" -o "$out/resumed.exr" --integrator path --width 48 --spp 32 --checkpoint 1e-9 --time-limit 1e-9
     cp "$out/resumed.exr" "$out/checkpoint.exr"
     r "$d" -o "$out/resumed.exr" --integrator path --width 48 --spp 32 --resume
+    build="$(cd "$(dirname "$bin")/.." && pwd)"
+    if [ -d "$build/python" ] && ls "$build"/python/penumbra*.so >/dev/null 2>&1; then
+      PYTHONPATH="$build/python" python3 - "$d" "$out/python-path.exr" <<'PY'
+import sys, penumbra
+scene = penumbra.load(sys.argv[1], quiet=True)
+result = scene.render(penumbra.RenderSettings(integrator="path", width=64, spp=16, accel="bvh"), aovs=["all"])
+result.write_exr(sys.argv[2], metadata={})
+PY
+    else
+      echo "note: no Python module beside $bin: the Python render is left out" >&2
+    fi
+    if [ -x "$build/benchmarks/penumbra-bench" ]; then
+      # The answers only (structure, rays, memory, SAH, count, wrong, ties), not the times.
+      "$build/benchmarks/penumbra-bench" "$d" --builds 1 --repeats 1 --threads 1 --width 64 --height 36 \
+        --accel embree,bvh,kdtree,grid,octree,bsp,brute | awk '$2 ~ /^(embree|bvh|kdtree|grid|octree|bsp|brute)$/ {
+        if ($2 == "embree") { $5 = "-"; $6 = "-" }  # Embree allocations vary from run to run
+        print $1, $2, $3, $5, $6, $7, $8, $9, $10 }' > "$out/bench.txt"
+    else
+      echo "note: no penumbra-bench beside $bin: the benchmark smoke run is left out" >&2
+    fi
     if [ -d "$corpus/valid" ]; then
       r "$corpus/valid/InterpolationTest/glTF-Binary/InterpolationTest.glb" -o "$out/anim-whitted.exr" --width 96 --spp 4 --time 0.7
       r "$corpus/valid/InterpolationTest/glTF-Binary/InterpolationTest.glb" -o "$out/anim-path.exr" --integrator path --width 64 --spp 8 --frame 17 --fps 24
@@ -50,7 +76,10 @@ case "$mode" in
   compare)
     a="$2"; b="$3"; fails=0; count=0
     header() {  # every attribute but the run's timing and command line
-      oiiotool -a --info -v "$1" 2>&1 | grep -vE 'render_seconds|command_line|DateTime|^'"$1" | sed "s|$(dirname "$1")/||g"
+      oiiotool -a --info -v "$1" 2>&1 | grep -vE 'render_seconds|command_line|DateTime|^'"$1" |
+        awk -v re="${IGNORE_ATTRS:-}" 'skip { if ($0 ~ /"$/) skip = 0; next }
+          re != "" && $0 ~ "^ *(" re "):" { if ($0 !~ /"$/ || $0 ~ /: "$/) skip = 1; next } { print }' |
+        sed "s|$(dirname "$1")/||g"
     }
     for fa in "$a"/*.exr; do
       name=$(basename "$fa"); fb="$b/$name"; count=$((count + 1))
@@ -69,7 +98,12 @@ case "$mode" in
       fi
     done
     for fb in "$b"/*.exr; do [ -e "$a/$(basename "$fb")" ] || { echo "EXTRA: $(basename "$fb")"; fails=$((fails + 1)); }; done
-    echo "compared $count EXRs: $((count - fails)) identical, $fails different"
+    for fa in "$a"/*.txt; do
+      [ -e "$fa" ] || continue
+      count=$((count + 1))
+      if ! cmp -s "$fa" "$b/$(basename "$fa")"; then echo "TEXT DIFFERS: $(basename "$fa")"; fails=$((fails + 1)); fi
+    done
+    echo "compared $count files: $((count - fails)) identical, $fails different"
     [ "$fails" -eq 0 ]
     ;;
   *)
