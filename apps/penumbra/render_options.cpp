@@ -128,14 +128,14 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
   }
   for (const std::string& name : names) {
     try {
-      check_aovs({name}, "path");
+      penumbra::check_aovs({name}, "path");
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--aov: ") + e.what());
     }
     if (!q.path && (name == "samples" || name == "variance" || name == "light"))
       throw UsageError("--aov " + name + " needs --integrator path");
   }
-  q.aovs = check_aovs(names, a.spec.integrator);
+  q.aovs = penumbra::check_aovs(names, a.spec.integrator);
   q.crypto = crypto_layers(q.aovs);
   if (a.crypto_depth_given && q.crypto.empty())
     throw UsageError("--crypto-depth needs --aov crypto_object, crypto_material or crypto_asset");

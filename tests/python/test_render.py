@@ -247,3 +247,24 @@ def test_render_releases_the_gil(default_scene):
         sys.setswitchinterval(old)
     assert seen["result"].beauty.shape == (90, 160, 4)
     assert seen["during"] > 0
+
+
+def test_every_setting_is_a_render_flag_and_the_same_default(cli):
+    # The settings spec is one table: each of its fields is a keyword here and a flag of
+    # `penumbra render` (dashes for underscores); the rest have flags of their own form.
+    import re
+    import subprocess
+
+    help_text = subprocess.run([str(cli), "render", "--help"], capture_output=True, text=True, check=True).stdout
+    flags = set(re.findall(r"--[a-z][a-z0-9-]*", help_text))
+    own_form = {"window": "--crop", "accel_params": "--accel-param", "env_color": "--env", "env_map": "--env"}
+    names = re.findall(r"(\w+)=", repr(penumbra.RenderSettings()))
+    assert len(names) > 20
+    for name in names:
+        flag = own_form.get(name, "--" + name.replace("_", "-"))
+        assert flag in flags, f"RenderSettings.{name} has no render flag {flag}"
+    # An unknown keyword names the known ones, which are exactly these.
+    with pytest.raises(TypeError) as e:
+        penumbra.RenderSettings(no_such_setting=1)
+    for name in names:
+        assert name in str(e.value)
