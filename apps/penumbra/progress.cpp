@@ -120,25 +120,26 @@ void ProgressReporter::finish() {
   m_open = false;
 }
 
-void print_render_summary(const RenderJob& job) {
-  const RenderArgs& a = job.args;
-  const RenderConfig& cfg = job.prepared.config;
-  const RenderStats& stats = job.image.stats;
-  const Scene& scene = job.loaded.scene;
-  const bool path = job.request.path;
+void print_render_summary(const RenderReport& r) {
+  const RenderSpec& spec = r.prepared.spec;
+  const RenderConfig& cfg = r.prepared.config;
+  const RenderStats& stats = r.image.stats;
+  const Scene& scene = r.scene;
+  const bool path = spec.integrator == "path";
   const uint64_t total = stats.rays.total();
   const std::string spp_text =
-      path ? format("%d spp max, %.2f mean in %d passes%s (sampler %s%s)", cfg.spp, job.mean_spp,
-                    stats.passes, stats.time_limited ? ", stopped by --time-limit" : "",
-                    a.spec.sampler.c_str(), cfg.adaptive_threshold > 0 ? ", adaptive" : "")
+      path ? format("%d spp max, %.2f mean in %d passes%s (sampler %s%s)", cfg.spp, r.mean_spp, stats.passes,
+                    stats.time_limited ? ", stopped by --time-limit" : "", spec.sampler.c_str(),
+                    cfg.adaptive_threshold > 0 ? ", adaptive" : "")
            : format("%d spp", cfg.spp);
   const std::string shapes_text = scene.shapes.empty()
                                       ? std::string()
                                       : format(" and %zu shapes (%llu placed)", scene.shapes.size(),
                                                static_cast<unsigned long long>(count_shape_instances(scene)));
   const std::string depth_text =
-      job.request.raster ? "shadows " + a.spec.raster_shadows
-                         : "max-depth " + std::to_string(path ? cfg.path.max_depth : cfg.whitted.max_depth);
+      spec.integrator == "raster"
+          ? "shadows " + spec.raster_shadows
+          : "max-depth " + std::to_string(path ? cfg.path.max_depth : cfg.whitted.max_depth);
   std::fprintf(
       stderr,
       "penumbra render %s\n"
@@ -148,15 +149,14 @@ void print_render_summary(const RenderJob& job) {
       "  time     load %.3fs  build %.3fs  render %.3fs  write %.3fs\n"
       "  rays     camera %s  shadow %s  %s %s  total %s  (%.2f Mrays/s)\n"
       "  memory   peak %.1f MiB\n",
-      a.scene_file.c_str(), scene.meshes.size(), shapes_text.c_str(), scene.instances.size(),
+      r.scene_file.c_str(), scene.meshes.size(), shapes_text.c_str(), scene.instances.size(),
       human_count(count_triangles(scene)).c_str(), human_count(count_stored_triangles(scene)).c_str(),
-      scene.materials.size(), scene.lights.size(), job.prepared.default_light ? " (default key light)" : "",
-      job.prepared.camera.name.c_str(),
-      job.prepared.camera.projection == Projection::Perspective ? "perspective" : "orthographic", cfg.width,
-      cfg.height, spp_text.c_str(), a.spec.integrator.c_str(), depth_text.c_str(),
-      filter_name(cfg.filter.type), double(cfg.filter.width), stats.threads,
-      job.structure.accel ? a.spec.accel.c_str() : "none (nothing traced)", job.load_s, job.build_s,
-      stats.seconds, job.write_s, human_count(stats.rays.camera).c_str(),
+      scene.materials.size(), scene.lights.size(), r.prepared.default_light ? " (default key light)" : "",
+      r.prepared.camera.name.c_str(),
+      r.prepared.camera.projection == Projection::Perspective ? "perspective" : "orthographic", cfg.width,
+      cfg.height, spp_text.c_str(), spec.integrator.c_str(), depth_text.c_str(), filter_name(cfg.filter.type),
+      double(cfg.filter.width), stats.threads, r.traced ? spec.accel.c_str() : "none (nothing traced)",
+      r.load_s, r.build_s, stats.seconds, r.write_s, human_count(stats.rays.camera).c_str(),
       human_count(stats.rays.shadow).c_str(), path ? "bounce" : "reflection",
       human_count(stats.rays.reflection).c_str(), human_count(total).c_str(),
       stats.seconds > 0 ? double(total) / stats.seconds / 1e6 : 0.0, peak_memory_mib());

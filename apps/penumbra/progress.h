@@ -11,10 +11,23 @@
 #include <vector>
 
 #include "apps/penumbra/cli_support.h"
+#include "render/session.h"
 
 namespace penumbra::cli {
 
-struct RenderJob;
+/// What the summary and the statistics file report of one finished render: the session's
+/// values and the command's timings, by reference (they outlive the report).
+struct RenderReport {
+  const std::string& scene_file;
+  const Scene& scene;                   ///< as rendered (with the default key light, if one was added)
+  const PreparedRender& prepared;       ///< resolved settings, config, camera
+  const RenderImage& image;             ///< film and statistics
+  const std::string& structure_update;  ///< Structure::update
+  bool traced = true;                   ///< an acceleration structure was built or kept
+  double load_s = 0, build_s = 0, write_s = 0;
+  double mean_spp = 0;
+  bool interrupted = false;
+};
 
 /// How progress is reported on stderr (--progress).
 enum class ProgressMode {
@@ -81,6 +94,6 @@ class ProgressReporter {
 };
 
 /// The run's summary: scene, camera, image settings, times per phase, rays and peak memory.
-void print_render_summary(const RenderJob& job);
+void print_render_summary(const RenderReport& report);
 
 }  // namespace penumbra::cli

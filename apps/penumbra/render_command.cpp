@@ -278,6 +278,27 @@ void render_phase(RenderJob& job) {
       double(job.image.stats.samples) / (double(job.image.film.width) * double(job.image.film.height));
 }
 
+/// What the summary and the statistics report of the job.
+RenderReport report_of(const RenderJob& job) {
+  RenderReport r{job.args.scene_file, job.loaded.scene, job.prepared, job.image, job.structure.update};
+  r.traced = job.structure.accel != nullptr;
+  r.load_s = job.load_s;
+  r.build_s = job.build_s;
+  r.write_s = job.write_s;
+  r.mean_spp = job.mean_spp;
+  r.interrupted = job.interrupted != 0;
+  return r;
+}
+
+/// The images as written with their hashes, for the statistics.
+std::vector<WrittenImage> written_images(const RenderJob& job) {
+  const RenderRequest& q = job.request;
+  std::vector<WrittenImage> w = {{"exr", q.out.string(), job.hashes.exr}};
+  if (q.png) w.push_back({"png", q.png->string(), job.hashes.png});
+  if (q.cost_png) w.push_back({"cost_png", q.cost_png->string(), job.hashes.cost_png});
+  return w;
+}
+
 /// The EXR with its layers, the display image, the heat map, then the statistics that record
 /// their hashes.
 void write_phase(RenderJob& job) {
@@ -299,7 +320,7 @@ void write_phase(RenderJob& job) {
                   *q.cost_png, cost_caption(buffers.layers.cost, job.args.spec.accel),
                   hashes ? &job.hashes.cost_png : nullptr);
   job.write_s = seconds_since(t0);
-  if (hashes) write_stats_json(job);
+  if (hashes) write_stats_json(report_of(job), written_images(job), job.args.stats_json);
   progress.finish();
 }
 
@@ -317,7 +338,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptS
   render_phase(job);
   write_phase(job);
   if (job.remove_state) fs::remove(fs::path(job.request.out).concat(".resume"));
-  if (prints_text(job.progress, a.quiet)) print_render_summary(job);
+  if (prints_text(job.progress, a.quiet)) print_render_summary(report_of(job));
   if (keep && !job.interrupted) keep_scene(job, kept);
   const RenderRequest& q = job.request;
   if (q.paths_to_stdout) {
