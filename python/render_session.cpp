@@ -10,7 +10,7 @@
 #include "io/files/error.h"
 #include "io/gltf/id_manifest.h"
 #include "io/image/environment_io.h"
-#include "render/accel_params.h"
+#include "render/exr_layers.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"
@@ -98,34 +98,8 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
       {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)},
       {"penumbra:version", PENUMBRA_VERSION}};
   exr.metadata.insert(exr.metadata.end(), options.metadata.begin(), options.metadata.end());
-  const auto& aovs = out.aovs;
-  const ChannelType colour = options.half ? ChannelType::Half : ChannelType::Float;
-  const DataAovs& d = out.data;
-  if (aovs.count("albedo"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("albedo.") + "RGB"[c], &d.albedo, colour, 3, c});
-  if (aovs.count("N"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("N.") + "XYZ"[c], &d.normal, ChannelType::Float, 3, c});
-  if (aovs.count("P"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("P.") + "XYZ"[c], &d.position, ChannelType::Float, 3, c});
-  if (aovs.count("Z")) exr.extra.push_back({"Z", &d.depth, ChannelType::Float});
-  if (aovs.count("UV"))
-    for (int c = 0; c < 2; ++c)
-      exr.extra.push_back({std::string("UV.") + "UV"[c], &d.uv, ChannelType::Float, 2, c});
-  if (aovs.count("id")) {
-    exr.extra.push_back({"object_id.X", &d.object_id, ChannelType::Float});
-    exr.extra.push_back({"material_id.X", &d.material_id, ChannelType::Float});
-    exr.metadata.push_back({"penumbra:manifest", out.id_manifest});
-  }
-  if (aovs.count("samples")) exr.extra.push_back({"samples.X", &out.samples_f, ChannelType::Float});
-  if (aovs.count("variance")) exr.extra.push_back({"variance.X", &out.variance, ChannelType::Float});
-  if (aovs.count("light"))
-    for (int g = 0; g < kLightGroupCount; ++g)
-      for (int c = 0; c < 3; ++c)
-        exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &out.groups, colour,
-                             kLightGroupChannels, g * 3 + c});
+  add_layer_channels(exr, out.aovs, {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups},
+                     options.half ? ChannelType::Half : ChannelType::Float);
   write_exr(out.film, path, exr);
 }
 

@@ -12,6 +12,7 @@
 #include "io/files/error.h"
 #include "io/gltf/id_manifest.h"
 #include "io/image/exr_merge.h"
+#include "render/exr_layers.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"
 
@@ -91,47 +92,14 @@ void add_part_identity(ExrOptions& exr, const RenderJob& job) {
   exr.metadata.push_back({kSettingsAttribute, canonical_text(part)});
 }
 
-/// The data AOVs' channels: colour albedo, float N, P, Z, UV and the ids (whole numbers as float, which
-/// compositors read as values) with their manifest.
-void add_data_channels(ExrOptions& exr, const RenderJob& job, DataAovs& data,
-                       const std::string& job_manifest) {
-  const auto& aovs = job.request.aovs;
-  const ChannelType colour = job.args.use_float ? ChannelType::Float : ChannelType::Half;
-  if (aovs.count("albedo"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("albedo.") + "RGB"[c], &data.albedo, colour, 3, c});
-  if (aovs.count("N"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("N.") + "XYZ"[c], &data.normal, ChannelType::Float, 3, c});
-  if (aovs.count("P"))
-    for (int c = 0; c < 3; ++c)
-      exr.extra.push_back({std::string("P.") + "XYZ"[c], &data.position, ChannelType::Float, 3, c});
-  if (aovs.count("Z")) exr.extra.push_back({"Z", &data.depth, ChannelType::Float});
-  if (aovs.count("UV"))
-    for (int c = 0; c < 2; ++c)
-      exr.extra.push_back({std::string("UV.") + "UV"[c], &data.uv, ChannelType::Float, 2, c});
-  if (aovs.count("id")) {
-    exr.extra.push_back({"object_id.X", &data.object_id, ChannelType::Float});
-    exr.extra.push_back({"material_id.X", &data.material_id, ChannelType::Float});
-    exr.metadata.push_back({"penumbra:manifest", job_manifest});
-  }
-}
-
-/// The path tracer's layers (sample counts, variance, light groups) and the cost layers.
+/// The data AOVs and the path tracer's layers (render/exr_layers.h), then the cost layers.
 void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
-  const auto& aovs = job.request.aovs;
   const RenderImage& image = job.image;
-  if (aovs.count("samples")) {
-    buffers.samples.assign(image.samples.begin(), image.samples.end());
-    exr.extra.push_back({"samples.X", &buffers.samples, ChannelType::Float});
-  }
-  if (aovs.count("variance")) exr.extra.push_back({"variance.X", &image.variance, ChannelType::Float});
-  if (aovs.count("light"))
-    for (int g = 0; g < kLightGroupCount; ++g)
-      for (int c = 0; c < 3; ++c)
-        exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], &image.groups,
-                             job.args.use_float ? ChannelType::Float : ChannelType::Half, kLightGroupChannels,
-                             g * 3 + c});
+  if (job.request.aovs.count("samples")) buffers.samples.assign(image.samples.begin(), image.samples.end());
+  add_layer_channels(
+      exr, job.request.aovs,
+      {&buffers.layers.data, &buffers.layers.id_manifest, &buffers.samples, &image.variance, &image.groups},
+      job.args.use_float ? ChannelType::Float : ChannelType::Half);
   if (job.request.cost_aov) {
     if (buffers.layers.cost.counted) {
       exr.extra.push_back({"cost_nodes.X", &buffers.layers.cost.nodes});
@@ -177,7 +145,6 @@ ExrOptions make_exr_options(const RenderJob& job, LayerBuffers& buffers) {
   add_camera_metadata(exr, job.prepared.camera, cfg.width, cfg.height);
   if (!a.reproducible)
     exr.float_metadata.push_back({kRenderSecondsAttribute, float(job.image.stats.seconds)});
-  if (job.request.data_aovs) add_data_channels(exr, job, buffers.layers.data, buffers.layers.id_manifest);
   add_render_channels(exr, job, buffers);
   add_crypto_channels(exr, job, buffers);
   // The display transform its display image is (or, for --no-png and farm stripes, would be)

@@ -1,0 +1,33 @@
+// The EXR channels of a render's layers.
+#include "render/exr_layers.h"
+
+#include "renderer/integrators/light_groups.h"
+
+namespace penumbra {
+
+void add_layer_channels(ExrOptions& exr, const std::set<std::string>& aovs, const LayerChannels& b,
+                        ChannelType colour) {
+  const auto vec = [&](const char* layer, const char* axes, const std::vector<float>* data, ChannelType type,
+                       int n) {
+    for (int c = 0; c < n; ++c) exr.extra.push_back({std::string(layer) + "." + axes[c], data, type, n, c});
+  };
+  if (aovs.count("albedo")) vec("albedo", "RGB", &b.data->albedo, colour, 3);
+  if (aovs.count("N")) vec("N", "XYZ", &b.data->normal, ChannelType::Float, 3);
+  if (aovs.count("P")) vec("P", "XYZ", &b.data->position, ChannelType::Float, 3);
+  if (aovs.count("Z")) exr.extra.push_back({"Z", &b.data->depth, ChannelType::Float});
+  if (aovs.count("UV")) vec("UV", "UV", &b.data->uv, ChannelType::Float, 2);
+  if (aovs.count("id")) {
+    exr.extra.push_back({"object_id.X", &b.data->object_id, ChannelType::Float});
+    exr.extra.push_back({"material_id.X", &b.data->material_id, ChannelType::Float});
+    exr.metadata.push_back({"penumbra:manifest", *b.id_manifest});
+  }
+  if (aovs.count("samples")) exr.extra.push_back({"samples.X", b.samples, ChannelType::Float});
+  if (aovs.count("variance")) exr.extra.push_back({"variance.X", b.variance, ChannelType::Float});
+  if (aovs.count("light"))
+    for (int g = 0; g < kLightGroupCount; ++g)
+      for (int c = 0; c < 3; ++c)
+        exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], b.groups, colour,
+                             kLightGroupChannels, g * 3 + c});
+}
+
+}  // namespace penumbra
