@@ -12,6 +12,7 @@
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
+#include "render/session.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
 
@@ -373,7 +374,8 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
 
 int run_info(const InfoArgs& a) {
   const std::string& file = a.file;
-  const AccelConfig accel_config = parse_accel(a.accel, a.accel_params);
+  // The structure's name and parameters, checked before loading with the command's messages.
+  parse_accel(a.accel, a.accel_params);
   // Bad camera flags fail before the scene loads.
   if (!a.frame.empty() && a.cam.turntable.empty())
     throw UsageError("info: --frame picks a --turntable frame");
@@ -382,9 +384,12 @@ int run_info(const InfoArgs& a) {
   const Scene& s = loaded.scene;
   const GltfInfo& i = loaded.info;
   const View view = resolve_view(a, s);
-  const std::string& accel_name = a.accel;
+  // The structure as a render of these settings builds it (the render session's build phase).
+  RenderSpec spec;
+  spec.accel = a.accel;
+  spec.accel_params = a.accel_params;
   if (a.json) {
-    const auto accel = make_scene_accelerator(accel_name, s, accel_config);
+    const auto accel = build_structure(s, spec, false).accel;
     const std::string doc = info_json(file, loaded, view, accel->stats())
                                 .dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
     std::printf("%s\n", doc.c_str());
@@ -448,7 +453,7 @@ int run_info(const InfoArgs& a) {
   else
     std::printf("bounds       empty\n");
   print_view(view);
-  auto accel = make_scene_accelerator(accel_name, s, accel_config);
+  const auto accel = build_structure(s, spec, false).accel;
   const AccelStats st = accel->stats();
   std::printf("accelerator  %s%s%s%s\n", st.name.c_str(), st.config.empty() ? "" : " (", st.config.c_str(),
               st.config.empty() ? "" : ")");
