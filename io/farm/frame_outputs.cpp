@@ -10,7 +10,7 @@
 #include <system_error>
 #include <vector>
 
-#include "io/image/exr_merge.h"
+#include "io/farm/render_settings.h"
 
 namespace penumbra {
 

@@ -10,6 +10,12 @@
 
 namespace penumbra {
 
+/// String attribute of an EXR: SHA-256 (hex) of the scene it was rendered from.
+inline constexpr const char* kSceneHashAttribute = "penumbra:scene_sha256";
+/// String attribute of an EXR: canonical_text of its render's settings without the keys that
+/// differ between tiles of one frame (window, crop, tile).
+inline constexpr const char* kSettingsAttribute = "penumbra:settings";
+
 /// Settings as key -> value text. Keys must be non-empty; values may be any bytes.
 struct RenderSettings {
   std::map<std::string, std::string> entries;

@@ -8,13 +8,9 @@
 #include <string>
 #include <vector>
 
-namespace penumbra {
+#include "io/farm/render_settings.h"
 
-/// String attribute of a tile: SHA-256 (hex) of the scene it was rendered from.
-inline constexpr const char* kSceneHashAttribute = "penumbra:scene_sha256";
-/// String attribute of a tile: canonical_text (io/render_settings.h) of its render settings
-/// without the keys that differ between tiles of one frame (window, crop, tile).
-inline constexpr const char* kSettingsAttribute = "penumbra:settings";
+namespace penumbra {
 
 /// Path tracer statistics of a render, as strings: the camera samples taken, their mean per
 /// pixel (format_mean_spp) and the passes. A merged frame holds the sum of its parts' samples,
