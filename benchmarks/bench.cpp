@@ -816,11 +816,8 @@ int run_refit(const std::string& file, int frames, const AccelConfig& config, in
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{
-      "penumbra-bench: acceleration structures on the same scenes and rays, verified against Embree"};
+/// The command line of penumbra-bench (defaults as --help prints them).
+struct BenchOptions {
   std::vector<std::string> scenes, accels{"embree", "bvh", "kdtree", "grid"},
       kinds{"primary", "shadow", "diffuse", "random"}, params;
   std::vector<int> threads{1, 0};
@@ -832,284 +829,343 @@ int main(int argc, char** argv) {
   bool raster = false, tradeoffs = false;
   std::string refit_file;
   int refit_frames = 240;
-  app.add_option("scenes", scenes,
+  std::string command;  ///< the command line as typed, for the JSON
+};
+
+/// Declares every option on `app`, bound to `o`.
+void add_bench_options(CLI::App& app, BenchOptions& o) {
+  app.add_option("scenes", o.scenes,
                  "glTF or PLY files, or generated scenes gen:NAME[:TRIANGLES] with NAME one of atrium, soup, "
                  "stadium, slivers, terrain (default: scenes/default.gltf)");
-  app.add_option("--seed", seed, "seed of the generated scenes (default 1)");
-  app.add_option("--accel", accels,
+  app.add_option("--seed", o.seed, "seed of the generated scenes (default 1)");
+  app.add_option("--accel", o.accels,
                  "structures to measure, comma separated: " + accelerator_list() +
                      " (default embree,bvh,kdtree,grid)")
       ->delimiter(',');
-  app.add_option("--rays", kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
-  app.add_option("--threads", threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
+  app.add_option("--rays", o.kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
+  app.add_option("--threads", o.threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
       ->delimiter(',')
       ->check(CLI::Range(0, 1024));
-  app.add_option("--width", width, "primary rays per row (default 512)")->check(CLI::Range(1, 8192));
-  app.add_option("--height", height, "primary rays per column (default 288)")->check(CLI::Range(1, 8192));
-  app.add_option("--builds", builds, "builds per structure; the median is reported (default 5)")
+  app.add_option("--width", o.width, "primary rays per row (default 512)")->check(CLI::Range(1, 8192));
+  app.add_option("--height", o.height, "primary rays per column (default 288)")->check(CLI::Range(1, 8192));
+  app.add_option("--builds", o.builds, "builds per structure; the median is reported (default 5)")
       ->check(CLI::Range(1, 100));
-  app.add_option("--repeats", repeats, "timed passes over each ray set; the median is reported (default 3)")
+  app.add_option("--repeats", o.repeats, "timed passes over each ray set; the median is reported (default 3)")
       ->check(CLI::Range(1, 100));
-  app.add_option("--accel-param", params, "build parameter KEY=VALUE, as for penumbra render");
-  app.add_option("--csv", csv, "also write the table as CSV (written atomically)");
+  app.add_option("--accel-param", o.params, "build parameter KEY=VALUE, as for penumbra render");
+  app.add_option("--csv", o.csv, "also write the table as CSV (written atomically)");
   app.add_option(
-      "--json", json,
+      "--json", o.json,
       "also write the results, machine, build, versions and command line as JSON (written atomically)");
   app.add_option(
-      "--heatmaps", heatmaps,
+      "--heatmaps", o.heatmaps,
       "also write a traversal-cost heat map (nodes + triangles per primary ray) per scene and structure "
       "into this folder: SCENE.ACCEL.cost.png (for embree, which keeps no counts: nanoseconds per ray)");
-  app.add_option("--svg", svg,
+  app.add_option("--svg", o.svg,
                  "also write a bar chart of throughput and build time as SVG (written atomically)");
-  app.add_option("--marching-cubes", mc_resolutions,
+  app.add_option("--marching-cubes", o.mc_resolutions,
                  "instead of the structures: extract the CSG part's surface at these resolutions (comma "
                  "separated, e.g. 64,128,256,512) with each --threads count, --repeats times")
       ->delimiter(',');
-  app.add_option("--noise", noise_count,
+  app.add_option("--noise", o.noise_count,
                  "instead of the structures: evaluate 3D Perlin noise, 5-octave fBm and Worley F1 at this "
                  "many random points on one thread, --repeats times, and print evaluations per second")
       ->check(CLI::Range(1, 1000000000));
-  app.add_flag("--tradeoffs", tradeoffs,
+  app.add_flag("--tradeoffs", o.tradeoffs,
                "instead of the main table: per scene and structure the memory, the build time with 1 thread "
                "and every core, the work per ray (median, 99th percentile, max of nodes + tests) and one "
                "thread's throughput on primary and random rays");
-  app.add_option("--refit", refit_file,
+  app.add_option("--refit", o.refit_file,
                  "instead of the structures: an animated glTF file's frames with the BVH rebuilt, refitted "
                  "and under the rebuild policy (bvh.refit_max_growth): update times, SAH and work per ray");
-  app.add_option("--refit-frames", refit_frames, "frames spanning the animation for --refit (default 240)")
+  app.add_option("--refit-frames", o.refit_frames, "frames spanning the animation for --refit (default 240)")
       ->check(CLI::Range(1, 100000));
-  app.add_flag("--raster", raster,
+  app.add_flag("--raster", o.raster,
                "instead of the structures: frames per second of primary visibility at --width x --height, "
                "rasterised against Embree's and the BVH's camera rays, and the shaded raster preview");
+}
+
+/// Prints `e` and returns the exit code: 2 for bad input (std::invalid_argument, InputError),
+/// else 1.
+int report_error(const std::exception& e) {
+  std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
+  const bool input = dynamic_cast<const std::invalid_argument*>(&e) || dynamic_cast<const InputError*>(&e);
+  return input ? 2 : 1;
+}
+
+/// --noise, --marching-cubes, --refit, --tradeoffs or --raster: the mode's exit code; nullopt
+/// when none is asked for (the main table).
+std::optional<int> run_mode(const BenchOptions& o) {
+  if (o.noise_count > 0) return run_noise(o.noise_count, o.repeats);
+  try {
+    if (!o.mc_resolutions.empty()) return run_marching_cubes(o.mc_resolutions, o.threads, o.repeats);
+    if (!o.refit_file.empty() || o.tradeoffs) {
+      AccelConfig config;
+      for (const auto& p : o.params) apply_accel_param(config, p);
+      validate(config);
+      if (!o.refit_file.empty())
+        return run_refit(o.refit_file, o.refit_frames, config, o.width, o.height, o.threads[0], o.csv);
+      return run_tradeoffs(o.scenes, o.seed, o.accels, config, o.width, o.height, o.builds, o.repeats, o.csv,
+                           o.svg, o.command);
+    }
+    if (o.raster) return run_raster(o.scenes, o.seed, o.width, o.height, o.threads, o.builds, o.repeats);
+  } catch (const std::exception& e) {
+    return report_error(e);
+  }
+  return std::nullopt;
+}
+
+/// The main table's options, checked before measuring for minutes: the output folders, the ray
+/// kinds, the structures' names and parameters. Returns the parameters' configuration. Throws
+/// std::invalid_argument.
+AccelConfig check_table_options(const BenchOptions& o) {
+  // Check the output folders before measuring for minutes.
+  for (const std::string* out : {&o.csv, &o.json, &o.svg}) {
+    if (out->empty()) continue;
+    const std::filesystem::path dir =
+        std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
+    if (!std::filesystem::is_directory(dir))
+      throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
+  }
+  if (!o.heatmaps.empty() && !std::filesystem::is_directory(o.heatmaps))
+    throw std::invalid_argument("--heatmaps: directory '" + o.heatmaps + "' does not exist");
+  for (const auto& k : o.kinds)
+    if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
+      throw std::invalid_argument("--rays: unknown ray kind '" + k +
+                                  "' (known: primary, shadow, diffuse, random)");
+  AccelConfig config;
+  for (const auto& p : o.params) apply_accel_param(config, p);
+  validate(config);  // every structure's parameters, as the render session checks them
+  for (const auto& a : o.accels) {
+    const auto names = accelerator_names();
+    if (std::find(names.begin(), names.end(), a) == names.end())
+      throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
+  }
+  return config;
+}
+
+/// One scene's ray sets and the references every answer is checked against.
+struct TableScene {
+  std::string name;
+  Scene scene;
+  std::vector<GeometryView> views;
+  std::vector<InstanceView> instances;
+  std::unique_ptr<Accelerator> embree, exact;  ///< Embree, and brute force to settle disagreements
+  std::vector<RaySet> sets;
+  float scale = 0;
+};
+
+/// The rows of structure `accel_name` over the scene's ray sets, each printed as it is measured:
+/// the median build, memory, SAH, agreement with Embree and throughput per thread count.
+void measure_structure(const BenchOptions& o, const AccelConfig& config, const TableScene& ts,
+                       const std::string& accel_name, std::vector<Row>& rows) {
+  const std::string& name = ts.name;
+  const Scene& scene = ts.scene;
+  const auto& views = ts.views;
+  const auto& instances = ts.instances;
+  const auto& sets = ts.sets;
+  const Accelerator& embree = *ts.embree;
+  const Accelerator& exact = *ts.exact;
+  const float scale = ts.scale;
+  // Build: median of `o.builds` o.builds (the last one is measured).
+  std::vector<double> times;
+  std::unique_ptr<Accelerator> accel;
+  for (int i = 0; i < o.builds; ++i) {
+    accel.reset();
+    const auto t0 = Clock::now();
+    accel = make_accelerator(accel_name, views, instances, config);
+    times.push_back(seconds_since(t0));
+  }
+  const AccelStats st = accel->stats();
+  // The SAH under the benchmark's one set of constants, from this tree's node boxes.
+  const bench::StructureSah sah = bench::measure_structure_sah(accel_name, views, instances, config, *accel);
+  if (!sah.cost && accel_name == "bvh")
+    std::fprintf(stderr, "penumbra-bench: %s %s: SAH n/a: %s\n", name.c_str(), accel_name.c_str(),
+                 sah.note.c_str());
+  if (!o.heatmaps.empty()) {
+    RenderConfig rc;
+    rc.width = o.width;
+    rc.height = o.height;
+    rc.spp = 1;
+    validate(rc);
+    const CostImage cost = render_cost(*accel, bench_camera(scene, o.width, o.height), rc);
+    write_heatmap(total_cost(cost), o.width, o.height,
+                  std::filesystem::path(o.heatmaps) / (name + "." + accel_name + ".cost.png"),
+                  name + " " + cost_caption(cost, accel_name));
+  }
+  for (const auto& set : sets) {
+    Row row{name, accel_name, set.kind, st.config, st.triangles, st.shapes, set.rays.size()};
+    row.bytes = st.bytes;
+    if (accel->counts_traversal() && st.shapes > 0) row.evals = evaluations_per_ray(*accel, set);
+    row.build_s = bench::spread_of(times);
+    row.sah = sah.cost;
+    row.builder_sah = st.sah_cost;
+    const Agreement g = check_against_embree(*accel, embree, exact, set, scale);
+    row.mismatches = g.wrong;
+    row.ties = g.ties;
+    for (int t : o.threads) {
+      const int n = t > 0 ? t : int(tbb::info::default_concurrency());
+      uint64_t hits = 0;
+      trace_seconds(*accel, set, n, hits);  // warm-up
+      std::vector<double> mrays;
+      for (int r = 0; r < o.repeats; ++r)
+        mrays.push_back(double(set.rays.size()) / trace_seconds(*accel, set, n, hits) / 1e6);
+      row.hits = hits;
+      row.mrays.push_back({n, bench::spread_of(mrays)});
+    }
+    // Ratio to Embree on the same rays (Embree is measured first, see above).
+    for (const auto& e : rows)
+      if (e.scene == name && e.accel == "embree" && e.kind == row.kind)
+        for (size_t i = 0; i < row.mrays.size(); ++i)
+          row.vs_embree.push_back(row.mrays[i].mrays.median / e.mrays[i].mrays.median);
+    if (accel_name == "embree")
+      for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(1.0);
+    std::printf("%s", bench::table_row(row).c_str());
+    std::fflush(stdout);
+    rows.push_back(row);
+  }
+}
+
+/// Every scene and structure of the main table, each row printed as it is measured (Embree's
+/// first, so that every later row shows its ratio); `embree_reference` receives the settings of
+/// the Embree every answer is checked against.
+std::vector<Row> measure_table(const BenchOptions& o, const AccelConfig& config,
+                               std::string& embree_reference) {
+  std::vector<Row> rows;
+  for (const auto& file : o.scenes) {
+    TableScene t;
+    t.scene = load_bench_scene(file, o.seed, t.name);
+    t.views = mesh_views(t.scene);
+    t.instances = instance_views(t.scene);  // identity placements unless shapes are placed
+    t.embree = make_accelerator("embree", t.views, t.instances);
+    t.exact = make_accelerator("brute", t.views, t.instances);
+    embree_reference = t.embree->stats().config;
+    t.sets = make_ray_sets(t.scene, *t.embree, o.width, o.height, o.kinds);
+    t.scale = length(compute_bounds(t.scene).extent());
+    for (const auto& accel_name : o.accels) measure_structure(o, config, t, accel_name, rows);
+  }
+  return rows;
+}
+
+/// The table as CSV at `path`, written atomically.
+void write_table_csv(const std::string& path, const std::vector<Row>& rows,
+                     const std::vector<int>& thread_counts) {
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << "scene,accel,rays,triangles,shapes,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties,evals_"
+         "per_ray";
+    for (int t : thread_counts) f << ",mrays_" << t << "t,vs_embree_" << t << "t";
+    f << ",builder_sah_cost,build_s_min,build_s_max";
+    for (int t : thread_counts) f << ",mrays_min_" << t << "t,mrays_max_" << t << "t";
+    f << "\n";
+    for (const auto& r : rows) {
+      f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.shapes << ','
+        << r.build_s.median << ',' << r.bytes << ',';
+      if (r.sah) f << *r.sah;  // empty: no SAH
+      f << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ',' << r.ties << ',';
+      if (r.evals >= 0) f << r.evals;
+      for (size_t i = 0; i < r.mrays.size(); ++i)
+        f << ',' << r.mrays[i].mrays.median << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
+      f << ',' << r.builder_sah << ',' << r.build_s.min << ',' << r.build_s.max;
+      for (const auto& m : r.mrays) f << ',' << m.mrays.min << ',' << m.mrays.max;
+      f << "\n";
+    }
+    if (!f) throw std::runtime_error(path + ": cannot write");
+  });
+}
+
+/// The results with the machine, the Embree reference, the SAH constants and the command line
+/// as JSON at --json, written atomically.
+void write_table_json(const BenchOptions& o, const std::vector<Row>& rows,
+                      const std::string& embree_reference) {
+  write_atomically(o.json, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    const auto per_thread = [&](const Row& r, double bench::Spread::*field) {
+      std::ostringstream out;
+      for (size_t k = 0; k < r.mrays.size(); ++k)
+        out << (k ? ", " : "") << '"' << r.mrays[k].threads << "\": " << r.mrays[k].mrays.*field;
+      return "{" + out.str() + "}";
+    };
+    f << "{\n  \"command\": \"" << json_escape(o.command) << "\",\n  \"machine\": {\n"
+      << machine_json() << "  },\n"
+      << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n"
+      << "  \"sah_constants\": {\"traversal\": " << bench::kSahConstants.traversal
+      << ", \"intersection\": " << bench::kSahConstants.intersection << "},\n  \"results\": [\n";
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const auto& r = rows[i];
+      f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel
+        << "\", \"config\": \"" << json_escape(r.config) << "\", \"rays\": \"" << r.kind
+        << "\", \"triangles\": " << r.triangles << ", \"shapes\": " << r.shapes
+        << ", \"evals_per_ray\": " << (r.evals >= 0 ? std::to_string(r.evals) : std::string("null"))
+        << ", \"build_s\": " << r.build_s.median << ", \"build_s_min\": " << r.build_s.min
+        << ", \"build_s_max\": " << r.build_s.max << ", \"bytes\": " << r.bytes
+        << ", \"sah_cost\": " << (r.sah ? std::to_string(*r.sah) : std::string("null"))
+        << ", \"builder_sah_cost\": " << r.builder_sah << ", \"ray_count\": " << r.rays
+        << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties
+        << ", \"mrays\": " << per_thread(r, &bench::Spread::median)
+        << ", \"mrays_min\": " << per_thread(r, &bench::Spread::min)
+        << ", \"mrays_max\": " << per_thread(r, &bench::Spread::max) << "}"
+        << (i + 1 < rows.size() ? "," : "") << "\n";
+    }
+    f << "  ]\n}\n";
+    if (!f) throw std::runtime_error(o.json + ": cannot write");
+  });
+}
+
+/// The bar chart of throughput and build time as SVG at --svg, written atomically.
+void write_table_svg(const BenchOptions& o, const std::vector<Row>& rows,
+                     const std::vector<int>& thread_counts) {
+  write_atomically(o.svg, [&](const std::filesystem::path& tmp) {
+    bench::RunSettings rs;
+    rs.width = o.width, rs.height = o.height, rs.builds = o.builds, rs.repeats = o.repeats;
+    rs.build_threads = int(tbb::info::default_concurrency());
+    rs.threads = thread_counts;
+    rs.machine = bench::describe(bench::read_machine_info());
+    rs.software = software_line();
+    std::ofstream f(tmp);
+    f << bench::bar_chart_svg(bench::results_chart(rows, rs));
+    if (!f) throw std::runtime_error(o.svg + ": cannot write");
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "penumbra-bench: acceleration structures on the same scenes and rays, verified against Embree"};
+  BenchOptions o;
+  add_bench_options(app, o);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;  // usage errors exit 2, as for penumbra
   }
-  if (noise_count > 0) return run_noise(noise_count, repeats);
-  if (!mc_resolutions.empty()) try {
-      return run_marching_cubes(mc_resolutions, threads, repeats);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
-    }
-  if (scenes.empty()) scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
-  if (!refit_file.empty() || tradeoffs) try {
-      AccelConfig config;
-      for (const auto& p : params) apply_accel_param(config, p);
-      validate(config);
-      if (!refit_file.empty())
-        return run_refit(refit_file, refit_frames, config, width, height, threads[0], csv);
-      std::string command;
-      for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
-      return run_tradeoffs(scenes, seed, accels, config, width, height, builds, repeats, csv, svg, command);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-      const bool input =
-          dynamic_cast<const std::invalid_argument*>(&e) || dynamic_cast<const InputError*>(&e);
-      return input ? 2 : 1;
-    }
-  if (raster) try {
-      return run_raster(scenes, seed, width, height, threads, builds, repeats);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-      return dynamic_cast<const std::invalid_argument*>(&e) ? 2 : 1;
-    }
-  std::string command;
-  for (int i = 0; i < argc; ++i) command += (i ? " " : "") + std::string(argv[i]);
-
+  for (int i = 0; i < argc; ++i) o.command += (i ? " " : "") + std::string(argv[i]);
+  if (o.scenes.empty()) o.scenes.push_back(PENUMBRA_SOURCE_DIR "/scenes/default.gltf");
+  if (const std::optional<int> rc = run_mode(o)) return *rc;
   try {
-    // Check the output folders before measuring for minutes.
-    for (const std::string* out : {&csv, &json, &svg}) {
-      if (out->empty()) continue;
-      const std::filesystem::path dir =
-          std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
-      if (!std::filesystem::is_directory(dir))
-        throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
-    }
-    if (!heatmaps.empty() && !std::filesystem::is_directory(heatmaps))
-      throw std::invalid_argument("--heatmaps: directory '" + heatmaps + "' does not exist");
-    for (const auto& k : kinds)
-      if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
-        throw std::invalid_argument("--rays: unknown ray kind '" + k +
-                                    "' (known: primary, shadow, diffuse, random)");
-    AccelConfig config;
-    for (const auto& p : params) apply_accel_param(config, p);
-    validate(config);  // every structure's parameters, as the render session checks them
-    for (const auto& a : accels) {
-      const auto names = accelerator_names();
-      if (std::find(names.begin(), names.end(), a) == names.end())
-        throw std::invalid_argument("--accel: unknown accelerator '" + a + "'");
-    }
+    const AccelConfig config = check_table_options(o);
     // Embree first, so every later row can show its ratio as soon as it is measured.
-    if (auto it = std::find(accels.begin(), accels.end(), "embree"); it != accels.end())
-      std::rotate(accels.begin(), it, it + 1);
+    if (auto it = std::find(o.accels.begin(), o.accels.end(), "embree"); it != o.accels.end())
+      std::rotate(o.accels.begin(), it, it + 1);
     // The table, one row as soon as it is measured (long runs show progress).
     std::vector<int> thread_counts;  // 0 resolved to all cores
-    for (int t : threads) thread_counts.push_back(t > 0 ? t : int(tbb::info::default_concurrency()));
+    for (int t : o.threads) thread_counts.push_back(t > 0 ? t : int(tbb::info::default_concurrency()));
     std::printf("%s%s", bench::sah_legend().c_str(), bench::table_header(thread_counts).c_str());
-    auto print_row = [](const Row& r) {
-      std::printf("%s", bench::table_row(r).c_str());
-      std::fflush(stdout);
-    };
-    std::vector<Row> rows;
-    std::string embree_reference;  // the settings of the Embree that every answer is checked against
-    for (const auto& file : scenes) {
-      std::string name;
-      const Scene scene = load_bench_scene(file, seed, name);
-      const auto views = mesh_views(scene);
-      const auto instances = instance_views(scene);  // identity placements unless shapes are placed
-      const auto embree = make_accelerator("embree", views, instances);
-      const auto exact = make_accelerator("brute", views, instances);  // settles disagreements with Embree
-      embree_reference = embree->stats().config;
-      const auto sets = make_ray_sets(scene, *embree, width, height, kinds);
-      const float scale = length(compute_bounds(scene).extent());
-      std::vector<Row> embree_rows;
-      for (const auto& accel_name : accels) {
-        // Build: median of `builds` builds (the last one is measured).
-        std::vector<double> times;
-        std::unique_ptr<Accelerator> accel;
-        for (int i = 0; i < builds; ++i) {
-          accel.reset();
-          const auto t0 = Clock::now();
-          accel = make_accelerator(accel_name, views, instances, config);
-          times.push_back(seconds_since(t0));
-        }
-        const AccelStats st = accel->stats();
-        // The SAH under the benchmark's one set of constants, from this tree's node boxes.
-        const bench::StructureSah sah =
-            bench::measure_structure_sah(accel_name, views, instances, config, *accel);
-        if (!sah.cost && accel_name == "bvh")
-          std::fprintf(stderr, "penumbra-bench: %s %s: SAH n/a: %s\n", name.c_str(), accel_name.c_str(),
-                       sah.note.c_str());
-        if (!heatmaps.empty()) {
-          RenderConfig rc;
-          rc.width = width;
-          rc.height = height;
-          rc.spp = 1;
-          validate(rc);
-          const CostImage cost = render_cost(*accel, bench_camera(scene, width, height), rc);
-          write_heatmap(total_cost(cost), width, height,
-                        std::filesystem::path(heatmaps) / (name + "." + accel_name + ".cost.png"),
-                        name + " " + cost_caption(cost, accel_name));
-        }
-        for (const auto& set : sets) {
-          Row row{name, accel_name, set.kind, st.config, st.triangles, st.shapes, set.rays.size()};
-          row.bytes = st.bytes;
-          if (accel->counts_traversal() && st.shapes > 0) row.evals = evaluations_per_ray(*accel, set);
-          row.build_s = bench::spread_of(times);
-          row.sah = sah.cost;
-          row.builder_sah = st.sah_cost;
-          const Agreement g = check_against_embree(*accel, *embree, *exact, set, scale);
-          row.mismatches = g.wrong;
-          row.ties = g.ties;
-          for (int t : threads) {
-            const int n = t > 0 ? t : int(tbb::info::default_concurrency());
-            uint64_t hits = 0;
-            trace_seconds(*accel, set, n, hits);  // warm-up
-            std::vector<double> mrays;
-            for (int r = 0; r < repeats; ++r)
-              mrays.push_back(double(set.rays.size()) / trace_seconds(*accel, set, n, hits) / 1e6);
-            row.hits = hits;
-            row.mrays.push_back({n, bench::spread_of(mrays)});
-          }
-          // Ratio to Embree on the same rays (Embree is measured first, see above).
-          for (const auto& e : rows)
-            if (e.scene == name && e.accel == "embree" && e.kind == row.kind)
-              for (size_t i = 0; i < row.mrays.size(); ++i)
-                row.vs_embree.push_back(row.mrays[i].mrays.median / e.mrays[i].mrays.median);
-          if (accel_name == "embree")
-            for (size_t i = 0; i < row.mrays.size(); ++i) row.vs_embree.push_back(1.0);
-          print_row(row);
-          rows.push_back(row);
-        }
-      }
-    }
-
+    std::string embree_reference;
+    const std::vector<Row> rows = measure_table(o, config, embree_reference);
     uint64_t wrong = 0;
     for (const auto& r : rows) wrong += r.mismatches;
-    if (!csv.empty())
-      write_atomically(csv, [&](const std::filesystem::path& tmp) {
-        std::ofstream f(tmp);
-        f << "scene,accel,rays,triangles,shapes,build_s,bytes,sah_cost,ray_count,hits,mismatches,ties,evals_"
-             "per_ray";
-        for (int t : thread_counts) f << ",mrays_" << t << "t,vs_embree_" << t << "t";
-        f << ",builder_sah_cost,build_s_min,build_s_max";
-        for (int t : thread_counts) f << ",mrays_min_" << t << "t,mrays_max_" << t << "t";
-        f << "\n";
-        for (const auto& r : rows) {
-          f << r.scene << ',' << r.accel << ',' << r.kind << ',' << r.triangles << ',' << r.shapes << ','
-            << r.build_s.median << ',' << r.bytes << ',';
-          if (r.sah) f << *r.sah;  // empty: no SAH
-          f << ',' << r.rays << ',' << r.hits << ',' << r.mismatches << ',' << r.ties << ',';
-          if (r.evals >= 0) f << r.evals;
-          for (size_t i = 0; i < r.mrays.size(); ++i)
-            f << ',' << r.mrays[i].mrays.median << ',' << (i < r.vs_embree.size() ? r.vs_embree[i] : 0);
-          f << ',' << r.builder_sah << ',' << r.build_s.min << ',' << r.build_s.max;
-          for (const auto& m : r.mrays) f << ',' << m.mrays.min << ',' << m.mrays.max;
-          f << "\n";
-        }
-        if (!f) throw std::runtime_error(csv + ": cannot write");
-      });
-    if (!json.empty())
-      write_atomically(json, [&](const std::filesystem::path& tmp) {
-        std::ofstream f(tmp);
-        const auto per_thread = [&](const Row& r, double bench::Spread::*field) {
-          std::ostringstream o;
-          for (size_t k = 0; k < r.mrays.size(); ++k)
-            o << (k ? ", " : "") << '"' << r.mrays[k].threads << "\": " << r.mrays[k].mrays.*field;
-          return "{" + o.str() + "}";
-        };
-        f << "{\n  \"command\": \"" << json_escape(command) << "\",\n  \"machine\": {\n"
-          << machine_json() << "  },\n"
-          << "  \"embree_reference\": \"" << json_escape(embree_reference) << "\",\n"
-          << "  \"sah_constants\": {\"traversal\": " << bench::kSahConstants.traversal
-          << ", \"intersection\": " << bench::kSahConstants.intersection << "},\n  \"results\": [\n";
-        for (size_t i = 0; i < rows.size(); ++i) {
-          const auto& r = rows[i];
-          f << "    {\"scene\": \"" << json_escape(r.scene) << "\", \"accel\": \"" << r.accel
-            << "\", \"config\": \"" << json_escape(r.config) << "\", \"rays\": \"" << r.kind
-            << "\", \"triangles\": " << r.triangles << ", \"shapes\": " << r.shapes
-            << ", \"evals_per_ray\": " << (r.evals >= 0 ? std::to_string(r.evals) : std::string("null"))
-            << ", \"build_s\": " << r.build_s.median << ", \"build_s_min\": " << r.build_s.min
-            << ", \"build_s_max\": " << r.build_s.max << ", \"bytes\": " << r.bytes
-            << ", \"sah_cost\": " << (r.sah ? std::to_string(*r.sah) : std::string("null"))
-            << ", \"builder_sah_cost\": " << r.builder_sah << ", \"ray_count\": " << r.rays
-            << ", \"mismatches\": " << r.mismatches << ", \"ties\": " << r.ties
-            << ", \"mrays\": " << per_thread(r, &bench::Spread::median)
-            << ", \"mrays_min\": " << per_thread(r, &bench::Spread::min)
-            << ", \"mrays_max\": " << per_thread(r, &bench::Spread::max) << "}"
-            << (i + 1 < rows.size() ? "," : "") << "\n";
-        }
-        f << "  ]\n}\n";
-        if (!f) throw std::runtime_error(json + ": cannot write");
-      });
-    if (!svg.empty())
-      write_atomically(svg, [&](const std::filesystem::path& tmp) {
-        bench::RunSettings rs;
-        rs.width = width, rs.height = height, rs.builds = builds, rs.repeats = repeats;
-        rs.build_threads = int(tbb::info::default_concurrency());
-        rs.threads = thread_counts;
-        rs.machine = bench::describe(bench::read_machine_info());
-        rs.software = software_line();
-        std::ofstream f(tmp);
-        f << bench::bar_chart_svg(bench::results_chart(rows, rs));
-        if (!f) throw std::runtime_error(svg + ": cannot write");
-      });
+    if (!o.csv.empty()) write_table_csv(o.csv, rows, thread_counts);
+    if (!o.json.empty()) write_table_json(o, rows, embree_reference);
+    if (!o.svg.empty()) write_table_svg(o, rows, thread_counts);
     if (wrong > 0) {
       std::fprintf(stderr, "penumbra-bench: %llu rays disagree with Embree: these results do not count\n",
                    static_cast<unsigned long long>(wrong));
       return 1;
     }
     return 0;
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-    return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "penumbra-bench: error: %s\n", e.what());
-    return 1;
+    return report_error(e);
   }
 }
