@@ -22,6 +22,7 @@
 #include "renderer/accel/common.h"
 #include "renderer/accel/polytope.h"
 #include "renderer/accel/stats.h"
+#include "renderer/accel/tree_common.h"
 
 namespace penumbra {
 namespace {
@@ -43,7 +44,27 @@ struct BspNode {
 static_assert(sizeof(BspNode) == 20, "BspNode must stay 20 bytes");
 
 constexpr int kMaxDepth = 64;
-constexpr uint32_t kMaxIndex = (1u << 31) - 1;  // node and count fields are 31 bits
+// Node and count fields are 31 bits.
+constexpr TreeFormat kFormat{"bsp", (1u << 31) - 1, "2^31 - 1"};
+
+/// The leaf and interior nodes flatten_tree() writes.
+BspNode leaf_node(uint32_t first_record, uint32_t count) {
+  BspNode n{};
+  n.prim_offset = first_record;
+  n.flags = (count << 1) | 1u;
+  return n;
+}
+
+BspNode interior_node(uint32_t negative, const BspPlane& p) {
+  BspNode n{};
+  n.n[0] = p.n.x;
+  n.n[1] = p.n.y;
+  n.n[2] = p.n.z;
+  n.k = p.k;
+  n.flags = negative << 1;
+  return n;
+}
+
 /// Extra references all splits together may add, as a multiple of the primitive count.
 constexpr double kReferenceBudget = 3.0;
 /// Relative error allowance of a traversal step's two float dot products (with margin: the sum
@@ -135,13 +156,9 @@ struct Ref {
   uint64_t cut = 0;
 };
 
-struct BuildNode {
-  std::unique_ptr<BuildNode> child[2];  // negative side, positive side
-  std::vector<uint32_t> prims;          // leaf only
-  BspPlane plane;
-  double area = 0;  // surface area of the node's polytope
-  bool leaf = true;
-};
+/// child[0] on the plane's negative side, child[1] on its positive side; `area` is the surface
+/// area of the node's polytope.
+using BuildNode = TreeBuildNode<2, BspPlane>;
 
 class Builder {
  public:
@@ -192,7 +209,7 @@ class Builder {
     }
     std::vector<Ref>().swap(refs);
     node->leaf = false;
-    node->plane = best.plane;
+    node->split = best.plane;
     Polytope rneg = region.clip(split.normal(), split.k, false),
              rpos = region.clip(split.normal(), split.k, true);
     region = Polytope{};
@@ -576,55 +593,31 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
  public:
   BspAccelerator(std::span<const GeometryView> views, const BspConfig& config) : m_config(config) {
     validate(config);
-    const BuildTimer timer;
-    const std::vector<PrimitiveRecord> prims = gather_primitives(views, m_shapes);
-    m_input_triangles = count_input_triangles(views);
-    if (prims.size() > kMaxIndex) throw std::runtime_error("bsp: too many primitives (max 2^31 - 1)");
-    m_max_depth =
-        config.max_depth > 0
-            ? config.max_depth
-            : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(prims.size(), 1)))));
-    if (!prims.empty()) {
-      for (const PrimitiveRecord& r : prims) m_bounds = merge(m_bounds, primitive_bounds(r));
-      m_clip = widen_for_rounding(m_bounds);
-      m_band = rounding_band(m_bounds);
-      std::vector<Ref> refs(prims.size());
-      for (uint32_t i = 0; i < refs.size(); ++i) refs[i].id = i;
-      const Polytope root(m_clip);
-      m_root_area = root.area();
-      Builder builder(m_config, prims, m_max_depth, double(m_band));
-      const auto tree =
-          builder.build(std::move(refs), root, 0, kReferenceBudget * double(prims.size()), nullptr);
-      m_nodes.emplace_back();
-      flatten(*tree, 0, 0, prims);
-      if (m_nodes.size() > kMaxIndex || m_leaf_prims.size() > kMaxIndex)
-        throw std::runtime_error("bsp: tree too large (more than 2^31 - 1 nodes or references)");
-      m_tally.fill(m_stats);
-    }
-    m_build_seconds = timer.seconds();
+    build_tree(
+        views, kFormat, {config.traversal_cost, config.intersection_cost}, m_shapes, m_tree,
+        [this](const std::vector<PrimitiveRecord>& prims) { return build_root(prims); }, leaf_node,
+        [this](uint32_t negative, const BspPlane& p) {
+          m_oblique += !is_axis(p.n);
+          return interior_node(negative, p);
+        });
   }
 
-  Bounds3f bounds() const override { return m_bounds; }
+  Bounds3f bounds() const override { return m_tree.bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = make_stats(
-        m_stats, "bsp",
-        "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
-            format_number(m_config.intersection_cost) + ", empty_bonus " +
-            format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth) + ", bins " +
-            std::to_string(m_config.bins) + ", triangle_planes " + std::to_string(m_config.triangle_planes) +
-            ", fixed_directions " + (m_config.fixed_directions ? "on" : "off") + ", " +
-            std::to_string(m_oblique) + " oblique planes",
-        m_input_triangles, m_nodes.size() * sizeof(BspNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
-        m_build_seconds);
-    s.nodes = m_nodes.size();
-    s.shapes = m_shapes.size();
-    return s;
+    return tree_stats(m_tree, kFormat,
+                      sah_tree_config(m_config.traversal_cost, m_config.intersection_cost,
+                                      m_config.empty_bonus, m_max_depth) +
+                          ", bins " + std::to_string(m_config.bins) + ", triangle_planes " +
+                          std::to_string(m_config.triangle_planes) + ", fixed_directions " +
+                          (m_config.fixed_directions ? "on" : "off") + ", " + std::to_string(m_oblique) +
+                          " oblique planes",
+                      m_shapes.size());
   }
 
   std::optional<BspPlane> root_plane() const {
-    if (m_nodes.empty() || m_nodes[0].leaf()) return std::nullopt;
-    const BspNode& r = m_nodes[0];
+    if (m_tree.nodes.empty() || m_tree.nodes[0].leaf()) return std::nullopt;
+    const BspNode& r = m_tree.nodes[0];
     return BspPlane{{r.n[0], r.n[1], r.n[2]}, r.k};
   }
 
@@ -634,6 +627,17 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
     float tmin, tmax;
   };
 
+  /// The build tree over `prims` (null if there are none), after setting m_max_depth for them.
+  std::unique_ptr<BuildNode> build_root(const std::vector<PrimitiveRecord>& prims) {
+    m_max_depth = tree_max_depth(m_config.max_depth, prims.size(), kMaxDepth);
+    if (prims.empty()) return nullptr;
+    std::vector<Ref> refs(prims.size());
+    for (uint32_t i = 0; i < refs.size(); ++i) refs[i].id = i;
+    Builder builder(m_config, prims, m_max_depth, double(m_tree.band));
+    return builder.build(std::move(refs), Polytope(m_tree.clip), 0, kReferenceBudget * double(prims.size()),
+                         nullptr);
+  }
+
   /// Front-to-back traversal: visits the child whose t-interval starts first and pushes the
   /// other; skips nodes whose interval starts beyond `best` (narrowed by closest-hit visitors).
   /// The children's intervals overlap, so the stack is not sorted by entry distance: skipped
@@ -642,27 +646,23 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
-    const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid || m_nodes.empty()) return false;
-    const RayBoxQuery q = prepare_box_query(ray);
-    float tmin = w.tnear, tmax = ray.tfar;
-    if (!intersect_box(m_clip.lo, m_clip.hi, q, tmin, tmax)) return false;
+    TreeRay r;
+    if (!enter_tree(m_tree, ray, r)) return false;
+    float tmin = r.t0, tmax = r.t1;
     const float org_eps =
-        2 * m_band + kDotError * (std::fabs(ray.org.x) + std::fabs(ray.org.y) + std::fabs(ray.org.z));
+        2 * m_tree.band + kDotError * (std::fabs(ray.org.x) + std::fabs(ray.org.y) + std::fabs(ray.org.z));
     Todo todo[kMaxDepth + 1];
     int sp = 0;
     uint32_t idx = 0;
     Mailbox mailbox;
     for (;;) {
       if (!(best < tmin)) {
-        const BspNode& node = m_nodes[idx];
+        const BspNode& node = m_tree.nodes[idx];
         counter.node();
         if (!node.leaf()) {
           if (step(node, ray, org_eps, idx, tmin, tmax, todo, sp)) continue;
         } else {
-          const PrimitiveRecord* recs = m_leaf_prims.data() + node.prim_offset;
-          for (uint32_t i = 0, cnt = node.count(); i < cnt; ++i)
-            if (!mailbox.seen(recs[i]) && visit(w, recs[i])) return true;
+          if (visit_leaf(m_tree, node.prim_offset, node.count(), r.w, mailbox, visit)) return true;
         }
       }
       if (sp == 0) return false;
@@ -727,51 +727,12 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
     return true;
   }
 
-  /// Writes build node `b` into m_nodes[idx] (already allocated), its children as an adjacent
-  /// pair after every node written so far, and a leaf's records contiguously into m_leaf_prims.
-  void flatten(const BuildNode& b, uint32_t idx, uint64_t depth, const std::vector<PrimitiveRecord>& prims) {
-    m_stats.max_depth = std::max(m_stats.max_depth, depth);
-    const double rel = m_root_area > 0 ? b.area / m_root_area : 1.0;
-    BspNode& node = m_nodes[idx];
-    if (b.leaf) {
-      const uint32_t n = uint32_t(b.prims.size());
-      m_tally.add(n);
-      m_stats.sah_cost += rel * m_config.intersection_cost * n;
-      m_stats.sah_leaf_area += rel * n;
-      node.n[0] = node.n[1] = node.n[2] = 0;
-      node.prim_offset = uint32_t(m_leaf_prims.size());
-      node.flags = (n << 1) | 1u;
-      for (const uint32_t t : b.prims) m_leaf_prims.push_back(prims[t]);
-      return;
-    }
-    m_stats.sah_cost += rel * m_config.traversal_cost;
-    m_stats.sah_node_area += rel;
-    m_oblique += !is_axis(b.plane.n);
-    const uint32_t first = uint32_t(m_nodes.size());
-    m_nodes.resize(m_nodes.size() + 2);
-    BspNode& inner = m_nodes[idx];  // resize may have moved it
-    inner.n[0] = b.plane.n.x;
-    inner.n[1] = b.plane.n.y;
-    inner.n[2] = b.plane.n.z;
-    inner.k = b.plane.k;
-    inner.flags = first << 1;
-    flatten(*b.child[0], first, depth + 1, prims);
-    flatten(*b.child[1], first + 1, depth + 1, prims);
-  }
-
   BspConfig m_config;
   int m_max_depth = 0;
-  std::vector<BspNode> m_nodes;               // node 0 is the root; children in adjacent pairs
-  std::vector<PrimitiveRecord> m_leaf_prims;  // each leaf's records, contiguous, in leaf order
-  Bounds3f m_bounds;                          // exact bounds of the primitives
-  Bounds3f m_clip;                            // m_bounds widened by m_band: the root's region
-  float m_band = 0;                           // the scene's rounding band (also the build's tolerance)
-  uint64_t m_input_triangles = 0;
+  // Children in adjacent pairs (negative, positive); m_tree.clip is the root's region and
+  // m_tree.band also the build's tolerance.
+  FlatTree<BspNode> m_tree;
   uint64_t m_oblique = 0;  // interior nodes whose plane is not axis-aligned
-  double m_root_area = 0;
-  LeafTally m_tally;
-  AccelStats m_stats;
-  double m_build_seconds = 0;
 };
 
 }  // namespace

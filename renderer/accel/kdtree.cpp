@@ -18,6 +18,7 @@
 #include "renderer/accel/clip.h"
 #include "renderer/accel/common.h"
 #include "renderer/accel/stats.h"
+#include "renderer/accel/tree_common.h"
 
 namespace penumbra {
 namespace {
@@ -41,7 +42,29 @@ struct KdNode {
 static_assert(sizeof(KdNode) == 8, "KdNode must stay 8 bytes");
 
 constexpr int kMaxDepth = 64;
-constexpr uint32_t kMaxIndex = (1u << 30) - 1;  // node and count fields are 30 bits
+// Node and count fields are 30 bits.
+constexpr TreeFormat kFormat{"kdtree", (1u << 30) - 1, "2^30 - 1"};
+
+/// An interior node's plane: x[axis] = pos.
+struct KdSplit {
+  float pos = 0;
+  int axis = 0;
+};
+
+/// The leaf and interior nodes flatten_tree() writes.
+KdNode leaf_node(uint32_t first_record, uint32_t count) {
+  KdNode n{};
+  n.prim_offset = first_record;
+  n.flags = (count << 2) | 3u;
+  return n;
+}
+
+KdNode interior_node(uint32_t below, const KdSplit& s) {
+  KdNode n{};
+  n.split = s.pos;
+  n.flags = (below << 2) | uint32_t(s.axis);
+  return n;
+}
 
 // ---- Build-time types -------------------------------------------------------------------------
 
@@ -73,13 +96,8 @@ void add_events(std::vector<Event>& out, uint32_t tri, const Bounds3f& b) {
   }
 }
 
-struct BuildNode {
-  std::unique_ptr<BuildNode> below, above;
-  std::vector<uint32_t> tris;  // leaf only
-  Bounds3f box;
-  float split = 0;
-  int axis = -1;  // -1 for a leaf
-};
+/// child[0] below the plane, child[1] above it; a leaf's triangles ascending.
+using BuildNode = TreeBuildNode<2, KdSplit>;
 
 class Builder {
  public:
@@ -88,7 +106,7 @@ class Builder {
 
   std::unique_ptr<BuildNode> build(std::vector<Event> events, uint32_t n, const Bounds3f& box, int depth) {
     auto node = std::make_unique<BuildNode>();
-    node->box = box;
+    node->area = surface_area(box);
     // Phase 1: find the cheapest plane by sweeping the sorted events (Wald & Havran, alg. 4).
     Split best;
     if (depth < m_max_depth && n > 0 && surface_area(box) > 0) best = find_plane(events, n, box);
@@ -144,16 +162,16 @@ class Builder {
     std::sort(right_new.begin(), right_new.end());
     left = merge_sorted(std::move(left), left_new);
     right = merge_sorted(std::move(right), right_new);
-    node->axis = best.axis;
-    node->split = best.pos;
+    node->leaf = false;
+    node->split = {best.pos, best.axis};
     // Phase 4: recurse; large nodes build their children in parallel. The tree's shape never
     // depends on scheduling.
     if (n >= m_config.parallel_threshold) {
-      tbb::parallel_invoke([&] { node->below = build(std::move(left), nl, lbox, depth + 1); },
-                           [&] { node->above = build(std::move(right), nr, rbox, depth + 1); });
+      tbb::parallel_invoke([&] { node->child[0] = build(std::move(left), nl, lbox, depth + 1); },
+                           [&] { node->child[1] = build(std::move(right), nr, rbox, depth + 1); });
     } else {
-      node->below = build(std::move(left), nl, lbox, depth + 1);
-      node->above = build(std::move(right), nr, rbox, depth + 1);
+      node->child[0] = build(std::move(left), nl, lbox, depth + 1);
+      node->child[1] = build(std::move(right), nr, rbox, depth + 1);
     }
     return node;
   }
@@ -207,8 +225,8 @@ class Builder {
 
   static void make_leaf(BuildNode& node, const std::vector<Event>& events) {
     for (const Event& e : events)
-      if (e.axis == 0 && e.type != kEnd) node.tris.push_back(e.tri);
-    std::sort(node.tris.begin(), node.tris.end());
+      if (e.axis == 0 && e.type != kEnd) node.prims.push_back(e.tri);
+    std::sort(node.prims.begin(), node.prims.end());
   }
 
   static std::vector<Event> merge_sorted(std::vector<Event> a, const std::vector<Event>& b) {
@@ -232,50 +250,19 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
  public:
   KdTreeAccelerator(std::span<const GeometryView> meshes, const KdTreeConfig& config) : m_config(config) {
     validate(config);
-    const BuildTimer timer;
-    const std::vector<PrimitiveRecord> prims = gather_primitives(meshes, m_shapes);
-    m_input_triangles = count_input_triangles(meshes);
-    if (prims.size() > kMaxIndex) throw std::runtime_error("kdtree: too many primitives (max 2^30 - 1)");
-    m_max_depth =
-        config.max_depth > 0
-            ? config.max_depth
-            : std::min(kMaxDepth, int(std::lround(8 + 1.3 * std::log2(std::max<size_t>(prims.size(), 1)))));
-    if (!prims.empty()) {
-      std::vector<Event> events;
-      events.reserve(prims.size() * 6);
-      for (uint32_t i = 0; i < prims.size(); ++i) {
-        const Bounds3f b = primitive_bounds(prims[i]);
-        m_bounds = merge(m_bounds, b);
-        add_events(events, i, b);
-      }
-      std::sort(events.begin(), events.end());
-      Builder builder(m_config, prims, m_max_depth);
-      auto root = builder.build(std::move(events), uint32_t(prims.size()), m_bounds, 0);
-      m_root_area = surface_area(m_bounds);
-      m_clip = widen_for_rounding(m_bounds);
-      m_band = rounding_band(m_bounds);
-      m_nodes.emplace_back();
-      flatten(*root, 0, 0, prims);
-      if (m_nodes.size() > kMaxIndex || m_leaf_prims.size() > kMaxIndex)
-        throw std::runtime_error("kdtree: tree too large (more than 2^30 nodes or references)");
-      m_tally.fill(m_stats);
-    }
-    m_build_seconds = timer.seconds();
+    build_tree(
+        meshes, kFormat, {config.traversal_cost, config.intersection_cost}, m_shapes, m_tree,
+        [this](const std::vector<PrimitiveRecord>& prims) { return build_root(prims); }, leaf_node,
+        interior_node);
   }
 
-  Bounds3f bounds() const override { return m_bounds; }
+  Bounds3f bounds() const override { return m_tree.bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = make_stats(
-        m_stats, "kdtree",
-        "traversal_cost " + format_number(m_config.traversal_cost) + ", intersection_cost " +
-            format_number(m_config.intersection_cost) + ", empty_bonus " +
-            format_number(m_config.empty_bonus) + ", max_depth " + std::to_string(m_max_depth),
-        m_input_triangles, m_nodes.size() * sizeof(KdNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
-        m_build_seconds);
-    s.nodes = m_nodes.size();
-    s.shapes = m_shapes.size();
-    return s;
+    return tree_stats(m_tree, kFormat,
+                      sah_tree_config(m_config.traversal_cost, m_config.intersection_cost,
+                                      m_config.empty_bonus, m_max_depth),
+                      m_shapes.size());
   }
 
  private:
@@ -290,35 +277,43 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     float org[3], dir[3], inv_dir[3];
   };
 
+  /// The build tree over `prims` (null if there are none), after setting m_max_depth for them.
+  std::unique_ptr<BuildNode> build_root(const std::vector<PrimitiveRecord>& prims) {
+    m_max_depth = tree_max_depth(m_config.max_depth, prims.size(), kMaxDepth);
+    if (prims.empty()) return nullptr;
+    std::vector<Event> events;
+    events.reserve(prims.size() * 6);
+    for (uint32_t i = 0; i < prims.size(); ++i) add_events(events, i, primitive_bounds(prims[i]));
+    std::sort(events.begin(), events.end());
+    Builder builder(m_config, prims, m_max_depth);
+    return builder.build(std::move(events), uint32_t(prims.size()), m_tree.bounds, 0);
+  }
+
   /// Front-to-back traversal with early exit: stops once `best` (narrowed by closest-hit
   /// visitors) lies before the next node's entry. `visit(w, tri)` returns true to stop
   /// (any-hit). Returns true iff a visitor stopped it.
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
-    const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid || m_nodes.empty()) return false;
-    const RayBoxQuery q = prepare_box_query(ray);
-    float tmin = w.tnear, tmax = ray.tfar;
-    if (!intersect_box(m_clip.lo, m_clip.hi, q, tmin, tmax)) return false;
+    TreeRay r;
+    if (!enter_tree(m_tree, ray, r)) return false;
+    float tmin = r.t0, tmax = r.t1;
     const PlaneQuery pq{{ray.org.x, ray.org.y, ray.org.z},
                         {ray.dir.x, ray.dir.y, ray.dir.z},
-                        {q.inv_dir.x, q.inv_dir.y, q.inv_dir.z}};
+                        {r.q.inv_dir.x, r.q.inv_dir.y, r.q.inv_dir.z}};
     Todo todo[kMaxDepth + 1];
     int sp = 0;
     uint32_t idx = 0;
     Mailbox mailbox;
     for (;;) {
       if (best < tmin) return false;  // nothing further can be closer
-      const KdNode& node = m_nodes[idx];
+      const KdNode& node = m_tree.nodes[idx];
       counter.node();
       if (!node.leaf()) {
         idx = step(node, pq, tmin, tmax, todo, sp);
         continue;
       }
-      const PrimitiveRecord* recs = m_leaf_prims.data() + node.prim_offset;
-      for (uint32_t i = 0, cnt = node.count(); i < cnt; ++i)
-        if (!mailbox.seen(recs[i]) && visit(w, recs[i])) return true;
+      if (visit_leaf(m_tree, node.prim_offset, node.count(), r.w, mailbox, visit)) return true;
       if (sp == 0) return false;
       --sp;
       idx = todo[sp].node;
@@ -339,7 +334,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     const uint32_t second = below_first ? above : below;
     const float delta = node.split - o;
     const float tplane = delta * q.inv_dir[axis];
-    const bool on_plane = std::fabs(delta) <= m_band;
+    const bool on_plane = std::fabs(delta) <= m_tree.band;
     if (!on_plane && d != 0 && !std::isnan(tplane)) [[likely]] {
       // The common case as selects rather than branches (the three outcomes are unpredictable
       // for incoherent rays): near child only, far child only, or both with the far one pushed.
@@ -365,43 +360,11 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
     return other;
   }
 
-  /// Writes build node `b` into m_nodes[idx] (already allocated), its children as an adjacent
-  /// pair after every node written so far, and a leaf's records contiguously into m_leaf_prims.
-  void flatten(const BuildNode& b, uint32_t idx, uint64_t depth, const std::vector<PrimitiveRecord>& prims) {
-    m_stats.max_depth = std::max(m_stats.max_depth, depth);
-    const double rel = m_root_area > 0 ? surface_area(b.box) / m_root_area : 1.0;
-    if (b.axis < 0) {
-      const uint32_t n = uint32_t(b.tris.size());
-      m_tally.add(n);
-      m_stats.sah_cost += rel * m_config.intersection_cost * n;
-      m_stats.sah_leaf_area += rel * n;
-      m_nodes[idx].prim_offset = uint32_t(m_leaf_prims.size());
-      for (const uint32_t t : b.tris) m_leaf_prims.push_back(prims[t]);
-      m_nodes[idx].flags = (n << 2) | 3u;
-      return;
-    }
-    m_stats.sah_cost += rel * m_config.traversal_cost;
-    m_stats.sah_node_area += rel;
-    const uint32_t below = uint32_t(m_nodes.size());
-    m_nodes.resize(m_nodes.size() + 2);
-    m_nodes[idx].split = b.split;
-    m_nodes[idx].flags = (below << 2) | uint32_t(b.axis);
-    flatten(*b.below, below, depth + 1, prims);
-    flatten(*b.above, below + 1, depth + 1, prims);
-  }
-
   KdTreeConfig m_config;
   int m_max_depth = 0;
-  std::vector<KdNode> m_nodes;                // node 0 is the root; children in adjacent pairs, depth first
-  std::vector<PrimitiveRecord> m_leaf_prims;  // each leaf's records, contiguous, in leaf order
-  Bounds3f m_bounds;                          // exact bounds of the triangles
-  Bounds3f m_clip;                            // m_bounds widened by m_band, for clipping rays
-  float m_band = 0;                           // origins this close to a split plane count as on it
-  uint64_t m_input_triangles = 0;
-  double m_root_area = 0;
-  LeafTally m_tally;
-  AccelStats m_stats;
-  double m_build_seconds = 0;
+  // Children in adjacent pairs (below, above); origins within m_tree.band of a split plane count
+  // as on it.
+  FlatTree<KdNode> m_tree;
 };
 
 }  // namespace

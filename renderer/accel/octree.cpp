@@ -20,6 +20,7 @@
 #include "renderer/accel/clip.h"
 #include "renderer/accel/common.h"
 #include "renderer/accel/stats.h"
+#include "renderer/accel/tree_common.h"
 
 namespace penumbra {
 namespace {
@@ -43,6 +44,21 @@ struct OctNode {
   bool leaf() const { return count != kInterior; }
 };
 static_assert(sizeof(OctNode) == 8, "OctNode must stay 8 bytes");
+
+// A leaf's count cannot be kInterior, so counts and indices stop one below it.
+constexpr TreeFormat kFormat{"octree", kInterior - 1, "2^32 - 2"};
+
+/// An interior node stores no split: its children halve its box at the centre.
+struct NoSplit {};
+
+/// The leaf and interior nodes flatten_tree() writes.
+OctNode leaf_node(uint32_t first_record, uint32_t count) {
+  return {first_record, count};
+}
+
+OctNode interior_node(uint32_t first_child, NoSplit) {
+  return {first_child, kInterior};
+}
 
 // ---- Subdivision, shared by build and traversal ------------------------------------------------
 
@@ -94,11 +110,9 @@ Bounds3f child_box(const Bounds3f& box, float band, int c) {
 
 // ---- Build ------------------------------------------------------------------------------------
 
-struct BuildNode {
-  std::array<std::unique_ptr<BuildNode>, 8> children;  // interior only
-  std::vector<uint32_t> prims;                         // leaf only, ascending
-  bool leaf = true;
-};
+/// child[c] is child c of the node (bit k of c: the upper half along axis k); a leaf's
+/// primitives ascending.
+using BuildNode = TreeBuildNode<8, NoSplit>;
 
 class Builder {
  public:
@@ -113,6 +127,7 @@ class Builder {
   std::unique_ptr<BuildNode> build(std::vector<uint32_t> ids, const Bounds3f& box, int depth,
                                    double budget) const {
     auto node = std::make_unique<BuildNode>();
+    node->area = surface_area(box);
     const size_t n = ids.size();
     if (n <= size_t(m_config.max_leaf_prims) || depth >= m_config.max_depth || !splits_any(box, m_band)) {
       node->prims = std::move(ids);
@@ -158,7 +173,7 @@ class Builder {
     node->leaf = false;
     const auto make_child = [&](int c) {
       const double share = total > 0 ? left * double(kids[c].size()) / double(total) : 0.0;
-      node->children[c] = build(std::move(kids[c]), boxes[c], depth + 1, share);
+      node->child[size_t(c)] = build(std::move(kids[c]), boxes[c], depth + 1, share);
     };
     if (n >= m_config.parallel_threshold) {
       tbb::parallel_for(0, 8, make_child);
@@ -195,42 +210,20 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
  public:
   OctreeAccelerator(std::span<const GeometryView> views, const OctreeConfig& config) : m_config(config) {
     validate(config);
-    const BuildTimer timer;
-    const std::vector<PrimitiveRecord> prims = gather_primitives(views, m_shapes);
-    m_input_triangles = count_input_triangles(views);
-    if (prims.size() >= kInterior) throw std::runtime_error("octree: too many primitives (max 2^32 - 2)");
-    if (!prims.empty()) {
-      for (const PrimitiveRecord& p : prims) m_bounds = merge(m_bounds, primitive_bounds(p));
-      m_band = rounding_band(m_bounds);
-      m_clip = widen_for_rounding(m_bounds);
-      m_root_area = surface_area(m_bounds);
-      std::vector<uint32_t> all(prims.size());
-      std::iota(all.begin(), all.end(), 0u);
-      const Builder builder(m_config, prims, m_band);
-      const double budget = double(m_config.reference_budget) * double(prims.size());
-      const auto root = builder.build(std::move(all), m_bounds, 0, budget);
-      m_nodes.emplace_back();
-      flatten(*root, 0, m_bounds, 0, prims);
-      if (m_nodes.size() >= kInterior || m_leaf_prims.size() >= kInterior)
-        throw std::runtime_error("octree: tree too large (2^32 - 1 or more nodes or references)");
-      m_tally.fill(m_stats);
-    }
-    m_build_seconds = timer.seconds();
+    build_tree(
+        views, kFormat, {kTraversalCost, kIntersectionCost}, m_shapes, m_tree,
+        [this](const std::vector<PrimitiveRecord>& prims) { return build_root(prims); }, leaf_node,
+        interior_node);
   }
 
-  Bounds3f bounds() const override { return m_bounds; }
+  Bounds3f bounds() const override { return m_tree.bounds; }
 
   AccelStats stats() const override {
-    AccelStats s = make_stats(
-        m_stats, "octree",
-        "max_leaf_prims " + std::to_string(m_config.max_leaf_prims) + ", max_depth " +
-            std::to_string(m_config.max_depth) + ", reference_budget " +
-            format_number(m_config.reference_budget),
-        m_input_triangles, m_nodes.size() * sizeof(OctNode) + m_leaf_prims.size() * sizeof(PrimitiveRecord),
-        m_build_seconds);
-    s.nodes = m_nodes.size();
-    s.shapes = m_shapes.size();
-    return s;
+    return tree_stats(m_tree, kFormat,
+                      "max_leaf_prims " + std::to_string(m_config.max_leaf_prims) + ", max_depth " +
+                          std::to_string(m_config.max_depth) + ", reference_budget " +
+                          format_number(m_config.reference_budget),
+                      m_shapes.size());
   }
 
  private:
@@ -242,6 +235,16 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
     float lo[3], hi[3];
   };
 
+  /// The build tree over `prims` (null if there are none).
+  std::unique_ptr<BuildNode> build_root(const std::vector<PrimitiveRecord>& prims) const {
+    if (prims.empty()) return nullptr;
+    std::vector<uint32_t> all(prims.size());
+    std::iota(all.begin(), all.end(), 0u);
+    const Builder builder(m_config, prims, m_tree.band);
+    const double budget = double(m_config.reference_budget) * double(prims.size());
+    return builder.build(std::move(all), m_tree.bounds, 0, budget);
+  }
+
   /// Front-to-back traversal with early exit: a node whose interval starts beyond `best`
   /// (narrowed by closest-hit visitors) is skipped. `visit(w, rec)` returns true to stop
   /// (any-hit). Returns true iff a visitor stopped it. Occlusion queries (AnyHit) take the same
@@ -249,30 +252,25 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
   template <typename Visit, typename Counter, bool AnyHit>
   bool traverse(const Ray& ray, const float& best, Visit&& visit, const Counter& counter,
                 std::bool_constant<AnyHit>) const {
-    const WatertightRay w = prepare_watertight(ray);
-    if (!w.valid || m_nodes.empty()) return false;
-    const RayBoxQuery q = prepare_box_query(ray);
-    float t0 = w.tnear, t1 = ray.tfar;
-    if (!intersect_box(m_clip.lo, m_clip.hi, q, t0, t1)) return false;
+    TreeRay r;
+    if (!enter_tree(m_tree, ray, r)) return false;
     Todo todo[kStackSize];
     int sp = 0;
     Todo cur{0,
-             t0,
-             t1,
-             {m_bounds.lo.x, m_bounds.lo.y, m_bounds.lo.z},
-             {m_bounds.hi.x, m_bounds.hi.y, m_bounds.hi.z}};
+             r.t0,
+             r.t1,
+             {m_tree.bounds.lo.x, m_tree.bounds.lo.y, m_tree.bounds.lo.z},
+             {m_tree.bounds.hi.x, m_tree.bounds.hi.y, m_tree.bounds.hi.z}};
     Mailbox mailbox;
     for (;;) {
       if (!(best < cur.t0)) {
-        const OctNode& node = m_nodes[cur.node];
+        const OctNode& node = m_tree.nodes[cur.node];
         counter.node();
         if (node.leaf()) {
-          const PrimitiveRecord* recs = m_leaf_prims.data() + node.index;
-          for (uint32_t i = 0; i < node.count; ++i)
-            if (!mailbox.seen(recs[i]) && visit(w, recs[i])) return true;
+          if (visit_leaf(m_tree, node.index, node.count, r.w, mailbox, visit)) return true;
         } else {
           Todo kids[8];
-          const int n = children(node, cur, q, best, kids);
+          const int n = children(node, cur, r.q, best, kids);
           if (n > 0) {
             for (int i = n - 1; i >= 1; --i) todo[sp++] = kids[i];
             cur = kids[0];
@@ -305,9 +303,9 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
       float t_exit = kInfinity, t_enter = -kInfinity;
       const float delta = mid[k] - q.org[k];
       const float tm = delta * q.inv_dir[k];
-      if (!splits(lo, mid[k], hi, m_band)) {
+      if (!splits(lo, mid[k], hi, m_tree.band)) {
         only = 0;  // the lower children span the whole axis
-      } else if (std::fabs(delta) <= m_band) {
+      } else if (std::fabs(delta) <= m_tree.band) {
         only = -1;  // the origin lies on the plane, within rounding
       } else if (std::isinf(q.inv_dir[k]) || std::isnan(tm)) {
         only = delta < 0 ? 1 : 0;  // parallel to the plane: the origin's side
@@ -330,7 +328,7 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
     }
     int n = 0;
     for (int c = 0; c < 8; ++c) {
-      if (m_nodes[node.index + c].count == 0) continue;  // an empty leaf
+      if (m_tree.nodes[node.index + c].count == 0) continue;  // an empty leaf
       float s = cur.t0, e = cur.t1;
       for (int k = 0; k < 3; ++k) {
         const int side = (c >> k) & 1;
@@ -345,50 +343,15 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
       out[i].t0 = s;
       out[i].t1 = e;
       for (int k = 0; k < 3; ++k)
-        child_range(cur.lo[k], mid[k], cur.hi[k], m_band, (c >> k) & 1, out[i].lo[k], out[i].hi[k]);
+        child_range(cur.lo[k], mid[k], cur.hi[k], m_tree.band, (c >> k) & 1, out[i].lo[k], out[i].hi[k]);
     }
     return n;
   }
 
-  /// Writes build node `b` (box `box`, at `depth`) into m_nodes[idx] (already allocated), an
-  /// interior node's eight children as a block after every node written so far, and a leaf's
-  /// records contiguously into m_leaf_prims; gathers the statistics on the way. The SAH cost
-  /// counts K_T = 15 per interior node and K_I = 20 per reference, each weighted by the node's
-  /// area over the root's.
-  void flatten(const BuildNode& b, uint32_t idx, const Bounds3f& box, uint64_t depth,
-               const std::vector<PrimitiveRecord>& prims) {
-    m_stats.max_depth = std::max(m_stats.max_depth, depth);
-    const double rel = m_root_area > 0 ? surface_area(box) / m_root_area : 1.0;
-    if (b.leaf) {
-      const uint32_t n = uint32_t(b.prims.size());
-      m_tally.add(n);
-      m_stats.sah_cost += rel * kIntersectionCost * n;
-      m_stats.sah_leaf_area += rel * n;
-      m_nodes[idx] = {uint32_t(m_leaf_prims.size()), n};
-      for (const uint32_t p : b.prims) m_leaf_prims.push_back(prims[p]);
-      return;
-    }
-    m_stats.sah_cost += rel * kTraversalCost;
-    m_stats.sah_node_area += rel;
-    const uint32_t first = uint32_t(m_nodes.size());
-    m_nodes.resize(m_nodes.size() + 8);
-    m_nodes[idx] = {first, kInterior};
-    for (int c = 0; c < 8; ++c)
-      flatten(*b.children[c], first + uint32_t(c), child_box(box, m_band, c), depth + 1, prims);
-  }
-
   OctreeConfig m_config;
-  std::vector<OctNode> m_nodes;               // node 0 is the root; children in blocks of 8, depth first
-  std::vector<PrimitiveRecord> m_leaf_prims;  // each leaf's records, contiguous, in leaf order
-  Bounds3f m_bounds;                          // exact bounds of the primitives: the root's box
-  Bounds3f m_clip;                            // m_bounds widened by m_band, for clipping rays
-  float m_band = 0;                           // rounding band: origins this close to a mid plane
-                                              // count as on it; child boxes are widened by it
-  uint64_t m_input_triangles = 0;
-  double m_root_area = 0;
-  LeafTally m_tally;
-  AccelStats m_stats;
-  double m_build_seconds = 0;
+  // Children in blocks of 8; m_tree.bounds is the root's box. Origins within m_tree.band of a mid
+  // plane count as on it, and child boxes are widened by it before clipping.
+  FlatTree<OctNode> m_tree;
 };
 
 }  // namespace

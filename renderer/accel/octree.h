@@ -49,8 +49,8 @@ void validate(const OctreeConfig& config);
 /// Builds an octree over copies of the primitives (`views` need not outlive it, apart from what
 /// the shapes reference). The structure, statistics and answers do not depend on the number of
 /// threads. An empty scene has empty bounds and every query misses.
-/// Throws std::invalid_argument for a bad config, std::runtime_error if the tree would exceed
-/// 2^32 - 1 nodes or references.
+/// Throws std::invalid_argument for a bad config, std::runtime_error past 2^32 - 2 primitives,
+/// nodes or references.
 std::unique_ptr<Accelerator> make_octree_accelerator(std::span<const GeometryView> views,
                                                      const OctreeConfig& config = {});
 
