@@ -604,6 +604,12 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
 
   Bounds3f bounds() const override { return m_tree.bounds; }
 
+  TreeWalk walk() const {
+    return walk_flat_tree<2>(m_tree, [](const BspNode& n) {
+      return n.leaf() ? TreeNodeView{true, n.prim_offset, n.count()} : TreeNodeView{false, n.negative(), 0};
+    });
+  }
+
   AccelStats stats() const override {
     return tree_stats(m_tree, kFormat,
                       sah_tree_config(m_config.traversal_cost, m_config.intersection_cost,
@@ -757,6 +763,11 @@ void validate(const BspConfig& c) {
 std::unique_ptr<Accelerator> make_bsp_accelerator(std::span<const GeometryView> views,
                                                   const BspConfig& config) {
   return std::make_unique<BspAccelerator>(views, config);
+}
+
+std::optional<TreeWalk> walk_bsp(const Accelerator& accel) {
+  const auto* bsp = dynamic_cast<const BspAccelerator*>(&accel);
+  return bsp ? std::optional(bsp->walk()) : std::nullopt;
 }
 
 std::optional<BspPlane> bsp_root_plane(const Accelerator& accel) {

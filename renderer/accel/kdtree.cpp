@@ -258,6 +258,12 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
 
   Bounds3f bounds() const override { return m_tree.bounds; }
 
+  TreeWalk walk() const {
+    return walk_flat_tree<2>(m_tree, [](const KdNode& n) {
+      return n.leaf() ? TreeNodeView{true, n.prim_offset, n.count()} : TreeNodeView{false, n.below(), 0};
+    });
+  }
+
   AccelStats stats() const override {
     return tree_stats(m_tree, kFormat,
                       sah_tree_config(m_config.traversal_cost, m_config.intersection_cost,
@@ -381,6 +387,11 @@ void validate(const KdTreeConfig& c) {
 std::unique_ptr<Accelerator> make_kdtree_accelerator(std::span<const GeometryView> meshes,
                                                      const KdTreeConfig& config) {
   return std::make_unique<KdTreeAccelerator>(meshes, config);
+}
+
+std::optional<TreeWalk> walk_kdtree(const Accelerator& accel) {
+  const auto* kd = dynamic_cast<const KdTreeAccelerator*>(&accel);
+  return kd ? std::optional(kd->walk()) : std::nullopt;
 }
 
 }  // namespace penumbra

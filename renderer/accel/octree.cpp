@@ -218,6 +218,12 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
 
   Bounds3f bounds() const override { return m_tree.bounds; }
 
+  TreeWalk walk() const {
+    return walk_flat_tree<8>(m_tree, [](const OctNode& n) {
+      return n.leaf() ? TreeNodeView{true, n.index, n.count} : TreeNodeView{false, n.index, 0};
+    });
+  }
+
   AccelStats stats() const override {
     return tree_stats(m_tree, kFormat,
                       "max_leaf_prims " + std::to_string(m_config.max_leaf_prims) + ", max_depth " +
@@ -370,6 +376,11 @@ void validate(const OctreeConfig& c) {
 std::unique_ptr<Accelerator> make_octree_accelerator(std::span<const GeometryView> views,
                                                      const OctreeConfig& config) {
   return std::make_unique<OctreeAccelerator>(views, config);
+}
+
+std::optional<TreeWalk> walk_octree(const Accelerator& accel) {
+  const auto* oct = dynamic_cast<const OctreeAccelerator*>(&accel);
+  return oct ? std::optional(oct->walk()) : std::nullopt;
 }
 
 }  // namespace penumbra

@@ -11,8 +11,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/accel/clip.h"
@@ -180,6 +182,66 @@ AccelStats tree_stats(const FlatTree<Node>& tree, const TreeFormat& format, std:
   s.shapes = shapes;
   return s;
 }
+
+// ---- Walking a built tree (tests and tools) -------------------------------------------------------
+
+/// A node as its back end decodes it: a leaf with `count` records from leaf_prims[index], or an
+/// interior node whose Arity children start at nodes[index].
+struct TreeNodeView {
+  bool leaf = true;
+  uint32_t index = 0;
+  uint32_t count = 0;
+};
+
+/// A leaf as a walk from the root meets it.
+struct TreeLeafEntry {
+  uint64_t depth = 0;  ///< root = 0
+  uint32_t first = 0;  ///< its first record in leaf_prims
+  uint32_t count = 0;  ///< its records
+};
+
+/// What a walk of a flat tree from its root finds, counted apart from the statistics the build
+/// gathered.
+struct TreeWalk {
+  uint64_t nodes = 0;                 ///< nodes reached
+  std::vector<TreeLeafEntry> leaves;  ///< in depth-first order, children in order
+  bool in_range = true;               ///< false if a child index or a leaf's records lie outside the arrays
+};
+
+/// Walks `tree` from node 0, decoding each node with describe(node) -> TreeNodeView. Allocates;
+/// not for traversal.
+template <int Arity, typename Node, typename Describe>
+TreeWalk walk_flat_tree(const FlatTree<Node>& tree, Describe&& describe) {
+  TreeWalk walk;
+  if (tree.nodes.empty()) return walk;
+  std::vector<std::pair<uint64_t, uint64_t>> stack{{0, 0}};  // (node, depth)
+  while (!stack.empty()) {
+    const auto [idx, depth] = stack.back();
+    stack.pop_back();
+    ++walk.nodes;
+    const TreeNodeView v = describe(tree.nodes[size_t(idx)]);
+    if (v.leaf) {
+      walk.in_range = walk.in_range && uint64_t(v.index) + v.count <= tree.leaf_prims.size();
+      walk.leaves.push_back({depth, v.index, v.count});
+      continue;
+    }
+    for (int c = Arity - 1; c >= 0; --c) {
+      const uint64_t child = uint64_t(v.index) + uint64_t(c);
+      if (child >= tree.nodes.size()) {
+        walk.in_range = false;
+        continue;
+      }
+      stack.push_back({child, depth + 1});
+    }
+  }
+  return walk;
+}
+
+/// The walks of trees made by make_kdtree_accelerator(), make_octree_accelerator() and
+/// make_bsp_accelerator(); nullopt if `accel` is not of that kind.
+std::optional<TreeWalk> walk_kdtree(const Accelerator& accel);
+std::optional<TreeWalk> walk_octree(const Accelerator& accel);
+std::optional<TreeWalk> walk_bsp(const Accelerator& accel);
 
 // ---- Traversal ----------------------------------------------------------------------------------
 
