@@ -91,6 +91,7 @@ expect 2 "expected key=value" -- "$bin" info "$src/scenes/default.gltf" --accel-
 d="$src/scenes/default.gltf"
 expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --env 1
 expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --adaptive 0.01
+expect 2 "--env-intensity needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --env-intensity 2
 expect 2 "--background applies to --integrator whitted" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --background 1
 expect 2 "integrator" -- "$bin" render "$d" -o "$work/p.exr" --integrator bidir
 expect 2 "unknown filter 'mitchell'" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --filter mitchell
