@@ -367,54 +367,95 @@ class Builder {
     return nd;
   }
 
+  /// The parts of a node's primitives projected onto its directions dirs[0, nd): project()
+  /// sets a part's range along direction j to [range[j], range[nd + j]] (lo > hi when the part
+  /// is empty).
+  struct Projection {
+    size_t nd = 0;
+    double nx[kMaxDirections], ny[kMaxDirections], nz[kMaxDirections];
+    double range[2 * kMaxDirections];
+    DVec3 pts[kMaxPoints];
+  };
+
+  /// Projection `p` of the part of r's primitive inside the node (`cuts`: its ancestors by depth).
+  void project(const Ref& r, const Cut* cuts, Projection& p) const {
+    const int np = points(r, cuts, p.pts);
+    double* lo = p.range;
+    double* hi = p.range + p.nd;
+    for (size_t j = 0; j < p.nd; ++j) lo[j] = INFINITY, hi[j] = -INFINITY;
+    for (int i = 0; i < np; ++i) {
+      const double x = p.pts[i].x, y = p.pts[i].y, z = p.pts[i].z;
+      for (size_t j = 0; j < p.nd; ++j) {
+        const double f = p.nx[j] * x + p.ny[j] * y + p.nz[j] * z;
+        lo[j] = f < lo[j] ? f : lo[j];
+        hi[j] = f > hi[j] ? f : hi[j];
+      }
+    }
+  }
+
   /// The cheapest candidate plane within the budget that beats `leaf_cost` (cost infinite if
   /// none does).
   Split find_split(const std::vector<Ref>& refs, const Cut* cuts, const Polytope& region, double area,
                    double budget, double leaf_cost) const {
     Scratch& sc = scratch();
-    std::vector<Direction>& dirs = sc.dirs;
-    const size_t nd = directions(refs, dirs);
-    const int bins = m_config.bins;
+    Projection proj;
+    proj.nd = directions(refs, sc.dirs);
     // Phase 1: the extents of the region and of each primitive's part along each direction,
     // kept for phase 3 unless the node is large (then computed again there).
-    for (size_t j = 0; j < nd; ++j) region.extent(dirs[j].nd, dirs[j].region_lo, dirs[j].region_hi);
-    const bool keep = refs.size() * nd <= kMaxKeptRanges;
-    if (keep) sc.ranges.resize(2 * refs.size() * nd);
-    DVec3 pts[kMaxPoints];
-    double nx[kMaxDirections], ny[kMaxDirections], nz[kMaxDirections];
-    for (size_t j = 0; j < nd; ++j) nx[j] = dirs[j].nd.x, ny[j] = dirs[j].nd.y, nz[j] = dirs[j].nd.z;
-    // A part's range along direction j: [range[j], range[nd + j]] (lo > hi when empty).
-    double range[2 * kMaxDirections];
-    const auto project = [&](const Ref& r) {
-      const int np = points(r, cuts, pts);
-      double* lo = range;
-      double* hi = range + nd;
-      for (size_t j = 0; j < nd; ++j) lo[j] = INFINITY, hi[j] = -INFINITY;
-      for (int i = 0; i < np; ++i) {
-        const double x = pts[i].x, y = pts[i].y, z = pts[i].z;
-        for (size_t j = 0; j < nd; ++j) {
-          const double f = nx[j] * x + ny[j] * y + nz[j] * z;
-          lo[j] = f < lo[j] ? f : lo[j];
-          hi[j] = f > hi[j] ? f : hi[j];
-        }
-      }
-    };
-    for (size_t r = 0; r < refs.size(); ++r) {
-      project(refs[r]);
-      for (size_t j = 0; j < nd; ++j) {
-        dirs[j].prims_lo = std::min(dirs[j].prims_lo, range[j]);
-        dirs[j].prims_hi = std::max(dirs[j].prims_hi, range[nd + j]);
-      }
-      if (keep) std::copy(range, range + 2 * nd, sc.ranges.begin() + ptrdiff_t(2 * nd * r));
-    }
+    const bool keep = refs.size() * proj.nd <= kMaxKeptRanges;
+    measure_extents(refs, cuts, region, keep, proj, sc);
     // Phase 2: the positions. Few primitives: the ends of every part, exactly (the events of
     // a kD-tree's sweep, which cut between primitives rather than through them); otherwise
     // bins over the primitives' extent within the region.
     const bool events = refs.size() <= kMaxEventPrims && keep;
+    place_positions(refs.size(), proj.nd, events, sc);
+    // Phase 3: count the primitives on each side of each position, by sides() (binned: to
+    // rounding of the bin index; exact positions: exactly).
+    const size_t stride = size_t(m_config.bins) + 1;
+    sc.neg_bins.assign(proj.nd * stride, 0);
+    sc.pos_bins.assign(proj.nd * stride, 0);
+    if (events) {
+      count_event_sides(refs.size(), proj.nd, sc);
+    } else {
+      count_binned_sides(refs, cuts, keep, proj, sc);
+    }
+    // Phase 4: the SAH of every position cutting the region, with the areas of both parts.
+    Split best;
+    best.cost = leaf_cost;  // only splits cheaper than a leaf
+    for (size_t j = 0; j < proj.nd; ++j) {
+      collect_candidates(j, double(refs.size()), budget, area, best.cost, sc);
+      if (!sc.positions.empty()) measure_candidates(sc.dirs[j], region, area, best, sc);
+    }
+    return best;
+  }
+
+  /// Phase 1 of find_split(): the region's extent (region_lo, region_hi) and the primitives'
+  /// (prims_lo, prims_hi) along each direction; each part's ranges go to sc.ranges when `keep`.
+  void measure_extents(const std::vector<Ref>& refs, const Cut* cuts, const Polytope& region, bool keep,
+                       Projection& proj, Scratch& sc) const {
+    const size_t nd = proj.nd;
+    std::vector<Direction>& dirs = sc.dirs;
+    for (size_t j = 0; j < nd; ++j) region.extent(dirs[j].nd, dirs[j].region_lo, dirs[j].region_hi);
+    if (keep) sc.ranges.resize(2 * refs.size() * nd);
+    for (size_t j = 0; j < nd; ++j)
+      proj.nx[j] = dirs[j].nd.x, proj.ny[j] = dirs[j].nd.y, proj.nz[j] = dirs[j].nd.z;
+    for (size_t r = 0; r < refs.size(); ++r) {
+      project(refs[r], cuts, proj);
+      for (size_t j = 0; j < nd; ++j) {
+        dirs[j].prims_lo = std::min(dirs[j].prims_lo, proj.range[j]);
+        dirs[j].prims_hi = std::max(dirs[j].prims_hi, proj.range[nd + j]);
+      }
+      if (keep) std::copy(proj.range, proj.range + 2 * nd, sc.ranges.begin() + ptrdiff_t(2 * nd * r));
+    }
+  }
+
+  /// Phase 2 of find_split(): each direction's exact positions (with `events`, the ends of the
+  /// kept parts, sorted and without repeats) or bins, and zeroed exact counts.
+  void place_positions(size_t nrefs, size_t nd, bool events, Scratch& sc) const {
     for (size_t j = 0; j < nd; ++j) {
-      Direction& d = dirs[j];
+      Direction& d = sc.dirs[j];
       if (events) {
-        for (size_t r = 0; r < refs.size(); ++r) {
+        for (size_t r = 0; r < nrefs; ++r) {
           const double lo = sc.ranges[2 * nd * r + j], hi = sc.ranges[2 * nd * r + nd + j];
           if (lo > hi) continue;
           d.exact.push_back(lo);
@@ -424,7 +465,7 @@ class Builder {
         const double lo = std::max(d.region_lo, d.prims_lo), hi = std::min(d.region_hi, d.prims_hi);
         if (hi > lo) {
           d.base = lo;
-          d.step = (hi - lo) / bins;
+          d.step = (hi - lo) / m_config.bins;
         }
       }
       std::sort(d.exact.begin(), d.exact.end());  // meshes share vertices: many repeat
@@ -432,151 +473,165 @@ class Builder {
       d.exact_neg.assign(d.exact.size(), 0);
       d.exact_pos.assign(d.exact.size(), 0);
     }
-    // Phase 3: count the primitives on each side of each position, by sides() (binned: to
-    // rounding of the bin index; exact positions: exactly). Small nodes sweep their sorted
-    // positions over the sorted ends of the parts: a part thicker than 2 eps is on the
-    // negative side of p iff lo < p - eps and on the positive side iff hi > p + eps.
-    const size_t stride = size_t(bins) + 1;
-    sc.neg_bins.assign(nd * stride, 0);
-    sc.pos_bins.assign(nd * stride, 0);
-    if (events) {
-      for (size_t j = 0; j < nd; ++j) {
-        Direction& d = dirs[j];
-        sc.los.clear();
-        sc.his.clear();
-        for (size_t r = 0; r < refs.size(); ++r) {
-          const double lo = sc.ranges[2 * nd * r + j], hi = sc.ranges[2 * nd * r + nd + j];
-          if (lo > hi) continue;  // an empty part
-          if (hi - lo > 2 * m_eps) {
-            sc.los.push_back(lo);
-            sc.his.push_back(hi);
-            continue;
-          }
-          for (size_t e = 0; e < d.exact.size(); ++e) {  // a thin part: by the rule itself
-            const Sides to = sides(lo, hi, d.exact[e], m_eps);
-            d.exact_neg[e] += to.neg;
-            d.exact_pos[e] += to.pos;
-          }
+  }
+
+  /// Phase 3 of find_split() for small nodes (kept ranges, exact positions only): sweeps the
+  /// sorted positions over the sorted ends of the parts: a part thicker than 2 eps is on the
+  /// negative side of p iff lo < p - eps and on the positive side iff hi > p + eps; thinner
+  /// parts are counted by sides() itself.
+  void count_event_sides(size_t nrefs, size_t nd, Scratch& sc) const {
+    for (size_t j = 0; j < nd; ++j) {
+      Direction& d = sc.dirs[j];
+      sc.los.clear();
+      sc.his.clear();
+      for (size_t r = 0; r < nrefs; ++r) {
+        const double lo = sc.ranges[2 * nd * r + j], hi = sc.ranges[2 * nd * r + nd + j];
+        if (lo > hi) continue;  // an empty part
+        if (hi - lo > 2 * m_eps) {
+          sc.los.push_back(lo);
+          sc.his.push_back(hi);
+          continue;
         }
-        std::sort(sc.los.begin(), sc.los.end());
-        std::sort(sc.his.begin(), sc.his.end());
-        size_t below = 0, ended = 0;
-        for (size_t e = 0; e < d.exact.size(); ++e) {
-          const double p = d.exact[e];
-          while (below < sc.los.size() && sc.los[below] < p - m_eps) ++below;
-          while (ended < sc.his.size() && sc.his[ended] <= p + m_eps) ++ended;
-          d.exact_neg[e] += uint32_t(below);
-          d.exact_pos[e] += uint32_t(sc.his.size() - ended);
-        }
+        count_exact(d, lo, hi);  // a thin part: by the rule itself
       }
-    } else {
-      for (size_t r = 0; r < refs.size(); ++r) {
-        const double* rr = range;
-        if (keep) {
-          rr = &sc.ranges[2 * nd * r];
-        } else {
-          project(refs[r]);
-        }
-        if (rr[0] > rr[nd]) continue;  // an empty part
-        for (size_t j = 0; j < nd; ++j) {
-          Direction& d = dirs[j];
-          const double lo = rr[j], hi = rr[nd + j];
-          if (d.step > 0) {
-            // First position p_i = base + i step on the negative side (p_i > min(lo + eps,
-            // hi - eps)) and last on the positive side (p_i < hi - eps), to rounding.
-            const double a = std::floor((std::min(lo + m_eps, hi - m_eps) - d.base) / d.step) + 1;
-            const double b = std::ceil((hi - m_eps - d.base) / d.step) - 1;
-            if (a <= bins) ++sc.neg_bins[j * stride + size_t(std::max(a, 0.0))];
-            if (b >= 0) ++sc.pos_bins[j * stride + size_t(std::min(b, double(bins)))];
-          }
-          for (size_t e = 0; e < d.exact.size(); ++e) {
-            const Sides to = sides(lo, hi, d.exact[e], m_eps);
-            d.exact_neg[e] += to.neg;
-            d.exact_pos[e] += to.pos;
-          }
-        }
+      std::sort(sc.los.begin(), sc.los.end());
+      std::sort(sc.his.begin(), sc.his.end());
+      size_t below = 0, ended = 0;
+      for (size_t e = 0; e < d.exact.size(); ++e) {
+        const double p = d.exact[e];
+        while (below < sc.los.size() && sc.los[below] < p - m_eps) ++below;
+        while (ended < sc.his.size() && sc.his[ended] <= p + m_eps) ++ended;
+        d.exact_neg[e] += uint32_t(below);
+        d.exact_pos[e] += uint32_t(sc.his.size() - ended);
       }
     }
-    // Phase 4: the SAH of every position cutting the region, with the areas of both parts.
-    // Since the parts' areas sum to at least the node's, a position costs at least
-    // K_T + K_I min(N_L, N_R) (times the bonus factor): those that cannot win are not measured.
-    Split best;
-    best.cost = leaf_cost;  // only splits cheaper than a leaf
-    const double n = double(refs.size());
-    const auto lambda = [&](double nl, double nr, double kept) {
-      // The bonus for an empty side needs a cut that removes a real share of the surface:
-      // otherwise shaving a node's corners along all 13 directions would always look cheap.
-      return (nl == 0 || nr == 0) && kept <= (1 - kMinEmptyCut) * area ? 1.0 - m_config.empty_bonus : 1.0;
-    };
+  }
+
+  /// Phase 3 of find_split() for binned nodes: per part, the first bin position on its
+  /// negative side and the last on its positive side (to rounding), and sides() at each exact
+  /// position. Parts are projected again unless their ranges were kept.
+  void count_binned_sides(const std::vector<Ref>& refs, const Cut* cuts, bool keep, Projection& proj,
+                          Scratch& sc) const {
+    const size_t nd = proj.nd;
+    const int bins = m_config.bins;
+    const size_t stride = size_t(bins) + 1;
+    for (size_t r = 0; r < refs.size(); ++r) {
+      const double* rr = proj.range;
+      if (keep) {
+        rr = &sc.ranges[2 * nd * r];
+      } else {
+        project(refs[r], cuts, proj);
+      }
+      if (rr[0] > rr[nd]) continue;  // an empty part
+      for (size_t j = 0; j < nd; ++j) {
+        Direction& d = sc.dirs[j];
+        const double lo = rr[j], hi = rr[nd + j];
+        if (d.step > 0) {
+          // First position p_i = base + i step on the negative side (p_i > min(lo + eps,
+          // hi - eps)) and last on the positive side (p_i < hi - eps), to rounding.
+          const double a = std::floor((std::min(lo + m_eps, hi - m_eps) - d.base) / d.step) + 1;
+          const double b = std::ceil((hi - m_eps - d.base) / d.step) - 1;
+          if (a <= bins) ++sc.neg_bins[j * stride + size_t(std::max(a, 0.0))];
+          if (b >= 0) ++sc.pos_bins[j * stride + size_t(std::min(b, double(bins)))];
+        }
+        count_exact(d, lo, hi);
+      }
+    }
+  }
+
+  /// Adds a part spanning [lo, hi] to the counts of every exact position of `d`, by sides().
+  void count_exact(Direction& d, double lo, double hi) const {
+    for (size_t e = 0; e < d.exact.size(); ++e) {
+      const Sides to = sides(lo, hi, d.exact[e], m_eps);
+      d.exact_neg[e] += to.neg;
+      d.exact_pos[e] += to.pos;
+    }
+  }
+
+  /// The SAH's factor for a split leaving nl and nr primitives on its sides, where `kept` is
+  /// the area of the non-empty side: the empty bonus needs a cut that removes a real share of
+  /// the surface (otherwise shaving a node's corners along all 13 directions would always look
+  /// cheap).
+  double bonus_factor(double nl, double nr, double kept, double area) const {
+    return (nl == 0 || nr == 0) && kept <= (1 - kMinEmptyCut) * area ? 1.0 - m_config.empty_bonus : 1.0;
+  }
+
+  /// Phase 4 of find_split(), first half: the positions of direction j inside its region (not
+  /// within kMinCut of its ends) that fit in the budget and may still beat `best_cost`, into
+  /// sc.positions with their counts. Since the parts' areas sum to at least the node's, a
+  /// position costs at least K_T + K_I min(N_L, N_R) (times the bonus factor).
+  void collect_candidates(size_t j, double n, double budget, double area, double best_cost,
+                          Scratch& sc) const {
+    const Direction& d = sc.dirs[j];
+    sc.positions.clear();
+    sc.neg_count.clear();
+    sc.pos_count.clear();
     const auto candidate = [&](double p, uint32_t nl, uint32_t nr) {
       if (double(nl) + double(nr) - n > budget) return;
-      const double bound = lambda(nl, nr, 0) *
+      const double bound = bonus_factor(nl, nr, 0, area) *
                            (m_config.traversal_cost + m_config.intersection_cost * double(std::min(nl, nr)));
-      if (bound >= best.cost) return;
+      if (bound >= best_cost) return;
       sc.positions.push_back(p);
       sc.neg_count.push_back(nl);
       sc.pos_count.push_back(nr);
     };
-    for (size_t j = 0; j < nd; ++j) {
-      const Direction& d = dirs[j];
-      sc.positions.clear();
-      sc.neg_count.clear();
-      sc.pos_count.clear();
-      const double margin = kMinCut * (d.region_hi - d.region_lo);  // no slivers
-      const auto inside = [&](double p) { return p > d.region_lo + margin && p < d.region_hi - margin; };
-      if (d.step > 0) {
-        uint32_t below = 0, above = 0;
-        for (int i = 0; i <= bins; ++i) above += sc.pos_bins[j * stride + size_t(i)];
-        for (int i = 0; i <= bins; ++i) {
-          below += sc.neg_bins[j * stride + size_t(i)];
-          const double p = d.base + d.step * i;
-          if (inside(p)) candidate(p, below, above);
-          above -= sc.pos_bins[j * stride + size_t(i)];
-        }
-      }
-      for (size_t e = 0; e < d.exact.size(); ++e)
-        if (inside(d.exact[e])) candidate(d.exact[e], d.exact_neg[e], d.exact_pos[e]);
-      const size_t m = sc.positions.size();
-      if (m == 0) continue;
-      // Exact areas at every position, or, with many positions (sorted), at every stride-th
-      // (the anchors) and at those between anchors a < i < b whose bound by the anchors' areas
-      // can still win: a part only grows with its side (convex sets), so A_neg(p_i) >=
-      // A_neg(p_a) and A_pos(p_i) >= A_pos(p_b).
-      sc.slicer.reset(region, d.nd);
-      sc.neg_area.resize(m);
-      sc.pos_area.resize(m);
-      const auto evaluate = [&](size_t i) {
-        double& al = sc.neg_area[i];
-        double& ar = sc.pos_area[i];
-        sc.slicer.areas(sc.positions[i], al, ar);
-        if (!(al > 0) || !(ar > 0)) return;
-        const double nl = sc.neg_count[i], nr = sc.pos_count[i];
-        const double cost =
-            lambda(nl, nr, nl == 0 ? ar : al) *
-            (m_config.traversal_cost + m_config.intersection_cost * (al * nl + ar * nr) / area);
-        if (cost < best.cost) best = {{d.n, float(sc.positions[i])}, cost};
-      };
-      const bool sorted = std::is_sorted(sc.positions.begin(), sc.positions.end());
-      if (m <= kMaxMeasuredPositions || !sorted) {
-        for (size_t i = 0; i < m; ++i) evaluate(i);
-        continue;
-      }
-      const size_t every = (m + kAnchors - 1) / kAnchors;
-      for (size_t i = 0; i < m; i += every) evaluate(i);
-      evaluate(m - 1);
-      for (size_t i = 0; i < m; ++i) {
-        if (i % every == 0 || i == m - 1) continue;
-        const size_t a = i - i % every, b = std::min(a + every, m - 1);
-        const double nl = sc.neg_count[i], nr = sc.pos_count[i];
-        const double bound =
-            lambda(nl, nr, 0) *
-            (m_config.traversal_cost +
-             m_config.intersection_cost * (sc.neg_area[a] * nl + sc.pos_area[b] * nr) / area) *
-            (1 - 1e-9);
-        if (bound < best.cost) evaluate(i);
+    const double margin = kMinCut * (d.region_hi - d.region_lo);  // no slivers
+    const auto inside = [&](double p) { return p > d.region_lo + margin && p < d.region_hi - margin; };
+    if (d.step > 0) {
+      const int bins = m_config.bins;
+      const size_t stride = size_t(bins) + 1;
+      uint32_t below = 0, above = 0;
+      for (int i = 0; i <= bins; ++i) above += sc.pos_bins[j * stride + size_t(i)];
+      for (int i = 0; i <= bins; ++i) {
+        below += sc.neg_bins[j * stride + size_t(i)];
+        const double p = d.base + d.step * i;
+        if (inside(p)) candidate(p, below, above);
+        above -= sc.pos_bins[j * stride + size_t(i)];
       }
     }
-    return best;
+    for (size_t e = 0; e < d.exact.size(); ++e)
+      if (inside(d.exact[e])) candidate(d.exact[e], d.exact_neg[e], d.exact_pos[e]);
+  }
+
+  /// Phase 4 of find_split(), second half: the SAH cost of sc.positions along `d` with the
+  /// exact areas of the region's two parts, narrowing `best`. With many positions (sorted),
+  /// areas are measured at every stride-th (the anchors) and at those between anchors a < i < b
+  /// whose bound by the anchors' areas can still win: a part only grows with its side (convex
+  /// sets), so A_neg(p_i) >= A_neg(p_a) and A_pos(p_i) >= A_pos(p_b).
+  void measure_candidates(const Direction& d, const Polytope& region, double area, Split& best,
+                          Scratch& sc) const {
+    const size_t m = sc.positions.size();
+    sc.slicer.reset(region, d.nd);
+    sc.neg_area.resize(m);
+    sc.pos_area.resize(m);
+    const auto evaluate = [&](size_t i) {
+      double& al = sc.neg_area[i];
+      double& ar = sc.pos_area[i];
+      sc.slicer.areas(sc.positions[i], al, ar);
+      if (!(al > 0) || !(ar > 0)) return;
+      const double nl = sc.neg_count[i], nr = sc.pos_count[i];
+      const double cost = bonus_factor(nl, nr, nl == 0 ? ar : al, area) *
+                          (m_config.traversal_cost + m_config.intersection_cost * (al * nl + ar * nr) / area);
+      if (cost < best.cost) best = {{d.n, float(sc.positions[i])}, cost};
+    };
+    const bool sorted = std::is_sorted(sc.positions.begin(), sc.positions.end());
+    if (m <= kMaxMeasuredPositions || !sorted) {
+      for (size_t i = 0; i < m; ++i) evaluate(i);
+      return;
+    }
+    const size_t every = (m + kAnchors - 1) / kAnchors;
+    for (size_t i = 0; i < m; i += every) evaluate(i);
+    evaluate(m - 1);
+    for (size_t i = 0; i < m; ++i) {
+      if (i % every == 0 || i == m - 1) continue;
+      const size_t a = i - i % every, b = std::min(a + every, m - 1);
+      const double nl = sc.neg_count[i], nr = sc.pos_count[i];
+      const double bound = bonus_factor(nl, nr, 0, area) *
+                           (m_config.traversal_cost +
+                            m_config.intersection_cost * (sc.neg_area[a] * nl + sc.pos_area[b] * nr) / area) *
+                           (1 - 1e-9);
+      if (bound < best.cost) evaluate(i);
+    }
   }
 
   const BspConfig& m_config;
