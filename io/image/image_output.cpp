@@ -50,10 +50,10 @@ void write_with_oiio(const std::filesystem::path& final_path, const std::filesys
   });
 }
 
-}  // namespace
-
-void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
-               std::string* sha256) {
+/// The spec of `film` as one EXR part: R, G, B, A in half or float, then options.extra, each in
+/// its own format; the frame window and the attributes. Throws std::invalid_argument naming
+/// `path` if an extra channel does not match the image size.
+OIIO::ImageSpec exr_spec(const Film& film, const std::filesystem::path& path, const ExrOptions& options) {
   const int nc = 4 + int(options.extra.size());
   const OIIO::TypeDesc colour = options.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT;
   OIIO::ImageSpec spec(film.width, film.height, nc, colour);
@@ -83,73 +83,92 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
   for (const auto& [k, v] : options.float_metadata) spec.attribute(k, v);
   for (const auto& [k, m] : options.matrix_metadata)
     spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
-  if (options.extra.empty()) {
-    write_atomically(
-        path,
-        [&](const std::filesystem::path& temp) {
-          write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
-        },
-        sha256);
-    return;
+  return spec;
+}
+
+/// Every channel of a spec interleaved per pixel, each in its channel's file format.
+struct PackedPixels {
+  std::vector<unsigned char> bytes;
+  std::vector<size_t> offsets;  ///< per channel: its first byte within a pixel
+  size_t stride = 0;            ///< bytes per pixel
+};
+
+/// Stores `v` at `dst` as `type`: half, float, or a raw uint32 (OIIO's float -> uint conversion
+/// would normalise integer ids): non-finite and non-positive values 0, truncated, clamped.
+void put_channel_value(unsigned char* dst, OIIO::TypeDesc type, float v) {
+  if (type == OIIO::TypeDesc::HALF) {
+    const half h(v);
+    std::memcpy(dst, &h, sizeof h);
+  } else if (type == OIIO::TypeDesc::UINT) {
+    const uint32_t u = std::isfinite(v) && v > 0 ? uint32_t(std::min(v, 4294967295.0f)) : 0u;
+    std::memcpy(dst, &u, sizeof u);
+  } else {
+    std::memcpy(dst, &v, sizeof v);
   }
-  // Pixels in each channel's own file format (OIIO's float -> uint conversion would normalise,
-  // so integer ids are packed as raw uint32): half, float or uint per channel, interleaved.
-  std::vector<size_t> offsets(static_cast<size_t>(nc));
-  size_t stride = 0;
-  for (size_t k = 0; k < size_t(nc); ++k) {
-    offsets[k] = stride;
-    stride += spec.channelformat(int(k)).size();
+}
+
+/// The film's R, G, B, A and options.extra packed in the formats of `spec` (from exr_spec()).
+PackedPixels pack_channels(const Film& film, const ExrOptions& options, const OIIO::ImageSpec& spec) {
+  const size_t nc = size_t(spec.nchannels);
+  const size_t pixels = size_t(film.width) * size_t(film.height);
+  PackedPixels p;
+  p.offsets.resize(nc);
+  for (size_t k = 0; k < nc; ++k) {
+    p.offsets[k] = p.stride;
+    p.stride += spec.channelformat(int(k)).size();
   }
-  std::vector<unsigned char> packed(pixels * stride);
-  auto put = [&](unsigned char* dst, OIIO::TypeDesc type, float v) {
-    if (type == OIIO::TypeDesc::HALF) {
-      const half h(v);
-      std::memcpy(dst, &h, sizeof h);
-    } else if (type == OIIO::TypeDesc::UINT) {
-      const uint32_t u = std::isfinite(v) && v > 0 ? uint32_t(std::min(v, 4294967295.0f)) : 0u;
-      std::memcpy(dst, &u, sizeof u);
-    } else {
-      std::memcpy(dst, &v, sizeof v);
-    }
-  };
+  p.bytes.resize(pixels * p.stride);
   for (size_t i = 0; i < pixels; ++i) {
-    unsigned char* px = &packed[i * stride];
-    for (size_t k = 0; k < 4; ++k) put(px + offsets[k], spec.channelformat(int(k)), film.rgba[i * 4 + k]);
+    unsigned char* px = &p.bytes[i * p.stride];
+    for (size_t k = 0; k < 4; ++k)
+      put_channel_value(px + p.offsets[k], spec.channelformat(int(k)), film.rgba[i * 4 + k]);
     for (size_t k = 0; k < options.extra.size(); ++k) {
       const ExrChannel& c = options.extra[k];
-      put(px + offsets[4 + k], spec.channelformat(int(4 + k)),
-          (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
+      put_channel_value(px + p.offsets[4 + k], spec.channelformat(int(4 + k)),
+                        (*c.data)[i * size_t(c.stride) + size_t(c.offset)]);
     }
   }
-  if (!options.multipart) {
-    write_atomically(
-        path,
-        [&](const std::filesystem::path& temp) {
-          write_with_oiio(path, temp, spec, packed.data(), OIIO::TypeDesc::UNKNOWN);
-        },
-        sha256);
-    return;
-  }
-  // Multi-part: "rgba" (R, G, B, A and the metadata), then one part per layer (the channel
-  // name's prefix before '.', or a lone channel such as Z), in first-appearance order.
-  std::vector<std::string> keys = {"rgba"};
-  std::vector<std::vector<size_t>> members = {{0, 1, 2, 3}};
+  return p;
+}
+
+/// The parts of a multi-part EXR: each one's name, spec and interleaved pixels.
+struct ExrParts {
+  std::vector<std::string> names;
+  std::vector<OIIO::ImageSpec> specs;
+  std::vector<std::vector<unsigned char>> pixels;
+};
+
+/// The parts' names and channels (indices into the spec of exr_spec()): "rgba" with R, G, B, A,
+/// then one part per layer of options.extra (the channel name's prefix before '.', or a lone
+/// channel such as Z), in first-appearance order.
+void group_layers(const ExrOptions& options, std::vector<std::string>& names,
+                  std::vector<std::vector<size_t>>& members) {
+  names = {"rgba"};
+  members = {{0, 1, 2, 3}};
   for (size_t k = 0; k < options.extra.size(); ++k) {
     const std::string& name = options.extra[k].name;
     const std::string key = name.substr(0, name.find('.'));
-    auto it = std::find(keys.begin(), keys.end(), key);
-    if (it == keys.end()) {
-      keys.push_back(key);
+    auto it = std::find(names.begin(), names.end(), key);
+    if (it == names.end()) {
+      names.push_back(key);
       members.emplace_back();
-      it = keys.end() - 1;
+      it = names.end() - 1;
     }
-    members[size_t(it - keys.begin())].push_back(4 + k);
+    members[size_t(it - names.begin())].push_back(4 + k);
   }
+}
+
+/// `spec` and `packed` (pixels x its channels) split into the parts of group_layers(). Each part
+/// keeps the attributes; the first holds the alpha channel; lossy codecs apply only to parts
+/// with a half channel (colour), data parts (float N, P, Z, ids) are written with zip.
+ExrParts split_parts(const ExrOptions& options, const OIIO::ImageSpec& spec, const PackedPixels& packed,
+                     size_t pixels) {
+  ExrParts parts;
+  std::vector<std::vector<size_t>> members;
+  group_layers(options, parts.names, members);
   const std::string& c = options.compression;
   const bool lossy = c == "dwaa" || c == "dwab" || c == "b44" || c == "b44a" || c == "pxr24";
-  std::vector<OIIO::ImageSpec> specs;
-  std::vector<std::vector<unsigned char>> buffers;
-  for (size_t part = 0; part < keys.size(); ++part) {
+  for (size_t part = 0; part < parts.names.size(); ++part) {
     OIIO::ImageSpec ps = spec;
     ps.nchannels = int(members[part].size());
     ps.channelnames.clear();
@@ -163,21 +182,25 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
       part_stride += spec.channelformat(int(ch)).size();
     }
     ps.alpha_channel = part == 0 ? 3 : -1;
-    ps.attribute("name", keys[part]);
-    // Lossy codecs only for colour; data layers (float N, P, Z, ids) stay lossless.
+    ps.attribute("name", parts.names[part]);
     if (lossy && !colour_part) ps.attribute("compression", "zip");
     std::vector<unsigned char> buf(pixels * part_stride);
     for (size_t i = 0; i < pixels; ++i) {
       size_t o = 0;
       for (size_t ch : members[part]) {
         const size_t n = spec.channelformat(int(ch)).size();
-        std::memcpy(&buf[i * part_stride + o], &packed[i * stride + offsets[ch]], n);
+        std::memcpy(&buf[i * part_stride + o], &packed.bytes[i * packed.stride + packed.offsets[ch]], n);
         o += n;
       }
     }
-    specs.push_back(ps);
-    buffers.push_back(std::move(buf));
+    parts.specs.push_back(ps);
+    parts.pixels.push_back(std::move(buf));
   }
+  return parts;
+}
+
+/// Writes `parts` as one multi-part EXR at `path` (atomically, as write_exr() does).
+void write_multipart(const std::filesystem::path& path, const ExrParts& parts, std::string* sha256) {
   write_atomically(
       path,
       [&](const std::filesystem::path& temp) {
@@ -185,19 +208,47 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
         if (!out || !out->supports("multiimage"))
           throw std::runtime_error(path.string() + ": no multi-part image writer for this extension");
         write_through_checked_file(out, temp, path, [&] {
-          if (!out->open(temp.string(), int(specs.size()), specs.data()))
+          if (!out->open(temp.string(), int(parts.specs.size()), parts.specs.data()))
             throw std::runtime_error(path.string() + ": cannot open for writing: " + out->geterror());
-          for (size_t part = 0; part < specs.size(); ++part) {
-            if (part > 0 && !out->open(temp.string(), specs[part], OIIO::ImageOutput::AppendSubimage))
-              throw std::runtime_error(path.string() + ": cannot start part " + keys[part] + ": " +
+          for (size_t part = 0; part < parts.specs.size(); ++part) {
+            if (part > 0 && !out->open(temp.string(), parts.specs[part], OIIO::ImageOutput::AppendSubimage))
+              throw std::runtime_error(path.string() + ": cannot start part " + parts.names[part] + ": " +
                                        out->geterror());
-            if (!out->write_image(OIIO::TypeDesc::UNKNOWN, buffers[part].data()))
+            if (!out->write_image(OIIO::TypeDesc::UNKNOWN, parts.pixels[part].data()))
               throw std::runtime_error(path.string() + ": write failed: " + out->geterror());
           }
           if (!out->close()) throw std::runtime_error(path.string() + ": close failed: " + out->geterror());
         });
       },
       sha256);
+}
+
+}  // namespace
+
+void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
+               std::string* sha256) {
+  const OIIO::ImageSpec spec = exr_spec(film, path, options);
+  if (options.extra.empty()) {
+    write_atomically(
+        path,
+        [&](const std::filesystem::path& temp) {
+          write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
+        },
+        sha256);
+    return;
+  }
+  // Pixels in each channel's own file format: half, float or uint per channel, interleaved.
+  const PackedPixels packed = pack_channels(film, options, spec);
+  if (!options.multipart) {
+    write_atomically(
+        path,
+        [&](const std::filesystem::path& temp) {
+          write_with_oiio(path, temp, spec, packed.bytes.data(), OIIO::TypeDesc::UNKNOWN);
+        },
+        sha256);
+    return;
+  }
+  write_multipart(path, split_parts(options, spec, packed, size_t(film.width) * size_t(film.height)), sha256);
 }
 
 namespace {
