@@ -276,7 +276,6 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
 }
 
 RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget) {
-  validate(spec);
   std::lock_guard<std::mutex> lock(session.mutex);
   PrepareOptions options;
   options.scene_file = session.file;
