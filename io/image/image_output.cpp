@@ -199,6 +199,15 @@ ExrParts split_parts(const ExrOptions& options, const OIIO::ImageSpec& spec, con
   return parts;
 }
 
+/// Writes `pixels` (of `pixel_type`, or each channel in its own format for UNKNOWN) as a
+/// single-part image with `spec` at `path`, atomically.
+void write_single_part(const std::filesystem::path& path, const OIIO::ImageSpec& spec, const void* pixels,
+                       OIIO::TypeDesc pixel_type, std::string* sha256) {
+  write_atomically(
+      path, [&](const std::filesystem::path& temp) { write_with_oiio(path, temp, spec, pixels, pixel_type); },
+      sha256);
+}
+
 /// Writes `parts` as one multi-part EXR at `path` (atomically, as write_exr() does).
 void write_multipart(const std::filesystem::path& path, const ExrParts& parts, std::string* sha256) {
   write_atomically(
@@ -229,23 +238,13 @@ void write_exr(const Film& film, const std::filesystem::path& path, const ExrOpt
                std::string* sha256) {
   const OIIO::ImageSpec spec = exr_spec(film, path, options);
   if (options.extra.empty()) {
-    write_atomically(
-        path,
-        [&](const std::filesystem::path& temp) {
-          write_with_oiio(path, temp, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT);
-        },
-        sha256);
+    write_single_part(path, spec, film.rgba.data(), OIIO::TypeDesc::FLOAT, sha256);
     return;
   }
   // Pixels in each channel's own file format: half, float or uint per channel, interleaved.
   const PackedPixels packed = pack_channels(film, options, spec);
   if (!options.multipart) {
-    write_atomically(
-        path,
-        [&](const std::filesystem::path& temp) {
-          write_with_oiio(path, temp, spec, packed.bytes.data(), OIIO::TypeDesc::UNKNOWN);
-        },
-        sha256);
+    write_single_part(path, spec, packed.bytes.data(), OIIO::TypeDesc::UNKNOWN, sha256);
     return;
   }
   write_multipart(path, split_parts(options, spec, packed, size_t(film.width) * size_t(film.height)), sha256);
