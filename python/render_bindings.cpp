@@ -182,10 +182,22 @@ void check_exr_path(const std::filesystem::path& path) {
   if (ext != ".exr") throw py::value_error(path.string() + ": the output must be an .exr file");
 }
 
+/// Issues the settings a render ignored as RuntimeWarnings naming the scene's file.
+void warn_ignored(const RenderOutput& r) {
+  for (const auto& w : r.warnings)
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, (r.scene_file + ": " + w).c_str(), 1) != 0)
+      throw py::error_already_set();
+}
+
 ResultPtr render(SceneSession& session, const RenderSettings& settings,
                  const std::vector<std::string>& aovs) {
-  py::gil_scoped_release release;
-  return std::make_shared<RenderOutput>(render_session(session, settings, aovs));
+  ResultPtr r;
+  {
+    py::gil_scoped_release release;
+    r = std::make_shared<RenderOutput>(render_session(session, settings, aovs));
+  }
+  warn_ignored(*r);
+  return r;
 }
 
 void bind_settings(py::module_& m) {
@@ -420,6 +432,7 @@ void bind_render(py::module_& m, SceneClass& scene) {
           write_render_exr(*r, exr, o);
           if (png_path) write_display_image(r->film, *png_path, d);
         }
+        warn_ignored(*r);
         return r;
       },
       py::arg("exr"), py::kw_only(), py::arg("png") = py::none(), py::arg("settings") = py::none(),

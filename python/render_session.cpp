@@ -70,6 +70,7 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   out.camera = r.prepared.camera;
   out.camera_index = r.prepared.camera_index;
   out.default_light = r.prepared.default_light;
+  out.warnings = r.prepared.warnings;
   out.film = std::move(r.image.film);
   out.stats = r.image.stats;
   if (out.aovs.count("samples")) {

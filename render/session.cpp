@@ -11,6 +11,7 @@
 #include "render/accel_params.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/visibility.h"
 
 namespace penumbra {
 
@@ -42,6 +43,68 @@ std::shared_ptr<const Environment> choose_environment(const LoadedScene& loaded,
         load_environment(s.env_map, s.env_intensity, s.env_rotation, budget));
   if (loaded.environment) return loaded.environment;
   return std::make_shared<Environment>();
+}
+
+/// The depth (along the view axis) of what pixel `at` shows through the pinhole, else of the
+/// scene bounds' centre; found with a brute-force scan (one ray, no build).
+float autofocus_depth(const Scene& scene, const Camera& cam, const RenderConfig& cfg, Vec2f at) {
+  const std::unique_ptr<Accelerator> accel = make_scene_accelerator("brute", scene, AccelConfig{});
+  const Ray ray = generate_camera_ray(cam, cfg.width, cfg.height, at.x + 0.5f, at.y + 0.5f);
+  Hit hit;
+  float depth = 0;
+  if (intersect_visible(scene, *accel, ray, hit, scene_needs_hit_filter(scene)))
+    depth = dot(ray.org + ray.dir * hit.t - cam.eye, -cam.w);
+  else if (!compute_bounds(scene).empty())
+    depth = dot(compute_bounds(scene).center() - cam.eye, -cam.w);
+  return depth > 0 && std::isfinite(depth) ? depth : 1.0f;
+}
+
+/// The thin lens the spec asks for, on the prepared camera (a pinhole for the raster preview,
+/// which says so in `warnings`).
+void set_lens(PreparedRender& p, const Scene& scene, const std::string& file) {
+  const RenderSpec& s = p.spec;
+  if (!wants_depth_of_field(s)) return;
+  if (p.integrator() == IntegratorType::Raster) {
+    p.warnings.push_back(s.fstop > 0
+                             ? "the raster preview renders through a pinhole: it ignores depth of "
+                               "field (fstop); use integrator 'whitted' or 'path' to see it"
+                             : "the raster preview renders through a pinhole: it ignores depth of "
+                               "field (aperture_radius); use integrator 'whitted' or 'path' to see it");
+    return;
+  }
+  const RenderConfig& cfg = p.config;
+  ThinLens lens;
+  if (s.fstop > 0) {
+    if (p.camera.projection == Projection::Orthographic)
+      throw std::invalid_argument(
+          "fstop needs a perspective camera (an f-number needs a focal length); give an orthographic camera "
+          "aperture_radius");
+    lens.radius = fstop_lens_radius(p.camera, s.fstop, cfg.width, cfg.height);
+  } else {
+    lens.radius = s.aperture_radius;
+  }
+  lens.blades = s.aperture_blades;
+  lens.rotation = s.aperture_rotation * kPi / 180;
+  lens.ratio = s.aperture_ratio;
+  if (s.focus_distance > 0) {
+    lens.focus_distance = s.focus_distance;
+  } else {
+    Vec2f at{0.5f * float(cfg.width) - 0.5f, 0.5f * float(cfg.height) - 0.5f};
+    if (!s.focus_at.empty()) {
+      at = parse_focus_at(s.focus_at);
+      if (!(at.x >= 0 && at.y >= 0 && at.x < float(cfg.width) && at.y < float(cfg.height)))
+        throw std::invalid_argument("focus_at: pixel " + s.focus_at + " lies outside the " +
+                                    std::to_string(cfg.width) + " x " + std::to_string(cfg.height) +
+                                    " image");
+    }
+    lens.focus_distance = autofocus_depth(scene, p.camera, cfg, at);
+  }
+  p.camera.lens = lens;
+  try {
+    validate_camera(p.camera, cfg.width, cfg.height);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(file, "the lens", e.what());
+  }
 }
 
 }  // namespace
@@ -100,6 +163,7 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
                      p.camera_index >= 0 ? "cameras[" + std::to_string(p.camera_index) + "]" : "the view",
                      e.what());
   }
+  set_lens(p, scene, o.scene_file);
   // The lights: the environment, the emissive triangles, the default key light.
   const bool path = p.integrator() == IntegratorType::Path;
   p.environment = choose_environment(loaded, p.spec, env_budget);
@@ -265,9 +329,12 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
       names.insert(name);
     }
     std::string manifest = "{";
-    for (const std::string& name : names)
-      manifest +=
-          (manifest.size() > 1 ? "," : "") + json_quote(name) + ":" + json_quote(crypto_hex(crypto_id(name)));
+    for (const std::string& name : names) {
+      if (manifest.size() > 1) manifest += ',';
+      manifest += json_quote(name);
+      manifest += ':';
+      manifest += json_quote(crypto_hex(crypto_id(name)));
+    }
     out.crypto_manifests.push_back(manifest + "}");
     layers.push_back(std::move(ids));
   }

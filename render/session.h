@@ -68,12 +68,16 @@ struct PreparedRender {
   std::shared_ptr<const AreaLights> area_lights;   ///< path tracer only, else null
   bool default_light = false;  ///< the scene had no light: prepare_render appended the default key light
   RenderSettings identity;     ///< render_identity() of this render
+  std::vector<std::string> warnings;  ///< settings the render ignores, for the front end to show
 
   IntegratorType integrator() const;
   PathLights path_lights() const { return {area_lights.get(), environment.get()}; }
 };
 
-/// Resolves `spec` (validate() first) for the scene, places the camera (validate_camera), loads
+/// Resolves `spec` (validate() first) for the scene, places the camera (validate_camera) and
+/// its thin lens (the f-number or radius, the focus distance or the depth autofocus finds
+/// through focus_at's pixel or the centre's, else the bounds' centre; the raster preview keeps
+/// a pinhole and says so in `warnings`), loads
 /// the environment (spec.env_color, spec.env_map, else the file's image-based light), builds the
 /// emissive triangles for the path tracer, appends the default key light to scene.lights when
 /// nothing lights the scene, and derives the identity. Throws std::invalid_argument for

@@ -198,6 +198,63 @@ std::vector<SpecField> make_fields() {
        4096,
        {},
        "pixels on a side of the tiles threads take (default 32; does not change pixels)"},
+      {"fstop",
+       &S::fstop,
+       kAnyIntegrator,
+       true,
+       0,
+       1e6,
+       {},
+       "depth of field: the lens' f-number (aperture diameter = focal length / N; the focal length from "
+       "--focal-length, else the field of view on a 36 mm sensor; metres as scene units) (default 0 = none)"},
+      {"aperture_radius",
+       &S::aperture_radius,
+       kAnyIntegrator,
+       true,
+       0,
+       kAny,
+       {},
+       "depth of field: the aperture radius in scene units, instead of --fstop (default 0 = none)"},
+      {"focus_distance",
+       &S::focus_distance,
+       kAnyIntegrator,
+       true,
+       0,
+       kAny,
+       {},
+       "depth of field: distance of the plane in focus along the view axis (default: autofocus)"},
+      {"focus_at",
+       &S::focus_at,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "depth of field: autofocus on what pixel X,Y shows (default: the image centre)"},
+      {"aperture_blades",
+       &S::aperture_blades,
+       kAnyIntegrator,
+       true,
+       0,
+       kMaxApertureBlades,
+       {},
+       "depth of field: a polygonal aperture of N blades (bokeh shape) (default 0 = round)"},
+      {"aperture_rotation",
+       &S::aperture_rotation,
+       kAnyIntegrator,
+       true,
+       -kAny,
+       kAny,
+       {},
+       "depth of field: the polygonal aperture's turn, degrees (default 0)"},
+      {"aperture_ratio",
+       &S::aperture_ratio,
+       kAnyIntegrator,
+       true,
+       0.01,
+       100,
+       {},
+       "depth of field: anamorphic aperture height / width; > 1 stretches bokeh vertically (default 1)"},
       {"accel", &S::accel, kAnyIntegrator, true, 0, 0, accelerator_names(),
        "acceleration structure: " + accelerator_list() +
            " (default embree; brute is a linear scan, for tests)"},
@@ -283,7 +340,51 @@ void check_lights(const RenderSpec& s) {
                                 " needs integrator 'path'");
 }
 
+/// The lens settings: one aperture, one focus, and the others only with an aperture.
+void check_lens(const RenderSpec& s) {
+  if (s.fstop > 0 && s.aperture_radius > 0)
+    throw std::invalid_argument("fstop and aperture_radius exclude each other (one sets the other)");
+  if (s.focus_distance > 0 && !s.focus_at.empty())
+    throw std::invalid_argument("focus_distance and focus_at exclude each other");
+  if (!s.focus_at.empty()) parse_focus_at(s.focus_at);
+  if (s.aperture_blades == 1 || s.aperture_blades == 2)
+    throw std::invalid_argument("aperture_blades must be 0 (round) or 3 to " +
+                                std::to_string(kMaxApertureBlades));
+  if (wants_depth_of_field(s)) return;
+  const RenderSpec defaults;
+  for (const char* name :
+       {"focus_distance", "focus_at", "aperture_blades", "aperture_rotation", "aperture_ratio"})
+    for (const SpecField& f : spec_fields())
+      if (name == std::string(f.name) && field_text(s, f) != field_text(defaults, f))
+        throw std::invalid_argument(std::string(name) + " needs depth of field: fstop or aperture_radius");
+}
+
 }  // namespace
+
+bool wants_depth_of_field(const RenderSpec& spec) {
+  return spec.fstop > 0 || spec.aperture_radius > 0;
+}
+
+Vec2f parse_focus_at(const std::string& text) {
+  const auto fail = [&] {
+    return std::invalid_argument("focus_at: '" + text + "' is not a pixel X,Y (two finite numbers)");
+  };
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos) throw fail();
+  float p[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string part = k == 0 ? text.substr(0, comma) : text.substr(comma + 1);
+    size_t used = 0;
+    try {
+      p[k] = std::stof(part, &used);
+    } catch (const std::exception&) {
+      throw fail();
+    }
+    if (part.empty() || used != part.size() || !std::isfinite(p[k]) || std::isspace((unsigned char)part[0]))
+      throw fail();
+  }
+  return {p[0], p[1]};
+}
 
 const std::vector<SpecField>& spec_fields() {
   static const std::vector<SpecField> fields = make_fields();
@@ -360,6 +461,7 @@ void validate(const RenderSpec& s) {
   for (const SpecField& f : spec_fields()) check_field(s, f, defaults);
   if (s.width < 0 || s.height < 0) throw std::invalid_argument("width and height must be >= 0");
   check_lights(s);
+  check_lens(s);
   accel_config(s.accel, s.accel_params);
   for (const auto& name : s.aovs) check_aovs({name}, s.integrator, aov_names());
   // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
@@ -432,6 +534,10 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
       (camera.projection == Projection::Orthographic ? "orthographic ymag " + exact(camera.ymag)
                                                      : "perspective yfov " + exact(camera.yfov)) +
       " near " + exact(camera.znear) + " far " + exact(camera.zfar);
+  if (camera.lens.radius > 0)
+    e["camera.lens"] += " aperture " + exact(camera.lens.radius) + " focus " +
+                        exact(camera.lens.focus_distance) + " blades " + std::to_string(camera.lens.blades) +
+                        " rotation " + exact(camera.lens.rotation) + " ratio " + exact(camera.lens.ratio);
   const unsigned bit = integrator_bit(r.integrator);
   for (const SpecField& f : spec_fields())
     if (f.identity && (f.applies & bit)) e[f.name] = field_text(r, f);

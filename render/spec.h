@@ -50,6 +50,13 @@ struct RenderSpec {
   double time_limit = 0;                      ///< path: seconds; 0: none
   float adaptive = 0;                         ///< path: adaptive sampling threshold; 0: off
   int adaptive_min_spp = 16;                  ///< path: samples before --adaptive may stop a pixel
+  float fstop = 0;                            ///< depth of field by f-number; 0: none
+  float aperture_radius = 0;                  ///< depth of field by aperture radius, scene units; 0: none
+  float focus_distance = 0;                   ///< depth of the plane in focus; 0: autofocus at focus_at
+  std::string focus_at;                       ///< "X,Y": autofocus through that pixel; empty: the centre
+  int aperture_blades = 0;                    ///< 0: a round aperture; 3..64: a polygon
+  float aperture_rotation = 0;                ///< the polygon's turn, degrees
+  float aperture_ratio = 1;                   ///< anamorphic: aperture height / width
   std::string accel = "embree";               ///< an accelerator_names() entry
   std::vector<std::string> accel_params;      ///< "bvh.max_leaf_size=4", ... of `accel` only
   std::set<std::string> aovs;                 ///< checked layer names (check_aovs)
@@ -104,6 +111,13 @@ void validate(const RenderSpec& spec);
 /// The spec with every default resolved for an image whose aspect follows `hint` where the width
 /// or height is open: size, spp, filter and width, depth.
 RenderSpec resolve(const RenderSpec& spec, float hint);
+
+/// Whether the spec asks for depth of field (an f-number or an aperture radius).
+bool wants_depth_of_field(const RenderSpec& spec);
+
+/// The pixel focus_at names, "X,Y" (column and row from the top left, any real numbers; the
+/// pixel's centre is traced). Throws std::invalid_argument naming focus_at otherwise.
+Vec2f parse_focus_at(const std::string& text);
 
 /// The renderer's configuration of a resolved spec (resolve()).
 RenderConfig make_render_config(const RenderSpec& resolved);

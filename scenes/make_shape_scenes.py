@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes scenes/csg.gltf, scenes/spheres.gltf and scenes/procedural.gltf: Penumbra's scenes of
+"""Writes scenes/csg.gltf, spheres.gltf, procedural.gltf and focus.gltf: Penumbra's scenes of
 PENUMBRA_shapes shapes and PENUMBRA_procedural materials.
 
 csg.gltf: the classic CSG part (a sphere intersected with a cube, minus three orthogonal
@@ -14,6 +14,11 @@ procedural.gltf: procedural materials: a marble sphere (sine bands distorted by 
 wooden block (rings distorted by fBm), a rock (an implicit sphere displaced by fBm, coloured and
 bumped by noise) on a floor of square tiles (Chebyshev Worley F2 - F1 through a constant ramp,
 grooved grout).
+
+focus.gltf: a depth-of-field study: a diagonal row of spheres receding from the camera over a
+tiled floor, small emissive spheres far behind them (highlights that defocus into the aperture's
+shape), two point lights and a 50 mm-like camera; scenes/focus-pull.json renders it focused near,
+in the middle and far.
 
 All list PENUMBRA_shapes and PENUMBRA_procedural in extensionsUsed only, so tools that do not know the extension still
 load them (as empty nodes, cameras and lights). Pure JSON with no buffers; pure standard library;
@@ -193,16 +198,21 @@ def ramp(*stops):
     return [{"position": p, "color": list(c)} for p, c in stops]
 
 
+def tile_material(b, base_roughness, scale, grout, grout_width, tile, **channels):
+    """Square floor tiles of world-space size 1 / scale: Chebyshev Worley F2 - F1 through a
+    constant ramp (grout below grout_width), with further procedural channels as given."""
+    return b.material("tiles", (1, 1, 1), 0.0, base_roughness, dict({
+        # The floor (y = 0) cuts the cells through their centres (q.y = 0.5), not along a face.
+        "space": "world", "scale": scale, "translation": [0, 0.5, 0],
+        "pattern": {"type": "voronoi", "feature": "f2-f1", "metric": "chebyshev", "randomness": 0},
+        "baseColor": {"ramp": ramp((0.0, grout), (grout_width, tile)),
+                      "interpolation": "constant", "compose": "replace"}}, **channels))
+
+
 def build_procedural():
     b = Builder("procedural")
-    tiles = b.material("tiles", (1, 1, 1), 0.0, 1.0, {
-        # The floor (y = 0) cuts the cells through their centres (q.y = 0.5), not along a face.
-        "space": "world", "scale": 1.25, "translation": [0, 0.5, 0],
-        "pattern": {"type": "voronoi", "feature": "f2-f1", "metric": "chebyshev", "randomness": 0},
-        "baseColor": {"ramp": ramp((0.0, (0.16, 0.15, 0.14)), (0.07, (0.66, 0.62, 0.55))),
-                      "interpolation": "constant", "compose": "replace"},
-        "roughness": {"range": [0.95, 0.35], "compose": "replace"},
-        "bump": {"height": 0.01}})
+    tiles = tile_material(b, 1.0, 1.25, (0.16, 0.15, 0.14), 0.07, (0.66, 0.62, 0.55),
+                          roughness={"range": [0.95, 0.35], "compose": "replace"}, bump={"height": 0.01})
     marble = b.material("marble", (1, 1, 1), 0.0, 0.25, {
         "space": "object", "scale": 1.3, "rotation": [0, 0, 35],
         "pattern": {"type": "wave", "profile": "sine", "phaseDistortion": 1.6,
@@ -242,10 +252,34 @@ def build_procedural():
     return b.gltf
 
 
+def build_focus():
+    b = Builder("focus")
+    tiles = tile_material(b, 0.6, 2.0, (0.12, 0.11, 0.1), 0.06, (0.7, 0.68, 0.62))
+    colours = [(0.8, 0.12, 0.08), (0.9, 0.6, 0.1), (0.2, 0.65, 0.25), (0.1, 0.35, 0.85),
+               (0.55, 0.2, 0.75), (0.85, 0.85, 0.85)]
+    b.shape("floor", {"type": "plane", "size": [60, 60]}, tiles)
+    # Six spheres 2.2 units apart along the view, from 2.5 to 13.5 units from the camera.
+    for k, colour in enumerate(colours):
+        material = b.material("sphere %d" % k, colour, 0.0, 0.35)
+        b.shape("sphere %d" % k, {"type": "sphere", "radius": 0.45}, material,
+                translation=[-0.9 + 0.45 * k, 0.45, 1.0 - 2.2 * k])
+    glow = b.material("glow", (0.0, 0.0, 0.0), 0.0, 1.0)
+    b.gltf["materials"][glow]["emissiveFactor"] = [1.0, 0.85, 0.6]
+    b.gltf["materials"][glow]["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": 12.0}}
+    b.gltf["extensionsUsed"].append("KHR_materials_emissive_strength")
+    for k in range(7):
+        b.shape("glow %d" % k, {"type": "sphere", "radius": 0.06}, glow,
+                translation=[-3.0 + 1.1 * k, 1.2 + 0.35 * (k % 3), -18.0 - 1.5 * (k % 2)])
+    b.point_light("key", [1.0, 0.9, 0.8], 120.0, [-3.0, 6.0, 2.0])
+    b.point_light("fill", [0.7, 0.8, 1.0], 60.0, [4.0, 4.0, -6.0])
+    b.camera("focus camera", [0.6, 1.1, 4.0], [-0.4, 0.55, -6.0], 0.5)
+    return b.gltf
+
+
 def main():
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres),
-                        ("procedural.gltf", build_procedural)]:
+                        ("procedural.gltf", build_procedural), ("focus.gltf", build_focus)]:
         path = os.path.join(out_dir, name)
         with open(path, "w") as f:
             json.dump(build(), f, indent=1)

@@ -40,6 +40,11 @@ render default-raster scenes/default.gltf --width 480 --integrator raster
 render csg scenes/csg.gltf --width 480
 render spheres scenes/spheres.gltf --width 480 --max-depth 8
 render procedural scenes/procedural.gltf --width 480
+# Depth of field: the focus study focused near and far (cameras).
+render focus-near scenes/focus.gltf --width 320 --integrator path --spp 48 --aperture-radius 0.08 \
+  --aperture-blades 6 --focus-distance 3.2
+render focus-far scenes/focus.gltf --width 320 --integrator path --spp 48 --aperture-radius 0.08 \
+  --aperture-blades 6 --focus-distance 13
 
 # Traversal-cost heat maps of two structures on the default scene (benchmarking).
 for accel in bvh grid; do

@@ -189,6 +189,11 @@ void setup_phase(RenderJob& job) {
   o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
   o.identity = scene_identity(a, q, job.scene_sha256);
   job.prepared = prepare_render(job.loaded, spec, o);
+  if (a.quiet) return;
+  if (job.progress == ProgressMode::Json)
+    print_json_warnings(a.scene_file, job.prepared.warnings);
+  else
+    for (const auto& w : job.prepared.warnings) std::fprintf(stderr, "penumbra: warning: %s\n", w.c_str());
 }
 
 /// The render session's structure phase: the kept frame's structure reused, refitted or

@@ -104,8 +104,7 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
         const size_t i = size_t(y - win.y0) * size_t(a.width) + size_t(x - win.x0);
         pixel.clear();
         for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
-          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
-          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          const Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           Hit hit;
           if (!intersect_visible(scene, accel, ray, hit, filter)) {
             pixel.add_miss();
@@ -153,8 +152,7 @@ CryptoImage render_cryptomatte(const Scene& scene, const Accelerator& accel, con
         const size_t i = size_t(y - win.y0) * size_t(img.width) + size_t(x - win.x0);
         hit_instance.clear();
         for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
-          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
-          Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           float remaining = 1;  // of this sample's weight, not yet given to a surface
           uint32_t given = 0;   // slots handed out
           for (int layer = 0; layer < kMaxBlendLayers && given < kSlots; ++layer) {

@@ -24,8 +24,7 @@ CostImage render_cost(const Accelerator& accel, const Camera& camera, const Rend
         TraversalCost cost;
         double seconds = 0;
         for (uint32_t s = 0; s < spp; ++s) {  // the beauty's samples (render.cpp)
-          const Vec2f p = camera_sample_position(config, integrator, x, y, s);
-          const Ray ray = generate_camera_ray(camera, config.width, config.height, p.x, p.y);
+          const Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           Hit hit;
           const auto t0 = std::chrono::steady_clock::now();
           accel.intersect_counted(ray, hit, cost);

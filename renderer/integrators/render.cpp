@@ -32,11 +32,31 @@ Vec2f whitted_position(const RenderConfig& config, int x, int y, uint32_t s) {
   return filtered_position(config, x, y, j);
 }
 
-// A camera ray at raster position (px, py) with differentials `step` pixels apart.
-Ray camera_ray(const Camera& camera, const RenderConfig& config, float px, float py, float step,
+// The aperture point of Whitted's sample s of pixel (x, y): its own Sobol stream, apart from
+// the stratified position's.
+Vec2f whitted_aperture(const Camera& camera, const RenderConfig& config, int x, int y, uint32_t s) {
+  if (!(camera.lens.radius > 0)) return {0, 0};
+  constexpr uint64_t kApertureSeed = 0xa9e7'0e5a'11e5'0f0cull;
+  SampleStream st =
+      make_sample_stream(SamplerType::Sobol, uint32_t(x), uint32_t(y), s, config.seed ^ kApertureSeed);
+  return sample_aperture(camera.lens, st.get2d());
+}
+
+// The camera sample a path stream begins with: its first request places it on the film, its
+// second (with a lens only) on the aperture.
+CameraSample take_path_camera_sample(const Camera& camera, const RenderConfig& config, int x, int y,
+                                     SampleStream& st) {
+  CameraSample cs;
+  cs.film = filtered_position(config, x, y, st.get2d());
+  if (camera.lens.radius > 0) cs.aperture = sample_aperture(camera.lens, st.get2d());
+  return cs;
+}
+
+// A camera ray of sample `cs` with differentials `step` pixels apart.
+Ray camera_ray(const Camera& camera, const RenderConfig& config, const CameraSample& cs, float step,
                RayDifferential& rd) {
   Ray r[3];
-  generate_camera_rays(camera, config.width, config.height, px, py, step, r);
+  generate_camera_rays(camera, config.width, config.height, cs.film.x, cs.film.y, step, r, cs.aperture);
   rd = RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir};
   return r[0];
 }
@@ -79,6 +99,22 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
   return filtered_position(config, x, y, st.get2d());  // the stream's first request (path_samples)
 }
 
+CameraSample camera_sample(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
+                           int y, uint32_t s) {
+  if (integrator == IntegratorType::Raster) return {whitted_position(config, x, y, s), {0, 0}};
+  if (integrator == IntegratorType::Whitted)
+    return {whitted_position(config, x, y, s), whitted_aperture(camera, config, x, y, s)};
+  SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
+  return take_path_camera_sample(camera, config, x, y, st);
+}
+
+Ray camera_sample_ray(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
+                      int y, uint32_t s) {
+  const CameraSample cs = camera_sample(camera, config, integrator, x, y, s);
+  const CameraRaster raster = camera_raster(camera, config.width, config.height);
+  return thin_lens_ray(camera, raster_ray(camera, raster, cs.film.x, cs.film.y), cs.aperture);
+}
+
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4], RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
@@ -86,9 +122,9 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
-    const Vec2f p = whitted_position(config, x, y, s);
+    const CameraSample cs{whitted_position(config, x, y, s), whitted_aperture(camera, config, x, y, s)};
     RayDifferential rd;
-    const Ray ray = camera_ray(camera, config, p.x, p.y, step, rd);
+    const Ray ray = camera_ray(camera, config, cs, step, rd);
     float coverage = 0;
     sum += whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts);
     alpha += coverage;
@@ -164,20 +200,22 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
   struct Footprint {
     const Camera& camera;
     const CameraRaster& raster;
-    Vec2f p;
+    CameraSample cs;
     float step;
   };
   const auto make_rd = [](const void* ctx) {
     const Footprint& f = *static_cast<const Footprint*>(ctx);
-    const Ray rx = raster_ray(f.camera, f.raster, f.p.x + f.step, f.p.y);
-    const Ray ry = raster_ray(f.camera, f.raster, f.p.x, f.p.y + f.step);
+    const Vec2f p = f.cs.film;
+    const Ray rx = thin_lens_ray(f.camera, raster_ray(f.camera, f.raster, p.x + f.step, p.y), f.cs.aperture);
+    const Ray ry = thin_lens_ray(f.camera, raster_ray(f.camera, f.raster, p.x, p.y + f.step), f.cs.aperture);
     return RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
   };
   const CameraRaster raster = camera_raster(camera, config.width, config.height);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Footprint fp{camera, raster, filtered_position(config, x, y, samples.get2d()), step};
-    const Ray ray = raster_ray(camera, raster, fp.p.x, fp.p.y);
+    const Footprint fp{camera, raster, take_path_camera_sample(camera, config, x, y, samples), step};
+    const Ray ray =
+        thin_lens_ray(camera, raster_ray(camera, raster, fp.cs.film.x, fp.cs.film.y), fp.cs.aperture);
     float coverage = 0;
     LightGroups lg;
     const Vec3f l = path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples,

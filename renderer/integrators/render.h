@@ -109,6 +109,25 @@ void render_path_pixel(const Scene& scene, const Accelerator& accel, const PathL
 /// the rasteriser, the data AOVs and the cost map share.
 Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrator, int x, int y, uint32_t s);
 
+/// A camera sample: where it lies on the film (raster position) and on the aperture (a
+/// sample_aperture point; {0, 0} for a pinhole).
+struct CameraSample {
+  Vec2f film;
+  Vec2f aperture{0, 0};
+};
+
+/// Camera sample `s` of pixel (x, y) exactly as `integrator` takes it: the position of
+/// camera_sample_position and, through a thin lens with a radius, the aperture point (the path
+/// stream's second request; Whitted's own Sobol stream). The raster integrator renders through
+/// a pinhole: its aperture point is always {0, 0}.
+CameraSample camera_sample(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
+                           int y, uint32_t s);
+
+/// The camera ray of camera_sample(...): what the integrators trace first, and what the data
+/// AOVs, Cryptomatte and the cost map trace to see the same surfaces.
+Ray camera_sample_ray(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
+                      int y, uint32_t s);
+
 /// The spacing in pixels of the differentials of a render with `spp` samples per pixel, the
 /// footprint textures are filtered over (pbrt-v4: max(1/8, 1/sqrt(spp))).
 float differential_step(int spp);

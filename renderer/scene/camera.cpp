@@ -40,6 +40,59 @@ Ray raster_ray(const Camera& cam, const CameraRaster& m, float x, float y) {
   return ray;
 }
 
+Vec2f sample_aperture(const ThinLens& lens, Vec2f u) {
+  Vec2f p{0, 0};
+  if (lens.blades >= 3) {
+    // A uniform point in one of the polygon's triangles (centre, corner k, corner k + 1), the
+    // triangle picked by u.x and the rest of u.x reused within it.
+    const float n = float(lens.blades), f = u.x * n;
+    const int k = std::min(int(f), lens.blades - 1);
+    const float a0 = lens.rotation + 2 * kPi * float(k) / n, a1 = a0 + 2 * kPi / n;
+    const float s = std::sqrt(std::clamp(f - float(k), 0.0f, 1.0f));
+    const float b1 = s * (1 - u.y), b2 = s * u.y;
+    p = {b1 * std::cos(a0) + b2 * std::cos(a1), b1 * std::sin(a0) + b2 * std::sin(a1)};
+  } else {
+    const float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
+    if (ox != 0 || oy != 0) {
+      float r, theta;
+      if (std::fabs(ox) > std::fabs(oy)) {
+        r = ox;
+        theta = 0.25f * kPi * (oy / ox);
+      } else {
+        r = oy;
+        theta = 0.5f * kPi - 0.25f * kPi * (ox / oy);
+      }
+      p = {r * std::cos(theta), r * std::sin(theta)};
+    }
+  }
+  p.x /= lens.ratio;
+  return p;
+}
+
+Ray thin_lens_ray(const Camera& cam, const Ray& pinhole, Vec2f aperture) {
+  if (!(cam.lens.radius > 0)) return pinhole;
+  // The pinhole ray meets the plane in focus at depth focus_distance (depth grows along -w).
+  const Vec3f forward = -cam.w;
+  const Vec3f focus = pinhole.org + pinhole.dir * (cam.lens.focus_distance / dot(pinhole.dir, forward));
+  Ray r = pinhole;
+  r.org = pinhole.org + cam.u * (aperture.x * cam.lens.radius) + cam.v * (aperture.y * cam.lens.radius);
+  r.dir = normalize(focus - r.org);
+  // The lens lies on the plane of depth 0, so the clip planes stay at depths znear and zfar.
+  const float c = dot(r.dir, forward);
+  r.tnear = cam.znear / c;
+  r.tfar = cam.zfar / c;
+  return r;
+}
+
+float fstop_lens_radius(const Camera& cam, float fstop, int width, int height) {
+  float focal_mm = cam.focal_mm;
+  if (!(focal_mm > 0)) {
+    const float tan_larger = std::tan(0.5f * cam.yfov) * std::max(1.0f, float(width) / float(height));
+    focal_mm = 18.0f / tan_larger;  // half the 36 mm sensor over the half-angle's tangent
+  }
+  return focal_mm * 1e-3f / (2 * fstop);
+}
+
 void validate_camera(const Camera& cam, int width, int height) {
   const auto fail = [](const std::string& what) {
     throw std::invalid_argument("camera: " + what + " (rays beyond single-precision range)");
@@ -72,10 +125,24 @@ void validate_camera(const Camera& cam, int width, int height) {
       fail("field of view " + shown(double(cam.yfov) * 180 / M_PI) + " degrees for a " +
            std::to_string(width) + " x " + std::to_string(height) + " image");
   }
+  const ThinLens& lens = cam.lens;
+  if (!(std::isfinite(lens.radius) && lens.radius >= 0))
+    fail("aperture radius " + shown(lens.radius) + " is not a finite number >= 0");
+  if (!(std::isfinite(lens.focus_distance) && lens.focus_distance > 0))
+    fail("focus distance " + shown(lens.focus_distance) + " is not a finite number > 0");
+  if (lens.blades != 0 && !(lens.blades >= 3 && lens.blades <= kMaxApertureBlades))
+    fail("an aperture of " + std::to_string(lens.blades) + " blades (0 for round, or 3 to " +
+         std::to_string(kMaxApertureBlades) + ")");
+  if (!std::isfinite(lens.rotation)) fail("the aperture rotation is not finite");
+  if (!(lens.ratio >= 0.01f && lens.ratio <= 100))
+    fail("aperture ratio " + shown(lens.ratio) + " is outside [0.01, 100]");
   double reach = 0;
   for (int k = 0; k < 3; ++k)
-    reach = std::max(reach, std::fabs(double(cam.eye[k])) + std::fabs(double(cam.u[k])) * half_w +
-                                std::fabs(double(cam.v[k])) * half_h);
+    reach =
+        std::max(reach, std::fabs(double(cam.eye[k])) + std::fabs(double(cam.u[k])) * half_w +
+                            std::fabs(double(cam.v[k])) * half_h +
+                            (std::fabs(double(cam.u[k])) / double(lens.ratio) + std::fabs(double(cam.v[k]))) *
+                                double(lens.radius));
   if (!(reach < double(kMaxCameraReach)))
     fail(std::string(cam.projection == Projection::Orthographic ? "the image plane reaches "
                                                                 : "the eye lies ") +
@@ -86,12 +153,12 @@ Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float
   return raster_ray(cam, camera_raster(cam, width, height), x, y);
 }
 
-void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step,
-                          Ray out[3]) {
+void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step, Ray out[3],
+                          Vec2f aperture) {
   const CameraRaster m = camera_raster(cam, width, height);
-  out[0] = raster_ray(cam, m, x, y);
-  out[1] = raster_ray(cam, m, x + step, y);
-  out[2] = raster_ray(cam, m, x, y + step);
+  out[0] = thin_lens_ray(cam, raster_ray(cam, m, x, y), aperture);
+  out[1] = thin_lens_ray(cam, raster_ray(cam, m, x + step, y), aperture);
+  out[2] = thin_lens_ray(cam, raster_ray(cam, m, x, y + step), aperture);
 }
 
 Transform view_matrix(const Camera& cam) {

@@ -13,12 +13,17 @@ namespace penumbra {
 /// 1.8e18) accept.
 inline constexpr float kMaxCameraReach = 1e18f;
 
+/// The most sides a polygonal aperture may have.
+inline constexpr int kMaxApertureBlades = 64;
+
 /// Throws std::invalid_argument, saying what is out of range, unless every ray that
 /// generate_camera_ray gives for a width x height image (each >= 1) is one every back end can
 /// trace: finite axes; every ray origin within kMaxCameraReach on each axis (the eye, and for an
 /// orthographic camera the image plane's corners, ymag high and ymag * width / height wide);
 /// a finite znear >= 0 and a zfar > znear (or infinite); a perspective field of view strictly
-/// inside (0, 180) degrees whose tangent is finite. Every front end calls it on the camera it
+/// inside (0, 180) degrees whose tangent is finite; a thin lens with a finite radius >= 0 (the
+/// aperture counted in the reach), a finite focus distance > 0, 0 or 3..kMaxApertureBlades
+/// blades, a finite rotation and a ratio in [0.01, 100]. Every front end calls it on the camera it
 /// renders with.
 void validate_camera(const Camera& cam, int width, int height);
 
@@ -38,10 +43,32 @@ CameraRaster camera_raster(const Camera& cam, int width, int height);
 /// generate_camera_ray(cam, width, height, x, y), bit for bit, from camera_raster(cam, width, height).
 Ray raster_ray(const Camera& cam, const CameraRaster& raster, float x, float y);
 
+/// A point of the camera's aperture from u in [0, 1)^2, in units of the lens radius on the lens
+/// plane's (u, v) axes: uniform over the unit disc by Shirley and Chiu's concentric map ("A
+/// Low Distortion Map Between Disk and Square", JGT 2(3), 1997), or over the regular polygon
+/// of `lens.blades` sides inscribed in it (turned by lens.rotation); then x divided by
+/// lens.ratio (an anamorphic aperture, taller than wide for a ratio > 1, as Cycles' ratio).
+Vec2f sample_aperture(const ThinLens& lens, Vec2f u);
+
+/// The ray from aperture point `aperture` (sample_aperture's) that meets the pinhole ray
+/// `pinhole` (raster_ray's, or generate_camera_ray's) on the plane in focus, at depth
+/// cam.lens.focus_distance (pbrt-v4's thin-lens step: the origin moved on the lens plane, the
+/// unit direction aimed at the point in focus). tnear and tfar still clip at the depths znear
+/// and zfar. Perspective lenses sit at the eye, orthographic ones at the ray's origin on the
+/// image plane. With a zero lens radius it returns `pinhole` unchanged.
+Ray thin_lens_ray(const Camera& cam, const Ray& pinhole, Vec2f aperture);
+
 /// The rays through (x, y), (x + step, y) and (x, y + step) (out[0..2]): a camera ray and its
 /// two differential rays, exactly as three generate_camera_ray calls give them, sharing the
-/// per-camera terms.
-void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step, Ray out[3]);
+/// per-camera terms; all three through aperture point `aperture` (thin_lens_ray).
+void generate_camera_rays(const Camera& cam, int width, int height, float x, float y, float step, Ray out[3],
+                          Vec2f aperture = {0, 0});
+
+/// The thin lens' radius in scene units for an f-number (aperture diameter = focal length /
+/// fstop, scene units being metres as in glTF): the focal length is cam.focal_mm when set,
+/// else that of the camera's field of view across the image's larger side on a 36 mm sensor
+/// (Blender's default sensor, "auto" fit). Perspective cameras only.
+float fstop_lens_radius(const Camera& cam, float fstop, int width, int height);
 
 /// The world-to-camera (view) matrix: rows u, v, w and translation -(u.eye, v.eye, w.eye), the
 /// rigid inverse [R^T  -R^T eye] of the camera's frame; camera space looks down -Z.

@@ -131,8 +131,9 @@ Camera lens(const CameraRig& r, const Camera* base, float aspect) {
   if (r.yfov || r.focal_mm) {
     c.projection = Projection::Perspective;
     c.yfov = float(r.yfov ? *r.yfov : focal_length_yfov(*r.focal_mm, r.sensor_mm, aspect));
+    c.focal_mm = r.focal_mm ? float(*r.focal_mm) : 0.0f;
   }
-  if (r.ortho_height || r.ortho_fit) c.projection = Projection::Orthographic;
+  if (r.ortho_height || r.ortho_fit) c.projection = Projection::Orthographic, c.focal_mm = 0;
   if (r.ortho_height) {
     c.ymag = float(0.5 * *r.ortho_height);
     c.xmag = c.ymag * aspect;

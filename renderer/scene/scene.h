@@ -140,6 +140,18 @@ struct Light {
 
 enum class Projection { Perspective, Orthographic };
 
+/// A thin lens in front of the camera (pbrt-v4's ProjectiveCamera; Kolb et al., "A Realistic
+/// Camera Model for Computer Graphics", SIGGRAPH 1995): rays leave a point of the aperture and
+/// meet, whatever the point, on the plane at `focus_distance` in front of the camera. A zero
+/// radius is a pinhole: no depth of field.
+struct ThinLens {
+  float radius = 0;          ///< aperture radius in scene units (metres for glTF); 0: pinhole
+  float focus_distance = 1;  ///< depth along -w of the plane in focus, > 0
+  int blades = 0;            ///< 0: a circular aperture; >= 3: a regular polygon of that many sides
+  float rotation = 0;        ///< the polygon's turn about the view axis, radians
+  float ratio = 1;           ///< anamorphic squeeze: the aperture's height / width (1: round bokeh)
+};
+
 /// A camera in world space: eye and a right-handed orthonormal frame (u right, v up, w back;
 /// the camera looks along -w), as glTF places cameras looking down their local -Z.
 struct Camera {
@@ -152,6 +164,8 @@ struct Camera {
   float xmag = 1, ymag = 1;  ///< orthographic half-extents
   float znear = 0;           ///< clip distances along -w
   float zfar = kInfinity;
+  float focal_mm = 0;  ///< the lens' focal length in millimetres when a rig set it; 0: unknown
+  ThinLens lens;       ///< depth of field; a pinhole by default
 };
 
 struct Scene {

@@ -268,3 +268,29 @@ def test_every_setting_is_a_render_flag_and_the_same_default(cli):
         penumbra.RenderSettings(no_such_setting=1)
     for name in names:
         assert name in str(e.value)
+
+
+def mixed_columns(r):
+    """Columns of the middle row whose colour lies strictly between the two quads' (an edge)."""
+    red = r.rgb[H // 2, :, 0]
+    lo, hi = sorted((red[0], red[-1]))
+    return int(np.sum((red > lo + 0.02 * (hi - lo)) & (red < hi - 0.02 * (hi - lo))))
+
+
+def test_depth_of_field_focuses_where_asked(quads):
+    # The front quad's edge lies at depth 2: focused there (autofocus on a pixel of the front quad)
+    # it is as sharp as through a pinhole; focused on the back quad (depth 3) it spreads.
+    front, back = column_sides()
+    base = dict(width=W, height=H, spp=64, integrator="whitted")
+    pinhole = quads.render(**base)
+    near = quads.render(**base, aperture_radius=0.6, focus_at=f"{front[0]},{H // 2}", aovs=["Z"])
+    far = quads.render(**base, aperture_radius=0.6, focus_at=f"{back[-1]},{H // 2}")
+    assert mixed_columns(near) <= mixed_columns(pinhole) + 1
+    assert mixed_columns(far) >= mixed_columns(pinhole) + 3
+    np.testing.assert_allclose(near.aovs["Z"][H // 2, front[0]], 2, rtol=1e-4)
+    with pytest.warns(RuntimeWarning, match="ignores depth of field"):
+        quads.render(width=W, height=H, integrator="raster", fstop=2)
+    with pytest.raises(ValueError, match="fstop and aperture_radius exclude each other"):
+        quads.render(fstop=2, aperture_radius=0.1)
+    with pytest.raises(ValueError, match="focus_at needs depth of field"):
+        quads.render(focus_at="1,1")

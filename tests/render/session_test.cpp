@@ -124,4 +124,84 @@ TEST_CASE("session: a camera that does not exist is an InputError naming the fil
                     Catch::Contains("default.gltf") && Catch::Contains("no camera named"));
 }
 
+TEST_CASE("session: the lens from the spec, focused by distance or by what a pixel shows", "[session][dof]") {
+  // The camera at the origin looks down -z at a near quad (depth 3) on the left and a far one
+  // (depth 6) on the right of the image.
+  LoadedScene loaded;
+  Scene& s = loaded.scene;
+  const int mat = test::add_material(s, {1, 1, 1}, 0, 1);
+  test::add_quad_z(s, -10, 0, -10, 10, -3, mat);
+  test::add_quad_z(s, 0, 10, -10, 10, -6, mat);
+  Camera cam;
+  cam.name = "lens";
+  cam.yfov = 2 * std::atan(0.5f);
+  s.cameras.push_back(cam);
+  PrepareOptions o;
+  o.scene_file = "lens.gltf";
+  RenderSpec spec = small("path");
+  spec.aperture_radius = 0.1f;
+  spec.focus_at = "4,8";
+  PreparedRender p = prepare_render(loaded, spec, o);
+  CHECK(p.camera.lens.radius == 0.1f);
+  CHECK(p.camera.lens.focus_distance == Approx(3).epsilon(1e-5));
+  CHECK(p.identity.entries.at("camera.lens").find("focus 3") != std::string::npos);
+  finish_render(loaded, p);
+  spec.focus_at = "20,8";
+  p = prepare_render(loaded, spec, o);
+  CHECK(p.camera.lens.focus_distance == Approx(6).epsilon(1e-5));
+  finish_render(loaded, p);
+  spec.focus_at.clear();
+  spec.focus_distance = 4.5f;
+  spec.aperture_blades = 5;
+  spec.aperture_rotation = 90;
+  p = prepare_render(loaded, spec, o);
+  CHECK(p.camera.lens.focus_distance == 4.5f);
+  CHECK(p.camera.lens.blades == 5);
+  CHECK(p.camera.lens.rotation == Approx(kPi / 2));
+  finish_render(loaded, p);
+  // An f-number: focal length from the field of view on a 36 mm sensor across the width.
+  spec.aperture_radius = 0;
+  spec.fstop = 4;
+  p = prepare_render(loaded, spec, o);
+  const double focal_m = 0.018 / (0.5 * 24.0 / 16.0);
+  CHECK(p.camera.lens.radius == Approx(focal_m / 8).epsilon(1e-5));
+  finish_render(loaded, p);
+  // The raster preview keeps its pinhole and says so.
+  spec.integrator = "raster";
+  p = prepare_render(loaded, spec, o);
+  CHECK(p.camera.lens.radius == 0);
+  REQUIRE(p.warnings.size() == 1);
+  CHECK(p.warnings[0].find("ignores depth of field") != std::string::npos);
+  finish_render(loaded, p);
+  // An orthographic camera takes a radius, not an f-number.
+  s.cameras[0].projection = Projection::Orthographic;
+  spec.integrator = "whitted";
+  CHECK_THROWS_WITH(prepare_render(loaded, spec, o), Catch::Contains("fstop needs a perspective camera"));
+  spec.focus_at = "900,1";
+  spec.fstop = 0;
+  spec.aperture_radius = 0.1f;
+  spec.focus_distance = 0;
+  CHECK_THROWS_WITH(prepare_render(loaded, spec, o), Catch::Contains("outside the 24 x 16 image"));
+}
+
+TEST_CASE("session: with a lens the data AOVs see what the beauty's samples see", "[session][dof]") {
+  // A quad at depth 2 fills the view; focused at 4 through a wide aperture, the depth of
+  // each sample still reads 2 (a plane facing the camera), and the albedo is its colour.
+  Session session;
+  session.file = "plane.gltf";
+  Scene& s = session.loaded.scene;
+  const int mat = test::add_material(s, {0.25f, 0.5f, 0.75f}, 0, 1);
+  test::add_quad_z(s, -10, 10, -10, 10, -2, mat);
+  Camera cam;
+  cam.yfov = 2 * std::atan(0.5f);
+  s.cameras.push_back(cam);
+  RenderSpec spec = small("whitted");
+  spec.aperture_radius = 0.3f;
+  spec.focus_distance = 4;
+  spec.aovs = {"Z", "albedo"};
+  const RenderResult r = render_scene(session, spec, 0);
+  for (float z : r.layers.data.depth) CHECK(z == Approx(2).epsilon(1e-4));
+  CHECK(r.layers.data.albedo[1] == Approx(0.5f));
+}
+
 }  // namespace penumbra

@@ -19,6 +19,10 @@ void perturb(RenderSpec& s, const SpecField& f) {
             s.*member = "gaussian";
             return;
           }
+          if (f.name == std::string("focus_at")) {
+            s.*member = "3,4";
+            return;
+          }
           for (const auto& c : f.choices)
             if (c != s.*member && !(f.name == std::string("integrator"))) {
               s.*member = c;
@@ -26,6 +30,8 @@ void perturb(RenderSpec& s, const SpecField& f) {
             }
         } else if constexpr (std::is_floating_point_v<T>) {
           s.*member = T(std::isinf(f.hi) ? std::max(f.lo, 0.0) + 0.25 : (f.lo + f.hi) / 2 + 0.125);
+        } else if (f.name == std::string("aperture_blades")) {
+          s.*member = 6;
         } else if (f.lo != 0 || f.hi != 0) {
           s.*member = T(f.lo + 1 == double(s.*member) ? f.lo + 2 : f.lo + 1);
         } else {
@@ -39,6 +45,13 @@ RenderSpec with_integrator(const char* integrator) {
   RenderSpec s;
   s.integrator = integrator;
   return s;
+}
+
+/// The lens settings that only apply with an aperture.
+bool needs_aperture(const SpecField& f) {
+  const std::string n = f.name;
+  return n == "focus_distance" || n == "focus_at" || n == "aperture_blades" || n == "aperture_rotation" ||
+         n == "aperture_ratio";
 }
 
 }  // namespace
@@ -57,11 +70,12 @@ TEST_CASE("spec: every field has a flag name and a help line", "[spec]") {
 
 TEST_CASE("spec: every identity field changes the identity, the others do not", "[spec]") {
   for (const char* integrator : {"whitted", "path", "raster"}) {
-    const RenderSpec base = with_integrator(integrator);
     const Camera cam = frame_bounds(Bounds3f{{-1, -1, -1}, {1, 1, 1}}, 1.5f);
-    const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
     for (const SpecField& f : spec_fields()) {
       if (f.name == std::string("integrator") || !(f.applies & integrator_bit(integrator))) continue;
+      RenderSpec base = with_integrator(integrator);
+      if (needs_aperture(f)) base.aperture_radius = 0.5f;
+      const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
       RenderSpec changed = base;
       perturb(changed, f);
       INFO(integrator << " " << f.name << " = " << field_text(changed, f));
@@ -163,6 +177,39 @@ TEST_CASE("spec: defaults resolve per integrator and follow the aspect hint", "[
   CHECK(cfg.height == 100);
   CHECK(cfg.path.max_depth == 12);
   CHECK(cfg.filter.type == FilterType::BlackmanHarris);
+}
+
+TEST_CASE("spec: the lens takes one aperture, one focus, and its other settings only with an aperture",
+          "[spec]") {
+  RenderSpec s = with_integrator("path");
+  s.fstop = 2;
+  CHECK_NOTHROW(validate(s));
+  CHECK(wants_depth_of_field(s));
+  s.aperture_radius = 0.1f;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("fstop and aperture_radius exclude each other"));
+  s.aperture_radius = 0;
+  s.focus_distance = 3;
+  s.focus_at = "1,2";
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("focus_distance and focus_at exclude each other"));
+  s.focus_distance = 0;
+  for (const char* bad : {"1", "1,", ",2", "a,b", "1,2,3", "nan,1", "1, 2", "inf,0"}) {
+    INFO(bad);
+    s.focus_at = bad;
+    CHECK_THROWS_WITH(validate(s), Catch::Contains("focus_at: '"));
+  }
+  s.focus_at = "-0.5,7.25";
+  CHECK(parse_focus_at(s.focus_at).x == -0.5f);
+  CHECK(parse_focus_at(s.focus_at).y == 7.25f);
+  s.aperture_blades = 2;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("aperture_blades must be 0 (round) or 3"));
+  for (const char* field :
+       {"focus_distance", "focus_at", "aperture_blades", "aperture_rotation", "aperture_ratio"}) {
+    INFO(field);
+    RenderSpec pinhole = with_integrator("whitted");
+    for (const SpecField& f : spec_fields())
+      if (f.name == std::string(field)) perturb(pinhole, f);
+    CHECK_THROWS_WITH(validate(pinhole), Catch::Contains(std::string(field) + " needs depth of field"));
+  }
 }
 
 }  // namespace penumbra

@@ -9,6 +9,8 @@
 #include "renderer/accel/factory.h"
 #include "renderer/core/rng.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/lights/area.h"
+#include "renderer/lights/environment.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -100,4 +102,97 @@ TEST_CASE("pixel RNG streams depend only on (pixel, sample, seed)", "[render][qu
   double sum = 0;
   for (int i = 0; i < 100000; ++i) sum += a.next_float();
   CHECK(std::fabs(sum / 100000 - 0.5) < 4 * std::sqrt(1.0 / 12 / 100000));
+}
+
+namespace {
+
+/// Renders `s` through `cam` (128 x 128) with Whitted or the path tracer, `spp` samples.
+Film render_lens_scene(const Scene& s, const Camera& cam, bool path, int spp) {
+  const auto accel = make_scene_accelerator("embree", s);
+  RenderConfig cfg;
+  cfg.width = 128;
+  cfg.height = 128;
+  cfg.spp = spp;
+  if (!path) return render_whitted(s, *accel, cam, cfg);
+  const AreaLights al = build_area_lights(s);
+  const Environment black;
+  return render_path(s, *accel, PathLights{&al, &black}, cam, cfg).film;
+}
+
+/// The area in pixels of the blur kernel an image of a small bright patch shows: its energy over
+/// its plateau (the mean of the pixels within `plateau_px` of the centre), which is exactly the
+/// kernel's area while the patch fits inside the kernel.
+double kernel_area(const Film& f, float plateau_px) {
+  double total = 0, plateau = 0;
+  int plateau_n = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const float v = f.pixel(x, y)[0];
+      total += v;
+      if (std::hypot(float(x) + 0.5f - 64, float(y) + 0.5f - 64) < plateau_px) plateau += v, ++plateau_n;
+    }
+  return total / (plateau / plateau_n);
+}
+
+/// Pixels of row 64 that are neither background nor surface (an edge's width).
+int edge_width(const Film& f) {
+  int n = 0;
+  for (int x = 0; x < f.width; ++x) n += f.pixel(x, 64)[0] > 0.02f && f.pixel(x, 64)[0] < 0.98f;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("depth of field: a small patch off the focal plane images as the thin lens' disc or polygon",
+          "[render][dof]") {
+  // A 0.02-wide unlit white square at depth 2, in focus at depth 4, aperture radius 0.2: the
+  // circle of confusion has radius R |1/F - 1/z| = 0.05 at depth 1, 12.8 px for tan(yfov/2) =
+  // 0.25 over 64 px.
+  Scene s;
+  const int mat = test::add_material(s, {1, 1, 1}, 0, 1, /*unlit=*/true);
+  test::add_quad_z(s, -0.01f, 0.01f, -0.01f, 0.01f, -2, mat);
+  Camera cam;
+  cam.yfov = 2 * std::atan(0.25f);
+  cam.lens.radius = 0.2f;
+  cam.lens.focus_distance = 4;
+  const double r = 0.2 * (1.0 / 2 - 1.0 / 4) / 0.25 * 64;
+  for (bool path : {false, true}) {
+    INFO((path ? "path" : "whitted"));
+    Camera round = cam;
+    const double disc = kernel_area(render_lens_scene(s, round, path, 256), 8);
+    CHECK(std::sqrt(disc / kPi) == Approx(r).margin(1.0));
+    Camera hex = cam;
+    hex.lens.blades = 6;
+    const double polygon = kernel_area(render_lens_scene(s, hex, path, 256), 8);
+    CHECK(std::sqrt(polygon / (1.5 * std::sqrt(3.0))) == Approx(r).margin(1.0));
+    // Through a pinhole the patch covers about its own 2.56 x 2.56 px.
+    Camera pinhole = cam;
+    pinhole.lens.radius = 0;
+    const Film sharp = render_lens_scene(s, pinhole, path, 64);
+    double energy = 0;
+    for (size_t i = 0; i < sharp.rgba.size(); i += 4) energy += sharp.rgba[i];
+    CHECK(energy == Approx(2.56 * 2.56).epsilon(0.1));
+  }
+}
+
+TEST_CASE("depth of field: the plane in focus stays as sharp as through a pinhole", "[render][dof]") {
+  // A half-plane's edge at depth 4 (x = 0.05, raster x = 64 + 3.2).
+  Scene s;
+  const int mat = test::add_material(s, {1, 1, 1}, 0, 1, /*unlit=*/true);
+  test::add_quad_z(s, -10, 0.05f, -10, 10, -4, mat);
+  Camera cam;
+  cam.yfov = 2 * std::atan(0.25f);
+  for (bool path : {false, true}) {
+    INFO((path ? "path" : "whitted"));
+    const int pinhole = edge_width(render_lens_scene(s, cam, path, 64));
+    Camera focused = cam;
+    focused.lens.radius = 0.2f;
+    focused.lens.focus_distance = 4;
+    CHECK(edge_width(render_lens_scene(s, focused, path, 64)) <= pinhole);
+    // Focused elsewhere the same edge spreads over the circle of confusion (R |1/F - 1/z| =
+    // 0.05 at depth 1: 12.8 px each side).
+    Camera defocused = focused;
+    defocused.lens.focus_distance = 2;
+    CHECK(edge_width(render_lens_scene(s, defocused, path, 64)) >= 20);
+  }
 }

@@ -242,3 +242,129 @@ TEST_CASE("validate_camera refuses cameras whose rays leave single precision", "
   nan.u.x = std::numeric_limits<float>::quiet_NaN();
   CHECK_THROWS_WITH(validate_camera(nan, 16, 16), Catch::Matchers::Contains("not finite"));
 }
+
+namespace {
+
+/// A u in [0, 1)^2 on a regular n x n lattice (cell centres).
+Vec2f lattice(int i, int n) {
+  return {(float(i % n) + 0.5f) / float(n), (float(i / n) + 0.5f) / float(n)};
+}
+
+}  // namespace
+
+TEST_CASE("sample_aperture: uniform over the unit disc, the polygon and the squeezed disc",
+          "[camera][quick]") {
+  const int n = 64;
+  ThinLens round;
+  double r2 = 0;
+  float far = 0;
+  for (int i = 0; i < n * n; ++i) {
+    const Vec2f p = sample_aperture(round, lattice(i, n));
+    far = std::max(far, std::hypot(p.x, p.y));
+    r2 += double(p.x) * p.x + double(p.y) * p.y;
+  }
+  CHECK(far <= 1.0f + 1e-6f);
+  CHECK(far > 0.98f);
+  CHECK(r2 / (n * n) == Approx(0.5).margin(0.01));  // E[r^2] = 1/2 for a uniform unit disc
+  // A hexagon turned by 30 degrees: every point inside its six edges; a corner at 30 degrees.
+  ThinLens hex;
+  hex.blades = 6;
+  hex.rotation = kPi / 6;
+  const float apothem = std::cos(kPi / 6);
+  double area_r2 = 0;
+  float reach_corner = 0, reach_edge = 0;
+  for (int i = 0; i < n * n; ++i) {
+    const Vec2f p = sample_aperture(hex, lattice(i, n));
+    for (int k = 0; k < 6; ++k) {
+      const float a = hex.rotation + kPi / 6 + float(k) * kPi / 3;  // edge k's outward normal
+      CHECK(p.x * std::cos(a) + p.y * std::sin(a) <= apothem + 1e-5f);
+    }
+    const float angle = std::atan2(p.y, p.x), r = std::hypot(p.x, p.y);
+    if (std::fabs(angle - kPi / 6) < 0.05f) reach_corner = std::max(reach_corner, r);
+    if (std::fabs(angle - kPi / 3) < 0.05f) reach_edge = std::max(reach_edge, r);
+    area_r2 += double(p.x) * p.x + double(p.y) * p.y;
+  }
+  CHECK(reach_corner > 0.95f);
+  CHECK(reach_edge <= apothem + 1e-3f);
+  // E[r^2] over a regular hexagon of circumradius 1: 5/12.
+  CHECK(area_r2 / (n * n) == Approx(5.0 / 12).margin(0.01));
+  ThinLens squeezed;
+  squeezed.ratio = 2;
+  float max_x = 0, max_y = 0;
+  for (int i = 0; i < n * n; ++i) {
+    const Vec2f p = sample_aperture(squeezed, lattice(i, n));
+    max_x = std::max(max_x, std::fabs(p.x));
+    max_y = std::max(max_y, std::fabs(p.y));
+  }
+  CHECK(max_x == Approx(0.5).margin(0.01));  // lattice cell centres reach 63/64 of the rim
+  CHECK(max_y == Approx(1.0).margin(0.02));
+}
+
+TEST_CASE("thin_lens_ray: every aperture point meets the pinhole ray on the plane in focus",
+          "[camera][quick]") {
+  for (Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    Camera cam = look_at({1, 2, 3}, {0, 0, -4}, {0, 1, 0}, 0.8f);
+    cam.projection = projection;
+    cam.ymag = 2;
+    cam.znear = 0.5f;
+    cam.zfar = 40;
+    cam.lens.radius = 0.25f;
+    cam.lens.focus_distance = 6;
+    const Ray pinhole = generate_camera_ray(cam, 64, 48, 40.3f, 11.7f);
+    // With no radius the ray is the pinhole's, bit for bit.
+    Camera pin = cam;
+    pin.lens.radius = 0;
+    const Ray same = thin_lens_ray(pin, pinhole, {0.7f, -0.2f});
+    CHECK(same.org == pinhole.org);
+    CHECK(same.dir == pinhole.dir);
+    const float t_focus = cam.lens.focus_distance / dot(pinhole.dir, -cam.w);
+    const Vec3f focus = pinhole.org + pinhole.dir * t_focus;
+    for (Vec2f a : {Vec2f{1, 0}, Vec2f{0, -1}, Vec2f{0.6f, 0.8f}, Vec2f{-0.3f, 0.1f}}) {
+      const Ray r = thin_lens_ray(cam, pinhole, a);
+      CHECK(length(r.dir) == Approx(1).margin(1e-6));
+      // The origin lies on the lens plane (depth 0 from the pinhole ray's origin), a * radius away.
+      const Vec3f off = r.org - pinhole.org;
+      CHECK(dot(off, cam.w) == Approx(0).margin(1e-5));
+      CHECK(dot(off, cam.u) == Approx(a.x * 0.25f).margin(1e-5));
+      CHECK(dot(off, cam.v) == Approx(a.y * 0.25f).margin(1e-5));
+      // It passes through the pinhole ray's point in focus.
+      const float t = dot(focus - r.org, r.dir);
+      CHECK(length(r.org + r.dir * t - focus) < 1e-4f);
+      // The clip planes stay at depths znear and zfar.
+      CHECK(dot(r.dir * r.tnear, -cam.w) == Approx(0.5).margin(1e-5));
+      CHECK(dot(r.dir * r.tfar, -cam.w) == Approx(40).margin(1e-3));
+    }
+  }
+}
+
+TEST_CASE("fstop_lens_radius: focal length / (2 N), from the rig's focal length or the field of view",
+          "[camera][quick]") {
+  Camera cam;
+  // A 50 mm lens on a 36 mm sensor spanning the width of a 3:2 image: f/2 gives a 12.5 mm radius.
+  const float tan_x = 18.0f / 50.0f;
+  cam.yfov = 2 * std::atan(tan_x * 2 / 3);
+  CHECK(fstop_lens_radius(cam, 2, 300, 200) == Approx(0.0125).epsilon(1e-4));
+  // Portrait: the sensor spans the height.
+  cam.yfov = 2 * std::atan(tan_x);
+  CHECK(fstop_lens_radius(cam, 2, 200, 300) == Approx(0.0125).epsilon(1e-4));
+  // A focal length known from the rig wins over the field of view.
+  cam.focal_mm = 85;
+  CHECK(fstop_lens_radius(cam, 1.4f, 200, 300) == Approx(0.085 / 2.8).epsilon(1e-5));
+}
+
+TEST_CASE("validate_camera: the lens' ranges", "[camera][quick]") {
+  Camera cam;
+  cam.lens.radius = 0.1f;
+  CHECK_NOTHROW(validate_camera(cam, 10, 10));
+  const auto refused = [&](auto change, const char* message) {
+    Camera bad = cam;
+    change(bad.lens);
+    CHECK_THROWS_WITH(validate_camera(bad, 10, 10), Catch::Contains(message));
+  };
+  refused([](ThinLens& l) { l.radius = std::numeric_limits<float>::quiet_NaN(); }, "aperture radius");
+  refused([](ThinLens& l) { l.focus_distance = 0; }, "focus distance");
+  refused([](ThinLens& l) { l.blades = 2; }, "2 blades");
+  refused([](ThinLens& l) { l.ratio = 0; }, "ratio");
+  refused([](ThinLens& l) { l.rotation = std::numeric_limits<float>::infinity(); }, "rotation");
+  refused([](ThinLens& l) { l.radius = 2e18f; }, "beyond");
+}
