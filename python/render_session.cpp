@@ -31,6 +31,7 @@ std::shared_ptr<SceneSession> load_session(const std::string& file, const GltfLo
   session->file = file;
   session->loaded = load_gltf(file, options);
   session->loaded_at_time = options.time.has_value();
+  session->time = options.time.value_or(0);
   return session;
 }
 
@@ -38,6 +39,7 @@ bool pose_session(SceneSession& session, double time) {
   if (!session.loaded.animation) return false;
   uint64_t moved = 0;
   if (!pose_gltf_scene(*session.loaded.animation, time, session.loaded.scene, &moved)) return false;
+  session.time = time;
   if (moved == 0) return true;
   session.area_lights.reset();
   Structure& s = session.structure;

@@ -9,6 +9,7 @@
 #include "io/gltf/id_manifest.h"
 #include "io/image/environment_io.h"
 #include "render/accel_params.h"
+#include "render/motion.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/visibility.h"
@@ -26,10 +27,11 @@ struct DefaultLightGuard {
   }
 };
 
-/// The structure's key: its name and parameters.
-std::string structure_key(const RenderSpec& spec) {
+/// The structure's key: its name and parameters, and whether it was built over moving instances.
+std::string structure_key(const RenderSpec& spec, const Scene& scene) {
   std::string key = spec.accel;
   for (const auto& p : spec.accel_params) key += " " + p;
+  if (!scene.instance_motion.empty()) key += " (motion)";
   return key;
 }
 
@@ -164,6 +166,10 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
                      e.what());
   }
   set_lens(p, scene, o.scene_file);
+  if (p.spec.motion_blur && p.integrator() == IntegratorType::Raster)
+    p.warnings.push_back(
+        "the raster preview renders the frame's time: it ignores motion blur (motion_blur); "
+        "use integrator 'whitted' or 'path' to see it");
   // The lights: the environment, the emissive triangles, the default key light.
   const bool path = p.integrator() == IntegratorType::Path;
   p.environment = choose_environment(loaded, p.spec, env_budget);
@@ -192,8 +198,9 @@ Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world
                           bool moved_vertices) {
   AccelConfig config = accel_config(spec.accel, spec.accel_params);
   config.embree.world_apart = world_apart;
-  const std::string key = structure_key(spec);
-  if (previous.accel && previous.key == key) {
+  const std::string key = structure_key(spec, scene);
+  // A structure over moving instances is built for its shutter: never kept for another.
+  if (previous.accel && previous.key == key && scene.instance_motion.empty()) {
     if (!moved_vertices) return previous;
     const RefitReport r =
         refit_or_rebuild_scene(previous.accel, previous.built_sah, spec.accel, scene, config);
@@ -348,6 +355,8 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   options.scene_file = session.file;
   options.env_budget = env_budget;
   options.area_lights = session.area_lights;
+  validate(spec);
+  options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file);
   RenderResult r;
   r.prepared = prepare_render(session.loaded, spec, options);
   DefaultLightGuard guard{session.loaded, &r.prepared};

@@ -166,6 +166,7 @@ struct Session {
   std::string file;  ///< as given to load (the name InputError messages carry)
   LoadedScene loaded;
   bool loaded_at_time = false;  ///< loaded with GltfLoadOptions::time
+  double time = 0;              ///< the time the scene is posed at (loaded or posed since); 0 for a still
   std::mutex mutex;
   Structure structure;                            ///< the last render's, or empty
   std::shared_ptr<const AreaLights> area_lights;  ///< the emissive triangles, once needed
@@ -178,9 +179,11 @@ struct RenderResult {
   RenderLayers layers;
 };
 
-/// One render of the session's scene (locking it): prepare_render, build_structure (kept for
-/// the next render with the same name and parameters), render_image, render_layers, and the
-/// default key light removed again however it ends. `env_budget` as in PrepareOptions.
+/// One render of the session's scene (locking it): the scene's motion over the shutter around
+/// session.time (set_scene_motion, cleared without motion blur), prepare_render,
+/// build_structure (kept for the next render with the same name and parameters), render_image,
+/// render_layers, and the default key light removed again however it ends. `env_budget` as in
+/// PrepareOptions.
 RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget);
 
 }  // namespace penumbra

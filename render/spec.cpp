@@ -255,6 +255,47 @@ std::vector<SpecField> make_fields() {
        100,
        {},
        "depth of field: anamorphic aperture height / width; > 1 stretches bokeh vertically (default 1)"},
+      {"fps",
+       &S::fps,
+       kAnyIntegrator,
+       false,
+       1e-3,
+       1e6,
+       {},
+       "frames per second: --frame N renders time N / fps, and the shutter is a fraction of 1 / fps (default "
+       "24)"},
+      {"motion_blur",
+       &S::motion_blur,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "motion blur: each camera sample sees the animation at a time within the shutter (default off)"},
+      {"shutter",
+       &S::shutter,
+       kAnyIntegrator,
+       true,
+       0,
+       4,
+       {},
+       "motion blur: the shutter's length as a fraction of the frame interval 1 / --fps (default 0.5)"},
+      {"shutter_offset",
+       &S::shutter_offset,
+       kAnyIntegrator,
+       true,
+       -4,
+       4,
+       {},
+       "motion blur: the shutter's centre after the frame's time, in frames (default 0: centred)"},
+      {"motion_steps",
+       &S::motion_steps,
+       kAnyIntegrator,
+       true,
+       2,
+       64,
+       {},
+       "motion blur: time samples of each moving transform over the shutter, slerped between (default 3)"},
       {"accel", &S::accel, kAnyIntegrator, true, 0, 0, accelerator_names(),
        "acceleration structure: " + accelerator_list() +
            " (default embree; brute is a linear scan, for tests)"},
@@ -340,8 +381,9 @@ void check_lights(const RenderSpec& s) {
                                 " needs integrator 'path'");
 }
 
-/// The lens settings: one aperture, one focus, and the others only with an aperture.
-void check_lens(const RenderSpec& s) {
+/// The lens and shutter settings: one aperture, one focus, and the others only with an aperture;
+/// the shutter's only with motion blur.
+void check_camera_settings(const RenderSpec& s) {
   if (s.fstop > 0 && s.aperture_radius > 0)
     throw std::invalid_argument("fstop and aperture_radius exclude each other (one sets the other)");
   if (s.focus_distance > 0 && !s.focus_at.empty())
@@ -350,8 +392,13 @@ void check_lens(const RenderSpec& s) {
   if (s.aperture_blades == 1 || s.aperture_blades == 2)
     throw std::invalid_argument("aperture_blades must be 0 (round) or 3 to " +
                                 std::to_string(kMaxApertureBlades));
-  if (wants_depth_of_field(s)) return;
   const RenderSpec defaults;
+  if (!s.motion_blur)
+    for (const char* name : {"shutter", "shutter_offset", "motion_steps"})
+      for (const SpecField& f : spec_fields())
+        if (name == std::string(f.name) && field_text(s, f) != field_text(defaults, f))
+          throw std::invalid_argument(std::string(name) + " needs motion_blur");
+  if (wants_depth_of_field(s)) return;
   for (const char* name :
        {"focus_distance", "focus_at", "aperture_blades", "aperture_rotation", "aperture_ratio"})
     for (const SpecField& f : spec_fields())
@@ -461,7 +508,7 @@ void validate(const RenderSpec& s) {
   for (const SpecField& f : spec_fields()) check_field(s, f, defaults);
   if (s.width < 0 || s.height < 0) throw std::invalid_argument("width and height must be >= 0");
   check_lights(s);
-  check_lens(s);
+  check_camera_settings(s);
   accel_config(s.accel, s.accel_params);
   for (const auto& name : s.aovs) check_aovs({name}, s.integrator, aov_names());
   // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
@@ -515,6 +562,7 @@ RenderConfig make_render_config(const RenderSpec& r) {
   cfg.adaptive_threshold = r.adaptive;
   cfg.adaptive_min_spp = r.adaptive_min_spp;
   cfg.light_groups = r.aovs.count("light") > 0;
+  cfg.motion_blur = r.motion_blur;
   return cfg;
 }
 
@@ -526,6 +574,7 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
   e["scene.flatten"] = scene.flatten ? "1" : "0";
   e["scene.variant"] = scene.variant.empty() ? "none" : scene.variant;
   e["scene.time"] = scene.time;
+  if (!scene.shutter.empty()) e["scene.shutter"] = scene.shutter;
   e["camera"] = scene.camera.empty() ? "default '" + camera.name + "'" : scene.camera;
   // The camera as rendered, whichever flags or file placed it.
   const auto vec = [](Vec3f v) { return exact(v.x) + "," + exact(v.y) + "," + exact(v.z); };

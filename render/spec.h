@@ -57,6 +57,11 @@ struct RenderSpec {
   int aperture_blades = 0;                    ///< 0: a round aperture; 3..64: a polygon
   float aperture_rotation = 0;                ///< the polygon's turn, degrees
   float aperture_ratio = 1;                   ///< anamorphic: aperture height / width
+  double fps = 24;                            ///< frames per second: the frame interval of the shutter
+  bool motion_blur = false;                   ///< the scene's motion over the shutter
+  float shutter = 0.5f;                       ///< the shutter's length, a fraction of the frame interval
+  float shutter_offset = 0;                   ///< the shutter's centre after the frame's time, in frames
+  int motion_steps = 3;                       ///< the transforms' keys over the shutter
   std::string accel = "embree";               ///< an accelerator_names() entry
   std::vector<std::string> accel_params;      ///< "bvh.max_leaf_size=4", ... of `accel` only
   std::set<std::string> aovs;                 ///< checked layer names (check_aovs)
@@ -68,8 +73,8 @@ enum IntegratorMask : unsigned { kWhitted = 1, kPath = 2, kRaster = 4, kAnyInteg
 
 /// One scalar setting of RenderSpec.
 struct SpecField {
-  using Member = std::variant<int RenderSpec::*, uint64_t RenderSpec::*, float RenderSpec::*,
-                              double RenderSpec::*, std::string RenderSpec::*>;
+  using Member = std::variant<bool RenderSpec::*, int RenderSpec::*, uint64_t RenderSpec::*,
+                              float RenderSpec::*, double RenderSpec::*, std::string RenderSpec::*>;
   const char* name;  ///< snake_case: the Python keyword and identity key; the flag is --name-with-dashes
   Member member;
   unsigned applies;  ///< IntegratorMask: elsewhere a value other than the default is an error
@@ -132,6 +137,7 @@ struct SceneIdentity {
   std::string camera;           ///< the camera as the spec names it; empty: the default (named by the camera)
   std::string env_sha256;       ///< the environment map's content hash (prepare_render reads it; empty for a
                                 ///< colour or none)
+  std::string shutter;  ///< motion blur: the shutter interval in seconds ("open..close"); empty without
 };
 
 /// Everything that decides a render's pixels except its window and sample target: the renderer

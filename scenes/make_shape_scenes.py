@@ -26,9 +26,11 @@ the output is deterministic, so re-running reproduces the committed files byte f
 
 Usage: python3 scenes/make_shape_scenes.py [OUTPUT_DIR]   (default: scenes/)
 """
+import base64
 import json
 import math
 import os
+import struct
 import sys
 
 
@@ -54,6 +56,41 @@ class Builder:
                 self.gltf["extensionsUsed"].append("PENUMBRA_procedural")
         self.gltf["materials"].append(material)
         return len(self.gltf["materials"]) - 1
+
+    def animate(self, node, path, times, values):
+        """A LINEAR channel of animations[0] moving `node`'s `path` through `values` (tuples) at
+        `times`, its keys stored in the file's one embedded buffer."""
+        def accessor(floats, type_, count, extra):
+            data = self.gltf.setdefault("_blob", bytearray())
+            view = {"buffer": 0, "byteOffset": len(data), "byteLength": 4 * len(floats)}
+            data += struct.pack("<%df" % len(floats), *floats)
+            self.gltf.setdefault("bufferViews", []).append(view)
+            self.gltf.setdefault("accessors", []).append(dict(
+                {"bufferView": len(self.gltf["bufferViews"]) - 1, "componentType": 5126,
+                 "count": count, "type": type_}, **extra))
+            return len(self.gltf["accessors"]) - 1
+        flat = [round(c, 6) for v in values for c in v]
+        inputs = accessor(times, "SCALAR", len(times), {"min": [min(times)], "max": [max(times)]})
+        outputs = accessor(flat, "VEC%d" % len(values[0]), len(values), {})
+        animation = self.gltf.setdefault("animations", [{"channels": [], "samplers": []}])[0]
+        animation["samplers"].append({"input": inputs, "output": outputs, "interpolation": "LINEAR"})
+        animation["channels"].append({"sampler": len(animation["samplers"]) - 1,
+                                      "target": {"node": node, "path": path}})
+
+    def child(self, parent, name, **fields):
+        """A node under `parent` (not a root of the scene)."""
+        self.gltf["nodes"].append(dict(name=name, **fields))
+        index = len(self.gltf["nodes"]) - 1
+        self.gltf["nodes"][parent].setdefault("children", []).append(index)
+        return index
+
+    def finish(self):
+        """The glTF, with the animation keys' buffer embedded as a data URI."""
+        blob = self.gltf.pop("_blob", None)
+        if blob is not None:
+            self.gltf["buffers"] = [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64,"
+                                     + base64.b64encode(bytes(blob)).decode()}]
+        return self.gltf
 
     def node(self, name, **fields):
         self.gltf["nodes"].append(dict(name=name, **fields))
@@ -88,6 +125,14 @@ def quat_axis_angle(axis, degrees):
     n = math.sqrt(sum(c * c for c in axis))
     return rounded([axis[0] / n * math.sin(half), axis[1] / n * math.sin(half),
                     axis[2] / n * math.sin(half), math.cos(half)])
+
+
+def quat_multiply(a, b):
+    """The Hamilton product a b (x, y, z, w): b's rotation, then a's."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz]
 
 
 def look_rotation(eye, target):
@@ -276,10 +321,39 @@ def build_focus():
     return b.gltf
 
 
+def build_motion():
+    b = Builder("motion")
+    floor = b.material("floor", (0.6, 0.6, 0.62), 0.0, 0.8)
+    blade = b.material("blade", (0.85, 0.25, 0.1), 0.0, 0.4)
+    hub = b.material("hub", (0.2, 0.2, 0.22), 1.0, 0.3)
+    ball = b.material("ball", (0.1, 0.4, 0.9), 0.0, 0.25)
+    b.shape("floor", {"type": "plane", "size": [30, 30]}, floor)
+    # A fan turning twice a second about its axis (its local +Y, turned to face the camera), keyed
+    # every 90 degrees; three blades, children of its hub, follow it.
+    fan = b.shape("fan hub", {"type": "sphere", "radius": 0.2}, hub,
+                  translation=[-1.2, 1.6, 0.0], rotation=quat_axis_angle((1, 0, 0), 90))
+    for k in range(3):
+        arm = b.child(fan, "blade arm %d" % k, rotation=quat_axis_angle((0, 1, 0), 120 * k))
+        b.child(arm, "blade %d" % k, translation=[0.0, 0.0, 0.6],
+                extensions={"PENUMBRA_shapes": {"type": "box", "size": [0.22, 0.05, 1.1], "material": blade}})
+    times = [0.125 * k for k in range(17)]
+    b.animate(fan, "rotation", times, [rounded(quat_multiply(quat_axis_angle((1, 0, 0), 90),
+                                                             quat_axis_angle((0, 1, 0), 90 * k)))
+                                       for k in range(17)])
+    # A ball flying across at 12 units per second.
+    flight = b.shape("ball", {"type": "sphere", "radius": 0.35}, ball, translation=[-12.0, 0.6, 0.8])
+    b.animate(flight, "translation", [0.0, 2.0], [(-12.0, 0.6, 0.8), (12.0, 0.6, 0.8)])
+    b.point_light("key", [1.0, 0.92, 0.85], 60.0, [-2.0, 5.0, 4.0])
+    b.point_light("fill", [0.7, 0.8, 1.0], 25.0, [3.0, 3.0, 3.0])
+    b.camera("motion camera", [0.0, 1.6, 6.0], [0.0, 1.0, 0.0], 0.6)
+    return b.finish()
+
+
 def main():
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres),
-                        ("procedural.gltf", build_procedural), ("focus.gltf", build_focus)]:
+                        ("procedural.gltf", build_procedural), ("focus.gltf", build_focus),
+                        ("motion.gltf", build_motion)]:
         path = os.path.join(out_dir, name)
         with open(path, "w") as f:
             json.dump(build(), f, indent=1)

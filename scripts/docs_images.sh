@@ -45,6 +45,8 @@ render focus-near scenes/focus.gltf --width 320 --integrator path --spp 48 --ape
   --aperture-blades 6 --focus-distance 3.2
 render focus-far scenes/focus.gltf --width 320 --integrator path --spp 48 --aperture-radius 0.08 \
   --aperture-blades 6 --focus-distance 13
+# Motion blur: the fan and the ball of scenes/motion.gltf at t = 1 s (cameras).
+render motion-blur scenes/motion.gltf --width 400 --integrator path --spp 32 --time 1 --motion-blur
 
 # Traversal-cost heat maps of two structures on the default scene (benchmarking).
 for accel in bvh grid; do

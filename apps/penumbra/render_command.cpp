@@ -23,6 +23,7 @@
 #include "io/files/hash.h"
 #include "io/image/contact_sheet.h"
 #include "io/image/environment_io.h"
+#include "render/motion.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
@@ -153,8 +154,10 @@ void load_phase(RenderJob& job, std::optional<KeptScene>& kept, bool keep) {
   } else {
     announce(job.progress, "loading " + a.scene_file);
     const bool json = job.progress == ProgressMode::Json;
-    job.loaded = load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget,
-                            a.quiet || json, job.request.time, keep, a.variant);
+    // Motion blur poses the scene over the shutter: it keeps the file's animation.
+    job.loaded =
+        load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, job.request.budget, a.quiet || json,
+                   job.request.time, keep || job.request.spec.motion_blur, a.variant);
     if (json && !a.quiet) print_json_warnings(a.scene_file, job.loaded.warnings);
   }
   job.load_s = posed_s + seconds_since(t0);
@@ -188,6 +191,7 @@ void setup_phase(RenderJob& job) {
   o.place = [&](const Scene& sc, int index, int w, int h) { return choose_camera(q.rig, sc, index, w, h); };
   o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
   o.identity = scene_identity(a, q, job.scene_sha256);
+  o.identity.shutter = set_scene_motion(job.loaded, spec, q.time.value_or(0), a.scene_file);
   job.prepared = prepare_render(job.loaded, spec, o);
   if (a.quiet) return;
   if (job.progress == ProgressMode::Json)

@@ -13,7 +13,7 @@ SceneIdentity scene_identity(const RenderArgs& a, const RenderRequest&, const st
   s.variant = a.variant;
   const bool frame_is_time = a.frame && a.cam.turntable.empty();  // a turntable's frame turns the camera
   s.time = a.time ? exact(*a.time)
-                  : (frame_is_time ? "frame " + *a.frame + " at " + exact(a.fps) + " fps" : "static");
+                  : (frame_is_time ? "frame " + *a.frame + " at " + exact(a.spec.fps) + " fps" : "static");
   s.camera = a.camera;
   return s;
 }

@@ -241,6 +241,10 @@ void add_spec_options(CLI::App& render, RenderSpec& spec) {
     std::visit(
         [&](auto member) {
           using T = std::remove_cvref_t<decltype(spec.*member)>;
+          if constexpr (std::is_same_v<T, bool>) {
+            render.add_flag(flag_name(f), spec.*member, f.help);
+            return;
+          }
           CLI::Option* o = render.add_option(flag_name(f), spec.*member, f.help);
           if constexpr (std::is_integral_v<T>) {
             if (f.lo != 0 || f.hi != 0) o->check(CLI::Range(T(f.lo), T(f.hi)));
@@ -317,7 +321,6 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
                   "render frames A to B inclusive (A-B, A-B:STEP or N), each at time N / --fps; every "
                   "output path needs a run of '#' for the frame number (#### -> 0012)")
       ->excludes(frame_opt);
-  render.add_option("--fps", args.fps, "frames per second for --frame and --frames (default 24)");
   render.add_option("--contact-sheet", args.contact_sheet,
                     "after --frames or --turntable, tile every frame's display image in order into this "
                     "image (.png, .jpg, .tif), left to right and top to bottom");
@@ -403,17 +406,19 @@ RenderRequest check_render_args(const RenderArgs& a) {
   check_output_collisions(a, q);
   q.time = a.time;
   if (q.time && !std::isfinite(*q.time)) throw UsageError("--time must be a finite number of seconds");
-  if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
+  if (!(std::isfinite(a.spec.fps) && a.spec.fps > 0)) throw UsageError("--fps must be a finite number > 0");
   if (a.time && (a.frame || a.frames) && a.cam.turntable.empty())
     throw UsageError(
         "--time excludes --frame and --frames (which set the time), except with --turntable, whose "
         "frames turn the camera");
   const long long frame = a.frame ? parse_integer(*a.frame, -(1ll << 40), 1ll << 40, "--frame") : 0;
   // A turntable's frames turn the camera; the scene stays at --time or its static pose.
-  if (a.frame && a.cam.turntable.empty()) q.time = double(frame) / a.fps;
+  if (a.frame && a.cam.turntable.empty()) q.time = double(frame) / a.spec.fps;
   q.rig = check_camera_args(a.cam, frame);
   q.budget = memory_budget(a.max_memory);
   q.spec = render_spec(a, q);
+  // Motion blur poses the animation around a frame: frame 0 unless a time or frame is given.
+  if (q.spec.motion_blur && !q.time) q.time = 0.0;
   return q;
 }
 

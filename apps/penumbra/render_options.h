@@ -48,14 +48,13 @@ struct RenderArgs {
   std::optional<double> time;         ///< --time, seconds
   std::optional<std::string> frame;   ///< --frame, an integer, converted with --fps
   std::optional<std::string> frames;  ///< --frames A-B[:STEP] or N, each frame as --frame
-  double fps = 24;
-  bool skip_existing = false;     ///< keep a frame whose -o is already a complete EXR
-  bool overwrite = false;         ///< the default, accepted explicitly
-  bool reproducible = false;      ///< no command line or timing in the EXR: equal renders, equal files
-  std::string progress = "auto";  ///< --progress: auto, text, json or none (see progress.h)
-  std::string contact_sheet;      ///< --contact-sheet: the frames' display images tiled into one
-  int contact_sheet_columns = 0;  ///< 0: as many as keep the sheet no taller than wide
-  CameraArgs cam;                 ///< --look-at, --orbit, --turntable, --fov, ... (camera_options.h)
+  bool skip_existing = false;         ///< keep a frame whose -o is already a complete EXR
+  bool overwrite = false;             ///< the default, accepted explicitly
+  bool reproducible = false;          ///< no command line or timing in the EXR: equal renders, equal files
+  std::string progress = "auto";      ///< --progress: auto, text, json or none (see progress.h)
+  std::string contact_sheet;          ///< --contact-sheet: the frames' display images tiled into one
+  int contact_sheet_columns = 0;      ///< 0: as many as keep the sheet no taller than wide
+  CameraArgs cam;                     ///< --look-at, --orbit, --turntable, --fov, ... (camera_options.h)
 };
 
 /// Declares every flag of `render` on `render`, bound to `args`.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "renderer/core/geometry.h"
+#include "renderer/core/motion.h"
 #include "renderer/shapes/shape.h"
 
 namespace penumbra {
@@ -36,6 +37,10 @@ struct GeometryView {
 struct InstanceView {
   uint32_t mesh = 0;  ///< index into the geometry span given to the builder
   Affine3f to_world;
+  /// Motion blur: the map's keys over the shutter (interpolate_motion at Ray::time), used
+  /// instead of to_world; empty for an instance that does not move. A moving instance is always
+  /// placed under the top level, its box bounding every time (motion_bounds).
+  std::span<const MotionKey> motion;
 };
 
 /// How a build over instances treats one: in world space (the identity map), never hit (a
@@ -44,8 +49,13 @@ struct InstanceView {
 enum class InstanceKind : uint8_t { Identity, Singular, Placed };
 
 inline InstanceKind instance_kind(const InstanceView& inst) {
-  if (is_identity(inst.to_world)) return InstanceKind::Identity;
   Affine3f to_object;
+  if (!inst.motion.empty()) {
+    for (const MotionKey& k : inst.motion)
+      if (!inverse(compose_motion(k), to_object)) return InstanceKind::Singular;
+    return InstanceKind::Placed;
+  }
+  if (is_identity(inst.to_world)) return InstanceKind::Identity;
   return inverse(inst.to_world, to_object) ? InstanceKind::Placed : InstanceKind::Singular;
 }
 

@@ -231,8 +231,9 @@ class EmbreeAccelerator final : public Accelerator {
       const GeometryView& mesh = meshes[inst.mesh];
       const unsigned id = unsigned(i);
       m_layout.add(inst);
+      const InstanceKind kind = m_layout.kinds.back();
       Affine3f inverse_map;
-      if (is_identity(inst.to_world)) {
+      if (kind == InstanceKind::Identity) {
         if (world == m_scene) {
           attach_geometry(m_scene, mesh, id);
         } else {
@@ -241,11 +242,11 @@ class EmbreeAccelerator final : public Accelerator {
         }
         continue;
       }
-      if (!inverse(inst.to_world, inverse_map)) {  // singular: an empty mesh keeps the id
+      if (kind == InstanceKind::Singular) {  // an empty mesh keeps the id
         attach_triangles(m_scene, GeometryView{}, id);
         continue;
       }
-      note_inverse(inverse_map);
+      note_inverses(inst);
       RTCScene& object = objects[inst.mesh];
       if (!object) {
         object = new_scene();
@@ -254,7 +255,7 @@ class EmbreeAccelerator final : public Accelerator {
         rtcCommitScene(object);
         throw_if_error("building an instanced mesh (rtcCommitScene)");
       }
-      attach_instance(object, inst.to_world, id);
+      attach_instance(object, inst.to_world, id, inst.motion);
       ++m_instances;
     }
     if (world != m_scene) {
@@ -309,17 +310,14 @@ class EmbreeAccelerator final : public Accelerator {
     for (size_t i = 0; i < instances.size(); ++i) {
       if (m_layout.kinds[i] != InstanceKind::Placed) continue;
       RTCGeometry geom = rtcGetGeometry(m_scene, unsigned(i));
-      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &instances[i].to_world.m[0][0]);
+      set_instance_motion(geom, instances[i].to_world, instances[i].motion);
       rtcCommitGeometry(geom);
     }
     throw_if_error("moving the instances");
     m_inverse_scale = 1;
     m_inverse_offset = 0;
-    for (size_t i = 0; i < instances.size(); ++i) {
-      Affine3f inverse_map;
-      if (m_layout.kinds[i] == InstanceKind::Placed && inverse(instances[i].to_world, inverse_map))
-        note_inverse(inverse_map);
-    }
+    for (size_t i = 0; i < instances.size(); ++i)
+      if (m_layout.kinds[i] == InstanceKind::Placed) note_inverses(instances[i]);
     rtcCommitScene(m_scene);
     throw_if_error("rebuilding the top level (rtcCommitScene)");
     read_bounds();
@@ -417,16 +415,59 @@ class EmbreeAccelerator final : public Accelerator {
     return r.tfar < 0;  // Embree sets tfar = -inf on occlusion
   }
 
-  /// An Embree instance of `object` placed by `to_world`, attached to the top scene as `id`.
-  void attach_instance(RTCScene object, const Affine3f& to_world, unsigned id) {
+  /// An Embree instance of `object` placed by `to_world`, attached to the top scene as `id`; a
+  /// moving one (`motion` not empty) gets one time step per key, each as Embree's quaternion
+  /// decomposition (which Embree slerps between steps as interpolate_motion does).
+  void attach_instance(RTCScene object, const Affine3f& to_world, unsigned id,
+                       std::span<const MotionKey> motion = {}) {
     RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(geom, object);
-    rtcSetGeometryTimeStepCount(geom, 1);
-    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &to_world.m[0][0]);
+    set_instance_motion(geom, to_world, motion);
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(m_scene, geom, id);
     rtcReleaseGeometry(geom);
     throw_if_error("attaching an instance");
+  }
+
+  /// The instance geometry's transform: one step, or one quaternion decomposition per key.
+  static void set_instance_motion(RTCGeometry geom, const Affine3f& to_world,
+                                  std::span<const MotionKey> motion) {
+    if (motion.empty()) {
+      rtcSetGeometryTimeStepCount(geom, 1);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &to_world.m[0][0]);
+      return;
+    }
+    rtcSetGeometryTimeStepCount(geom, unsigned(motion.size()));
+    for (size_t k = 0; k < motion.size(); ++k) {
+      const MotionKey& key = motion[k];
+      RTCQuaternionDecomposition q;
+      rtcInitQuaternionDecomposition(&q);
+      q.scale_x = key.u[0];
+      q.skew_xy = key.u[1];
+      q.skew_xz = key.u[2];
+      q.scale_y = key.u[3];
+      q.skew_yz = key.u[4];
+      q.scale_z = key.u[5];
+      q.translation_x = key.translation.x;
+      q.translation_y = key.translation.y;
+      q.translation_z = key.translation.z;
+      q.quaternion_r = float(key.rotation.w);
+      q.quaternion_i = float(key.rotation.x);
+      q.quaternion_j = float(key.rotation.y);
+      q.quaternion_k = float(key.rotation.z);
+      rtcSetGeometryTransformQuaternion(geom, unsigned(k), &q);
+    }
+  }
+
+  /// note_inverse() of the instance's map, or of every key's map for a moving instance.
+  void note_inverses(const InstanceView& inst) {
+    Affine3f inverse_map;
+    if (inst.motion.empty()) {
+      if (inverse(inst.to_world, inverse_map)) note_inverse(inverse_map);
+      return;
+    }
+    for (const MotionKey& k : inst.motion)
+      if (inverse(compose_motion(k), inverse_map)) note_inverse(inverse_map);
   }
 
   /// m_bounds from the committed top scene (empty without triangles or shapes).
@@ -531,7 +572,7 @@ class EmbreeAccelerator final : public Accelerator {
     r.dir_x = in.dir.x;
     r.dir_y = in.dir.y;
     r.dir_z = in.dir.z;
-    r.time = 0;
+    r.time = in.time;
     r.tfar = in.tfar;
     r.mask = 0xffffffffu;
     r.id = 0;

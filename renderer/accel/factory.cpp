@@ -41,7 +41,7 @@ namespace {
 
 bool all_identity(std::span<const InstanceView> instances) {
   return std::all_of(instances.begin(), instances.end(),
-                     [](const InstanceView& i) { return is_identity(i.to_world); });
+                     [](const InstanceView& i) { return i.motion.empty() && is_identity(i.to_world); });
 }
 
 /// The views of a flattened scene: each instance's mesh, in instance order.

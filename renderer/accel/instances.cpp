@@ -25,13 +25,17 @@ class TwoLevelAccelerator final : public Accelerator {
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
       m_layout.add(inst);
-      if (is_identity(inst.to_world)) {
+      const InstanceKind kind = m_layout.kinds.back();
+      if (kind == InstanceKind::Identity) {
         world.push_back(meshes[inst.mesh]);
         m_world_ids.push_back(uint32_t(i));
         continue;
       }
+      if (kind == InstanceKind::Singular) continue;  // never hit
       Affine3f to_object;
-      if (!inverse(inst.to_world, to_object)) continue;  // singular: never hit
+      inverse(inst.to_world, to_object);
+      const uint32_t motion = inst.motion.empty() ? kStill : uint32_t(m_motion.size());
+      if (!inst.motion.empty()) m_motion.emplace_back(inst.motion.begin(), inst.motion.end());
       if (const Shape* shape = meshes[inst.mesh].shape) {
         // A placed shape is tested directly in the top level's leaf: a bottom-level structure
         // over its one primitive would only add a traversal.
@@ -44,7 +48,7 @@ class TwoLevelAccelerator final : public Accelerator {
         const Bounds3f b = shape_bounds(*shape);
         if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) continue;  // never hit
         m_items.push_back(
-            {kShapeLevel, uint32_t(i), to_object, transform_bounds(inst.to_world, b), uint32_t(copy)});
+            {kShapeLevel, uint32_t(i), to_object, world_box(inst, motion, b), uint32_t(copy), motion});
         ++m_instances;
         continue;
       }
@@ -55,7 +59,7 @@ class TwoLevelAccelerator final : public Accelerator {
         m_level_mesh.push_back(inst.mesh);
       }
       m_items.push_back({uint32_t(object), uint32_t(i), to_object,
-                         transform_bounds(inst.to_world, m_levels[size_t(object)]->bounds())});
+                         world_box(inst, motion, m_levels[size_t(object)]->bounds()), 0, motion});
       ++m_instances;
     }
     if (!world.empty() || m_levels.empty()) {  // an empty world level still names the back end
@@ -109,11 +113,17 @@ class TwoLevelAccelerator final : public Accelerator {
     const BuildTimer timer;
     for (Item& item : m_items) {
       if (item.instance == kWorld) continue;
-      const Affine3f& to_world = instances[item.instance].to_world;
-      inverse(to_world, item.to_object);
+      const InstanceView& inst = instances[item.instance];
+      if ((item.motion == kStill) != inst.motion.empty()) return false;  // checked before any change
+    }
+    for (Item& item : m_items) {
+      if (item.instance == kWorld) continue;
+      const InstanceView& inst = instances[item.instance];
+      inverse(inst.to_world, item.to_object);
+      if (item.motion != kStill) m_motion[item.motion].assign(inst.motion.begin(), inst.motion.end());
       const Bounds3f object =
           item.level == kShapeLevel ? shape_bounds(m_shapes[item.shape]) : m_levels[item.level]->bounds();
-      item.box = transform_bounds(to_world, object);
+      item.box = world_box(inst, item.motion, object);
     }
     std::sort(m_items.begin(), m_items.end(),
               [](const Item& a, const Item& b) { return a.instance < b.instance; });
@@ -186,14 +196,22 @@ class TwoLevelAccelerator final : public Accelerator {
  private:
   static constexpr uint32_t kWorld = 0xffffffffu;       // Item::instance of the world-space level
   static constexpr uint32_t kShapeLevel = 0xffffffffu;  // Item::level of a placed shape
+  static constexpr uint32_t kStill = 0xffffffffu;       // Item::motion of an item that stays put
 
   struct Item {
     uint32_t level;     // index into m_levels, or kShapeLevel
     uint32_t instance;  // the instance index reported in hits, or kWorld
     Affine3f to_object;
-    Bounds3f box;        // world bounds
-    uint32_t shape = 0;  // index into m_shapes when level == kShapeLevel
+    Bounds3f box;              // world bounds (over the shutter for a moving item)
+    uint32_t shape = 0;        // index into m_shapes when level == kShapeLevel
+    uint32_t motion = kStill;  // index into m_motion: the item's keys
   };
+
+  /// The world box of object-space box `b` under the instance's map, or every map its motion
+  /// takes.
+  Bounds3f world_box(const InstanceView& inst, uint32_t motion, const Bounds3f& b) const {
+    return motion == kStill ? transform_bounds(inst.to_world, b) : motion_bounds(m_motion[motion], b);
+  }
 
   /// The caller's filter as a bottom level must apply it: to the world ray, with the bottom
   /// level's geom_id replaced by the instance index (Hit's geom_id over instances).
@@ -267,7 +285,12 @@ class TwoLevelAccelerator final : public Accelerator {
             const Item& item = m_items[i];
             Ray local = ray;
             local.tfar = best;
-            if (item.instance != kWorld) {
+            if (item.motion != kStill) {
+              Affine3f to_object;
+              if (!inverse(interpolate_motion(m_motion[item.motion], ray.time), to_object)) continue;
+              local.org = apply_point(to_object, ray.org);
+              local.dir = apply_vector(to_object, ray.dir);
+            } else if (item.instance != kWorld) {
               local.org = apply_point(item.to_object, ray.org);
               local.dir = apply_vector(item.to_object, ray.dir);
             }
@@ -316,6 +339,7 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<uint32_t> m_level_mesh;                  // each bottom level's mesh, or kWorld
   std::vector<uint32_t> m_shape_mesh;                  // each placed shape's mesh (view)
   std::vector<Item> m_items;                           // in top-level leaf order
+  std::vector<std::vector<MotionKey>> m_motion;        // the moving items' keys
   std::vector<BvhNode> m_nodes;                        // top level, depth first
   std::vector<AccelStats> m_stats_bottom;
   InstanceLayout m_layout;  // every instance's mesh and kind, as built

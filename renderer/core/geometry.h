@@ -13,6 +13,8 @@ struct Ray {
   float tnear = 0;
   Vec3f dir;
   float tfar = kInfinity;
+  float time = 0.5f;  ///< when within the shutter, 0 (open) to 1 (close); moving geometry is
+                      ///< where it is then. Rays spawned from a hit keep their parent's time.
 };
 
 /// Closest-hit record shared by every accelerator. On a miss geom_id == kInvalidId and the

@@ -224,6 +224,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     seg.ray = Ray{};
     seg.ray.org = spawn_origin(si, wi);
     seg.ray.dir = wi;
+    seg.ray.time = si.time;
     ++counts.reflection;
   }
   return path.radiance;

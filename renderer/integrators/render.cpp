@@ -32,23 +32,28 @@ Vec2f whitted_position(const RenderConfig& config, int x, int y, uint32_t s) {
   return filtered_position(config, x, y, j);
 }
 
-// The aperture point of Whitted's sample s of pixel (x, y): its own Sobol stream, apart from
-// the stratified position's.
-Vec2f whitted_aperture(const Camera& camera, const RenderConfig& config, int x, int y, uint32_t s) {
-  if (!(camera.lens.radius > 0)) return {0, 0};
-  constexpr uint64_t kApertureSeed = 0xa9e7'0e5a'11e5'0f0cull;
+// Whitted's sample s of pixel (x, y): the stratified position, then the aperture point and the
+// time from a Sobol stream of their own.
+CameraSample whitted_camera_sample(const Camera& camera, const RenderConfig& config, int x, int y,
+                                   uint32_t s) {
+  CameraSample cs{whitted_position(config, x, y, s)};
+  if (!(camera.lens.radius > 0) && !config.motion_blur) return cs;
+  constexpr uint64_t kLensTimeSeed = 0xa9e7'0e5a'11e5'0f0cull;
   SampleStream st =
-      make_sample_stream(SamplerType::Sobol, uint32_t(x), uint32_t(y), s, config.seed ^ kApertureSeed);
-  return sample_aperture(camera.lens, st.get2d());
+      make_sample_stream(SamplerType::Sobol, uint32_t(x), uint32_t(y), s, config.seed ^ kLensTimeSeed);
+  if (camera.lens.radius > 0) cs.aperture = sample_aperture(camera.lens, st.get2d());
+  if (config.motion_blur) cs.time = st.get1d();
+  return cs;
 }
 
 // The camera sample a path stream begins with: its first request places it on the film, its
-// second (with a lens only) on the aperture.
+// second (with a lens only) on the aperture, the next (with motion blur only) in the shutter.
 CameraSample take_path_camera_sample(const Camera& camera, const RenderConfig& config, int x, int y,
                                      SampleStream& st) {
   CameraSample cs;
   cs.film = filtered_position(config, x, y, st.get2d());
   if (camera.lens.radius > 0) cs.aperture = sample_aperture(camera.lens, st.get2d());
+  if (config.motion_blur) cs.time = st.get1d();
   return cs;
 }
 
@@ -58,6 +63,7 @@ Ray camera_ray(const Camera& camera, const RenderConfig& config, const CameraSam
   Ray r[3];
   generate_camera_rays(camera, config.width, config.height, cs.film.x, cs.film.y, step, r, cs.aperture);
   rd = RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir};
+  r[0].time = cs.time;
   return r[0];
 }
 
@@ -101,9 +107,8 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
 
 CameraSample camera_sample(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
                            int y, uint32_t s) {
-  if (integrator == IntegratorType::Raster) return {whitted_position(config, x, y, s), {0, 0}};
-  if (integrator == IntegratorType::Whitted)
-    return {whitted_position(config, x, y, s), whitted_aperture(camera, config, x, y, s)};
+  if (integrator == IntegratorType::Raster) return {whitted_position(config, x, y, s)};
+  if (integrator == IntegratorType::Whitted) return whitted_camera_sample(camera, config, x, y, s);
   SampleStream st = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
   return take_path_camera_sample(camera, config, x, y, st);
 }
@@ -112,7 +117,9 @@ Ray camera_sample_ray(const Camera& camera, const RenderConfig& config, Integrat
                       int y, uint32_t s) {
   const CameraSample cs = camera_sample(camera, config, integrator, x, y, s);
   const CameraRaster raster = camera_raster(camera, config.width, config.height);
-  return thin_lens_ray(camera, raster_ray(camera, raster, cs.film.x, cs.film.y), cs.aperture);
+  Ray ray = thin_lens_ray(camera, raster_ray(camera, raster, cs.film.x, cs.film.y), cs.aperture);
+  ray.time = cs.time;
+  return ray;
 }
 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
@@ -122,7 +129,7 @@ void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Ca
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
-    const CameraSample cs{whitted_position(config, x, y, s), whitted_aperture(camera, config, x, y, s)};
+    const CameraSample cs = whitted_camera_sample(camera, config, x, y, s);
     RayDifferential rd;
     const Ray ray = camera_ray(camera, config, cs, step, rd);
     float coverage = 0;
@@ -214,8 +221,8 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
     const Footprint fp{camera, raster, take_path_camera_sample(camera, config, x, y, samples), step};
-    const Ray ray =
-        thin_lens_ray(camera, raster_ray(camera, raster, fp.cs.film.x, fp.cs.film.y), fp.cs.aperture);
+    Ray ray = thin_lens_ray(camera, raster_ray(camera, raster, fp.cs.film.x, fp.cs.film.y), fp.cs.aperture);
+    ray.time = fp.cs.time;
     float coverage = 0;
     LightGroups lg;
     const Vec3f l = path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples,

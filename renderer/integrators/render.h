@@ -114,12 +114,14 @@ Vec2f camera_sample_position(const RenderConfig& config, IntegratorType integrat
 struct CameraSample {
   Vec2f film;
   Vec2f aperture{0, 0};
+  float time = 0.5f;  ///< in the shutter (Ray::time); the middle without motion blur
 };
 
 /// Camera sample `s` of pixel (x, y) exactly as `integrator` takes it: the position of
 /// camera_sample_position and, through a thin lens with a radius, the aperture point (the path
-/// stream's second request; Whitted's own Sobol stream). The raster integrator renders through
-/// a pinhole: its aperture point is always {0, 0}.
+/// stream's second request; Whitted's own Sobol stream), and with config.motion_blur the time
+/// (the path stream's next request; the next of Whitted's own stream). The raster integrator
+/// renders through a pinhole at the middle of the shutter.
 CameraSample camera_sample(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
                            int y, uint32_t s);
 

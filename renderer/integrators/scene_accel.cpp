@@ -14,9 +14,11 @@ std::vector<GeometryView> mesh_views(const Scene& scene) {
 std::vector<InstanceView> instance_views(const Scene& scene) {
   std::vector<InstanceView> views;
   views.reserve(scene.instances.size());
-  for (const Instance& inst : scene.instances) {
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
     const size_t geometry = inst.shape >= 0 ? scene.meshes.size() + size_t(inst.shape) : size_t(inst.mesh);
     views.push_back({uint32_t(geometry), inst.to_world});
+    if (i < scene.instance_motion.size()) views.back().motion = scene.instance_motion[i];
   }
   return views;
 }

@@ -92,6 +92,7 @@ Ray shadow_ray(const SurfaceInteraction& si, Vec3f wi, float distance) {
   Ray r;
   r.org = spawn_origin(si, wi);
   r.dir = wi;
+  r.time = si.time;
   r.tnear = 0;
   r.tfar = std::isfinite(distance) ? distance * (1 - 1e-4f) : kInfinity;
   return r;

@@ -147,6 +147,7 @@ struct Tracer {
       Ray refl;
       refl.org = spawn_origin(si, r);
       refl.dir = r;
+      refl.time = ray.time;
       ++counts.reflection;
       radiance += w.kr * trace(refl, reflect_differential(si, rd, v, n, r), depth + 1, 0, rweight, nullptr);
     }
@@ -167,6 +168,7 @@ struct Tracer {
     Ray next;
     next.org = spawn_origin(si, dir);
     next.dir = dir;
+    next.time = ray.time;
     ++counts.reflection;
     return w.kt * trace(next, rd, depth + 1, 0, tweight, nullptr);
   }

@@ -39,6 +39,7 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   SurfaceInteraction si;
   si.instance = hit.geom_id;
+  si.time = ray.time;
   si.shape = inst.shape;
   si.material = ss.material;
   float world_tol = 0;
@@ -67,7 +68,8 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
 }
 
 void shape_differentials(const Scene& scene, SurfaceInteraction& si) {
-  const Instance& inst = scene.instances[si.instance];
+  Instance posed;
+  const Instance& inst = instance_at(scene, si.instance, si.time, posed);
   const Shape& shape = scene.shapes[size_t(si.shape)].shape;
   const auto to_obj = [&](Vec3f q) { return inst.identity ? q : apply_point(inst.to_object, q); };
   const Vec3f p = to_obj(si.p);
@@ -87,7 +89,8 @@ Vec3f spawn_origin(const SurfaceInteraction& si, Vec3f dir) {
 }
 
 Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
-  const Instance& inst = scene.instances[hit.geom_id];
+  Instance posed;
+  const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
   if (inst.shape < 0) return world_triangle(scene, inst, hit.prim_id).ng;
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   float world_tol = 0;
@@ -97,20 +100,23 @@ Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
 }
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit) {
-  const Instance& inst = scene.instances[hit.geom_id];
+  Instance posed;
+  const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
   if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
   return make_interaction(scene, ray, hit, world_triangle(scene, inst, hit.prim_id));
 }
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit,
                                     const WorldTriangle& tri) {
-  const Instance& inst = scene.instances[hit.geom_id];
+  Instance posed;
+  const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
   if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const float w = 1.0f - hit.u - hit.v;
   SurfaceInteraction si;
   si.instance = hit.geom_id;
+  si.time = ray.time;
   si.mesh = uint32_t(inst.mesh);
   si.prim = hit.prim_id;
   si.tri = tri;
@@ -189,7 +195,8 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
 
 namespace {
 void barycentric_derivatives(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by) {
-  const Instance& inst = scene.instances[si.instance];
+  Instance posed;
+  const Instance& inst = instance_at(scene, si.instance, si.time, posed);
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
   const WorldTriangle& tri = si.tri;
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];

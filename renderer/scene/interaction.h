@@ -29,6 +29,7 @@ struct SurfaceInteraction {
   int shape = -1;          ///< index into Scene::shapes for a shape hit (mesh and prim are then 0)
   bool back_face = false;  ///< true if the ray hit the triangle's back (clockwise) side, or a
                            ///< shape from inside (flat shapes: from -Y)
+  float time = 0.5f;       ///< the ray's time (Ray::time): rays spawned here keep it
   float spawn_offset = 0;  ///< extra world distance along ng that spawned rays keep from the
                            ///< surface: the implicit shapes' hit tolerance, 0 otherwise
   // Screen-space derivatives, zero unless compute_differentials() found a footprint.

@@ -24,6 +24,15 @@ Instance placed(Instance inst, const Affine3f& to_world, int node, const std::st
 
 }  // namespace
 
+const Instance& instance_at(const Scene& scene, uint32_t index, float time, Instance& storage) {
+  const Instance& inst = scene.instances[index];
+  if (index >= scene.instance_motion.size() || scene.instance_motion[index].empty()) return inst;
+  storage = inst;
+  storage.to_world = interpolate_motion(scene.instance_motion[index], time);
+  if (!inverse(storage.to_world, storage.to_object)) storage.to_object = inst.to_object;
+  return storage;
+}
+
 Instance make_instance(int mesh, const Affine3f& to_world, int node) {
   Instance inst;
   inst.mesh = mesh;

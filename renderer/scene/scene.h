@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "renderer/core/math.h"
+#include "renderer/core/motion.h"
 #include "renderer/procedural/pattern.h"
 #include "renderer/scene/texture.h"
 #include "renderer/shapes/shape.h"
@@ -172,12 +173,21 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<SceneShape> shapes;
   std::vector<Instance> instances;  ///< what is rendered: a mesh without an instance is not
+  /// Motion blur: empty (nothing moves), or one entry per instance: its transform's keys spaced
+  /// evenly over the shutter (Ray::time 0 to 1), empty for an instance that stays put. A moving
+  /// instance's to_world is its map at the frame's time (what the data of a still uses).
+  std::vector<std::vector<MotionKey>> instance_motion;
   std::vector<Material> materials;
   std::vector<Texture> textures;
   std::vector<ProceduralTexture> procedurals;  ///< procedural textures of materials
   std::vector<Light> lights;
   std::vector<Camera> cameras;
 };
+
+/// Instance `index` where it is at ray time `time`: the scene's own entry when it does not move,
+/// else `storage` filled with the interpolated map (interpolate_motion) and its inverse. Never
+/// allocates or throws.
+const Instance& instance_at(const Scene& scene, uint32_t index, float time, Instance& storage);
 
 /// An instance of `mesh` placed by `to_world`. Throws std::invalid_argument if the map is
 /// singular or not finite.

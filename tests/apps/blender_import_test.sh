@@ -11,7 +11,7 @@ if ! command -v blender >/dev/null; then
 fi
 rm -rf "$work"; mkdir -p "$work"
 fails=0
-for scene in csg spheres procedural; do
+for scene in csg spheres procedural focus; do
   file="$src/scenes/$scene.gltf"
   blender -b --factory-startup --python-exit-code 1 \
     --python-expr "import bpy; bpy.ops.import_scene.gltf(filepath=r'''$file''')" >"$work/$scene.log" 2>&1

@@ -205,6 +205,42 @@ expect 2 "focus_distance needs depth of field" -- "$bin" render "$sphere" --focu
 expect 2 "fstop and aperture_radius exclude" -- "$bin" render "$sphere" --fstop 2 --aperture-radius 1 -o "$work/bad.exr"
 [ ! -e "$work/bad.exr" ] && ok || fail "a refused render wrote bad.exr"
 
+# Motion blur: the shutter is in the identity (stripes of another shutter refuse to merge), job
+# files take the settings, frame ranges blur each frame, the raster preview warns, and the
+# shutter's settings need --motion-blur.
+motion="$src/scenes/motion.gltf"
+expect 0 "" -- "$bin" render "$motion" --time 1 --motion-blur --width 64 --height 36 --spp 4 -o "$work/mb.exr" --no-png -q
+oiiotool --info -v "$work/mb.exr" >"$work/mb_info.txt" 2>&1
+grep -q 'motion_blur=1' "$work/mb_info.txt" && grep -q 'scene.shutter=0.98958333333333337..1.0104166666666667' \
+  "$work/mb_info.txt" && ok || fail "the identity lacks the shutter: $(grep -o 'scene.shutter=[^;]*' "$work/mb_info.txt")"
+"$bin" render "$motion" --time 1 --width 64 --height 36 --spp 4 -o "$work/mb_still.exr" --no-png -q
+oiiotool "$work/mb.exr" "$work/mb_still.exr" --fail 0 --diff >/dev/null 2>&1 && fail "motion blur changed nothing" || ok
+for t in 0 1; do
+  "$bin" render "$motion" --time 1 --motion-blur --shutter "0.$((5 + t))" --width 40 --height 30 --spp 2 \
+    --tile "$t/2" -o "$work/mb_tile$t.exr" --no-png -q
+done
+expect 2 "rendered with other settings" -- "$bin" merge "$work/mb_tile0.exr" "$work/mb_tile1.exr" -o "$work/mb_merged.exr"
+cat >"$work/mb_job.json" <<EOF
+{"version": 1, "defaults": {"width": 40, "height": 30, "spp": 4},
+ "shots": [{"name": "mb", "scene": "$motion", "output": "$work/job_mb.####.exr", "frames": "24",
+            "settings": {"motion-blur": true, "shutter": 1, "motion-steps": 5}}]}
+EOF
+expect 0 "" -- "$bin" batch "$work/mb_job.json" -q --output-root "$work"
+"$bin" render "$motion" --time 1 --motion-blur --shutter 1 --motion-steps 5 --width 40 --height 30 --spp 4 \
+  -o "$work/cli_mb.exr" --no-png -q
+same_pixels "$work/job_mb.0024.exr" "$work/cli_mb.exr"
+expect 0 "" -- "$bin" render "$motion" --frames 23-24 --motion-blur --width 40 --height 30 --spp 2 \
+  -o "$work/mb_frame.####.exr" --no-png -q
+[ -e "$work/mb_frame.0023.exr" ] && [ -e "$work/mb_frame.0024.exr" ] && ok || fail "the blurred frames are missing"
+# Frame 24 of the range is the single frame 24 (the kept scene is posed and blurred anew).
+"$bin" render "$motion" --frame 24 --motion-blur --width 40 --height 30 --spp 2 -o "$work/mb_single.exr" --no-png -q
+same_pixels "$work/mb_frame.0024.exr" "$work/mb_single.exr"
+expect 0 "ignores motion blur" -- "$bin" render "$motion" --integrator raster --motion-blur --width 40 --height 30 \
+  -o "$work/mb_raster.exr" --no-png
+expect 2 "shutter needs motion_blur" -- "$bin" render "$motion" --shutter 1 -o "$work/bad.exr"
+expect 2 "motion-steps" -- "$bin" render "$motion" --motion-blur --motion-steps 1 -o "$work/bad.exr"
+[ ! -e "$work/bad.exr" ] && ok || fail "a refused render wrote bad.exr"
+
 # Bad values: exit 2 naming the flag, nothing written.
 refused() {  # PATTERN FLAGS... (the output is $out, bad.exr unless set)
   local pattern="$1"; shift

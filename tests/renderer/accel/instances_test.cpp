@@ -326,3 +326,75 @@ TEST_CASE("refit_or_rebuild: refits the BVH while its SAH cost holds, rebuilds p
   CHECK_THROWS_WITH(make_accelerator("bvh", s.views(), bad),
                     Catch::Contains("refit_max_growth must be 0 or in [1, 1000], got 0.5"));
 }
+
+TEST_CASE("instances: moving instances, every back end against the triangles placed at the ray's time",
+          "[accel][instances][motion][crosscheck]") {
+  // Spheres and planes, some moving (translation, a turn of up to 1.5 radians, scale), some
+  // still; random rays, each at its own time. The oracle places every triangle at that time
+  // (interpolate_motion) and scans them all; each back end must agree ray by ray, Embree through
+  // its own quaternion motion blur. Hits that graze an edge (a barycentric within 1e-3) may
+  // differ by rounding; no other answer may.
+  Soup s;
+  Soup sphere = icosphere(2, 1, {0, 0, 0});
+  s.add(sphere.positions[0], sphere.indices[0]);
+  s.add_plane(1, 0.0f, -1.0f, 1.0f, 4);
+  const auto meshes = s.views();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<std::vector<MotionKey>> motion;
+  std::vector<InstanceView> instances;
+  for (int i = 0; i < 12; ++i) {
+    const Vec3f at{u(rng) * 4, u(rng) * 4, u(rng) * 4};
+    instances.push_back({uint32_t(i % 2), placement(at, {0, 0, 1}, 0, {1, 1, 1})});
+    if (i % 3 == 0) continue;  // still
+    std::vector<Affine3f> maps;
+    for (int k = 0; k < 3; ++k)
+      maps.push_back(placement(at + Vec3f{u(rng), u(rng), u(rng)} * float(k),
+                               normalize(Vec3f{u(rng), u(rng), 1}), 0.75 * k * u(rng),
+                               {1 + 0.3f * u(rng), 1 + 0.3f * u(rng), 1}));
+    motion.push_back(make_motion_keys(maps));
+  }
+  for (size_t i = 0, m = 0; i < instances.size(); ++i)
+    if (i % 3 != 0) instances[i].motion = motion[m++];
+  std::vector<NamedAccel> all;
+  for (const auto& n : accelerator_names()) all.push_back({n, make_accelerator(n, meshes, instances)});
+  int rays = 0, hits = 0;
+  for (int r = 0; r < 1500; ++r) {
+    Ray ray;
+    ray.org = normalize(Vec3f{u(rng), u(rng), u(rng)}) * 12.0f;
+    ray.dir = normalize(Vec3f{u(rng) * 4, u(rng) * 4, u(rng) * 4} - ray.org);
+    ray.time = 0.5f * (u(rng) + 1);
+    // The oracle: every instance's triangles placed at the ray's time, scanned.
+    std::vector<std::vector<Vec3f>> placed;
+    std::vector<GeometryView> world;
+    for (const InstanceView& inst : instances) {
+      const Affine3f m = inst.motion.empty() ? inst.to_world : interpolate_motion(inst.motion, ray.time);
+      std::vector<Vec3f> p;
+      for (const Vec3f& v : meshes[inst.mesh].positions) p.push_back(apply_point(m, v));
+      placed.push_back(std::move(p));
+    }
+    for (size_t i = 0; i < instances.size(); ++i)
+      world.push_back({placed[i], meshes[instances[i].mesh].indices});
+    const auto oracle = make_accelerator("brute", world);
+    Hit want;
+    const bool found = oracle->intersect(ray, want);
+    ++rays;
+    hits += found;
+    const auto grazes = [](const Hit& h) { return std::min({h.u, h.v, 1 - h.u - h.v}) < 1e-3f; };
+    for (const NamedAccel& a : all) {
+      Hit got;
+      const bool f = a.accel->intersect(ray, got);
+      if (f != found) {
+        INFO(a.name << " ray " << r << " time " << ray.time);
+        CHECK(grazes(f ? got : want));
+        continue;
+      }
+      if (!found) continue;
+      INFO(a.name << " ray " << r << " time " << ray.time);
+      CHECK(got.t == Approx(want.t).epsilon(1e-4));
+      if (got.geom_id != want.geom_id || got.prim_id != want.prim_id) CHECK((grazes(got) || grazes(want)));
+      CHECK(a.accel->occluded(ray));
+    }
+  }
+  CHECK(hits > rays / 4);  // the rays meet the moving spheres and planes often
+}

@@ -1,0 +1,225 @@
+// Motion blur through the render session: a blurred streak as long as the velocity times the
+// shutter, a spinning bar whose blur follows the arc (slerp) and not the chord, and a blurred
+// render equal to the mean of still renders spread over the shutter; the shutter's settings are
+// checked and recorded in the identity. Scenes are small glTF files with node animations.
+#include "render/motion.h"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "io/files/error.h"
+#include "render/session.h"
+#include "support/gltf_writer.h"
+#include "support/test_util.h"
+
+namespace penumbra {
+namespace {
+
+/// A glTF file: an orthographic camera at z = 5 looking down -Z (half-height `ymag`) and one
+/// mesh (`xyz`, a quad's two triangles) on node 1, animated by `anim`.
+template <class Animate>
+std::filesystem::path write_scene(const std::string& name, const std::vector<float>& xyz, float ymag,
+                                  Animate&& anim) {
+  test::GltfWriter w;
+  const int mesh = w.mesh(w.positions(xyz), w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
+  w.j["cameras"] = {{{"type", "orthographic"},
+                     {"orthographic", {{"xmag", ymag}, {"ymag", ymag}, {"znear", 0.01}, {"zfar", 100}}}}};
+  w.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+  const int node = w.node({{"mesh", mesh}});
+  anim(w, node);
+  const auto dir = test::temp_dir("motion");
+  std::filesystem::create_directories(dir);
+  const auto path = dir / (name + ".gltf");
+  w.write_embedded(path);
+  return path;
+}
+
+/// The scene loaded at `time` with its animation kept, as a session.
+void load(Session& s, const std::filesystem::path& file, double time) {
+  GltfLoadOptions o;
+  o.time = time;
+  o.keep_animation = true;
+  s.file = file.string();
+  s.loaded = load_gltf(file, o);
+  s.loaded_at_time = true;
+  s.time = time;
+}
+
+RenderSpec spec_of(int size, int spp, const char* accel = "embree") {
+  return {.width = size, .height = size, .spp = spp, .accel = accel};
+}
+
+float alpha(const Film& f, int x, int y) {
+  return f.pixel(x, y)[3];
+}
+
+}  // namespace
+
+TEST_CASE("motion blur: a translating quad's streak is its velocity times the shutter", "[motion]") {
+  // A 0.1-wide quad moving along +X at 24 units per second; at frame time 1 (24 fps, shutter
+  // 0.5: 1/48 s) it sweeps x in [-0.25, 0.25]: its blur spans 0.6 units (19.2 px at 32 px per
+  // unit) with a plateau of coverage 0.1 / 0.5 = 0.2 in the middle.
+  const auto file =
+      write_scene("streak", {-0.05f, -0.05f, 0, 0.05f, -0.05f, 0, 0.05f, 0.05f, 0, -0.05f, 0.05f, 0}, 2,
+                  [](test::GltfWriter& w, int node) {
+                    w.channel(node, "translation", {0, 2}, {-24, 0, 0, 24, 0, 0}, "VEC3", 3);
+                  });
+  for (const char* accel : {"embree", "bvh"}) {
+    INFO(accel);
+    Session s;
+    load(s, file, 1.0);
+    RenderSpec spec = spec_of(128, 256, accel);
+    spec.motion_blur = true;
+    const RenderResult r = render_scene(s, spec, 0);
+    const Film& f = r.image.film;
+    int first = -1, last = -1;
+    double energy = 0;
+    for (int x = 0; x < 128; ++x) {
+      const float a = 0.5f * (alpha(f, x, 63) + alpha(f, x, 64));
+      energy += a;
+      if (a > 0.01f) last = x, first = first < 0 ? x : first;
+    }
+    CHECK(float(last + 1 - first) == Approx(19.2).margin(1.5));
+    CHECK(energy == Approx(3.2).epsilon(0.05));  // coverage is conserved: the quad's own 3.2 px
+    for (int x = 60; x < 68; ++x) CHECK(alpha(f, x, 64) == Approx(0.2).margin(0.04));
+    CHECK(r.prepared.identity.entries.at("motion_blur") == "1");
+    CHECK(r.prepared.identity.entries.at("scene.shutter").find("..") != std::string::npos);
+    // Without motion blur the quad is still, at x = 0: 3.2 px wide.
+    const RenderResult still = render_scene(s, spec_of(128, 16, accel), 0);
+    int covered = 0;
+    for (int x = 0; x < 128; ++x) covered += alpha(still.image.film, x, 64) > 0.01f;
+    CHECK(covered <= 5);
+    CHECK(still.prepared.identity.entries.count("scene.shutter") == 0);
+  }
+}
+
+TEST_CASE("motion blur: a spinning bar blurs along the arc its end draws, not the chord", "[motion]") {
+  // A bar from the origin to x = 1 turning about +Z: 0, 90 and 180 degrees at t = 0, 1, 2.
+  // Rendered at t = 1 with a shutter of one frame at 1 fps it sweeps 45..135 degrees, keyed at
+  // 45, 90 and 135 (3 steps). Slerp keeps the tip on the unit circle between keys; a blend of
+  // the matrices would pull it to radius cos(22.5 deg) = 0.92 half-way between them.
+  const float h = 0.02f;
+  const auto file =
+      write_scene("bar", {0, -h, 0, 1, -h, 0, 1, h, 0, 0, h, 0}, 1.2f, [](test::GltfWriter& w, int node) {
+        const float s = std::sqrt(0.5f);
+        w.channel(node, "rotation", {0, 1, 2}, {0, 0, 0, 1, 0, 0, s, s, 0, 0, 1, 0}, "VEC4", 4);
+      });
+  Session s;
+  load(s, file, 1.0);
+  RenderSpec spec = spec_of(128, 256, "bvh");
+  spec.motion_blur = true;
+  spec.fps = 1;
+  spec.shutter = 1;
+  const RenderResult r = render_scene(s, spec, 0);
+  const Film& f = r.image.film;
+  const float px = 128 / 2.4f;  // pixels per unit
+  double rim = 0, outside = 0;
+  int rim_pixels = 0;
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) {
+      const float wx = (float(x) + 0.5f - 64) / px, wy = (64 - float(y) - 0.5f) / px;
+      const float radius = std::hypot(wx, wy), angle = std::atan2(wy, wx) * 180 / float(kPi);
+      if (radius > 1.04f) outside += alpha(f, x, y);
+      // Half-way between the keys at 45 and 90 degrees, and between 90 and 135.
+      const bool between = std::fabs(angle - 67.5f) < 6 || std::fabs(angle - 112.5f) < 6;
+      if (between && radius > 0.95f && radius < 0.99f) rim += alpha(f, x, y), ++rim_pixels;
+    }
+  CHECK(outside == 0);
+  REQUIRE(rim_pixels > 0);
+  // The bar covers a point at radius r for (2 h / r) / (pi / 2) of the shutter: ~0.026 at 0.97.
+  CHECK(rim / rim_pixels == Approx(2 * h / 0.97 / (kPi / 2)).epsilon(0.35));
+}
+
+TEST_CASE("motion blur: a blurred render is the mean of still renders over the shutter", "[motion]") {
+  // A quad translating and turning; 16 still renders at the midpoints of 16 equal slices of
+  // the shutter against one blurred render with the same number of samples in all.
+  const auto file =
+      write_scene("average", {-0.4f, -0.3f, 0, 0.4f, -0.3f, 0, 0.4f, 0.3f, 0, -0.4f, 0.3f, 0}, 1.5f,
+                  [](test::GltfWriter& w, int node) {
+                    const float s = std::sin(0.6f), c = std::cos(0.6f);
+                    w.channel(node, "translation", {0, 2}, {-1.5f, 0, 0, 1.5f, 0.5f, 0}, "VEC3", 3);
+                    w.channel(node, "rotation", {0, 2}, {0, 0, 0, 1, 0, 0, s, c}, "VEC4", 4);
+                  });
+  for (const char* accel : {"embree", "bvh", "kdtree"}) {
+    INFO(accel);
+    Session s;
+    load(s, file, 1.0);
+    RenderSpec spec = spec_of(48, 256, accel);
+    spec.motion_blur = true;
+    spec.fps = 2;
+    spec.shutter = 1;  // t in [0.75, 1.25]
+    const Film blurred = render_scene(s, spec, 0).image.film;
+    std::vector<double> mean(blurred.rgba.size(), 0.0);
+    const int n = 16;
+    for (int i = 0; i < n; ++i) {
+      REQUIRE(pose_gltf_scene(*s.loaded.animation, 0.75 + 0.5 * (i + 0.5) / n, s.loaded.scene));
+      s.structure = Structure{};  // the placements moved: built anew
+      const Film still = render_scene(s, spec_of(48, 16, accel), 0).image.film;
+      for (size_t k = 0; k < mean.size(); ++k) mean[k] += still.rgba[k] / n;
+    }
+    REQUIRE(pose_gltf_scene(*s.loaded.animation, 1.0, s.loaded.scene));
+    s.structure = Structure{};
+    const Film frame = render_scene(s, spec_of(48, 16, accel), 0).image.film;
+    double err = 0, err_still = 0;
+    for (size_t k = 3; k < mean.size(); k += 4) {
+      err += (blurred.rgba[k] - mean[k]) * (blurred.rgba[k] - mean[k]);
+      err_still += (frame.rgba[k] - mean[k]) * (frame.rgba[k] - mean[k]);
+    }
+    const double pixels = double(mean.size() / 4);
+    const double rmse = std::sqrt(err / pixels), rmse_still = std::sqrt(err_still / pixels);
+    // Coverage noise of 256 samples is at most 0.03 per pixel; the still frame is far off.
+    CHECK(rmse < 0.02);
+    CHECK(rmse_still > 5 * rmse);
+  }
+}
+
+TEST_CASE("motion blur: the shutter's settings need motion blur and are checked", "[motion][quick]") {
+  RenderSpec s;
+  s.shutter = 0.25f;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("shutter needs motion_blur"));
+  s.motion_blur = true;
+  CHECK_NOTHROW(validate(s));
+  s.motion_steps = 1;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("motion_steps must be in [2, 64]"));
+  s.motion_steps = 3;
+  s.shutter_offset = 0.5f;
+  s.fps = 25;
+  const Shutter sh = shutter_interval(s, 2.0);
+  CHECK(sh.open == Approx(2.0 + 0.5 / 25 - 0.125 / 25));
+  CHECK(sh.close == Approx(2.0 + 0.5 / 25 + 0.125 / 25));
+}
+
+TEST_CASE("motion blur: a morph-target animation is refused by name", "[motion]") {
+  test::GltfWriter w;
+  const int base = w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int delta = w.positions({0, 0, 1, 0, 0, 1, 0, 0, 1});
+  const int node = w.node({{"mesh", w.morph_mesh(base, delta)}});
+  w.channel(node, "weights", {0, 1}, {0, 1}, "SCALAR", 1);
+  const auto dir = test::temp_dir("motion");
+  std::filesystem::create_directories(dir);
+  w.write_embedded(dir / "morph.gltf");
+  Session s;
+  load(s, dir / "morph.gltf", 0.5);
+  RenderSpec spec = spec_of(16, 1);
+  spec.motion_blur = true;
+  CHECK_THROWS_WITH(render_scene(s, spec, 0), Catch::Contains("morph.gltf") && Catch::Contains("deforms meshes"));
+}
+
+TEST_CASE("motion blur: a scene loaded without its animation is refused, a still file renders", "[motion]") {
+  const auto file = write_scene("refused", test::quad_positions(), 2, [](test::GltfWriter& w, int node) {
+    w.channel(node, "translation", {0, 1}, {0, 0, 0, 1, 0, 0}, "VEC3", 3);
+  });
+  Session s;
+  s.file = file.string();
+  s.loaded = load_gltf(file);  // the static pose, without the animation
+  RenderSpec spec = spec_of(16, 1);
+  spec.motion_blur = true;
+  CHECK_THROWS_AS(render_scene(s, spec, 0), InputError);
+  const auto still = write_scene("still", test::quad_positions(), 2, [](test::GltfWriter&, int) {});
+  Session t;
+  load(t, still, 0);
+  CHECK(render_scene(t, spec, 0).image.film.rgba.size() == 16 * 16 * 4);
+  CHECK(t.loaded.scene.instance_motion.empty());
+}
+
+}  // namespace penumbra
