@@ -39,7 +39,8 @@ case "$mode" in
     #   shipped scenes through paths the unit tests and the other scripts also take here);
     # - the two Slurm tests (they drive slurmctld, slurmd and munge around the same commands the
     #   other CLI tests run), the Blender compositor check (Penumbra's side of it runs in
-    #   cli.cryptomatte), the install and package tests (packaging, not code paths);
+    #   cli.cryptomatte), the Blender depth-of-field cross-check (Penumbra's lens is in
+    #   cli.camera and the unit tests), the install and package tests (packaging, not code paths);
     # - the Python tests (an instrumented module cannot load into Debian's uninstrumented
     #   python3), the benchmark's smoke runs and tests (measurement code), and the format and
     #   OCIO-config checks and the documentation site (the same in any build).
@@ -49,7 +50,7 @@ case "$mode" in
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
       cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests render_tests
       ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\.|layout\."
+        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|cli\.blender_dof|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\.|layout\."
     fi
     ;;
 esac
