@@ -47,7 +47,8 @@ Vec2f sample_aperture(const ThinLens& lens, Vec2f u) {
     // triangle picked by u.x and the rest of u.x reused within it.
     const float n = float(lens.blades), f = u.x * n;
     const int k = std::min(int(f), lens.blades - 1);
-    const float a0 = lens.rotation + 2 * kPi * float(k) / n, a1 = a0 + 2 * kPi / n;
+    // Corners at rotation + (k + 1/2) 360/N degrees, as Cycles places its blades.
+    const float a0 = lens.rotation + kPi / n + 2 * kPi * float(k) / n, a1 = a0 + 2 * kPi / n;
     const float s = std::sqrt(std::clamp(f - float(k), 0.0f, 1.0f));
     const float b1 = s * (1 - u.y), b2 = s * u.y;
     p = {b1 * std::cos(a0) + b2 * std::cos(a1), b1 * std::sin(a0) + b2 * std::sin(a1)};

@@ -46,7 +46,8 @@ Ray raster_ray(const Camera& cam, const CameraRaster& raster, float x, float y);
 /// A point of the camera's aperture from u in [0, 1)^2, in units of the lens radius on the lens
 /// plane's (u, v) axes: uniform over the unit disc by Shirley and Chiu's concentric map ("A
 /// Low Distortion Map Between Disk and Square", JGT 2(3), 1997), or over the regular polygon
-/// of `lens.blades` sides inscribed in it (turned by lens.rotation); then x divided by
+/// of `lens.blades` = N sides inscribed in it, its corners at lens.rotation + (k + 1/2) 2 pi / N
+/// (Cycles' blade convention); then x divided by
 /// lens.ratio (an anamorphic aperture, taller than wide for a ratio > 1, as Cycles' ratio).
 Vec2f sample_aperture(const ThinLens& lens, Vec2f u);
 

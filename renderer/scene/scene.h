@@ -149,7 +149,8 @@ struct ThinLens {
   float radius = 0;          ///< aperture radius in scene units (metres for glTF); 0: pinhole
   float focus_distance = 1;  ///< depth along -w of the plane in focus, > 0
   int blades = 0;            ///< 0: a circular aperture; >= 3: a regular polygon of that many sides
-  float rotation = 0;        ///< the polygon's turn about the view axis, radians
+  float rotation = 0;        ///< the polygon's turn about the view axis, radians: its corners lie at
+                             ///< rotation + (k + 1/2) 2 pi / blades, as Cycles' blades
   float ratio = 1;           ///< anamorphic squeeze: the aperture's height / width (1: round bokeh)
 };
 

@@ -18,8 +18,8 @@
 #   ray D, a depth along the view axis, as --focus-distance;
 # - the anamorphic ratio: Cycles multiplies the aperture sample's x by 1 / aperture_ratio,
 #   Penumbra divides it by --aperture-ratio (both: A times as tall as wide);
-# - the blades: Cycles' polygon has its corners at aperture_rotation + 180/N + k 360/N degrees,
-#   Penumbra's at --aperture-rotation + k 360/N: Cycles' aperture_rotation is Penumbra's - 180/N;
+# - the blades: both put the polygon's corners at the rotation + 180/N + k 360/N degrees, so
+#   Cycles' aperture_rotation is --aperture-rotation;
 # - the pixel filter: a 1-pixel box in both, so that coverage differs only through the lens.
 #
 # Tolerance. Both renderers are unbiased estimators of the same coverage, so the RMS of
@@ -29,8 +29,8 @@
 # RMS(C1 - C2)^2) / 2), from the round aperture (the three-bladed pair, blurred as much, is held
 # to the same bound). A match must be within 1.3 x noise: room for the spread of the measured
 # RMS values themselves (thousands of blurred edge pixels: a few per cent), while a systematic
-# difference as large as 0.83 x the noise fails (so does the three-bladed aperture with Cycles'
-# rotation taken as Penumbra's, 60 degrees off: about 1.9 x noise). The lens settings that are
+# difference as large as 0.83 x the noise fails (so does a three-bladed aperture turned 60
+# degrees from Cycles': about 1.9 x noise). The lens settings that are
 # wrong on purpose (a pinhole, twice the f-number, a round aperture for a three-bladed one, the
 # anamorphic ratio inverted) must miss by more than twice that bound, so the check tells a wrong
 # aperture from noise.
@@ -87,10 +87,10 @@ pen pinhole
 pen f2x --fstop "$(awk -v n=$fstop 'BEGIN {print 2 * n}')" --focus-distance $focus
 cyc c1 fstop=$fstop focus=$focus seed=1
 cyc c2 fstop=$fstop focus=$focus seed=2
-# Three blades turned by 15 degrees, twice as tall as wide (Cycles: 15 - 180/3 degrees).
+# Three blades turned by 15 degrees, twice as tall as wide.
 pen tri --fstop $fstop --focus-distance $focus --aperture-blades 3 --aperture-rotation 15 --aperture-ratio 2 --seed 1
 pen triwide --fstop $fstop --focus-distance $focus --aperture-blades 3 --aperture-rotation 15 --aperture-ratio 0.5
-cyc ctri fstop=$fstop focus=$focus blades=3 rotation=-45 ratio=2 seed=2
+cyc ctri fstop=$fstop focus=$focus blades=3 rotation=15 ratio=2 seed=2
 
 noise=$(awk -v a="$(rms p1 p2)" -v b="$(rms c1 c2)" 'BEGIN {printf "%.6g", sqrt((a * a + b * b) / 2)}')
 bound=$(awk -v n="$noise" 'BEGIN {printf "%.6g", 1.3 * n}')
