@@ -26,8 +26,9 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
   if (loaded.info.animation_count == 0) return text;  // nothing moves
   if (!loaded.animation)
     throw InputError(file, "motion blur",
-                     "the scene was loaded without its animation: load it at a time (and keep the animation) "
-                     "to blur its motion");
+                     "the scene's animation cannot be posed over the shutter: it deforms meshes (skins or morph "
+                     "targets), which motion blur does not cover, or the scene was loaded without a time and "
+                     "its animation kept");
   const int steps = spec.motion_steps;
   std::vector<std::vector<Affine3f>> maps(scene.instances.size());
   for (int k = 0; k < steps; ++k) {

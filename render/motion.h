@@ -25,9 +25,9 @@ Shutter shutter_interval(const RenderSpec& spec, double frame_time);
 /// maps as keys (make_motion_keys), and the scene posed back at `frame_time`; without it, or
 /// when the file has no animation, clears it. Returns the shutter as the render identity records
 /// it ("open..close" seconds; empty without motion blur). Throws InputError(file, "motion blur")
-/// when the file's animation cannot be posed that way: loaded without its animation (a time and
-/// GltfLoadOptions::keep_animation are needed), or deforming meshes (skins, morph targets),
-/// which this motion blur does not cover.
+/// when the file's animation cannot be posed that way: it deforms meshes (skins, morph targets),
+/// which this motion blur does not cover, or the scene was loaded without a time and
+/// GltfLoadOptions::keep_animation (LoadedScene::animation is null for both).
 std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double frame_time,
                              const std::string& file);
 

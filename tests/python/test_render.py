@@ -3,7 +3,10 @@
 # (for every integrator and accelerator), windows equal to slices of the frame, identical images
 # for 1 and 2 threads and for concurrent renders, the path tracer's layers, the settings' checks,
 # and the GIL released while a render runs.
+import base64
+import json
 import math
+import pathlib
 import sys
 import threading
 import time
@@ -294,3 +297,41 @@ def test_depth_of_field_focuses_where_asked(quads):
         quads.render(fstop=2, aperture_radius=0.1)
     with pytest.raises(ValueError, match="focus_at needs depth of field"):
         quads.render(focus_at="1,1")
+
+
+def test_motion_blur_streaks_a_moving_quad(tmp_path):
+    # A 0.2-wide quad moving along +X at 12 units per second, seen by an orthographic camera 4
+    # units high over 64 pixels: at t = 1 with a one-frame shutter at 24 fps it sweeps 0.5 units,
+    # so its blur spans 0.7 units (11.2 px) and coverage in the middle is 0.2 / 0.5.
+    p, i = quad(-0.1, 0.1, -0.1, 0.1, 0)
+    path = write_gltf(tmp_path / "moving.gltf",
+                      nodes=[{"camera": 0, "translation": [0, 0, 5]}, {"name": "mover", "mesh": 0}],
+                      meshes=[(p, i, None)],
+                      cameras=[{"type": "orthographic",
+                                "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.01, "zfar": 100}}])
+    gltf = json.loads(pathlib.Path(path).read_text())
+    blob = base64.b64decode(gltf["buffers"][0]["uri"].split(",", 1)[1])
+    keys = np.array([0, 2], np.float32).tobytes() + np.array([-12, 0, 0, 12, 0, 0], np.float32).tobytes()
+    gltf["bufferViews"] += [{"buffer": 0, "byteOffset": len(blob), "byteLength": 8},
+                            {"buffer": 0, "byteOffset": len(blob) + 8, "byteLength": 24}]
+    n = len(gltf["accessors"])
+    gltf["accessors"] += [{"bufferView": len(gltf["bufferViews"]) - 2, "componentType": 5126, "count": 2,
+                           "type": "SCALAR", "min": [0], "max": [2]},
+                          {"bufferView": len(gltf["bufferViews"]) - 1, "componentType": 5126, "count": 2,
+                           "type": "VEC3"}]
+    gltf["animations"] = [{"samplers": [{"input": n, "output": n + 1}],
+                           "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
+    blob += keys
+    gltf["buffers"] = [{"byteLength": len(blob),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
+    pathlib.Path(path).write_text(json.dumps(gltf))
+    scene = penumbra.load(path, time=1.0, keep_animation=True)
+    r = scene.render(width=64, height=64, spp=256, motion_blur=True, shutter=1, fps=24)
+    row = r.beauty[32, :, 3]
+    covered = np.nonzero(row > 0.01)[0]
+    assert abs((covered[-1] + 1 - covered[0]) - 11.2) <= 1.5
+    np.testing.assert_allclose(row[30:34], 0.4, atol=0.06)
+    still = scene.render(width=64, height=64, spp=16)
+    assert np.count_nonzero(still.beauty[32, :, 3] > 0.01) <= 5
+    with pytest.raises(ValueError, match="shutter needs motion_blur"):
+        scene.render(shutter=1)

@@ -47,6 +47,12 @@ RenderSpec with_integrator(const char* integrator) {
   return s;
 }
 
+/// The shutter settings that only apply with motion blur.
+bool needs_motion_blur(const SpecField& f) {
+  const std::string n = f.name;
+  return n == "shutter" || n == "shutter_offset" || n == "motion_steps";
+}
+
 /// The lens settings that only apply with an aperture.
 bool needs_aperture(const SpecField& f) {
   const std::string n = f.name;
@@ -75,6 +81,7 @@ TEST_CASE("spec: every identity field changes the identity, the others do not", 
       if (f.name == std::string("integrator") || !(f.applies & integrator_bit(integrator))) continue;
       RenderSpec base = with_integrator(integrator);
       if (needs_aperture(f)) base.aperture_radius = 0.5f;
+      if (needs_motion_blur(f)) base.motion_blur = true;
       const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
       RenderSpec changed = base;
       perturb(changed, f);
