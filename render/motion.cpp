@@ -25,10 +25,11 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
   std::snprintf(text, sizeof text, "%.17g..%.17g", s.open, s.close);
   if (loaded.info.animation_count == 0) return text;  // nothing moves
   if (!loaded.animation)
-    throw InputError(file, "motion blur",
-                     "the scene's animation cannot be posed over the shutter: it deforms meshes (skins or morph "
-                     "targets), which motion blur does not cover, or the scene was loaded without a time and "
-                     "its animation kept");
+    throw InputError(
+        file, "motion blur",
+        "the scene's animation cannot be posed over the shutter: it deforms meshes (skins or morph "
+        "targets), which motion blur does not cover, or the scene was loaded without a time and "
+        "its animation kept");
   const int steps = spec.motion_steps;
   std::vector<std::vector<Affine3f>> maps(scene.instances.size());
   for (int k = 0; k < steps; ++k) {

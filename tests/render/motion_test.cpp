@@ -202,7 +202,8 @@ TEST_CASE("motion blur: a morph-target animation is refused by name", "[motion]"
   load(s, dir / "morph.gltf", 0.5);
   RenderSpec spec = spec_of(16, 1);
   spec.motion_blur = true;
-  CHECK_THROWS_WITH(render_scene(s, spec, 0), Catch::Contains("morph.gltf") && Catch::Contains("deforms meshes"));
+  CHECK_THROWS_WITH(render_scene(s, spec, 0),
+                    Catch::Contains("morph.gltf") && Catch::Contains("deforms meshes"));
 }
 
 TEST_CASE("motion blur: a scene loaded without its animation is refused, a still file renders", "[motion]") {
