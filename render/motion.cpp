@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "io/files/error.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra {
 
@@ -15,10 +16,26 @@ Shutter shutter_interval(const RenderSpec& spec, double frame_time) {
   return {centre - half, centre + half};
 }
 
+namespace {
+
+/// Whether the maps of one thing over the shutter differ (bit for bit) and are all invertible.
+bool moves(const std::vector<Affine3f>& maps) {
+  bool differ = false;
+  for (size_t k = 1; k < maps.size() && !differ; ++k)
+    differ = std::memcmp(&maps[k], &maps[0], sizeof(Affine3f)) != 0;
+  Affine3f inverse_map;
+  for (const Affine3f& a : maps)
+    if (!inverse(a, inverse_map)) return false;  // a key that collapses it: it stays at its frame pose
+  return differ;
+}
+
+}  // namespace
+
 std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double frame_time,
                              const std::string& file) {
   Scene& scene = loaded.scene;
   scene.instance_motion.clear();
+  for (Camera& c : scene.cameras) c.motion.clear();
   if (!spec.motion_blur) return "";
   const Shutter s = shutter_interval(spec, frame_time);
   char text[64];
@@ -31,32 +48,28 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
         "targets), which motion blur does not cover, or the scene was loaded without a time and "
         "its animation kept");
   const int steps = spec.motion_steps;
-  std::vector<std::vector<Affine3f>> maps(scene.instances.size());
+  std::vector<std::vector<Affine3f>> maps(scene.instances.size()), frames(scene.cameras.size());
   for (int k = 0; k < steps; ++k) {
     const double t = s.open + (s.close - s.open) * double(k) / double(steps - 1);
     if (!pose_gltf_scene(*loaded.animation, t, scene))
       throw InputError(file, "motion blur",
-                       "the animation deforms meshes (skins or morph targets): only moving nodes, instances "
-                       "and their transforms are blurred");
+                       "the animation deforms meshes (skins or morph targets): only moving nodes, instances, "
+                       "cameras and their transforms are blurred");
     for (size_t i = 0; i < scene.instances.size(); ++i) maps[i].push_back(scene.instances[i].to_world);
+    for (size_t i = 0; i < scene.cameras.size(); ++i) frames[i].push_back(camera_frame(scene.cameras[i]));
   }
   if (!pose_gltf_scene(*loaded.animation, frame_time, scene))
     throw InputError(file, "motion blur", "the scene cannot be posed back at the frame's time");
   scene.instance_motion.resize(scene.instances.size());
   bool any = false;
   for (size_t i = 0; i < maps.size(); ++i) {
-    const auto& m = maps[i];
-    bool moves = false;
-    for (size_t k = 1; k < m.size() && !moves; ++k) moves = std::memcmp(&m[k], &m[0], sizeof(Affine3f)) != 0;
-    if (!moves) continue;
-    Affine3f inverse_map;
-    bool invertible = true;
-    for (const Affine3f& a : m) invertible = invertible && inverse(a, inverse_map);
-    if (!invertible) continue;  // a key that collapses the instance: it stays at its frame pose
-    scene.instance_motion[i] = make_motion_keys(m);
+    if (!moves(maps[i])) continue;
+    scene.instance_motion[i] = make_motion_keys(maps[i]);
     any = true;
   }
   if (!any) scene.instance_motion.clear();
+  for (size_t i = 0; i < frames.size(); ++i)
+    if (moves(frames[i])) scene.cameras[i].motion = make_motion_keys(frames[i]);
   return text;
 }
 

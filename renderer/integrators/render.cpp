@@ -57,14 +57,23 @@ CameraSample take_path_camera_sample(const Camera& camera, const RenderConfig& c
   return cs;
 }
 
+// The ray of camera sample `cs` through film position `film` (the sample's own, or a
+// differential's): through its aperture point, at its time, from where the camera is then.
+Ray sample_ray(const Camera& camera, const CameraRaster& raster, const CameraSample& cs, Vec2f film) {
+  Ray r = move_camera_ray(
+      camera, thin_lens_ray(camera, raster_ray(camera, raster, film.x, film.y), cs.aperture), cs.time);
+  r.time = cs.time;
+  return r;
+}
+
 // A camera ray of sample `cs` with differentials `step` pixels apart.
 Ray camera_ray(const Camera& camera, const RenderConfig& config, const CameraSample& cs, float step,
                RayDifferential& rd) {
-  Ray r[3];
-  generate_camera_rays(camera, config.width, config.height, cs.film.x, cs.film.y, step, r, cs.aperture);
-  rd = RayDifferential{true, r[1].org, r[1].dir, r[2].org, r[2].dir};
-  r[0].time = cs.time;
-  return r[0];
+  const CameraRaster raster = camera_raster(camera, config.width, config.height);
+  const Ray rx = sample_ray(camera, raster, cs, {cs.film.x + step, cs.film.y});
+  const Ray ry = sample_ray(camera, raster, cs, {cs.film.x, cs.film.y + step});
+  rd = RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
+  return sample_ray(camera, raster, cs, cs.film);
 }
 
 struct RayCounters {
@@ -116,10 +125,7 @@ CameraSample camera_sample(const Camera& camera, const RenderConfig& config, Int
 Ray camera_sample_ray(const Camera& camera, const RenderConfig& config, IntegratorType integrator, int x,
                       int y, uint32_t s) {
   const CameraSample cs = camera_sample(camera, config, integrator, x, y, s);
-  const CameraRaster raster = camera_raster(camera, config.width, config.height);
-  Ray ray = thin_lens_ray(camera, raster_ray(camera, raster, cs.film.x, cs.film.y), cs.aperture);
-  ray.time = cs.time;
-  return ray;
+  return sample_ray(camera, camera_raster(camera, config.width, config.height), cs, cs.film);
 }
 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
@@ -213,16 +219,15 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
   const auto make_rd = [](const void* ctx) {
     const Footprint& f = *static_cast<const Footprint*>(ctx);
     const Vec2f p = f.cs.film;
-    const Ray rx = thin_lens_ray(f.camera, raster_ray(f.camera, f.raster, p.x + f.step, p.y), f.cs.aperture);
-    const Ray ry = thin_lens_ray(f.camera, raster_ray(f.camera, f.raster, p.x, p.y + f.step), f.cs.aperture);
+    const Ray rx = sample_ray(f.camera, f.raster, f.cs, {p.x + f.step, p.y});
+    const Ray ry = sample_ray(f.camera, f.raster, f.cs, {p.x, p.y + f.step});
     return RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
   };
   const CameraRaster raster = camera_raster(camera, config.width, config.height);
   for (uint32_t s = s0; s < s1; ++s) {
     SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
     const Footprint fp{camera, raster, take_path_camera_sample(camera, config, x, y, samples), step};
-    Ray ray = thin_lens_ray(camera, raster_ray(camera, raster, fp.cs.film.x, fp.cs.film.y), fp.cs.aperture);
-    ray.time = fp.cs.time;
+    const Ray ray = sample_ray(camera, raster, fp.cs, fp.cs.film);
     float coverage = 0;
     LightGroups lg;
     const Vec3f l = path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples,

@@ -150,6 +150,26 @@ void validate_camera(const Camera& cam, int width, int height) {
          shown(reach) + " scene units out, beyond " + shown(kMaxCameraReach));
 }
 
+Affine3f camera_frame(const Camera& cam) {
+  Affine3f m;
+  const Vec3f cols[4] = {cam.u, cam.v, cam.w, cam.eye};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 3; ++r) m.m[r][c] = cols[c][r];
+  return m;
+}
+
+Ray move_camera_ray(const Camera& cam, const Ray& ray, float time) {
+  if (cam.motion.empty()) return ray;
+  const Affine3f at = interpolate_motion(cam.motion, time);
+  const Vec3f o = ray.org - cam.eye;
+  const Vec3f local_org{dot(o, cam.u), dot(o, cam.v), dot(o, cam.w)};
+  const Vec3f local_dir{dot(ray.dir, cam.u), dot(ray.dir, cam.v), dot(ray.dir, cam.w)};
+  Ray r = ray;
+  r.org = apply_point(at, local_org);
+  r.dir = normalize(apply_vector(at, local_dir));
+  return r;
+}
+
 Ray generate_camera_ray(const Camera& cam, int width, int height, float x, float y) {
   return raster_ray(cam, camera_raster(cam, width, height), x, y);
 }

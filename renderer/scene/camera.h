@@ -59,6 +59,15 @@ Vec2f sample_aperture(const ThinLens& lens, Vec2f u);
 /// image plane. With a zero lens radius it returns `pinhole` unchanged.
 Ray thin_lens_ray(const Camera& cam, const Ray& pinhole, Vec2f aperture);
 
+/// The camera's frame as a map from camera to world space: columns u, v, w and the eye.
+Affine3f camera_frame(const Camera& cam);
+
+/// `ray`, a ray of the camera at its frame (eye, u, v, w), carried along with the camera to
+/// where cam.motion puts it at shutter time `time` (the ray's origin and direction taken into
+/// the camera's space, then out through the interpolated frame). `ray` itself without motion.
+/// Never allocates or throws.
+Ray move_camera_ray(const Camera& cam, const Ray& ray, float time);
+
 /// The rays through (x, y), (x + step, y) and (x, y + step) (out[0..2]): a camera ray and its
 /// two differential rays, exactly as three generate_camera_ray calls give them, sharing the
 /// per-camera terms; all three through aperture point `aperture` (thin_lens_ray).

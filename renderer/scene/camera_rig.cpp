@@ -229,6 +229,7 @@ Camera rig_camera(const CameraRig& r, const Camera* base, const Bounds3f& bounds
         c = fit_keeping_height(c, r, bounds, aspect);
       break;
   }
+  if (r.placement != CameraPlacement::Base) c.motion.clear();  // placed by flags: it stays put
   if (r.znear) c.znear = float(*r.znear);
   if (r.zfar) c.zfar = float(*r.zfar);
   check_result(c);

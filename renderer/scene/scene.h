@@ -168,6 +168,9 @@ struct Camera {
   float zfar = kInfinity;
   float focal_mm = 0;  ///< the lens' focal length in millimetres when a rig set it; 0: unknown
   ThinLens lens;       ///< depth of field; a pinhole by default
+  /// Motion blur: the frame's keys over the shutter (camera_frame maps, spaced evenly over
+  /// Ray::time 0 to 1); empty for a camera that stays put. eye, u, v, w are the frame time's.
+  std::vector<MotionKey> motion;
 };
 
 struct Scene {

@@ -93,6 +93,28 @@ TEST_CASE("motion blur: a translating quad's streak is its velocity times the sh
   }
 }
 
+TEST_CASE("motion blur: a still quad seen by a moving camera streaks as far as the camera moves",
+          "[motion]") {
+  // The camera (node 0) moves along +X at 24 units per second; the 0.1-wide quad stays at the
+  // origin: at t = 1 it sweeps the image over 0.5 units (16 px), its blur spans 19.2 px.
+  const auto file =
+      write_scene("camera", {-0.05f, -0.05f, 0, 0.05f, -0.05f, 0, 0.05f, 0.05f, 0, -0.05f, 0.05f, 0}, 2,
+                  [](test::GltfWriter& w, int) {
+                    w.channel(0, "translation", {0, 2}, {-24, 0, 5, 24, 0, 5}, "VEC3", 3);
+                  });
+  Session s;
+  load(s, file, 1.0);
+  RenderSpec spec = spec_of(128, 256, "bvh");
+  spec.motion_blur = true;
+  const RenderResult r = render_scene(s, spec, 0);
+  CHECK(s.loaded.scene.instance_motion.empty());  // nothing else moves
+  int first = -1, last = -1;
+  for (int x = 0; x < 128; ++x)
+    if (alpha(r.image.film, x, 64) > 0.01f) last = x, first = first < 0 ? x : first;
+  CHECK(float(last + 1 - first) == Approx(19.2).margin(1.5));
+  CHECK(alpha(r.image.film, 64, 64) == Approx(0.2).margin(0.04));
+}
+
 TEST_CASE("motion blur: a spinning bar blurs along the arc its end draws, not the chord", "[motion]") {
   // A bar from the origin to x = 1 turning about +Z: 0, 90 and 180 degrees at t = 0, 1, 2.
   // Rendered at t = 1 with a shutter of one frame at 1 fps it sweeps 45..135 degrees, keyed at
