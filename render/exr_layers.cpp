@@ -2,6 +2,7 @@
 #include "render/exr_layers.h"
 
 #include "renderer/integrators/light_groups.h"
+#include "renderer/integrators/motion_vectors.h"
 
 namespace penumbra {
 
@@ -28,6 +29,7 @@ void add_layer_channels(ExrOptions& exr, const std::set<std::string>& aovs, cons
       for (int c = 0; c < 3; ++c)
         exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], b.groups, colour,
                              kLightGroupChannels, g * 3 + c});
+  if (aovs.count("vector")) vec("vector", "XYZW", b.vector, ChannelType::Float, kMotionVectorChannels);
 }
 
 }  // namespace penumbra

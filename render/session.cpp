@@ -179,10 +179,50 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
     scene.lights.push_back(default_key_light(p.camera));
     p.default_light = true;
   }
+  if (p.spec.aovs.count("vector")) {
+    if (o.time)
+      p.motion = std::make_shared<const MotionFrames>(load_motion_frames(scene, p, *o.time, o));
+    else
+      p.warnings.push_back(
+          "the vector layer of a render at the file's static pose is 0 everywhere (the static pose is no "
+          "point of the animation's timeline): give the render a time for motion");
+  }
   SceneIdentity identity = o.identity;
   if (!p.spec.env_color && !p.spec.env_map.empty()) identity.env_sha256 = sha256_file(p.spec.env_map);
   p.identity = render_identity(p.spec, p.camera, identity);
   return p;
+}
+
+MotionFrames load_motion_frames(const Scene& scene, const PreparedRender& p, double time,
+                                const PrepareOptions& o) {
+  if (!o.load_at)
+    throw std::invalid_argument(
+        "the vector layer needs the scene at other times: this front end cannot load it");
+  const RenderConfig& cfg = p.config;
+  const auto load = [&](double t, LoadedScene& loaded, Camera& camera) {
+    loaded = o.load_at(t);
+    char at[64];
+    std::snprintf(at, sizeof at, "the scene at %.9g s", t);
+    const std::string why = check_motion_frame(scene, loaded.scene);
+    if (!why.empty())
+      throw InputError(o.scene_file, at,
+                       "the vector layer cannot follow the surfaces to this time (" + why + ")");
+    // The file's camera as posed at that time; a camera placed from the command line or
+    // framed from the bounds stays where the render has it.
+    const Scene& posed = loaded.scene;
+    camera = p.camera;
+    if (p.camera_index < 0) return;
+    if (size_t(p.camera_index) >= posed.cameras.size())
+      throw InputError(o.scene_file, at,
+                       "the vector layer's camera " + std::to_string(p.camera_index) +
+                           " is not in the scene at this time");
+    camera = o.place ? o.place(posed, p.camera_index, cfg.width, cfg.height)
+                     : posed.cameras[size_t(p.camera_index)];
+  };
+  MotionFrames m;
+  load(time - 1.0 / p.spec.fps, m.previous, m.previous_camera);
+  load(time + 1.0 / p.spec.fps, m.next, m.next_camera);
+  return m;
 }
 
 void finish_render(LoadedScene& loaded, const PreparedRender& prepared) {
@@ -191,7 +231,7 @@ void finish_render(LoadedScene& loaded, const PreparedRender& prepared) {
 
 bool needs_structure(const RenderSpec& spec, bool probe) {
   return spec.integrator != "raster" || spec.raster_shadows == "ray" || spec.aovs.count("cost") ||
-         !crypto_layers(spec.aovs).empty() || probe;
+         spec.aovs.count("vector") || !crypto_layers(spec.aovs).empty() || probe;
 }
 
 Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world_apart, Structure previous,
@@ -325,6 +365,17 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
                    : render_data_aovs(scene, *accel, p.camera, p.config, integrator);
   if (p.spec.aovs.count("id")) out.id_manifest = id_manifest(scene, loaded.info);
   if (p.spec.aovs.count("cost")) out.cost = render_cost(*accel, p.camera, p.config, integrator);
+  if (p.spec.aovs.count("vector")) {
+    if (p.motion) {
+      const MotionFrames& m = *p.motion;
+      out.vector =
+          render_motion_vectors(scene, *accel, p.camera, p.config, {&m.previous.scene, m.previous_camera},
+                                {&m.next.scene, m.next_camera});
+    } else {
+      const PixelWindow win = render_window(p.config);
+      out.vector.assign(size_t(win.width()) * size_t(win.height()) * kMotionVectorChannels, 0.0f);
+    }
+  }
   const std::vector<std::string> crypto = crypto_layers(p.spec.aovs);
   if (crypto.empty()) return out;
   std::vector<CryptoLayerIds> layers;
@@ -357,6 +408,8 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   options.area_lights = session.area_lights;
   validate(spec);
   options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file);
+  options.time = session.loaded_at_time ? std::optional<double>(session.time) : std::nullopt;
+  options.load_at = session.load_at;
   RenderResult r;
   r.prepared = prepare_render(session.loaded, spec, options);
   DefaultLightGuard guard{session.loaded, &r.prepared};

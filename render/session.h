@@ -28,6 +28,7 @@
 #include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/cost_map.h"
+#include "renderer/integrators/motion_vectors.h"
 #include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"
 #include "renderer/lights/environment.h"
@@ -44,6 +45,10 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
 /// The default places the scene's camera as it is, or frames the scene's bounds.
 using PlaceCamera = std::function<Camera(const Scene& scene, int index, int width, int height)>;
 
+/// Loads the render's scene file posed at `time` seconds, with the options the render's own
+/// scene was loaded with (the vector layer's neighbouring frames). Throws as load_gltf does.
+using LoadAtTime = std::function<LoadedScene(double time)>;
+
 /// What prepare_render needs besides the spec and the scene.
 struct PrepareOptions {
   std::string scene_file;   ///< names the file in InputError messages
@@ -56,6 +61,17 @@ struct PrepareOptions {
   /// The emissive triangles from an earlier render of the same scene, reused; null: built.
   std::shared_ptr<const AreaLights> area_lights;
   SceneIdentity identity;  ///< the scene part of the identity (sha256, index, time, ...)
+  /// The vector layer: the time the scene was posed at (unset: its static pose), and how to
+  /// load it at another time (required when the layer is asked for at a time).
+  std::optional<double> time;
+  LoadAtTime load_at;
+};
+
+/// The vector layer's neighbouring frames: the scene at the render's time -/+ 1/fps, each with
+/// the camera placed as the render's own (the same index or placement, at that time).
+struct MotionFrames {
+  LoadedScene previous, next;
+  Camera previous_camera, next_camera;
 };
 
 /// A render ready to run: everything resolved, the scene's lights set up.
@@ -69,6 +85,9 @@ struct PreparedRender {
   bool default_light = false;  ///< the scene had no light: prepare_render appended the default key light
   RenderSettings identity;     ///< render_identity() of this render
   std::vector<std::string> warnings;  ///< settings the render ignores, for the front end to show
+  /// The vector layer's neighbouring frames; null without the layer or for a static render
+  /// (whose vectors are all 0).
+  std::shared_ptr<const MotionFrames> motion;
 
   IntegratorType integrator() const;
   PathLights path_lights() const { return {area_lights.get(), environment.get()}; }
@@ -80,15 +99,24 @@ struct PreparedRender {
 /// a pinhole and says so in `warnings`), loads
 /// the environment (spec.env_color, spec.env_map, else the file's image-based light), builds the
 /// emissive triangles for the path tracer, appends the default key light to scene.lights when
-/// nothing lights the scene, and derives the identity. Throws std::invalid_argument for
-/// settings, InputError for the camera or the environment map.
+/// nothing lights the scene, loads the vector layer's neighbouring frames (load_motion_frames)
+/// and derives the identity. Throws std::invalid_argument for settings, InputError for the
+/// camera, the environment map or the neighbouring frames.
 PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& options);
+
+/// The scene at `time` -/+ 1/spec.fps through options.load_at, each checked against `scene`
+/// (check_motion_frame) and its camera placed as `prepared` placed the render's (options.place
+/// with the same camera index, else the scene's camera, else framing its bounds) at the
+/// render's size. Throws InputError naming the time when a frame does not match the scene,
+/// std::invalid_argument when options.load_at is empty.
+MotionFrames load_motion_frames(const Scene& scene, const PreparedRender& prepared, double time,
+                                const PrepareOptions& options);
 
 /// Removes the default key light prepare_render appended, if it did.
 void finish_render(LoadedScene& loaded, const PreparedRender& prepared);
 
 /// Whether the render queries an acceleration structure: every integrator does but the raster
-/// one without shadow rays, Cryptomatte, the cost layer or a pixel probe.
+/// one without shadow rays, Cryptomatte, the cost or vector layer or a pixel probe.
 bool needs_structure(const RenderSpec& spec, bool probe = false);
 
 /// An acceleration structure with what its reuse policy needs.
@@ -143,6 +171,7 @@ struct RenderLayers {
   CryptoImage crypto;                         ///< ranked ids, one layer per crypto_layers() entry
   std::vector<std::string> crypto_manifests;  ///< each Cryptomatte layer's {"name": "hex"} JSON
   std::string id_manifest;                    ///< JSON names of the id layer's ids ("id")
+  std::vector<float> vector;                  ///< kMotionVectorChannels per pixel of the window ("vector")
 };
 
 /// The Cryptomatte layers `aovs` asks for: CryptoObject, CryptoMaterial, CryptoAsset.
@@ -157,7 +186,8 @@ bool wants_data_aovs(const std::set<std::string>& aovs);
 std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
                                                const std::string& layer);
 
-/// Traces what the requested data, Cryptomatte and cost layers need.
+/// Traces what the requested data, Cryptomatte, cost and vector layers need (the vector layer
+/// from prepared.motion; all 0 without it).
 RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel,
                            const PreparedRender& prepared);
 
@@ -167,6 +197,7 @@ struct Session {
   LoadedScene loaded;
   bool loaded_at_time = false;  ///< loaded with GltfLoadOptions::time
   double time = 0;              ///< the time the scene is posed at (loaded or posed since); 0 for a still
+  LoadAtTime load_at;           ///< loads the file at another time (the vector layer); may be empty
   std::mutex mutex;
   Structure structure;                            ///< the last render's, or empty
   std::shared_ptr<const AreaLights> area_lights;  ///< the emissive triangles, once needed

@@ -57,15 +57,16 @@ struct RenderSpec {
   int aperture_blades = 0;                    ///< 0: a round aperture; 3..64: a polygon
   float aperture_rotation = 0;                ///< the polygon's turn, degrees
   float aperture_ratio = 1;                   ///< anamorphic: aperture height / width
-  double fps = 24;                            ///< frames per second: the frame interval of the shutter
-  bool motion_blur = false;                   ///< the scene's motion over the shutter
-  float shutter = 0.5f;                       ///< the shutter's length, a fraction of the frame interval
-  float shutter_offset = 0;                   ///< the shutter's centre after the frame's time, in frames
-  int motion_steps = 3;                       ///< the transforms' keys over the shutter
-  std::string accel = "embree";               ///< an accelerator_names() entry
-  std::vector<std::string> accel_params;      ///< "bvh.max_leaf_size=4", ... of `accel` only
-  std::set<std::string> aovs;                 ///< checked layer names (check_aovs)
-  int crypto_depth = 6;                       ///< Cryptomatte ranks per pixel
+  double fps =
+      24;  ///< frames per second: the shutter's frame interval; the vector layer's frames lie 1/fps away
+  bool motion_blur = false;               ///< the scene's motion over the shutter
+  float shutter = 0.5f;                   ///< the shutter's length, a fraction of the frame interval
+  float shutter_offset = 0;               ///< the shutter's centre after the frame's time, in frames
+  int motion_steps = 3;                   ///< the transforms' keys over the shutter
+  std::string accel = "embree";           ///< an accelerator_names() entry
+  std::vector<std::string> accel_params;  ///< "bvh.max_leaf_size=4", ... of `accel` only
+  std::set<std::string> aovs;             ///< checked layer names (check_aovs)
+  int crypto_depth = 6;                   ///< Cryptomatte ranks per pixel
 };
 
 /// The integrators a setting applies to (a bit mask).
@@ -101,8 +102,9 @@ unsigned integrator_bit(const std::string& integrator);
 const std::vector<std::string>& aov_names();
 
 /// The layer names `names` asks for ("all": every layer of `known` the integrator has, except
-/// cost), checked against `known` and the integrator. Throws std::invalid_argument naming the
-/// layer ("unknown AOV 'x' (known: ...)", "'samples' needs integrator 'path'").
+/// cost and vector, which trace or load more), checked against `known` and the integrator. Throws
+/// std::invalid_argument naming the layer ("unknown AOV 'x' (known: ...)", "'samples' needs integrator
+/// 'path'").
 std::set<std::string> check_aovs(const std::vector<std::string>& names, const std::string& integrator,
                                  const std::vector<std::string>& known = aov_names());
 
@@ -143,7 +145,7 @@ struct SceneIdentity {
 /// Everything that decides a render's pixels except its window and sample target: the renderer
 /// version, the scene, the camera as rendered, every pixel-deciding spec_fields() entry that
 /// applies to the integrator (by name), the colours, the environment and the accelerator's
-/// parameters. `resolved` is resolve()'s result.
+/// parameters; with the vector layer, fps. `resolved` is resolve()'s result.
 RenderSettings render_identity(const RenderSpec& resolved, const Camera& camera, const SceneIdentity& scene);
 
 }  // namespace penumbra
