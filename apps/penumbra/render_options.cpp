@@ -372,7 +372,9 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "a name manifest), and for the path tracer samples, variance, light (emission, diffuse/specular "
       "direct/indirect); crypto_object, crypto_material, crypto_asset = Cryptomatte mattes of node, "
       "material and root node names; all = every one of these; cost = traversal cost of the camera rays "
-      "(cost_nodes, cost_triangles, cost_shapes, cost_ns) and a heat map");
+      "(cost_nodes, cost_triangles, cost_shapes, cost_ns) and a heat map; vector = motion vectors in "
+      "pixels to the frames 1/--fps before and after --time or --frame (vector.XYZW, Blender's Vector "
+      "pass)");
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }
