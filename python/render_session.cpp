@@ -32,6 +32,12 @@ std::shared_ptr<SceneSession> load_session(const std::string& file, const GltfLo
   session->loaded = load_gltf(file, options);
   session->loaded_at_time = options.time.has_value();
   session->time = options.time.value_or(0);
+  session->load_at = [file, options](double time) {
+    GltfLoadOptions at = options;
+    at.time = time;
+    at.keep_animation = false;
+    return load_gltf(file, at);
+  };
   return session;
 }
 
@@ -53,8 +59,8 @@ bool pose_session(SceneSession& session, double time) {
 }
 
 const std::vector<std::string>& python_aov_names() {
-  static const std::vector<std::string> names = {"albedo", "N",       "P",        "Z",    "UV",
-                                                 "id",     "samples", "variance", "light"};
+  static const std::vector<std::string> names = {"albedo", "N",       "P",        "Z",     "UV",
+                                                 "id",     "samples", "variance", "light", "vector"};
   return names;
 }
 
@@ -83,6 +89,7 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   if (out.aovs.count("light")) out.groups = std::move(r.image.groups);
   out.data = std::move(r.layers.data);
   out.id_manifest = std::move(r.layers.id_manifest);
+  out.vector = std::move(r.layers.vector);
   return out;
 }
 
@@ -101,7 +108,8 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
       {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)},
       {"penumbra:version", PENUMBRA_VERSION}};
   exr.metadata.insert(exr.metadata.end(), options.metadata.begin(), options.metadata.end());
-  add_layer_channels(exr, out.aovs, {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups},
+  add_layer_channels(exr, out.aovs,
+                     {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector},
                      options.half ? ChannelType::Half : ChannelType::Float);
   write_exr(out.film, path, exr);
 }

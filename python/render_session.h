@@ -65,6 +65,7 @@ struct RenderOutput {
   std::vector<uint32_t> samples;      ///< path: samples per pixel
   std::vector<float> variance;        ///< path: variance of each pixel's mean luminance
   std::vector<float> groups;          ///< path with "light": kLightGroupChannels per pixel
+  std::vector<float> vector;          ///< with "vector": kMotionVectorChannels per pixel
   std::vector<float> samples_f;       ///< `samples` as floats, for the EXR
   std::string id_manifest;            ///< JSON: object id -> node name, material id -> material name
   RenderStats stats;
@@ -88,7 +89,7 @@ struct ExrWriteOptions {
 /// The EXR `penumbra render` writes for these settings: R, G, B, A, then every AOV the render
 /// holds with the command's channel names and types (albedo.RGB, N.XYZ, P.XYZ, Z, UV.UV,
 /// object_id.X / material_id.X as whole-number floats with the name manifest, samples.X,
-/// variance.X, the light groups' .RGB) and the settings as metadata. Throws as write_exr.
+/// variance.X, the light groups' .RGB, vector.XYZW) and the settings as metadata. Throws as write_exr.
 void write_render_exr(const RenderOutput& output, const std::filesystem::path& path,
                       const ExrWriteOptions& options);
 

@@ -335,3 +335,23 @@ def test_motion_blur_streaks_a_moving_quad(tmp_path):
     assert np.count_nonzero(still.beauty[32, :, 3] > 0.01) <= 5
     with pytest.raises(ValueError, match="shutter needs motion_blur"):
         scene.render(shutter=1)
+
+
+def test_vector_layer_follows_the_scenes_time():
+    # The fly-through's camera moves: at a time the layer is (rows, columns, 4) and not all 0;
+    # posed to that time it equals a scene loaded there; a render at the static pose is 0 and warns.
+    at = penumbra.load(SCENES / "flythrough.gltf", time=1.0)
+    r = at.render(width=32, height=18, spp=1, accel="bvh", aovs=["vector"])
+    v = r.aovs["vector"]
+    assert v.shape == (18, 32, 4)
+    assert np.abs(v).max() > 0.1
+    assert "vector" not in at.render(width=32, height=18, spp=1, accel="bvh", aovs=["all"]).aovs
+    posed = penumbra.load(SCENES / "flythrough.gltf", time=0.0, keep_animation=True)
+    assert posed.pose(1.0)
+    np.testing.assert_allclose(posed.render(width=32, height=18, spp=1, accel="bvh", aovs=["vector"]).aovs["vector"],
+                               v, atol=1e-4)
+    slower = at.render(width=32, height=18, spp=1, accel="bvh", aovs=["vector"], fps=48)
+    assert np.abs(slower.aovs["vector"]).max() < np.abs(v).max()
+    with pytest.warns(RuntimeWarning, match="static pose"):
+        still = penumbra.load(SCENES / "flythrough.gltf").render(width=32, height=18, spp=1, aovs=["vector"])
+    assert not np.any(still.aovs["vector"])
