@@ -19,27 +19,41 @@ constexpr float kYfov = 0.8f;
 constexpr double kFps = 24;
 constexpr float kTolerance = 0.01f;  // pixels
 
+/// How the quad's vertices are given.
+enum class Quad { Rigid, Morph, Skin };
+
 /// A 2 x 2 quad in the z = 0 plane (centred on its node) seen by a camera node at z = 5 looking
-/// down -z; `animate` adds what moves. Written as `name`.gltf in a fresh folder.
+/// down -z; `animate` adds what moves (given the writer, the node that moves the quad: its own,
+/// or for Quad::Skin the joint its right edge follows, and the camera's node). Written as
+/// `name`.gltf in a fresh folder.
 template <class Animate>
-std::filesystem::path write_scene(const std::string& name, bool morph, Animate&& animate) {
+std::filesystem::path write_scene(const std::string& name, Quad kind, Animate&& animate) {
   test::GltfWriter w;
   const int pos = w.positions({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0});
   const int idx = w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3});
   int mesh = 0;
-  if (morph) {
-    // Every vertex moves +1 in x at weight 1; the primitive needs no index list for the target.
-    const int target = w.positions({1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0});
-    mesh = w.morph_mesh(pos, target);
-    w.j["meshes"][0]["primitives"][0]["indices"] = idx;
+  if (kind == Quad::Morph) {
+    // Every vertex moves +1 in x at weight 1.
+    mesh = w.morph_mesh(pos, w.positions({1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0}));
+  } else if (kind == Quad::Skin) {
+    // The left vertices follow joint 0, the right ones joint 1 (bind pose: identity).
+    mesh = w.skinned_mesh(pos, {0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0},
+                          {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0});
   } else {
-    mesh = w.mesh(pos, idx);
+    mesh = w.mesh(pos);
   }
-  const int quad = w.node({{"mesh", mesh}});
+  w.j["meshes"][size_t(mesh)]["primitives"][0]["indices"] = idx;
+  int moved = w.node({{"mesh", mesh}});
+  if (kind == Quad::Skin) {
+    w.j["nodes"][size_t(moved)]["skin"] = 0;
+    const int left = w.node(nlohmann::json::object());
+    moved = w.node(nlohmann::json::object());
+    w.j["skins"] = {{{"joints", {left, moved}}}};
+  }
   w.j["cameras"] = {
       {{"type", "perspective"}, {"perspective", {{"yfov", kYfov}, {"znear", 0.1}, {"aspectRatio", 1.5}}}}};
   const int camera = w.node({{"camera", 0}, {"translation", {0, 0, 5}}});
-  animate(w, quad, camera);
+  animate(w, moved, camera);
   const auto dir = test::temp_dir("vector-" + name);
   const auto file = dir / (name + ".gltf");
   w.write_embedded(file);
@@ -123,7 +137,7 @@ void check_pixels(const std::vector<float>& v, Vec3f eye, Vec3f centre, const fl
 
 TEST_CASE("vector: a translating object moves by its projected displacement", "[session][vector]") {
   // The quad moves +x at 1.5 units per second (0.3 s to 3.3 s: linear through 1 s +- 1/24).
-  const auto file = write_scene("translate", false, [](test::GltfWriter& w, int quad, int) {
+  const auto file = write_scene("translate", Quad::Rigid, [](test::GltfWriter& w, int quad, int) {
     w.channel(quad, "translation", {0.0f, 2.0f}, {0, 0, 0, 3, 0, 0}, "VEC3", 3);
   });
   const double time = 1.0;
@@ -139,7 +153,7 @@ TEST_CASE("vector: a translating object moves by its projected displacement", "[
 
 TEST_CASE("vector: a moving camera reprojects the still world point of each pixel", "[session][vector]") {
   // The camera rises at 2 units per second and moves -x at 1: its eye at time t is (-t, 2t, 5).
-  const auto file = write_scene("camera", false, [](test::GltfWriter& w, int, int camera) {
+  const auto file = write_scene("camera", Quad::Rigid, [](test::GltfWriter& w, int, int camera) {
     w.channel(camera, "translation", {0.0f, 1.0f}, {0, 0, 5, -1, 2, 5}, "VEC3", 3);
   });
   const double time = 0.25;
@@ -176,7 +190,7 @@ TEST_CASE("vector: a moving camera reprojects the still world point of each pixe
 
 TEST_CASE("vector: a morph target's moving vertices", "[session][vector]") {
   // The weight of a +1 x offset rises from 0 to 1 over 2 s: the vertices move +x at 0.5 per second.
-  const auto file = write_scene("morph", true, [](test::GltfWriter& w, int quad, int) {
+  const auto file = write_scene("morph", Quad::Morph, [](test::GltfWriter& w, int quad, int) {
     w.channel(quad, "weights", {0.0f, 2.0f}, {0, 1}, "SCALAR", 1);
   });
   const float step = float(0.5 / kFps) * pixels_per_unit();
@@ -186,12 +200,41 @@ TEST_CASE("vector: a morph target's moving vertices", "[session][vector]") {
   check_pixels(layers.vector, {0, 0, 5}, {0.5f, 0, 0}, expected);
 }
 
+TEST_CASE("vector: a skin stretching the quad moves each point by its share", "[session][vector]") {
+  // The right edge's joint moves +x at 1.5 units per second; the left edge stays. At time 1 the
+  // quad spans x in [-1, 2.5]; a point a fraction f of the way across moves f * 1.5 / fps.
+  const auto file = write_scene("skin", Quad::Skin, [](test::GltfWriter& w, int joint, int) {
+    w.channel(joint, "translation", {0.0f, 2.0f}, {0, 0, 0, 3, 0, 0}, "VEC3", 3);
+  });
+  const RenderLayers layers = render_vectors(file, 1.0);
+  REQUIRE(layers.vector.size() == size_t(kWidth) * kHeight * 4);
+  int on = 0;
+  float largest = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const Vec3f p = plane_point({0, 0, 5}, x, y);
+      if (!(p.x > -0.9f && p.x < 2.4f && std::abs(p.y) < 0.9f)) continue;
+      ++on;
+      const float f = (p.x + 1) / 3.5f;
+      const float step = f * float(1.5 / kFps) * pixels_per_unit();
+      const size_t i = (size_t(y) * kWidth + size_t(x)) * 4;
+      INFO("pixel " << x << "," << y);
+      CHECK(std::abs(layers.vector[i] + step) < kTolerance);
+      CHECK(std::abs(layers.vector[i + 1]) < kTolerance);
+      CHECK(std::abs(layers.vector[i + 2] + step) < kTolerance);
+      CHECK(std::abs(layers.vector[i + 3]) < kTolerance);
+      largest = std::max(largest, step);
+    }
+  CHECK(on > 50);
+  CHECK(largest > 0.3f);
+}
+
 TEST_CASE("vector: still scenes and static renders give zero vectors", "[session][vector]") {
-  const auto still = write_scene("still", false, [](test::GltfWriter&, int, int) {});
+  const auto still = write_scene("still", Quad::Rigid, [](test::GltfWriter&, int, int) {});
   const float zero[4] = {0, 0, 0, 0};
   check_pixels(render_vectors(still, 2.0).vector, {0, 0, 5}, {0, 0, 0}, zero);
   // The static pose is no point of the timeline: zero, with a warning.
-  const auto moving = write_scene("static", false, [](test::GltfWriter& w, int quad, int) {
+  const auto moving = write_scene("static", Quad::Rigid, [](test::GltfWriter& w, int quad, int) {
     w.channel(quad, "translation", {0.0f, 2.0f}, {0, 0, 0, 3, 0, 0}, "VEC3", 3);
   });
   PreparedRender p;
@@ -203,8 +246,8 @@ TEST_CASE("vector: still scenes and static renders give zero vectors", "[session
 }
 
 TEST_CASE("vector: neighbouring frames that do not match the scene are an error", "[session][vector]") {
-  const auto file = write_scene("mismatch", false, [](test::GltfWriter&, int, int) {});
-  const auto other = write_scene("mismatch-other", true, [](test::GltfWriter& w, int, int) {
+  const auto file = write_scene("mismatch", Quad::Rigid, [](test::GltfWriter&, int, int) {});
+  const auto other = write_scene("mismatch-other", Quad::Morph, [](test::GltfWriter& w, int, int) {
     w.node({{"mesh", 0}, {"translation", {3, 0, 0}}});
   });
   LoadedScene loaded = load_gltf(file, {});
