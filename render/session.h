@@ -8,7 +8,8 @@
 //   render_image     prepared + structure -> RenderImage (the beauty through one integrator
 //                                            signature, with the path tracer's layers)
 //   render_layers    prepared + structure -> RenderLayers (data AOVs, Cryptomatte, cost map,
-//                                            from the beauty's own camera samples)
+//                                            from the beauty's own camera samples; motion
+//                                            vectors from the pixel centres)
 //
 // render_scene() runs them all on a Session (a loaded scene, its lock and the structure kept
 // between renders), as the Python module does. Writing files stays with the front ends.
@@ -105,10 +106,11 @@ struct PreparedRender {
 PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& options);
 
 /// The scene at `time` -/+ 1/spec.fps through options.load_at, each checked against `scene`
-/// (check_motion_frame) and its camera placed as `prepared` placed the render's (options.place
-/// with the same camera index, else the scene's camera, else framing its bounds) at the
-/// render's size. Throws InputError naming the time when a frame does not match the scene,
-/// std::invalid_argument when options.load_at is empty.
+/// (check_motion_frame), with its camera: the file's camera the render uses, as posed at that
+/// time (placed by options.place with the same index when given, at the render's size); a
+/// camera placed from the command line or framed from the bounds stays prepared.camera. Throws InputError
+/// naming the time when a frame does not match the scene, std::invalid_argument when options.load_at is
+/// empty.
 MotionFrames load_motion_frames(const Scene& scene, const PreparedRender& prepared, double time,
                                 const PrepareOptions& options);
 
