@@ -262,8 +262,8 @@ std::vector<SpecField> make_fields() {
        1e-3,
        1e6,
        {},
-       "frames per second: --frame N renders time N / fps, and the shutter is a fraction of 1 / fps (default "
-       "24)"},
+       "frames per second: --frame N renders time N / fps, the shutter is a fraction of 1 / fps, and --aov "
+       "vector's frames lie 1 / fps away (default 24)"},
       {"motion_blur",
        &S::motion_blur,
        kAnyIntegrator,

@@ -90,7 +90,11 @@ std::vector<float> render_motion_vectors(const Scene& scene, const Accelerator& 
         if (!intersect_visible(scene, accel, ray, hit, filter)) continue;
         // The surface point, kept in the terms each frame's scene re-evaluates.
         SurfacePoint sp{hit.geom_id, hit.prim_id, hit.u, hit.v, {}};
-        const Instance& inst = scene.instances[hit.geom_id];
+        // A shape's point through its instance as the ray met it (under motion blur, at the ray's
+        // time); its motion is measured from its frame pose, which is where the centre ray's
+        // time, the shutter's middle, places it unless the shutter is offset.
+        Instance moving;
+        const Instance& inst = instance_at(scene, hit.geom_id, ray.time, moving);
         if (inst.shape >= 0) sp.object = apply_point(inst.to_object, ray.org + ray.dir * hit.t);
         // Where it is now (the projection of the point itself, not the pixel centre, so that
         // a still surface under a still camera moves by exactly 0) and in each frame.
