@@ -3,8 +3,8 @@
 # a translation animation at 1.5 units per second, seen by a still camera 5 units away): the EXR
 # holds vector.X, .Y, .Z, .W; on the quad X and Z equal minus the displacement of one frame in
 # pixels (computed here from the pinhole formula) for each integrator, twice as large at half
-# the --fps; Y and W are 0; the background is 0; a render without --time or --frame warns and
-# writes zeros; --help lists the layer.
+# the --fps, and the same with --motion-blur; Y and W are 0; the background is 0; a render
+# without --time or --frame warns and writes zeros; --help lists the layer.
 # Usage: vector_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -84,6 +84,13 @@ expect 0 "" -- "$bin" render "$work/slide.gltf" -o "$work/fps12.exr" --width 48 
 want=$(python3 -c "print(-$(step 12))")
 got=$(mean "$work/fps12.exr" vector.X 34 14)
 near "$got" "$want" && passes=$((passes + 1)) || fail "--fps 12: vector.X is $got, want $want"
+
+# With motion blur the layer is the same: the centre ray meets the scene at the frame's time.
+expect 0 "" -- "$bin" render "$work/slide.gltf" -o "$work/blur.exr" --width 48 --height 32 --spp 2 --accel bvh \
+  --frame 24 --aov vector --motion-blur
+want=$(python3 -c "print(-$(step 24))")
+got=$(mean "$work/blur.exr" vector.X 34 14)
+near "$got" "$want" && passes=$((passes + 1)) || fail "--motion-blur: vector.X is $got, want $want"
 
 # The static pose: a warning, and zeros.
 expect 0 "vector layer.*static pose" -- "$bin" render "$work/slide.gltf" -o "$work/static.exr" --width 48 \

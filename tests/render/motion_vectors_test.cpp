@@ -229,6 +229,43 @@ TEST_CASE("vector: a skin stretching the quad moves each point by its share", "[
   CHECK(largest > 0.3f);
 }
 
+TEST_CASE("vector: EXT_mesh_gpu_instancing copies follow their animated node", "[session][vector]") {
+  // Two copies of a 0.8-wide quad at x = -1.5 and +1.5 under a node rising at 1.5 units per
+  // second: every copy moves up 1.5 / fps a frame (Y = W = minus that, in pixels).
+  test::GltfWriter w;
+  const int pos = w.positions({-0.4f, -0.4f, 0, 0.4f, -0.4f, 0, 0.4f, 0.4f, 0, -0.4f, 0.4f, 0});
+  const int mesh = w.mesh(pos, w.indices(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}));
+  const int copies = w.floats({-1.5f, 0, 0, 1.5f, 0, 0}, "VEC3", 3);
+  nlohmann::json node = {{"mesh", mesh}};
+  node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = {{"TRANSLATION", copies}};
+  const int moved = w.node(node);
+  w.j["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  w.j["cameras"] = {
+      {{"type", "perspective"}, {"perspective", {{"yfov", kYfov}, {"znear", 0.1}, {"aspectRatio", 1.5}}}}};
+  w.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+  w.channel(moved, "translation", {0.0f, 2.0f}, {0, 0, 0, 0, 3, 0}, "VEC3", 3);
+  const auto file = test::temp_dir("vector-instancing") / "instancing.gltf";
+  w.write_embedded(file);
+  // At time 0.2 the copies are centred at (-+1.5, 0.3).
+  const RenderLayers layers = render_vectors(file, 0.2);
+  REQUIRE(layers.vector.size() == size_t(kWidth) * kHeight * 4);
+  const float step = float(1.5 / kFps) * pixels_per_unit();
+  int on = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const Vec3f p = plane_point({0, 0, 5}, x, y);
+      const bool inside = std::abs(std::abs(p.x) - 1.5f) < 0.3f && std::abs(p.y - 0.3f) < 0.3f;
+      const bool outside = std::abs(std::abs(p.x) - 1.5f) > 0.5f || std::abs(p.y - 0.3f) > 0.5f;
+      if (!inside && !outside) continue;
+      on += inside;
+      const float want[4] = {0, inside ? -step : 0, 0, inside ? -step : 0};
+      const size_t i = (size_t(y) * kWidth + size_t(x)) * 4;
+      INFO("pixel " << x << "," << y);
+      for (int c = 0; c < 4; ++c) CHECK(std::abs(layers.vector[i + size_t(c)] - want[c]) < kTolerance);
+    }
+  CHECK(on > 20);
+}
+
 TEST_CASE("vector: still scenes and static renders give zero vectors", "[session][vector]") {
   const auto still = write_scene("still", Quad::Rigid, [](test::GltfWriter&, int, int) {});
   const float zero[4] = {0, 0, 0, 0};
