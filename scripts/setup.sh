@@ -50,7 +50,7 @@ case "$mode" in
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
       cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests render_tests
       ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|cli\.blender_dof|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\.|layout\."
+        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|cli\.blender_dof|cli\.vector|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\.|layout\."
     fi
     ;;
 esac
