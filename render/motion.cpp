@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "io/files/error.h"
+#include "renderer/integrators/motion_vectors.h"
 #include "renderer/scene/camera.h"
 
 namespace penumbra {
@@ -31,45 +32,122 @@ bool moves(const std::vector<Affine3f>& maps) {
 
 }  // namespace
 
+namespace {
+
+/// The scene at every step of the shutter: each instance's map, each camera's frame, and (from
+/// loaded frames) each mesh's positions and normals, step after step.
+struct ShutterSteps {
+  std::vector<std::vector<Affine3f>> maps, frames;
+  std::vector<std::vector<Vec3f>> positions, normals;
+  bool cameras = true;  ///< every step has the scene's cameras
+};
+
+void record_step(const Scene& at, bool vertices, ShutterSteps& out) {
+  for (size_t i = 0; i < at.instances.size(); ++i) out.maps[i].push_back(at.instances[i].to_world);
+  out.cameras = out.cameras && at.cameras.size() == out.frames.size();
+  for (size_t i = 0; out.cameras && i < at.cameras.size(); ++i)
+    out.frames[i].push_back(camera_frame(at.cameras[i]));
+  if (!vertices) return;
+  for (size_t m = 0; m < at.meshes.size(); ++m) {
+    const Mesh& mesh = at.meshes[m];
+    out.positions[m].insert(out.positions[m].end(), mesh.positions.begin(), mesh.positions.end());
+    out.normals[m].insert(out.normals[m].end(), mesh.normals.begin(), mesh.normals.end());
+  }
+}
+
+/// The steps by posing the kept animation; false (the scene posed back at `frame_time`) when it
+/// cannot pose every step.
+bool pose_steps(LoadedScene& loaded, const Shutter& s, int steps, double frame_time, const std::string& file,
+                ShutterSteps& out) {
+  if (!loaded.animation) return false;
+  bool posed = true;
+  for (int k = 0; k < steps && posed; ++k) {
+    const double t = s.open + (s.close - s.open) * double(k) / double(steps - 1);
+    posed = pose_gltf_scene(*loaded.animation, t, loaded.scene);
+    if (posed) record_step(loaded.scene, false, out);
+  }
+  if (!pose_gltf_scene(*loaded.animation, frame_time, loaded.scene))
+    throw InputError(file, "motion blur", "the scene cannot be posed back at the frame's time");
+  return posed;
+}
+
+/// The steps from the file loaded at each step's time, each checked against the scene.
+void load_steps(const Scene& scene, const Shutter& s, int steps, const std::string& file,
+                const LoadAtTime& load_at, ShutterSteps& out) {
+  if (!load_at)
+    throw InputError(file, "motion blur",
+                     "the scene's animation deforms meshes (skins or morph targets) or was not kept with the "
+                     "scene, and this front end cannot load the file at the shutter's times");
+  for (int k = 0; k < steps; ++k) {
+    const double t = s.open + (s.close - s.open) * double(k) / double(steps - 1);
+    const LoadedScene frame = load_at(t);
+    const std::string why = check_motion_frame(scene, frame.scene);
+    if (!why.empty()) {
+      char at[64];
+      std::snprintf(at, sizeof at, "the scene at %.9g s", t);
+      throw InputError(file, at, "motion blur cannot follow the scene to this time (" + why + ")");
+    }
+    record_step(frame.scene, true, out);
+  }
+}
+
+template <class T>
+bool differ(const std::vector<T>& keys, size_t count) {
+  for (size_t i = count; i < keys.size(); ++i)
+    if (std::memcmp(&keys[i], &keys[i % count], sizeof(T)) != 0) return true;
+  return false;
+}
+
+}  // namespace
+
 std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double frame_time,
-                             const std::string& file) {
+                             const std::string& file, const LoadAtTime& load_at) {
   Scene& scene = loaded.scene;
   scene.instance_motion.clear();
   for (Camera& c : scene.cameras) c.motion.clear();
+  for (Mesh& m : scene.meshes) {
+    m.motion_positions = {};
+    m.motion_normals = {};
+    m.motion_steps = 0;
+  }
   if (!spec.motion_blur) return "";
   const Shutter s = shutter_interval(spec, frame_time);
   char text[64];
   std::snprintf(text, sizeof text, "%.17g..%.17g", s.open, s.close);
   if (loaded.info.animation_count == 0) return text;  // nothing moves
-  if (!loaded.animation)
-    throw InputError(
-        file, "motion blur",
-        "the scene's animation cannot be posed over the shutter: it deforms meshes (skins or morph "
-        "targets), which motion blur does not cover, or the scene was loaded without a time and "
-        "its animation kept");
   const int steps = spec.motion_steps;
-  std::vector<std::vector<Affine3f>> maps(scene.instances.size()), frames(scene.cameras.size());
-  for (int k = 0; k < steps; ++k) {
-    const double t = s.open + (s.close - s.open) * double(k) / double(steps - 1);
-    if (!pose_gltf_scene(*loaded.animation, t, scene))
-      throw InputError(file, "motion blur",
-                       "the animation deforms meshes (skins or morph targets): only moving nodes, instances, "
-                       "cameras and their transforms are blurred");
-    for (size_t i = 0; i < scene.instances.size(); ++i) maps[i].push_back(scene.instances[i].to_world);
-    for (size_t i = 0; i < scene.cameras.size(); ++i) frames[i].push_back(camera_frame(scene.cameras[i]));
+  const auto fresh = [&] {
+    ShutterSteps st;
+    st.maps.resize(scene.instances.size());
+    st.frames.resize(scene.cameras.size());
+    st.positions.resize(scene.meshes.size());
+    st.normals.resize(scene.meshes.size());
+    return st;
+  };
+  ShutterSteps st = fresh();
+  if (!pose_steps(loaded, s, steps, frame_time, file, st)) {
+    st = fresh();
+    load_steps(scene, s, steps, file, load_at, st);
   }
-  if (!pose_gltf_scene(*loaded.animation, frame_time, scene))
-    throw InputError(file, "motion blur", "the scene cannot be posed back at the frame's time");
   scene.instance_motion.resize(scene.instances.size());
   bool any = false;
-  for (size_t i = 0; i < maps.size(); ++i) {
-    if (!moves(maps[i])) continue;
-    scene.instance_motion[i] = make_motion_keys(maps[i]);
+  for (size_t i = 0; i < st.maps.size(); ++i) {
+    if (!moves(st.maps[i])) continue;
+    scene.instance_motion[i] = make_motion_keys(st.maps[i]);
     any = true;
   }
   if (!any) scene.instance_motion.clear();
-  for (size_t i = 0; i < frames.size(); ++i)
-    if (moves(frames[i])) scene.cameras[i].motion = make_motion_keys(frames[i]);
+  for (size_t i = 0; st.cameras && i < st.frames.size(); ++i)
+    if (moves(st.frames[i])) scene.cameras[i].motion = make_motion_keys(st.frames[i]);
+  for (size_t m = 0; m < st.positions.size(); ++m) {
+    Mesh& mesh = scene.meshes[m];
+    const size_t n = mesh.positions.size();
+    if (n == 0 || st.positions[m].size() != n * size_t(steps) || !differ(st.positions[m], n)) continue;
+    mesh.motion_positions = std::move(st.positions[m]);
+    if (st.normals[m].size() == mesh.normals.size() * size_t(steps))
+      mesh.motion_normals = std::move(st.normals[m]);
+    mesh.motion_steps = uint32_t(steps);
+  }
   return text;
 }
 

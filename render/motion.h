@@ -3,12 +3,18 @@
 // before a render with RenderSpec::motion_blur.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "io/gltf/loader.h"
 #include "render/spec.h"
 
 namespace penumbra {
+
+/// Loads the render's scene file posed at `time` seconds, with the options the render's own
+/// scene was loaded with (the vector layer's neighbouring frames, the steps of deformation
+/// motion blur). Throws as load_gltf does.
+using LoadAtTime = std::function<LoadedScene(double time)>;
 
 /// When a frame's shutter is open, in seconds.
 struct Shutter {
@@ -19,16 +25,20 @@ struct Shutter {
 /// long, centred spec.shutter_offset frames after the frame's time (centred on it by default).
 Shutter shutter_interval(const RenderSpec& spec, double frame_time);
 
-/// With spec.motion_blur, fills loaded.scene.instance_motion: the scene posed at
-/// spec.motion_steps times spread evenly over the shutter (key k at open + k (close - open) /
-/// (steps - 1), which Ray::time k / (steps - 1) meets), each instance whose map changes given its
-/// maps as keys (make_motion_keys), and the scene posed back at `frame_time`; without it, or
-/// when the file has no animation, clears it. Returns the shutter as the render identity records
+/// With spec.motion_blur, fills the scene's motion over the shutter from the scene posed at
+/// spec.motion_steps times spread evenly over it (key k at open + k (close - open) / (steps - 1),
+/// which Ray::time k / (steps - 1) meets): each instance whose map changes gets its maps as keys
+/// (Scene::instance_motion, make_motion_keys), each file camera that moves its frames
+/// (Camera::motion), and each mesh whose vertices move (skins, morph targets) its positions and
+/// normals at every step (Mesh::motion_positions, motion_normals). A file whose animation moves
+/// only placements is posed by pose_gltf_scene and posed back at `frame_time`; one that deforms
+/// meshes, or whose animation was not kept, is loaded at each step's time through `load_at`,
+/// each load checked against the scene (check_motion_frame). Without motion blur, or when the
+/// file has no animation, clears all of it. Returns the shutter as the render identity records
 /// it ("open..close" seconds; empty without motion blur). Throws InputError(file, "motion blur")
-/// when the file's animation cannot be posed that way: it deforms meshes (skins, morph targets),
-/// which this motion blur does not cover, or the scene was loaded without a time and
-/// GltfLoadOptions::keep_animation (LoadedScene::animation is null for both).
+/// when the animation cannot be followed: no kept animation and no `load_at`, or a step's load
+/// with other meshes or instances than the scene; and whatever `load_at` throws.
 std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double frame_time,
-                             const std::string& file);
+                             const std::string& file, const LoadAtTime& load_at = {});
 
 }  // namespace penumbra

@@ -407,7 +407,8 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   options.env_budget = env_budget;
   options.area_lights = session.area_lights;
   validate(spec);
-  options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file);
+  options.identity.shutter =
+      set_scene_motion(session.loaded, spec, session.time, session.file, session.load_at);
   options.time = session.loaded_at_time ? std::optional<double>(session.time) : std::nullopt;
   options.load_at = session.load_at;
   RenderResult r;

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "io/gltf/loader.h"
+#include "render/motion.h"
 #include "render/spec.h"
 #include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
@@ -45,10 +46,6 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
 /// Places the camera once the image size is known: from the scene's camera `index` (-1: none).
 /// The default places the scene's camera as it is, or frames the scene's bounds.
 using PlaceCamera = std::function<Camera(const Scene& scene, int index, int width, int height)>;
-
-/// Loads the render's scene file posed at `time` seconds, with the options the render's own
-/// scene was loaded with (the vector layer's neighbouring frames). Throws as load_gltf does.
-using LoadAtTime = std::function<LoadedScene(double time)>;
 
 /// What prepare_render needs besides the spec and the scene.
 struct PrepareOptions {
@@ -213,7 +210,7 @@ struct RenderResult {
 };
 
 /// One render of the session's scene (locking it): the scene's motion over the shutter around
-/// session.time (set_scene_motion, cleared without motion blur), prepare_render,
+/// session.time (set_scene_motion through session.load_at, cleared without motion blur), prepare_render,
 /// build_structure (kept for the next render with the same name and parameters), render_image,
 /// render_layers, and the default key light removed again however it ends. `env_budget` as in
 /// PrepareOptions.

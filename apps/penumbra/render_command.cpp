@@ -191,12 +191,12 @@ void setup_phase(RenderJob& job) {
   o.place = [&](const Scene& sc, int index, int w, int h) { return choose_camera(q.rig, sc, index, w, h); };
   o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
   o.identity = scene_identity(a, q, job.scene_sha256);
-  o.identity.shutter = set_scene_motion(job.loaded, spec, q.time.value_or(0), a.scene_file);
   o.time = q.time;
   o.load_at = [&](double t) {
     return load_scene(a.scene_file, a.scene, a.allow_external, a.flatten, q.budget, true, t, false,
                       a.variant);
   };
+  o.identity.shutter = set_scene_motion(job.loaded, spec, q.time.value_or(0), a.scene_file, o.load_at);
   job.prepared = prepare_render(job.loaded, spec, o);
   if (a.quiet) return;
   if (job.progress == ProgressMode::Json)

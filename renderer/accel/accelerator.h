@@ -26,6 +26,15 @@ struct GeometryView {
   std::span<const Vec3f> positions;
   std::span<const uint32_t> indices;  ///< 3 per triangle, each < positions.size()
   const Shape* shape = nullptr;       ///< a shape instead of triangles (positions, indices unused)
+  /// Deformation motion blur: `motion_steps` >= 2 copies of the positions (step after step,
+  /// motion_steps x positions.size() entries) spread evenly over Ray::time 0 to 1, each vertex
+  /// linearly interpolated between the two steps around a ray's time (interpolate_vertex). 0 (and
+  /// no motion_positions): the mesh stays as `positions` has it, which is then only its frame-time
+  /// pose for the data that has no ray time.
+  std::span<const Vec3f> motion_positions;
+  uint32_t motion_steps = 0;
+
+  bool deforms() const { return motion_steps >= 2 && !shape; }
 };
 
 /// One placement of a geometry: the mesh's triangles (or the shape) mapped by `to_world` (object

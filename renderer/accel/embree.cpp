@@ -76,25 +76,38 @@ void throw_if_error(const char* what) {
 
 /// A new triangle geometry holding a copy of `mesh` (an empty mesh gets one degenerate triangle,
 /// which is never hit, so it still occupies its id), committed and attached to `scene` as `id`.
+/// A deforming mesh gets one vertex buffer per time step (rtcSetGeometryTimeStepCount), which
+/// Embree interpolates linearly at each ray's time.
 void attach_triangles(RTCScene scene, const GeometryView& mesh, unsigned id) {
   RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_TRIANGLE);
   const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        sizeof(float) * 3, nv ? nv : 1));
-  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             sizeof(uint32_t) * 3, nt ? nt : 1));
-  if (!v || !idx) {
+  const unsigned steps = mesh.deforms() && nv && nt ? mesh.motion_steps : 1;
+  if (steps > 1) rtcSetGeometryTimeStepCount(geom, steps);
+  bool allocated = true;
+  for (unsigned k = 0; k < steps; ++k) {
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, k, RTC_FORMAT_FLOAT3,
+                                                          sizeof(float) * 3, nv ? nv : 1));
+    allocated = allocated && v;
+    if (!v) break;
+    if (!nv || !nt)
+      std::memset(v, 0, sizeof(float) * 3);
+    else
+      std::memcpy(v, (steps > 1 ? mesh.motion_positions.data() + k * nv : mesh.positions.data()),
+                  nv * sizeof(float) * 3);
+  }
+  auto* idx = allocated
+                  ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+                        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, nt ? nt : 1))
+                  : nullptr;
+  if (!idx) {
     rtcReleaseGeometry(geom);
     throw_if_error("allocating geometry buffers");
     throw std::runtime_error("embree: allocating geometry buffers failed");
   }
-  if (nv) std::memcpy(v, mesh.positions.data(), nv * sizeof(float) * 3);
-  if (nt) {
+  if (nv && nt)
     std::memcpy(idx, mesh.indices.data(), nt * sizeof(uint32_t) * 3);
-  } else {
-    std::memset(v, 0, sizeof(float) * 3);
-    std::memset(idx, 0, sizeof(uint32_t) * 3);
-  }
+  else
+    std::memset(idx, 0, sizeof(uint32_t) * 3 * (nt ? nt : 1));
   rtcCommitGeometry(geom);
   rtcAttachGeometryByID(scene, geom, id);
   rtcReleaseGeometry(geom);

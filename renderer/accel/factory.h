@@ -31,7 +31,9 @@ struct AccelConfig {
 /// Names accepted by make_accelerator, default ("embree") first.
 std::vector<std::string> accelerator_names();
 
-/// Builds the named back end over `meshes`. Every back end except "brute" copies what it needs;
+/// Builds the named back end over `meshes`. Deforming meshes (GeometryView::deforms()) go to
+/// Embree's multi-step geometry, or for the other back ends to the time-aware structure of
+/// accel/deforming.h under a top level. Every back end except "brute" copies what it needs;
 /// for "brute" the meshes must outlive the accelerator. Throws std::invalid_argument for an
 /// unknown name or an invalid configuration, std::runtime_error if the build fails (the message
 /// names the back end).

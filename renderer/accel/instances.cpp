@@ -9,6 +9,7 @@
 
 #include "renderer/accel/bvh_build.h"
 #include "renderer/accel/common.h"
+#include "renderer/accel/deforming.h"
 #include "renderer/accel/stats.h"
 
 namespace penumbra {
@@ -17,18 +18,20 @@ namespace {
 class TwoLevelAccelerator final : public Accelerator {
  public:
   TwoLevelAccelerator(const AcceleratorBuilder& build, std::span<const GeometryView> meshes,
-                      std::span<const InstanceView> instances) {
+                      std::span<const InstanceView> instances, const DeformingConfig& deforming) {
     validate_instances(instances, meshes.size());
     const BuildTimer timer;
-    std::vector<GeometryView> world;
+    std::vector<GeometryView> world, deforming_world;
     std::vector<int> object_of(meshes.size(), -1), shape_of(meshes.size(), -1);
     for (size_t i = 0; i < instances.size(); ++i) {
       const InstanceView& inst = instances[i];
       m_layout.add(inst);
       const InstanceKind kind = m_layout.kinds.back();
+      const bool deforms = meshes[inst.mesh].deforms();
       if (kind == InstanceKind::Identity) {
-        world.push_back(meshes[inst.mesh]);
-        m_world_ids.push_back(uint32_t(i));
+        // In world space: the back end's world level, or the deforming meshes' own.
+        (deforms ? deforming_world : world).push_back(meshes[inst.mesh]);
+        (deforms ? m_deforming_ids : m_world_ids).push_back(uint32_t(i));
         continue;
       }
       if (kind == InstanceKind::Singular) continue;  // never hit
@@ -55,16 +58,28 @@ class TwoLevelAccelerator final : public Accelerator {
       int& object = object_of[inst.mesh];
       if (object < 0) {
         object = int(m_levels.size());
-        m_levels.push_back(build(meshes.subspan(inst.mesh, 1)));
+        // A deforming mesh gets the time-aware structure.
+        m_levels.push_back(deforms ? make_deforming_accelerator(meshes.subspan(inst.mesh, 1), deforming)
+                                   : build(meshes.subspan(inst.mesh, 1)));
         m_level_mesh.push_back(inst.mesh);
+        m_level_deforms.push_back(deforms);
+        if (!deforms) m_built_level = true;
       }
       m_items.push_back({uint32_t(object), uint32_t(i), to_object,
                          world_box(inst, motion, m_levels[size_t(object)]->bounds()), 0, motion});
       ++m_instances;
     }
-    if (!world.empty() || m_levels.empty()) {  // an empty world level still names the back end
+    if (!deforming_world.empty()) {
+      m_levels.push_back(make_deforming_accelerator(deforming_world, deforming));
+      m_level_mesh.push_back(kWorld);
+      m_level_deforms.push_back(1);
+      m_items.push_back(
+          {uint32_t(m_levels.size() - 1), kDeformingWorld, Affine3f{}, m_levels.back()->bounds()});
+    }
+    if (!world.empty() || !m_built_level) {  // an empty world level still names the back end
       m_levels.push_back(build(world));
       m_level_mesh.push_back(kWorld);
+      m_level_deforms.push_back(0);
       m_items.push_back({uint32_t(m_levels.size() - 1), kWorld, Affine3f{}, m_levels.back()->bounds()});
     }
     for (const auto& level : m_levels) m_stats_bottom.push_back(level->stats());
@@ -112,12 +127,12 @@ class TwoLevelAccelerator final : public Accelerator {
     if (!m_layout.matches(instances)) return false;
     const BuildTimer timer;
     for (Item& item : m_items) {
-      if (item.instance == kWorld) continue;
+      if (in_world(item.instance)) continue;
       const InstanceView& inst = instances[item.instance];
       if ((item.motion == kStill) != inst.motion.empty()) return false;  // checked before any change
     }
     for (Item& item : m_items) {
-      if (item.instance == kWorld) continue;
+      if (in_world(item.instance)) continue;
       const InstanceView& inst = instances[item.instance];
       inverse(inst.to_world, item.to_object);
       if (item.motion != kStill) m_motion[item.motion].assign(inst.motion.begin(), inst.motion.end());
@@ -165,10 +180,12 @@ class TwoLevelAccelerator final : public Accelerator {
 
   AccelStats stats() const override {
     AccelStats s;
-    if (!m_stats_bottom.empty()) {
-      s.name = m_stats_bottom.front().name;
-      s.config = m_stats_bottom.front().config;
-    }
+    for (size_t l = 0; l < m_levels.size(); ++l)
+      if (!m_level_deforms[l]) {  // the back end's own levels name it
+        s.name = m_stats_bottom[l].name;
+        s.config = m_stats_bottom[l].config;
+        break;
+      }
     s.instances = m_instances;
     s.shapes = m_shapes.size();  // placed shapes; the levels add the world's
     uint64_t bottom_depth = 0;
@@ -194,9 +211,10 @@ class TwoLevelAccelerator final : public Accelerator {
   }
 
  private:
-  static constexpr uint32_t kWorld = 0xffffffffu;       // Item::instance of the world-space level
-  static constexpr uint32_t kShapeLevel = 0xffffffffu;  // Item::level of a placed shape
-  static constexpr uint32_t kStill = 0xffffffffu;       // Item::motion of an item that stays put
+  static constexpr uint32_t kWorld = 0xffffffffu;           // Item::instance of the world-space level
+  static constexpr uint32_t kDeformingWorld = 0xfffffffeu;  // ... of the world's deforming meshes
+  static constexpr uint32_t kShapeLevel = 0xffffffffu;      // Item::level of a placed shape
+  static constexpr uint32_t kStill = 0xffffffffu;           // Item::motion of an item that stays put
 
   struct Item {
     uint32_t level;     // index into m_levels, or kShapeLevel
@@ -232,8 +250,10 @@ class TwoLevelAccelerator final : public Accelerator {
 
   /// The instance index a hit of item `instance`'s bottom level reports as geom_id.
   uint32_t instance_of(uint32_t instance, uint32_t level_geom_id) const {
-    return instance == kWorld ? m_world_ids[level_geom_id] : instance;
+    if (instance == kWorld) return m_world_ids[level_geom_id];
+    return instance == kDeformingWorld ? m_deforming_ids[level_geom_id] : instance;
   }
+  static bool in_world(uint32_t instance) { return instance == kWorld || instance == kDeformingWorld; }
 
   void build_top() {
     std::vector<BvhBuildRef> refs;
@@ -290,7 +310,7 @@ class TwoLevelAccelerator final : public Accelerator {
               if (!inverse(interpolate_motion(m_motion[item.motion], ray.time), to_object)) continue;
               local.org = apply_point(to_object, ray.org);
               local.dir = apply_vector(to_object, ray.dir);
-            } else if (item.instance != kWorld) {
+            } else if (!in_world(item.instance)) {
               local.org = apply_point(item.to_object, ray.org);
               local.dir = apply_vector(item.to_object, ray.dir);
             }
@@ -336,7 +356,10 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<std::unique_ptr<Accelerator>> m_levels;  // bottom levels: per mesh, then world
   std::vector<Shape> m_shapes;                         // the placed shapes, one copy per view
   std::vector<uint32_t> m_world_ids;                   // world level's geom_id -> instance index
+  std::vector<uint32_t> m_deforming_ids;               // the same for the world's deforming meshes
   std::vector<uint32_t> m_level_mesh;                  // each bottom level's mesh, or kWorld
+  std::vector<uint8_t> m_level_deforms;                // each bottom level is a deforming mesh's
+  bool m_built_level = false;                          // some bottom level is the back end's own
   std::vector<uint32_t> m_shape_mesh;                  // each placed shape's mesh (view)
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<std::vector<MotionKey>> m_motion;        // the moving items' keys
@@ -362,8 +385,9 @@ void validate_instances(std::span<const InstanceView> instances, size_t mesh_cou
 
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
                                                         std::span<const GeometryView> meshes,
-                                                        std::span<const InstanceView> instances) {
-  return std::make_unique<TwoLevelAccelerator>(build, meshes, instances);
+                                                        std::span<const InstanceView> instances,
+                                                        const DeformingConfig& deforming) {
+  return std::make_unique<TwoLevelAccelerator>(build, meshes, instances, deforming);
 }
 
 }  // namespace penumbra

@@ -12,6 +12,7 @@
 #include <span>
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/accel/deforming.h"
 
 namespace penumbra {
 
@@ -23,13 +24,17 @@ using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<
 /// parameterisation: the direction is mapped, not normalised). `build` makes every bottom level:
 /// one per mesh used by a non-identity instance, and one over the identity instances' views
 /// (built even when empty). A shape placed by a non-identity instance has no bottom level: the
-/// top level's leaf maps the ray and calls the shape test itself. Instances with a singular or
+/// top level's leaf maps the ray and calls the shape test itself. A deforming mesh
+/// (GeometryView::deforms()) gets the structure of accel/deforming.h with `deforming`'s
+/// parameters instead of `build`'s, placed under the top level even by the identity, its box
+/// that of the whole shutter. Instances with a singular or
 /// non-finite map are left out. Throws std::invalid_argument if an instance names a mesh outside
 /// `meshes`, and whatever `build` throws. update_instances() keeps every bottom level and builds
 /// the top level again over the instances' new world boxes.
 std::unique_ptr<Accelerator> make_two_level_accelerator(const AcceleratorBuilder& build,
                                                         std::span<const GeometryView> meshes,
-                                                        std::span<const InstanceView> instances);
+                                                        std::span<const InstanceView> instances,
+                                                        const DeformingConfig& deforming = {});
 
 /// Throws std::invalid_argument naming the instance if it refers to a mesh outside `mesh_count`.
 void validate_instances(std::span<const InstanceView> instances, size_t mesh_count);

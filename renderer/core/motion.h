@@ -1,7 +1,8 @@
 // Transform motion over a shutter: keys decomposed as Embree's quaternion motion blur does
 // (M = T * R * U: a translation, a unit quaternion and an upper-triangular scale-and-shear
 // matrix), interpolated per ray time with T and U linear and R by slerp, so that rotations blur
-// along arcs rather than chords; and conservative bounds of a box moved that way.
+// along arcs rather than chords; conservative bounds of a box moved that way; and the linear
+// interpolation of deforming vertices between their time steps.
 #pragma once
 
 #include <span>
@@ -42,5 +43,28 @@ Affine3f interpolate_motion(std::span<const MotionKey> keys, float time);
 /// at 16 steps per key interval, padded by the arc a corner may bulge out between steps
 /// (conservative). Empty for an empty box.
 Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b);
+
+/// Where `time` in [0, 1] (clamped; NaN as 0) falls among `steps` >= 2 time steps spaced
+/// evenly over [0, 1]: between step `k` and k + 1, at fraction `a` of the way, k <= steps - 2.
+/// Embree interpolates its multi-step geometry the same way (linearly between the two steps).
+struct MotionSegment {
+  uint32_t k = 0;
+  float a = 0;
+};
+inline MotionSegment motion_segment(float time, uint32_t steps) {
+  const float t = time > 0 ? (time < 1 ? time : 1.0f) : 0.0f;
+  const float f = t * float(steps - 1);
+  uint32_t k = uint32_t(f);
+  if (k > steps - 2) k = steps - 2;
+  return {k, f - float(k)};
+}
+
+/// Vertex `i` of a deforming mesh at `time`: `keys` holds `steps` copies of its `count`
+/// vertices, step after step, linearly interpolated between the two steps around `time`.
+inline Vec3f interpolate_vertex(const Vec3f* keys, size_t count, uint32_t steps, size_t i, float time) {
+  const MotionSegment s = motion_segment(time, steps);
+  const Vec3f p0 = keys[size_t(s.k) * count + i], p1 = keys[size_t(s.k + 1) * count + i];
+  return p0 * (1.0f - s.a) + p1 * s.a;
+}
 
 }  // namespace penumbra

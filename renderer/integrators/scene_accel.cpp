@@ -6,7 +6,13 @@ namespace penumbra {
 std::vector<GeometryView> mesh_views(const Scene& scene) {
   std::vector<GeometryView> views;
   views.reserve(scene.meshes.size() + scene.shapes.size());
-  for (const auto& m : scene.meshes) views.push_back({m.positions, m.indices});
+  for (const auto& m : scene.meshes) {
+    views.push_back({m.positions, m.indices});
+    if (m.motion_steps >= 2) {
+      views.back().motion_positions = m.motion_positions;
+      views.back().motion_steps = m.motion_steps;
+    }
+  }
   for (const auto& s : scene.shapes) views.push_back({{}, {}, &s.shape});
   return views;
 }

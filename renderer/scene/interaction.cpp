@@ -91,7 +91,7 @@ Vec3f spawn_origin(const SurfaceInteraction& si, Vec3f dir) {
 Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
   Instance posed;
   const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
-  if (inst.shape < 0) return world_triangle(scene, inst, hit.prim_id).ng;
+  if (inst.shape < 0) return world_triangle(scene, inst, hit.prim_id, ray.time).ng;
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   float world_tol = 0;
   const Vec3f p = shape_hit_point(ss, inst, ray, hit.t, world_tol);
@@ -103,7 +103,7 @@ SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hi
   Instance posed;
   const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
   if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
-  return make_interaction(scene, ray, hit, world_triangle(scene, inst, hit.prim_id));
+  return make_interaction(scene, ray, hit, world_triangle(scene, inst, hit.prim_id, ray.time));
 }
 
 SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hit& hit,
@@ -126,8 +126,10 @@ SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hi
   if (!(dot(si.ng, si.ng) > 0)) si.ng = normalize(-ray.dir);
   Vec3f ns = si.ng;
   if (!mesh.normals.empty()) {
-    ns = normalize(world_normal(inst, mesh.normals[i0]) * w + world_normal(inst, mesh.normals[i1]) * hit.u +
-                   world_normal(inst, mesh.normals[i2]) * hit.v);
+    const float t = ray.time;
+    ns = normalize(world_normal(inst, mesh_normal(mesh, i0, t)) * w +
+                   world_normal(inst, mesh_normal(mesh, i1, t)) * hit.u +
+                   world_normal(inst, mesh_normal(mesh, i2, t)) * hit.v);
     if (!(dot(ns, ns) > 0)) ns = si.ng;
   }
   auto lerp2 = [&](const std::vector<Vec2f>& t) -> Vec2f {
@@ -213,9 +215,9 @@ void barycentric_derivatives(const Scene& scene, SurfaceInteraction& si, Vec2f b
     si.duvdy[1] = deriv2(mesh.uvs1, by);
   }
   if (!mesh.normals.empty()) {
-    const Vec3f n0 = world_normal(inst, mesh.normals[i0]);
-    const Vec3f n1 = world_normal(inst, mesh.normals[i1]) - n0,
-                n2 = world_normal(inst, mesh.normals[i2]) - n0;
+    const Vec3f n0 = world_normal(inst, mesh_normal(mesh, i0, si.time));
+    const Vec3f n1 = world_normal(inst, mesh_normal(mesh, i1, si.time)) - n0,
+                n2 = world_normal(inst, mesh_normal(mesh, i2, si.time)) - n0;
     const float s = si.back_face ? -1.0f : 1.0f;  // si.ns was face-forwarded
     si.dndx = (n1 * bx.x + n2 * bx.y) * s;
     si.dndy = (n1 * by.x + n2 * by.y) * s;

@@ -104,7 +104,7 @@ uint64_t scene_memory_bytes(const Scene& scene) {
   uint64_t total = bytes(scene.instances) + bytes(scene.materials) + bytes(scene.lights);
   for (const Mesh& m : scene.meshes)
     total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
-             bytes(m.colors) + bytes(m.indices);
+             bytes(m.colors) + bytes(m.indices) + bytes(m.motion_positions) + bytes(m.motion_normals);
   total += bytes(scene.shapes);
   for (const SceneShape& s : scene.shapes) {
     total += bytes(s.shape.sdf.nodes) + bytes(s.shape.sdf.planes) + bytes(s.shape.sdf.displacements);
@@ -135,6 +135,29 @@ WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t 
   t.ng = triangle_normal(t.p[0], t.p[1], t.p[2]);
   if (inst.mirrored) t.ng = -t.ng;
   return t;
+}
+
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim, float time) {
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  if (mesh.motion_steps < 2) return world_triangle(scene, inst, prim);
+  const size_t base = size_t(prim) * 3;
+  WorldTriangle t;
+  for (int k = 0; k < 3; ++k) {
+    t.index[k] = mesh.indices[base + size_t(k)];
+    const Vec3f p = interpolate_vertex(mesh.motion_positions.data(), mesh.positions.size(), mesh.motion_steps,
+                                       t.index[k], time);
+    t.p[k] = inst.identity ? p : apply_point(inst.to_world, p);
+  }
+  t.ng = triangle_normal(t.p[0], t.p[1], t.p[2]);
+  if (inst.mirrored) t.ng = -t.ng;
+  return t;
+}
+
+Vec3f mesh_normal(const Mesh& mesh, uint32_t i, float time) {
+  if (mesh.motion_steps < 2 || mesh.motion_normals.empty()) return mesh.normals[i];
+  const Vec3f n = normalize(
+      interpolate_vertex(mesh.motion_normals.data(), mesh.normals.size(), mesh.motion_steps, i, time));
+  return dot(n, n) > 0 ? n : mesh.normals[i];
 }
 
 std::vector<Vec3f> compute_smooth_normals(std::span<const Vec3f> positions,

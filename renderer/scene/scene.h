@@ -96,6 +96,12 @@ struct Mesh {
   /// For a mesh moved into world space from a node: world -> the node's local frame, the object
   /// space of procedural textures (identity otherwise: instances place object-space meshes).
   Affine3f object_from_world;
+  /// Deformation motion blur (skins, morph targets): `motion_steps` >= 2 copies of positions
+  /// and of normals, step after step, spread evenly over Ray::time 0 to 1 and interpolated
+  /// linearly (interpolate_vertex); empty, with motion_steps 0, for a mesh that keeps its shape
+  /// over the shutter. positions and normals stay the frame time's pose.
+  std::vector<Vec3f> motion_positions, motion_normals;
+  uint32_t motion_steps = 0;
 };
 
 /// An analytic primitive or an implicit surface in its object space with its material, placed
@@ -230,6 +236,12 @@ struct WorldTriangle {
   Vec3f ng;
 };
 WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim);
+/// The triangle at ray time `time`: a deforming mesh's vertices interpolated at that time (the
+/// triangle every structure intersects), else world_triangle(scene, inst, prim).
+WorldTriangle world_triangle(const Scene& scene, const Instance& inst, uint32_t prim, float time);
+/// Unit vertex normal `i` of `mesh` at ray time `time` (object space): a deforming mesh's
+/// normals interpolated at that time and normalised, else normals[i]. The mesh has normals.
+Vec3f mesh_normal(const Mesh& mesh, uint32_t i, float time);
 /// World-space vertex normal: L^-T n, normalised (n itself for identity instances).
 inline Vec3f world_normal(const Instance& inst, Vec3f n) {
   return inst.identity ? n : normalize(apply_normal(inst.to_object, n));

@@ -237,6 +237,21 @@ expect 0 "" -- "$bin" render "$motion" --frames 23-24 --motion-blur --width 40 -
 same_pixels "$work/mb_frame.0024.exr" "$work/mb_single.exr"
 expect 0 "ignores motion blur" -- "$bin" render "$motion" --integrator raster --motion-blur --width 40 --height 30 \
   -o "$work/mb_raster.exr" --no-png
+# Deformation blur: the corpus' morph-target cube blurs (the file loaded at each step's time)
+# with Embree and the own BVH, and differs from its still frame.
+corpus="${PENUMBRA_CORPUS:-${PENUMBRA_CORPUS_DEFAULT:-$src/../shared/corpus}}"
+morph="$corpus/extensions/AnimatedMorphCube/glTF-Quantized/AnimatedMorphCube.gltf"
+if [ -f "$morph" ]; then
+  for accel in embree bvh; do
+    expect 0 "" -- "$bin" render "$morph" --time 1 --motion-blur --shutter 1 --accel "$accel" --width 48 \
+      --height 48 --spp 8 -o "$work/morph_$accel.exr" --no-png -q
+  done
+  "$bin" render "$morph" --time 1 --width 48 --height 48 --spp 8 -o "$work/morph_still.exr" --no-png -q
+  oiiotool "$work/morph_embree.exr" "$work/morph_still.exr" --fail 0 --diff >/dev/null 2>&1 &&
+    fail "deformation blur changed nothing" || ok
+else
+  echo "PENUMBRA_SKIP: corpus not found (set PENUMBRA_CORPUS); deformation blur from the CLI skipped"
+fi
 expect 2 "shutter needs motion_blur" -- "$bin" render "$motion" --shutter 1 -o "$work/bad.exr"
 expect 2 "motion-steps" -- "$bin" render "$motion" --motion-blur --motion-steps 1 -o "$work/bad.exr"
 [ ! -e "$work/bad.exr" ] && ok || fail "a refused render wrote bad.exr"
