@@ -1,6 +1,7 @@
 // The render session's phases.
 #include "render/session.h"
 
+#include <algorithm>
 #include <set>
 #include <stdexcept>
 
@@ -27,11 +28,19 @@ struct DefaultLightGuard {
   }
 };
 
-/// The structure's key: its name and parameters, and whether it was built over moving instances.
+/// Whether any mesh keeps vertex positions per motion step.
+bool scene_deforms(const Scene& scene) {
+  return std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                     [](const Mesh& m) { return m.motion_steps >= 2; });
+}
+
+/// The structure's key: its name and parameters, and whether it was built over moving instances
+/// or deforming meshes.
 std::string structure_key(const RenderSpec& spec, const Scene& scene) {
   std::string key = spec.accel;
   for (const auto& p : spec.accel_params) key += " " + p;
   if (!scene.instance_motion.empty()) key += " (motion)";
+  if (scene_deforms(scene)) key += " (deforming)";
   return key;
 }
 
@@ -239,8 +248,9 @@ Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world
   AccelConfig config = accel_config(spec.accel, spec.accel_params);
   config.embree.world_apart = world_apart;
   const std::string key = structure_key(spec, scene);
-  // A structure over moving instances is built for its shutter: never kept for another.
-  if (previous.accel && previous.key == key && scene.instance_motion.empty()) {
+  // A structure over moving instances or deforming meshes is built for its shutter: never kept
+  // for another.
+  if (previous.accel && previous.key == key && scene.instance_motion.empty() && !scene_deforms(scene)) {
     if (!moved_vertices) return previous;
     const RefitReport r =
         refit_or_rebuild_scene(previous.accel, previous.built_sah, spec.accel, scene, config);
@@ -407,8 +417,9 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   options.env_budget = env_budget;
   options.area_lights = session.area_lights;
   validate(spec);
-  options.identity.shutter =
-      set_scene_motion(session.loaded, spec, session.time, session.file, session.load_at);
+  // Loads at the shutter's times match the scene only when it too was loaded at a time.
+  options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file,
+                                              session.loaded_at_time ? session.load_at : LoadAtTime{});
   options.time = session.loaded_at_time ? std::optional<double>(session.time) : std::nullopt;
   options.load_at = session.load_at;
   RenderResult r;

@@ -259,7 +259,7 @@ class DeformingAccelerator final : public Accelerator {
   uint32_t m_steps = 0;
   bool m_exhaustive = false;
   std::vector<uint32_t> m_prims;    // triangle indices in leaf order
-  std::vector<BvhNode> m_nodes;     // topology; their boxes bound the whole shutter
+  std::vector<BvhNode> m_nodes;     // topology (split by step-averaged boxes); traversal reads m_lbounds
   std::vector<Bounds3f> m_lbounds;  // node x segment x {start, end}: linear bounds
   Bounds3f m_bounds;
   uint64_t m_depth = 0;

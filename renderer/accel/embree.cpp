@@ -82,6 +82,10 @@ void attach_triangles(RTCScene scene, const GeometryView& mesh, unsigned id) {
   RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_TRIANGLE);
   const size_t nv = mesh.positions.size(), nt = mesh.indices.size() / 3;
   const unsigned steps = mesh.deforms() && nv && nt ? mesh.motion_steps : 1;
+  if (steps > 1 && (steps > 129 || mesh.motion_positions.size() != size_t(steps) * nv)) {
+    rtcReleaseGeometry(geom);
+    throw std::invalid_argument("a deforming mesh needs 2 to 129 motion steps of all its vertices");
+  }
   if (steps > 1) rtcSetGeometryTimeStepCount(geom, steps);
   bool allocated = true;
   for (unsigned k = 0; k < steps; ++k) {

@@ -101,6 +101,8 @@ RefitReport refit_or_rebuild(std::unique_ptr<Accelerator>& accel, double& built_
     report.reason = "the " + std::string(name) + " back end does not refit";
   else if (config.bvh.refit_max_growth == 0)
     report.reason = "refitting is off (bvh.refit_max_growth=0)";
+  else if (any_deforms(meshes))
+    report.reason = "deforming meshes are rebuilt";
   else if (!accel || !(all_identity(meshes, instances) ? accel->refit(flattened_views(meshes, instances))
                                                        : accel->refit_instances(meshes, instances)))
     report.reason = "the geometry's layout changed";

@@ -33,10 +33,11 @@ std::vector<std::string> accelerator_names();
 
 /// Builds the named back end over `meshes`. Deforming meshes (GeometryView::deforms()) go to
 /// Embree's multi-step geometry, or for the other back ends to the time-aware structure of
-/// accel/deforming.h under a top level. Every back end except "brute" copies what it needs;
-/// for "brute" the meshes must outlive the accelerator. Throws std::invalid_argument for an
-/// unknown name or an invalid configuration, std::runtime_error if the build fails (the message
-/// names the back end).
+/// accel/deforming.h under a top level, where they must all have the same motion_steps.
+/// Every back end except "brute" copies what it needs; for "brute" the meshes must outlive the
+/// accelerator. Throws std::invalid_argument for an unknown name, an invalid configuration or
+/// (back ends other than Embree) deforming meshes that differ in motion_steps, std::runtime_error if the
+/// build fails (the message names the back end).
 std::unique_ptr<Accelerator> make_accelerator(std::string_view name, std::span<const GeometryView> meshes,
                                               const AccelConfig& config = {});
 
@@ -62,7 +63,8 @@ struct RefitReport {
 /// counts), and `built_sah` is its SAH cost when it was last built (stats().sah_cost). Refits it
 /// to the new pose when the back end can (the BVH, alone or under instances) and
 /// config.bvh.refit_max_growth is not 0, and keeps it while its SAH cost is at most that factor
-/// of `built_sah`; otherwise builds it anew (updating `built_sah`). The answers are those of a
+/// of `built_sah`; otherwise, and always when a mesh deforms, builds it anew (updating
+/// `built_sah`). The answers are those of a
 /// fresh build either way. Throws as make_accelerator does.
 RefitReport refit_or_rebuild(std::unique_ptr<Accelerator>& accel, double& built_sah, std::string_view name,
                              std::span<const GeometryView> meshes, std::span<const InstanceView> instances,

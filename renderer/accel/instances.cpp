@@ -158,6 +158,8 @@ class TwoLevelAccelerator final : public Accelerator {
   bool refit_instances(std::span<const GeometryView> meshes,
                        std::span<const InstanceView> instances) override {
     if (!m_layout.matches(instances)) return false;
+    for (const uint8_t deforms : m_level_deforms)
+      if (deforms) return false;  // a deforming level is rebuilt for its new steps, never refitted
     for (const uint32_t mesh : m_shape_mesh) {
       if (mesh >= meshes.size() || !meshes[mesh].shape) return false;
       const Bounds3f b = shape_bounds(*meshes[mesh].shape);

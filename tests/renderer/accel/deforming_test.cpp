@@ -193,3 +193,47 @@ TEST_CASE("deforming meshes: steps that disagree with the vertices are refused",
   view.motion_steps = 0;
   CHECK_THROWS_WITH(make_deforming_accelerator(one()), Catch::Contains("mesh 0 has no motion steps"));
 }
+
+TEST_CASE("deforming meshes: Embree refuses steps that disagree with the vertices",
+          "[accel][motion][deforming][quick]") {
+  const std::vector<Vec3f> frame{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<Vec3f> short_keys(5), keys(6);
+  const std::vector<uint32_t> idx{0, 1, 2};
+  GeometryView view{frame, idx};
+  view.motion_steps = 2;
+  view.motion_positions = short_keys;
+  CHECK_THROWS_WITH(make_accelerator("embree", std::span<const GeometryView>(&view, 1)),
+                    Catch::Contains("motion steps of all its vertices"));
+  view.motion_positions = keys;
+  CHECK_NOTHROW(make_accelerator("embree", std::span<const GeometryView>(&view, 1)));
+}
+
+TEST_CASE("deforming meshes: a new pose is built anew, never refitted", "[accel][motion][deforming][quick]") {
+  // A triangle deforming from z = 0 to z = 1; its next pose moves it to z = 4 to 5. A refit would
+  // keep the first pose's linear bounds; the rebuild must find the triangle where it now is.
+  const std::vector<Vec3f> frame{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<uint32_t> idx{0, 1, 2};
+  std::vector<Vec3f> keys;
+  for (float z : {0.0f, 1.0f})
+    for (const Vec3f& p : frame) keys.push_back(p + Vec3f{0, 0, z});
+  GeometryView view{frame, idx};
+  view.motion_steps = 2;
+  view.motion_positions = keys;
+  const std::vector<InstanceView> inst{{0, Affine3f{}}};
+  AccelConfig config;
+  std::unique_ptr<Accelerator> accel =
+      make_accelerator("bvh", std::span<const GeometryView>(&view, 1), inst, config);
+  double sah = accel->stats().sah_cost;
+  std::vector<Vec3f> moved;
+  for (const Vec3f& p : keys) moved.push_back(p + Vec3f{0, 0, 4});
+  view.motion_positions = moved;
+  const RefitReport r =
+      refit_or_rebuild(accel, sah, "bvh", std::span<const GeometryView>(&view, 1), inst, config);
+  CHECK_FALSE(r.refitted);
+  CHECK(r.reason == "deforming meshes are rebuilt");
+  Ray ray{{0.25f, 0.25f, 10}, 0, {0, 0, -1}, kInfinity};
+  ray.time = 0.5f;
+  Hit hit;
+  REQUIRE(accel->intersect(ray, hit));
+  CHECK(hit.t == Approx(10 - 4.5f).margin(1e-4));
+}
