@@ -77,7 +77,8 @@ void load_steps(const Scene& scene, const Shutter& s, int steps, const std::stri
   if (!load_at)
     throw InputError(file, "motion blur",
                      "the scene's animation deforms meshes (skins or morph targets) or was not kept with the "
-                     "scene, and this front end cannot load the file at the shutter's times");
+                     "scene, and the scene was not loaded at a time, so the file cannot be loaded at the "
+                     "shutter's times to match it (load the scene at a time)");
   for (int k = 0; k < steps; ++k) {
     const double t = s.open + (s.close - s.open) * double(k) / double(steps - 1);
     const LoadedScene frame = load_at(t);

@@ -315,6 +315,41 @@ TEST_CASE("motion blur: a deforming animation without a way to load the file is 
   CHECK(s.loaded.scene.meshes[0].motion_steps == 0);
 }
 
+TEST_CASE("motion blur: a deforming scene's structure follows each render's shutter", "[motion]") {
+  // One session renders the morph with two shutters; the second render must equal a fresh
+  // session's render of that shutter (a structure kept from the first would hold its steps).
+  const auto file = write_deforming(false);
+  for (const char* accel : {"embree", "bvh"}) {
+    INFO(accel);
+    RenderSpec spec = spec_of(24, 16, accel);
+    spec.motion_blur = true;
+    spec.fps = 2;
+    Session s;
+    load_with_frames(s, file, 1.0);
+    render_scene(s, spec, 0);
+    spec.shutter_offset = -1;
+    const Film second = render_scene(s, spec, 0).image.film;
+    Session fresh;
+    load_with_frames(fresh, file, 1.0);
+    const Film expected = render_scene(fresh, spec, 0).image.film;
+    CHECK(second.rgba == expected.rgba);
+  }
+}
+
+TEST_CASE("motion blur: a deforming scene loaded at its rest pose is not matched to loads at times",
+          "[motion]") {
+  // Loads at the shutter's times are posed; a scene loaded without a time is not: refused.
+  const auto file = write_deforming(false);
+  Session s;
+  load_with_frames(s, file, 1.0);
+  s.loaded = load_gltf(file);  // the rest pose
+  s.loaded_at_time = false;
+  RenderSpec spec = spec_of(16, 1);
+  spec.motion_blur = true;
+  CHECK_THROWS_WITH(render_scene(s, spec, 0),
+                    Catch::Contains("morph.gltf") && Catch::Contains("not loaded at a time"));
+}
+
 TEST_CASE("motion blur: a scene loaded without its animation is refused, a still file renders", "[motion]") {
   const auto file = write_scene("refused", test::quad_positions(), 2, [](test::GltfWriter& w, int node) {
     w.channel(node, "translation", {0, 1}, {0, 0, 0, 1, 0, 0}, "VEC3", 3);
