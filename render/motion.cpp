@@ -34,12 +34,14 @@ bool moves(const std::vector<Affine3f>& maps) {
 
 namespace {
 
-/// The scene at every step of the shutter: each instance's map, each camera's frame, and (from
-/// loaded frames) each mesh's positions and normals, step after step.
+/// The scene at every step of the shutter: each instance's map, each camera's frame, each light,
+/// and (from loaded frames) each mesh's positions and normals, step after step.
 struct ShutterSteps {
   std::vector<std::vector<Affine3f>> maps, frames;
   std::vector<std::vector<Vec3f>> positions, normals;
+  std::vector<std::vector<Light>> lights;
   bool cameras = true;  ///< every step has the scene's cameras
+  bool lit = true;      ///< every step has the scene's lights
 };
 
 void record_step(const Scene& at, bool vertices, ShutterSteps& out) {
@@ -47,6 +49,8 @@ void record_step(const Scene& at, bool vertices, ShutterSteps& out) {
   out.cameras = out.cameras && at.cameras.size() == out.frames.size();
   for (size_t i = 0; out.cameras && i < at.cameras.size(); ++i)
     out.frames[i].push_back(camera_frame(at.cameras[i]));
+  out.lit = out.lit && at.lights.size() == out.lights.size();
+  for (size_t i = 0; out.lit && i < at.lights.size(); ++i) out.lights[i].push_back(at.lights[i]);
   if (!vertices) return;
   for (size_t m = 0; m < at.meshes.size(); ++m) {
     const Mesh& mesh = at.meshes[m];
@@ -92,6 +96,18 @@ void load_steps(const Scene& scene, const Shutter& s, int steps, const std::stri
   }
 }
 
+/// Whether a light's steps differ in what light_at interpolates.
+bool light_moves(const std::vector<Light>& steps) {
+  for (const Light& l : steps) {
+    const Light& a = steps.front();
+    if (std::memcmp(&l.position, &a.position, sizeof(Vec3f)) != 0 ||
+        std::memcmp(&l.direction, &a.direction, sizeof(Vec3f)) != 0 ||
+        std::memcmp(&l.color, &a.color, sizeof(Vec3f)) != 0 || l.intensity != a.intensity)
+      return true;
+  }
+  return false;
+}
+
 template <class T>
 bool differ(const std::vector<T>& keys, size_t count) {
   for (size_t i = count; i < keys.size(); ++i)
@@ -105,6 +121,7 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
                              const std::string& file, const LoadAtTime& load_at) {
   Scene& scene = loaded.scene;
   scene.instance_motion.clear();
+  scene.light_motion.clear();
   for (Camera& c : scene.cameras) c.motion.clear();
   for (Mesh& m : scene.meshes) {
     m.motion_positions = {};
@@ -121,6 +138,7 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
     ShutterSteps st;
     st.maps.resize(scene.instances.size());
     st.frames.resize(scene.cameras.size());
+    st.lights.resize(scene.lights.size());
     st.positions.resize(scene.meshes.size());
     st.normals.resize(scene.meshes.size());
     return st;
@@ -140,6 +158,11 @@ std::string set_scene_motion(LoadedScene& loaded, const RenderSpec& spec, double
   if (!any) scene.instance_motion.clear();
   for (size_t i = 0; st.cameras && i < st.frames.size(); ++i)
     if (moves(st.frames[i])) scene.cameras[i].motion = make_motion_keys(st.frames[i]);
+  for (size_t i = 0; st.lit && i < st.lights.size(); ++i)
+    if (light_moves(st.lights[i])) {
+      scene.light_motion.resize(scene.lights.size());
+      scene.light_motion[i] = std::move(st.lights[i]);
+    }
   for (size_t m = 0; m < st.positions.size(); ++m) {
     Mesh& mesh = scene.meshes[m];
     const size_t n = mesh.positions.size();

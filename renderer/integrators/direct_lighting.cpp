@@ -85,8 +85,11 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
                             const DirectLightingVertex& v, const DirectLightingMode& mode,
                             SampleStream& samples, RayCounts& counts, PathRadiance& out) {
   IncidentLight l;
-  for (const Light& light : scene.lights)
-    if (sample_incident(light, v.si.p, l)) estimate(scene, accel, v, mode, l, counts, out);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    Light moved;
+    if (sample_incident(light_at(scene, i, v.si.time, moved), v.si.p, l))
+      estimate(scene, accel, v, mode, l, counts, out);
+  }
   if (!mode.sample_lights) return;
   if (!lights.area->pmf.empty()) {
     const float u1 = samples.get1d();

@@ -78,7 +78,8 @@ Vec3f whitted_local(const Scene& scene, const WhittedConfig& cfg, const SurfaceI
   // Direct light: diffuse + Blinn-Phong specular, each light as visible as `visibility` says.
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     LightSample ls;
-    if (!sample_light(scene.lights[i], si.p, ls)) continue;
+    Light moved;
+    if (!sample_light(light_at(scene, i, si.time, moved), si.p, ls)) continue;
     const float ndotl = dot(mp.ns, ls.wi);
     const bool from_back = dot(ls.wi, si.ng) <= 0;  // light below the geometric surface
     if (from_back != (ndotl <= 0) || (from_back && !(max_component(w.kdt) > 0))) continue;

@@ -33,6 +33,22 @@ const Instance& instance_at(const Scene& scene, uint32_t index, float time, Inst
   return storage;
 }
 
+const Light& light_at(const Scene& scene, size_t index, float time, Light& storage) {
+  const Light& light = scene.lights[index];
+  if (index >= scene.light_motion.size() || scene.light_motion[index].size() < 2) return light;
+  const std::vector<Light>& keys = scene.light_motion[index];
+  const MotionSegment s = motion_segment(time, uint32_t(keys.size()));
+  const Light &a = keys[s.k], &b = keys[s.k + 1];
+  const float wa = 1.0f - s.a, wb = s.a;
+  storage = a;
+  storage.position = a.position * wa + b.position * wb;
+  storage.color = a.color * wa + b.color * wb;
+  storage.intensity = a.intensity * wa + b.intensity * wb;
+  const Vec3f d = a.direction * wa + b.direction * wb;
+  if (dot(d, d) > 0) storage.direction = normalize(d);
+  return storage;
+}
+
 Instance make_instance(int mesh, const Affine3f& to_world, int node) {
   Instance inst;
   inst.mesh = mesh;

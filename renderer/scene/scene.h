@@ -191,8 +191,17 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<ProceduralTexture> procedurals;  ///< procedural textures of materials
   std::vector<Light> lights;
+  /// Motion blur: empty (no light moves), or up to one entry per light: the light at each motion
+  /// step, spaced evenly over the shutter (Ray::time 0 to 1), empty for a light that stays put.
+  /// lights[i] is the light at the frame's time.
+  std::vector<std::vector<Light>> light_motion;
   std::vector<Camera> cameras;
 };
+
+/// Light `index` at ray time `time`: the scene's own entry when it does not move, else `storage`
+/// filled with the two steps around `time` interpolated linearly (position, colour, intensity;
+/// the direction normalised after). Never allocates or throws.
+const Light& light_at(const Scene& scene, size_t index, float time, Light& storage);
 
 /// Instance `index` where it is at ray time `time`: the scene's own entry when it does not move,
 /// else `storage` filled with the interpolated map (interpolate_motion) and its inverse. Never

@@ -300,6 +300,49 @@ TEST_CASE("motion blur: a skinned or morphed mesh blurs as the mean of still ren
   }
 }
 
+TEST_CASE("motion blur: a moving point light lights a still floor as the mean of its poses", "[motion]") {
+  // A point light 0.6 above a floor filling the view, sliding along x at 2 units per second:
+  // over the shutter t in [0.75, 1.25] it covers a unit. Whitted: the blurred render against 16
+  // stills at the midpoints of 16 slices of the shutter.
+  const auto file =
+      write_scene("light", {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, 2, 0}, 1.5f, [](test::GltfWriter& w, int) {
+        w.j["extensionsUsed"] = {"KHR_lights_punctual"};
+        w.j["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1.0}}};
+        nlohmann::json node = {{"translation", {-2, 0, 0.6}}};
+        node["extensions"]["KHR_lights_punctual"]["light"] = 0;
+        const int light = w.node(node);
+        w.channel(light, "translation", {0, 2}, {-2, 0, 0.6f, 2, 0, 0.6f}, "VEC3", 3);
+      });
+  Session s;
+  load(s, file, 1.0);
+  RenderSpec spec = spec_of(48, 64);
+  spec.motion_blur = true;
+  spec.fps = 2;
+  spec.shutter = 1;
+  const Film blurred = render_scene(s, spec, 0).image.film;
+  REQUIRE(s.loaded.scene.light_motion.size() == 1);
+  CHECK(s.loaded.scene.light_motion[0].size() == 3);
+  std::vector<double> mean(blurred.rgba.size(), 0.0);
+  const int n = 16;
+  for (int i = 0; i < n; ++i) {
+    REQUIRE(pose_gltf_scene(*s.loaded.animation, 0.75 + 0.5 * (i + 0.5) / n, s.loaded.scene));
+    const Film still = render_scene(s, spec_of(48, 4), 0).image.film;
+    for (size_t k = 0; k < mean.size(); ++k) mean[k] += still.rgba[k] / n;
+  }
+  REQUIRE(pose_gltf_scene(*s.loaded.animation, 1.0, s.loaded.scene));
+  const Film frame = render_scene(s, spec_of(48, 4), 0).image.film;
+  double err = 0, err_still = 0, level = 0;
+  for (size_t k = 0; k < mean.size(); ++k) {
+    if (k % 4 == 3) continue;
+    err += (blurred.rgba[k] - mean[k]) * (blurred.rgba[k] - mean[k]);
+    err_still += (frame.rgba[k] - mean[k]) * (frame.rgba[k] - mean[k]);
+    level += mean[k] * mean[k];
+  }
+  INFO("rms " << std::sqrt(level) << " blurred " << std::sqrt(err) << " still " << std::sqrt(err_still));
+  CHECK(std::sqrt(err) < 0.02 * std::sqrt(level));
+  CHECK(err_still > 25 * err);
+}
+
 TEST_CASE("motion blur: a deforming animation without a way to load the file is refused by name",
           "[motion]") {
   const auto file = write_deforming(false);
