@@ -299,42 +299,79 @@ def test_depth_of_field_focuses_where_asked(quads):
         quads.render(focus_at="1,1")
 
 
-def test_motion_blur_streaks_a_moving_quad(tmp_path):
-    # A 0.2-wide quad moving along +X at 12 units per second, seen by an orthographic camera 4
-    # units high over 64 pixels: at t = 1 with a one-frame shutter at 24 fps it sweeps 0.5 units,
-    # so its blur spans 0.7 units (11.2 px) and coverage in the middle is 0.2 / 0.5.
-    p, i = quad(-0.1, 0.1, -0.1, 0.1, 0)
-    path = write_gltf(tmp_path / "moving.gltf",
-                      nodes=[{"camera": 0, "translation": [0, 0, 5]}, {"name": "mover", "mesh": 0}],
+def write_animated_quad(path, x0, data, add):
+    """A 0.2-wide quad centred at (x0, 0) seen by an orthographic camera 4 units high, written to
+    `path` with `data` appended to its buffer; add(gltf, base, views, accessors) adds what uses
+    the data (buffer offset `base`, first new buffer view and accessor index)."""
+    p, i = quad(x0 - 0.1, x0 + 0.1, -0.1, 0.1, 0)
+    path = write_gltf(path, nodes=[{"camera": 0, "translation": [0, 0, 5]}, {"name": "quad", "mesh": 0}],
                       meshes=[(p, i, None)],
                       cameras=[{"type": "orthographic",
                                 "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.01, "zfar": 100}}])
     gltf = json.loads(pathlib.Path(path).read_text())
     blob = base64.b64decode(gltf["buffers"][0]["uri"].split(",", 1)[1])
-    keys = np.array([0, 2], np.float32).tobytes() + np.array([-12, 0, 0, 12, 0, 0], np.float32).tobytes()
-    gltf["bufferViews"] += [{"buffer": 0, "byteOffset": len(blob), "byteLength": 8},
-                            {"buffer": 0, "byteOffset": len(blob) + 8, "byteLength": 24}]
-    n = len(gltf["accessors"])
-    gltf["accessors"] += [{"bufferView": len(gltf["bufferViews"]) - 2, "componentType": 5126, "count": 2,
-                           "type": "SCALAR", "min": [0], "max": [2]},
-                          {"bufferView": len(gltf["bufferViews"]) - 1, "componentType": 5126, "count": 2,
-                           "type": "VEC3"}]
-    gltf["animations"] = [{"samplers": [{"input": n, "output": n + 1}],
-                           "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
-    blob += keys
+    add(gltf, len(blob), len(gltf["bufferViews"]), len(gltf["accessors"]))
+    blob += data
     gltf["buffers"] = [{"byteLength": len(blob),
                         "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
     pathlib.Path(path).write_text(json.dumps(gltf))
-    scene = penumbra.load(path, time=1.0, keep_animation=True)
-    r = scene.render(width=64, height=64, spp=256, motion_blur=True, shutter=1, fps=24)
+    return path
+
+
+def check_streak(scene, **kw):
+    """At t = 1 with a one-frame shutter at 24 fps a quad moving 12 units per second sweeps 0.5
+    units: its blur spans 0.7 units (11.2 px of 64 over 4 units) and coverage in the middle is
+    0.2 / 0.5; the still frame covers about 3 px."""
+    r = scene.render(width=64, height=64, spp=256, motion_blur=True, shutter=1, fps=24, **kw)
     row = r.beauty[32, :, 3]
     covered = np.nonzero(row > 0.01)[0]
     assert abs((covered[-1] + 1 - covered[0]) - 11.2) <= 1.5
     np.testing.assert_allclose(row[30:34], 0.4, atol=0.06)
-    still = scene.render(width=64, height=64, spp=16)
+    still = scene.render(width=64, height=64, spp=16, **kw)
     assert np.count_nonzero(still.beauty[32, :, 3] > 0.01) <= 5
+
+
+def test_motion_blur_streaks_a_moving_quad(tmp_path):
+    # The quad's node moves along +X at 12 units per second.
+    def add(gltf, base, v, n):
+        gltf["bufferViews"] += [{"buffer": 0, "byteOffset": base, "byteLength": 8},
+                                {"buffer": 0, "byteOffset": base + 8, "byteLength": 24}]
+        gltf["accessors"] += [{"bufferView": v, "componentType": 5126, "count": 2, "type": "SCALAR",
+                               "min": [0], "max": [2]},
+                              {"bufferView": v + 1, "componentType": 5126, "count": 2, "type": "VEC3"}]
+        gltf["animations"] = [{"samplers": [{"input": n, "output": n + 1}],
+                               "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
+
+    keys = np.array([0, 2], np.float32).tobytes() + np.array([-12, 0, 0, 12, 0, 0], np.float32).tobytes()
+    scene = penumbra.load(write_animated_quad(tmp_path / "moving.gltf", 0, keys, add), time=1.0,
+                          keep_animation=True)
+    check_streak(scene)
     with pytest.raises(ValueError, match="shutter needs motion_blur"):
         scene.render(shutter=1)
+
+
+def test_motion_blur_streaks_a_morphing_quad(tmp_path):
+    # The same motion from a morph target instead of the node: every vertex +24 units in X at
+    # weight 1, the weight 0 to 1 over two seconds, the quad at x = -12 at weight 0 (centred at
+    # t = 1). The file is loaded at each motion step's time; the streak is as long as the node's.
+    def add(gltf, base, v, n):
+        gltf["bufferViews"] += [{"buffer": 0, "byteOffset": base, "byteLength": 48},
+                                {"buffer": 0, "byteOffset": base + 48, "byteLength": 8},
+                                {"buffer": 0, "byteOffset": base + 56, "byteLength": 8}]
+        gltf["accessors"] += [{"bufferView": v, "componentType": 5126, "count": 4, "type": "VEC3",
+                               "min": [24, 0, 0], "max": [24, 0, 0]},
+                              {"bufferView": v + 1, "componentType": 5126, "count": 2, "type": "SCALAR",
+                               "min": [0], "max": [2]},
+                              {"bufferView": v + 2, "componentType": 5126, "count": 2, "type": "SCALAR"}]
+        gltf["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": n}]
+        gltf["meshes"][0]["weights"] = [0]
+        gltf["animations"] = [{"samplers": [{"input": n + 1, "output": n + 2}],
+                               "channels": [{"sampler": 0, "target": {"node": 1, "path": "weights"}}]}]
+
+    data = (np.tile(np.array([24, 0, 0], np.float32), 4).tobytes() + np.array([0, 2], np.float32).tobytes()
+            + np.array([0, 1], np.float32).tobytes())
+    scene = penumbra.load(write_animated_quad(tmp_path / "morphing.gltf", -12, data, add), time=1.0)
+    check_streak(scene, accel="bvh")
 
 
 def test_vector_layer_follows_the_scenes_time():
