@@ -22,6 +22,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -71,7 +72,7 @@ double median(std::vector<double> v) {
 }
 
 struct RaySet {
-  std::string kind;  // primary, shadow, diffuse, random
+  std::string kind;  // primary, shadow, diffuse, random, motion
   std::vector<Ray> rays;
   bool any_hit = false;  // shadow rays are occlusion queries
 };
@@ -842,7 +843,10 @@ void add_bench_options(CLI::App& app, BenchOptions& o) {
                  "structures to measure, comma separated: " + accelerator_list() +
                      " (default embree,bvh,kdtree,grid)")
       ->delimiter(',');
-  app.add_option("--rays", o.kinds, "ray kinds: primary,shadow,diffuse,random (default all)")->delimiter(',');
+  app.add_option("--rays", o.kinds,
+                 "ray kinds: primary,shadow,diffuse,random (default), and motion (primary rays at random "
+                 "times through the scene's meshes deforming over the shutter)")
+      ->delimiter(',');
   app.add_option("--threads", o.threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
       ->delimiter(',')
       ->check(CLI::Range(0, 1024));
@@ -930,9 +934,9 @@ AccelConfig check_table_options(const BenchOptions& o) {
   if (!o.heatmaps.empty() && !std::filesystem::is_directory(o.heatmaps))
     throw std::invalid_argument("--heatmaps: directory '" + o.heatmaps + "' does not exist");
   for (const auto& k : o.kinds)
-    if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random")
+    if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random" && k != "motion")
       throw std::invalid_argument("--rays: unknown ray kind '" + k +
-                                  "' (known: primary, shadow, diffuse, random)");
+                                  "' (known: primary, shadow, diffuse, random, motion)");
   AccelConfig config;
   for (const auto& p : o.params) apply_accel_param(config, p);
   validate(config);  // every structure's parameters, as the render session checks them
@@ -1026,6 +1030,39 @@ void measure_structure(const BenchOptions& o, const AccelConfig& config, const T
   }
 }
 
+/// Makes every mesh of `scene` deform over a shutter of 3 motion steps: step k moves each vertex
+/// p by (k - 1) D (sin(7 y / L), sin(5 z / L), sin(3 x / L)) with L the bounds' diagonal and D 1 %
+/// of it, a smooth, spatially varying motion in which neighbouring triangles move together as in
+/// a skinned character (the still pose is step 1).
+void deform_for_motion(Scene& scene) {
+  const float L = std::max(length(compute_bounds(scene).extent()), 1e-30f), D = 0.01f * L;
+  for (Mesh& m : scene.meshes) {
+    if (m.positions.empty()) continue;
+    m.motion_steps = 3;
+    m.motion_positions.clear();
+    for (int k = 0; k < 3; ++k)
+      for (const Vec3f& p : m.positions) {
+        const Vec3f d{std::sin(7 * p.y / L), std::sin(5 * p.z / L), std::sin(3 * p.x / L)};
+        m.motion_positions.push_back(p + d * (float(k - 1) * D));
+      }
+  }
+}
+
+/// The motion ray set: the primary rays of make_ray_sets, each at a random time in [0, 1].
+RaySet motion_rays(const Scene& scene, int w, int h) {
+  const Camera cam = bench_camera(scene, w, h);
+  std::mt19937 rng(20261205u);
+  std::uniform_real_distribution<float> u(0, 1);
+  RaySet set{"motion", {}, false};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Ray r = generate_camera_ray(cam, w, h, x + 0.5f, y + 0.5f);
+      r.time = u(rng);
+      set.rays.push_back(r);
+    }
+  return set;
+}
+
 /// Every scene and structure of the main table, each row printed as it is measured (Embree's
 /// first, so that every later row shows its ratio); `embree_reference` receives the settings of
 /// the Embree every answer is checked against.
@@ -1040,8 +1077,21 @@ std::vector<Row> measure_table(const BenchOptions& o, const AccelConfig& config,
     t.embree = make_accelerator("embree", t.views, t.instances);
     t.exact = make_accelerator("brute", t.views, t.instances);
     embree_reference = t.embree->stats().config;
-    t.sets = make_ray_sets(t.scene, *t.embree, o.width, o.height, o.kinds);
+    std::vector<std::string> still;
+    std::copy_if(o.kinds.begin(), o.kinds.end(), std::back_inserter(still),
+                 [](const std::string& k) { return k != "motion"; });
     t.scale = length(compute_bounds(t.scene).extent());
+    if (!still.empty()) {
+      t.sets = make_ray_sets(t.scene, *t.embree, o.width, o.height, still);
+      for (const auto& accel_name : o.accels) measure_structure(o, config, t, accel_name, rows);
+    }
+    if (still.size() == o.kinds.size()) continue;
+    // The motion rays: the same scene deforming, every structure built over it anew.
+    deform_for_motion(t.scene);
+    t.views = mesh_views(t.scene);
+    t.embree = make_accelerator("embree", t.views, t.instances);
+    t.exact = make_accelerator("brute", t.views, t.instances);
+    t.sets = {motion_rays(t.scene, o.width, o.height)};
     for (const auto& accel_name : o.accels) measure_structure(o, config, t, accel_name, rows);
   }
   return rows;

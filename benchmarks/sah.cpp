@@ -151,6 +151,10 @@ StructureSah measure_structure_sah(std::string_view name, std::span<const Geomet
     out.note = std::string(name) + " is not a tree";
     return out;
   }
+  if (std::any_of(views.begin(), views.end(), [](const GeometryView& v) { return v.deforms(); })) {
+    out.note = "deforming meshes: linear bounds over time, no still SAH";
+    return out;
+  }
   std::vector<GeometryView> level;
   if (!single_level_views(views, instances, level)) {
     out.note = "two-level build (placed instances): the top level is not visible";

@@ -62,6 +62,7 @@ struct StructureSah {
 ///    them; the BSP's areas are those of its convex cells).
 ///  - "embree" (no access to its nodes), "grid", "brute" (no tree): n/a.
 ///  - Two-level builds (some instance not the identity): n/a (the top level is not visible).
+///  - Deforming meshes (motion steps): n/a (the boxes a ray tests depend on its time).
 /// Throws what make_accelerator throws for these inputs.
 StructureSah measure_structure_sah(std::string_view name, std::span<const GeometryView> views,
                                    std::span<const InstanceView> instances, const AccelConfig& config,
