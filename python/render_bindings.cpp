@@ -146,6 +146,8 @@ py::dict aov_dict(const py::object& self) {
       out[kLightGroupNames[g]] = view(self, r.groups.data() + 3 * g, h, w, 3, kLightGroupChannels);
   if (r.aovs.count("vector"))
     out["vector"] = view(self, r.vector.data(), h, w, kMotionVectorChannels, kMotionVectorChannels);
+  if (r.aovs.count("velocity"))
+    out["velocity"] = view(self, r.velocity.data(), h, w, kVelocityChannels, kVelocityChannels);
   return out;
 }
 
@@ -409,8 +411,9 @@ void bind_render(py::module_& m, SceneClass& scene) {
       py::arg("settings") = py::none(), py::kw_only(), py::arg("aovs") = std::vector<std::string>{},
       "Renders into memory with `settings` (a RenderSettings, None: the defaults) and any setting as a "
       "keyword; aovs: names of data AOVs (albedo, N, P, Z, UV, id), the path tracer's layers (samples, "
-      "variance, light), vector (motion vectors to the frames 1/fps before and after the scene's time) "
-      "or 'all' (every one but vector). The GIL is released while it renders.");
+      "variance, light), vector (motion vectors to the frames 1/fps before and after the scene's time), "
+      "velocity (camera-space velocity in scene units per second) or 'all' (every one but vector and "
+      "velocity). The GIL is released while it renders.");
   scene.def(
       "render_to_file",
       [](SceneSession& s, const std::filesystem::path& exr, const py::object& png, const py::object& settings,

@@ -59,8 +59,8 @@ bool pose_session(SceneSession& session, double time) {
 }
 
 const std::vector<std::string>& python_aov_names() {
-  static const std::vector<std::string> names = {"albedo", "N",       "P",        "Z",     "UV",
-                                                 "id",     "samples", "variance", "light", "vector"};
+  static const std::vector<std::string> names = {"albedo",  "N",        "P",     "Z",      "UV",      "id",
+                                                 "samples", "variance", "light", "vector", "velocity"};
   return names;
 }
 
@@ -90,6 +90,7 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   out.data = std::move(r.layers.data);
   out.id_manifest = std::move(r.layers.id_manifest);
   out.vector = std::move(r.layers.vector);
+  out.velocity = std::move(r.layers.velocity);
   return out;
 }
 
@@ -108,9 +109,10 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
       {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)},
       {"penumbra:version", PENUMBRA_VERSION}};
   exr.metadata.insert(exr.metadata.end(), options.metadata.begin(), options.metadata.end());
-  add_layer_channels(exr, out.aovs,
-                     {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector},
-                     options.half ? ChannelType::Half : ChannelType::Float);
+  add_layer_channels(
+      exr, out.aovs,
+      {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector, &out.velocity},
+      options.half ? ChannelType::Half : ChannelType::Float);
   write_exr(out.film, path, exr);
 }
 

@@ -66,6 +66,7 @@ struct RenderOutput {
   std::vector<float> variance;        ///< path: variance of each pixel's mean luminance
   std::vector<float> groups;          ///< path with "light": kLightGroupChannels per pixel
   std::vector<float> vector;          ///< with "vector": kMotionVectorChannels per pixel
+  std::vector<float> velocity;        ///< with "velocity": kVelocityChannels per pixel
   std::vector<float> samples_f;       ///< `samples` as floats, for the EXR
   std::string id_manifest;            ///< JSON: object id -> node name, material id -> material name
   RenderStats stats;

@@ -30,6 +30,7 @@ void add_layer_channels(ExrOptions& exr, const std::set<std::string>& aovs, cons
         exr.extra.push_back({std::string(kLightGroupNames[g]) + "." + "RGB"[c], b.groups, colour,
                              kLightGroupChannels, g * 3 + c});
   if (aovs.count("vector")) vec("vector", "XYZW", b.vector, ChannelType::Float, kMotionVectorChannels);
+  if (aovs.count("velocity")) vec("velocity", "XYZ", b.velocity, ChannelType::Float, kVelocityChannels);
 }
 
 }  // namespace penumbra

@@ -1,8 +1,8 @@
 // The EXR channels of a render's layers, as every front end writes them: data AOVs (albedo.RGB
 // in the colour type, N.XYZ, P.XYZ, Z, UV.UV, object_id.X and material_id.X as whole-number
 // floats with their name manifest) and the path tracer's layers (samples.X, variance.X, the
-// light groups' .RGB in the colour type) and the motion vectors (vector.XYZW, Blender's Vector
-// pass), pointing into the render's buffers.
+// light groups' .RGB in the colour type), the motion vectors (vector.XYZW, Blender's Vector
+// pass) and the camera-space velocity (velocity.XYZ), pointing into the render's buffers.
 #pragma once
 
 #include <set>
@@ -22,6 +22,7 @@ struct LayerChannels {
   const std::vector<float>* variance = nullptr;  ///< with variance
   const std::vector<float>* groups = nullptr;    ///< with light: kLightGroupChannels per pixel
   const std::vector<float>* vector = nullptr;    ///< with vector: kMotionVectorChannels per pixel
+  const std::vector<float>* velocity = nullptr;  ///< with velocity: kVelocityChannels per pixel
 };
 
 /// Appends the channels of every layer `aovs` names (and the id layer's penumbra:manifest

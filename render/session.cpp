@@ -188,13 +188,14 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
     scene.lights.push_back(default_key_light(p.camera));
     p.default_light = true;
   }
-  if (p.spec.aovs.count("vector")) {
+  if (wants_motion_layers(p.spec.aovs)) {
     if (o.time)
       p.motion = std::make_shared<const MotionFrames>(load_motion_frames(scene, p, *o.time, o));
     else
       p.warnings.push_back(
-          "the vector layer of a render at the file's static pose is 0 everywhere (the static pose is no "
-          "point of the animation's timeline): give the render a time for motion");
+          std::string(p.spec.aovs.count("vector") ? "the vector layer" : "the velocity layer") +
+          " of a render at the file's static pose is 0 everywhere (the static pose is no point of the "
+          "animation's timeline): give the render a time for motion");
   }
   SceneIdentity identity = o.identity;
   if (!p.spec.env_color && !p.spec.env_map.empty()) identity.env_sha256 = sha256_file(p.spec.env_map);
@@ -240,7 +241,7 @@ void finish_render(LoadedScene& loaded, const PreparedRender& prepared) {
 
 bool needs_structure(const RenderSpec& spec, bool probe) {
   return spec.integrator != "raster" || spec.raster_shadows == "ray" || spec.aovs.count("cost") ||
-         spec.aovs.count("vector") || !crypto_layers(spec.aovs).empty() || probe;
+         wants_motion_layers(spec.aovs) || !crypto_layers(spec.aovs).empty() || probe;
 }
 
 Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world_apart, Structure previous,
@@ -336,6 +337,10 @@ bool wants_data_aovs(const std::set<std::string>& aovs) {
   return false;
 }
 
+bool wants_motion_layers(const std::set<std::string>& aovs) {
+  return aovs.count("vector") || aovs.count("velocity");
+}
+
 std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
                                                const std::string& layer) {
   auto node_name = [&](int n) {
@@ -375,16 +380,19 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
                    : render_data_aovs(scene, *accel, p.camera, p.config, integrator);
   if (p.spec.aovs.count("id")) out.id_manifest = id_manifest(scene, loaded.info);
   if (p.spec.aovs.count("cost")) out.cost = render_cost(*accel, p.camera, p.config, integrator);
-  if (p.spec.aovs.count("vector")) {
+  if (wants_motion_layers(p.spec.aovs)) {
+    const bool velocity = p.spec.aovs.count("velocity") != 0;
     if (p.motion) {
       const MotionFrames& m = *p.motion;
-      out.vector =
-          render_motion_vectors(scene, *accel, p.camera, p.config, {&m.previous.scene, m.previous_camera},
-                                {&m.next.scene, m.next_camera});
+      out.vector = render_motion_vectors(
+          scene, *accel, p.camera, p.config, {&m.previous.scene, m.previous_camera},
+          {&m.next.scene, m.next_camera}, velocity ? &out.velocity : nullptr, 1.0 / p.spec.fps);
     } else {
       const PixelWindow win = render_window(p.config);
       out.vector.assign(size_t(win.width()) * size_t(win.height()) * kMotionVectorChannels, 0.0f);
+      if (velocity) out.velocity.assign(size_t(win.width()) * size_t(win.height()) * kVelocityChannels, 0.0f);
     }
+    if (!p.spec.aovs.count("vector")) out.vector = {};
   }
   const std::vector<std::string> crypto = crypto_layers(p.spec.aovs);
   if (crypto.empty()) return out;

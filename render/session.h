@@ -171,6 +171,7 @@ struct RenderLayers {
   std::vector<std::string> crypto_manifests;  ///< each Cryptomatte layer's {"name": "hex"} JSON
   std::string id_manifest;                    ///< JSON names of the id layer's ids ("id")
   std::vector<float> vector;                  ///< kMotionVectorChannels per pixel of the window ("vector")
+  std::vector<float> velocity;                ///< kVelocityChannels per pixel of the window ("velocity")
 };
 
 /// The Cryptomatte layers `aovs` asks for: CryptoObject, CryptoMaterial, CryptoAsset.
@@ -178,6 +179,9 @@ std::vector<std::string> crypto_layers(const std::set<std::string>& aovs);
 
 /// Whether `aovs` asks for a data AOV (albedo, N, P, Z, UV or id).
 bool wants_data_aovs(const std::set<std::string>& aovs);
+
+/// Whether `aovs` asks for a layer traced against the neighbouring frames (vector, velocity).
+bool wants_motion_layers(const std::set<std::string>& aovs);
 
 /// The name each scene instance has in Cryptomatte layer `layer` (CryptoObject: its glTF node's
 /// name; CryptoMaterial: its material's name, "default" for none; CryptoAsset: its root node's

@@ -476,7 +476,8 @@ const std::vector<std::string>& aov_names() {
                                                  "crypto_object",
                                                  "crypto_material",
                                                  "crypto_asset",
-                                                 "vector"};
+                                                 "vector",
+                                                 "velocity"};
   return names;
 }
 
@@ -490,7 +491,7 @@ std::set<std::string> check_aovs(const std::vector<std::string>& names, const st
   for (const auto& name : names) {
     if (name == "all") {
       for (const auto& n : known)
-        if (n != "cost" && n != "vector" && (path || !is_path_layer(n))) aovs.insert(n);
+        if (n != "cost" && n != "vector" && n != "velocity" && (path || !is_path_layer(n))) aovs.insert(n);
       continue;
     }
     if (std::find(known.begin(), known.end(), name) == known.end())
@@ -600,7 +601,7 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
     e["background"] = colour_text(r.background.value_or(Vec3f{0, 0, 0}));
     e["ambient"] = colour_text(r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f}));
   }
-  if (r.aovs.count("vector")) e["vector.fps"] = exact(r.fps);
+  if (r.aovs.count("vector") || r.aovs.count("velocity")) e["vector.fps"] = exact(r.fps);
   return {e};
 }
 

@@ -374,7 +374,8 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "material and root node names; all = every one of these; cost = traversal cost of the camera rays "
       "(cost_nodes, cost_triangles, cost_shapes, cost_ns) and a heat map; vector = motion vectors in "
       "pixels to the frames 1/--fps before and after --time or --frame (vector.XYZW, Blender's Vector "
-      "pass)");
+      "pass); velocity = the same surface's camera-space velocity in scene units per second "
+      "(velocity.XYZ)");
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }

@@ -73,12 +73,20 @@ bool project_to_raster(const Camera& cam, int width, int height, Vec3f p, Vec2f&
   return std::isfinite(raster.x) && std::isfinite(raster.y);
 }
 
+Vec3f to_camera_space(const Camera& cam, Vec3f p) {
+  const Vec3f d = p - cam.eye;
+  return {dot(d, cam.u), dot(d, cam.v), dot(d, cam.w)};
+}
+
 std::vector<float> render_motion_vectors(const Scene& scene, const Accelerator& accel, const Camera& camera,
                                          const RenderConfig& config, const MotionFrame& previous,
-                                         const MotionFrame& next) {
+                                         const MotionFrame& next, std::vector<float>* velocity,
+                                         double interval) {
   const PixelWindow win = render_window(config);
   const size_t w = size_t(win.width());
   std::vector<float> out(w * size_t(win.height()) * kMotionVectorChannels, 0.0f);
+  if (velocity) velocity->assign(w * size_t(win.height()) * kVelocityChannels, 0.0f);
+  const float per_second = interval > 0 ? float(0.5 / interval) : 0.0f;
   const bool filter = scene_needs_hit_filter(scene);
   TileScheduler scheduler(win, config.tile_size, config.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) {
@@ -96,18 +104,24 @@ std::vector<float> render_motion_vectors(const Scene& scene, const Accelerator& 
         Instance moving;
         const Instance& inst = instance_at(scene, hit.geom_id, ray.time, moving);
         if (inst.shape >= 0) sp.object = apply_point(inst.to_object, ray.org + ray.dir * hit.t);
+        const size_t pixel = size_t(y - win.y0) * w + size_t(x - win.x0);
+        const Vec3f was = world_point(*previous.scene, sp), will = world_point(*next.scene, sp);
+        if (velocity) {
+          const Vec3f v =
+              (to_camera_space(next.camera, will) - to_camera_space(previous.camera, was)) * per_second;
+          for (int c = 0; c < kVelocityChannels; ++c)
+            (*velocity)[pixel * kVelocityChannels + size_t(c)] = v[c];
+        }
         // Where it is now (the projection of the point itself, not the pixel centre, so that
         // a still surface under a still camera moves by exactly 0) and in each frame.
         Vec2f now, before, after;
         if (!project_to_raster(camera, config.width, config.height, world_point(scene, sp), now)) continue;
-        const size_t i = (size_t(y - win.y0) * w + size_t(x - win.x0)) * kMotionVectorChannels;
-        if (project_to_raster(previous.camera, config.width, config.height, world_point(*previous.scene, sp),
-                              before)) {
+        const size_t i = pixel * kMotionVectorChannels;
+        if (project_to_raster(previous.camera, config.width, config.height, was, before)) {
           out[i] = before.x - now.x;
           out[i + 1] = now.y - before.y;  // +Y up
         }
-        if (project_to_raster(next.camera, config.width, config.height, world_point(*next.scene, sp),
-                              after)) {
+        if (project_to_raster(next.camera, config.width, config.height, will, after)) {
           out[i + 2] = now.x - after.x;
           out[i + 3] = after.y - now.y;  // +Y up
         }

@@ -4,7 +4,8 @@
 # holds vector.X, .Y, .Z, .W; on the quad X and Z equal minus the displacement of one frame in
 # pixels (computed here from the pinhole formula) for each integrator, twice as large at half
 # the --fps, and the same with --motion-blur; Y and W are 0; the background is 0; a render
-# without --time or --frame warns and writes zeros; --help lists the layer.
+# without --time or --frame warns and writes zeros; the velocity layer beside it holds the quad's
+# camera-space velocity; --help lists both layers.
 # Usage: vector_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -92,6 +93,21 @@ want=$(python3 -c "print(-$(step 24))")
 got=$(mean "$work/blur.exr" vector.X 34 14)
 near "$got" "$want" && passes=$((passes + 1)) || fail "--motion-blur: vector.X is $got, want $want"
 
+# The velocity layer beside it: the quad's camera-space velocity, 1.5 units per second along +x.
+expect 0 "" -- "$bin" render "$work/slide.gltf" -o "$work/velocity.exr" --width 48 --height 32 --spp 1 \
+  --accel bvh --frame 24 --aov vector,velocity
+header=$(oiiotool --info -v "$work/velocity.exr" 2>/dev/null)
+for c in X Y Z; do
+  grep -q "velocity\.$c" <<<"$header" || fail "no channel velocity.$c"
+done
+for pair in X:1.5 Y:0 Z:0; do
+  c=${pair%%:*}; want=${pair#*:}
+  got=$(mean "$work/velocity.exr" "velocity.$c" 34 14)
+  near "$got" "$want" && passes=$((passes + 1)) || fail "velocity.$c on the quad is $got, want $want"
+done
+got=$(mean "$work/velocity.exr" velocity.X 2 2)
+near "$got" 0 && passes=$((passes + 1)) || fail "velocity.X off the quad is $got, want 0"
+
 # The static pose: a warning, and zeros.
 expect 0 "vector layer.*static pose" -- "$bin" render "$work/slide.gltf" -o "$work/static.exr" --width 48 \
   --height 32 --spp 1 --aov vector
@@ -99,6 +115,7 @@ got=$(mean "$work/static.exr" vector.X 22 14)
 near "$got" 0 && passes=$((passes + 1)) || fail "static pose: vector.X is $got, want 0"
 
 expect 0 "vector" -- "$bin" render --help
+expect 0 "velocity" -- "$bin" render --help
 
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -7,6 +7,8 @@ import base64
 import json
 import math
 import pathlib
+import shutil
+import subprocess
 import sys
 import threading
 import time
@@ -318,6 +320,22 @@ def write_animated_quad(path, x0, data, add):
     return path
 
 
+def write_sliding_quad(path, speed):
+    """The quad of write_animated_quad whose node moves along +X at `speed` units per second,
+    through x = 0 at t = 1 (keys at 0 and 2 s)."""
+    def add(gltf, base, v, n):
+        gltf["bufferViews"] += [{"buffer": 0, "byteOffset": base, "byteLength": 8},
+                                {"buffer": 0, "byteOffset": base + 8, "byteLength": 24}]
+        gltf["accessors"] += [{"bufferView": v, "componentType": 5126, "count": 2, "type": "SCALAR",
+                               "min": [0], "max": [2]},
+                              {"bufferView": v + 1, "componentType": 5126, "count": 2, "type": "VEC3"}]
+        gltf["animations"] = [{"samplers": [{"input": n, "output": n + 1}],
+                               "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
+
+    keys = np.array([0, 2], np.float32).tobytes() + np.array([-speed, 0, 0, speed, 0, 0], np.float32).tobytes()
+    return write_animated_quad(path, 0, keys, add)
+
+
 def check_streak(scene, **kw):
     """At t = 1 with a one-frame shutter at 24 fps a quad moving 12 units per second sweeps 0.5
     units: its blur spans 0.7 units (11.2 px of 64 over 4 units) and coverage in the middle is
@@ -333,18 +351,7 @@ def check_streak(scene, **kw):
 
 def test_motion_blur_streaks_a_moving_quad(tmp_path):
     # The quad's node moves along +X at 12 units per second.
-    def add(gltf, base, v, n):
-        gltf["bufferViews"] += [{"buffer": 0, "byteOffset": base, "byteLength": 8},
-                                {"buffer": 0, "byteOffset": base + 8, "byteLength": 24}]
-        gltf["accessors"] += [{"bufferView": v, "componentType": 5126, "count": 2, "type": "SCALAR",
-                               "min": [0], "max": [2]},
-                              {"bufferView": v + 1, "componentType": 5126, "count": 2, "type": "VEC3"}]
-        gltf["animations"] = [{"samplers": [{"input": n, "output": n + 1}],
-                               "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
-
-    keys = np.array([0, 2], np.float32).tobytes() + np.array([-12, 0, 0, 12, 0, 0], np.float32).tobytes()
-    scene = penumbra.load(write_animated_quad(tmp_path / "moving.gltf", 0, keys, add), time=1.0,
-                          keep_animation=True)
+    scene = penumbra.load(write_sliding_quad(tmp_path / "moving.gltf", 12), time=1.0, keep_animation=True)
     check_streak(scene)
     with pytest.raises(ValueError, match="shutter needs motion_blur"):
         scene.render(shutter=1)
@@ -372,6 +379,22 @@ def test_motion_blur_streaks_a_morphing_quad(tmp_path):
             + np.array([0, 1], np.float32).tobytes())
     scene = penumbra.load(write_animated_quad(tmp_path / "morphing.gltf", -12, data, add), time=1.0)
     check_streak(scene, accel="bvh")
+
+
+def test_velocity_layer_is_the_camera_space_velocity(tmp_path):
+    # The quad's node moves +X at 1.5 units per second under a still camera looking down -Z.
+    scene = penumbra.load(write_sliding_quad(tmp_path / "sliding.gltf", 1.5), time=1.0)
+    r = scene.render(width=32, height=32, spp=1, aovs=["velocity"])
+    v = r.aovs["velocity"]
+    assert v.shape == (32, 32, 3)
+    assert "vector" not in r.aovs
+    np.testing.assert_allclose(v[16, 16], [1.5, 0, 0], atol=1e-3)
+    np.testing.assert_allclose(v[2, 2], [0, 0, 0])
+    exr = tmp_path / "velocity.exr"
+    r.write_exr(exr)
+    if shutil.which("oiiotool"):
+        info = subprocess.run(["oiiotool", "--info", "-v", str(exr)], capture_output=True, text=True).stdout
+        assert all(f"velocity.{c}" in info for c in "XYZ")
 
 
 def test_vector_layer_follows_the_scenes_time():

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <optional>
+#include <set>
 
 #include "io/files/error.h"
 #include "render/session.h"
@@ -72,9 +73,10 @@ RenderSpec vector_spec(const char* integrator) {
   return s;
 }
 
-/// Renders the vector layer of `file` at `time` (unset: its static pose).
+/// Renders the vector layer (or the layers `aovs`) of `file` at `time` (unset: its static pose).
 RenderLayers render_vectors(const std::filesystem::path& file, std::optional<double> time,
-                            const char* integrator = "whitted", PreparedRender* prepared_out = nullptr) {
+                            const char* integrator = "whitted", PreparedRender* prepared_out = nullptr,
+                            const std::set<std::string>& aovs = {"vector"}) {
   GltfLoadOptions lo;
   lo.time = time;
   LoadedScene loaded = load_gltf(file, lo);
@@ -86,7 +88,9 @@ RenderLayers render_vectors(const std::filesystem::path& file, std::optional<dou
     at.time = t;
     return load_gltf(file, at);
   };
-  const PreparedRender p = prepare_render(loaded, vector_spec(integrator), o);
+  RenderSpec spec = vector_spec(integrator);
+  spec.aovs = aovs;
+  const PreparedRender p = prepare_render(loaded, spec, o);
   const Structure s = build_structure(loaded.scene, p.spec, time.has_value());
   RenderLayers layers = render_layers(loaded, s.accel.get(), p);
   finish_render(loaded, p);
@@ -301,6 +305,60 @@ TEST_CASE("vector: neighbouring frames that do not match the scene are an error"
   CHECK_THROWS_AS(prepare_render(loaded, vector_spec("whitted"), o), std::invalid_argument);
 }
 
+/// Checks the velocity layer at every pixel whose centre sees the quad at `centre` (0.1 inside
+/// its edges) through a camera at `eye`: `expected`, in camera space; 0 well off the quad.
+void check_velocity(const std::vector<float>& v, Vec3f eye, Vec3f centre, Vec3f expected) {
+  REQUIRE(v.size() == size_t(kWidth) * kHeight * kVelocityChannels);
+  int on = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const Vec3f p = plane_point(eye, x, y);
+      const bool inside = on_quad(p, centre, 0.1f), outside = !on_quad(p, centre, -0.3f);
+      if (!inside && !outside) continue;
+      on += inside;
+      const size_t i = (size_t(y) * kWidth + size_t(x)) * kVelocityChannels;
+      for (int c = 0; c < kVelocityChannels; ++c) {
+        INFO("pixel " << x << "," << y << " channel "
+                      << "XYZ"[c]);
+        CHECK(v[i + size_t(c)] == Approx(inside ? expected[c] : 0.0f).margin(1e-3));
+      }
+    }
+  CHECK(on > 50);
+}
+
+TEST_CASE("velocity: a translating quad's camera-space velocity", "[session][vector]") {
+  // The quad moves +x at 1.5 units per second and, in a second file, towards the camera (+z) at
+  // 1; the camera stays at z = 5 looking down -z, so camera space is world space shifted.
+  const auto across = write_scene("velocity-x", Quad::Rigid, [](test::GltfWriter& w, int quad, int) {
+    w.channel(quad, "translation", {0.0f, 2.0f}, {0, 0, 0, 3, 0, 0}, "VEC3", 3);
+  });
+  const RenderLayers both = render_vectors(across, 1.0, "whitted", nullptr, {"vector", "velocity"});
+  check_velocity(both.velocity, {0, 0, 5}, {1.5f, 0, 0}, {1.5f, 0, 0});
+  REQUIRE(both.vector.size() == size_t(kWidth) * kHeight * kMotionVectorChannels);
+  // The velocity alone: the same numbers, and no vector layer.
+  const RenderLayers alone = render_vectors(across, 1.0, "path", nullptr, {"velocity"});
+  CHECK(alone.velocity == both.velocity);
+  CHECK(alone.vector.empty());
+  const auto towards = write_scene("velocity-z", Quad::Rigid, [](test::GltfWriter& w, int quad, int) {
+    w.channel(quad, "translation", {0.0f, 2.0f}, {0, 0, 0, 0, 0, 2}, "VEC3", 3);
+  });
+  const RenderLayers z = render_vectors(towards, 1.0, "whitted", nullptr, {"velocity"});
+  const size_t centre = (size_t(kHeight / 2) * kWidth + size_t(kWidth / 2)) * kVelocityChannels;
+  CHECK(z.velocity[centre] == Approx(0).margin(1e-3));
+  CHECK(z.velocity[centre + 1] == Approx(0).margin(1e-3));
+  CHECK(z.velocity[centre + 2] == Approx(1).margin(1e-3));  // approaching: +Z
+}
+
+TEST_CASE("velocity: a moving camera sees the still quad move the other way", "[session][vector]") {
+  // The camera's eye moves (-1, 2, 0) units per second: in its space (axes those of the world)
+  // every still point moves (1, -2, 0).
+  const auto file = write_scene("velocity-camera", Quad::Rigid, [](test::GltfWriter& w, int, int camera) {
+    w.channel(camera, "translation", {0.0f, 1.0f}, {0, 0, 5, -1, 2, 5}, "VEC3", 3);
+  });
+  const RenderLayers layers = render_vectors(file, 0.25, "whitted", nullptr, {"velocity"});
+  check_velocity(layers.velocity, {-0.25f, 0.5f, 5}, {0, 0, 0}, {1, -2, 0});
+}
+
 TEST_CASE("vector: the identity records fps with the layer", "[session][vector]") {
   RenderSpec a = vector_spec("path"), b = a;
   b.fps = 30;
@@ -310,6 +368,8 @@ TEST_CASE("vector: the identity records fps with the layer", "[session][vector]"
   a.aovs.clear();
   b.aovs.clear();
   CHECK(render_identity(a, cam, scene).entries == render_identity(b, cam, scene).entries);
+  a.aovs = b.aovs = {"velocity"};
+  CHECK(render_identity(a, cam, scene).entries != render_identity(b, cam, scene).entries);
 }
 
 }  // namespace penumbra

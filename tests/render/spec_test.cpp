@@ -162,6 +162,9 @@ TEST_CASE("spec: colours, environments and the structure's parameters are checke
   CHECK(check_aovs({"all"}, "whitted").count("samples") == 0);
   CHECK(check_aovs({"all"}, "path").count("samples") == 1);
   CHECK(check_aovs({"all"}, "path").count("cost") == 0);
+  CHECK(check_aovs({"all"}, "path").count("vector") == 0);
+  CHECK(check_aovs({"all"}, "path").count("velocity") == 0);
+  CHECK(check_aovs({"velocity"}, "whitted").count("velocity") == 1);
 }
 
 TEST_CASE("spec: defaults resolve per integrator and follow the aspect hint", "[spec]") {
