@@ -98,8 +98,8 @@ void load_steps(const Scene& scene, const Shutter& s, int steps, const std::stri
 
 /// Whether a light's steps differ in what light_at interpolates.
 bool light_moves(const std::vector<Light>& steps) {
+  const Light& a = steps.front();
   for (const Light& l : steps) {
-    const Light& a = steps.front();
     if (std::memcmp(&l.position, &a.position, sizeof(Vec3f)) != 0 ||
         std::memcmp(&l.direction, &a.direction, sizeof(Vec3f)) != 0 ||
         std::memcmp(&l.color, &a.color, sizeof(Vec3f)) != 0 || l.intensity != a.intensity)
