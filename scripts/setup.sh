@@ -2,7 +2,8 @@
 # The two set-up commands of README.md:
 #   scripts/setup.sh render   install deps, Release build, render scenes/default.gltf (EXR + PNG)
 #   scripts/setup.sh test     install deps, Release build, run the whole test suite with ctest,
-#                             then again in a Sanitize (ASan + UBSan) build (SANITIZE=0 skips)
+#                             the unit tests and bad-input scripts in a Sanitize (ASan + UBSan)
+#                             build (SANITIZE=0 skips it)
 # BUILD_DIR (default: build) and JOBS (default: nproc) may be overridden from the environment.
 set -euo pipefail
 
@@ -28,29 +29,31 @@ case "$mode" in
       -o "$BUILD_DIR/renders/default.exr" --png "$BUILD_DIR/renders/default.png"
     ;;
   test)
-    ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
-    # The same suite again under AddressSanitizer + UndefinedBehaviorSanitizer (build type
-    # Sanitize): the unit tests, every hostile corpus file and hostile job file through the CLI,
-    # and the command-line scripts. Each slow check runs once, in the stage where it tells the
-    # most: these run in the Release suite above only, and their targets are not built here:
-    # - the accelerator cross-check over all corpus models (11 minutes instrumented) and the one
-    #   of huge and tiny coordinates;
-    # - the end-to-end, frame-range, extension and ray-limit scripts (hundreds of renders of the
-    #   shipped scenes through paths the unit tests and the other scripts also take here);
-    # - the two Slurm tests (they drive slurmctld, slurmd and munge around the same commands the
-    #   other CLI tests run), the Blender compositor check (Penumbra's side of it runs in
-    #   cli.cryptomatte), the Blender depth-of-field cross-check (Penumbra's lens is in
-    #   cli.camera and the unit tests), the install and package tests (packaging, not code paths);
-    # - the Python tests (an instrumented module cannot load into Debian's uninstrumented
-    #   python3), the benchmark's smoke runs and tests (measurement code), and the format and
-    #   OCIO-config checks and the documentation site (the same in any build).
-    # SANITIZE=0 skips this stage.
+    # The suite runs in two stages, each check once, in the stage where it tells the most.
+    # Release (build/): everything, except the scripts labelled bad-input when the sanitizer
+    # stage follows.
+    # Sanitize (build-sanitize/, ASan + UBSan; SANITIZE=0 skips it, and the Release stage then
+    # runs everything): the unit tests and the scripts that feed the command hostile input, where
+    # a memory error is what a test must catch:
+    # - the scripts labelled bad-input run here only: cli.hostile_input (every malformed corpus
+    #   file), cli.job_hardening (hostile job files), cli.output_safety (unwritable, hostile and
+    #   half-written outputs);
+    # - unit test cases tagged [heavy] (the accelerator and raster cross-checks over every corpus
+    #   model, huge and tiny coordinates) are filtered out of this build's ctest commands;
+    # - the other scripts run in Release only: they render the shipped scenes through the
+    #   command's options, paths the unit tests take here too; so do the Slurm tests (daemons
+    #   around the same commands), the Blender checks, install and package, Python (an
+    #   instrumented module cannot load into Debian's uninstrumented python3), the benchmark's
+    #   smoke runs and tests (measurement code, not built here), and the format, OCIO-config,
+    #   layering and documentation checks (the same in any build).
     if [ "${SANITIZE:-1}" != 0 ]; then
+      ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" -LE '^bad-input$'
       SAN_DIR="${SAN_BUILD_DIR:-build-sanitize}"
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
       cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests render_tests
-      ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" \
-        -E "cross-check: every valid corpus model|cross-check: huge and tiny coordinates|cli\.end_to_end|cli\.frames|cli\.extensions|cli\.ray_limits|cli\.slurm_farm|cli\.slurm_cluster|cli\.compositor|cli\.blender_dof|cli\.vector|install\.|python\.|bench\.|scenegen\.|bench_tests_NOT_BUILT|format\.|ocio\.|docs\.|layout\."
+      ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" -L '^(unit|bad-input)$' -E '^benchmarks/'
+    else
+      ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
     fi
     ;;
 esac

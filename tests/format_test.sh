@@ -9,12 +9,14 @@ if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
 else
   mapfile -t files < <(find apps benchmarks fuzz io render renderer tests -name '*.h' -o -name '*.cpp')
 fi
-bad=0
-for f in "${files[@]}"; do
-  if ! "$cf" --style=file --dry-run --Werror "$f" >/dev/null 2>&1; then
-    echo "not formatted: $f"
-    bad=$((bad + 1))
-  fi
-done
-echo "format: ${#files[@]} files, $bad not formatted"
-[ "$bad" -eq 0 ] && [ "${#files[@]}" -gt 0 ]
+# One clang-format process checks every file; each violation is reported as
+# "FILE:LINE:COL: error: code should be clang-formatted".
+report=$("$cf" --style=file --dry-run --Werror "${files[@]}" 2>&1)
+status=$?
+mapfile -t bad < <(printf '%s\n' "$report" | sed -n 's/^\(.*\):[0-9]*:[0-9]*: error: .*clang-format.*/\1/p' | sort -u)
+for f in "${bad[@]}"; do echo "not formatted: $f"; done
+if [ "$status" -ne 0 ] && [ "${#bad[@]}" -eq 0 ]; then
+  echo "clang-format failed:"; printf '%s\n' "$report" | head -5
+fi
+echo "format: ${#files[@]} files, ${#bad[@]} not formatted"
+[ "$status" -eq 0 ] && [ "${#bad[@]}" -eq 0 ] && [ "${#files[@]}" -gt 0 ]

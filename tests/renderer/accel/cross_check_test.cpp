@@ -116,7 +116,7 @@ TEST_CASE("cross-check: a tessellated plane, rays through vertices, along edges 
   check_scene("plane", s.views(), {}, 1, extra);
 }
 
-TEST_CASE("cross-check: huge and tiny coordinates", "[accel][crosscheck]") {
+TEST_CASE("cross-check: huge and tiny coordinates", "[accel][crosscheck][heavy]") {
   struct Variant {
     float scale;
     Vec3f offset;
@@ -340,7 +340,7 @@ TEST_CASE("cross-check: Embree without the robust flag and at low and high build
   }
 }
 
-TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus]") {
+TEST_CASE("cross-check: every valid corpus model", "[accel][crosscheck][corpus][heavy]") {
   const auto corpus = corpus_dir();
   if (!corpus) return skip("no corpus (set PENUMBRA_CORPUS)");
   size_t models = 0;

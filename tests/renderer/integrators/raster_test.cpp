@@ -264,7 +264,7 @@ TEST_CASE("raster cross-check: id and Z agree with the ray tracer on the shipped
 }
 
 TEST_CASE("raster cross-check: id and Z agree with the ray tracer on every valid corpus model",
-          "[raster][crosscheck][corpus]") {
+          "[raster][crosscheck][corpus][heavy]") {
   const auto corpus = corpus_dir();
   if (!corpus) return skip("no corpus (set PENUMBRA_CORPUS)");
   int models = 0;
