@@ -136,13 +136,12 @@ class TwoLevelAccelerator final : public Accelerator {
       const InstanceView& inst = instances[item.instance];
       inverse(inst.to_world, item.to_object);
       if (item.motion != kStill) m_motion[item.motion].assign(inst.motion.begin(), inst.motion.end());
-      const Bounds3f object =
-          item.level == kShapeLevel ? shape_bounds(m_shapes[item.shape]) : m_levels[item.level]->bounds();
-      item.box = world_box(inst, item.motion, object);
+      item.box = world_box(inst, item.motion, object_box(item));
     }
     std::sort(m_items.begin(), m_items.end(),
               [](const Item& a, const Item& b) { return a.instance < b.instance; });
     m_nodes.clear();
+    m_time_nodes.clear();
     m_bounds = Bounds3f{};
     m_top_depth = 0;
     m_sah_cost = 0;
@@ -207,16 +206,18 @@ class TwoLevelAccelerator final : public Accelerator {
     s.nodes += m_nodes.size();
     s.max_depth = m_top_depth + bottom_depth;
     s.sah_cost = m_sah_cost;
-    s.bytes += m_nodes.size() * sizeof(BvhNode) + m_items.size() * sizeof(Item);
+    s.bytes += (m_nodes.size() * (1 + m_time_nodes.size())) * sizeof(BvhNode) + m_items.size() * sizeof(Item);
     s.build_seconds = m_build_seconds;
     return s;
   }
 
  private:
-  static constexpr uint32_t kWorld = 0xffffffffu;           // Item::instance of the world-space level
-  static constexpr uint32_t kDeformingWorld = 0xfffffffeu;  // ... of the world's deforming meshes
-  static constexpr uint32_t kShapeLevel = 0xffffffffu;      // Item::level of a placed shape
-  static constexpr uint32_t kStill = 0xffffffffu;           // Item::motion of an item that stays put
+  static constexpr uint32_t kWorld = 0xffffffffu;             // Item::instance of the world-space level
+  static constexpr uint32_t kDeformingWorld = 0xfffffffeu;    // ... of the world's deforming meshes
+  static constexpr uint32_t kShapeLevel = 0xffffffffu;        // Item::level of a placed shape
+  static constexpr uint32_t kStill = 0xffffffffu;             // Item::motion of an item that stays put
+  static constexpr uint32_t kTimeSegments = 8;                // time segments of the moving top level
+  static constexpr size_t kTimeNodeBytes = size_t(32) << 20;  // most memory its per-segment nodes take
 
   struct Item {
     uint32_t level;     // index into m_levels, or kShapeLevel
@@ -231,6 +232,53 @@ class TwoLevelAccelerator final : public Accelerator {
   /// takes.
   Bounds3f world_box(const InstanceView& inst, uint32_t motion, const Bounds3f& b) const {
     return motion == kStill ? transform_bounds(inst.to_world, b) : motion_bounds(m_motion[motion], b);
+  }
+
+  /// The object-space box an item's map places: its shape's or its bottom level's.
+  Bounds3f object_box(const Item& item) const {
+    return item.level == kShapeLevel ? shape_bounds(m_shapes[item.shape]) : m_levels[item.level]->bounds();
+  }
+
+  /// With moving items, the top level's boxes per time segment: m_time_nodes[k] is m_nodes with
+  /// each box bounding its items over the times [k, k + 1] / kTimeSegments only (a moving item by
+  /// motion_bounds over that span, a still one by its box), so that a ray tests the boxes of its
+  /// own time's segment and not the whole shutter's (Embree's motion-blur BVH bounds nodes over
+  /// time segments too, linearly within each). Left empty, and the shutter's boxes used, when
+  /// nothing moves or the copies would pass kTimeNodeBytes.
+  void build_time_nodes() {
+    m_time_nodes.clear();
+    if (m_motion.empty() || m_nodes.size() * kTimeSegments * sizeof(BvhNode) > kTimeNodeBytes) return;
+    m_time_nodes.assign(kTimeSegments, m_nodes);
+    std::vector<Bounds3f> boxes(m_nodes.size());
+    for (uint32_t k = 0; k < kTimeSegments; ++k) {
+      const float t0 = float(k) / float(kTimeSegments), t1 = float(k + 1) / float(kTimeSegments);
+      std::vector<BvhNode>& nodes = m_time_nodes[k];
+      for (size_t i = nodes.size(); i-- > 0;) {  // children follow their parent
+        BvhNode& node = nodes[i];
+        Bounds3f b;
+        if (node.count > 0) {
+          for (uint32_t j = node.offset, e = node.offset + node.count; j < e; ++j) {
+            const Item& item = m_items[j];
+            b = merge(b, item.motion == kStill
+                             ? item.box
+                             : motion_bounds(m_motion[item.motion], object_box(item), t0, t1));
+          }
+        } else {
+          b = merge(boxes[i + 1], boxes[node.offset]);
+        }
+        boxes[i] = b;
+        const Bounds3f w = widen_for_rounding(b);
+        node.lo = w.lo;
+        node.hi = w.hi;
+      }
+    }
+  }
+
+  /// The top-level nodes a ray at `time` walks: its time segment's, else the shutter's.
+  const std::vector<BvhNode>& nodes_at(float time) const {
+    if (m_time_nodes.empty()) return m_nodes;
+    const float t = time > 0 ? (time < 1 ? time : 1.0f) : 0.0f;  // NaN as 0
+    return m_time_nodes[std::min(uint32_t(t * float(kTimeSegments)), kTimeSegments - 1)];
   }
 
   /// The caller's filter as a bottom level must apply it: to the world ray, with the bottom
@@ -271,6 +319,7 @@ class TwoLevelAccelerator final : public Accelerator {
     m_bounds = root->box;
     flatten_bvh(*root, m_nodes);
     m_top_depth = depth(*root);
+    build_time_nodes();
     // Expected cost of a ray through the root: top nodes at cost 1 each, and per item the
     // probability of entering its box times its bottom level's own SAH cost. Reported only if
     // every bottom level has one.
@@ -298,7 +347,7 @@ class TwoLevelAccelerator final : public Accelerator {
   bool walk(const Ray& ray, const float& best, TraversalCost* cost, Query&& query) const {
     if (!is_valid_query(ray)) return false;
     return walk_bvh(
-        m_nodes, prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
+        nodes_at(ray.time), prepare_box_query(ray), std::max(ray.tnear, 0.0f), best,
         [&] {
           if (cost) ++cost->nodes;
         },
@@ -366,6 +415,7 @@ class TwoLevelAccelerator final : public Accelerator {
   std::vector<Item> m_items;                           // in top-level leaf order
   std::vector<std::vector<MotionKey>> m_motion;        // the moving items' keys
   std::vector<BvhNode> m_nodes;                        // top level, depth first
+  std::vector<std::vector<BvhNode>> m_time_nodes;      // the same per time segment (build_time_nodes)
   std::vector<AccelStats> m_stats_bottom;
   InstanceLayout m_layout;  // every instance's mesh and kind, as built
   Bounds3f m_bounds;

@@ -27,7 +27,9 @@ using AcceleratorBuilder = std::function<std::unique_ptr<Accelerator>(std::span<
 /// top level's leaf maps the ray and calls the shape test itself. A deforming mesh
 /// (GeometryView::deforms()) gets the structure of accel/deforming.h with `deforming`'s
 /// parameters instead of `build`'s, placed under the top level even by the identity, its box
-/// that of the whole shutter; deforming meshes must all have the same motion_steps. Instances
+/// that of the whole shutter; deforming meshes must all have the same motion_steps. With moving
+/// instances (InstanceView::motion) the top level keeps its boxes per time segment (eight over
+/// the shutter; up to 32 MiB of them, else the shutter's) and a ray walks its time's. Instances
 /// with a singular or non-finite map are left out. Throws std::invalid_argument if an instance
 /// names a mesh outside `meshes` or deforming meshes differ in motion_steps, and whatever `build`
 /// throws. update_instances() keeps every bottom level and builds the top level again over the

@@ -98,9 +98,14 @@ Affine3f interpolate_motion(std::span<const MotionKey> keys, float time) {
 }
 
 Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b) {
+  return motion_bounds(keys, b, 0, 1);
+}
+
+Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b, float t0, float t1) {
   if (b.empty() || keys.empty()) return {};
   constexpr int kSteps = 16;  // per key interval
-  const int n = keys.size() == 1 ? 1 : int(keys.size() - 1) * kSteps + 1;
+  const int intervals = int(keys.size()) - 1;
+  const int n = intervals == 0 ? 1 : std::max(2, int(std::ceil(double(t1 - t0) * intervals * kSteps)) + 1);
   // How far a corner lies from the object origin under U: the arm a rotation swings.
   float arm = 0;
   for (const MotionKey& k : keys) {
@@ -110,17 +115,19 @@ Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b) {
   }
   Bounds3f out;
   for (int s = 0; s < n; ++s) {
-    const float t = n == 1 ? 0.0f : float(s) / float(n - 1);
+    const float t = n == 1 ? t0 : (s == n - 1 ? t1 : t0 + (t1 - t0) * float(s) / float(n - 1));
     const Bounds3f m = transform_bounds(interpolate_motion(keys, t), b);
     out = merge(merge(out, m.lo), m.hi);
   }
-  // Between two steps a corner turns by at most the interval's angle / kSteps: it leaves the
-  // chord by less than arm * angle (generous: the sagitta is arm * angle^2 / 8).
+  // Between two steps a corner turns by at most the largest key interval's angle times the
+  // share of an interval the steps are apart: it leaves the chord by less than arm * angle
+  // (generous: the sagitta is arm * angle^2 / 8).
   double angle = 0;
   for (size_t i = 0; i + 1 < keys.size(); ++i)
     angle =
         std::max(angle, 2 * std::acos(std::min(1.0, std::fabs(dot(keys[i].rotation, keys[i + 1].rotation)))));
-  const float pad = arm * float(angle / kSteps) + 1e-6f * (length(out.hi - out.lo) + arm);
+  const double step = n > 1 ? double(t1 - t0) / (n - 1) * intervals : 0.0;
+  const float pad = arm * float(angle * step) + 1e-6f * (length(out.hi - out.lo) + arm);
   out.lo = out.lo - Vec3f{pad, pad, pad};
   out.hi = out.hi + Vec3f{pad, pad, pad};
   return out;

@@ -43,6 +43,9 @@ Affine3f interpolate_motion(std::span<const MotionKey> keys, float time);
 /// at 16 steps per key interval, padded by the arc a corner may bulge out between steps
 /// (conservative). Empty for an empty box.
 Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b);
+/// The same over the times in [t0, t1] only (0 <= t0 <= t1 <= 1): the box mapped at t0, t1 and
+/// steps between them as dense as motion_bounds()'s, padded the same way.
+Bounds3f motion_bounds(std::span<const MotionKey> keys, const Bounds3f& b, float t0, float t1);
 
 /// Where `time` in [0, 1] (clamped; NaN as 0) falls among `steps` >= 2 time steps spaced
 /// evenly over [0, 1]: between step `k` and k + 1, at fraction `a` of the way, k <= steps - 2.

@@ -14,10 +14,10 @@ bool sample_incident(const Light& light, Vec3f p, IncidentLight& out) {
   return true;
 }
 
-bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float u1, Vec2f u2,
+bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float time, float u1, Vec2f u2,
                      IncidentLight& out) {
   AreaLightSample ls;
-  if (!sample_area_light(area, u1, u2, ls)) return false;
+  if (!sample_area_light(area, scene, time, u1, u2, ls)) return false;
   const Vec3f d = ls.p - p;
   const float dist2 = dot(d, d), dist = std::sqrt(dist2);
   const Vec3f wi = d / dist;
@@ -30,13 +30,14 @@ bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float 
     Ray to_light;
     to_light.org = p;
     to_light.dir = wi;
+    to_light.time = time;
     Hit lh;
     lh.t = dist;
     lh.u = ls.u;
     lh.v = ls.v;
     lh.geom_id = ls.instance;
     lh.prim_id = ls.prim;
-    le = eval_emission(scene, make_interaction(scene, to_light, lh, *ls.tri));
+    le = eval_emission(scene, make_interaction(scene, to_light, lh, ls.tri));
   }
   if (!(max_component(le) > 0)) return false;
   out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};
@@ -94,7 +95,7 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
   if (!lights.area->pmf.empty()) {
     const float u1 = samples.get1d();
     const Vec2f u2 = samples.get2d();
-    if (sample_incident(*lights.area, scene, v.si.p, u1, u2, l))
+    if (sample_incident(*lights.area, scene, v.si.p, v.si.time, u1, u2, l))
       estimate(scene, accel, v, mode, l, counts, out);
   }
   if (!is_black(*lights.environment)) {

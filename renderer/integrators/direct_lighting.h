@@ -35,10 +35,11 @@ struct IncidentLight {
 
 /// Samples of each light kind towards point p; false when the light sends nothing there.
 bool sample_incident(const Light& light, Vec3f p, IncidentLight& out);
-/// An emissive triangle chosen by power with u1 and a point on it with u2; li is the emission
-/// there times the emitter's coverage (a Blend emitter is hit by BSDF-sampled rays with
-/// probability alpha, a Mask hole not at all). False for the emitter's invisible side.
-bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float u1, Vec2f u2,
+/// An emissive triangle chosen by power with u1 and a point on it with u2, where the triangle
+/// is at ray time `time`; li is the emission there times the emitter's coverage (a Blend
+/// emitter is hit by BSDF-sampled rays with probability alpha, a Mask hole not at all). False
+/// for the emitter's invisible side.
+bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float time, float u1, Vec2f u2,
                      IncidentLight& out);
 /// An environment direction from u.
 bool sample_incident(const Environment& env, Vec2f u, IncidentLight& out);

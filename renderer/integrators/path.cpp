@@ -65,9 +65,9 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, co
       w = 0;
     } else if (ctx.sample_lights) {
       const float cos_l = std::fabs(dot(si.ng, seg.ray.dir));
-      const float pdf_l =
-          cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id) * hit.t * hit.t / cos_l
-                    : 0.0f;
+      const float pdf_l = cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id, si.tri) *
+                                          hit.t * hit.t / cos_l
+                                    : 0.0f;
       w = power_heuristic(seg.prev_pdf, pdf_l);
     }
   }

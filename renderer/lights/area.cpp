@@ -10,6 +10,11 @@
 namespace penumbra {
 
 namespace {
+float triangle_area(const WorldTriangle& tri) {
+  const float area = 0.5f * length(cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
+  return std::isfinite(area) ? area : 0.0f;
+}
+
 // Luminance of the emission averaged over the triangle: the material evaluated at the
 // centroid with the triangle's UV edges as the footprint (so the texture lookup reads the MIP
 // level where the triangle is about one texel).
@@ -51,11 +56,12 @@ AreaLights build_area_lights(const Scene& scene) {
     const Material& mat = material_of(scene, mesh.material);
     if (!(max_component(mat.emissive) > 0) || mat.unlit) continue;
     lights.first[i] = int64_t(lights.triangles.size());
+    const bool moves =
+        mesh.motion_steps > 0 || (i < scene.instance_motion.size() && !scene.instance_motion[i].empty());
     const uint32_t n = uint32_t(mesh.indices.size() / 3);
     for (uint32_t prim = 0; prim < n; ++prim) {
       const WorldTriangle tri = world_triangle(scene, inst, prim);
-      const float area = 0.5f * length(cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
-      EmissiveTriangle t{uint32_t(i), prim, std::isfinite(area) ? area : 0.0f, tri};
+      EmissiveTriangle t{uint32_t(i), prim, triangle_area(tri), tri, moves};
       double p = 0;
       if (t.area > 0)
         p = double(emission_estimate(scene, t.instance, prim, tri, mat)) * t.area *
@@ -80,15 +86,30 @@ AreaLights build_area_lights(const Scene& scene) {
   return lights;
 }
 
+namespace {
+const EmissiveTriangle* find_light(const AreaLights& lights, uint32_t instance, uint32_t prim, size_t& k) {
+  if (lights.pmf.empty() || instance >= lights.first.size() || lights.first[instance] < 0) return nullptr;
+  k = size_t(lights.first[instance]) + prim;
+  return k < lights.triangles.size() ? &lights.triangles[k] : nullptr;
+}
+}  // namespace
+
 float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim) {
-  if (lights.pmf.empty() || instance >= lights.first.size() || lights.first[instance] < 0) return 0;
-  const size_t k = size_t(lights.first[instance]) + prim;
-  if (k >= lights.triangles.size()) return 0;
-  const EmissiveTriangle& t = lights.triangles[k];
-  return t.area > 0 ? lights.pmf[k] / t.area : 0.0f;
+  size_t k = 0;
+  const EmissiveTriangle* t = find_light(lights, instance, prim, k);
+  return t && t->area > 0 ? lights.pmf[k] / t->area : 0.0f;
 }
 
-bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSample& out) {
+float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim, const WorldTriangle& tri) {
+  size_t k = 0;
+  const EmissiveTriangle* t = find_light(lights, instance, prim, k);
+  if (!t) return 0;
+  const float area = t->moves ? triangle_area(tri) : t->area;
+  return area > 0 ? lights.pmf[k] / area : 0.0f;
+}
+
+bool sample_area_light(const AreaLights& lights, const Scene& scene, float time, float u1, Vec2f u,
+                       AreaLightSample& out) {
   if (lights.pmf.empty()) return false;
   const size_t n = lights.triangles.size();
   auto it = std::upper_bound(lights.cdf.begin(), lights.cdf.end(), u1);
@@ -96,7 +117,15 @@ bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSam
   while (k + 1 < n && !(lights.pmf[k] > 0)) ++k;  // rounding may land on a zero-power entry
   if (!(lights.pmf[k] > 0)) return false;
   const EmissiveTriangle& t = lights.triangles[k];
-  const WorldTriangle& tri = t.tri;
+  float area = t.area;
+  if (t.moves) {
+    Instance posed;
+    out.tri = world_triangle(scene, instance_at(scene, t.instance, time, posed), t.prim, time);
+    area = triangle_area(out.tri);
+  } else {
+    out.tri = t.tri;
+  }
+  const WorldTriangle& tri = out.tri;
   // Uniform point: b0 = 1 - sqrt(u.x), b1 = u.y sqrt(u.x), b2 = (1 - u.y) sqrt(u.x)
   // (pbrt-v3 UniformSampleTriangle); the Hit convention's (u, v) are (b1, b2).
   const float su = std::sqrt(u.x);
@@ -106,8 +135,7 @@ bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSam
   out.v = (1 - u.y) * su;
   out.p = tri.p[0] * (1 - out.u - out.v) + tri.p[1] * out.u + tri.p[2] * out.v;
   out.ng = tri.ng;
-  out.tri = &t.tri;
-  out.pdf_area = t.area > 0 ? lights.pmf[k] / t.area : 0.0f;
+  out.pdf_area = area > 0 ? lights.pmf[k] / area : 0.0f;
   return out.pdf_area > 0 && dot(out.ng, out.ng) > 0;
 }
 

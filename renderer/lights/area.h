@@ -20,8 +20,10 @@ namespace penumbra {
 
 struct EmissiveTriangle {
   uint32_t instance = 0, prim = 0;
-  float area = 0;     ///< world-space area
-  WorldTriangle tri;  ///< world_triangle() of the triangle, kept so sampling does not rebuild it
+  float area = 0;      ///< world-space area at the frame's time
+  WorldTriangle tri;   ///< world_triangle() of the triangle, kept so sampling does not rebuild it
+  bool moves = false;  ///< its instance moves or its mesh deforms over the shutter: sampled
+                       ///< where it is at each sample's time
 };
 
 struct AreaLights {
@@ -37,20 +39,26 @@ struct AreaLights {
 AreaLights build_area_lights(const Scene& scene);
 
 /// Density (per unit world area) with which sample_area_light() picks a point on triangle
-/// `prim` of instance `instance`: pmf / area, or 0 if it is not a light.
+/// `prim` of instance `instance` at the frame's time: pmf / area, or 0 if it is not a light.
 float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim);
+/// The same density at the time where the triangle is `tri` (the world triangle a ray hit at
+/// its time): pmf / area of `tri` for a light that moves or deforms, else as above.
+float area_light_pdf(const AreaLights& lights, uint32_t instance, uint32_t prim, const WorldTriangle& tri);
 
 struct AreaLightSample {
   uint32_t instance = 0, prim = 0;
-  float u = 0, v = 0;                  ///< barycentrics of the point (Hit convention)
-  Vec3f p;                             ///< world point
-  Vec3f ng;                            ///< unit front-side geometric normal
-  float pdf_area = 0;                  ///< pmf / area
-  const WorldTriangle* tri = nullptr;  ///< the light's world triangle (points into AreaLights)
+  float u = 0, v = 0;  ///< barycentrics of the point (Hit convention)
+  Vec3f p;             ///< world point
+  Vec3f ng;            ///< unit front-side geometric normal
+  float pdf_area = 0;  ///< pmf / area
+  WorldTriangle tri;   ///< the light's world triangle at the sample's time
 };
 
-/// Picks a triangle by power with u1 and a uniform point on it with u. False if there are
-/// no lights (or the chosen triangle is degenerate). Never allocates.
-bool sample_area_light(const AreaLights& lights, float u1, Vec2f u, AreaLightSample& out);
+/// Picks a triangle by power with u1 and a uniform point on it with u, where the triangle is
+/// at ray time `time` (instance_at, world_triangle: a light that moves or deforms is sampled
+/// where every structure intersects it then). False if there are no lights (or the chosen
+/// triangle is degenerate). Never allocates.
+bool sample_area_light(const AreaLights& lights, const Scene& scene, float time, float u1, Vec2f u,
+                       AreaLightSample& out);
 
 }  // namespace penumbra

@@ -28,6 +28,7 @@ const Instance& instance_at(const Scene& scene, uint32_t index, float time, Inst
   const Instance& inst = scene.instances[index];
   if (index >= scene.instance_motion.size() || scene.instance_motion[index].empty()) return inst;
   storage = inst;
+  storage.identity = false;  // moving: mapped at every time, whatever its frame's map
   storage.to_world = interpolate_motion(scene.instance_motion[index], time);
   if (!inverse(storage.to_world, storage.to_object)) storage.to_object = inst.to_object;
   return storage;

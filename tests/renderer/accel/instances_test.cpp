@@ -398,3 +398,35 @@ TEST_CASE("instances: moving instances, every back end against the triangles pla
   }
   CHECK(hits > rays / 4);  // the rays meet the moving spheres and planes often
 }
+
+TEST_CASE("instances: a moving instance's top-level box follows the ray's time",
+          "[accel][instances][motion]") {
+  // A sphere of radius 0.5 sliding from x = -10 to x = 10 over the shutter beside a still one at
+  // y = 5: a ray at time 0 straight down onto x = 10 meets no top-level box of its time (one
+  // node visited, no bottom level entered), while the same ray at time 1 hits the sphere there.
+  Soup s;
+  Soup sphere = icosphere(2, 0.5f, {0, 0, 0});
+  s.add(sphere.positions[0], sphere.indices[0]);
+  const auto meshes = s.views();
+  const std::vector<MotionKey> slide =
+      make_motion_keys(std::vector<Affine3f>{translation({-10, 0, 0}), translation({10, 0, 0})});
+  std::vector<InstanceView> instances = {{0, translation({-10, 0, 0})}, {0, translation({0, 5, 0})}};
+  instances[0].motion = slide;
+  for (const auto& name : accelerator_names()) {
+    const auto accel = make_accelerator(name, meshes, instances);
+    if (!accel->counts_traversal()) continue;  // Embree counts no nodes
+    INFO(name);
+    Ray ray;
+    ray.org = {10, 0, 5};
+    ray.dir = {0, 0, -1};
+    ray.time = 0;
+    Hit hit;
+    TraversalCost cost;
+    CHECK_FALSE(accel->intersect_counted(ray, hit, cost));
+    CHECK(cost.nodes == 1);
+    ray.time = 1;
+    REQUIRE(accel->intersect(ray, hit));
+    CHECK(hit.geom_id == 0);
+    CHECK(hit.t == Approx(4.5).epsilon(0.02));
+  }
+}

@@ -42,7 +42,7 @@ TEST_CASE("area lights: power-proportional choice, uniform points, consistent de
   const int n = 200000;
   for (int i = 0; i < n; ++i) {
     AreaLightSample ls;
-    REQUIRE(sample_area_light(al, rng.next_float(), {rng.next_float(), rng.next_float()}, ls));
+    REQUIRE(sample_area_light(al, s, 0, rng.next_float(), {rng.next_float(), rng.next_float()}, ls));
     REQUIRE(ls.instance >= 1);
     ++counts[ls.instance];
     REQUIRE(ls.pdf_area == Approx(area_light_pdf(al, ls.instance, ls.prim)));
@@ -58,7 +58,7 @@ TEST_CASE("area lights: power-proportional choice, uniform points, consistent de
   check_vec(mean_big / float(counts[3]), {2, 1, 3}, 0.01f);
   // The quad facing down has its front normal -z.
   AreaLightSample ls;
-  REQUIRE(sample_area_light(al, 0.01f, {0.5f, 0.5f}, ls));
+  REQUIRE(sample_area_light(al, s, 0, 0.01f, {0.5f, 0.5f}, ls));
   CHECK(ls.instance == 1);
   check_vec(ls.ng, {0, 0, -1});
 }
@@ -69,5 +69,33 @@ TEST_CASE("area lights: a scene without emission has none", "[lights][quick]") {
   const AreaLights al = build_area_lights(s);
   CHECK(al.pmf.empty());
   AreaLightSample ls;
-  CHECK_FALSE(sample_area_light(al, 0.5f, {0.5f, 0.5f}, ls));
+  CHECK_FALSE(sample_area_light(al, s, 0, 0.5f, {0.5f, 0.5f}, ls));
+}
+
+TEST_CASE("area lights: a moving light is sampled where it is at the sample's time",
+          "[lights][quick][motion]") {
+  // A unit emissive quad at z = 2 whose instance slides +4 in x and doubles in x and y over the
+  // shutter (keys at times 0 and 1): at time 0.5 it spans x in [2, 3.5], y in [0, 1.5] (area 2.25).
+  Scene s;
+  add_quad_z(s, 0, 1, 0, 1, 2, add_lambert(s, {0, 0, 0}, {1, 1, 1}, /*double_sided=*/true));
+  s.instance_motion = {{decompose_motion(to_affine(scale(1, 1, 1))),
+                        decompose_motion(to_affine(translate(4, 0, 0) * scale(2, 2, 1)))}};
+  const AreaLights al = build_area_lights(s);
+  REQUIRE(al.triangles.size() == 2);
+  CHECK(al.triangles[0].moves);
+  Rng rng;
+  Vec3f lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+  for (int i = 0; i < 20000; ++i) {
+    AreaLightSample ls;
+    REQUIRE(sample_area_light(al, s, 0.5f, rng.next_float(), {rng.next_float(), rng.next_float()}, ls));
+    lo = min(lo, ls.p);
+    hi = max(hi, ls.p);
+    // The density is the pmf over the area at that time, as a ray hitting the light then reports.
+    REQUIRE(ls.pdf_area == Approx(al.pmf[ls.prim] / 1.125));
+    REQUIRE(area_light_pdf(al, 0, ls.prim, ls.tri) == Approx(ls.pdf_area));
+  }
+  check_vec(lo, {2, 0, 2}, 0.02f);
+  check_vec(hi, {3.5f, 1.5f, 2}, 0.02f);
+  // At the frame's time (the scene's own map) the stored triangle and area hold.
+  CHECK(area_light_pdf(al, 0, 0) == Approx(al.pmf[0] / 0.5));
 }
