@@ -136,6 +136,16 @@ std::vector<SpecField> make_fields() {
        0,
        {"sobol", "independent"},
        "path: sobol (Owen-scrambled, default) or independent (PCG32)"},
+      {"energy_compensation",
+       &S::energy_compensation,
+       kPath,
+       true,
+       0,
+       0,
+       {"on", "off"},
+       "path: on (default) adds the energy rough GGX reflection loses to single scattering (Kulla-Conty); "
+       "off "
+       "for comparisons with renderers without it (Cycles 3.4's Principled BSDF)"},
       {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
       {"env_rotation",
        &S::env_rotation,
@@ -559,6 +569,7 @@ RenderConfig make_render_config(const RenderSpec& r) {
   cfg.path.strategy = r.light_sampling == "bsdf"    ? LightStrategy::Bsdf
                       : r.light_sampling == "light" ? LightStrategy::Light
                                                     : LightStrategy::Mis;
+  cfg.path.energy_compensation = r.energy_compensation == "on";
   cfg.sampler = r.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   cfg.time_limit = r.time_limit;
   cfg.adaptive_threshold = r.adaptive;

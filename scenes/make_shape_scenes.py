@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes scenes/csg.gltf, spheres.gltf, procedural.gltf and focus.gltf: Penumbra's scenes of
+"""Writes scenes/csg.gltf, spheres.gltf, procedural.gltf, focus.gltf, motion.gltf and
+furnace.gltf: Penumbra's scenes of
 PENUMBRA_shapes shapes and PENUMBRA_procedural materials.
 
 csg.gltf: the classic CSG part (a sphere intersected with a cube, minus three orthogonal
@@ -19,6 +20,10 @@ focus.gltf: a depth-of-field study: a diagonal row of spheres receding from the 
 tiled floor, small emissive spheres far behind them (highlights that defocus into the aperture's
 shape), two point lights and a 50 mm-like camera; scenes/focus-pull.json renders it focused near,
 in the middle and far.
+
+furnace.gltf: the white furnace: five white metal spheres of roughness 0.2 to 1.0 and no lights,
+to render with --integrator path --env 1: with energy compensation they vanish into the
+background, without it the rough ones show as grey discs.
 
 All list PENUMBRA_shapes and PENUMBRA_procedural in extensionsUsed only, so tools that do not know the extension still
 load them (as empty nodes, cameras and lights). Pure JSON with no buffers; pure standard library;
@@ -321,6 +326,19 @@ def build_focus():
     return b.gltf
 
 
+def build_furnace():
+    b = Builder("furnace")
+    # Five white metal spheres (F0 = 1) of roughness 0.2 to 1.0 in a row, no lights: under a
+    # uniform white environment (--env 1) a BSDF that conserves energy leaves them invisible.
+    for k in range(5):
+        roughness = 0.2 * (k + 1)
+        material = b.material("white metal %.1f" % roughness, (1.0, 1.0, 1.0), 1.0, roughness)
+        b.shape("sphere %.1f" % roughness, {"type": "sphere", "radius": 0.45}, material,
+                translation=[-2.0 + 1.0 * k, 0.0, 0.0])
+    b.camera("furnace camera", [0.0, 0.0, 9.0], [0.0, 0.0, 0.0], 0.32)
+    return b.gltf
+
+
 def build_motion():
     b = Builder("motion")
     floor = b.material("floor", (0.6, 0.6, 0.62), 0.0, 0.8)
@@ -353,7 +371,7 @@ def main():
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     for name, build in [("csg.gltf", build_csg), ("spheres.gltf", build_spheres),
                         ("procedural.gltf", build_procedural), ("focus.gltf", build_focus),
-                        ("motion.gltf", build_motion)]:
+                        ("motion.gltf", build_motion), ("furnace.gltf", build_furnace)]:
         path = os.path.join(out_dir, name)
         with open(path, "w") as f:
             json.dump(build(), f, indent=1)

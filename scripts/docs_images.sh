@@ -47,6 +47,9 @@ render focus-far scenes/focus.gltf --width 320 --integrator path --spp 48 --aper
   --aperture-blades 6 --focus-distance 13
 # Motion blur: the fan and the ball of scenes/motion.gltf at t = 1 s (cameras).
 render motion-blur scenes/motion.gltf --width 400 --integrator path --spp 32 --time 1 --motion-blur
+# The white furnace without and with energy compensation (integrators).
+render furnace-off scenes/furnace.gltf --width 320 --integrator path --spp 64 --env 1 --energy-compensation off
+render furnace-on scenes/furnace.gltf --width 320 --integrator path --spp 64 --env 1
 
 # Traversal-cost heat maps of two structures on the default scene (benchmarking).
 for accel in bvh grid; do

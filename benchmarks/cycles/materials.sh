@@ -48,7 +48,7 @@ for m in "${models[@]}"; do
   # Blender's copy: nothing required, so that its importer loads what it can and drops the rest.
   cscene=$(python3 "$here/add_camera.py" "$corpus/$file" "$work/$name-cycles" $eye 0.75 0 --optional-extensions)
   t0=$(date +%s.%N)
-  "$penumbra" render "$scene" -o "$work/$name-penumbra.exr" --png "$work/$name-penumbra.png" --integrator path \
+  "$penumbra" render "$scene" -o "$work/$name-penumbra.exr" --png "$work/$name-penumbra.png" --integrator path --energy-compensation off \
     --spp "$SPP" --width $W --height $H --camera bench --threads "$THREADS" --env 1 --quiet
   t1=$(date +%s.%N)
   blender -b --factory-startup -P "$here/render_cycles.py" -- "$cscene" "$work/$name-cycles.exr" $W $H "$SPP" \

@@ -35,7 +35,7 @@ scenes=(
 
 rmse() { oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | awk '/RMS error/ {print $4}'; }
 pen() {  # scene out spp bg -> seconds
-  "$penumbra" render "$1" -o "$2" --no-png --integrator path --spp "$3" --width $W --height $H --camera bench \
+  "$penumbra" render "$1" -o "$2" --no-png --integrator path --energy-compensation off --spp "$3" --width $W --height $H --camera bench \
     --threads "$THREADS" --env "$4" --float 2>&1 | awk '/render [0-9.]+s/ {for (i=1;i<=NF;i++) if ($i=="render") {sub("s","",$(i+1)); print $(i+1)}}'
 }
 cyc() {

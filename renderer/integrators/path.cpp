@@ -77,9 +77,11 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, co
 // The BSDF and, for thin-walled transmission, the transmission/reflection choice by
 // estimated energy: transmitted vs reflected (Fresnel-weighted specular plus the remaining
 // diffuse) at this view angle.
-Lobes choose_lobes(const MaterialPoint& mp, const SurfaceInteraction& si, Vec3f wo, int channel) {
+Lobes choose_lobes(const MaterialPoint& mp, const SurfaceInteraction& si, Vec3f wo, int channel,
+                   bool energy_compensation) {
   Lobes l;
   l.brdf = make_bsdf(mp, si.back_face, channel);
+  l.brdf.energy_compensation = energy_compensation;
   if (l.brdf.volume || !(l.brdf.transmission > 0)) return l;
   const float cos_o = std::fabs(dot(mp.ns, wo));
   const float fd = dielectric_fresnel(l.brdf, cos_o);
@@ -207,7 +209,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     // Next-event estimation.
     const Vec3f wo = -seg.ray.dir;
     choose_channel(mp, samples, seg);
-    const Lobes lobes = choose_lobes(mp, si, wo, seg.channel);
+    const Lobes lobes = choose_lobes(mp, si, wo, seg.channel, cfg.energy_compensation);
     // Shadow rays cross the volume the ray arrived in, or through the surface the volume behind it.
     const Vec3f behind = mp.volume ? (si.back_face ? Vec3f{} : mp.sigma_a) : seg.sigma_a;
     sample_direct_lighting(scene, accel, lights,

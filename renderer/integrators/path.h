@@ -41,9 +41,10 @@ struct PathConfig {
                              ///< is scaled so its largest channel is at most this. Biased;
                              ///< 0 = off (default)
   LightStrategy strategy = LightStrategy::Mis;
-  int max_blend_layers = 16;  ///< Blend surfaces passed along one ray segment before the next
-                              ///< counts as opaque
-  bool hit_filter = true;     ///< as WhittedConfig::hit_filter
+  int max_blend_layers = 16;        ///< Blend surfaces passed along one ray segment before the next
+                                    ///< counts as opaque
+  bool hit_filter = true;           ///< as WhittedConfig::hit_filter
+  bool energy_compensation = true;  ///< GltfBsdf::energy_compensation (multiple-scattering GGX)
 };
 
 /// A camera ray's differentials, made on demand: only a first hit whose material reads texture

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "renderer/materials/ggx_albedo.h"
 #include "renderer/materials/sheen.h"
 #include "renderer/materials/thin_film.h"
 
@@ -147,6 +148,32 @@ void eval_coat(const GltfBsdf& b, Vec3f wo, Vec3f wi, Vec3f nc, Vec3f& value, fl
   pdf = smith_g1(polar(cv), a) * d / (4 * cv);
 }
 
+// Kulla and Conty's multiple-scattering lobe of the base's reflection (ggx_albedo.h) at local
+// cosines cos_v, cos_l: F_ms mixed between the dielectric's and the metal's by metallic.
+Vec3f base_multiscatter(const GltfBsdf& b, GgxAlpha a, float cos_v, float cos_l) {
+  const float alpha = std::sqrt(a.x * a.y);
+  const float ms = ggx_multiscatter(cos_v, cos_l, alpha);
+  if (!(ms > 0)) return {};
+  const float e_avg = ggx_average_albedo(alpha);
+  Vec3f f_metal, f_dielectric;
+  for (int k = 0; k < 3; ++k) {
+    f_metal[k] = schlick_average(std::clamp(b.base_color[k], 0.0f, 1.0f));
+    const float r = (b.eta - 1) / (b.eta + 1);
+    const float f0 = std::min((b.volume ? r * r : b.f0) * b.specular_color[k], 1.0f);
+    f_dielectric[k] = b.specular * schlick_average(f0);
+  }
+  return mix(multiscatter_fresnel(f_dielectric, e_avg), multiscatter_fresnel(f_metal, e_avg), b.metallic) *
+         ms;
+}
+
+// The share of the specular lobe's samples drawn by cosine for the multiple-scattering lobe at
+// view cosine cos_v: its albedo 1 - E(cos_v) for a Fresnel of 1 (0 without compensation). The
+// visible normals alone would reach its broad lobe only in their tails.
+float multiscatter_share(const GltfBsdf& b, GgxAlpha a, float cos_v) {
+  if (!b.energy_compensation) return 0;
+  return std::clamp(1 - ggx_albedo(cos_v, std::sqrt(a.x * a.y)), 0.0f, 1.0f);
+}
+
 // The base's reflection terms (local v, l above the surface).
 void eval_base_reflection(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice& c, PairEval& e) {
   const Vec3f h = normalize(v + l);
@@ -155,9 +182,12 @@ void eval_base_reflection(const GltfBsdf& b, Vec3f v, Vec3f l, const LobeChoice&
   const float dv = ggx_d(h, a) * smith_g2(v, l, a) / (4 * v.z * l.z);
   const Vec3f fd = dielectric_fresnel_rgb(b, vh);
   e.other = mix(fd, metal_fresnel(b, vh), b.metallic) * dv;
+  if (b.energy_compensation) e.other += base_multiscatter(b, a, v.z, l.z);
   e.diffuse = b.base_color * ((1 - max_component(fd)) * (1 - b.metallic) * (1 - b.transmission) *
                               (1 - b.diffuse_transmission) / kPi);
-  e.pdf += c.p[kSpecular] * smith_g1(v, a) * ggx_d(h, a) / (4 * v.z) + c.p[kDiffuse] * l.z / kPi;
+  const float q = multiscatter_share(b, a, v.z);
+  e.pdf += c.p[kSpecular] * ((1 - q) * smith_g1(v, a) * ggx_d(h, a) / (4 * v.z) + q * l.z / kPi) +
+           c.p[kDiffuse] * l.z / kPi;
 }
 
 // The base's transmission terms (local v above, l below the surface).
@@ -226,8 +256,9 @@ PairEval eval_pair(const GltfBsdf& b, Vec3f wo, Vec3f wi) {
 }
 
 // A direction from lobe `lobe` in world space; false if it fails (total internal reflection,
-// below the horizon of a reflection lobe).
-bool sample_lobe(const GltfBsdf& b, int lobe, Vec3f wo, Vec2f u, Vec3f& wi) {
+// below the horizon of a reflection lobe). u_lobe in [0, 1) picks within the specular lobe
+// between its visible normals and the multiple-scattering lobe's cosine samples.
+bool sample_lobe(const GltfBsdf& b, int lobe, Vec3f wo, Vec2f u, float u_lobe, Vec3f& wi) {
   const Local f = base_frame(b);
   const Vec3f v = f.to_local(wo);
   Vec3f l;
@@ -253,7 +284,10 @@ bool sample_lobe(const GltfBsdf& b, int lobe, Vec3f wo, Vec2f u, Vec3f& wi) {
       l.z = -l.z;
       break;
     case kSpecular:
-      l = reflect(-v, sample_ggx_vndf(v, base_alpha(b), u));
+      if (u_lobe < multiscatter_share(b, base_alpha(b), v.z))
+        l = sample_cosine_hemisphere(u);
+      else
+        l = reflect(-v, sample_ggx_vndf(v, base_alpha(b), u));
       break;
     case kRefraction: {
       const Vec3f h = sample_ggx_vndf(v, base_alpha(b), u);
@@ -312,16 +346,18 @@ bool bsdf_sample(const GltfBsdf& b, Vec3f wo, float u1, Vec2f u, BsdfSample& out
   if (!(cos_v > 0)) return false;
   const LobeChoice c = choose(b, cos_v, dot(coat_normal(b), wo));
   int lobe = kLobes - 1;
-  float acc = 0;
+  float acc = 0, u_lobe = 0.5f;
   for (int k = 0; k < kLobes; ++k) {
     acc += c.p[k];
     if (u1 < acc && c.p[k] > 0) {
       lobe = k;
+      u_lobe =
+          std::clamp((u1 - (acc - c.p[k])) / c.p[k], 0.0f, 0x1.fffffep-1f);  // u1 within the lobe's share
       break;
     }
   }
   while (lobe > 0 && !(c.p[lobe] > 0)) --lobe;  // rounding left u1 past the last lobe
-  if (!sample_lobe(b, lobe, wo, u, out.wi)) return false;
+  if (!sample_lobe(b, lobe, wo, u, u_lobe, out.wi)) return false;
   out.transmitted = lobe == kDiffuseTransmission || lobe == kRefraction;
   const Vec3f value = bsdf_eval_pdf(b, wo, out.wi, out.pdf);
   if (!(out.pdf > 0) || !std::isfinite(out.pdf)) return false;

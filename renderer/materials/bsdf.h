@@ -21,6 +21,12 @@
 //   channel (KHR_materials_specular's factor s and colour c_s) and F_m =
 //   Schlick(c), each mixed with the thin-film Fresnel by the iridescence factor
 //   (KHR_materials_iridescence, thin_film.h).
+//   plus, with energy_compensation, Kulla and Conty's multiple-scattering lobe
+//     [(1 - m) F_ms,d + m F_ms,m] (1 - E(n.v)) (1 - E(n.l)) / (pi (1 - E_avg))
+//   (ggx_albedo.h; F_avg of Schlick per channel, for a volume that of eta's f0; the
+//   anisotropic lobe uses the table at sqrt(alpha_t alpha_b)), which makes a white metal's
+//   albedo 1 at every roughness. The specular lobe samples it by cosine with probability
+//   1 - E(n.v), its visible normals otherwise.
 // - base, transmission (l below the surface):
 //     (1 - m)(1 - t) d c_d / pi (1 - F_d(|n.v|))(1 - F_d(|n.l|))       diffuse transmission
 //   + (1 - m) t c (1 - F) D G2 |v.h||l.h| / (|n.v||n.l| (l.h + v.h/eta)^2 eta^2)
@@ -63,6 +69,9 @@ struct GltfBsdf {
   Vec3f clearcoat_n{0, 0, 0};                 ///< unit coat normal; zero: the shading normal n
   float diffuse_transmission = 0;             ///< KHR_materials_diffuse_transmission factor
   Vec3f diffuse_transmission_color{1, 1, 1};  ///< its colour
+  /// Kulla-Conty multiple-scattering compensation of the base's GGX reflection (ggx_albedo.h),
+  /// metal and dielectric: the energy single scattering loses at high roughness comes back.
+  bool energy_compensation = true;
 };
 
 /// Fresnel reflectance of the dielectric layer at cos(theta) = cos_theta: s Schlick(f0), or

@@ -55,7 +55,7 @@ fails=0
 
 pen() {  # OUT [flags...]
   local out=$1; shift
-  "$penumbra" render "$model" -o "$work/$out.exr" --no-png --float --integrator path --env 0.8 \
+  "$penumbra" render "$model" -o "$work/$out.exr" --no-png --float --integrator path --env 0.8 --energy-compensation off \
     --max-depth 0 --spp $SPP --width $W --height $H --threads 2 --filter box --filter-width 1 \
     --look-at $eye $target --focal-length 50 --sensor 36 "$@" >"$work/$out.log" 2>&1 ||
     { echo "FAIL: penumbra render $out"; tail -5 "$work/$out.log"; exit 1; }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # PENUMBRA_shapes through `penumbra`: files with bad shapes exit 2 from render and info with the
 # file, the JSON path and the field in the message and leave no output; the shipped shape scenes
-# and a displaced sphere render and `info` lists their shapes. Usage: shapes_test.sh PENUMBRA_BINARY SRC WORK_DIR
+# and a displaced sphere render and `info` lists their shapes; the white furnace vanishes with
+# energy compensation. Usage: shapes_test.sh PENUMBRA_BINARY SRC WORK_DIR
 set -u
 bin="$1"; src="$2"; work="$3"
 rm -rf "$work"; mkdir -p "$work"
@@ -59,6 +60,29 @@ expect 0 "required.png" -- "$bin" render "$work/required.gltf" -o "$work/require
 # and the analytic ground).
 expect 0 "4 shapes \(4 placed\)" -- "$bin" render "$src/scenes/csg.gltf" -o "$work/csg.exr" --width 32 --spp 1 --no-png --stats-json "$work/csg.json"
 expect 0 '^4$' -- python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shapes"])' "$work/csg.json"
+
+# The white furnace (scenes/furnace.gltf): white metal spheres of roughness 0.2 to 1 under
+# environment 1 vanish with energy compensation (the image's mean and the roughest sphere's
+# pixels are 1), and without it the roughest sphere is darker than its background.
+if command -v oiiotool >/dev/null; then
+  furnace() {  # NAME FLAGS...: renders the furnace at 96 x 54, 256 spp
+    local name="$1"; shift
+    "$bin" render "$src/scenes/furnace.gltf" -o "$work/$name.exr" --no-png --float -q --integrator path \
+      --env 1 --width 96 --height 54 --spp 256 "$@"
+  }
+  avg() {  # FILE [CUT]: mean of R over the image or a region
+    oiiotool "$1" --ch R ${2:+--cut "$2"} --printstats 2>/dev/null | sed -n 's/.*Avg: *\([0-9.e+-]*\).*/\1/p' | head -1
+  }
+  furnace furnace_on && furnace furnace_off --energy-compensation off || fails=$((fails + 1))
+  rough="8x8+81+23"  # inside the roughness-1 sphere (centre x = 2 at pixel 85, radius 8 pixels)
+  if python3 -c "import sys; a, r, off = map(float, sys.argv[1:]); sys.exit(0 if abs(a - 1) < 0.01 and abs(r - 1) < 0.02 and off < 0.97 else 1)" \
+      "$(avg "$work/furnace_on.exr")" "$(avg "$work/furnace_on.exr" "$rough")" "$(avg "$work/furnace_off.exr" "$rough")"; then
+    passes=$((passes + 1))
+  else
+    echo "FAIL: furnace: mean $(avg "$work/furnace_on.exr"), roughest sphere $(avg "$work/furnace_on.exr" "$rough") compensated, $(avg "$work/furnace_off.exr" "$rough") without"
+    fails=$((fails + 1))
+  fi
+fi
 
 echo "shapes cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]
