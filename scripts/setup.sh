@@ -39,7 +39,9 @@ case "$mode" in
     #   file), cli.job_hardening (hostile job files), cli.output_safety (unwritable, hostile and
     #   half-written outputs);
     # - unit test cases tagged [heavy] (the accelerator and raster cross-checks over every corpus
-    #   model, huge and tiny coordinates) are filtered out of this build's ctest commands;
+    #   model and at huge and tiny coordinates, the renders with every accelerator, the grid's
+    #   stadium, the corpus's counts and materials re-read after every file has loaded here) are
+    #   filtered out of this build's ctest commands;
     # - the other scripts run in Release only: they render the shipped scenes through the
     #   command's options, paths the unit tests take here too; so do the Slurm tests (daemons
     #   around the same commands), the Blender checks, install and package, Python (an

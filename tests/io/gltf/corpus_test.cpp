@@ -27,7 +27,7 @@ std::vector<fs::path> gltf_files(const fs::path& root) {
 }
 }  // namespace
 
-TEST_CASE("corpus: valid models load with the expected counts", "[io][corpus]") {
+TEST_CASE("corpus: valid models load with the expected counts", "[io][corpus][heavy]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   struct Expect {
@@ -142,7 +142,8 @@ TEST_CASE("corpus: every invalid file ends in a clear error or warnings, never a
   CHECK(errors + loaded > 150);
 }
 
-TEST_CASE("corpus: materials, alpha modes and textures load as the files say", "[io][corpus][texture]") {
+TEST_CASE("corpus: materials, alpha modes and textures load as the files say",
+          "[io][corpus][texture][heavy]") {
   const auto corpus = test::corpus_dir();
   if (!corpus) return test::skip("../shared/corpus not found (set PENUMBRA_CORPUS)");
   auto find = [](const Scene& s, const std::string& name) -> const Material& {

@@ -371,7 +371,7 @@ TEST_CASE("cross-check, slow: the default scene and spheres with 16x the rays",
 
 // ---- Renderer level -------------------------------------------------------------------------------
 
-TEST_CASE("the default scene renders the same image with every accelerator", "[accel][render]") {
+TEST_CASE("the default scene renders the same image with every accelerator", "[accel][render][heavy]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   RenderConfig cfg;
   cfg.width = 160;

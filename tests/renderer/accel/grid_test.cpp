@@ -220,7 +220,7 @@ Soup slivers(int n) {
 }  // namespace
 
 TEST_CASE("grid: a dense object in a huge room gets sub-grids, tests fewer triangles, and answers exactly",
-          "[accel][grid]") {
+          "[accel][grid][heavy]") {
   const Soup soup = sphere_in_stadium();
   const auto views = soup.views();
   const std::vector<Ray> rays = stadium_rays(views);
