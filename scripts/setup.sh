@@ -40,8 +40,10 @@ case "$mode" in
     #   half-written outputs);
     # - unit test cases tagged [heavy] (the accelerator and raster cross-checks over every corpus
     #   model and at huge and tiny coordinates, the renders with every accelerator, the grid's
-    #   stadium, the corpus's counts and materials re-read after every file has loaded here) are
-    #   filtered out of this build's ctest commands;
+    #   stadium, the corpus's counts and materials re-read after every file has loaded here, and
+    #   the statistical estimates of many samples: BSDF albedo furnaces, the path tracer's
+    #   convergence rate, the refitted BVH against brute force, the noise bounds) are filtered out
+    #   of this build's ctest commands;
     # - the other scripts run in Release only: they render the shipped scenes through the
     #   command's options, paths the unit tests take here too; so do the Slurm tests (daemons
     #   around the same commands), the Blender checks, install and package, Python (an

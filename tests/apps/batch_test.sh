@@ -6,8 +6,9 @@
 # same settings pixel for pixel; --skip-existing keeps complete files and renders a deleted one
 # again; bad job files exit 2 naming the job file, the shot and the key, and write no file;
 # `submit slurm --dry-run` prints the scripts (array, CPUs and memory from the settings) and
-# writes none; submission without or with a failing sbatch exits 1, with a fake sbatch it
-# prints the job ids and writes the scripts under JOB.slurm/.
+# writes none (also for a job of a million units, which --list prints one per line);
+# submission without or with a failing sbatch exits 1, with a fake sbatch it prints the job ids
+# and writes the scripts under JOB.slurm/.
 # Usage: batch_test.sh PENUMBRA_BINARY SRC WORK_DIR
 set -u
 bin="$1"; src="$2"; work="$3"
@@ -233,6 +234,24 @@ expect 0 "#SBATCH --array=4-6$" -- "$bin" submit slurm "$sub/tiled.json" --dry-r
 run 0 -- "$bin" batch "$sub/plain.json" --threads 1 --max-memory 256M -q
 expect 0 "every frame of .*plain.json is complete; nothing to submit" -- env PATH="$fake:$PATH" "$bin" submit slurm "$sub/plain.json" --threads 1 --max-memory 1G
 [ -e "$sub/plain.slurm" ] && fail "a complete job created $sub/plain.slurm"
+
+# A million units (a hundred thousand frames of ten stripes): listed one per line and dry-run
+# submitted as one array, without a file written.
+cp "$src/scenes/default.gltf" "$work/million-scene.gltf"
+printf '{"defaults": {"width": 16, "height": 24, "spp": 1, "threads": 1, "max-memory": "256M"}, "shots": [%s]}\n' \
+  '{"name": "m", "scene": "million-scene.gltf", "output": "m/m.#######.exr", "frames": "1-100000", "tiles": 10}' \
+  >"$work/million.json"
+if "$bin" batch "$work/million.json" --list >"$work/million.txt" 2>"$work/err"; then
+  [ "$(wc -l <"$work/million.txt")" -eq 1000000 ] && passes=$((passes + 1)) ||
+    fail "batch --list printed $(wc -l <"$work/million.txt") units"
+  [ "$(tail -1 "$work/million.txt")" = "999999	m	100000	9/10	$work/m/m.0100000.exr" ] &&
+    passes=$((passes + 1)) || fail "the last unit is '$(tail -1 "$work/million.txt")'"
+else
+  fail "batch --list of a million units failed: $(head -3 "$work/err")"
+fi
+expect 0 "^#SBATCH --array=0-999999$" -- "$bin" submit slurm "$work/million.json" --dry-run
+[ -e "$work/m" ] || [ -e "$work/million.slurm" ] && fail "a dry run of a million units wrote files"
+rm -f "$work/million.txt"
 
 echo "batch: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

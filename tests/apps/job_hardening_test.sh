@@ -3,8 +3,8 @@
 # backquotes and non-UTF-8 bytes in their path run exactly the intended command (a stub sbatch
 # takes them, and the render script is then run as a task would run it) with exactly the
 # intended directives; paths with control characters exit 2; every file the units write is
-# checked up front (a shot's output on another shot's stripe, more stripes than rows); a job
-# of a million units lists and dry-runs; and the output root confines what a job writes.
+# checked up front (a shot's output on another shot's stripe, more stripes than rows); and the
+# output root confines what a job writes.
 # Usage: job_hardening_test.sh PENUMBRA SRC WORK_DIR
 set -u
 bin="$1"; src="$2"; work="$3"
@@ -117,18 +117,6 @@ expect 2 "shots\[0\] \(a\)\.tiles: 4096 stripes of a frame 24 rows high" -- "$bi
 expect 2 "4096 stripes of a frame 24 rows high" -- "$bin" submit slurm "$work/rows.json" --dry-run
 job rows_ok '{"name": "a", "scene": "scene.gltf", "output": "t/a.exr", "tiles": 24}'
 expect 0 "^23	a	-	23/24	" -- "$bin" batch "$work/rows_ok.json" --list
-
-# A million units: listed one per line and dry-run submitted as one array.
-job million '{"name": "m", "scene": "scene.gltf", "output": "m/m.#######.exr", "frames": "1-100000", "tiles": 10}'
-if "$bin" batch "$work/million.json" --list >"$work/million.txt" 2>"$work/err"; then
-  [ "$(wc -l <"$work/million.txt")" -eq 1000000 ] && ok || fail "batch --list printed $(wc -l <"$work/million.txt") units"
-  [ "$(tail -1 "$work/million.txt")" = "999999	m	100000	9/10	$work/m/m.0100000.exr" ] && ok ||
-    fail "the last unit is '$(tail -1 "$work/million.txt")'"
-else
-  fail "batch --list of a million units failed: $(head -3 "$work/err")"
-fi
-expect 0 "^#SBATCH --array=0-999999$" -- "$bin" submit slurm "$work/million.json" --dry-run
-rm -f "$work/million.txt"
 
 # The output root: the job's folder by default; --output-root allows another; the job's
 # "output_root" only narrows; a symbolic link out of the root is refused.

@@ -384,7 +384,7 @@ std::filesystem::path write_moving_emitter(bool deform) {
 
 }  // namespace
 
-TEST_CASE("motion blur: a moving emitter lights a still floor as the mean of its poses", "[motion]") {
+TEST_CASE("motion blur: a moving emitter lights a still floor as the mean of its poses", "[motion][heavy]") {
   // The path tracer's light sampling picks points on the emitter where it is at each sample's
   // time (and weighs them against BSDF hits with the density at that time): the blurred render
   // equals the mean of 16 stills at the midpoints of 16 slices of the shutter t in [0.75, 1.25],

@@ -172,7 +172,7 @@ std::vector<Hit> check_filtered(const std::string& scene, const std::vector<Name
 }  // namespace
 
 TEST_CASE("accelerator: filtered queries equal re-shooting past rejected hits, every back end",
-          "[accel][filter]") {
+          "[accel][filter][heavy]") {
   FilterScene s(20261202u);
   s.views.push_back({{}, {}, &s.shapes[0]});  // a unit sphere at the origin, its lower half cut out
   s.world.add_sphere(Rule::Checker, {});

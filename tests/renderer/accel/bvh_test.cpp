@@ -421,7 +421,7 @@ std::vector<std::pair<std::string, BvhConfig>> refit_configs() {
 }  // namespace
 
 TEST_CASE("bvh: a refitted tree answers exactly as brute force over the moved vertices",
-          "[accel][bvh][refit]") {
+          "[accel][bvh][refit][heavy]") {
   const Soup rest = refit_scene();
   const Shape ball = analytic_shape(ShapeKind::Sphere, 0.4f);
   for (const auto& [what, config] : refit_configs()) {

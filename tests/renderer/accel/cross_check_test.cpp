@@ -134,7 +134,7 @@ TEST_CASE("cross-check: huge and tiny coordinates", "[accel][crosscheck][heavy]"
 }
 
 TEST_CASE("cross-check: rays from inside a closed sphere always hit (watertightness)",
-          "[accel][crosscheck]") {
+          "[accel][crosscheck][heavy]") {
   const Soup s = icosphere(4, 1.0f, {0.1f, -0.2f, 0.3f});  // 5120 triangles
   const auto views = s.views();
   const auto all = build_all(views);
@@ -319,7 +319,7 @@ TEST_CASE("cross-check: the default scene", "[accel][crosscheck]") {
 }
 
 TEST_CASE("cross-check: Embree without the robust flag and at low and high build quality",
-          "[accel][crosscheck]") {
+          "[accel][crosscheck][heavy]") {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   const auto views = mesh_views(l.scene);
   for (const auto& [robust, quality] : {std::pair{false, 1}, std::pair{true, 0}, std::pair{true, 2}}) {

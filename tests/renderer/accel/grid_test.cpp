@@ -127,7 +127,7 @@ TEST_CASE("grid: configuration is validated", "[accel][grid][quick]") {
 }
 
 TEST_CASE("grid: thousands of large overlapping triangles build quickly and still answer exactly",
-          "[accel][grid][hostile]") {
+          "[accel][grid][hostile][heavy]") {
   // 3000 triangles each spanning the whole scene: lambda N cells would give lambda N^2 candidate
   // references; the builder must coarsen instead of running for minutes.
   std::vector<Vec3f> pos;

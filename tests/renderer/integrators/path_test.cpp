@@ -81,7 +81,7 @@ double corner_form_factor(double a, double b, double h) {
 
 }  // namespace
 
-TEST_CASE("path: a closed emitting enclosure converges to the geometric series", "[path]") {
+TEST_CASE("path: a closed emitting enclosure converges to the geometric series", "[path][heavy]") {
   // Camera inside a closed sphere of albedo a emitting Le: L = Le (1 + a + ... + a^(D+1)) for
   // max depth D (light reaching hits 0..D), i.e. Le / (1 - a) as D grows.
   const Camera cam = look_at({0.1f, 0.2f, 0}, {1, 0.3f, 0.2f}, {0, 1, 0}, 1.2f);
@@ -315,7 +315,7 @@ TEST_CASE("path: Blend alpha is the hit probability", "[path][quick]") {
   CHECK(channel_mean(r.image.film, 3) == Approx(0.25).epsilon(0.02));
 }
 
-TEST_CASE("path: the error falls as 1/sqrt(spp)", "[path]") {
+TEST_CASE("path: the error falls as 1/sqrt(spp)", "[path][heavy]") {
   // RMSE against a 16384-spp reference at 16, 64 and 256 spp: log-log slope -1/2 for
   // independent samples; the Owen-scrambled Sobol sampler converges at least as fast.
   Scene s;

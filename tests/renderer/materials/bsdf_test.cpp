@@ -130,7 +130,7 @@ TEST_CASE("bsdf: the pdf integrates to 1 and sampling agrees with it", "[bsdf][q
 }
 
 TEST_CASE("bsdf: GGX furnace: sampled directional albedo equals quadrature; smooth metal keeps all energy",
-          "[bsdf]") {
+          "[bsdf][heavy]") {
   for (float rough : {0.25f, 0.5f, 1.0f})
     for (float metal : {0.0f, 1.0f})
       for (float theta : {0.0f, 0.8f, 1.3f}) {
@@ -205,7 +205,7 @@ GltfBsdf random_layers(Rng& rng) {
 
 }  // namespace
 
-TEST_CASE("bsdf layers: white furnace on a parameter grid: no layer adds energy to the base", "[bsdf]") {
+TEST_CASE("bsdf layers: white furnace on a parameter grid: no layer adds energy to the base", "[bsdf][heavy]") {
   double worst = 0, worst_excess = -1;
   std::string worst_case;
   for (float rough : {0.3f, 1.0f})
@@ -347,7 +347,7 @@ TEST_CASE("bsdf layers: sampling agrees with pdf and eval, and the pdf integrate
   }
 }
 
-TEST_CASE("bsdf layers: sampled albedo equals quadrature within 1%", "[bsdf]") {
+TEST_CASE("bsdf layers: sampled albedo equals quadrature within 1%", "[bsdf][heavy]") {
   Rng rng = make_pixel_rng(8, 6, 4, 2);
   for (int k = 0; k < 6; ++k) {
     GltfBsdf b = random_layers(rng);

@@ -279,7 +279,7 @@ TEST_CASE("noise: non-finite coordinates give zero", "[procedural][noise][quick]
 }
 
 TEST_CASE("noise: the supremum constants match a re-derivation from the gradient sets",
-          "[procedural][noise][quick]") {
+          "[procedural][noise][quick][heavy]") {
   // Coarse grids (sign symmetry of every set: half cells for 3D and 4D).
   const auto check = [](auto dim, int r, double hi) {
     constexpr int N = decltype(dim)::value;
@@ -308,7 +308,7 @@ TEST_CASE("noise: the 3D gradient bound covers a re-derivation from the gradient
   CHECK(kPerlinGradientBound3 <= 1.05 * sup);
 }
 
-TEST_CASE("noise: values lie in [-1, 1] and come close to its ends", "[procedural][noise]") {
+TEST_CASE("noise: values lie in [-1, 1] and come close to its ends", "[procedural][noise][heavy]") {
   const auto max_abs = [](auto dim, long samples) {
     constexpr int N = decltype(dim)::value;
     const PerlinTable t = make_perlin_table(11);
