@@ -205,7 +205,8 @@ GltfBsdf random_layers(Rng& rng) {
 
 }  // namespace
 
-TEST_CASE("bsdf layers: white furnace on a parameter grid: no layer adds energy to the base", "[bsdf][heavy]") {
+TEST_CASE("bsdf layers: white furnace on a parameter grid: no layer adds energy to the base",
+          "[bsdf][heavy]") {
   double worst = 0, worst_excess = -1;
   std::string worst_case;
   for (float rough : {0.3f, 1.0f})
