@@ -179,7 +179,7 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
     p.warnings.push_back(
         "the raster preview renders the frame's time: it ignores motion blur (motion_blur); "
         "use integrator 'whitted' or 'path' to see it");
-  // The lights: the environment, the emissive triangles, the default key light.
+  // The lights: the environment, the emissive triangles and shapes, the default key light.
   const bool path = p.integrator() == IntegratorType::Path;
   p.environment = choose_environment(loaded, p.spec, env_budget);
   if (path)

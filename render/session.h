@@ -56,7 +56,8 @@ struct PrepareOptions {
   /// Called with the resolved config before any light is loaded: charges the image's buffers to
   /// a memory budget and returns the bytes left for an environment map; may throw.
   std::function<uint64_t(const RenderConfig&)> charge_budget;
-  /// The emissive triangles from an earlier render of the same scene, reused; null: built.
+  /// The area lights (emissive triangles and shapes) from an earlier render of the same scene,
+  /// reused; null: built.
   std::shared_ptr<const AreaLights> area_lights;
   SceneIdentity identity;  ///< the scene part of the identity (sha256, index, time, ...)
   /// The vector layer: the time the scene was posed at (unset: its static pose), and how to
@@ -96,7 +97,7 @@ struct PreparedRender {
 /// through focus_at's pixel or the centre's, else the bounds' centre; the raster preview keeps
 /// a pinhole and says so in `warnings`), loads
 /// the environment (spec.env_color, spec.env_map, else the file's image-based light), builds the
-/// emissive triangles for the path tracer, appends the default key light to scene.lights when
+/// emissive triangles and shapes for the path tracer, appends the default key light to scene.lights when
 /// nothing lights the scene, loads the vector layer's neighbouring frames (load_motion_frames)
 /// and derives the identity. Throws std::invalid_argument for settings, InputError for the
 /// camera, the environment map or the neighbouring frames.
@@ -203,7 +204,7 @@ struct Session {
   LoadAtTime load_at;           ///< loads the file at another time (the vector layer); may be empty
   std::mutex mutex;
   Structure structure;                            ///< the last render's, or empty
-  std::shared_ptr<const AreaLights> area_lights;  ///< the emissive triangles, once needed
+  std::shared_ptr<const AreaLights> area_lights;  ///< the emissive triangles and shapes, once needed
 };
 
 /// Everything one render produced.

@@ -146,6 +146,15 @@ std::vector<SpecField> make_fields() {
        "path: on (default) adds the energy rough GGX reflection loses to single scattering (Kulla-Conty); "
        "off "
        "for comparisons with renderers without it (Cycles 3.4's Principled BSDF)"},
+      {"light_sampler",
+       &S::light_sampler,
+       kPath,
+       true,
+       0,
+       0,
+       {"tree", "power", "uniform"},
+       "path: how an emissive triangle or shape is chosen for a light sample: tree (default; a light BVH, "
+       "by importance at the shading point), power (in proportion to power) or uniform (for tests)"},
       {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
       {"env_rotation",
        &S::env_rotation,
@@ -570,6 +579,9 @@ RenderConfig make_render_config(const RenderSpec& r) {
                       : r.light_sampling == "light" ? LightStrategy::Light
                                                     : LightStrategy::Mis;
   cfg.path.energy_compensation = r.energy_compensation == "on";
+  cfg.path.light_sampler = r.light_sampler == "power"     ? LightSampler::Power
+                           : r.light_sampler == "uniform" ? LightSampler::Uniform
+                                                          : LightSampler::Tree;
   cfg.sampler = r.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   cfg.time_limit = r.time_limit;
   cfg.adaptive_threshold = r.adaptive;

@@ -65,6 +65,14 @@ double determinant3x3(const Transform& t) {
          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 
+void orthonormal_basis(Vec3f n, Vec3f& t, Vec3f& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = {1 + sign * n.x * n.x * a, sign * c, -sign * n.x};
+  b = {c, sign + n.y * n.y * a, -n.y};
+}
+
 bool inverse(const Transform& t, Transform& out) {
   // Cofactor expansion of the full 4x4 (Laplace, 2x2 sub-determinants).
   const auto& a = t.m;

@@ -118,6 +118,10 @@ inline Bounds3f intersect(Bounds3f a, Bounds3f b) {
   return {max(a.lo, b.lo), min(a.hi, b.hi)};
 }
 
+/// An orthonormal basis (t, b, n) around unit n (Duff et al., "Building an Orthonormal Basis,
+/// Revisited", JCGT 6(1), 2017).
+void orthonormal_basis(Vec3f n, Vec3f& t, Vec3f& b);
+
 /// Unit quaternion (x, y, z, w) in glTF order.
 struct Quat {
   double x = 0, y = 0, z = 0, w = 1;

@@ -14,15 +14,16 @@ bool sample_incident(const Light& light, Vec3f p, IncidentLight& out) {
   return true;
 }
 
-bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float time, float u1, Vec2f u2,
-                     IncidentLight& out) {
+bool sample_incident(const AreaLights& area, const Scene& scene, const LightChoice& choice, float time,
+                     float u1, Vec2f u2, IncidentLight& out) {
   AreaLightSample ls;
-  if (!sample_area_light(area, scene, time, u1, u2, ls)) return false;
+  if (!sample_area_light(area, scene, choice, time, u1, u2, ls)) return false;
+  const Vec3f p = choice.p;
   const Vec3f d = ls.p - p;
   const float dist2 = dot(d, d), dist = std::sqrt(dist2);
   const Vec3f wi = d / dist;
   const float cos_l = dot(ls.ng, wi);  // > 0: the point sees the light's back side
-  const Material& lm = material_of(scene, scene.meshes[size_t(scene.instances[ls.instance].mesh)].material);
+  const Material& lm = material_of(scene, instance_material(scene, scene.instances[ls.instance]));
   const bool visible_side = lm.double_sided || cos_l < 0;
   if (!(dist2 > 0 && std::isfinite(dist) && visible_side && std::fabs(cos_l) > 0)) return false;
   Vec3f le = lm.emissive;
@@ -37,7 +38,8 @@ bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float 
     lh.v = ls.v;
     lh.geom_id = ls.instance;
     lh.prim_id = ls.prim;
-    le = eval_emission(scene, make_interaction(scene, to_light, lh, ls.tri));
+    le = eval_emission(scene, ls.shape ? make_interaction(scene, to_light, lh)
+                                       : make_interaction(scene, to_light, lh, ls.tri));
   }
   if (!(max_component(le) > 0)) return false;
   out = IncidentLight{wi, dist, le, ls.pdf_area * dist2 / std::fabs(cos_l), false};
@@ -95,7 +97,7 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
   if (!lights.area->pmf.empty()) {
     const float u1 = samples.get1d();
     const Vec2f u2 = samples.get2d();
-    if (sample_incident(*lights.area, scene, v.si.p, v.si.time, u1, u2, l))
+    if (sample_incident(*lights.area, scene, {v.si.p, v.si.ng, mode.light_sampler}, v.si.time, u1, u2, l))
       estimate(scene, accel, v, mode, l, counts, out);
   }
   if (!is_black(*lights.environment)) {

@@ -3,7 +3,7 @@
 #pragma once
 
 // At a surface point it takes one sample of every light kind (each punctual light, one
-// emissive triangle chosen by power, one environment direction), brings each to the same form
+// emissive triangle or shape chosen by power, one environment direction), brings each to the same form
 // (direction, incident radiance, distance, density), and estimates it the same way: BRDF
 // value, one shadow ray, the MIS weight against BSDF sampling (none for delta lights).
 
@@ -35,12 +35,12 @@ struct IncidentLight {
 
 /// Samples of each light kind towards point p; false when the light sends nothing there.
 bool sample_incident(const Light& light, Vec3f p, IncidentLight& out);
-/// An emissive triangle chosen by power with u1 and a point on it with u2, where the triangle
-/// is at ray time `time`; li is the emission there times the emitter's coverage (a Blend
-/// emitter is hit by BSDF-sampled rays with probability alpha, a Mask hole not at all). False
-/// for the emitter's invisible side.
-bool sample_incident(const AreaLights& area, const Scene& scene, Vec3f p, float time, float u1, Vec2f u2,
-                     IncidentLight& out);
+/// An emissive triangle or shape chosen as `choice` says (from its point p) with u1 and a point
+/// on it with u2, where the light is at ray time `time`; li is the emission there times the emitter's
+/// coverage (a Blend emitter is hit by BSDF-sampled rays with probability alpha, a Mask hole not at all).
+/// False for the emitter's invisible side.
+bool sample_incident(const AreaLights& area, const Scene& scene, const LightChoice& choice, float time,
+                     float u1, Vec2f u2, IncidentLight& out);
 /// An environment direction from u.
 bool sample_incident(const Environment& env, Vec2f u, IncidentLight& out);
 
@@ -58,13 +58,14 @@ struct DirectLightingVertex {
 
 /// Which estimators run, as PathConfig's LightStrategy and hit filter set them.
 struct DirectLightingMode {
-  bool sample_lights = true;  ///< sample emissive triangles and the environment here
-  bool bsdf_mis = true;       ///< BSDF sampling also finds them: weight by MIS
-  bool hit_filter = true;     ///< filtered shadow rays (visibility.h)
+  bool sample_lights = true;                        ///< sample emissive triangles and the environment here
+  bool bsdf_mis = true;                             ///< BSDF sampling also finds them: weight by MIS
+  bool hit_filter = true;                           ///< filtered shadow rays (visibility.h)
+  LightSampler light_sampler = LightSampler::Tree;  ///< how the area-light sample is chosen
 };
 
 /// Adds the direct light at v to `out`: every punctual light, then (with sample_lights) one
-/// area-light sample (draws 1d + 2d when the scene has emitters) and one environment sample
+/// area-light sample (draws 1d + 2d when the scene has sampled emitters) and one environment sample
 /// (draws 2d when it emits), each counted as one shadow ray when it reaches the BRDF.
 /// Never allocates, throws or logs.
 void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const PathLights& lights,

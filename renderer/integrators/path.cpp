@@ -26,6 +26,7 @@ struct Segment {
   Ray ray;
   Vec3f beta{1, 1, 1};
   float prev_pdf = 0;      // solid-angle density of the direction that produced `ray`
+  Vec3f prev_p, prev_n;    // the surface point that produced `ray` and its geometric normal
   bool prev_delta = true;  // the camera ray or a delta lobe produced `ray`: no MIS
   int layers = 0;          // Blend surfaces passed on this segment
   Vec3f sigma_a{0, 0, 0};  // absorption coefficient of the volume the ray travels in
@@ -55,7 +56,7 @@ void add_escaped(const PathContext& ctx, const Segment& seg, int vertex, PathRad
 }
 
 // Emitter hit: emission of the surface hit, seen by the previous vertex (or the camera),
-// MIS-weighted against the area-light sample taken there.
+// MIS-weighted against the area-light sample taken there (a triangle's or a shape's).
 void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, const SurfaceInteraction& si,
                   const MaterialPoint& mp, int vertex, PathRadiance& path) {
   if (!(max_component(mp.emissive) > 0) || mp.unlit) return;
@@ -65,9 +66,12 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, co
       w = 0;
     } else if (ctx.sample_lights) {
       const float cos_l = std::fabs(dot(si.ng, seg.ray.dir));
-      const float pdf_l = cos_l > 0 ? area_light_pdf(*ctx.lights.area, hit.geom_id, hit.prim_id, si.tri) *
-                                          hit.t * hit.t / cos_l
-                                    : 0.0f;
+      const LightChoice choice{seg.prev_p, seg.prev_n, ctx.cfg.light_sampler};
+      const float pdf_a =
+          si.shape >= 0
+              ? shape_light_pdf(*ctx.lights.area, ctx.scene, choice, hit.geom_id, si.p, seg.ray.time)
+              : area_light_pdf(*ctx.lights.area, choice, hit.geom_id, hit.prim_id, si.tri);
+      const float pdf_l = cos_l > 0 ? pdf_a * hit.t * hit.t / cos_l : 0.0f;
       w = power_heuristic(seg.prev_pdf, pdf_l);
     }
   }
@@ -170,7 +174,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
                         !is_black(*lights.environment),
                         cfg.strategy != LightStrategy::Bsdf,
                         cfg.strategy != LightStrategy::Light};
-  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter};
+  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter, cfg.light_sampler};
   Segment seg;
   seg.ray = camera_ray;
   seg.ray.dir = normalize(seg.ray.dir);
@@ -219,6 +223,8 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     // BSDF sampling.
     Vec3f wi;
     if (!sample_bsdf(lobes, si, mp, wo, vertex, samples, seg, path, wi)) break;
+    seg.prev_p = si.p;
+    seg.prev_n = si.ng;
     ++vertex;
 
     // Russian roulette.

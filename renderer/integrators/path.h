@@ -45,6 +45,7 @@ struct PathConfig {
                                     ///< counts as opaque
   bool hit_filter = true;           ///< as WhittedConfig::hit_filter
   bool energy_compensation = true;  ///< GltfBsdf::energy_compensation (multiple-scattering GGX)
+  LightSampler light_sampler = LightSampler::Tree;  ///< how next-event estimation chooses an area light
 };
 
 /// A camera ray's differentials, made on demand: only a first hit whose material reads texture

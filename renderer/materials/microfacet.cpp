@@ -80,11 +80,7 @@ bool refract(Vec3f v, Vec3f m, float eta, Vec3f& out) {
 }
 
 void make_frame(Vec3f n, Vec3f& t, Vec3f& b) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float c = n.x * n.y * a;
-  t = {1 + sign * n.x * n.x * a, sign * c, -sign * n.x};
-  b = {c, sign + n.y * n.y * a, -n.y};
+  orthonormal_basis(n, t, b);
 }
 
 Vec3f sample_cosine_hemisphere(Vec2f u) {

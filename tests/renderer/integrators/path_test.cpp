@@ -56,6 +56,32 @@ std::pair<double, double> mean_and_error(const PathImage& img) {
   return {sum / double(n), std::sqrt(var) / double(n)};
 }
 
+// The image's mean and standard error with MIS, BSDF sampling alone and light sampling alone.
+std::vector<std::pair<double, double>> strategy_means(const Scene& s, const Environment& env,
+                                                      const Camera& cam, RenderConfig cfg) {
+  std::vector<std::pair<double, double>> results;
+  for (LightStrategy st : {LightStrategy::Mis, LightStrategy::Bsdf, LightStrategy::Light}) {
+    cfg.path.strategy = st;
+    results.push_back(mean_and_error(render(s, env, cam, cfg).image));
+  }
+  return results;
+}
+
+// The three estimators of strategy_means() agree within 4 standard errors, the comparison is
+// tight (within 5% of the mean), and MIS is no noisier than either single technique.
+void check_strategies_agree(const std::vector<std::pair<double, double>>& results) {
+  const auto [mis, mis_err] = results[0];
+  INFO("mis " << mis << " +- " << mis_err << ", bsdf " << results[1].first << " +- " << results[1].second
+              << ", light " << results[2].first << " +- " << results[2].second);
+  for (int k : {1, 2}) {
+    const double tolerance =
+        4 * std::sqrt(mis_err * mis_err + results[size_t(k)].second * results[size_t(k)].second);
+    CHECK(std::fabs(results[size_t(k)].first - mis) < tolerance);
+    CHECK(tolerance < 0.05 * mis);
+    CHECK(mis_err <= results[size_t(k)].second * 1.05);
+  }
+}
+
 // The mean of `n` samples of one camera ray's radiance.
 Vec3f ray_mean(const Scene& s, const Environment& env, const PathConfig& pc, const Ray& ray, int n) {
   const auto accel = make_scene_accelerator("embree", s);
@@ -219,24 +245,61 @@ TEST_CASE("path: MIS, BSDF sampling alone and light sampling alone agree in the 
   RenderConfig cfg = small_config(24, 24, 512);
   cfg.sampler = SamplerType::Independent;  // independent samples: the error estimate is honest
   cfg.path.max_depth = 3;
-  std::vector<std::pair<double, double>> results;
-  for (LightStrategy st : {LightStrategy::Mis, LightStrategy::Bsdf, LightStrategy::Light}) {
-    cfg.path.strategy = st;
-    results.push_back(mean_and_error(render(s, env, cam, cfg).image));
-  }
+  const auto results = strategy_means(s, env, cam, cfg);
+  CHECK(results[0].first > 0.1);
+  check_strategies_agree(results);
+}
+
+TEST_CASE(
+    "path: emissive shapes: MIS, BSDF or light sampling alone, and every light sampler agree in the mean",
+    "[path][shapes]") {
+  // A rough floor lit only by emissive shapes: a sphere placed by a similarity (sampled by its
+  // cone), a sphere stretched into an ellipsoid, a one-sided disk facing down, a sheared box and
+  // a capsule (sampled by area, densities through the placement's area scale).
+  Scene s;
+  add_quad_z(s, -4, 4, -4, 4, 0, add_material(s, {0.7f, 0.6f, 0.5f}, 0, 0.5f));
+  const auto emitter = [&](Vec3f le, bool two_sided) { return add_lambert(s, {0, 0, 0}, le, two_sided); };
+  add_shape(s, sphere_shape(0.3f), translation({-1.2f, 0.5f, 0.8f}), emitter({8, 6, 4}, false));
+  Affine3f stretched = translation({1.0f, 1.0f, 0.6f});
+  stretched.m[0][0] = 0.6f, stretched.m[1][1] = 0.2f, stretched.m[2][2] = 0.3f, stretched.m[0][1] = 0.15f;
+  add_shape(s, sphere_shape(1), stretched, emitter({3, 5, 8}, false));
+  Shape disk;
+  disk.kind = ShapeKind::Disk;
+  disk.radius = 0.5f;
+  Affine3f down = translation({0.2f, -1.0f, 2.0f});  // +Y (the disk's front) to -Z
+  down.m[1][1] = 0, down.m[1][2] = 1, down.m[2][1] = -1, down.m[2][2] = 0;
+  add_shape(s, disk, down, emitter({6, 6, 6}, false));
+  Shape box;
+  box.kind = ShapeKind::Box;
+  box.half_size = {0.2f, 0.1f, 0.15f};
+  Affine3f sheared = translation({0.8f, -1.2f, 0.4f});
+  sheared.m[0][1] = 0.5f, sheared.m[2][0] = 0.3f;
+  add_shape(s, box, sheared, emitter({4, 2, 1}, true));
+  Shape capsule;
+  capsule.kind = ShapeKind::Capsule;
+  capsule.radius = 0.1f;
+  capsule.half_height = 0.4f;
+  add_shape(s, capsule, translation({-0.5f, -0.8f, 0.5f}), emitter({2, 6, 3}, false));
+  REQUIRE(build_area_lights(s).shapes.size() == 5);
+  const Environment env = make_constant_environment({0, 0, 0});
+  const Camera cam = look_at({0.3f, -4, 3}, {0, 0, 0.5f}, {0, 0, 1}, 0.9f);
+  RenderConfig cfg = small_config(24, 24, 256);
+  cfg.sampler = SamplerType::Independent;
+  cfg.path.max_depth = 2;
+  const auto results = strategy_means(s, env, cam, cfg);
   const auto [mis, mis_err] = results[0];
-  INFO("mis " << mis << " +- " << mis_err << ", bsdf " << results[1].first << " +- " << results[1].second
-              << ", light " << results[2].first << " +- " << results[2].second);
-  CHECK(mis > 0.1);
-  for (int k : {1, 2}) {
-    const double tolerance =
-        4 * std::sqrt(mis_err * mis_err + results[size_t(k)].second * results[size_t(k)].second);
-    CHECK(std::fabs(results[size_t(k)].first - mis) < tolerance);
-    CHECK(tolerance < 0.05 * mis);  // and the comparison is tight enough to mean something
+  CHECK(mis > 0.05);
+  check_strategies_agree(results);
+  // Light sampling finds the small shapes that BSDF sampling rarely hits: less noise.
+  CHECK(results[2].second < results[1].second);
+  // The light tree (the default above), the power table and uniform choice agree.
+  cfg.path.strategy = LightStrategy::Mis;
+  for (LightSampler sampler : {LightSampler::Power, LightSampler::Uniform}) {
+    cfg.path.light_sampler = sampler;
+    const auto [m, err] = mean_and_error(render(s, env, cam, cfg).image);
+    INFO("sampler " << int(sampler) << ": " << m << " +- " << err);
+    CHECK(std::fabs(m - mis) < 4 * std::sqrt(mis_err * mis_err + err * err));
   }
-  // MIS is no noisier than either single technique.
-  CHECK(mis_err <= results[1].second * 1.05);
-  CHECK(mis_err <= results[2].second * 1.05);
 }
 
 TEST_CASE("path: a Lambertian plane under a point light equals the Whitted diffuse term", "[path][quick]") {
