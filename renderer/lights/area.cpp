@@ -97,10 +97,6 @@ void add_shape_light(const Scene& scene, size_t i, AreaLights& lights, std::vect
   power.push_back(std::isfinite(p) && p > 0 ? p : 0.0);
 }
 
-}  // namespace
-
-namespace {
-
 // A light's box over the shutter: its box at 33 times, grown by the largest step between two
 // of them (so that motion between the samples stays inside).
 template <typename BoxAt>
