@@ -2,6 +2,8 @@
 #include "render/session.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <set>
 #include <stdexcept>
 
@@ -18,6 +20,16 @@
 namespace penumbra {
 
 namespace {
+
+/// A camera's frame (eye, u, v, w) as exact text.
+std::string frame_text(const Camera& c) {
+  char text[320];
+  std::snprintf(text, sizeof text, "%.9g,%.9g,%.9g u %.9g,%.9g,%.9g v %.9g,%.9g,%.9g w %.9g,%.9g,%.9g",
+                double(c.eye.x), double(c.eye.y), double(c.eye.z), double(c.u.x), double(c.u.y),
+                double(c.u.z), double(c.v.x), double(c.v.y), double(c.v.z), double(c.w.x), double(c.w.y),
+                double(c.w.z));
+  return text;
+}
 
 /// Removes the default key light a render added, however the render ends.
 struct DefaultLightGuard {
@@ -118,6 +130,36 @@ void set_lens(PreparedRender& p, const Scene& scene, const std::string& file) {
   }
 }
 
+/// The keys of a camera that `turn` moves over the render's shutter (spec.shutter frame
+/// intervals centred spec.shutter_offset frames after the frame): at spec.motion_steps times at
+/// least, and more (up to 65) until consecutive keys turn by at most a degree, so that the eye
+/// follows its arc closely rather than one chord between the shutter's ends. Empty when the
+/// camera does not move over the shutter.
+std::vector<MotionKey> turning_camera_motion(const PreparedRender& p, const Scene& scene,
+                                             const TurnCamera& turn) {
+  const double open = double(p.spec.shutter_offset) - 0.5 * double(p.spec.shutter);
+  const double length = double(p.spec.shutter);
+  const float cos_degree = float(std::cos(kPi / 180.0));
+  for (int steps = std::max(p.spec.motion_steps, 2);; steps = 2 * steps - 1) {
+    std::vector<Camera> cams;
+    for (int k = 0; k < steps; ++k)
+      cams.push_back(turn(scene, p.camera_index, p.config.width, p.config.height,
+                          open + length * double(k) / double(steps - 1)));
+    bool moves = false, fine = true;
+    for (size_t k = 1; k < cams.size(); ++k) {
+      moves = moves || frame_text(cams[k]) != frame_text(cams[0]);
+      fine =
+          fine && dot(cams[k].w, cams[k - 1].w) >= cos_degree && dot(cams[k].u, cams[k - 1].u) >= cos_degree;
+    }
+    if (!moves) return {};
+    if (fine || steps >= 65) {
+      std::vector<Affine3f> maps;
+      for (const Camera& c : cams) maps.push_back(camera_frame(c));
+      return make_motion_keys(maps);
+    }
+  }
+}
+
 }  // namespace
 
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file,
@@ -188,8 +230,17 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
     scene.lights.push_back(default_key_light(p.camera));
     p.default_light = true;
   }
+  if (o.turn && p.spec.motion_blur) p.camera.motion = turning_camera_motion(p, scene, o.turn);
+  SceneIdentity identity = o.identity;
   if (wants_motion_layers(p.spec.aovs)) {
-    if (o.time)
+    if (o.turn) {
+      auto m = std::make_shared<MotionFrames>();
+      m->same_scene = true;
+      m->previous_camera = o.turn(scene, p.camera_index, cfg.width, cfg.height, -1);
+      m->next_camera = o.turn(scene, p.camera_index, cfg.width, cfg.height, 1);
+      identity.vector_cameras = frame_text(m->previous_camera) + " | " + frame_text(m->next_camera);
+      p.motion = std::move(m);
+    } else if (o.time)
       p.motion = std::make_shared<const MotionFrames>(load_motion_frames(scene, p, *o.time, o));
     else
       p.warnings.push_back(
@@ -197,7 +248,6 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
           " of a render at the file's static pose is 0 everywhere (the static pose is no point of the "
           "animation's timeline): give the render a time for motion");
   }
-  SceneIdentity identity = o.identity;
   if (!p.spec.env_color && !p.spec.env_map.empty()) identity.env_sha256 = sha256_file(p.spec.env_map);
   p.identity = render_identity(p.spec, p.camera, identity);
   return p;
@@ -385,8 +435,8 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
     if (p.motion) {
       const MotionFrames& m = *p.motion;
       out.vector = render_motion_vectors(
-          scene, *accel, p.camera, p.config, {&m.previous.scene, m.previous_camera},
-          {&m.next.scene, m.next_camera}, velocity ? &out.velocity : nullptr, 1.0 / p.spec.fps);
+          scene, *accel, p.camera, p.config, {&m.previous_scene(scene), m.previous_camera},
+          {&m.next_scene(scene), m.next_camera}, velocity ? &out.velocity : nullptr, 1.0 / p.spec.fps);
     } else {
       const PixelWindow win = render_window(p.config);
       out.vector.assign(size_t(win.width()) * size_t(win.height()) * kMotionVectorChannels, 0.0f);

@@ -47,11 +47,21 @@ int find_camera(const Scene& scene, const std::string& spec, const std::string& 
 /// The default places the scene's camera as it is, or frames the scene's bounds.
 using PlaceCamera = std::function<Camera(const Scene& scene, int index, int width, int height)>;
 
+/// A camera placed by the front end that moves from frame to frame of its own accord (a
+/// turntable): the camera PlaceCamera gives, `frames` frame intervals after the render's frame
+/// (any finite value within 2^20; 0 is the render's own camera).
+using TurnCamera = std::function<Camera(const Scene& scene, int index, int width, int height, double frames)>;
+
 /// What prepare_render needs besides the spec and the scene.
 struct PrepareOptions {
-  std::string scene_file;   ///< names the file in InputError messages
-  int camera_index = -2;    ///< -2: from spec.camera (find_camera); else the index to use (-1: none)
-  PlaceCamera place;        ///< empty: the scene's camera or framing the bounds
+  std::string scene_file;  ///< names the file in InputError messages
+  int camera_index = -2;   ///< -2: from spec.camera (find_camera); else the index to use (-1: none)
+  PlaceCamera place;       ///< empty: the scene's camera or framing the bounds
+  /// Set when `place` puts the camera where it moves from frame to frame (a turntable, whose
+  /// frames show the scene at one time): its motion over the shutter blurs the render and the
+  /// vector layer's neighbouring frames are this scene seen from its previous and next
+  /// placements. Empty: a placed camera stays still.
+  TurnCamera turn;
   uint64_t env_budget = 0;  ///< bytes an environment map may take (unless charge_budget says)
   /// Called with the resolved config before any light is loaded: charges the image's buffers to
   /// a memory budget and returns the bytes left for an environment map; may throw.
@@ -69,8 +79,11 @@ struct PrepareOptions {
 /// The vector layer's neighbouring frames: the scene at the render's time -/+ 1/fps, each with
 /// the camera placed as the render's own (the same index or placement, at that time).
 struct MotionFrames {
-  LoadedScene previous, next;
+  LoadedScene previous, next;  ///< empty when same_scene
   Camera previous_camera, next_camera;
+  bool same_scene = false;  ///< the neighbouring frames pose the scene as the render does (a turntable)
+  const Scene& previous_scene(const Scene& render) const { return same_scene ? render : previous.scene; }
+  const Scene& next_scene(const Scene& render) const { return same_scene ? render : next.scene; }
 };
 
 /// A render ready to run: everything resolved, the scene's lights set up.
@@ -98,8 +111,10 @@ struct PreparedRender {
 /// a pinhole and says so in `warnings`), loads
 /// the environment (spec.env_color, spec.env_map, else the file's image-based light), builds the
 /// emissive triangles and shapes for the path tracer, appends the default key light to scene.lights when
-/// nothing lights the scene, loads the vector layer's neighbouring frames (load_motion_frames)
-/// and derives the identity. Throws std::invalid_argument for settings, InputError for the
+/// nothing lights the scene, loads the vector layer's neighbouring frames (load_motion_frames;
+/// with options.turn: the scene as it is, seen from the camera's previous and next placements),
+/// keys a turning camera (options.turn) over the shutter with motion blur, and derives the
+/// identity. Throws std::invalid_argument for settings, InputError for the
 /// camera, the environment map or the neighbouring frames.
 PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& options);
 

@@ -604,6 +604,18 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
   // The camera as rendered, whichever flags or file placed it.
   const auto vec = [](Vec3f v) { return exact(v.x) + "," + exact(v.y) + "," + exact(v.z); };
   e["camera.frame"] = vec(camera.eye) + " u " + vec(camera.u) + " v " + vec(camera.v) + " w " + vec(camera.w);
+  if (!camera.motion.empty()) {
+    std::string keys;
+    for (const MotionKey& k : camera.motion) {
+      if (!keys.empty()) keys.append(" | ");
+      keys.append(vec(k.translation)).append(" q ");
+      for (double q : {k.rotation.x, k.rotation.y, k.rotation.z, k.rotation.w})
+        keys.append(exact(q)).append(",");
+      keys.append("u");
+      for (float u : k.u) keys.append(",").append(exact(u));
+    }
+    e["camera.motion"] = keys;
+  }
   e["camera.lens"] =
       (camera.projection == Projection::Orthographic ? "orthographic ymag " + exact(camera.ymag)
                                                      : "perspective yfov " + exact(camera.yfov)) +
@@ -624,7 +636,10 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
     e["background"] = colour_text(r.background.value_or(Vec3f{0, 0, 0}));
     e["ambient"] = colour_text(r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f}));
   }
-  if (r.aovs.count("vector") || r.aovs.count("velocity")) e["vector.fps"] = exact(r.fps);
+  if (r.aovs.count("vector") || r.aovs.count("velocity")) {
+    e["vector.fps"] = exact(r.fps);
+    if (!scene.vector_cameras.empty()) e["vector.cameras"] = scene.vector_cameras;
+  }
   return {e};
 }
 

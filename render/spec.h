@@ -142,12 +142,15 @@ struct SceneIdentity {
   std::string env_sha256;       ///< the environment map's content hash (prepare_render reads it; empty for a
                                 ///< colour or none)
   std::string shutter;  ///< motion blur: the shutter interval in seconds ("open..close"); empty without
+  std::string vector_cameras;  ///< the vector layer's previous and next cameras when the front end
+                               ///< moves them (a turntable; prepare_render fills it); else empty
 };
 
 /// Everything that decides a render's pixels except its window and sample target: the renderer
 /// version, the scene, the camera as rendered, every pixel-deciding spec_fields() entry that
 /// applies to the integrator (by name), the colours, the environment and the accelerator's
-/// parameters; with the vector layer, fps. `resolved` is resolve()'s result.
+/// parameters; with the vector layer, fps; the camera's motion over the shutter when it has one.
+/// `resolved` is resolve()'s result.
 RenderSettings render_identity(const RenderSpec& resolved, const Camera& camera, const SceneIdentity& scene);
 
 }  // namespace penumbra

@@ -189,6 +189,12 @@ void setup_phase(RenderJob& job) {
   o.scene_file = a.scene_file;
   o.camera_index = cam;
   o.place = [&](const Scene& sc, int index, int w, int h) { return choose_camera(q.rig, sc, index, w, h); };
+  if (q.rig.turntable_frames > 0)
+    o.turn = [&](const Scene& sc, int index, int w, int h, double frames) {
+      CameraRig rig = q.rig;
+      rig.turntable_phase = frames;
+      return choose_camera(rig, sc, index, w, h);
+    };
   o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
   o.identity = scene_identity(a, q, job.scene_sha256);
   o.time = q.time;

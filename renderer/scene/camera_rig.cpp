@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace penumbra {
@@ -107,7 +108,8 @@ Camera fit_keeping_height(const Camera& cam, const CameraRig& r, const Bounds3f&
 Camera fit_turntable(const Camera& cam, const CameraRig& r, const Bounds3f& bounds, float aspect) {
   Camera c = fit_keeping_height(cam, r, bounds, aspect);
   const Vec3f centre = framed_centre(bounds);
-  float dist = dot(c.eye - centre, c.w), ymag = c.ymag;
+  // The distance of the whole frames only: a time between frames keeps the turn's radius.
+  float dist = -std::numeric_limits<float>::infinity(), ymag = 0;
   for (int k = 0; k < r.turntable_frames; ++k) {
     const Quat q = turntable_orientation(r.azimuth, r.elevation, k, r.turntable_frames);
     const Camera f = fit_keeping_height(oriented(cam, q), r, bounds, aspect);
@@ -165,6 +167,9 @@ void check_rig(const CameraRig& r) {
   }
   if (r.turntable_frames < 0)
     fail("turntable: " + std::to_string(r.turntable_frames) + " frames (>= 1 frames per turn; 0 for none)");
+  if (!(std::fabs(r.turntable_phase) <= 1048576.0))
+    fail("turntable: phase " + std::to_string(r.turntable_phase) +
+         " frames (finite, at most 2^20 either way)");
   if (r.turntable_frames > 0 && r.placement != CameraPlacement::Orbit)
     fail("turntable: the camera orbits; it cannot also be placed by look-at or Euler angles");
   check_lens(r);
@@ -210,7 +215,7 @@ Camera rig_camera(const CameraRig& r, const Camera* base, const Bounds3f& bounds
     }
     case CameraPlacement::Orbit: {
       const Quat q = r.turntable_frames > 0 ? turntable_orientation(r.azimuth, r.elevation, r.turntable_frame,
-                                                                    r.turntable_frames)
+                                                                    r.turntable_frames, r.turntable_phase)
                                             : orbit_orientation(r.azimuth, r.elevation);
       c = oriented(c, q);
       if (r.distance) {
@@ -262,10 +267,11 @@ Quat orbit_orientation(double azimuth, double elevation) {
   return quat_from_euler({azimuth, -elevation, 0});
 }
 
-Quat turntable_orientation(double azimuth, double elevation, long long frame, int frames) {
+Quat turntable_orientation(double azimuth, double elevation, long long frame, int frames, double phase) {
   const long long n = std::max(frames, 1);
   const long long k = ((frame % n) + n) % n;
-  const double quarters = 4.0 * double(k) / double(n);  // [0, 4)
+  double quarters = 4.0 * (double(k) + phase) / double(n);  // [0, 4) for phase 0
+  quarters -= 4.0 * std::floor(quarters / 4.0);
   const double key = std::floor(quarters);
   return slerp(orbit_orientation(azimuth + key * kHalfPi, elevation),
                orbit_orientation(azimuth + (key + 1) * kHalfPi, elevation), quarters - key);

@@ -39,6 +39,8 @@ struct CameraRig {
   EulerAngles euler;                  ///< Euler
   int turntable_frames = 0;           ///< > 0: an Orbit turned by 2 pi * turntable_frame / turntable_frames
   long long turntable_frame = 0;      ///< any integer; frame N is frame 0 again
+  double turntable_phase = 0;         ///< frames added to turntable_frame (finite, |phase| <= 2^20):
+                                      ///< shutter times and neighbouring frames between the frames
 
   std::optional<double> yfov;          ///< vertical field of view, in (0, pi)
   std::optional<double> focal_mm;      ///< with sensor_mm: the field of view
@@ -52,7 +54,8 @@ struct CameraRig {
 /// value, eye == target, a zero up vector or one parallel to the view direction, an elevation
 /// outside [-pi/2, pi/2], a distance <= 0, a field of view outside (0, pi), a focal length,
 /// sensor or orthographic height <= 0, both a field of view and a focal length, an
-/// orthographic camera with either, near < 0, far <= near, turntable_frames < 0, or a fitted
+/// orthographic camera with either, near < 0, far <= near, turntable_frames < 0, a
+/// turntable_phase that is not finite or is past 2^20 frames, or a fitted
 /// orthographic height on a placement that never frames (a look-at, an orbit with a distance,
 /// Euler angles at an eye; rig_camera also refuses it on a base camera's pose).
 void check_rig(const CameraRig& rig);
@@ -84,8 +87,10 @@ Quat orbit_orientation(double azimuth, double elevation);
 
 /// The orientation of turntable frame `frame` of `frames` starting at `azimuth`: slerped between
 /// keys a quarter turn apart (each key an orbit_orientation), so the camera turns about +Y at
-/// constant angular speed and frame `frames` is frame 0 again. frames >= 1.
-Quat turntable_orientation(double azimuth, double elevation, long long frame, int frames);
+/// constant angular speed and frame `frames` is frame 0 again. `phase` (finite) adds a part of
+/// a frame or whole frames: phase 1 is frame + 1 bit for bit, phase 0 is the frame itself.
+/// frames >= 1.
+Quat turntable_orientation(double azimuth, double elevation, long long frame, int frames, double phase = 0);
 
 /// The vertical field of view (radians) of a lens of `focal_mm` on a sensor of `sensor_mm`
 /// spanning the larger side of an image of the given aspect (width / height).

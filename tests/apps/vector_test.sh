@@ -5,7 +5,8 @@
 # pixels (computed here from the pinhole formula) for each integrator, twice as large at half
 # the --fps, and the same with --motion-blur; Y and W are 0; the background is 0; a render
 # without --time or --frame warns and writes zeros; the velocity layer beside it holds the quad's
-# camera-space velocity; --help lists both layers.
+# camera-space velocity; a turntable's vectors reproject the still quad through its neighbouring
+# orbits; --help lists both layers.
 # Usage: vector_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -113,6 +114,42 @@ expect 0 "vector layer.*static pose" -- "$bin" render "$work/slide.gltf" -o "$wo
   --height 32 --spp 1 --aov vector
 got=$(mean "$work/static.exr" vector.X 22 14)
 near "$got" 0 && passes=$((passes + 1)) || fail "static pose: vector.X is $got, want 0"
+
+# A turntable's frames show one pose from an orbit turned 2 pi / N a frame: its vectors are
+# the reprojection of the still quad (static pose, at the origin) through the orbit one frame
+# before and after (azimuth -/+ 10 degrees at distance 5, --fov 45), computed here.
+expect 0 "" -- "$bin" render "$work/slide.gltf" -o "$work/turn.exr" --width 48 --height 32 --spp 1 \
+  --accel bvh --turntable 36 --orbit 0,0,5 --fov 45 --frame 0 --aov vector
+turn_want() {  # channel X|Y|Z|W, block corner x y: the mean over the 4 x 4 pixels
+  python3 - "$@" <<'PY'
+import math, sys
+ch, bx, by = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+W, H = 48, 32
+ty = math.tan(math.radians(22.5)); tx = ty * W / H
+def raster(p, az):
+    eye = (5 * math.sin(az), 0, 5 * math.cos(az))
+    u, w = (math.cos(az), 0, -math.sin(az)), (math.sin(az), 0, math.cos(az))
+    d = [p[i] - eye[i] for i in range(3)]
+    xc = sum(d[i] * u[i] for i in range(3)); depth = -sum(d[i] * w[i] for i in range(3))
+    return ((xc / (depth * tx) + 1) * W / 2, (1 - d[1] / (depth * ty)) * H / 2)
+total = 0
+for y in range(by, by + 4):
+    for x in range(bx, bx + 4):
+        sx, sy = (x + 0.5) / W * 2 - 1, 1 - (y + 0.5) / H * 2
+        p = (5 * tx * sx, 5 * ty * sy, 0)
+        nx, ny = raster(p, 0)
+        (px, py), (qx, qy) = raster(p, -math.radians(10)), raster(p, math.radians(10))
+        total += {"X": px - nx, "Y": ny - py, "Z": nx - qx, "W": qy - ny}[ch]
+print(total / 16)
+PY
+}
+for block in "28 10" "18 19"; do
+  for c in X Y Z W; do
+    want=$(turn_want "$c" $block)
+    got=$(mean "$work/turn.exr" "vector.$c" ${block% *} ${block#* })
+    near "$got" "$want" && passes=$((passes + 1)) || fail "--turntable: vector.$c at $block is $got, want $want"
+  done
+done
 
 expect 0 "vector" -- "$bin" render --help
 expect 0 "velocity" -- "$bin" render --help

@@ -5,8 +5,10 @@
 #include <catch2/catch.hpp>
 
 #include "io/files/error.h"
+#include "renderer/core/motion.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/camera_rig.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -202,6 +204,164 @@ TEST_CASE("session: with a lens the data AOVs see what the beauty's samples see"
   const RenderResult r = render_scene(session, spec, 0);
   for (float z : r.layers.data.depth) CHECK(z == Approx(2).epsilon(1e-4));
   CHECK(r.layers.data.albedo[1] == Approx(0.5f));
+}
+
+namespace {
+
+/// A 6 x 6 checkerboard of unlit quads at z = 0 before a grey one at z = -1.5.
+LoadedScene checker_scene() {
+  LoadedScene loaded;
+  Scene& s = loaded.scene;
+  const int dark = test::add_material(s, {0.1f, 0.2f, 0.1f}, 0, 1, true);
+  const int light = test::add_material(s, {0.9f, 0.8f, 0.7f}, 0, 1, true);
+  const int grey = test::add_material(s, {0.4f, 0.4f, 0.4f}, 0, 1, true);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i)
+      test::add_quad_z(s, -1.5f + 0.5f * float(i), -1.0f + 0.5f * float(i), -1.5f + 0.5f * float(j),
+                       -1.0f + 0.5f * float(j), 0, (i + j) % 2 ? dark : light);
+  test::add_quad_z(s, -4, 4, -4, 4, -1.5f, grey);
+  return loaded;
+}
+
+/// An orbit turned by a 24-frame turntable, at frame 3 plus `frames`.
+Camera turntable_camera(const Scene& scene, int width, int height, double frames) {
+  CameraRig rig;
+  rig.placement = CameraPlacement::Orbit;
+  rig.azimuth = 0.1;
+  rig.elevation = 0.2;
+  rig.distance = 6;
+  rig.turntable_frames = 24;
+  rig.turntable_frame = 3;
+  rig.turntable_phase = frames;
+  return rig_camera(rig, nullptr, compute_bounds(scene), float(width) / float(height));
+}
+
+double rmse(const std::vector<float>& a, const std::vector<float>& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) sum += double(a[i] - b[i]) * double(a[i] - b[i]);
+  return std::sqrt(sum / double(a.size()));
+}
+
+}  // namespace
+
+TEST_CASE("session: a turning camera blurs over the shutter as the mean of its stills", "[session][motion]") {
+  LoadedScene loaded = checker_scene();
+  RenderSpec spec = small("whitted");
+  spec.width = 32;
+  spec.height = 24;
+  PrepareOptions o;
+  o.scene_file = "default.gltf";
+  o.camera_index = -1;
+  double phase = 0;
+  o.place = [&](const Scene& sc, int, int w, int h) { return turntable_camera(sc, w, h, phase); };
+  o.turn = [](const Scene& sc, int, int w, int h, double frames) {
+    return turntable_camera(sc, w, h, frames);
+  };
+  // Without motion blur the camera holds still.
+  PreparedRender p = prepare_render(loaded, spec, o);
+  CHECK(p.camera.motion.empty());
+  CHECK(p.identity.entries.count("camera.motion") == 0);
+  finish_render(loaded, p);
+  // The shutter [0, 0.5] frames after the frame: the keys follow the turn (its arc, to well under
+  // a thousandth of the distance).
+  spec.motion_blur = true;
+  spec.shutter = 0.5f;
+  spec.shutter_offset = 0.25f;
+  p = prepare_render(loaded, spec, o);
+  REQUIRE(p.camera.motion.size() >= 3);
+  CHECK(p.identity.entries.count("camera.motion") == 1);
+  const float reach = length(p.camera.eye - compute_bounds(loaded.scene).center());
+  for (double t : {0.0, 0.3, 0.5, 0.77, 1.0}) {
+    const Camera want = turntable_camera(loaded.scene, 32, 24, 0.5 * t);
+    const Affine3f got = interpolate_motion(p.camera.motion, float(t));
+    const Vec3f eye{got.m[0][3], got.m[1][3], got.m[2][3]};
+    const Vec3f w{got.m[0][2], got.m[1][2], got.m[2][2]};
+    INFO("time " << t);
+    CHECK(length(eye - want.eye) < 1e-4f * reach);
+    CHECK(dot(w, want.w) > 1 - 1e-6f);
+  }
+  const Structure s = build_structure(loaded.scene, p.spec, false);
+  spec.spp = 256;
+  p = prepare_render(loaded, spec, o);
+  const Film blurred = render_image(loaded.scene, s.accel.get(), p).film;
+  finish_render(loaded, p);
+  // The mean of 16 stills spread over the shutter, and the still at the frame itself.
+  spec.motion_blur = false;
+  spec.shutter_offset = 0;
+  spec.shutter = 0.5f;
+  spec.spp = 16;
+  std::vector<float> mean(blurred.rgba.size(), 0.0f);
+  constexpr int kStills = 16;
+  for (int k = 0; k < kStills; ++k) {
+    phase = 0.5 * (k + 0.5) / kStills;
+    p = prepare_render(loaded, spec, o);
+    const Film still = render_image(loaded.scene, s.accel.get(), p).film;
+    finish_render(loaded, p);
+    for (size_t i = 0; i < mean.size(); ++i) mean[i] += still.rgba[i] / kStills;
+  }
+  phase = 0;
+  spec.spp = 64;
+  p = prepare_render(loaded, spec, o);
+  const Film frame = render_image(loaded.scene, s.accel.get(), p).film;
+  finish_render(loaded, p);
+  const double to_mean = rmse(blurred.rgba, mean), to_frame = rmse(blurred.rgba, frame.rgba);
+  INFO("RMSE to the mean of stills " << to_mean << ", to the frame's still " << to_frame);
+  CHECK(to_frame > 0.01);
+  CHECK(to_mean < 0.2 * to_frame);
+}
+
+TEST_CASE("session: a turning camera's vector layer reprojects through its previous and next placements",
+          "[session][vector]") {
+  LoadedScene loaded = checker_scene();
+  RenderSpec spec = small("whitted");
+  spec.width = 32;
+  spec.height = 24;
+  spec.aovs = {"vector"};
+  PrepareOptions o;
+  o.scene_file = "default.gltf";
+  o.camera_index = -1;
+  o.place = [](const Scene& sc, int, int w, int h) { return turntable_camera(sc, w, h, 0); };
+  o.turn = [](const Scene& sc, int, int w, int h, double frames) {
+    return turntable_camera(sc, w, h, frames);
+  };
+  const PreparedRender p = prepare_render(loaded, spec, o);  // no time: the scene's static pose
+  CHECK(p.warnings.empty());
+  REQUIRE(p.motion);
+  CHECK(p.motion->same_scene);
+  CHECK(p.identity.entries.count("vector.cameras") == 1);
+  const Structure s = build_structure(loaded.scene, p.spec, false);
+  const RenderLayers layers = render_layers(loaded, s.accel.get(), p);
+  REQUIRE(layers.vector.size() == size_t(32 * 24 * 4));
+  const Camera before = turntable_camera(loaded.scene, 32, 24, -1),
+               after = turntable_camera(loaded.scene, 32, 24, 1);
+  CHECK(length(p.motion->previous_camera.eye - before.eye) < 1e-6f);
+  CHECK(length(p.motion->next_camera.eye - after.eye) < 1e-6f);
+  CHECK(length(p.camera.eye - turntable_camera(loaded.scene, 32, 24, 0).eye) < 1e-6f);
+  int surface = 0, moving = 0;
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const float* v = &layers.vector[size_t(y * 32 + x) * 4];
+      Hit hit;
+      const Ray ray = generate_camera_ray(p.camera, 32, 24, x + 0.5f, y + 0.5f);
+      if (!s.accel->intersect(ray, hit)) {
+        for (int c = 0; c < 4; ++c) CHECK(v[c] == 0);
+        continue;
+      }
+      ++surface;
+      const Vec3f point = ray.org + ray.dir * hit.t;
+      Vec2f was, will;
+      REQUIRE(project_to_raster(before, 32, 24, point, was));
+      REQUIRE(project_to_raster(after, 32, 24, point, will));
+      INFO("pixel " << x << "," << y);
+      // Raster rows run down, the layer's Y up.
+      CHECK(v[0] == Approx(was.x - (x + 0.5f)).margin(0.01));
+      CHECK(v[1] == Approx((y + 0.5f) - was.y).margin(0.01));
+      CHECK(v[2] == Approx((x + 0.5f) - will.x).margin(0.01));
+      CHECK(v[3] == Approx(will.y - (y + 0.5f)).margin(0.01));
+      moving += std::fabs(v[0]) > 0.5f;
+    }
+  CHECK(surface > 100);
+  CHECK(moving > 100);
 }
 
 }  // namespace penumbra

@@ -330,6 +330,43 @@ TEST_CASE("rig: a framed turntable keeps one distance, every frame inside, the w
       }
 }
 
+TEST_CASE("rig: a turntable's phase turns it between and across frames", "[camera][rig][quick]") {
+  for (int n : {1, 3, 8, 36})
+    for (double el : {0.0, 0.4, -90 * kDeg}) {
+      CAPTURE(n, el);
+      const double az = 0.3;
+      for (long long k = 0; k < n; ++k) {
+        CAPTURE(k);
+        // Phase 0 is the frame; phase 1 is the next frame bit for bit; -1 the previous one.
+        CHECK(identical(turntable_orientation(az, el, k, n, 0), turntable_orientation(az, el, k, n)));
+        CHECK(identical(turntable_orientation(az, el, k, n, 1), turntable_orientation(az, el, k + 1, n)));
+        CHECK(angle_between(turntable_orientation(az, el, k, n, -1),
+                            turntable_orientation(az, el, k - 1, n)) < 1e-9);
+        // A fraction of a frame turns by that fraction of 2 pi / n about +Y.
+        for (double f : {0.25, 0.5, -0.375, 2.5}) {
+          CAPTURE(f);
+          CHECK(angle_between(turntable_orientation(az, el, k, n, f),
+                              orbit_orientation(az + 2 * M_PI * (double(k) + f) / n, el)) < 1e-9);
+        }
+      }
+    }
+  // A framed turntable keeps the turn's radius between frames; the phase must be finite.
+  for (double f : {0.0, 0.5, -0.25, 1.0}) {
+    CAPTURE(f);
+    CameraRig r = turntable(0.2, 0.35, 8, 2);
+    r.turntable_phase = f;
+    const Camera c = rig_camera(r, nullptr, kBox, 1.5f);
+    const Camera frame = rig_camera(turntable(0.2, 0.35, 8, 2), nullptr, kBox, 1.5f);
+    CHECK(length(c.eye - kCentre) == Approx(length(frame.eye - kCentre)).epsilon(1e-6));
+    check_near(normalize(c.eye - kCentre), c.w, 1e-5);
+  }
+  CameraRig bad = turntable(0, 0, 8, 0);
+  bad.turntable_phase = std::nan("");
+  CHECK_THROWS_WITH(check_rig(bad), Catch::Contains("phase"));
+  bad.turntable_phase = 1e7;
+  CHECK_THROWS_WITH(check_rig(bad), Catch::Contains("phase"));
+}
+
 TEST_CASE("rig: lens overrides", "[camera][rig][quick]") {
   // A 50 mm lens on a 36 mm sensor spanning the larger side: 16:9 has tan_x = 18 / 50, a portrait
   // image has tan_y = 18 / 50, a square image both.
