@@ -46,8 +46,8 @@ bool pose_session(SceneSession& session, double time) {
   uint64_t moved = 0;
   if (!pose_gltf_scene(*session.loaded.animation, time, session.loaded.scene, &moved)) return false;
   session.time = time;
+  session.area_lights.reset();  // punctual lights among them may have moved
   if (moved == 0) return true;
-  session.area_lights.reset();
   Structure& s = session.structure;
   try {
     if (s.accel && !s.accel->update_instances(instance_views(session.loaded.scene))) s = Structure{};

@@ -473,17 +473,21 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   PrepareOptions options;
   options.scene_file = session.file;
   options.env_budget = env_budget;
-  options.area_lights = session.area_lights;
   validate(spec);
   // Loads at the shutter's times match the scene only when it too was loaded at a time.
   options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file,
                                               session.loaded_at_time ? session.load_at : LoadAtTime{});
+  // The lights move with the shutter: those of another shutter are built again.
+  if (session.area_lights_shutter == options.identity.shutter) options.area_lights = session.area_lights;
   options.time = session.loaded_at_time ? std::optional<double>(session.time) : std::nullopt;
   options.load_at = session.load_at;
   RenderResult r;
   r.prepared = prepare_render(session.loaded, spec, options);
   DefaultLightGuard guard{session.loaded, &r.prepared};
-  if (r.prepared.area_lights) session.area_lights = r.prepared.area_lights;
+  if (r.prepared.area_lights) {
+    session.area_lights = r.prepared.area_lights;
+    session.area_lights_shutter = options.identity.shutter;
+  }
   const Scene& scene = session.loaded.scene;
   // An animated scene loaded at a time keeps Embree's still placements apart, as the command does.
   const bool world_apart = session.loaded.info.animation_count != 0 && session.loaded_at_time;

@@ -153,8 +153,10 @@ std::vector<SpecField> make_fields() {
        0,
        0,
        {"tree", "power", "uniform"},
-       "path: how an emissive triangle or shape is chosen for a light sample: tree (default; a light BVH, "
-       "by importance at the shading point), power (in proportion to power) or uniform (for tests)"},
+       "path: how an emissive triangle or shape (or a point or spot light, past eight of them) is chosen for "
+       "a light sample: tree (default; a light BVH, by importance at the shading point), power (in "
+       "proportion "
+       "to power) or uniform (for tests)"},
       {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
       {"env_rotation",
        &S::env_rotation,

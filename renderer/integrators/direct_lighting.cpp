@@ -19,6 +19,12 @@ bool sample_incident(const AreaLights& area, const Scene& scene, const LightChoi
   AreaLightSample ls;
   if (!sample_area_light(area, scene, choice, time, u1, u2, ls)) return false;
   const Vec3f p = choice.p;
+  if (ls.light >= 0) {  // a punctual light, chosen with probability ls.pdf_area
+    Light moved;
+    if (!sample_incident(light_at(scene, size_t(ls.light), time, moved), p, out)) return false;
+    out.pdf = ls.pdf_area;
+    return true;
+  }
   const Vec3f d = ls.p - p;
   const float dist2 = dot(d, d), dist = std::sqrt(dist2);
   const Vec3f wi = d / dist;
@@ -88,7 +94,10 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
                             const DirectLightingVertex& v, const DirectLightingMode& mode,
                             SampleStream& samples, RayCounts& counts, PathRadiance& out) {
   IncidentLight l;
+  // Every punctual light the area lights do not choose among (all of them without light sampling).
+  const std::vector<uint8_t>& sampled = lights.area->sampled;
   for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (mode.sample_lights && i < sampled.size() && sampled[i]) continue;
     Light moved;
     if (sample_incident(light_at(scene, i, v.si.time, moved), v.si.p, l))
       estimate(scene, accel, v, mode, l, counts, out);

@@ -29,7 +29,8 @@ struct IncidentLight {
   Vec3f wi;            ///< unit direction towards the light
   float distance = 0;  ///< to the sampled point (kInfinity: at infinity)
   Vec3f li;            ///< radiance arriving along -wi (irradiance for delta lights)
-  float pdf = 1;       ///< solid-angle density of wi (1 for delta lights)
+  float pdf = 1;       ///< solid-angle density of wi; for a delta light 1, or the probability of
+                       ///< choosing it when it was chosen among the area lights
   bool delta = true;   ///< a punctual light: no MIS
 };
 
@@ -64,10 +65,11 @@ struct DirectLightingMode {
   LightSampler light_sampler = LightSampler::Tree;  ///< how the area-light sample is chosen
 };
 
-/// Adds the direct light at v to `out`: every punctual light, then (with sample_lights) one
-/// area-light sample (draws 1d + 2d when the scene has sampled emitters) and one environment sample
-/// (draws 2d when it emits), each counted as one shadow ray when it reaches the BRDF.
-/// Never allocates, throws or logs.
+/// Adds the direct light at v to `out`: every punctual light that is not among the sampled
+/// entries of lights.area (every one without sample_lights), then (with sample_lights) one
+/// area-light sample (an emissive triangle or shape, or a punctual light divided by its pmf) (draws 1d + 2d
+/// when the scene has sampled emitters) and one environment sample (draws 2d when it emits), each counted as
+/// one shadow ray when it reaches the BRDF. Never allocates, throws or logs.
 void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                             const DirectLightingVertex& v, const DirectLightingMode& mode,
                             SampleStream& samples, RayCounts& counts, PathRadiance& out);

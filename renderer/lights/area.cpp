@@ -97,6 +97,29 @@ void add_shape_light(const Scene& scene, size_t i, AreaLights& lights, std::vect
   power.push_back(std::isfinite(p) && p > 0 ? p : 0.0);
 }
 
+// Appends the point and spot lights as entries when there are more than `evaluated` of them.
+// The power: 4 x luminance(colour) x intensity, a point light's flux 4 pi I over pi (the area
+// lights' unit); a spot's cone is left to its bounds, as pbrt-v4's SpotLight::Bounds does.
+void add_punctual_lights(const Scene& scene, size_t evaluated, AreaLights& lights,
+                         std::vector<double>& power) {
+  size_t count = 0;
+  for (const Light& l : scene.lights) count += l.type != LightType::Directional;
+  if (count <= evaluated) return;
+  lights.sampled.assign(scene.lights.size(), 0);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (l.type == LightType::Directional) continue;
+    // A moving light's strongest step steers sampling.
+    double phi = double(luminance(l.color)) * double(l.intensity);
+    if (i < scene.light_motion.size())
+      for (const Light& step : scene.light_motion[i])
+        phi = std::max(phi, double(luminance(step.color)) * double(step.intensity));
+    lights.punctual.push_back(uint32_t(i));
+    lights.sampled[i] = 1;
+    power.push_back(std::isfinite(phi) && phi > 0 ? 4 * phi : 0.0);
+  }
+}
+
 // A light's box over the shutter: its box at 33 times, grown by the largest step between two
 // of them (so that motion between the samples stays inside).
 template <typename BoxAt>
@@ -140,6 +163,28 @@ LightBounds entry_bounds(const Scene& scene, const AreaLights& lights, size_t k,
     b.cos_o = -1;
     return b;
   }
+  if (k >= lights.triangles.size() + lights.shapes.size()) {
+    const size_t i = lights.punctual[k - lights.triangles.size() - lights.shapes.size()];
+    const Light& l = scene.lights[i];
+    const bool moves = i < scene.light_motion.size() && !scene.light_motion[i].empty();
+    b.two_sided = false;
+    if (moves) {
+      for (const Light& step : scene.light_motion[i]) b.bounds = merge(b.bounds, step.position);
+      // Linear steps: the segments between them lie in the box of their ends.
+      b.cos_o = -1;
+      b.cos_e = 0;
+      return b;
+    }
+    b.bounds = {l.position, l.position};
+    if (l.type == LightType::Spot) {
+      b.w = l.direction;
+      b.cos_o = std::cos(l.inner_cone);
+      b.cos_e = std::cos(std::max(l.outer_cone - l.inner_cone, 0.0f));
+    } else {
+      b.cos_o = -1;
+    }
+    return b;
+  }
   const EmissiveShape& e = lights.shapes[k - lights.triangles.size()];
   const Instance& inst = scene.instances[e.instance];
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
@@ -163,7 +208,7 @@ LightBounds entry_bounds(const Scene& scene, const AreaLights& lights, size_t k,
 
 }  // namespace
 
-AreaLights build_area_lights(const Scene& scene) {
+AreaLights build_area_lights(const Scene& scene, size_t evaluated_punctual) {
   AreaLights lights;
   lights.first.assign(scene.instances.size(), -1);
   std::vector<double> power;
@@ -175,6 +220,7 @@ AreaLights build_area_lights(const Scene& scene) {
     add_shape_light(scene, i, lights, power);
     if (lights.shapes.size() > before) lights.first[i] = int64_t(lights.triangles.size() + before);
   }
+  add_punctual_lights(scene, evaluated_punctual, lights, power);
   double total = 0;
   for (double p : power) total += p;
   if (!(total > 0)) {
@@ -346,6 +392,13 @@ bool sample_area_light(const AreaLights& lights, const Scene& scene, const Light
   size_t k = 0;
   float pmf = 0;
   if (!choose_entry(lights, choice, u1, k, pmf)) return false;
+  out.light = -1;
+  if (const size_t areas = lights.triangles.size() + lights.shapes.size(); k >= areas) {
+    out.light = int32_t(lights.punctual[k - areas]);
+    out.shape = false;
+    out.pdf_area = pmf;
+    return pmf > 0;
+  }
   if (k >= lights.triangles.size()) {
     if (!sample_shape_light(lights.shapes[k - lights.triangles.size()], scene, choice.p, time, u, out))
       return false;

@@ -1,6 +1,7 @@
 // Emissive triangles and emissive analytic shapes as area lights for next-event estimation:
 // every triangle of every instance whose material emits and every placed sphere, plane, disk,
-// box or capsule whose material emits (pbrt-v4 12.2 "DiffuseAreaLight"), chosen through a light
+// box or capsule whose material emits (pbrt-v4 12.2 "DiffuseAreaLight"), and the point and spot
+// lights of a scene with many of them, chosen through a light
 // BVH by their importance at the shading point (light_tree.h), or in proportion to an estimate
 // of their power (pbrt-v4 12.6.2), or uniformly (LightSampler). Triangles
 // are then sampled uniformly by area; a sphere placed by a similarity (rotation, uniform
@@ -47,11 +48,20 @@ enum class LightSampler : uint8_t {
   Uniform  ///< every light of non-zero power equally (for tests)
 };
 
+/// A scene with at most this many point and spot lights evaluates each of them at every
+/// shading point (no variance); one with more samples them among the area lights.
+inline constexpr size_t kEvaluatedPunctualLights = 8;
+
 /// The lights: entry k < triangles.size() is triangles[k], entry triangles.size() + j is
-/// shapes[j]; cdf, pmf and the tree run over all entries.
+/// shapes[j], entry triangles.size() + shapes.size() + j is the punctual light
+/// scene.lights[punctual[j]]; cdf, pmf and the tree run over all entries.
 struct AreaLights {
   std::vector<EmissiveTriangle> triangles;
   std::vector<EmissiveShape> shapes;
+  std::vector<uint32_t> punctual;  ///< the point and spot lights chosen like the others, when the
+                                   ///< scene has more than its evaluated limit; else empty
+  std::vector<uint8_t> sampled;    ///< per scene light: 1 when it is an entry (chosen, not
+                                   ///< evaluated at every point); empty when none is
   std::vector<float> cdf;          ///< entries + 1 values, cdf[0] = 0, back() = 1
   std::vector<float> pmf;          ///< selection probability of each entry by power
   std::vector<uint32_t> positive;  ///< the entries of non-zero power (LightSampler::Uniform)
@@ -61,11 +71,16 @@ struct AreaLights {
                                    ///< nothing or is not sampled (an implicit shape)
 };
 
-/// Collects the scene's emissive triangles and analytic shapes, their power table and their
-/// light tree (each light's bounds: a triangle's box and normal, a flat shape's box and normal,
-/// a closed shape's box with normals in every direction; a light that moves: its box over the
-/// shutter and every direction). Allocates; call once per render.
-AreaLights build_area_lights(const Scene& scene);
+/// Collects the scene's emissive triangles and analytic shapes, and its point and spot lights
+/// when there are more than `evaluated_punctual` of them, their power table and their light
+/// tree (each light's bounds: a triangle's box and normal, a flat shape's box and normal, a
+/// closed shape's box with normals in every direction; a point light's position and every
+/// direction, a spot's axis with its inner cone and the falloff to the outer one as pbrt-v4's
+/// SpotLight::Bounds; a light that moves: its box over the shutter and every direction).
+/// Powers: the emission's luminance times the area (twice for two sides), 4 x the luminance of
+/// a point or spot light's colour x intensity (its flux over pi, the area lights' unit).
+/// Allocates; call once per render.
+AreaLights build_area_lights(const Scene& scene, size_t evaluated_punctual = kEvaluatedPunctualLights);
 
 /// Where and how a light is chosen: the shading point, its geometric normal (zero: none) and
 /// the sampler.
@@ -98,9 +113,12 @@ struct AreaLightSample {
   float pdf_area = 0;  ///< density per unit world area: pmf x the point's density on its light
   WorldTriangle tri;   ///< the light's world triangle at the sample's time (triangles only)
   bool shape = false;  ///< the light is a shape (instance places it), not a triangle
+  int32_t light = -1;  ///< >= 0: the punctual light scene.lights[light] was chosen, with
+                       ///< probability pdf_area; no point is sampled (the caller evaluates it)
 };
 
-/// Chooses a light as `choice` says with u1 and a point on it with u, where the light is at ray
+/// Chooses a light as `choice` says with u1 and a point on it with u (a punctual light: see
+/// AreaLightSample::light), where the light is at ray
 /// time `time` (instance_at, world_triangle: a light that moves or deforms is sampled where
 /// every structure intersects it then). False if there are no lights, none reaches the point,
 /// or the chosen light is degenerate. Never allocates.

@@ -322,6 +322,43 @@ TEST_CASE("path: a Lambertian plane under a point light equals the Whitted diffu
   check_vec(whitted, expected, 1e-6f);
 }
 
+TEST_CASE("path: many point and spot lights chosen among the lights equal all of them evaluated", "[path]") {
+  // Twelve lights over a grey floor and a box: past the evaluated limit they are chosen one per
+  // vertex (tree, power table or uniformly) and divided by their probability; the image's mean
+  // equals that of evaluating each at every vertex.
+  Scene s;
+  add_quad_z(s, -10, 10, -10, 10, 0, add_lambert(s, {0.5f, 0.5f, 0.5f}));
+  add_shape(s, sphere_shape(0.5f), translation({0, 0, 0.5f}), add_lambert(s, {0.8f, 0.3f, 0.2f}));
+  for (int i = 0; i < 12; ++i) {
+    const float a = float(i) * 0.52f;
+    Light l = point_light({3 * std::cos(a), 3 * std::sin(a), 1.0f + 0.2f * float(i % 4)}, 1.0f + float(i));
+    if (i % 3 == 0) {
+      l.type = LightType::Spot;
+      l.direction = normalize(Vec3f{-std::cos(a), -std::sin(a), -1});
+      l.outer_cone = 0.6f;
+      l.inner_cone = 0.3f;
+    }
+    s.lights.push_back(l);
+  }
+  const Camera cam = look_at({0, -6, 4}, {0, 0, 0}, {0, 0, 1}, 0.8f);
+  RenderConfig cfg = small_config(24, 16, 64);
+  cfg.path.max_depth = 3;
+  const Environment env = make_constant_environment({0, 0, 0});
+  const auto accel = make_scene_accelerator("embree", s);
+  const AreaLights all = build_area_lights(s, 12), chosen = build_area_lights(s);
+  REQUIRE(all.pmf.empty());
+  REQUIRE(chosen.punctual.size() == 12);
+  const auto [exact, exact_err] = mean_and_error(render_path(s, *accel, PathLights{&all, &env}, cam, cfg));
+  for (LightSampler sampler : {LightSampler::Tree, LightSampler::Power, LightSampler::Uniform}) {
+    cfg.path.light_sampler = sampler;
+    const auto [m, err] = mean_and_error(render_path(s, *accel, PathLights{&chosen, &env}, cam, cfg));
+    INFO("sampler " << int(sampler) << ": " << m << " +- " << err << ", every light " << exact << " +- "
+                    << exact_err);
+    CHECK(std::fabs(m - exact) < 4 * std::sqrt(exact_err * exact_err + err * err));
+    CHECK(err < 0.02 * exact);
+  }
+}
+
 TEST_CASE("path: a square area light gives its form factor; one-sided lights emit forward only", "[path]") {
   // A 2 x 2 light at height 1 straight above a Lambertian point of albedo rho: L = rho Le F,
   // F = 4 F_corner(1, 1, 1).

@@ -10,6 +10,7 @@
 
 #include "renderer/core/rng.h"
 #include "renderer/lights/area.h"
+#include "renderer/lights/punctual.h"
 #include "renderer/materials/material.h"
 #include "support/scene_builder.h"
 
@@ -177,5 +178,70 @@ TEST_CASE("light tree: tree, power and uniform sampling estimate the same irradi
     CHECK(mean[0] > 0);
     for (int k : {1, 2}) CHECK(std::fabs(mean[k] - mean[0]) < 5 * std::sqrt(var[0] + var[k]));
     CHECK(var[0] < var[1]);
+  }
+}
+
+TEST_CASE("light tree: point and spot lights among the entries estimate their exact sum", "[lights][tree]") {
+  // 40 point and 20 spot lights of varied power scattered over emissive quads, and a
+  // directional light (never an entry). Choosing one entry per sample and dividing a punctual
+  // light's irradiance by its probability estimates the sum over every punctual light.
+  Scene s = many_lights(50, 5);
+  Rng rng = make_pixel_rng(0, 0, 0, 21);
+  for (int i = 0; i < 60; ++i) {
+    Light l = point_light({rng.next_float() * 20 - 10, rng.next_float() * 20 - 10, rng.next_float() * 4},
+                          std::pow(10.0f, 2 * rng.next_float()));
+    if (i >= 40) {
+      l.type = LightType::Spot;
+      l.direction = normalize(Vec3f{rng.next_float() - 0.5f, rng.next_float() - 0.5f, -1});
+      l.outer_cone = 0.2f + 0.8f * rng.next_float();
+      l.inner_cone = l.outer_cone * rng.next_float();
+    }
+    if (i % 7 == 0) l.range = 6;
+    s.lights.push_back(l);
+  }
+  Light sun;
+  sun.type = LightType::Directional;
+  s.lights.push_back(sun);
+  // At most the limit of them: every one evaluated, none an entry.
+  const AreaLights few = build_area_lights(s, 60);
+  CHECK(few.punctual.empty());
+  CHECK(few.sampled.empty());
+  const AreaLights al = build_area_lights(s);
+  REQUIRE(al.punctual.size() == 60);
+  REQUIRE(al.sampled.size() == 61);
+  CHECK(al.sampled[60] == 0);
+  CHECK(al.pmf.size() == al.triangles.size() + al.shapes.size() + 60);
+  for (int point = 0; point < 4; ++point) {
+    const Vec3f p{rng.next_float() * 16 - 8, rng.next_float() * 16 - 8, -0.5f}, n{0, 0, 1};
+    double exact = 0;
+    for (size_t i = 0; i < 60; ++i) {
+      LightSample ls;
+      if (sample_light(s.lights[i], p, ls)) exact += double(ls.irradiance.x) * std::max(0.0f, dot(n, ls.wi));
+    }
+    for (LightSampler sampler : {LightSampler::Tree, LightSampler::Power, LightSampler::Uniform}) {
+      const int count = 200000;
+      double sum = 0, sum2 = 0;
+      for (int i = 0; i < count; ++i) {
+        AreaLightSample as;
+        double e = 0;
+        LightSample ls;
+        if (sample_area_light(al, s, {p, n, sampler}, 0, rng.next_float(),
+                              {rng.next_float(), rng.next_float()}, as) &&
+            as.light >= 0 && sample_light(s.lights[size_t(as.light)], p, ls)) {
+          if (i < 100)
+            CHECK(as.pdf_area ==
+                  Approx(light_pmf(al, {p, n, sampler}, al.pmf.size() - 60 + size_t(as.light))));
+          e = double(ls.irradiance.x) * std::max(0.0f, dot(n, ls.wi)) / double(as.pdf_area);
+        }
+        sum += e;
+        sum2 += e * e;
+      }
+      const double mean = sum / count, err = std::sqrt((sum2 / count - mean * mean) / count);
+      INFO("point " << point << " sampler " << int(sampler) << ": " << mean << " +- " << err << ", exact "
+                    << exact);
+      CHECK(exact > 0);
+      CHECK(std::fabs(mean - exact) < 5 * err + 1e-9 * exact);
+      CHECK(err < 0.05 * exact);
+    }
   }
 }
