@@ -153,10 +153,18 @@ std::vector<SpecField> make_fields() {
        0,
        0,
        {"tree", "power", "uniform"},
-       "path: how an emissive triangle or shape (or a point or spot light, past eight of them) is chosen for "
-       "a light sample: tree (default; a light BVH, by importance at the shading point), power (in "
-       "proportion "
-       "to power) or uniform (for tests)"},
+       "path: how an emissive triangle or shape (or a point or spot light, past eight of them) is "
+       "chosen for a light sample: tree (default; a light BVH, by importance at the shading point), "
+       "power (in proportion to power) or uniform (for tests)"},
+      {"light_samples",
+       &S::light_samples,
+       kPath,
+       true,
+       1,
+       64,
+       {},
+       "path: lights chosen at each vertex, each with its own shadow ray (default 1); more lowers the "
+       "noise of direct light at the cost of shadow rays"},
       {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
       {"env_rotation",
        &S::env_rotation,
@@ -584,6 +592,7 @@ RenderConfig make_render_config(const RenderSpec& r) {
   cfg.path.light_sampler = r.light_sampler == "power"     ? LightSampler::Power
                            : r.light_sampler == "uniform" ? LightSampler::Uniform
                                                           : LightSampler::Tree;
+  cfg.path.light_samples = r.light_samples;
   cfg.sampler = r.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   cfg.time_limit = r.time_limit;
   cfg.adaptive_threshold = r.adaptive;

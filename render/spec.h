@@ -33,21 +33,22 @@ struct RenderSpec {
   int threads = 0;  ///< 0: every hardware thread (does not change pixels)
   int tile_size = 32;
   std::string camera;  ///< index (digits) or name; empty: the first camera, else framing the bounds
-  std::string integrator = "whitted";         ///< whitted, path or raster
-  std::string filter;                         ///< box, tent, gaussian, blackman-harris; empty: per integrator
-  float filter_width = 0;                     ///< pixels; 0: the filter's default width
-  int max_depth = -1;                         ///< -1: 5 mirror bounces (whitted), 12 bounces (path)
-  std::optional<Vec3f> background, ambient;   ///< whitted and raster; unset: black, 0.05 grey
-  std::string raster_shadows = "ray";         ///< raster: ray, map or none
-  int shadow_map_size = 1024;                 ///< raster with map shadows: texels on a side
-  int rr_depth = 3;                           ///< path: Russian roulette from this bounce on
-  float clamp_indirect = 0;                   ///< path: 0 = off
-  std::string light_sampling = "mis";         ///< path: mis, bsdf or light
-  std::string sampler = "sobol";              ///< path: sobol or independent
-  std::string energy_compensation = "on";     ///< path: on or off (multiple-scattering GGX)
-  std::string light_sampler = "tree";         ///< path: tree, power or uniform (choosing an area light)
-  std::optional<Vec3f> env_color;             ///< path: constant environment radiance
-  std::string env_map;                        ///< path: equirectangular map file
+  std::string integrator = "whitted";        ///< whitted, path or raster
+  std::string filter;                        ///< box, tent, gaussian, blackman-harris; empty: per integrator
+  float filter_width = 0;                    ///< pixels; 0: the filter's default width
+  int max_depth = -1;                        ///< -1: 5 mirror bounces (whitted), 12 bounces (path)
+  std::optional<Vec3f> background, ambient;  ///< whitted and raster; unset: black, 0.05 grey
+  std::string raster_shadows = "ray";        ///< raster: ray, map or none
+  int shadow_map_size = 1024;                ///< raster with map shadows: texels on a side
+  int rr_depth = 3;                          ///< path: Russian roulette from this bounce on
+  float clamp_indirect = 0;                  ///< path: 0 = off
+  std::string light_sampling = "mis";        ///< path: mis, bsdf or light
+  std::string sampler = "sobol";             ///< path: sobol or independent
+  std::string energy_compensation = "on";    ///< path: on or off (multiple-scattering GGX)
+  std::string light_sampler = "tree";        ///< path: tree, power or uniform (choosing an area light)
+  int light_samples = 1;                     ///< path: lights chosen at each vertex, each with its shadow ray
+  std::optional<Vec3f> env_color;            ///< path: constant environment radiance
+  std::string env_map;                       ///< path: equirectangular map file
   float env_intensity = 1, env_rotation = 0;  ///< path: the environment's multiplier and turn (degrees)
   double time_limit = 0;                      ///< path: seconds; 0: none
   float adaptive = 0;                         ///< path: adaptive sampling threshold; 0: off

@@ -104,10 +104,16 @@ void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const 
   }
   if (!mode.sample_lights) return;
   if (!lights.area->pmf.empty()) {
-    const float u1 = samples.get1d();
-    const Vec2f u2 = samples.get2d();
-    if (sample_incident(*lights.area, scene, {v.si.p, v.si.ng, mode.light_sampler}, v.si.time, u1, u2, l))
+    // n samples of one technique: each an estimate of density n p (Veach 1997, 9.2.2).
+    const int n = mode.light_samples;
+    for (int k = 0; k < n; ++k) {
+      const float u1 = samples.get1d();
+      const Vec2f u2 = samples.get2d();
+      if (!sample_incident(*lights.area, scene, {v.si.p, v.si.ng, mode.light_sampler}, v.si.time, u1, u2, l))
+        continue;
+      l.pdf *= float(n);
       estimate(scene, accel, v, mode, l, counts, out);
+    }
   }
   if (!is_black(*lights.environment)) {
     if (sample_incident(*lights.environment, samples.get2d(), l))

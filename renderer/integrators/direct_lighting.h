@@ -63,13 +63,16 @@ struct DirectLightingMode {
   bool bsdf_mis = true;                             ///< BSDF sampling also finds them: weight by MIS
   bool hit_filter = true;                           ///< filtered shadow rays (visibility.h)
   LightSampler light_sampler = LightSampler::Tree;  ///< how the area-light sample is chosen
+  int light_samples = 1;                            ///< area-light samples (>= 1), each weighted 1 / count
 };
 
 /// Adds the direct light at v to `out`: every punctual light that is not among the sampled
-/// entries of lights.area (every one without sample_lights), then (with sample_lights) one
-/// area-light sample (an emissive triangle or shape, or a punctual light divided by its pmf) (draws 1d + 2d
-/// when the scene has sampled emitters) and one environment sample (draws 2d when it emits), each counted as
-/// one shadow ray when it reaches the BRDF. Never allocates, throws or logs.
+/// entries of lights.area (every one without sample_lights), then (with sample_lights)
+/// mode.light_samples area-light samples (an emissive triangle or shape, or a punctual light
+/// divided by its pmf; each density multiplied by the count, as the MIS of a multi-sample
+/// technique; each draws 1d + 2d when the scene has sampled emitters) and one environment
+/// sample (draws 2d when it emits), each counted as one shadow ray when it reaches the BRDF.
+/// Never allocates, throws or logs.
 void sample_direct_lighting(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                             const DirectLightingVertex& v, const DirectLightingMode& mode,
                             SampleStream& samples, RayCounts& counts, PathRadiance& out);

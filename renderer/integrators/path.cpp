@@ -71,7 +71,8 @@ void add_emission(const PathContext& ctx, const Segment& seg, const Hit& hit, co
           si.shape >= 0
               ? shape_light_pdf(*ctx.lights.area, ctx.scene, choice, hit.geom_id, si.p, seg.ray.time)
               : area_light_pdf(*ctx.lights.area, choice, hit.geom_id, hit.prim_id, si.tri);
-      const float pdf_l = cos_l > 0 ? pdf_a * hit.t * hit.t / cos_l : 0.0f;
+      // The light technique took light_samples samples at the previous vertex.
+      const float pdf_l = cos_l > 0 ? float(ctx.cfg.light_samples) * pdf_a * hit.t * hit.t / cos_l : 0.0f;
       w = power_heuristic(seg.prev_pdf, pdf_l);
     }
   }
@@ -174,7 +175,8 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
                         !is_black(*lights.environment),
                         cfg.strategy != LightStrategy::Bsdf,
                         cfg.strategy != LightStrategy::Light};
-  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter, cfg.light_sampler};
+  const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter, cfg.light_sampler,
+                                cfg.light_samples};
   Segment seg;
   seg.ray = camera_ray;
   seg.ray.dir = normalize(seg.ray.dir);

@@ -46,6 +46,8 @@ struct PathConfig {
   bool hit_filter = true;           ///< as WhittedConfig::hit_filter
   bool energy_compensation = true;  ///< GltfBsdf::energy_compensation (multiple-scattering GGX)
   LightSampler light_sampler = LightSampler::Tree;  ///< how next-event estimation chooses an area light
+  int light_samples = 1;  ///< lights chosen (each with its shadow ray) at every vertex, 1..64; the
+                          ///< MIS weights of BSDF samples that hit an emitter count all of them
 };
 
 /// A camera ray's differentials, made on demand: only a first hit whose material reads texture

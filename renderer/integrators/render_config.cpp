@@ -44,6 +44,7 @@ void validate(const RenderConfig& c) {
   check_range("raster.shadow_map_size", c.raster.shadow_map_size, 16, 8192);
   check_range("path.max_depth", c.path.max_depth, 0, kMaxDepth);
   check_range("path.rr_depth", c.path.rr_depth, 1, kMaxDepth);
+  check_range("path.light_samples", c.path.light_samples, 1, 64);
   check_range("path.max_blend_layers", c.path.max_blend_layers, 0, kMaxSpp);
   check_non_negative("path.clamp_indirect", double(c.path.clamp_indirect));
   check_non_negative("time_limit", c.time_limit);

@@ -300,6 +300,16 @@ TEST_CASE(
     INFO("sampler " << int(sampler) << ": " << m << " +- " << err);
     CHECK(std::fabs(m - mis) < 4 * std::sqrt(mis_err * mis_err + err * err));
   }
+  // Four light samples a vertex, weighted as one technique of four samples against the BSDF's:
+  // the same mean as one; light sampling alone too.
+  cfg.path.light_sampler = LightSampler::Tree;
+  cfg.path.light_samples = 4;
+  for (LightStrategy st : {LightStrategy::Mis, LightStrategy::Light}) {
+    cfg.path.strategy = st;
+    const auto [m, err] = mean_and_error(render(s, env, cam, cfg).image);
+    INFO("strategy " << int(st) << ", 4 light samples: " << m << " +- " << err);
+    CHECK(std::fabs(m - mis) < 4 * std::sqrt(mis_err * mis_err + err * err));
+  }
 }
 
 TEST_CASE("path: a Lambertian plane under a point light equals the Whitted diffuse term", "[path][quick]") {
@@ -356,6 +366,13 @@ TEST_CASE("path: many point and spot lights chosen among the lights equal all of
                     << exact_err);
     CHECK(std::fabs(m - exact) < 4 * std::sqrt(exact_err * exact_err + err * err));
     CHECK(err < 0.02 * exact);
+    // Four lights chosen at each vertex: the same mean, less noise.
+    cfg.path.light_samples = 4;
+    const auto [m4, err4] = mean_and_error(render_path(s, *accel, PathLights{&chosen, &env}, cam, cfg));
+    cfg.path.light_samples = 1;
+    INFO("4 light samples: " << m4 << " +- " << err4);
+    CHECK(std::fabs(m4 - exact) < 4 * std::sqrt(exact_err * exact_err + err4 * err4));
+    CHECK(err4 < 0.7 * err);
   }
 }
 
