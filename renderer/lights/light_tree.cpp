@@ -30,16 +30,6 @@ float box_area(const Bounds3f& b) {
   return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
 }
 
-// Cosine of the half-angle of the cone of directions from p that holds the box (through its
-// bounding sphere); -1 when p is inside that sphere.
-float cos_subtended(const Bounds3f& b, Vec3f p) {
-  const Vec3f c = b.center();
-  const float r2 = dot(b.extent(), b.extent()) / 4;
-  const float d2 = dot(p - c, p - c);
-  if (d2 <= r2) return -1;
-  return safe_sqrt(1 - r2 / d2);
-}
-
 // Rotation of v by `angle` about the unit axis k (Rodrigues' formula).
 Vec3f rotate(Vec3f v, Vec3f k, float angle) {
   const float c = std::cos(angle), s = std::sin(angle);
@@ -166,31 +156,64 @@ struct Builder {
 
 }  // namespace
 
-float light_importance(const LightBounds& b, Vec3f p, Vec3f n) {
-  const Vec3f pc = b.bounds.center();
-  const Vec3f to_p = p - pc;
-  const float d2 = std::max(dot(to_p, to_p), length(b.bounds.extent()) / 2);
-  const float len = length(to_p);
-  const Vec3f wi = len > 0 ? to_p / len : b.w;
+namespace {
+
+// The terms of a node that importance reads besides its bounds.
+void set_terms(LightTreeNode& node) {
+  const Bounds3f& b = node.lb.bounds;
+  node.centre = b.center();
+  node.radius2 = dot(b.extent(), b.extent()) / 4;
+  node.min_d2 = length(b.extent()) / 2;
+  node.sin_o = safe_sqrt(1 - node.lb.cos_o * node.lb.cos_o);
+}
+
+// light_importance() of a node, with `n` unit or zero.
+float node_importance(const LightTreeNode& node, Vec3f p, Vec3f n) {
+  const LightBounds& b = node.lb;
+  const Vec3f to_p = p - node.centre;
+  const float dist2 = dot(to_p, to_p);
+  const float d2 = std::max(dist2, node.min_d2);
+  const float inv_len = dist2 > 0 ? 1 / std::sqrt(dist2) : 0.0f;
+  const Vec3f wi = dist2 > 0 ? to_p * inv_len : b.w;
   float cos_w = dot(b.w, wi);
   if (b.two_sided) cos_w = std::fabs(cos_w);
   const float sin_w = safe_sqrt(1 - cos_w * cos_w);
-  const float cos_b = cos_subtended(b.bounds, p), sin_b = safe_sqrt(1 - cos_b * cos_b);
+  // The cone from p around the box's bounding sphere (the whole sphere from inside it).
+  float cos_b = -1, sin_b = 0;
+  if (dist2 > node.radius2) {
+    const float s2 = node.radius2 / dist2;
+    sin_b = std::sqrt(s2);
+    cos_b = std::sqrt(1 - s2);
+  }
   // theta' = max(0, theta_w - theta_o - theta_b): the smallest angle between an emitting
   // normal and a direction towards p.
-  const float sin_o = safe_sqrt(1 - b.cos_o * b.cos_o);
-  const float cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, b.cos_o);
-  const float sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, b.cos_o);
+  const float cos_x = cos_sub_clamped(sin_w, cos_w, node.sin_o, b.cos_o);
+  const float sin_x = sin_sub_clamped(sin_w, cos_w, node.sin_o, b.cos_o);
   const float cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
   if (cos_p <= b.cos_e) return 0;
   float importance = b.phi * cos_p / d2;
   if (n.x != 0 || n.y != 0 || n.z != 0) {
     // The receiver's cosine, bounded over the subtended directions (either side of the surface).
-    const float cos_i = std::fabs(dot(wi, n)) / std::max(length(n), 1e-30f);
+    const float cos_i = std::fabs(dot(wi, n));
     const float sin_i = safe_sqrt(1 - cos_i * cos_i);
     importance *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
   }
   return std::isfinite(importance) ? std::max(importance, 0.0f) : 0.0f;
+}
+
+// `n` made unit, or left zero.
+Vec3f unit_or_zero(Vec3f n) {
+  const float len2 = dot(n, n);
+  return len2 > 0 && std::isfinite(len2) ? n / std::sqrt(len2) : Vec3f{0, 0, 0};
+}
+
+}  // namespace
+
+float light_importance(const LightBounds& b, Vec3f p, Vec3f n) {
+  LightTreeNode node;
+  node.lb = b;
+  set_terms(node);
+  return node_importance(node, p, unit_or_zero(n));
 }
 
 LightBounds merge(const LightBounds& a, const LightBounds& b) {
@@ -231,6 +254,7 @@ LightTree build_light_tree(std::span<const LightBounds> lights) {
   if (ids.empty()) return tree;
   tree.nodes.reserve(2 * ids.size());
   Builder{lights, tree}.build(ids, 0, ids.size(), 0, 0);
+  for (LightTreeNode& node : tree.nodes) set_terms(node);
   return tree;
 }
 
@@ -238,8 +262,8 @@ namespace {
 // The probability of taking the first child of interior node `node` at p; false when neither
 // child can reach p.
 bool first_child_probability(const LightTree& tree, uint32_t node, Vec3f p, Vec3f n, float& p0) {
-  const float c0 = light_importance(tree.nodes[node + 1].lb, p, n);
-  const float c1 = light_importance(tree.nodes[tree.nodes[node].index].lb, p, n);
+  const float c0 = node_importance(tree.nodes[node + 1], p, n);
+  const float c1 = node_importance(tree.nodes[tree.nodes[node].index], p, n);
   if (!(c0 + c1 > 0)) return false;
   p0 = c0 / (c0 + c1);
   return true;
@@ -248,6 +272,7 @@ bool first_child_probability(const LightTree& tree, uint32_t node, Vec3f p, Vec3
 
 bool sample_light_tree(const LightTree& tree, Vec3f p, Vec3f n, float u, uint32_t& light, float& pmf) {
   if (tree.nodes.empty()) return false;
+  n = unit_or_zero(n);
   uint32_t node = 0;
   pmf = 1;
   while (!tree.nodes[node].leaf) {
@@ -263,7 +288,7 @@ bool sample_light_tree(const LightTree& tree, Vec3f p, Vec3f n, float u, uint32_
       node = tree.nodes[node].index;
     }
   }
-  if (!(light_importance(tree.nodes[node].lb, p, n) > 0) || !(pmf > 0)) return false;
+  if (!(node_importance(tree.nodes[node], p, n) > 0) || !(pmf > 0)) return false;
   light = tree.nodes[node].index;
   return true;
 }
@@ -271,6 +296,7 @@ bool sample_light_tree(const LightTree& tree, Vec3f p, Vec3f n, float u, uint32_
 float light_tree_pmf(const LightTree& tree, Vec3f p, Vec3f n, uint32_t light) {
   if (light >= tree.trail.size() || tree.trail[light] == LightTree::kNotInTree) return 0;
   const uint64_t trail = tree.trail[light];
+  n = unit_or_zero(n);
   uint32_t node = 0;
   float pmf = 1;
   for (int depth = 0; !tree.nodes[node].leaf; ++depth) {
@@ -284,7 +310,7 @@ float light_tree_pmf(const LightTree& tree, Vec3f p, Vec3f n, uint32_t light) {
       node = node + 1;
     }
   }
-  return light_importance(tree.nodes[node].lb, p, n) > 0 ? pmf : 0.0f;
+  return node_importance(tree.nodes[node], p, n) > 0 ? pmf : 0.0f;
 }
 
 }  // namespace penumbra

@@ -41,6 +41,11 @@ struct LightTreeNode {
   LightBounds lb;
   uint32_t index = 0;  ///< interior: its second child (the first is the next node); leaf: the light
   bool leaf = false;
+  // What light_importance() derives from lb, kept so that sampling does not derive it again.
+  Vec3f centre;       ///< of lb.bounds
+  float radius2 = 0;  ///< squared radius of the bounding sphere of lb.bounds
+  float min_d2 = 0;   ///< the squared distance's floor: half the box's diagonal (pbrt-v4's)
+  float sin_o = 0;    ///< sin theta_o
 };
 
 /// Nodes in depth-first order (node 0 the root). Lights of zero or non-finite power are left out.
