@@ -34,12 +34,12 @@ scenes=(
 )
 
 rmse() { oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | awk '/RMS error/ {print $4}'; }
-pen() {  # scene out spp bg -> seconds
-  "$penumbra" render "$1" -o "$2" --no-png --integrator path --energy-compensation off --spp "$3" --width $W --height $H --camera bench \
+pen() {  # scene out spp bg [seed] -> seconds
+  "$penumbra" render "$1" -o "$2" --no-png --integrator path --energy-compensation off --spp "$3" --seed "${5:-0}" --width $W --height $H --camera bench \
     --threads "$THREADS" --env "$4" --float 2>&1 | awk '/render [0-9.]+s/ {for (i=1;i<=NF;i++) if ($i=="render") {sub("s","",$(i+1)); print $(i+1)}}'
 }
-cyc() {
-  blender -b --factory-startup -P "$here/render_cycles.py" -- "$1" "$2" $W $H "$3" "$THREADS" "$4" 2>&1 |
+cyc() {  # scene out spp bg [seed] -> seconds
+  blender -b --factory-startup -P "$here/render_cycles.py" -- "$1" "$2" $W $H "$3" "$THREADS" "$4" "seed=${5:-0}" 2>&1 |
     awk '/cycles_render_seconds/ {print $2}'
 }
 
@@ -56,7 +56,8 @@ for s in "${scenes[@]}"; do
   scene=$(python3 "$here/add_camera.py" "$file" "$work/$name" $eye "$fov" "$pitch")
   for r in penumbra cycles; do
     f=$([ $r = penumbra ] && echo pen || echo cyc)
-    t=$($f "$scene" "$work/$name-$r-ref.exr" "$REF_SPP" "$bg")
+    # The reference with another seed, so that it shares no samples with the renders it measures.
+    t=$($f "$scene" "$work/$name-$r-ref.exr" "$REF_SPP" "$bg" 1)
     echo "$name $r $REF_SPP $t reference" | tee -a "$out"
     for spp in $SPPS; do
       t=$($f "$scene" "$work/$name-$r-$spp.exr" "$spp" "$bg")
