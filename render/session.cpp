@@ -477,8 +477,9 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   // Loads at the shutter's times match the scene only when it too was loaded at a time.
   options.identity.shutter = set_scene_motion(session.loaded, spec, session.time, session.file,
                                               session.loaded_at_time ? session.load_at : LoadAtTime{});
-  // The lights move with the shutter: those of another shutter are built again.
-  if (session.area_lights_shutter == options.identity.shutter) options.area_lights = session.area_lights;
+  // The lights move with the shutter: those of another shutter or step count are built again.
+  const std::string lights_key = options.identity.shutter + " steps " + std::to_string(spec.motion_steps);
+  if (session.area_lights_key == lights_key) options.area_lights = session.area_lights;
   options.time = session.loaded_at_time ? std::optional<double>(session.time) : std::nullopt;
   options.load_at = session.load_at;
   RenderResult r;
@@ -486,7 +487,7 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   DefaultLightGuard guard{session.loaded, &r.prepared};
   if (r.prepared.area_lights) {
     session.area_lights = r.prepared.area_lights;
-    session.area_lights_shutter = options.identity.shutter;
+    session.area_lights_key = lights_key;
   }
   const Scene& scene = session.loaded.scene;
   // An animated scene loaded at a time keeps Embree's still placements apart, as the command does.

@@ -220,7 +220,7 @@ struct Session {
   std::mutex mutex;
   Structure structure;                            ///< the last render's, or empty
   std::shared_ptr<const AreaLights> area_lights;  ///< the emissive triangles and shapes, once needed
-  std::string area_lights_shutter;                ///< the shutter area_lights were built for
+  std::string area_lights_key;                    ///< the shutter and motion steps area_lights were built for
 };
 
 /// Everything one render produced.

@@ -296,13 +296,17 @@ float aspect_hint(const Scene& scene, int index) {
                                                                : 16.0f / 9.0f;
 }
 
-Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height) {
+Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height,
+                     const Bounds3f* bounds) {
   const Camera* base = index >= 0 ? &scene.cameras[size_t(index)] : nullptr;
   try {
     // The bounds only where the rig uses them: framing, or an orbit's centre.
     const bool uses_bounds =
         rig.placement == CameraPlacement::Orbit || rig_frames_bounds(rig, base != nullptr);
-    return rig_camera(rig, base, uses_bounds ? compute_bounds(scene) : Bounds3f{},
+    return rig_camera(rig, base,
+                      !uses_bounds ? Bounds3f{}
+                      : bounds     ? *bounds
+                                   : compute_bounds(scene),
                       float(width) / float(height));
   } catch (const std::invalid_argument& e) {
     // What only the scene decides: the framed near plane against --far, single-precision limits.

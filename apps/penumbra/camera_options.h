@@ -55,7 +55,9 @@ float aspect_hint(const Scene& scene, int index);
 
 /// The camera a render of `scene` uses for an image of `width` x `height`: the rig applied to
 /// camera `index` of the scene (-1: none) as CameraRig documents. Throws UsageError with the
-/// rig's message when the result is not a camera (a far plane before the near one).
-Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height);
+/// rig's message when the result is not a camera (a far plane before the near one). `bounds`:
+/// compute_bounds(scene) when the caller has it (a turntable placed many times), else null.
+Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height,
+                     const Bounds3f* bounds = nullptr);
 
 }  // namespace penumbra::cli

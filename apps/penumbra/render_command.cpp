@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -189,12 +190,16 @@ void setup_phase(RenderJob& job) {
   o.scene_file = a.scene_file;
   o.camera_index = cam;
   o.place = [&](const Scene& sc, int index, int w, int h) { return choose_camera(q.rig, sc, index, w, h); };
-  if (q.rig.turntable_frames > 0)
-    o.turn = [&](const Scene& sc, int index, int w, int h, double frames) {
+  if (q.rig.turntable_frames > 0) {
+    // The turn is placed many times over one scene (the shutter's keys): its bounds once.
+    auto bounds = std::make_shared<std::pair<const Scene*, Bounds3f>>(nullptr, Bounds3f{});
+    o.turn = [&q, bounds](const Scene& sc, int index, int w, int h, double frames) {
+      if (bounds->first != &sc) *bounds = {&sc, compute_bounds(sc)};
       CameraRig rig = q.rig;
       rig.turntable_phase = frames;
-      return choose_camera(rig, sc, index, w, h);
+      return choose_camera(rig, sc, index, w, h, &bounds->second);
     };
+  }
   o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
   o.identity = scene_identity(a, q, job.scene_sha256);
   o.time = q.time;

@@ -43,14 +43,17 @@ cyc() {  # out spp [seed] -> seconds
   blender -b --factory-startup -P "$root/benchmarks/cycles/render_cycles.py" -- "$scene" "$1" "$W" "$H" "$2" \
     "$THREADS" 0 "seed=${3:-0}" 2>&1 | awk '/cycles_render_seconds/ {print $2}'
 }
+efficiency() {  # rmse seconds -> 1 / (rmse^2 seconds), or - when either is missing or zero
+  awk -v e="$1" -v t="$2" 'BEGIN {if (e + 0 > 0 && t + 0 > 0) printf "%.4g", 1 / (e * e * t); else print "-"}'
+}
 row() {  # name spp seconds exr reference [reflected exr, reference]
   local e r="-" re="-"
   e=$(rmse "$4" "$5" || true)  # oiiotool --diff exits 1 when the images differ
   if [ $# -ge 7 ]; then
     r=$(rmse "$6" "$7" || true)
-    re=$(awk -v t="$3" -v e="$r" 'BEGIN {printf "%.4g", 1 / (e * e * t)}')
+    re=$(efficiency "$r" "$3")
   fi
-  echo "$1 $2 $3 $e $(awk -v t="$3" -v e="$e" 'BEGIN {printf "%.4g", 1 / (e * e * t)}') $r $re" | tee -a "$out"
+  echo "$1 $2 $3 $e $(efficiency "$e" "$3") $r $re" | tee -a "$out"
 }
 
 {

@@ -109,14 +109,20 @@ void add_punctual_lights(const Scene& scene, size_t evaluated, AreaLights& light
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
     if (l.type == LightType::Directional) continue;
-    // A moving light's strongest step steers sampling.
-    double phi = double(luminance(l.color)) * double(l.intensity);
+    // A moving light: its brightest colour and intensity over the steps (interpolated apart,
+    // their product between two steps may exceed both steps').
+    double lum = double(luminance(l.color)), intensity = double(l.intensity);
     if (i < scene.light_motion.size())
-      for (const Light& step : scene.light_motion[i])
-        phi = std::max(phi, double(luminance(step.color)) * double(step.intensity));
+      for (const Light& step : scene.light_motion[i]) {
+        lum = std::max(lum, double(luminance(step.color)));
+        intensity = std::max(intensity, double(step.intensity));
+      }
+    const double phi = 4 * lum * intensity;
+    // A light of no estimated power stays evaluated at every vertex.
+    if (!(std::isfinite(phi) && phi > 0)) continue;
     lights.punctual.push_back(uint32_t(i));
     lights.sampled[i] = 1;
-    power.push_back(std::isfinite(phi) && phi > 0 ? 4 * phi : 0.0);
+    power.push_back(phi);
   }
 }
 

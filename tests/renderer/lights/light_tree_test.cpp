@@ -202,14 +202,16 @@ TEST_CASE("light tree: point and spot lights among the entries estimate their ex
   Light sun;
   sun.type = LightType::Directional;
   s.lights.push_back(sun);
-  // At most the limit of them: every one evaluated, none an entry.
-  const AreaLights few = build_area_lights(s, 60);
+  s.lights.push_back(point_light({0, 0, 2}, 0.0f));  // no power: evaluated, never an entry
+  // At most the limit of them (61 with the dark one): every one evaluated, none an entry.
+  const AreaLights few = build_area_lights(s, 61);
   CHECK(few.punctual.empty());
   CHECK(few.sampled.empty());
   const AreaLights al = build_area_lights(s);
   REQUIRE(al.punctual.size() == 60);
-  REQUIRE(al.sampled.size() == 61);
+  REQUIRE(al.sampled.size() == 62);
   CHECK(al.sampled[60] == 0);
+  CHECK(al.sampled[61] == 0);
   CHECK(al.pmf.size() == al.triangles.size() + al.shapes.size() + 60);
   for (int point = 0; point < 4; ++point) {
     const Vec3f p{rng.next_float() * 16 - 8, rng.next_float() * 16 - 8, -0.5f}, n{0, 0, 1};
