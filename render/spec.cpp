@@ -154,8 +154,8 @@ std::vector<SpecField> make_fields() {
        0,
        {"tree", "power", "uniform"},
        "path: how an emissive triangle or shape (or a point or spot light, past eight of them) is "
-       "chosen for a light sample: tree (default; a light BVH, by importance at the shading point), "
-       "power (in proportion to power) or uniform (for tests)"},
+       "chosen for a light sample: power (default; in proportion to power), tree (a light BVH, by "
+       "importance at the shading point: for lights spread far apart) or uniform (for tests)"},
       {"light_samples",
        &S::light_samples,
        kPath,
@@ -589,9 +589,9 @@ RenderConfig make_render_config(const RenderSpec& r) {
                       : r.light_sampling == "light" ? LightStrategy::Light
                                                     : LightStrategy::Mis;
   cfg.path.energy_compensation = r.energy_compensation == "on";
-  cfg.path.light_sampler = r.light_sampler == "power"     ? LightSampler::Power
+  cfg.path.light_sampler = r.light_sampler == "tree"      ? LightSampler::Tree
                            : r.light_sampler == "uniform" ? LightSampler::Uniform
-                                                          : LightSampler::Tree;
+                                                          : LightSampler::Power;
   cfg.path.light_samples = r.light_samples;
   cfg.sampler = r.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   cfg.time_limit = r.time_limit;

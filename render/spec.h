@@ -45,7 +45,7 @@ struct RenderSpec {
   std::string light_sampling = "mis";        ///< path: mis, bsdf or light
   std::string sampler = "sobol";             ///< path: sobol or independent
   std::string energy_compensation = "on";    ///< path: on or off (multiple-scattering GGX)
-  std::string light_sampler = "tree";        ///< path: tree, power or uniform (choosing an area light)
+  std::string light_sampler = "power";       ///< path: tree, power or uniform (choosing an area light)
   int light_samples = 1;                     ///< path: lights chosen at each vertex, each with its shadow ray
   std::optional<Vec3f> env_color;            ///< path: constant environment radiance
   std::string env_map;                       ///< path: equirectangular map file

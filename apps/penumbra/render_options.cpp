@@ -77,7 +77,7 @@ void check_integrator_flags(const RenderArgs& a, RenderRequest& q) {
                                       {a.spec.light_sampling != "mis", "--light-sampling"},
                                       {a.spec.sampler != "sobol", "--sampler"},
                                       {a.spec.energy_compensation != "on", "--energy-compensation"},
-                                      {a.spec.light_sampler != "tree", "--light-sampler"},
+                                      {a.spec.light_sampler != "power", "--light-sampler"},
                                       {a.spec.light_samples != 1, "--light-samples"},
                                       {a.spec.env_intensity != 1, "--env-intensity"},
                                       {a.spec.env_rotation != 0, "--env-rotation"},

@@ -59,11 +59,11 @@ struct DirectLightingVertex {
 
 /// Which estimators run, as PathConfig's LightStrategy and hit filter set them.
 struct DirectLightingMode {
-  bool sample_lights = true;                        ///< sample emissive triangles and the environment here
-  bool bsdf_mis = true;                             ///< BSDF sampling also finds them: weight by MIS
-  bool hit_filter = true;                           ///< filtered shadow rays (visibility.h)
-  LightSampler light_sampler = LightSampler::Tree;  ///< how the area-light sample is chosen
-  int light_samples = 1;                            ///< area-light samples (>= 1), each weighted 1 / count
+  bool sample_lights = true;                         ///< sample emissive triangles and the environment here
+  bool bsdf_mis = true;                              ///< BSDF sampling also finds them: weight by MIS
+  bool hit_filter = true;                            ///< filtered shadow rays (visibility.h)
+  LightSampler light_sampler = LightSampler::Power;  ///< how the area-light sample is chosen
+  int light_samples = 1;                             ///< area-light samples (>= 1), each weighted 1 / count
 };
 
 /// Adds the direct light at v to `out`: every punctual light that is not among the sampled

@@ -87,7 +87,7 @@ AreaLights build_area_lights(const Scene& scene, size_t evaluated_punctual = kEv
 struct LightChoice {
   Vec3f p;
   Vec3f n;
-  LightSampler sampler = LightSampler::Tree;
+  LightSampler sampler = LightSampler::Power;
 };
 
 /// The probability that sample_area_light(lights, scene, choice, ...) chooses entry `entry`.

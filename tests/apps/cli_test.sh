@@ -93,7 +93,7 @@ expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --env 
 expect 2 "needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --adaptive 0.01
 expect 2 "--env-intensity needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --env-intensity 2
 expect 2 "--light-samples needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --light-samples 4
-expect 2 "--light-sampler needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --light-sampler power
+expect 2 "--light-sampler needs --integrator path" -- "$bin" render "$d" -o "$work/p.exr" --light-sampler tree
 expect 2 "--background applies to --integrator whitted" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --background 1
 expect 2 "integrator" -- "$bin" render "$d" -o "$work/p.exr" --integrator bidir
 expect 2 "unknown filter 'mitchell'" -- "$bin" render "$d" -o "$work/p.exr" --integrator path --filter mitchell

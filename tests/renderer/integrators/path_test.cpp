@@ -286,13 +286,15 @@ TEST_CASE(
   RenderConfig cfg = small_config(24, 24, 256);
   cfg.sampler = SamplerType::Independent;
   cfg.path.max_depth = 2;
+  cfg.path.light_sampler = LightSampler::Tree;
   const auto results = strategy_means(s, env, cam, cfg);
   const auto [mis, mis_err] = results[0];
   CHECK(mis > 0.05);
   check_strategies_agree(results);
-  // Light sampling finds the small shapes that BSDF sampling rarely hits: less noise.
+  // Light sampling through the tree finds the small shapes that BSDF sampling rarely hits:
+  // less noise.
   CHECK(results[2].second < results[1].second);
-  // The light tree (the default above), the power table and uniform choice agree.
+  // The light tree (above), the power table and uniform choice agree.
   cfg.path.strategy = LightStrategy::Mis;
   for (LightSampler sampler : {LightSampler::Power, LightSampler::Uniform}) {
     cfg.path.light_sampler = sampler;

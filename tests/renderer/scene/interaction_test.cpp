@@ -113,3 +113,49 @@ TEST_CASE("interaction: a flat mirror reflects the differential rays exactly", "
   CHECK(out.rx_org.y == Approx(rx.org.y + rx.dir.y * tx).margin(1e-5));
   CHECK_FALSE(reflect_differential(si, RayDifferential{}, wo, n, wi).valid);
 }
+
+TEST_CASE(
+    "interaction: the approximate differential of a point matches the footprint of the pixel that sees it",
+    "[interaction][quick]") {
+  const Scene s = uv_quad();
+  const float d = 4, fov = 0.5f;
+  const Camera cam = look_at({0, 0, d}, {0, 0, 0}, {0, 1, 0}, fov);
+  const int w = 200, h = 200;
+  auto pixel_rd = [&](float px, float py) {
+    const Ray rx = generate_camera_ray(cam, w, h, px + 1, py),
+              ry = generate_camera_ray(cam, w, h, px, py + 1);
+    return RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
+  };
+  const Ray centre = generate_camera_ray(cam, w, h, 100, 100);
+  const RayDifferential centre_rd = pixel_rd(100, 100);
+  // A point seen through another pixel: the approximation (the centre pixel's differentials
+  // turned towards it) against that pixel's own differentials.
+  const float px = 140, py = 75;
+  const Ray seen = generate_camera_ray(cam, w, h, px, py);
+  SurfaceInteraction exact = make_interaction(s, seen, hit_quad(s, seen));
+  SurfaceInteraction approx = exact;
+  compute_differentials(s, exact, pixel_rd(px, py));
+  const RayDifferential turned = approximate_differential(centre, centre_rd, exact.p);
+  REQUIRE(turned.valid);
+  compute_differentials(s, approx, turned);
+  // The off-axis pixel's solid angle is smaller by cos^3 of its angle (here within 3%).
+  CHECK(length(approx.dpdx) == Approx(length(exact.dpdx)).epsilon(0.03));
+  CHECK(length(approx.dpdy) == Approx(length(exact.dpdy)).epsilon(0.03));
+  CHECK(approx.duvdx[0].x == Approx(exact.duvdx[0].x).epsilon(0.03));
+  CHECK(approx.duvdy[0].y == Approx(exact.duvdy[0].y).epsilon(0.03));
+  CHECK(dot(normalize(approx.dpdx), normalize(exact.dpdx)) > 0.999f);
+  // On the camera ray itself the turn is the identity.
+  const RayDifferential same = approximate_differential(centre, centre_rd, centre.org + centre.dir * 3.0f);
+  CHECK(same.rx_dir.x == Approx(centre_rd.rx_dir.x).margin(1e-6));
+  CHECK(same.ry_dir.y == Approx(centre_rd.ry_dir.y).margin(1e-6));
+  CHECK(same.rx_org.z == Approx(centre_rd.rx_org.z).margin(1e-6));
+  // A point twice as far has a footprint twice as wide.
+  SurfaceInteraction far = make_interaction(s, seen, hit_quad(s, seen));
+  far.p = exact.p + (exact.p - centre.org);
+  compute_differentials(s, far, approximate_differential(centre, centre_rd, far.p));
+  CHECK(length(far.dpdx) == Approx(2 * length(approx.dpdx)).epsilon(1e-3));
+  // Behind the camera, at its origin, or without differentials: none.
+  CHECK_FALSE(approximate_differential(centre, centre_rd, centre.org - centre.dir).valid);
+  CHECK_FALSE(approximate_differential(centre, centre_rd, centre.org).valid);
+  CHECK_FALSE(approximate_differential(centre, RayDifferential{}, exact.p).valid);
+}
