@@ -180,7 +180,6 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
   Segment seg;
   seg.ray = camera_ray;
   seg.ray.dir = normalize(seg.ray.dir);
-  RayDifferential camera_rd;  // made on the first hit that reads a texture footprint
 
   for (int vertex = 0;;) {
     Hit hit;
@@ -190,14 +189,9 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     }
     if (max_component(seg.sigma_a) > 0) seg.beta *= beer_lambert(seg.sigma_a, hit.t - seg.ray.tnear);
     SurfaceInteraction si = make_interaction(scene, seg.ray, hit);
-    if ((vertex > 0 || seg.layers == 0) && rd.make &&
-        material_reads_footprint(material_of(scene, si.material))) {
-      // The first hit's footprint from the camera ray's differentials; later hits' as if the
-      // camera saw them directly (coarser texture levels, fewer cache misses, less noise).
-      if (!camera_rd.valid) camera_rd = rd.make(rd.ctx);
-      compute_differentials(scene, si,
-                            vertex == 0 ? camera_rd : approximate_differential(camera_ray, camera_rd, si.p));
-    }
+    if (vertex == 0 && seg.layers == 0 && rd.make &&
+        material_reads_footprint(material_of(scene, si.material)))
+      compute_differentials(scene, si, rd.make(rd.ctx));
     const MaterialPoint mp = eval_material(scene, si, false);  // occlusion is ambient-only
 
     // Blend: hit with probability alpha, else continue along the same ray.

@@ -50,7 +50,7 @@ struct PathConfig {
                           ///< MIS weights of BSDF samples that hit an emitter count all of them
 };
 
-/// A camera ray's differentials, made on demand: only a hit whose material reads texture
+/// A camera ray's differentials, made on demand: only a first hit whose material reads texture
 /// footprints asks for them. make(ctx) returns them; make == nullptr: none (finest level).
 struct LazyDifferential {
   RayDifferential (*make)(const void* ctx) = nullptr;
@@ -59,10 +59,10 @@ struct LazyDifferential {
 
 /// Radiance along a camera ray (counted as one camera ray; bounce rays are counted as
 /// `reflection`, shadow rays as `shadow`). `rd` gives texture footprints at the first hit
-/// (may be invalid), and at later hits as the camera would see them (approximate_differential). `coverage` is
-/// 1 if the path hit a surface, 0 if the camera ray escaped (then the environment is returned). Draws its
-/// random numbers from `samples`. Non-finite contributions are dropped. With `groups`, also adds each
-/// contribution to its light group. Thread-safe; never allocates, throws or logs.
+/// (may be invalid). `coverage` is 1 if the path hit a surface, 0 if the camera ray escaped
+/// (then the environment is returned). Draws its random numbers from `samples`.
+/// Non-finite contributions are dropped. With `groups`, also adds each contribution to its
+/// light group. Thread-safe; never allocates, throws or logs.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
                     SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);

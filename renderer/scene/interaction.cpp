@@ -195,21 +195,6 @@ void compute_differentials(const Scene& scene, SurfaceInteraction& si, const Ray
   barycentric_derivatives(scene, si, solve(dpdx), solve(dpdy));
 }
 
-RayDifferential approximate_differential(const Ray& camera_ray, const RayDifferential& rd, Vec3f p) {
-  if (!rd.valid) return {};
-  const Vec3f o = camera_ray.org;
-  const float len_a = length(camera_ray.dir), len_b = length(p - o);
-  if (!(len_a > 0) || !(len_b > 0) || !std::isfinite(len_a * len_b)) return {};
-  const Vec3f a = camera_ray.dir / len_a, b = (p - o) / len_b;
-  // Rotation taking a to b: x c + v x x + v (v . x) / (1 + c) with v = a x b, c = a . b.
-  const Vec3f v = cross(a, b);
-  const float c = dot(a, b);
-  if (!(c > -0.99f)) return {};
-  const float k = 1.0f / (1.0f + c);
-  const auto turn = [&](Vec3f x) { return x * c + cross(v, x) + v * (dot(v, x) * k); };
-  return {true, o + turn(rd.rx_org - o), turn(rd.rx_dir), o + turn(rd.ry_org - o), turn(rd.ry_dir)};
-}
-
 namespace {
 void barycentric_derivatives(const Scene& scene, SurfaceInteraction& si, Vec2f bx, Vec2f by) {
   Instance posed;

@@ -63,16 +63,6 @@ Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit);
 /// them zero when rd is not valid or the plane is parallel to an auxiliary ray.
 void compute_differentials(const Scene& scene, SurfaceInteraction& si, const RayDifferential& rd);
 
-/// Differentials for a point `p` that a path reaches after its first bounce, as if the camera
-/// saw `p` directly (pbrt-v4's Camera::Approximate_dp_dxy): `rd`, the differentials of camera
-/// ray `camera_ray`, turned about the ray's origin by the rotation that takes its direction to
-/// the direction from that origin to `p`. Their footprint at `p` is then the camera's footprint
-/// at that distance, so that texture lookups past the first bounce read a level as coarse as a
-/// directly seen surface at that distance would. Invalid if rd is invalid, or `p` lies behind
-/// the ray's origin within about 8 degrees of the opposite direction (where the turn is
-/// ill-conditioned) or on it.
-RayDifferential approximate_differential(const Ray& camera_ray, const RayDifferential& rd, Vec3f p);
-
 /// Fills a triangle hit's derivatives from the screen-space derivatives of its barycentrics
 /// (u, v) over one differential step in x (bx) and in y (by), as a rasteriser knows them:
 /// dp = e1 du + e2 dv on the world triangle, and the UVs' and normal's derivatives likewise.
