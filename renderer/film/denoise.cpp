@@ -74,34 +74,56 @@ Plane half_variance(const Plane& a, const Plane& b, float scale, int tile_size, 
 // tile (row-major), n = tile pixels; 0 where the neighbour lies outside the image.
 class NlmWeights {
  public:
+  /// Keeps planar copies of guide and variance padded by R + F pixels (the border replicated),
+  /// so the distance loops read contiguous rows.
   NlmWeights(const Plane& guide, const Plane& var, int radius, int patch, float k)
-      : m_guide(guide), m_var(var), m_r(radius), m_f(patch), m_k2(k * k) {}
+      : m_w(guide.w),
+        m_h(guide.h),
+        m_c(guide.c),
+        m_r(radius),
+        m_f(patch),
+        m_pad(radius + patch),
+        m_k2(k * k) {
+    m_pw = m_w + 2 * m_pad;
+    m_ph = m_h + 2 * m_pad;
+    const size_t plane = size_t(m_pw) * size_t(m_ph);
+    m_guide.resize(plane * size_t(m_c));
+    m_var.resize(plane * size_t(m_c));
+    for (int ch = 0; ch < m_c; ++ch)
+      for (int y = 0; y < m_ph; ++y)
+        for (int x = 0; x < m_pw; ++x) {
+          const size_t o = size_t(ch) * plane + size_t(y) * size_t(m_pw) + size_t(x);
+          m_guide[o] = guide.clamped(x - m_pad, y - m_pad)[ch];
+          m_var[o] = var.clamped(x - m_pad, y - m_pad)[ch];
+        }
+  }
   int offsets() const { return (2 * m_r + 1) * (2 * m_r + 1); }
   int radius() const { return m_r; }
 
   void compute(const PixelWindow& t, std::vector<float>& weights, std::vector<float>& scratch) const {
     const int tw = t.width(), th = t.height(), pw = tw + 2 * m_f, ph = th + 2 * m_f;
-    const size_t n = size_t(tw) * size_t(th);
+    const size_t n = size_t(tw) * size_t(th), plane = size_t(m_pw) * size_t(m_ph);
     weights.assign(size_t(offsets()) * n, 0.0f);
     scratch.assign(size_t(pw) * size_t(ph) + size_t(tw) * size_t(ph), 0.0f);
     float* dist = scratch.data();                  // per-pixel distance over the padded tile
     float* rows = dist + size_t(pw) * size_t(ph);  // horizontal box sums
-    const float inv_patch = 1.0f / float((2 * m_f + 1) * (2 * m_f + 1));
-    const int c = m_guide.c;
+    const float inv_patch = 1.0f / float((2 * m_f + 1) * (2 * m_f + 1)), inv_c = 1.0f / float(m_c);
     for (int dy = -m_r; dy <= m_r; ++dy)
       for (int dx = -m_r; dx <= m_r; ++dx) {
-        for (int y = 0; y < ph; ++y)
-          for (int x = 0; x < pw; ++x) {
-            const int px = t.x0 + x - m_f, py = t.y0 + y - m_f;
-            const float *g0 = m_guide.clamped(px, py), *g1 = m_guide.clamped(px + dx, py + dy);
-            const float *v0 = m_var.clamped(px, py), *v1 = m_var.clamped(px + dx, py + dy);
-            float sum = 0;
-            for (int ch = 0; ch < c; ++ch) {
-              const float diff = g0[ch] - g1[ch];
-              const float num = diff * diff - (v0[ch] + std::min(v0[ch], v1[ch]));
-              sum += num / (1e-10f + m_k2 * (v0[ch] + v1[ch]));
+        std::fill(dist, dist + size_t(pw) * size_t(ph), 0.0f);
+        for (int ch = 0; ch < m_c; ++ch)
+          for (int y = 0; y < ph; ++y) {
+            // Padded-plane row of the tile's row y - F, and of its neighbours at (dx, dy).
+            const size_t r0 = size_t(ch) * plane + size_t(t.y0 + y - m_f + m_pad) * size_t(m_pw) +
+                              size_t(t.x0 - m_f + m_pad);
+            const size_t r1 = r0 + size_t(ptrdiff_t(dy) * m_pw + dx);
+            const float *g0 = &m_guide[r0], *g1 = &m_guide[r1], *v0 = &m_var[r0], *v1 = &m_var[r1];
+            float* d = dist + size_t(y) * size_t(pw);
+            for (int x = 0; x < pw; ++x) {
+              const float diff = g0[x] - g1[x];
+              const float num = diff * diff - (v0[x] + std::min(v0[x], v1[x]));
+              d[x] += num / (1e-10f + m_k2 * (v0[x] + v1[x]));
             }
-            dist[size_t(y) * size_t(pw) + size_t(x)] = sum / float(c);
           }
         for (int y = 0; y < ph; ++y)
           for (int x = 0; x < tw; ++x) {
@@ -113,19 +135,18 @@ class NlmWeights {
         for (int y = 0; y < th; ++y)
           for (int x = 0; x < tw; ++x) {
             const int qx = t.x0 + x + dx, qy = t.y0 + y + dy;
-            if (qx < 0 || qy < 0 || qx >= m_guide.w || qy >= m_guide.h) continue;
+            if (qx < 0 || qy < 0 || qx >= m_w || qy >= m_h) continue;
             float s = 0;
             for (int i = 0; i <= 2 * m_f; ++i) s += rows[size_t(y + i) * size_t(tw) + size_t(x)];
-            w[size_t(y) * size_t(tw) + size_t(x)] = std::exp(-std::max(0.0f, s * inv_patch));
+            w[size_t(y) * size_t(tw) + size_t(x)] = std::exp(-std::max(0.0f, s * inv_c * inv_patch));
           }
       }
   }
 
  private:
-  const Plane& m_guide;
-  const Plane& m_var;
-  int m_r, m_f;
+  int m_w, m_h, m_c, m_r, m_f, m_pad, m_pw = 0, m_ph = 0;
   float m_k2;
+  std::vector<float> m_guide, m_var;  // planar, padded
 };
 
 // Non-local means: each pixel the weighted mean of `image` over its window, weighted by
@@ -196,23 +217,29 @@ bool solve_spd(double a[kDims][kDims], double b[kDims][3]) {
 // False when nothing in the window has weight (then the pixel keeps its own colour).
 bool fit_pixel(const Plane& color, const Plane& feat, const float* w, size_t n, size_t i, int x, int y, int r,
                double beta[kDims][3]) {
-  double a[kDims][kDims] = {}, b[kDims][3] = {};
+  // Sums in float (the rows are differences from the centre, of order one), solved in double.
+  float af[kDims][kDims] = {}, bf[kDims][3] = {};
   const float* fc = feat.at(x, y);
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx) {
-      const double wj = w[size_t((dy + r) * (2 * r + 1) + dx + r) * n + i];
+      const float wj = w[size_t((dy + r) * (2 * r + 1) + dx + r) * n + i];
       if (wj <= 0) continue;
-      double row[kDims];
+      float row[kDims];
       row[0] = 1;
       const float* fj = feat.at(x + dx, y + dy);
-      for (int k = 0; k < kDenoiseFeatures; ++k) row[k + 1] = double(fj[k]) - fc[k];
+      for (int k = 0; k < kDenoiseFeatures; ++k) row[k + 1] = fj[k] - fc[k];
       const float* cj = color.at(x + dx, y + dy);
       for (int p = 0; p < kDims; ++p) {
-        const double wr = wj * row[p];
-        for (int q = 0; q <= p; ++q) a[p][q] += wr * row[q];
-        for (int c = 0; c < 3; ++c) b[p][c] += wr * cj[c];
+        const float wr = wj * row[p];
+        for (int q = 0; q < kDims; ++q) af[p][q] += wr * row[q];
+        for (int c = 0; c < 3; ++c) bf[p][c] += wr * cj[c];
       }
     }
+  double a[kDims][kDims], b[kDims][3];
+  for (int p = 0; p < kDims; ++p) {
+    for (int q = 0; q < kDims; ++q) a[p][q] = af[p][q];
+    for (int c = 0; c < 3; ++c) b[p][c] = bf[p][c];
+  }
   if (!(a[0][0] > 0)) return false;
   double s[kDims];
   s[0] = 1;
@@ -250,8 +277,11 @@ Plane regression(const Plane& color, const Plane& feat, const NlmWeights& weight
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
           const size_t i = size_t(y - t.y0) * size_t(t.width()) + size_t(x - t.x0);
-          double beta[kDims][3];
-          if (!fit_pixel(color, feat, wts.data(), n, i, x, y, r, beta)) continue;
+          double beta_d[kDims][3];
+          if (!fit_pixel(color, feat, wts.data(), n, i, x, y, r, beta_d)) continue;
+          float beta[kDims][3];
+          for (int p = 0; p < kDims; ++p)
+            for (int c = 0; c < 3; ++c) beta[p][c] = float(beta_d[p][c]);
           const float* fc = feat.at(x, y);
           for (int dy = -r; dy <= r; ++dy)
             for (int dx = -r; dx <= r; ++dx) {
@@ -259,10 +289,12 @@ Plane regression(const Plane& color, const Plane& feat, const NlmWeights& weight
               if (wj <= 0) continue;
               const float* fj = feat.at(x + dx, y + dy);
               float* o = &buf[(size_t(y - t.y0 + r + dy) * size_t(bw) + size_t(x - t.x0 + r + dx)) * 4];
+              float d[kDenoiseFeatures];
+              for (int k = 0; k < kDenoiseFeatures; ++k) d[k] = fj[k] - fc[k];
               for (int c = 0; c < 3; ++c) {
-                double e = beta[0][c];
-                for (int k = 0; k < kDenoiseFeatures; ++k) e += beta[k + 1][c] * (double(fj[k]) - fc[k]);
-                o[c] += wj * float(e);
+                float e = beta[0][c];
+                for (int k = 0; k < kDenoiseFeatures; ++k) e += beta[k + 1][c] * d[k];
+                o[c] += wj * e;
               }
               o[3] += wj;
             }
