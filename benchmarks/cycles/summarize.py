@@ -40,6 +40,8 @@ def time_to(points, target):
     """Seconds to reach RMSE `target` on the log-log line through the two (seconds, rmse)
     points whose RMSEs bracket it (else the two nearest)."""
     pts = sorted(points, key=lambda p: -p[1])  # falling RMSE
+    if len(pts) < 2:
+        return float("nan")
     i = 0
     while i + 2 < len(pts) and pts[i + 1][1] > target:
         i += 1
@@ -74,7 +76,11 @@ for scene in order:
         mp = pixels * (n - 1) / (p[n][0] - p[1][0]) / 1e6 if p[n][0] > p[1][0] else float("nan")
         mc = pixels * (n - 1) / (c[n][0] - c[1][0]) / 1e6 if c[n][0] > c[1][0] else float("nan")
         cells.append(f"{fmt(mp)} / {fmt(mc)} = **{fmt(mp / mc)}×**")
-    n = spps[-1]
+    common = [k for k in p if k in c and k > 1]
+    if not common:
+        print("| " + " | ".join(cells + ["–"] * 4) + " |")
+        continue
+    n = max(common)
     tp, tc = pixels * n / p[n][0] / 1e6, pixels * n / c[n][0] / 1e6
     cells.append(f"{fmt(tp)} / {fmt(tc)} = {fmt(tp / tc)}×")
     ep, ec = p[n][1], c[n][1]

@@ -2,6 +2,7 @@
 #include "renderer/film/denoise.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 
@@ -339,6 +340,68 @@ Plane mean_variance(const Plane& a, const Plane& b) {
   return m;
 }
 
+// The channels [first, first + count) of a plane.
+Plane channels(const Plane& p, int first, int count) {
+  Plane out(p.w, p.h, count);
+  for (size_t i = 0; i < size_t(p.w) * size_t(p.h); ++i)
+    for (int c = 0; c < count; ++c)
+      out.v[i * size_t(count) + size_t(c)] = p.v[i * size_t(p.c) + size_t(first + c)];
+  return out;
+}
+
+// Non-local means of the features one group at a time (albedo, normal, depth), each group
+// weighted by its own guide channels and variance (NFOR section 5.1), so that a feature
+// without noise (variance 0) does not stop the filtering of a noisy one.
+Plane filter_features(const Plane& image, const Plane& guide, const Plane& var, int radius, int patch,
+                      float k, int tile_size, int threads) {
+  constexpr int kGroups[3][2] = {{0, 3}, {3, 3}, {6, 1}};  // first channel, count
+  Plane out(image.w, image.h, image.c);
+  for (const auto& [first, count] : kGroups) {
+    const Plane g = channels(guide, first, count), v = channels(var, first, count);
+    const Plane f =
+        nl_means(channels(image, first, count), NlmWeights(g, v, radius, patch, k), tile_size, threads);
+    for (size_t i = 0; i < size_t(image.w) * size_t(image.h); ++i)
+      for (int c = 0; c < count; ++c)
+        out.v[i * size_t(image.c) + size_t(first + c)] = f.v[i * size_t(count) + size_t(c)];
+  }
+  return out;
+}
+
+// NFOR sections 5.2-5.3: each colour half regressed on the other half's features, guided by
+// the other half, at both bandwidths; each candidate's error estimated against the other half
+// and smoothed; per pixel, the halves at the bandwidth of lower error (a smoothed selection).
+std::array<Plane, 2> selected_halves(const Plane color[2], const Plane feat[2], const DenoiseConfig& cfg) {
+  const int w = color[0].w, h = color[0].h, ts = cfg.tile_size, th = cfg.threads;
+  const Plane var_half = half_variance(color[0], color[1], 1.0f, ts, th);
+  const Plane mean = mean_of(color[0], color[1]);
+  Plane mean_var = var_half;
+  for (float& v : mean_var.v) v *= 0.5f;
+  Plane cand[2][2], mse[2];
+  for (int b = 0; b < 2; ++b) {
+    for (int s = 0; s < 2; ++s)
+      cand[b][s] = regression(
+          color[s], feat[1 - s],
+          NlmWeights(color[1 - s], var_half, cfg.window_radius, cfg.patch_radius, cfg.bandwidths[b]), ts, th);
+    Plane noisy(w, h, 3);
+    for (size_t i = 0; i < noisy.v.size(); ++i) {
+      const float ea = (color[1].v[i] - cand[b][0].v[i]) * (color[1].v[i] - cand[b][0].v[i]) - var_half.v[i];
+      const float eb = (color[0].v[i] - cand[b][1].v[i]) * (color[0].v[i] - cand[b][1].v[i]) - var_half.v[i];
+      const float residual =
+          0.25f * (cand[b][1].v[i] - cand[b][0].v[i]) * (cand[b][1].v[i] - cand[b][0].v[i]);
+      noisy.v[i] = 0.5f * (ea + eb) - residual;
+    }
+    mse[b] = nl_means(noisy, NlmWeights(mean, mean_var, cfg.window_radius, 1, 1.0f), ts, th);
+  }
+  Plane select(w, h, 3);
+  for (size_t i = 0; i < select.v.size(); ++i) select.v[i] = mse[0].v[i] < mse[1].v[i] ? 0.0f : 1.0f;
+  select = nl_means(select, NlmWeights(mean, mean_var, cfg.window_radius, 1, 1.0f), ts, th);
+  std::array<Plane, 2> result = {Plane(w, h, 3), Plane(w, h, 3)};
+  for (int s = 0; s < 2; ++s)
+    for (size_t i = 0; i < select.v.size(); ++i)
+      result[size_t(s)].v[i] = cand[0][s].v[i] + select.v[i] * (cand[1][s].v[i] - cand[0][s].v[i]);
+  return result;
+}
+
 }  // namespace
 
 const char* validate(const DenoiseConfig& c) {
@@ -366,16 +429,21 @@ const char* validate(const DenoiseInput& in) {
 }
 
 size_t denoise_bytes(int width, int height, const DenoiseConfig& c) {
-  // Planes alive at once (floats per pixel): the inputs as planes (20), colour variance (3),
-  // filtered features and their variance (21), the four candidate colours (12), two MSE maps
-  // (6) and one being filtered (3); the regression's double accumulators (4 doubles = 8).
-  const size_t per_pixel = (20 + 3 + 21 + 12 + 9 + 8) * sizeof(float);
-  const size_t r = size_t(c.window_radius), t = size_t(c.tile_size), f = size_t(c.patch_radius);
+  // The peak, in floats per pixel, is in the regressions of steps 2-3: the inputs as planes
+  // (20), the colour variance, the halves' mean and its variance (9), the four candidate
+  // colours (12), an error map being filtered and the two filtered ones (9), a regression's
+  // output (3) and double accumulators (8); step 4 holds less (the inputs, the two selected
+  // halves and about 40 more). Weights keep padded copies of at most 3 guide and 3 variance
+  // channels, and every thread a tile of weights.
+  const size_t pixels = size_t(width) * size_t(height);
+  const size_t r = size_t(std::max(c.window_radius, c.feature_window_radius)), t = size_t(c.tile_size),
+               f = size_t(c.patch_radius), pad = r + f;
+  const size_t padded = 6 * (size_t(width) + 2 * pad) * (size_t(height) + 2 * pad);
   const size_t tiles_x = (size_t(width) + t - 1) / t;
   const size_t tile_weights = (2 * r + 1) * (2 * r + 1) * t * t + 2 * (t + 2 * f) * (t + 2 * f);
   const size_t row_buffers = tiles_x * (t + 2 * r) * (t + 2 * r) * 4;
-  return size_t(width) * size_t(height) * per_pixel +
-         (size_t(thread_count(c.threads)) * tile_weights + row_buffers) * sizeof(float);
+  return (pixels * 61 + padded + size_t(thread_count(c.threads)) * tile_weights + row_buffers) *
+         sizeof(float);
 }
 
 std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg) {
@@ -383,64 +451,34 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
   const Plane color[2] = {finite_plane(in.color[0], w, h, 3), finite_plane(in.color[1], w, h, 3)};
   Plane feat[2];
   fill_missing_depth(in, feat);
-  const Plane var_half = half_variance(color[0], color[1], 1.0f, ts, th);
 
   // 1. Feature prefiltering: each half with weights from the other.
   if (cfg.feature_window_radius > 0) {
     const Plane fvar = half_variance(feat[0], feat[1], 1.0f, ts, th);
     Plane filtered[2];
     for (int s = 0; s < 2; ++s)
-      filtered[s] = nl_means(
-          feat[s],
-          NlmWeights(feat[1 - s], fvar, cfg.feature_window_radius, cfg.patch_radius, cfg.feature_bandwidth),
-          ts, th);
+      filtered[s] = filter_features(feat[s], feat[1 - s], fvar, cfg.feature_window_radius, cfg.patch_radius,
+                                    cfg.feature_bandwidth, ts, th);
     feat[0] = std::move(filtered[0]);
     feat[1] = std::move(filtered[1]);
   }
 
-  // 2. Collaborative regression of each half, guided by the other half, at both bandwidths;
-  // 3. each candidate's error estimated against the other half and smoothed.
-  const Plane mean = mean_of(color[0], color[1]);
-  Plane mean_var = var_half;
-  for (float& v : mean_var.v) v *= 0.5f;
-  Plane cand[2][2], mse[2];
-  for (int b = 0; b < 2; ++b) {
-    for (int s = 0; s < 2; ++s)
-      cand[b][s] = regression(
-          color[s], feat[1 - s],
-          NlmWeights(color[1 - s], var_half, cfg.window_radius, cfg.patch_radius, cfg.bandwidths[b]), ts, th);
-    Plane noisy(w, h, 3);
-    for (size_t i = 0; i < noisy.v.size(); ++i) {
-      const float ea = (color[1].v[i] - cand[b][0].v[i]) * (color[1].v[i] - cand[b][0].v[i]) - var_half.v[i];
-      const float eb = (color[0].v[i] - cand[b][1].v[i]) * (color[0].v[i] - cand[b][1].v[i]) - var_half.v[i];
-      const float residual =
-          0.25f * (cand[b][1].v[i] - cand[b][0].v[i]) * (cand[b][1].v[i] - cand[b][0].v[i]);
-      noisy.v[i] = 0.5f * (ea + eb) - residual;
-    }
-    mse[b] = nl_means(noisy, NlmWeights(mean, mean_var, cfg.window_radius, 1, 1.0f), ts, th);
-  }
-  Plane select(w, h, 3);
-  for (size_t i = 0; i < select.v.size(); ++i) select.v[i] = mse[0].v[i] < mse[1].v[i] ? 0.0f : 1.0f;
-  select = nl_means(select, NlmWeights(mean, mean_var, cfg.window_radius, 1, 1.0f), ts, th);
-  Plane result[2] = {Plane(w, h, 3), Plane(w, h, 3)};
-  for (int s = 0; s < 2; ++s)
-    for (size_t i = 0; i < select.v.size(); ++i)
-      result[s].v[i] = cand[0][s].v[i] + select.v[i] * (cand[1][s].v[i] - cand[0][s].v[i]);
+  // 2.-3. The two halves, each regressed at the bandwidth selected per pixel.
+  const std::array<Plane, 2> result = selected_halves(color, feat, cfg);
 
   // 4. The second pass: the selected halves' mean regressed on the halves' mean features.
   const Plane combined = mean_of(result[0], result[1]);
   if (!cfg.second_pass) return combined.v;
   const Plane combined_var = mean_variance(result[0], result[1]);
   const Plane feat_mean = mean_of(feat[0], feat[1]), feat_var = mean_variance(feat[0], feat[1]);
-  const Plane final_feat =
-      nl_means(feat_mean, NlmWeights(feat_mean, feat_var, 2, cfg.patch_radius, 0.5f), ts, th);
+  const Plane final_feat = filter_features(feat_mean, feat_mean, feat_var, 2, cfg.patch_radius, 0.5f, ts, th);
   return regression(combined, final_feat,
                     NlmWeights(combined, combined_var, cfg.window_radius, cfg.patch_radius, 1.0f), ts, th)
       .v;
 }
 
-std::vector<float> denoise_cross_bilateral(const DenoiseInput& in, int r, int threads) {
-  const int w = in.width, h = in.height;
+std::vector<float> denoise_cross_bilateral(const DenoiseInput& in, int window_radius, int threads) {
+  const int w = in.width, h = in.height, r = std::max(1, window_radius);
   const Plane color = mean_of(finite_plane(in.color[0], w, h, 3), finite_plane(in.color[1], w, h, 3));
   Plane feat[2];
   fill_missing_depth(in, feat);

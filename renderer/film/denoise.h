@@ -4,8 +4,9 @@
 #pragma once
 
 // NFOR in four steps, each a pass over the image in tiles:
-//   1. Feature prefiltering: each half of each feature (albedo, normal, depth) filtered by
-//      non-local means (Buades et al. 2005) with weights from the other half, so that noisy
+//   1. Feature prefiltering: each half of each feature (albedo, normal, depth, one group at a
+//      time) filtered by non-local means (Buades et al. 2005) with weights from the other
+//      half's same group, so that noisy
 //      features (depth of field, motion blur, antialiased edges) do not carry noise into the
 //      regression.
 //   2. Collaborative first-order regression: for every pixel c, a weighted least-squares fit of
@@ -61,15 +62,16 @@ const char* validate(const DenoiseConfig& config);
 const char* validate(const DenoiseInput& input);
 
 /// The denoised colour (3 floats per pixel) of a valid input under a valid config. Never
-/// throws for valid input; allocates about (24 + 4 kDenoiseFeatures) floats per pixel plus
-/// per-thread tile buffers (denoise_bytes).
+/// throws for valid input; allocates about 61 floats per pixel, padded copies of the weights'
+/// guides and per-thread tile buffers (denoise_bytes).
 std::vector<float> denoise_nfor(const DenoiseInput& input, const DenoiseConfig& config);
 
 /// Bytes denoise_nfor allocates at most for an image of width x height.
 size_t denoise_bytes(int width, int height, const DenoiseConfig& config);
 
 /// The cross-bilateral baseline: each pixel the weighted mean of the halves' mean colour over
-/// a (2R+1)^2 window, with Gaussian weights in pixel distance (sigma R/2) and in each feature's
+/// a (2R+1)^2 window (R below 1 is read as 1), with Gaussian weights in pixel distance (sigma
+/// max(1, R/2)) and in each feature's
 /// difference (albedo 0.1, normal 0.2, depth 2% of the pixel's depth). Same input and output.
 std::vector<float> denoise_cross_bilateral(const DenoiseInput& input, int window_radius, int threads);
 

@@ -75,12 +75,19 @@ TEST_CASE("denoise: a noisy constant keeps its mean and loses most of its varian
   const float sigma = 0.2f;
   const DenoiseInput in = make_halves(w, h, sigma, 7, [](int, int) { return grey(0.5f); });
   const double input_mean = 0.5 * (mean_of(in.color[0], 1) + mean_of(in.color[1], 1));
-  // Cross-bilateral with constant features is a Gaussian of sigma R/2 in pixels: the variance
-  // of the halves' mean (sigma^2 / 2) times sum w^2 / (sum w)^2 = 1 / (4 pi (R/2)^2) away from
-  // the border (truncation at R makes it slightly larger).
+  // Cross-bilateral with constant features is a Gaussian of sigma R/2 in pixels truncated to
+  // the (2R+1)^2 window: away from the border, the variance of the halves' mean (sigma^2 / 2)
+  // times sum w^2 / (sum w)^2 over the window.
   const int r = 6;
   const std::vector<float> cb = denoise_cross_bilateral(in, r, 2);
-  const double s_p = r / 2.0, predicted = sigma * sigma / 2 / (4 * M_PI * s_p * s_p);
+  double sw = 0, sw2 = 0;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const double wq = std::exp(-double(dx * dx + dy * dy) / (2 * (r / 2.0) * (r / 2.0)));
+      sw += wq;
+      sw2 += wq * wq;
+    }
+  const double predicted = sigma * sigma / 2 * sw2 / (sw * sw);
   double var = 0;
   int n = 0;
   for (int y = r; y < h - r; ++y)
