@@ -43,7 +43,8 @@ const fs::path& work_dir() {
   return d;
 }
 
-// A consistent w x h state after `reached` samples, every other pixel stopped at 2.
+// A consistent w x h state after `reached` samples, every other pixel stopped at 2; `groups`
+// adds light-group and odd-sample sums.
 penumbra::PathAccumulators seed_state(int w, int h, uint32_t reached, bool groups) {
   penumbra::PathAccumulators st;
   st.window = {1, 2, 1 + w, 2 + h};
@@ -58,6 +59,9 @@ penumbra::PathAccumulators seed_state(int w, int h, uint32_t reached, bool group
     p.sum_y2 = 0.25 * p.n;
   }
   if (groups) st.groups.assign(st.pixels.size() * penumbra::kLightGroupChannels, 0.125);
+  if (groups)  // with the odd samples' sums too: a quarter of the colour and coverage
+    for (const auto& p : st.pixels)
+      for (int c = 0; c < 4; ++c) st.odd.push_back(p.rgba[c] / 4);
   st.reached = reached;
   st.passes = 3;
   return st;

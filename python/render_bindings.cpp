@@ -9,12 +9,16 @@
 #include <algorithm>
 #include <cctype>
 #include <climits>
+#include <cmath>
 #include <map>
 #include <string>
 #include <type_traits>
 #include <variant>
 
+#include "io/files/atomic_file.h"
+#include "io/image/exr_denoise.h"
 #include "python/bindings.h"
+#include "renderer/film/denoise.h"
 #include "renderer/integrators/light_groups.h"
 
 namespace penumbra::python {
@@ -148,6 +152,15 @@ py::dict aov_dict(const py::object& self) {
     out["vector"] = view(self, r.vector.data(), h, w, kMotionVectorChannels, kMotionVectorChannels);
   if (r.aovs.count("velocity"))
     out["velocity"] = view(self, r.velocity.data(), h, w, kVelocityChannels, kVelocityChannels);
+  if (r.aovs.count("halves") && !r.halves.empty() && !d.halves.empty())
+    for (int half = 0; half < 2; ++half) {
+      const std::string name = half ? "odd" : "even";
+      const float* f = d.halves.data() + half * kDenoiseFeatures;
+      out[py::str(name)] = view(self, r.halves.data() + 3 * half, h, w, 3, kHalfChannels);
+      out[py::str(name + "_albedo")] = view(self, f, h, w, 3, 2 * kDenoiseFeatures);
+      out[py::str(name + "_N")] = view(self, f + 3, h, w, 3, 2 * kDenoiseFeatures);
+      out[py::str(name + "_Z")] = view(self, f + 6, h, w, 1, 2 * kDenoiseFeatures);
+    }
   return out;
 }
 
@@ -318,7 +331,8 @@ void bind_result(py::module_& m) {
             const RenderOutput& r = self.cast<const RenderOutput&>();
             return view(self, r.film.rgba.data(), r.film.height, r.film.width, 4, 4);
           },
-          "float32 (height, width, 4): scene-linear RGBA, colour premultiplied by alpha (coverage)")
+          "float32 (height, width, 4): scene-linear RGBA, colour premultiplied by alpha (coverage); with "
+          "denoise=True the denoised beauty (the noisy one with denoise_main='noisy')")
       .def_property_readonly(
           "rgb",
           [](const py::object& self) {
@@ -331,7 +345,28 @@ void bind_result(py::module_& m) {
           "the requested AOVs by name: albedo, N, P (float32 h x w x 3), Z (float32 h x w, "
           "inf where nothing is hit), UV (h x w x 2), object_id (glTF node + 1) and "
           "material_id (material + 1) (uint32 h x w, 0 = background), samples (uint32), "
-          "variance, and the light groups (emission, diffuse_direct, ...: h x w x 3)")
+          "variance, the light groups (emission, diffuse_direct, ...: h x w x 3) and with halves the "
+          "denoiser's input: even, odd (colour of the even and odd samples), even_albedo, odd_albedo, "
+          "even_N, "
+          "odd_N (h x w x 3), even_Z, odd_Z (h x w)")
+      .def_property_readonly(
+          "noisy",
+          [](const py::object& self) -> py::object {
+            const RenderOutput& r = self.cast<const RenderOutput&>();
+            if (!r.settings.denoise) return py::none();
+            const Film& f = r.settings.denoise_main == "noisy" ? r.film : r.second;
+            return view(self, f.rgba.data(), f.height, f.width, 4, 4);
+          },
+          "with denoise=True: the render's beauty before denoising (float32 h x w x 4); else None")
+      .def_property_readonly(
+          "denoised",
+          [](const py::object& self) -> py::object {
+            const RenderOutput& r = self.cast<const RenderOutput&>();
+            if (!r.settings.denoise) return py::none();
+            const Film& f = r.settings.denoise_main == "noisy" ? r.second : r.film;
+            return view(self, f.rgba.data(), f.height, f.width, 4, 4);
+          },
+          "with denoise=True: the denoised beauty (float32 h x w x 4, alpha the render's); else None")
       .def_property_readonly("width", [](const RenderOutput& r) { return r.film.width; })
       .def_property_readonly("height", [](const RenderOutput& r) { return r.film.height; })
       .def_property_readonly(
@@ -401,9 +436,114 @@ void bind_result(py::module_& m) {
 
 }  // namespace
 
+namespace {
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+// A (2, h, w, channels) array (channels 1: (2, h, w)) of halves, checked; throws ValueError.
+void check_halves(const FloatArray& a, const char* name, int channels, py::ssize_t h, py::ssize_t w) {
+  const bool ok = channels == 1 ? a.ndim() == 3 : a.ndim() == 4 && a.shape(3) == channels;
+  if (!ok || a.shape(0) != 2 || a.shape(1) != h || a.shape(2) != w)
+    throw py::value_error(std::string(name) + ": expected shape (2, " + std::to_string(h) + ", " +
+                          std::to_string(w) + (channels == 1 ? "" : ", " + std::to_string(channels)) +
+                          "): the even and odd samples' halves");
+  const float* v = a.data();
+  const bool depth = channels == 1;
+  for (py::ssize_t i = 0; i < a.size(); ++i)
+    if (!(std::isfinite(v[i]) || (depth && v[i] > 0)))
+      throw py::value_error(std::string(name) + ": non-finite value at flat index " + std::to_string(i) +
+                            (depth ? " (a depth may be +inf, nothing else)" : ""));
+}
+
+void bind_denoise(py::module_& m) {
+  m.def(
+      "denoise",
+      [](const std::filesystem::path& input, const std::filesystem::path& output,
+         const std::string& denoise_main, int threads) {
+        check_exr_path(output);
+        if (denoise_main != "denoised" && denoise_main != "noisy")
+          throw py::value_error("denoise_main must be 'denoised' or 'noisy'");
+        if (threads < 0) throw py::value_error("threads must be >= 0");
+        check_distinct_files({{"output", output}}, {{"input", input}});
+        ExrDenoiseOptions o;
+        o.noisy_main = denoise_main == "noisy";
+        o.config.threads = threads;
+        o.max_memory_bytes = default_memory_budget();
+        py::gil_scoped_release release;
+        (void)denoise_exr(input, output, o);
+      },
+      py::arg("input"), py::arg("output"), py::kw_only(), py::arg("denoise_main") = "denoised",
+      py::arg("threads") = 0,
+      "Denoises a Penumbra EXR with the halves layers (render with denoise=True or aovs=['halves']) into "
+      "`output`, as `penumbra denoise` does: R, G, B denoised and the noisy beauty kept as noisy.RGBA "
+      "(denoise_main='noisy': the reverse, denoised.RGBA). Raises penumbra.InputError naming the file and "
+      "the missing layer.");
+  m.def(
+      "denoise",
+      [](const py::object& color_in, const py::object& albedo_in, const py::object& normal_in,
+         const py::object& depth_in, int threads, const std::string& method) {
+        if (method != "nfor" && method != "cross_bilateral")
+          throw py::value_error("method must be 'nfor' or 'cross_bilateral'");
+        // Any array-like of numbers, copied to contiguous float32 (views and other dtypes too).
+        const auto as_array = [](const py::object& o, const char* name) {
+          FloatArray a = FloatArray::ensure(o);
+          if (!a) throw py::value_error(std::string(name) + ": not an array of numbers");
+          return a;
+        };
+        const FloatArray color = as_array(color_in, "color"), albedo = as_array(albedo_in, "albedo");
+        const FloatArray normal = as_array(normal_in, "normal"), depth = as_array(depth_in, "depth");
+        if (color.ndim() != 4) throw py::value_error("color: expected shape (2, height, width, 3)");
+        const py::ssize_t h = color.shape(1), w = color.shape(2);
+        check_halves(color, "color", 3, h, w);
+        check_halves(albedo, "albedo", 3, h, w);
+        check_halves(normal, "normal", 3, h, w);
+        check_halves(depth, "depth", 1, h, w);
+        if (threads < 0) throw py::value_error("threads must be >= 0");
+        if (h < 1 || w < 1) throw py::value_error("color: the image is empty");
+        DenoiseInput in;
+        in.width = int(w);
+        in.height = int(h);
+        const size_t n = size_t(h) * size_t(w);
+        for (size_t half = 0; half < 2; ++half) {
+          in.color[half].assign(color.data() + half * n * 3, color.data() + (half + 1) * n * 3);
+          in.features[half].resize(n * kDenoiseFeatures);
+          for (size_t i = 0; i < n; ++i) {
+            float* f = &in.features[half][i * kDenoiseFeatures];
+            for (int c = 0; c < 3; ++c) {
+              f[c] = albedo.data()[(half * n + i) * 3 + size_t(c)];
+              f[3 + c] = normal.data()[(half * n + i) * 3 + size_t(c)];
+            }
+            f[6] = depth.data()[half * n + i];
+          }
+        }
+        DenoiseConfig cfg;
+        cfg.threads = threads;
+        std::vector<float> out;
+        {
+          py::gil_scoped_release release;
+          out = method == "nfor" ? denoise_nfor(in, cfg)
+                                 : denoise_cross_bilateral(in, cfg.window_radius, threads);
+        }
+        FloatArray a({h, w, py::ssize_t(3)});
+        std::copy(out.begin(), out.end(), a.mutable_data());
+        return a;
+      },
+      py::kw_only(), py::arg("color"), py::arg("albedo"), py::arg("normal"), py::arg("depth"),
+      py::arg("threads") = 0, py::arg("method") = "nfor",
+      "Denoises arrays with NFOR: color, albedo and normal of shape (2, height, width, 3) and depth (2, "
+      "height, width), each the means of the even and odd samples (RenderResult.aovs with halves: "
+      "even/odd, even_albedo/odd_albedo, ...; colour premultiplied, depth +inf where nothing is hit). "
+      "Returns the denoised colour, float32 (height, width, 3). method='cross_bilateral' runs the "
+      "baseline NFOR is measured against (a 19 x 19 cross-bilateral filter on the same features). Raises "
+      "ValueError for shapes that do not match or non-finite values.");
+}
+
+}  // namespace
+
 void bind_render(py::module_& m, SceneClass& scene) {
   bind_settings(m);
   bind_result(m);
+  bind_denoise(m);
   scene.def(
       "render",
       [](SceneSession& s, const py::object& settings, const std::vector<std::string>& aovs,

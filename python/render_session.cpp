@@ -10,6 +10,7 @@
 #include "io/files/error.h"
 #include "io/gltf/id_manifest.h"
 #include "io/image/environment_io.h"
+#include "io/image/exr_denoise.h"
 #include "render/exr_layers.h"
 #include "renderer/accel/factory.h"
 #include "renderer/integrators/light_groups.h"
@@ -59,8 +60,8 @@ bool pose_session(SceneSession& session, double time) {
 }
 
 const std::vector<std::string>& python_aov_names() {
-  static const std::vector<std::string> names = {"albedo",  "N",        "P",     "Z",      "UV",      "id",
-                                                 "samples", "variance", "light", "vector", "velocity"};
+  static const std::vector<std::string> names = {
+      "albedo", "N", "P", "Z", "UV", "id", "samples", "variance", "light", "halves", "vector", "velocity"};
   return names;
 }
 
@@ -74,12 +75,18 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   out.scene_file = session.file;
   out.settings = settings;
   out.aovs = spec.aovs;
+  if (spec.denoise) out.aovs.insert("halves");
   out.config = r.prepared.config;
   out.camera = r.prepared.camera;
   out.camera_index = r.prepared.camera_index;
   out.default_light = r.prepared.default_light;
   out.warnings = r.prepared.warnings;
   out.film = std::move(r.image.film);
+  if (spec.denoise) {
+    out.second = std::move(r.image.denoised);
+    if (spec.denoise_main == "denoised") std::swap(out.film, out.second);
+  }
+  out.halves = std::move(r.image.halves);
   out.stats = r.image.stats;
   if (out.aovs.count("samples")) {
     out.samples = std::move(r.image.samples);
@@ -109,10 +116,18 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
       {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)},
       {"penumbra:version", PENUMBRA_VERSION}};
   exr.metadata.insert(exr.metadata.end(), options.metadata.begin(), options.metadata.end());
-  add_layer_channels(
-      exr, out.aovs,
-      {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector, &out.velocity},
-      options.half ? ChannelType::Half : ChannelType::Float);
+  add_layer_channels(exr, out.aovs,
+                     {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector,
+                      &out.velocity, &out.halves},
+                     options.half ? ChannelType::Half : ChannelType::Float);
+  if (out.settings.denoise) {  // the second beauty and the attributes `penumbra denoise` writes
+    const bool noisy_main = out.settings.denoise_main == "noisy";
+    for (int c = 0; c < 4; ++c)
+      exr.extra.push_back({std::string(noisy_main ? "denoised." : "noisy.") + "RGBA"[c], &out.second.rgba,
+                           options.half ? ChannelType::Half : ChannelType::Float, 4, c});
+    exr.metadata.push_back({kDenoiserAttribute, "nfor"});
+    exr.metadata.push_back({kDenoiseMainAttribute, out.settings.denoise_main});
+  }
   write_exr(out.film, path, exr);
 }
 

@@ -60,15 +60,19 @@ struct RenderOutput {
   int camera_index = -1;              ///< into the scene's cameras; -1: framed from the bounds
   bool default_light = false;         ///< the scene had no light: the default key light lit it
   std::vector<std::string> warnings;  ///< settings the render ignored (PreparedRender::warnings)
-  Film film;                          ///< premultiplied RGBA of render_window(config)
-  DataAovs data;                      ///< filled when a data AOV was asked for
-  std::vector<uint32_t> samples;      ///< path: samples per pixel
-  std::vector<float> variance;        ///< path: variance of each pixel's mean luminance
-  std::vector<float> groups;          ///< path with "light": kLightGroupChannels per pixel
-  std::vector<float> vector;          ///< with "vector": kMotionVectorChannels per pixel
-  std::vector<float> velocity;        ///< with "velocity": kVelocityChannels per pixel
-  std::vector<float> samples_f;       ///< `samples` as floats, for the EXR
-  std::string id_manifest;            ///< JSON: object id -> node name, material id -> material name
+  Film film;                          ///< premultiplied RGBA of render_window(config): the main beauty
+  /// With denoise: the other beauty (the noisy one, or the denoised one when denoise_main is
+  /// "noisy"); else empty.
+  Film second;
+  std::vector<float> halves;      ///< with "halves" or denoise: kHalfChannels per pixel
+  DataAovs data;                  ///< filled when a data AOV was asked for
+  std::vector<uint32_t> samples;  ///< path: samples per pixel
+  std::vector<float> variance;    ///< path: variance of each pixel's mean luminance
+  std::vector<float> groups;      ///< path with "light": kLightGroupChannels per pixel
+  std::vector<float> vector;      ///< with "vector": kMotionVectorChannels per pixel
+  std::vector<float> velocity;    ///< with "velocity": kVelocityChannels per pixel
+  std::vector<float> samples_f;   ///< `samples` as floats, for the EXR
+  std::string id_manifest;        ///< JSON: object id -> node name, material id -> material name
   RenderStats stats;
 };
 

@@ -1,6 +1,7 @@
 // The EXR channels of a render's layers.
 #include "render/exr_layers.h"
 
+#include "io/image/exr_denoise.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/motion_vectors.h"
 
@@ -31,6 +32,16 @@ void add_layer_channels(ExrOptions& exr, const std::set<std::string>& aovs, cons
                              kLightGroupChannels, g * 3 + c});
   if (aovs.count("vector")) vec("vector", "XYZW", b.vector, ChannelType::Float, kMotionVectorChannels);
   if (aovs.count("velocity")) vec("velocity", "XYZ", b.velocity, ChannelType::Float, kVelocityChannels);
+  if (aovs.count("halves"))
+    for (int h = 0; h < 2; ++h)
+      for (int k = 0; k < kDenoiseChannelsPerHalf; ++k) {
+        const std::string name = denoise_channel_name(h, k);
+        if (k < 3)
+          exr.extra.push_back({name, b.halves, ChannelType::Float, kHalfChannels, h * 3 + k});
+        else
+          exr.extra.push_back({name, &b.data->halves, ChannelType::Float, 2 * kDenoiseFeatures,
+                               h * kDenoiseFeatures + k - 3});
+      }
 }
 
 }  // namespace penumbra

@@ -2,7 +2,9 @@
 // in the colour type, N.XYZ, P.XYZ, Z, UV.UV, object_id.X and material_id.X as whole-number
 // floats with their name manifest) and the path tracer's layers (samples.X, variance.X, the
 // light groups' .RGB in the colour type), the motion vectors (vector.XYZW, Blender's Vector
-// pass) and the camera-space velocity (velocity.XYZ), pointing into the render's buffers.
+// pass), the camera-space velocity (velocity.XYZ) and the denoiser's halves (even.RGB, odd.RGB,
+// even_albedo.RGB, ..., odd_Z.Z in float: io/image/exr_denoise.h), pointing into the render's
+// buffers.
 #pragma once
 
 #include <set>
@@ -23,6 +25,8 @@ struct LayerChannels {
   const std::vector<float>* groups = nullptr;    ///< with light: kLightGroupChannels per pixel
   const std::vector<float>* vector = nullptr;    ///< with vector: kMotionVectorChannels per pixel
   const std::vector<float>* velocity = nullptr;  ///< with velocity: kVelocityChannels per pixel
+  const std::vector<float>* halves = nullptr;    ///< with halves: kHalfChannels per pixel (the
+                                                 ///< features from data->halves)
 };
 
 /// Appends the channels of every layer `aovs` names (and the id layer's penumbra:manifest

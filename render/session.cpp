@@ -12,6 +12,7 @@
 #include "io/gltf/id_manifest.h"
 #include "io/image/environment_io.h"
 #include "render/accel_params.h"
+#include "render/denoise_render.h"
 #include "render/motion.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
@@ -338,6 +339,7 @@ RenderImage render_image(const Scene& scene, const Accelerator* accel, const Pre
       out.samples = std::move(image.samples);
       out.variance = std::move(image.variance);
       out.groups = std::move(image.groups);
+      out.halves = std::move(image.halves);
       out.complete = state->complete;
       break;
     }
@@ -382,7 +384,7 @@ std::vector<std::string> crypto_layers(const std::set<std::string>& aovs) {
 }
 
 bool wants_data_aovs(const std::set<std::string>& aovs) {
-  for (const char* name : {"albedo", "N", "P", "Z", "UV", "id"})
+  for (const char* name : {"albedo", "N", "P", "Z", "UV", "id", "halves"})
     if (aovs.count(name)) return true;
   return false;
 }
@@ -496,6 +498,7 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   const Accelerator* accel = session.structure.accel.get();
   r.image = render_image(scene, accel, r.prepared);
   r.layers = render_layers(session.loaded, accel, r.prepared);
+  if (r.prepared.spec.denoise) r.image.denoised = denoise_render(r.image, r.layers.data, r.prepared.config);
   return r;
 }
 

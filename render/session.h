@@ -166,6 +166,9 @@ struct RenderImage {
   std::vector<uint32_t> samples;  ///< path: samples per pixel
   std::vector<float> variance;    ///< path: variance of each pixel's mean luminance
   std::vector<float> groups;      ///< path with light groups: kLightGroupChannels per pixel
+  std::vector<float> halves;      ///< path with "halves": kHalfChannels per pixel (even, odd RGB)
+  /// With spec.denoise, after render_scene: the denoised beauty (film stays the noisy one).
+  Film denoised;
   RenderStats stats;
   bool complete = true;  ///< every requested sample taken (a path render may stop early)
 };
@@ -193,7 +196,8 @@ struct RenderLayers {
 /// The Cryptomatte layers `aovs` asks for: CryptoObject, CryptoMaterial, CryptoAsset.
 std::vector<std::string> crypto_layers(const std::set<std::string>& aovs);
 
-/// Whether `aovs` asks for a data AOV (albedo, N, P, Z, UV or id).
+/// Whether `aovs` asks for a data AOV (albedo, N, P, Z, UV or id) or the halves (whose features
+/// the data AOVs' pass computes).
 bool wants_data_aovs(const std::set<std::string>& aovs);
 
 /// Whether `aovs` asks for a layer traced against the neighbouring frames (vector, velocity).
@@ -233,7 +237,8 @@ struct RenderResult {
 /// One render of the session's scene (locking it): the scene's motion over the shutter around
 /// session.time (set_scene_motion through session.load_at, cleared without motion blur), prepare_render,
 /// build_structure (kept for the next render with the same name and parameters), render_image,
-/// render_layers, and the default key light removed again however it ends. `env_budget` as in
+/// render_layers, with spec.denoise the denoised beauty (denoise_render), and the default key
+/// light removed again however it ends. `env_budget` as in
 /// PrepareOptions.
 RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget);
 

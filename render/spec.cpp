@@ -165,6 +165,24 @@ std::vector<SpecField> make_fields() {
        {},
        "path: lights chosen at each vertex, each with its own shadow ray (default 1); more lowers the "
        "noise of direct light at the cost of shadow rays"},
+      {"denoise",
+       &S::denoise,
+       kPath,
+       true,
+       0,
+       0,
+       {},
+       "path: denoise the beauty with NFOR feature regression from the even and odd samples' halves "
+       "(the 'halves' layers, kept in the EXR); needs at least 2 spp (default off)"},
+      {"denoise_main",
+       &S::denoise_main,
+       kPath,
+       true,
+       0,
+       0,
+       {"denoised", "noisy"},
+       "path with denoise: which beauty is the main layer (R, G, B, A): denoised (default; the noisy one "
+       "is kept as noisy.RGBA) or noisy (the denoised one written as denoised.RGBA)"},
       {"env_intensity", &S::env_intensity, kPath, true, 0, kAny, {}, "path: multiplies --env (default 1)"},
       {"env_rotation",
        &S::env_rotation,
@@ -501,6 +519,7 @@ const std::vector<std::string>& aov_names() {
                                                  "samples",
                                                  "variance",
                                                  "light",
+                                                 "halves",
                                                  "cost",
                                                  "crypto_object",
                                                  "crypto_material",
@@ -514,13 +533,14 @@ std::set<std::string> check_aovs(const std::vector<std::string>& names, const st
                                  const std::vector<std::string>& known) {
   const bool path = integrator == "path";
   const auto is_path_layer = [](const std::string& n) {
-    return n == "samples" || n == "variance" || n == "light";
+    return n == "samples" || n == "variance" || n == "light" || n == "halves";
   };
   std::set<std::string> aovs;
   for (const auto& name : names) {
     if (name == "all") {
       for (const auto& n : known)
-        if (n != "cost" && n != "vector" && n != "velocity" && (path || !is_path_layer(n))) aovs.insert(n);
+        if (n != "cost" && n != "vector" && n != "velocity" && n != "halves" && (path || !is_path_layer(n)))
+          aovs.insert(n);
       continue;
     }
     if (std::find(known.begin(), known.end(), name) == known.end())
@@ -542,6 +562,10 @@ void validate(const RenderSpec& s) {
   check_camera_settings(s);
   accel_config(s.accel, s.accel_params);
   for (const auto& name : s.aovs) check_aovs({name}, s.integrator, aov_names());
+  if (s.denoise && s.spp == 1)
+    throw std::invalid_argument("denoise needs spp >= 2 (it compares the even and odd samples)");
+  if (!s.denoise && s.denoise_main != defaults.denoise_main)
+    throw std::invalid_argument("denoise_main needs denoise");
   // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
   RenderConfig probe = make_render_config(resolve(s, 16.0f / 9.0f));
   probe.window = {};
@@ -551,6 +575,7 @@ void validate(const RenderSpec& s) {
 RenderSpec resolve(const RenderSpec& s, float hint) {
   RenderSpec r = s;
   const bool path = s.integrator == "path";
+  if (r.denoise) r.aovs.insert("halves");
   if (!r.width && !r.height) r.width = 960;
   if (!r.height) r.height = std::max(1, int(std::lround(float(r.width) / hint)));
   if (!r.width) r.width = std::max(1, int(std::lround(float(r.height) * hint)));
@@ -598,6 +623,7 @@ RenderConfig make_render_config(const RenderSpec& r) {
   cfg.adaptive_threshold = r.adaptive;
   cfg.adaptive_min_spp = r.adaptive_min_spp;
   cfg.light_groups = r.aovs.count("light") > 0;
+  cfg.halves = r.aovs.count("halves") > 0;
   cfg.motion_blur = r.motion_blur;
   return cfg;
 }
@@ -643,6 +669,7 @@ RenderSettings render_identity(const RenderSpec& r, const Camera& camera, const 
     e["env"] = r.env_color ? colour_text(*r.env_color) : r.env_map.empty() ? "none" : r.env_map;
     if (!scene.env_sha256.empty()) e["env.sha256"] = scene.env_sha256;
     e["light_groups"] = r.aovs.count("light") ? "1" : "0";
+    e["halves"] = r.aovs.count("halves") ? "1" : "0";
   } else {
     e["background"] = colour_text(r.background.value_or(Vec3f{0, 0, 0}));
     e["ambient"] = colour_text(r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f}));

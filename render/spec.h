@@ -47,8 +47,10 @@ struct RenderSpec {
   std::string energy_compensation = "on";    ///< path: on or off (multiple-scattering GGX)
   std::string light_sampler = "power";       ///< path: tree, power or uniform (choosing an area light)
   int light_samples = 1;                     ///< path: lights chosen at each vertex, each with its shadow ray
-  std::optional<Vec3f> env_color;            ///< path: constant environment radiance
-  std::string env_map;                       ///< path: equirectangular map file
+  bool denoise = false;                   ///< path: denoise the beauty (render/denoise.h); implies "halves"
+  std::string denoise_main = "denoised";  ///< path with denoise: the main layer, denoised or noisy
+  std::optional<Vec3f> env_color;         ///< path: constant environment radiance
+  std::string env_map;                    ///< path: equirectangular map file
   float env_intensity = 1, env_rotation = 0;  ///< path: the environment's multiplier and turn (degrees)
   double time_limit = 0;                      ///< path: seconds; 0: none
   float adaptive = 0;                         ///< path: adaptive sampling threshold; 0: off

@@ -98,7 +98,7 @@ void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& bu
   if (job.request.aovs.count("samples")) buffers.samples.assign(image.samples.begin(), image.samples.end());
   add_layer_channels(exr, job.request.aovs,
                      {&buffers.layers.data, &buffers.layers.id_manifest, &buffers.samples, &image.variance,
-                      &image.groups, &buffers.layers.vector, &buffers.layers.velocity},
+                      &image.groups, &buffers.layers.vector, &buffers.layers.velocity, &image.halves},
                      job.args.use_float ? ChannelType::Float : ChannelType::Half);
   if (job.request.cost_aov) {
     if (buffers.layers.cost.counted) {

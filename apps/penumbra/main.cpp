@@ -1,9 +1,9 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
-// `info`, assemble farm tiles with `merge`, render job files with `batch` and submit them to Slurm with
-// `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`. This file wires the subcommands'
-// flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1 a failure outside the input
-// (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a parse error
-// included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
+// `info`, assemble farm tiles with `merge`, denoise an EXR with `denoise`, render job files with `batch` and
+// submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`. This
+// file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1
+// a failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a
+// parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
@@ -34,6 +34,27 @@ void add_merge_options(CLI::App& merge, MergeArgs& a) {
       "--force", a.force,
       "merge parts without Penumbra's scene and settings metadata, or with differing metadata (parts "
       "cut by other tools); the windows and channels are still checked");
+}
+
+void add_denoise_options(CLI::App& denoise, DenoiseArgs& a) {
+  denoise
+      .add_option("input", a.input,
+                  "a Penumbra EXR with the halves layers (render --denoise or --aov halves)")
+      ->required();
+  denoise.add_option("-o,--output", a.output, "the denoised EXR (written atomically)")->required();
+  denoise
+      .add_option("--denoise-main", a.denoise_main,
+                  "the main layer (R, G, B, A): denoised (default; the noisy beauty kept as noisy.RGBA) or "
+                  "noisy (the denoised beauty written as denoised.RGBA)")
+      ->check(CLI::IsMember({"denoised", "noisy"}));
+  denoise.add_option("--threads", a.threads, "worker threads (default: all; does not change pixels)")
+      ->check(CLI::Range(0, 1024));
+  denoise.add_option(
+      "--max-memory", a.max_memory,
+      "budget for the file's pixels and the denoiser's buffers, e.g. 4G (default: half the RAM)");
+  denoise.add_option("--progress", a.progress, progress_option_help())
+      ->check(CLI::IsMember(progress_modes()));
+  denoise.add_flag("-q,--quiet", a.quiet, "no progress");
 }
 
 void add_mesh_options(CLI::App& mesh, MeshArgs& a) {
@@ -130,6 +151,10 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand(
       "merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   add_merge_options(*merge, merge_args);
+  DenoiseArgs denoise_args;
+  auto* denoise = app.add_subcommand(
+      "denoise", "Denoise a path-traced EXR from its halves layers (NFOR feature regression)");
+  add_denoise_options(*denoise, denoise_args);
   BatchArgs batch_args;
   auto* batch = app.add_subcommand(
       "batch", "Render the shots of a job file, or list its work units and render one of them (farms)");
@@ -158,6 +183,7 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
+    if (*denoise) return run_denoise(denoise_args);
     if (*batch) return run_batch(batch_args);
     if (*submit) return run_submit_slurm(submit_args);
     if (*mesh) return run_mesh(mesh_args);

@@ -24,6 +24,8 @@
 #include "io/files/hash.h"
 #include "io/image/contact_sheet.h"
 #include "io/image/environment_io.h"
+#include "io/image/exr_denoise.h"
+#include "render/denoise_render.h"
 #include "render/motion.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/raster.h"
@@ -52,6 +54,8 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   if (q.data_aovs) b += 14 * 4;
   if (q.cost_aov) b += 3 * 4 + 3;
   if (q.aovs.count("samples")) b += 4;  // the counts as floats for the EXR
+  if (q.aovs.count("halves"))           // odd sums, colour and feature halves, their channels
+    b += 4 * 8 + kHalfChannels * 4 + 2 * kDenoiseFeatures * 4 + (kHalfChannels + 2 * kDenoiseFeatures) * 4;
   const uint64_t crypto = q.crypto.size() * 4 * uint64_t((q.crypto_depth + 1) / 2);  // ranked (id, coverage)
   b += crypto * 4;
   const uint64_t channels = 4 + (q.data_aovs ? 14 : 0) + (light_groups ? kLightGroupChannels : 0) +
@@ -61,13 +65,24 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   return b;
 }
 
+/// Whether the render denoises its frame itself (--denoise): a whole frame does; a crop or
+/// stripe keeps the noisy beauty and the halves, and `penumbra merge` denoises the frame.
+bool denoises_now(const RenderConfig& cfg) {
+  const PixelWindow w = render_window(cfg);
+  return w.x0 == 0 && w.y0 == 0 && w.x1 == cfg.width && w.y1 == cfg.height;
+}
+
 /// Charges the scene, the accelerator and every image buffer to the budget; returns the bytes
 /// taken. Throws UsageError (exit 2) naming the image when they do not fit.
 uint64_t charge_image_budget(const RenderJob& job, const RenderConfig& cfg) {
   const uint64_t budget = job.request.budget;
   const PixelWindow w = render_window(cfg);
-  const uint64_t image =
+  uint64_t image =
       uint64_t(w.width()) * uint64_t(w.height()) * image_bytes_per_pixel(job.request, job.args.multipart);
+  // The denoiser runs on the noisy file once it is written (denoise_exr's own estimate); a
+  // stripe or crop leaves it to the merge.
+  if (job.args.spec.denoise && denoises_now(cfg))
+    image += exr_denoise_bytes(w.width(), w.height(), denoise_config(cfg));
   const Scene& scene = job.loaded.scene;
   uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle +
                          job.loaded.animation_bytes;
@@ -338,8 +353,25 @@ void write_phase(RenderJob& job) {
   for (const auto& [sidecar, text] : buffers.sidecars)
     write_atomically(
         sidecar, [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), sidecar); });
-  write_exr(job.image.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
-  if (q.png) write_display_image(job.image.film, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
+  const Film* shown = &job.image.film;
+  Film main;
+  if (job.args.spec.denoise && denoises_now(job.prepared.config)) {
+    // The noisy frame, then the denoiser on it: the bytes `penumbra denoise` and a merge give.
+    ProgressReporter denoise_progress(job.progress, "denoise", job.frame);
+    ExrDenoiseOptions d;
+    d.noisy_main = job.args.spec.denoise_main == "noisy";
+    d.config = denoise_config(job.prepared.config);
+    d.max_memory_bytes = q.budget;
+    d.progress = [&](int done, int total) { denoise_progress(done, total); };
+    main = denoise_through_file(
+        q.out, [&](const fs::path& noisy) { write_exr(job.image.film, noisy, exr); }, d,
+        hashes ? &job.hashes.exr : nullptr);
+    denoise_progress.finish();
+    shown = &main;
+  } else {
+    write_exr(job.image.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
+  }
+  if (q.png) write_display_image(*shown, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
   if (q.cost_png)
     write_heatmap(total_cost(buffers.layers.cost), job.prepared.config.width, job.prepared.config.height,
                   *q.cost_png, cost_caption(buffers.layers.cost, job.args.spec.accel),

@@ -137,10 +137,11 @@ void check_aovs(const RenderArgs& a, RenderRequest& q) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--aov: ") + e.what());
     }
-    if (!q.path && (name == "samples" || name == "variance" || name == "light"))
+    if (!q.path && (name == "samples" || name == "variance" || name == "light" || name == "halves"))
       throw UsageError("--aov " + name + " needs --integrator path");
   }
   q.aovs = penumbra::check_aovs(names, a.spec.integrator);
+  if (a.spec.denoise && q.path) q.aovs.insert("halves");  // what the denoiser reads, kept in the EXR
   q.crypto = crypto_layers(q.aovs);
   if (a.crypto_depth_given && q.crypto.empty())
     throw UsageError("--crypto-depth needs --aov crypto_object, crypto_material or crypto_asset");

@@ -1,6 +1,6 @@
-// Resume state files ("PNMBRCK2"): header, settings text, pixel records, light-group sums and
-// a trailing SHA-256. Reading validates sizes against the file size, then the checksum, then
-// the settings, then every value.
+// Resume state files ("PNMBRCK3"): header, settings text, pixel records, light-group sums,
+// odd-sample sums and a trailing SHA-256. Reading validates sizes against the file size, then the checksum,
+// then the settings, then every value.
 #include "io/farm/checkpoint.h"
 
 #include <algorithm>
@@ -24,8 +24,9 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "resume state files are little-endian");
 
-constexpr char kMagic[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '2'};
+constexpr char kMagic[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '3'};
 constexpr char kOldMagic[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '1'};
+constexpr char kOldMagic2[8] = {'P', 'N', 'M', 'B', 'R', 'C', 'K', '2'};
 constexpr size_t kDigestBytes = 32;
 constexpr uint64_t kGroupsPerPixel = kLightGroupChannels;
 
@@ -33,7 +34,7 @@ using Pixel = PathAccumulators::Pixel;
 static_assert(sizeof(Pixel) == kPathPixelBytes,
               "Pixel: rgba, sum_y, sum_y2 (6 doubles), n, active (2 uint32)");
 
-// 56 bytes after the magic, no padding.
+// 64 bytes after the magic, no padding.
 struct Header {
   int32_t window[4];        ///< x0, y0, x1, y1
   uint32_t reached;         ///< PathAccumulators::reached
@@ -42,9 +43,10 @@ struct Header {
   uint32_t pixel_bytes;     ///< sizeof(Pixel) of the writer
   uint64_t pixels;          ///< pixel records
   uint64_t groups;          ///< light-group doubles
+  uint64_t odd;             ///< odd-sample doubles (RGBA per pixel)
   uint64_t settings_bytes;  ///< canonical settings text
 };
-static_assert(sizeof(Header) == 56);
+static_assert(sizeof(Header) == 64);
 
 constexpr uint64_t kPrefixBytes = sizeof kMagic + sizeof(Header);
 
@@ -57,9 +59,11 @@ void check_sizes(const std::string& file, const Header& h, uint64_t file_size) {
                          " bytes, expected " + std::to_string(sizeof(Pixel)));
   const uint64_t budget =
       file_size < kPrefixBytes + kDigestBytes ? 0 : file_size - kPrefixBytes - kDigestBytes;
-  const bool fits = h.settings_bytes <= kMaxCheckpointSettingsBytes && h.settings_bytes <= budget &&
-                    h.pixels <= budget / sizeof(Pixel) && h.groups <= budget / sizeof(double) &&
-                    h.settings_bytes + h.pixels * sizeof(Pixel) + h.groups * sizeof(double) == budget;
+  const bool fits =
+      h.settings_bytes <= kMaxCheckpointSettingsBytes && h.settings_bytes <= budget &&
+      h.pixels <= budget / sizeof(Pixel) && h.groups <= budget / sizeof(double) &&
+      h.odd <= budget / sizeof(double) &&
+      h.settings_bytes + h.pixels * sizeof(Pixel) + (h.groups + h.odd) * sizeof(double) == budget;
   if (!fits)
     throw InputError(file, "",
                      "truncated or corrupt checkpoint: its header does not describe its " +
@@ -104,6 +108,13 @@ void check_pixel(const std::string& file, const PathAccumulators& s, size_t i) {
     if (!finite_non_negative(g) || (p.n == 0 && g != 0))
       throw bad("light-group sum " + std::to_string(g) + " is not finite and >= 0 (or has no samples)");
   }
+  if (s.odd.empty()) return;
+  const double* odd = &s.odd[i * 4];
+  for (int c = 0; c < 4; ++c)
+    if (!finite_non_negative(odd[c]) || odd[c] > p.rgba[c] * (1 + 1e-9) + 1e-9)
+      throw bad("odd-sample sum " + std::to_string(odd[c]) +
+                " is not finite, >= 0 and within the pixel's sum");
+  if (odd[3] > double(p.n / 2)) throw bad("odd-sample coverage exceeds the odd samples");
 }
 
 // Throws unless the counters, the window and every pixel agree with each other.
@@ -121,6 +132,9 @@ void check_consistency(const std::string& file, const PathAccumulators& s) {
               std::to_string(s.pixels.size()));
   if (!s.groups.empty() && s.groups.size() != s.pixels.size() * kGroupsPerPixel)
     throw bad(std::to_string(s.groups.size()) + " light-group sums for " + std::to_string(s.pixels.size()) +
+              " pixels");
+  if (!s.odd.empty() && s.odd.size() != s.pixels.size() * 4)
+    throw bad(std::to_string(s.odd.size()) + " odd-sample sums for " + std::to_string(s.pixels.size()) +
               " pixels");
   if (s.passes < 0 || uint64_t(s.passes) > s.reached)
     throw bad(std::to_string(s.passes) + " passes for " + std::to_string(s.reached) + " samples");
@@ -144,15 +158,18 @@ void write_checkpoint(const std::filesystem::path& path, const PathAccumulators&
   h.pixel_bytes = sizeof(Pixel);
   h.pixels = state.pixels.size();
   h.groups = state.groups.size();
+  h.odd = state.odd.size();
   h.settings_bytes = text.size();
   const size_t pixel_bytes = state.pixels.size() * sizeof(Pixel);
   const size_t group_bytes = state.groups.size() * sizeof(double);
+  const size_t odd_bytes = state.odd.size() * sizeof(double);
   Sha256 sha;
   sha.update(kMagic, sizeof kMagic);
   sha.update(&h, sizeof h);
   sha.update(text);
   sha.update(state.pixels.data(), pixel_bytes);
   sha.update(state.groups.data(), group_bytes);
+  sha.update(state.odd.data(), odd_bytes);
   const std::array<uint8_t, 32> digest = sha.finish();
   write_atomically(path, [&](const std::filesystem::path& temp) {
     std::ofstream out(temp, std::ios::binary);
@@ -161,6 +178,7 @@ void write_checkpoint(const std::filesystem::path& path, const PathAccumulators&
     out.write(text.data(), std::streamsize(text.size()));
     out.write(reinterpret_cast<const char*>(state.pixels.data()), std::streamsize(pixel_bytes));
     out.write(reinterpret_cast<const char*>(state.groups.data()), std::streamsize(group_bytes));
+    out.write(reinterpret_cast<const char*>(state.odd.data()), std::streamsize(odd_bytes));
     out.write(reinterpret_cast<const char*>(digest.data()), std::streamsize(digest.size()));
     out.flush();
     if (!out) throw std::runtime_error(path.string() + ": cannot write the checkpoint");
@@ -181,6 +199,11 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
     throw InputError(file, "",
                      "is a resume state in the old format (PNMBRCK1, without a checksum) that this version "
                      "cannot verify; delete it to render from the beginning");
+  if (in && std::memcmp(magic, kOldMagic2, sizeof kOldMagic2) == 0)
+    throw InputError(
+        file, "",
+        "is a resume state in an older format (PNMBRCK2) that this version cannot read; delete it "
+        "to render from the beginning");
   if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
     throw InputError(file, "", "not a Penumbra checkpoint");
   in.read(reinterpret_cast<char*>(&h), sizeof h);
@@ -228,8 +251,10 @@ PathAccumulators read_checkpoint(const std::filesystem::path& path, const Render
   PathAccumulators state;
   state.pixels.resize(h.pixels);
   state.groups.resize(h.groups);
+  state.odd.resize(h.odd);
   in.read(reinterpret_cast<char*>(state.pixels.data()), std::streamsize(h.pixels * sizeof(Pixel)));
   in.read(reinterpret_cast<char*>(state.groups.data()), std::streamsize(h.groups * sizeof(double)));
+  in.read(reinterpret_cast<char*>(state.odd.data()), std::streamsize(h.odd * sizeof(double)));
   if (!in) throw InputError(file, "", "truncated or corrupt checkpoint: read failed");
 
   // The values, checked against each other.

@@ -19,13 +19,20 @@
 #include "io/files/checked_file.h"
 #include "io/files/error.h"
 #include "io/files/file_checks.h"
+#include "io/image/exr_denoise.h"
+#include "io/image/exr_parts.h"
 
 namespace penumbra {
 
 namespace {
-
 constexpr const char* kForceHint = "use --force to merge parts from other tools";
+}  // namespace
+
+namespace exr_parts {
+
+namespace {
 constexpr int64_t kMaxSide = 65536;
+}  // namespace
 
 // Bytes of one EXR part's pixels: its data window, or its display window when `full`.
 double image_bytes(const OIIO::ImageSpec& spec, bool full) {
@@ -192,6 +199,12 @@ std::vector<OIIO::ImageSpec> read_specs(OIIO::ImageInput& in, const std::string&
   return specs;
 }
 
+}  // namespace exr_parts
+
+namespace {
+
+using namespace exr_parts;
+
 const OIIO::ParamValue* string_attribute(const OIIO::ImageSpec& spec, const char* name) {
   return spec.find_attribute(name, OIIO::TypeDesc::STRING);
 }
@@ -218,6 +231,21 @@ std::string part_scene(const std::string& name, const OIIO::ImageSpec& spec) {
         name, "",
         std::string("has no ") + kSceneHashAttribute + " metadata (not a Penumbra tile?); " + kForceHint);
   return p->get_string();
+}
+
+// Whether the parts' settings ask for the frame to be denoised, and with the noisy beauty as
+// the main layer: (denoise, noisy_main). Parts without settings (--force) are not denoised.
+std::pair<bool, bool> requested_denoise(const OIIO::ImageSpec& spec) {
+  const OIIO::ParamValue* p = string_attribute(spec, kSettingsAttribute);
+  if (!p) return {false, false};
+  try {
+    const RenderSettings s = parse_canonical_text(p->get_string());
+    const auto d = s.entries.find("denoise");
+    const auto m = s.entries.find("denoise_main");
+    return {d != s.entries.end() && d->second == "1", m != s.entries.end() && m->second == "noisy"};
+  } catch (const std::invalid_argument&) {
+    return {false, false};
+  }
 }
 
 // What makes tiles parts of one frame: the scene and the settings they were rendered with.
@@ -339,40 +367,48 @@ struct PartStatistics {
   }
 };
 
-void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> specs,
-                 const std::vector<std::vector<unsigned char>>& pixels) {
+}  // namespace
+
+void exr_parts::write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> specs,
+                            const std::vector<std::vector<unsigned char>>& pixels, bool whole_frame,
+                            std::string* sha256) {
   for (auto& sp : specs) {
-    sp.x = sp.y = 0;
-    sp.width = sp.full_width;
-    sp.height = sp.full_height;
+    if (whole_frame) {
+      sp.x = sp.y = 0;
+      sp.width = sp.full_width;
+      sp.height = sp.full_height;
+    }
     sp.tile_width = sp.tile_height = 0;
     sp.erase_attribute("openexr:chunkCount");  // a part's count; the writer counts the frame's
   }
-  write_atomically(out, [&](const std::filesystem::path& temp) {
-    auto o = OIIO::ImageOutput::create(out.string());
-    if (!o) throw std::runtime_error(out.string() + ": no image writer (" + OIIO::geterror() + ")");
-    const bool multi = specs.size() > 1;
-    write_through_checked_file(o, temp, out, [&] {
-      if (!(multi ? o->open(temp.string(), int(specs.size()), specs.data())
-                  : o->open(temp.string(), specs[0])))
-        throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
-      for (size_t sub = 0; sub < specs.size(); ++sub) {
-        if (sub > 0 && !o->open(temp.string(), specs[sub], OIIO::ImageOutput::AppendSubimage))
-          throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " +
-                                   o->geterror());
-        if (!o->write_image(OIIO::TypeDesc::UNKNOWN, pixels[sub].data()))
-          throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
-      }
-      if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
-    });
-  });
+  write_atomically(
+      out,
+      [&](const std::filesystem::path& temp) {
+        auto o = OIIO::ImageOutput::create(out.string());
+        if (!o) throw std::runtime_error(out.string() + ": no image writer (" + OIIO::geterror() + ")");
+        const bool multi = specs.size() > 1;
+        write_through_checked_file(o, temp, out, [&] {
+          if (!(multi ? o->open(temp.string(), int(specs.size()), specs.data())
+                      : o->open(temp.string(), specs[0])))
+            throw std::runtime_error(out.string() + ": cannot open for writing: " + o->geterror());
+          for (size_t sub = 0; sub < specs.size(); ++sub) {
+            if (sub > 0 && !o->open(temp.string(), specs[sub], OIIO::ImageOutput::AppendSubimage))
+              throw std::runtime_error(out.string() + ": cannot start part " + std::to_string(sub) + ": " +
+                                       o->geterror());
+            if (!o->write_image(OIIO::TypeDesc::UNKNOWN, pixels[sub].data()))
+              throw std::runtime_error(out.string() + ": write failed: " + o->geterror());
+          }
+          if (!o->close()) throw std::runtime_error(out.string() + ": close failed: " + o->geterror());
+        });
+      },
+      sha256);
 }
 
 /// Cryptomatte manifests kept in sidecar files (cryptomatte/<key>/manif_file, relative to the
 /// EXR) follow the frame: each is copied from beside the first part to beside `out`
 /// ("OUT.{name}.json") and the attribute renamed in every part's header.
-void move_crypto_sidecars(const std::filesystem::path& first, const std::filesystem::path& out,
-                          std::vector<OIIO::ImageSpec>& specs) {
+void exr_parts::move_crypto_sidecars(const std::filesystem::path& first, const std::filesystem::path& out,
+                                     std::vector<OIIO::ImageSpec>& specs) {
   constexpr uint64_t kMaxManifestBytes = uint64_t(1) << 30;
   for (const OIIO::ParamValue& p : OIIO::ParamValueList(specs[0].extra_attribs)) {
     const std::string attr = p.name().string();
@@ -394,8 +430,6 @@ void move_crypto_sidecars(const std::filesystem::path& first, const std::filesys
       if (sp.find_attribute(attr)) sp.attribute(attr, dest.filename().string());
   }
 }
-
-}  // namespace
 
 void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
                      const MergeOptions& options) {
@@ -465,7 +499,23 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
   }
   move_crypto_sidecars(parts[0], out, full);
-  write_frame(out, full, pixels);
+  const auto [denoise, noisy_main] = requested_denoise(full[0]);
+  if (!denoise) {
+    write_frame(out, full, pixels);
+    return;
+  }
+  ExrDenoiseOptions d;
+  d.noisy_main = noisy_main;
+  d.config.threads = options.threads;
+  d.max_memory_bytes = options.max_memory_bytes;
+  d.progress = options.denoise_progress;
+  denoise_through_file(
+      out,
+      [&](const std::filesystem::path& noisy) {
+        write_frame(noisy, full, pixels);
+        std::vector<std::vector<unsigned char>>().swap(pixels);  // the denoiser reads the file
+      },
+      d);
 }
 
 std::string format_mean_spp(uint64_t samples, uint64_t pixels) {

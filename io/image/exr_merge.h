@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct MergeOptions {
   bool force = false;  ///< accept parts without or with differing Penumbra metadata (from other tools)
   /// Bound on the decoded full frame (every EXR part) plus one part's decoded pixels.
   uint64_t max_memory_bytes = uint64_t(8) << 30;
+  int threads = 0;  ///< the denoiser's, for parts rendered with denoise (0: every hardware thread)
+  std::function<void(int done, int total)> denoise_progress;  ///< the denoiser's steps; may be empty
 };
 
 /// Reads every part (an OpenEXR file whose data window lies inside its display window) and
@@ -49,6 +52,9 @@ struct MergeOptions {
 ///  - all share the display window and the channel list (names and types) of every EXR part;
 ///  - they do not overlap and together cover the whole display window;
 ///  - the frame fits in `options.max_memory_bytes`.
+/// Parts rendered with `denoise` (their settings say so) hold the noisy beauty and the halves
+/// layers: the merged frame is denoised (denoise_through_file, within the same memory bound)
+/// and written as `penumbra render --denoise` writes the whole frame.
 void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
                      const MergeOptions& options = {});
 

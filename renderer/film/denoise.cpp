@@ -5,7 +5,9 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 
+#include "renderer/core/math.h"
 #include "renderer/core/parallel.h"
 
 namespace penumbra {
@@ -43,6 +45,35 @@ void fill_missing_depth(const DenoiseInput& in, Plane out[2]) {
     for (size_t i = kDenoiseFeatures - 1; i < out[h].v.size(); i += kDenoiseFeatures)
       if (!std::isfinite(in.features[h][i])) out[h].v[i] = far;
   }
+}
+
+// Firefly removal: a pixel of one half whose luminance exceeds twice the brightest pixel of the
+// other half's 5 x 5 neighbourhood is scaled down to that bound. A sample that rarely finds a
+// bright path (a caustic through a mirror) lands in one half only; left in, the regression
+// spreads it over whole windows with overshoot, since the weights come from the other half,
+// which never saw it. Detail present in both halves (a highlight) stays. This is biased (the
+// rare paths' energy is dropped, as a clamp drops it); spreading the energy instead measured
+// far worse in relative error, since one 16-spp draw of such paths is far from their mean.
+void remove_spikes(Plane color[2]) {
+  const int w = color[0].w, h = color[0].h;
+  const auto lum = [](const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; };
+  Plane bound[2] = {Plane(w, h, 1), Plane(w, h, 1)};
+  for (int s = 0; s < 2; ++s)
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        float m = 0;
+        for (int dy = -2; dy <= 2; ++dy)
+          for (int dx = -2; dx <= 2; ++dx) m = std::max(m, lum(color[1 - s].clamped(x + dx, y + dy)));
+        bound[s].at(x, y)[0] = 2 * m + 1e-3f;
+      }
+  for (int s = 0; s < 2; ++s)
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        float* c = color[s].at(x, y);
+        const float l = lum(c), b = bound[s].at(x, y)[0];
+        if (l > b)
+          for (int k = 0; k < 3; ++k) c[k] *= b / l;
+      }
 }
 
 // Runs fn(tile) over the image's tiles on `threads` workers.
@@ -256,14 +287,42 @@ bool fit_pixel(const Plane& color, const Plane& feat, const float* w, size_t n, 
   return true;
 }
 
+// Each channel's minimum and maximum over the 3 x 3 pixels around every pixel (clamped at the
+// border).
+struct LocalRange {
+  Plane lo, hi;
+};
+
+LocalRange local_range(const Plane& color) {
+  LocalRange r{Plane(color.w, color.h, 3), Plane(color.w, color.h, 3)};
+  for (int y = 0; y < color.h; ++y)
+    for (int x = 0; x < color.w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        float lo = kInfinity, hi = -kInfinity;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const float v = color.clamped(x + dx, y + dy)[c];
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+          }
+        r.lo.at(x, y)[c] = lo;
+        r.hi.at(x, y)[c] = hi;
+      }
+  return r;
+}
+
 // Collaborative first-order regression (NFOR section 5.2) of `color` on `feat` with `weights`:
 // every pixel's fit evaluated at each neighbour of its window, and each pixel the weighted
-// mean of the estimates it receives. Tiles of one row of tiles run in parallel into private
-// padded buffers, which are then added in tile order (deterministic for any thread count).
+// mean of the estimates it receives. Each estimate is clamped to the range of the colour
+// around the pixel it is for (3 x 3): a fit extrapolated along the features from a small
+// bright spot the features do not explain (a light's highlight on a mirror) would otherwise
+// draw a streak across the window, or overshoot below zero. Tiles of one row of tiles run in parallel into
+// private padded buffers, which are then added in tile order (deterministic for any thread count).
 Plane regression(const Plane& color, const Plane& feat, const NlmWeights& weights, int tile_size,
                  int threads) {
   const int w = color.w, h = color.h, r = weights.radius();
   std::vector<double> acc(size_t(w) * size_t(h) * 4, 0.0);  // RGB sums and weight sum
+  const LocalRange range = local_range(color);
   const int tiles_x = (w + tile_size - 1) / tile_size;
   std::vector<std::vector<float>> bufs(static_cast<size_t>(tiles_x));
   for (int ty = 0; ty < h; ty += tile_size) {
@@ -290,12 +349,14 @@ Plane regression(const Plane& color, const Plane& feat, const NlmWeights& weight
               if (wj <= 0) continue;
               const float* fj = feat.at(x + dx, y + dy);
               float* o = &buf[(size_t(y - t.y0 + r + dy) * size_t(bw) + size_t(x - t.x0 + r + dx)) * 4];
+              const float* lo = range.lo.at(x + dx, y + dy);
+              const float* hi = range.hi.at(x + dx, y + dy);
               float d[kDenoiseFeatures];
               for (int k = 0; k < kDenoiseFeatures; ++k) d[k] = fj[k] - fc[k];
               for (int c = 0; c < 3; ++c) {
                 float e = beta[0][c];
                 for (int k = 0; k < kDenoiseFeatures; ++k) e += beta[k + 1][c] * d[k];
-                o[c] += wj * e;
+                o[c] += wj * std::clamp(e, lo[c], hi[c]);
               }
               o[3] += wj;
             }
@@ -432,7 +493,8 @@ size_t denoise_bytes(int width, int height, const DenoiseConfig& c) {
   // The peak, in floats per pixel, is in the regressions of steps 2-3: the inputs as planes
   // (20), the colour variance, the halves' mean and its variance (9), the four candidate
   // colours (12), an error map being filtered and the two filtered ones (9), a regression's
-  // output (3) and double accumulators (8); step 4 holds less (the inputs, the two selected
+  // output (3), the 3 x 3 colour range its estimates are clamped to (6) and double accumulators
+  // (8); step 4 holds less (the inputs, the two selected
   // halves and about 40 more). Weights keep padded copies of at most 3 guide and 3 variance
   // channels, and every thread a tile of weights.
   const size_t pixels = size_t(width) * size_t(height);
@@ -442,13 +504,19 @@ size_t denoise_bytes(int width, int height, const DenoiseConfig& c) {
   const size_t tiles_x = (size_t(width) + t - 1) / t;
   const size_t tile_weights = (2 * r + 1) * (2 * r + 1) * t * t + 2 * (t + 2 * f) * (t + 2 * f);
   const size_t row_buffers = tiles_x * (t + 2 * r) * (t + 2 * r) * 4;
-  return (pixels * 61 + padded + size_t(thread_count(c.threads)) * tile_weights + row_buffers) *
+  return (pixels * 67 + padded + size_t(thread_count(c.threads)) * tile_weights + row_buffers) *
          sizeof(float);
 }
 
-std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg) {
+std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg,
+                                const std::function<void(int, int)>& progress) {
   const int w = in.width, h = in.height, ts = cfg.tile_size, th = cfg.threads;
-  const Plane color[2] = {finite_plane(in.color[0], w, h, 3), finite_plane(in.color[1], w, h, 3)};
+  const int steps = cfg.second_pass ? 3 : 2;
+  const auto step_done = [&](int done) {
+    if (progress) progress(done, steps);
+  };
+  Plane color[2] = {finite_plane(in.color[0], w, h, 3), finite_plane(in.color[1], w, h, 3)};
+  remove_spikes(color);
   Plane feat[2];
   fill_missing_depth(in, feat);
 
@@ -462,9 +530,11 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
     feat[0] = std::move(filtered[0]);
     feat[1] = std::move(filtered[1]);
   }
+  step_done(1);
 
   // 2.-3. The two halves, each regressed at the bandwidth selected per pixel.
   const std::array<Plane, 2> result = selected_halves(color, feat, cfg);
+  step_done(2);
 
   // 4. The second pass: the selected halves' mean regressed on the halves' mean features.
   const Plane combined = mean_of(result[0], result[1]);
@@ -472,9 +542,12 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
   const Plane combined_var = mean_variance(result[0], result[1]);
   const Plane feat_mean = mean_of(feat[0], feat[1]), feat_var = mean_variance(feat[0], feat[1]);
   const Plane final_feat = filter_features(feat_mean, feat_mean, feat_var, 2, cfg.patch_radius, 0.5f, ts, th);
-  return regression(combined, final_feat,
-                    NlmWeights(combined, combined_var, cfg.window_radius, cfg.patch_radius, 1.0f), ts, th)
-      .v;
+  std::vector<float> out =
+      regression(combined, final_feat,
+                 NlmWeights(combined, combined_var, cfg.window_radius, cfg.patch_radius, 1.0f), ts, th)
+          .v;
+  step_done(3);
+  return out;
 }
 
 std::vector<float> denoise_cross_bilateral(const DenoiseInput& in, int window_radius, int threads) {

@@ -3,7 +3,10 @@
 // Carlo Renderings"), and a cross-bilateral filter on the same features as the baseline.
 #pragma once
 
-// NFOR in four steps, each a pass over the image in tiles:
+// NFOR in four steps, each a pass over the image in tiles, after firefly removal (a pixel of
+// one half brighter than twice the brightest of the other half's 5 x 5 neighbourhood is scaled
+// down to that bound: a rare path found by one half only, which the regression would spread
+// over whole windows; biased, as a clamp is):
 //   1. Feature prefiltering: each half of each feature (albedo, normal, depth, one group at a
 //      time) filtered by non-local means (Buades et al. 2005) with weights from the other
 //      half's same group, so that noisy
@@ -13,20 +16,24 @@
 //      colour = a + B (f - f(c)) over a (2R+1)^2 window, with non-local-means weights between
 //      c's and each neighbour's patch in the *other* half (Rousselle et al. 2012's
 //      variance-cancelling distance), so that weights and data are independent; the fit is
-//      evaluated at every neighbour and the estimates a pixel receives are averaged. Run for
-//      each half with bandwidths k = 0.5 and 1.
+//      evaluated at every neighbour, each estimate clamped to the colour range of the 3 x 3
+//      pixels around the neighbour (a fit extrapolated from a bright spot the features do not
+//      explain would streak), and the estimates a pixel receives are averaged. Run for each
+//      half with bandwidths k = 0.5 and 1.
 //   3. Bandwidth selection: per pixel, the candidate whose error, estimated from the other
 //      half (E[(F_A - B)^2] - Var B), smoothed by non-local means, is lower; the selection map
 //      is smoothed in turn.
 //   4. A second regression of the two selected halves' mean, guided by itself, with features
 //      and variance from the halves.
 // Variances come from the halves alone (per channel, (A - B)^2 / 2 for a half, averaged over
-// 3 x 3 pixels), so a denoise needs only what the EXR stores. Every step is an affine
-// combination of pixels with weights summing to one, so a constant image stays constant.
+// 3 x 3 pixels), so a denoise needs only what the EXR stores. Every step is a combination of
+// pixels with weights summing to one (clamped to ranges of the image), so a constant image stays
+// constant.
 // Deterministic: tiles scatter into private buffers that are added in tile order, so the output
 // is bit-identical for any thread count.
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace penumbra {
@@ -62,9 +69,12 @@ const char* validate(const DenoiseConfig& config);
 const char* validate(const DenoiseInput& input);
 
 /// The denoised colour (3 floats per pixel) of a valid input under a valid config. Never
-/// throws for valid input; allocates about 61 floats per pixel, padded copies of the weights'
+/// throws for valid input; allocates about 67 floats per pixel, padded copies of the weights'
 /// guides and per-thread tile buffers (denoise_bytes).
-std::vector<float> denoise_nfor(const DenoiseInput& input, const DenoiseConfig& config);
+/// `progress`, if set, is called from the calling thread with (steps done, steps) after the
+/// feature prefilter, the selected halves and the second pass.
+std::vector<float> denoise_nfor(const DenoiseInput& input, const DenoiseConfig& config,
+                                const std::function<void(int done, int total)>& progress = {});
 
 /// Bytes denoise_nfor allocates at most for an image of width x height.
 size_t denoise_bytes(int width, int height, const DenoiseConfig& config);

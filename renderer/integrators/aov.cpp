@@ -5,12 +5,13 @@
 #include <cmath>
 
 #include "renderer/core/parallel.h"
+#include "renderer/film/denoise.h"
 #include "renderer/integrators/visibility.h"
 #include "renderer/materials/material.h"
 
 namespace penumbra {
 
-DataAovs make_data_aovs(const PixelWindow& win) {
+DataAovs make_data_aovs(const PixelWindow& win, bool halves) {
   DataAovs a;
   a.width = win.width();
   a.height = win.height();
@@ -22,6 +23,7 @@ DataAovs make_data_aovs(const PixelWindow& win) {
   a.depth.assign(n, kInfinity);
   a.object_id.assign(n, 0.0f);
   a.material_id.assign(n, 0.0f);
+  if (halves) a.halves.assign(n * 2 * kDenoiseFeatures, 0.0f);
   return a;
 }
 
@@ -32,15 +34,29 @@ void AovPixel::clear() {
   m_depth = kInfinity;
   m_objects.clear();
   m_materials.clear();
+  for (int h = 0; h < 2; ++h) {
+    m_half_samples[h] = m_half_hits[h] = 0;
+    m_half_albedo[h] = m_half_normal[h] = Vec3f{};
+    m_half_depth[h] = kInfinity;
+  }
 }
 
-void AovPixel::add_miss() {
+void AovPixel::add_miss(uint32_t s) {
   m_objects.push_back(0);
   m_materials.push_back(0);
+  ++m_half_samples[s & 1u];
 }
 
-void AovPixel::add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp,
-                       float depth) {
+void AovPixel::add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
+                       uint32_t s, const DenoiseFeature* feature) {
+  const int h = int(s & 1u);
+  ++m_half_samples[h];
+  if (!feature || feature->hit) {
+    ++m_half_hits[h];
+    m_half_albedo[h] += feature ? feature->albedo : mp.base_color;
+    m_half_normal[h] += feature ? feature->normal : mp.ns;
+    m_half_depth[h] = std::min(m_half_depth[h], feature ? feature->depth : depth);
+  }
   m_albedo += mp.base_color;
   m_normal += mp.ns;
   m_position += si.p;
@@ -89,12 +105,64 @@ void AovPixel::store(DataAovs& a, size_t i, int spp) {
     a.uv[i * 2] = m_uv.x * inv;
     a.uv[i * 2 + 1] = m_uv.y * inv;
   }
+  if (a.halves.empty()) return;
+  for (int h = 0; h < 2; ++h) {
+    // A pixel of one sample has no odd half: the even one stands in for it.
+    const int src = m_half_samples[h] > 0 ? h : 0;
+    float* f = &a.halves[(i * 2 + size_t(h)) * kDenoiseFeatures];
+    const float inv_n = m_half_samples[src] > 0 ? 1.0f / float(m_half_samples[src]) : 0.0f;
+    const Vec3f nn = m_half_hits[src] > 0 ? normalize(m_half_normal[src]) : Vec3f{};
+    for (int c = 0; c < 3; ++c) {
+      f[c] = m_half_albedo[src][c] * inv_n;
+      f[3 + c] = nn[c];
+    }
+    f[6] = m_half_depth[src];
+  }
+}
+
+DenoiseFeature denoise_feature(const Scene& scene, const Accelerator& accel, const Ray& ray,
+                               const SurfaceInteraction& first, const MaterialPoint& first_mp, float depth,
+                               bool filter) {
+  constexpr int kMaxSmooth = 4;
+  DenoiseFeature f;
+  Vec3f tint{1, 1, 1};
+  SurfaceInteraction si = first;
+  MaterialPoint mp = first_mp;
+  Ray r = ray;
+  float travelled = 0;  // after the first hit
+  for (int bounce = 0;; ++bounce) {
+    const bool mirror = mp.metallic >= 0.9f && mp.roughness <= 0.1f;
+    const bool glass = !mirror && mp.transmission >= 0.9f && mp.roughness <= 0.1f;
+    if ((!mirror && !glass) || bounce == kMaxSmooth) {
+      f.hit = true;
+      f.albedo = tint * (mp.base_color + mp.emissive);  // a light differs from a white wall
+      f.normal = mp.ns;
+      f.depth = depth + travelled;
+      return f;
+    }
+    tint = tint * mp.base_color;
+    const Vec3f d = normalize(r.dir);
+    Vec3f next = reflect(d, mp.ns);
+    if (glass) {  // Snell's law through the shading normal (total internal reflection: reflect)
+      const float cosi = std::min(1.0f, -dot(d, mp.ns));
+      const float eta = si.back_face ? mp.ior : 1 / mp.ior;
+      const float k = 1 - eta * eta * (1 - cosi * cosi);
+      if (k >= 0) next = d * eta + mp.ns * (eta * cosi - std::sqrt(k));
+    }
+    Ray n{spawn_origin(si, next), 0, next, kInfinity, r.time};
+    Hit hit;
+    if (!intersect_visible(scene, accel, n, hit, filter)) return f;  // reflects the background
+    travelled += hit.t * length(next);
+    si = make_interaction(scene, n, hit);
+    mp = eval_material(scene, si);
+    r = n;
+  }
 }
 
 DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, IntegratorType integrator) {
   const PixelWindow win = render_window(config);
-  DataAovs a = make_data_aovs(win);
+  DataAovs a = make_data_aovs(win, config.halves);
   const bool filter = scene_needs_hit_filter(scene);
   TileScheduler scheduler(win, config.tile_size, config.threads);
   scheduler.for_each_tile([&](const PixelWindow& tile) {
@@ -107,11 +175,18 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
           const Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           Hit hit;
           if (!intersect_visible(scene, accel, ray, hit, filter)) {
-            pixel.add_miss();
+            pixel.add_miss(s);
             continue;
           }
           const SurfaceInteraction si = make_interaction(scene, ray, hit);
-          pixel.add_hit(scene, si, eval_material(scene, si), dot(si.p - camera.eye, -camera.w));
+          const MaterialPoint mp = eval_material(scene, si);
+          const float depth = dot(si.p - camera.eye, -camera.w);
+          if (a.halves.empty()) {
+            pixel.add_hit(scene, si, mp, depth, s);
+          } else {
+            const DenoiseFeature f = denoise_feature(scene, accel, ray, si, mp, depth, filter);
+            pixel.add_hit(scene, si, mp, depth, s, &f);
+          }
         }
         pixel.store(a, i, config.spp);
       }

@@ -30,20 +30,46 @@ struct DataAovs {
   std::vector<float> depth;        ///< 1 per pixel
   std::vector<float> object_id;    ///< 1 per pixel (integer values)
   std::vector<float> material_id;  ///< 1 per pixel (integer values)
+  /// With RenderConfig::halves: 2 x kDenoiseFeatures floats per pixel, albedo, N and Z as above
+  /// over the pixel's even-numbered samples, then over its odd-numbered ones (the denoiser's
+  /// features); else empty.
+  std::vector<float> halves;
 };
 
-/// Data AOVs covering `window`, cleared to their background values (0, and +inf for Z).
-DataAovs make_data_aovs(const PixelWindow& window);
+/// What the denoiser's feature halves record of one camera sample.
+struct DenoiseFeature {
+  bool hit = false;         ///< false: the sample ends in the background (albedo 0, depth +inf)
+  Vec3f albedo, normal;     ///< the surface's, tinted by the smooth surfaces seen it through
+  float depth = kInfinity;  ///< camera depth of the first hit plus the distance travelled after it
+};
+
+/// The denoiser's features of camera ray `ray`, whose first visible surface is si (values mp,
+/// camera depth `depth`): the first surface that is not a smooth mirror (metallic >= 0.9,
+/// roughness <= 0.1) or smooth glass (transmission >= 0.9, roughness <= 0.1), followed through
+/// up to 4 of them by reflection or refraction, with their base colours multiplied into its
+/// albedo (base colour plus emission, so that a light stands apart from a white surface). A mirror's
+/// reflection then brings its own edges to the denoiser, as in production denoisers' guides.
+DenoiseFeature denoise_feature(const Scene& scene, const Accelerator& accel, const Ray& ray,
+                               const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
+                               bool filter);
+
+/// Data AOVs covering `window`, cleared to their background values (0, and +inf for Z), with
+/// the halves when `halves` is set.
+DataAovs make_data_aovs(const PixelWindow& window, bool halves = false);
 
 /// The per-pixel reduction above, sample by sample: what render_data_aovs and the raster
 /// integrator's AOVs share. clear() before each pixel; store() writes pixel i of the AOVs.
 class AovPixel {
  public:
   void clear();
-  /// A sample that sees nothing.
-  void add_miss();
-  /// A sample whose first visible surface is si (material values mp) at camera depth `depth`.
-  void add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth);
+  /// A sample (number `s` of the pixel) that sees nothing.
+  void add_miss(uint32_t s = 0);
+  /// Sample `s` of the pixel, whose first visible surface is si (material values mp) at camera
+  /// depth `depth`. `feature`, if given, is what the halves record instead of the first hit's
+  /// albedo, normal and depth (denoise_feature).
+  void add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
+               uint32_t s = 0, const DenoiseFeature* feature = nullptr);
+  /// Writes pixel i; the halves too when aovs.halves is not empty.
   void store(DataAovs& aovs, size_t i, int spp);
 
  private:
@@ -51,6 +77,10 @@ class AovPixel {
   Vec2f m_uv;
   int m_hits = 0;
   float m_depth = kInfinity;
+  // Per half (even, odd sample numbers): samples, hits, albedo and normal sums, nearest depth.
+  int m_half_samples[2] = {0, 0}, m_half_hits[2] = {0, 0};
+  Vec3f m_half_albedo[2], m_half_normal[2];
+  float m_half_depth[2] = {kInfinity, kInfinity};
   std::vector<uint32_t> m_objects, m_materials;
 };
 

@@ -204,10 +204,11 @@ namespace {
 using PixelAccum = PathAccumulators::Pixel;
 
 // Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`,
-// kLightGroupChannels sums, if not null).
+// kLightGroupChannels sums, and the odd-numbered samples' RGBA to `odd`, if not null).
 void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                   const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
-                  uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr) {
+                  uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr,
+                  double* odd = nullptr) {
   const float step = differential_step(config.spp);
   // The differential rays of camera ray p, made only for a first hit that needs them.
   struct Footprint {
@@ -237,6 +238,12 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
     acc.rgba[1] += l.y;
     acc.rgba[2] += l.z;
     acc.rgba[3] += coverage;
+    if (odd && (s & 1u)) {
+      odd[0] += l.x;
+      odd[1] += l.y;
+      odd[2] += l.z;
+      odd[3] += coverage;
+    }
     const double y_lum = luminance(l);
     acc.sum_y += y_lum;
     acc.sum_y2 += y_lum * y_lum;
@@ -277,6 +284,18 @@ PathImage resolve_path_image(const PathAccumulators& state, const RenderConfig& 
       for (size_t k = 0; k < kG; ++k)
         image.groups[i * kG + k] = acc.n ? float(state.groups[i * kG + k] / acc.n) : 0.0f;
     }
+    if (!state.odd.empty()) {
+      if (image.halves.empty()) image.halves.assign(npix * kHalfChannels, 0.0f);
+      // Samples 0, 2, 4, ... are the even half, 1, 3, ... the odd one.
+      const uint32_t n_odd = acc.n / 2, n_even = acc.n - n_odd;
+      float* h = &image.halves[i * kHalfChannels];
+      for (int c = 0; c < 3; ++c) {
+        const double odd_sum = state.odd[i * 4 + size_t(c)];
+        const double even = n_even ? (acc.rgba[c] - odd_sum) / n_even : 0.0;
+        h[c] = float(even);
+        h[3 + c] = n_odd ? float(odd_sum / n_odd) : float(even);
+      }
+    }
     if (acc.n >= 2) {
       const double mean = acc.sum_y / acc.n;
       image.variance[i] = float(std::max(0.0, (acc.sum_y2 - acc.sum_y * mean) / double(acc.n - 1)) / acc.n);
@@ -289,7 +308,8 @@ bool matches(const PathAccumulators& state, const RenderConfig& config) {
   const PixelWindow w = render_window(config);
   return state.window.x0 == w.x0 && state.window.y0 == w.y0 && state.window.x1 == w.x1 &&
          state.window.y1 == w.y1 && state.pixels.size() == size_t(w.width()) * size_t(w.height()) &&
-         state.groups.size() == (config.light_groups ? state.pixels.size() * kLightGroupChannels : 0);
+         state.groups.size() == (config.light_groups ? state.pixels.size() * kLightGroupChannels : 0) &&
+         state.odd.size() == (config.halves ? state.pixels.size() * 4 : 0);
 }
 
 PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLights& lights,
@@ -307,6 +327,7 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
     state.window = win;
     state.pixels.assign(npix, PixelAccum{});
     state.groups.assign(config.light_groups ? npix * kLightGroupChannels : 0, 0.0);
+    state.odd.assign(config.halves ? npix * 4 : 0, 0.0);
   }
   std::vector<PixelAccum>& accum = state.pixels;
   std::vector<double>& group_sums = state.groups;
@@ -338,7 +359,8 @@ PathImage render_path(const Scene& scene, const Accelerator& accel, const PathLi
           PixelAccum& acc = accum[pi];
           if (!acc.active) continue;
           path_samples(scene, accel, lights, camera, config, pc, x, y, begin, end, acc, counts,
-                       group_sums.empty() ? nullptr : &group_sums[pi * kLightGroupChannels]);
+                       group_sums.empty() ? nullptr : &group_sums[pi * kLightGroupChannels],
+                       state.odd.empty() ? nullptr : &state.odd[pi * 4]);
           if (adaptive && acc.n >= min_spp &&
               pixel_error(acc.sum_y, acc.sum_y2, acc.n) < config.adaptive_threshold)
             acc.active = false;

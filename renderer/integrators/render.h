@@ -58,7 +58,14 @@ struct PathImage {
   /// With RenderConfig::light_groups: kLightGroupChannels floats per pixel, the means of the
   /// light groups in kLightGroupNames order (RGB each).
   std::vector<float> groups;
+  /// With RenderConfig::halves: kHalfChannels floats per pixel, the mean RGB (premultiplied) of
+  /// the pixel's even-numbered samples, then of its odd-numbered ones (the even mean again for a
+  /// pixel of one sample).
+  std::vector<float> halves;
 };
+
+/// Floats per pixel of PathImage::halves.
+inline constexpr int kHalfChannels = 6;
 
 /// The path tracer's per-pixel running sums, accumulated in each pixel's sample order: what a
 /// checkpoint saves and a resumed render continues from (plain data, written as raw bytes).
@@ -72,9 +79,11 @@ struct PathAccumulators {
   PixelWindow window;  ///< the render window the pixels cover
   std::vector<Pixel> pixels;
   std::vector<double> groups;  ///< kLightGroupChannels light-group sums per pixel, or empty
-  uint32_t reached = 0;        ///< samples every still-active pixel has taken
-  int passes = 0;              ///< passes completed
-  bool complete = false;       ///< the requested spp (or adaptive convergence) was reached
+  /// With RenderConfig::halves: 4 sums per pixel (RGBA) of its odd-numbered samples, or empty.
+  std::vector<double> odd;
+  uint32_t reached = 0;   ///< samples every still-active pixel has taken
+  int passes = 0;         ///< passes completed
+  bool complete = false;  ///< the requested spp (or adaptive convergence) was reached
 };
 
 /// Bytes of one pixel's accumulators as a checkpoint stores them (raw, native byte order).

@@ -49,8 +49,11 @@ struct RenderConfig {
   float adaptive_threshold = 0;  ///< finite >= 0; > 0: stop a pixel once its error estimate is below this
   int adaptive_min_spp = 16;     ///< [2, kMaxSpp]: samples every pixel takes before it may stop
   bool light_groups = false;     ///< also accumulate the LightGroups split (PathImage::groups)
-  bool motion_blur = false;      ///< give each camera sample a time in the shutter (Ray::time), for
-                                 ///< scenes with motion (Scene::instance_motion)
+  /// Also keep the means of each pixel's even- and odd-numbered samples apart (PathImage::halves,
+  /// DataAovs::halves): two independent estimates of every pixel, what the denoiser reads.
+  bool halves = false;
+  bool motion_blur = false;  ///< give each camera sample a time in the shutter (Ray::time), for
+                             ///< scenes with motion (Scene::instance_motion)
   /// Only these pixels of the width x height frame (crops, farm tiles); all zero = the whole
   /// frame, else non-empty and inside the frame. Every pixel is computed exactly as in the
   /// whole frame, so parts merge bit for bit.

@@ -155,7 +155,7 @@ expect 0 '^camera 576 shadow [0-9]+ bounce [0-9]+$' -- json_field "$work/st.json
 expect 0 '^True$' -- json_field "$work/st.json" 'all(isinstance(j["seconds"][k], float) and j["seconds"][k] >= 0 for k in ("load", "build", "render", "write"))' 
 expect 2 "--stats-json .*nodir" -- "$bin" render "$d" -o "$work/st.exr" --stats-json "$work/nodir/s.json"
 # AOVs: names, refusals, the layers and metadata as compositors read them (oiiotool, exrheader).
-expect 2 "unknown AOV 'depth' \(known: albedo, N, P, Z, UV, id, samples, variance, light, cost, crypto_object, crypto_material, crypto_asset, vector, velocity, all\)" -- "$bin" render "$d" -o "$work/v.exr" --aov depth
+expect 2 "unknown AOV 'depth' \(known: albedo, N, P, Z, UV, id, samples, variance, light, halves, cost, crypto_object, crypto_material, crypto_asset, vector, velocity, all\)" -- "$bin" render "$d" -o "$work/v.exr" --aov depth
 expect 2 "--aov samples needs --integrator path" -- "$bin" render "$d" -o "$work/v.exr" --aov albedo,samples
 expect 0 "wa.exr" -- "$bin" render "$d" -o "$work/wa.exr" --width 48 --spp 2 --aov all -q --no-png
 expect 0 "pa.exr" -- "$bin" render "$d" -o "$work/pa.exr" --integrator path --width 48 --spp 4 --aov all -q --no-png

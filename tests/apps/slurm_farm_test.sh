@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `penumbra submit slurm` on a throw-away single-node Slurm cluster (tests/apps/slurm_cluster.sh):
-# a job of 2 shots x 3 frames, frame 2 of the second shot tiled 4 ways, goes in as one array job
+# a job of 2 shots x 3 frames, frame 2 of the second (denoised) shot tiled 4 ways, goes in as one array job
 # of 9 units and a merge job after it; every frame (EXR and PNG) must be byte-identical (cmp) to
 # `penumbra batch` of the same shots in one local process, and no stripe may be left. Then one
 # finished frame is deleted and two others are rendered again, one of whose tasks is cancelled
@@ -38,7 +38,7 @@ write_job() {  # write_job FILE OUTPUT_FOLDER
      "output": "$2/sh010.####.exr", "png": "$2/sh010.####.png", "settings": {"spp": 2}},
     {"name": "sh020", "scene": "$src/scenes/spheres.gltf", "frames": "1-3", "tiles": 4, "tile_frames": "2",
      "output": "$2/sh020.####.exr", "png": "$2/sh020.####.png",
-     "settings": {"integrator": "path", "spp": 256, "width": 96, "height": 54, "aov": ["Z", "N"]}}
+     "settings": {"integrator": "path", "spp": 256, "width": 96, "height": 54, "aov": ["Z", "N"], "denoise": true}}
   ]
 }
 EOF

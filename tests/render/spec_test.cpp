@@ -82,6 +82,7 @@ TEST_CASE("spec: every identity field changes the identity, the others do not", 
       RenderSpec base = with_integrator(integrator);
       if (needs_aperture(f)) base.aperture_radius = 0.5f;
       if (needs_motion_blur(f)) base.motion_blur = true;
+      if (f.name == std::string("denoise_main")) base.denoise = true;
       const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
       RenderSpec changed = base;
       perturb(changed, f);
@@ -220,6 +221,26 @@ TEST_CASE("spec: the lens takes one aperture, one focus, and its other settings 
       if (f.name == std::string(field)) perturb(pinhole, f);
     CHECK_THROWS_WITH(validate(pinhole), Catch::Contains(std::string(field) + " needs depth of field"));
   }
+}
+
+TEST_CASE("spec: denoise keeps the halves, needs two samples, and denoise_main needs it", "[spec]") {
+  RenderSpec s = with_integrator("path");
+  s.denoise_main = "noisy";
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("denoise_main needs denoise"));
+  s.denoise = true;
+  REQUIRE_NOTHROW(validate(s));
+  const RenderSpec r = resolve(s, 1.5f);
+  CHECK(r.aovs.count("halves") == 1);
+  CHECK(make_render_config(r).halves);
+  CHECK(render_identity(r, frame_bounds(Bounds3f{{-1, -1, -1}, {1, 1, 1}}, 1.5f), {}).entries.at("halves") ==
+        "1");
+  s.spp = 1;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("denoise needs spp >= 2"));
+  CHECK_FALSE(make_render_config(resolve(with_integrator("path"), 1.5f)).halves);
+  // "all" leaves the halves out (twenty float channels only a denoiser reads); they are path-only.
+  CHECK(check_aovs({"all"}, "path").count("halves") == 0);
+  CHECK(check_aovs({"halves"}, "path").count("halves") == 1);
+  CHECK_THROWS_WITH(check_aovs({"halves"}, "whitted"), Catch::Contains("'halves' needs integrator 'path'"));
 }
 
 }  // namespace penumbra

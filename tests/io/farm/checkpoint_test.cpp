@@ -33,6 +33,8 @@ PathAccumulators sample_state() {
     st.pixels[i].sum_y2 = 1.0 / 3.0;
   }
   st.groups.assign(8 * 15, 0.25);
+  for (const auto& p : st.pixels)  // the odd samples' sums: half the colour, a quarter of the coverage
+    for (const double v : {p.rgba[0] / 2, 0.0, 0.0, p.rgba[3] / 2}) st.odd.push_back(v);
   st.reached = 16;
   st.passes = 5;
   return st;
@@ -75,6 +77,7 @@ TEST_CASE("checkpoint: round trip, settings check and damaged files", "[io][chec
   REQUIRE(back.pixels.size() == 8);
   CHECK(std::memcmp(back.pixels.data(), st.pixels.data(), 8 * sizeof(PathAccumulators::Pixel)) == 0);
   CHECK(back.groups == st.groups);
+  CHECK(back.odd == st.odd);
 
   REQUIRE_THROWS_WITH(
       read_checkpoint(dir / "a.resume", settings("settings B")),
@@ -117,9 +120,9 @@ TEST_CASE("checkpoint: one flipped byte anywhere is refused, outside the magic a
   const auto dir = test::temp_dir("checkpoint-flip");
   write_checkpoint(dir / "good.resume", sample_state(), settings("A"));
   const std::string good = read_bytes(dir / "good.resume");
-  const size_t settings_begin = 64, settings_end = settings_begin + canonical_text(settings("A")).size();
+  const size_t settings_begin = 72, settings_end = settings_begin + canonical_text(settings("A")).size();
   const size_t digest_begin = good.size() - 32;
-  const auto is_size_field = [](size_t i) { return i >= 36 && i < 64; };  // pixel size and the three counts
+  const auto is_size_field = [](size_t i) { return i >= 36 && i < 72; };  // pixel size and the four counts
   int checksum_errors = 0, regions[4] = {0, 0, 0, 0};
   for (size_t i = 0; i < good.size(); ++i) {
     std::string bad = good;
@@ -139,10 +142,10 @@ TEST_CASE("checkpoint: one flipped byte anywhere is refused, outside the magic a
       ++regions[i < settings_begin ? 0 : i < settings_end ? 1 : i < digest_begin ? 2 : 3];
     }
   }
-  CHECK(checksum_errors == int(good.size()) - 8 - 28);
+  CHECK(checksum_errors == int(good.size()) - 8 - 36);
   CHECK(regions[0] == 28);  // header: window, reached, passes, complete
   CHECK(regions[1] > 0);    // settings
-  CHECK(regions[2] == 8 * 56 + 8 * 15 * 8);
+  CHECK(regions[2] == 8 * 56 + 8 * 15 * 8 + 8 * 4 * 8);
   CHECK(regions[3] == 32);
   std::filesystem::remove_all(dir);
 }
@@ -162,7 +165,7 @@ TEST_CASE("checkpoint: truncated, extended and absurdly sized files are refused 
   CHECK_THAT(error_of(dir / "t.resume", settings("A")), Contains("truncated or corrupt"));
   // Counts near 2^64 (that would overflow a naive size sum) or 2^40 pixels.
   for (const uint64_t count : {~uint64_t(0), ~uint64_t(0) / 56 + 1, uint64_t(1) << 40}) {
-    for (const size_t field : {size_t(40), size_t(48), size_t(56)}) {
+    for (const size_t field : {size_t(40), size_t(48), size_t(56), size_t(64)}) {
       std::string bad = good;
       std::memcpy(&bad[field], &count, 8);
       write_bytes(dir / "h.resume", bad);
@@ -193,6 +196,10 @@ TEST_CASE("checkpoint: the old format without a checksum is refused with a clear
   write_bytes(dir / "old.resume", old);
   CHECK_THAT(error_of(dir / "old.resume", settings("A")),
              Contains("old.resume") && Contains("old format") && Contains("delete it"));
+  // PNMBRCK2: sealed, but without the odd-sample sums' count.
+  write_bytes(dir / "old2.resume", "PNMBRCK2" + std::string(56, '\0'));
+  CHECK_THAT(error_of(dir / "old2.resume", settings("A")),
+             Contains("old2.resume") && Contains("PNMBRCK2") && Contains("delete it"));
   std::filesystem::remove_all(dir);
 }
 
@@ -239,6 +246,16 @@ TEST_CASE("checkpoint: well-sealed files with impossible values are refused", "[
       {"empty window", [](PathAccumulators& s) { s.window = {}; }, "empty"},
       {"light groups of another size", [](PathAccumulators& s) { s.groups.resize(8 * 14); },
        "light-group sums for 8"},
+      {"odd sums of another size", [](PathAccumulators& s) { s.odd.resize(8 * 3); }, "odd-sample sums for 8"},
+      {"NaN odd sum", [](PathAccumulators& s) { s.odd[6] = std::nan(""); }, "odd-sample sum"},
+      {"odd sum above the pixel's", [](PathAccumulators& s) { s.odd[4] = s.pixels[1].rgba[0] + 1; },
+       "odd-sample sum"},
+      {"odd coverage above the odd samples",
+       [](PathAccumulators& s) {
+         s.pixels[1].rgba[3] = 12;
+         s.odd[7] = 10;
+       },
+       "odd-sample coverage"},
       {"negative passes", [](PathAccumulators& s) { s.passes = -1; }, "passes"},
       {"more passes than samples", [](PathAccumulators& s) { s.passes = 17; }, "passes"},
       {"samples without passes", [](PathAccumulators& s) { s.passes = 0; }, "without a completed pass"},

@@ -1,0 +1,44 @@
+// Reading and writing an OpenEXR file part by part in its native channel types, shared by
+// `penumbra merge` and `penumbra denoise`: the header check that comes before OpenImageIO sees
+// the file, the parts' specs, and the atomic multi-part write.
+#pragma once
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace penumbra::exr_parts {
+
+/// Bytes of one EXR part's pixels: its data window, or its display window when `full`.
+double image_bytes(const OIIO::ImageSpec& spec, bool full);
+
+/// Throws InputError naming `path` unless its header (of a file of `size` bytes) is one
+/// OpenImageIO can read safely: attributes that describe their own bytes, windows of at most
+/// 65536 pixels a side.
+void check_exr_header(const std::filesystem::path& path, uint64_t size);
+
+/// The file opened for reading; throws InputError naming it if it is not a readable OpenEXR.
+std::unique_ptr<OIIO::ImageInput> open_part(const std::string& name);
+
+/// The specs of every EXR part of `in`, checked to share one non-empty data window inside one
+/// display window at the origin (not deep). Throws InputError naming `name`.
+std::vector<OIIO::ImageSpec> read_specs(OIIO::ImageInput& in, const std::string& name);
+
+/// Writes `specs` with `pixels` (per part, its data window in the part's native channel types;
+/// with `whole_frame`, the specs' windows are widened to the display window and `pixels` cover
+/// it) to `out` atomically; `sha256`, if not null, receives the file's SHA-256.
+void write_frame(const std::filesystem::path& out, std::vector<OIIO::ImageSpec> specs,
+                 const std::vector<std::vector<unsigned char>>& pixels, bool whole_frame = true,
+                 std::string* sha256 = nullptr);
+
+/// Cryptomatte manifests kept in sidecar files (cryptomatte/<key>/manif_file, relative to the
+/// EXR) follow the image: each is copied from beside `first` to beside `out` ("OUT.{name}.json")
+/// and the attribute renamed in every part's header.
+void move_crypto_sidecars(const std::filesystem::path& first, const std::filesystem::path& out,
+                          std::vector<OIIO::ImageSpec>& specs);
+
+}  // namespace penumbra::exr_parts
