@@ -263,7 +263,7 @@ bool fit_pixel(const Plane& color, const Plane& feat, const float* w, size_t n, 
       const float* cj = color.at(x + dx, y + dy);
       for (int p = 0; p < kDims; ++p) {
         const float wr = wj * row[p];
-        for (int q = 0; q < kDims; ++q) af[p][q] += wr * row[q];
+        for (int q = 0; q <= p; ++q) af[p][q] += wr * row[q];  // the lower triangle: A is symmetric
         for (int c = 0; c < 3; ++c) bf[p][c] += wr * cj[c];
       }
     }

@@ -44,7 +44,10 @@ void AovPixel::clear() {
 void AovPixel::add_miss(uint32_t s) {
   m_objects.push_back(0);
   m_materials.push_back(0);
+  // The halves see the background as white: an edge's albedo is then the same blend of the
+  // object's and the background's as its colour, which a first-order fit can follow.
   ++m_half_samples[s & 1u];
+  m_half_albedo[s & 1u] += Vec3f{1, 1, 1};
 }
 
 void AovPixel::add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
@@ -136,7 +139,7 @@ DenoiseFeature denoise_feature(const Scene& scene, const Accelerator& accel, con
     if ((!mirror && !glass) || bounce == kMaxSmooth) {
       f.hit = true;
       f.albedo = tint * (mp.base_color + mp.emissive);  // a light differs from a white wall
-      f.normal = mp.ns;
+      f.normal = first_mp.ns;
       f.depth = depth + travelled;
       return f;
     }
@@ -151,7 +154,14 @@ DenoiseFeature denoise_feature(const Scene& scene, const Accelerator& accel, con
     }
     Ray n{spawn_origin(si, next), 0, next, kInfinity, r.time};
     Hit hit;
-    if (!intersect_visible(scene, accel, n, hit, filter)) return f;  // reflects the background
+    if (!intersect_visible(scene, accel, n, hit, filter)) {
+      // Reflects the background: the smooth surfaces' own colour (a mirror's texture) and the
+      // last one's normal remain the features; the depth is a miss's.
+      f.hit = true;
+      f.albedo = tint;
+      f.normal = first_mp.ns;
+      return f;
+    }
     travelled += hit.t * length(next);
     si = make_interaction(scene, n, hit);
     mp = eval_material(scene, si);

@@ -31,8 +31,9 @@ struct DataAovs {
   std::vector<float> object_id;    ///< 1 per pixel (integer values)
   std::vector<float> material_id;  ///< 1 per pixel (integer values)
   /// With RenderConfig::halves: 2 x kDenoiseFeatures floats per pixel, albedo, N and Z as above
-  /// over the pixel's even-numbered samples, then over its odd-numbered ones (the denoiser's
-  /// features); else empty.
+  /// over the pixel's even-numbered samples, then over its odd-numbered ones, seen through
+  /// smooth mirrors and glass (denoise_feature), with the background counted as white albedo:
+  /// the denoiser's features; else empty.
   std::vector<float> halves;
 };
 
@@ -47,7 +48,9 @@ struct DenoiseFeature {
 /// camera depth `depth`): the first surface that is not a smooth mirror (metallic >= 0.9,
 /// roughness <= 0.1) or smooth glass (transmission >= 0.9, roughness <= 0.1), followed through
 /// up to 4 of them by reflection or refraction, with their base colours multiplied into its
-/// albedo (base colour plus emission, so that a light stands apart from a white surface). A mirror's
+/// albedo (base colour plus emission, so that a light stands apart from a white surface). A
+/// reflection of the background keeps the smooth surfaces' colours as albedo, the last one's
+/// normal and an infinite depth. A mirror's
 /// reflection then brings its own edges to the denoiser, as in production denoisers' guides.
 DenoiseFeature denoise_feature(const Scene& scene, const Accelerator& accel, const Ray& ray,
                                const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
