@@ -47,6 +47,28 @@ void fill_missing_depth(const DenoiseInput& in, Plane out[2]) {
   }
 }
 
+float luminance(const float* c) {
+  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+// Per pixel, `scale` times the (rank+1)-th largest luminance of `src` over the (2 radius + 1)^2
+// pixels around it (clamped at the border; without the pixel itself if `skip_centre`), plus
+// 1e-3.
+Plane luminance_bound(const Plane& src, int radius, bool skip_centre, int rank, float scale) {
+  Plane bound(src.w, src.h, 1);
+  std::array<float, 25> n{};
+  for (int y = 0; y < src.h; ++y)
+    for (int x = 0; x < src.w; ++x) {
+      size_t k = 0;
+      for (int dy = -radius; dy <= radius; ++dy)
+        for (int dx = -radius; dx <= radius; ++dx)
+          if (!skip_centre || dx != 0 || dy != 0) n[k++] = luminance(src.clamped(x + dx, y + dy));
+      std::nth_element(n.begin(), n.begin() + rank, n.begin() + std::ptrdiff_t(k), std::greater<float>());
+      bound.at(x, y)[0] = scale * n[size_t(rank)] + 1e-3f;
+    }
+  return bound;
+}
+
 // Firefly removal: a pixel of one half whose luminance exceeds twice the brightest pixel of the
 // other half's 5 x 5 neighbourhood is scaled down to that bound. A sample that rarely finds a
 // bright path (a caustic through a mirror) lands in one half only; left in, the regression
@@ -55,25 +77,49 @@ void fill_missing_depth(const DenoiseInput& in, Plane out[2]) {
 // rare paths' energy is dropped, as a clamp drops it); spreading the energy instead measured
 // far worse in relative error, since one 16-spp draw of such paths is far from their mean.
 void remove_spikes(Plane color[2]) {
-  const int w = color[0].w, h = color[0].h;
-  const auto lum = [](const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; };
-  Plane bound[2] = {Plane(w, h, 1), Plane(w, h, 1)};
+  const Plane bound[2] = {luminance_bound(color[1], 2, false, 0, 2.0f),
+                          luminance_bound(color[0], 2, false, 0, 2.0f)};
   for (int s = 0; s < 2; ++s)
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        float m = 0;
-        for (int dy = -2; dy <= 2; ++dy)
-          for (int dx = -2; dx <= 2; ++dx) m = std::max(m, lum(color[1 - s].clamped(x + dx, y + dy)));
-        bound[s].at(x, y)[0] = 2 * m + 1e-3f;
-      }
-  for (int s = 0; s < 2; ++s)
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
+    for (int y = 0; y < color[s].h; ++y)
+      for (int x = 0; x < color[s].w; ++x) {
         float* c = color[s].at(x, y);
-        const float l = lum(c), b = bound[s].at(x, y)[0];
+        const float l = luminance(c), b = bound[s].at(x, y)[0];
         if (l > b)
           for (int k = 0; k < 3; ++k) c[k] *= b / l;
       }
+}
+
+// Isolated highlights: a pixel whose luminance, in both halves, exceeds 4 times the third
+// brightest of its 8 neighbours in that half (a glint of a point light, one pixel or a
+// one-pixel line, in focus) is scaled down to that bound before the regression, and the excess
+// (the halves' mean) returned, to be added back to the filtered image. Left in, the regression
+// spreads it over its neighbours (each window's fit sees it); taken out, it stays sharp and
+// its energy stays in its pixel. Noise rarely passes the test in both independent halves.
+Plane split_highlights(Plane color[2]) {
+  const int w = color[0].w, h = color[0].h;
+  const Plane bound[2] = {luminance_bound(color[0], 1, true, 2, 4.0f),
+                          luminance_bound(color[1], 1, true, 2, 4.0f)};
+  Plane residual(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float l0 = luminance(color[0].at(x, y)), l1 = luminance(color[1].at(x, y));
+      const float b0 = bound[0].at(x, y)[0], b1 = bound[1].at(x, y)[0];
+      if (!(l0 > b0 && l1 > b1)) continue;
+      for (int s = 0; s < 2; ++s) {
+        float* c = color[s].at(x, y);
+        const float f = (s == 0 ? b0 / l0 : b1 / l1);
+        for (int i = 0; i < 3; ++i) {
+          residual.at(x, y)[i] += 0.5f * c[i] * (1 - f);
+          c[i] *= f;
+        }
+      }
+    }
+  return residual;
+}
+
+// Adds `residual` to the 3-channel image `out`.
+void add_residual(std::vector<float>& out, const Plane& residual) {
+  for (size_t i = 0; i < out.size(); ++i) out[i] += residual.v[i];
 }
 
 // Runs fn(tile) over the image's tiles on `threads` workers.
@@ -491,12 +537,11 @@ const char* validate(const DenoiseInput& in) {
 
 size_t denoise_bytes(int width, int height, const DenoiseConfig& c) {
   // The peak, in floats per pixel, is in the regressions of steps 2-3: the inputs as planes
-  // (20), the colour variance, the halves' mean and its variance (9), the four candidate
-  // colours (12), an error map being filtered and the two filtered ones (9), a regression's
-  // output (3), the 3 x 3 colour range its estimates are clamped to (6) and double accumulators
-  // (8); step 4 holds less (the inputs, the two selected
-  // halves and about 40 more). Weights keep padded copies of at most 3 guide and 3 variance
-  // channels, and every thread a tile of weights.
+  // (20), the highlights' excess (3), the colour variance, the halves' mean and its variance (9), the four
+  // candidate colours (12), an error map being filtered and the two filtered ones (9), a regression's output
+  // (3), the 3 x 3 colour range its estimates are clamped to (6) and double accumulators (8); step 4 holds
+  // less (the inputs, the two selected halves and about 40 more). Weights keep padded copies of at most 3
+  // guide and 3 variance channels, and every thread a tile of weights.
   const size_t pixels = size_t(width) * size_t(height);
   const size_t r = size_t(std::max(c.window_radius, c.feature_window_radius)), t = size_t(c.tile_size),
                f = size_t(c.patch_radius), pad = r + f;
@@ -504,7 +549,7 @@ size_t denoise_bytes(int width, int height, const DenoiseConfig& c) {
   const size_t tiles_x = (size_t(width) + t - 1) / t;
   const size_t tile_weights = (2 * r + 1) * (2 * r + 1) * t * t + 2 * (t + 2 * f) * (t + 2 * f);
   const size_t row_buffers = tiles_x * (t + 2 * r) * (t + 2 * r) * 4;
-  return (pixels * 67 + padded + size_t(thread_count(c.threads)) * tile_weights + row_buffers) *
+  return (pixels * 70 + padded + size_t(thread_count(c.threads)) * tile_weights + row_buffers) *
          sizeof(float);
 }
 
@@ -517,6 +562,7 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
   };
   Plane color[2] = {finite_plane(in.color[0], w, h, 3), finite_plane(in.color[1], w, h, 3)};
   remove_spikes(color);
+  const Plane highlights = split_highlights(color);
   Plane feat[2];
   fill_missing_depth(in, feat);
 
@@ -537,8 +583,11 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
   step_done(2);
 
   // 4. The second pass: the selected halves' mean regressed on the halves' mean features.
-  const Plane combined = mean_of(result[0], result[1]);
-  if (!cfg.second_pass) return combined.v;
+  Plane combined = mean_of(result[0], result[1]);
+  if (!cfg.second_pass) {
+    add_residual(combined.v, highlights);
+    return std::move(combined.v);
+  }
   const Plane combined_var = mean_variance(result[0], result[1]);
   const Plane feat_mean = mean_of(feat[0], feat[1]), feat_var = mean_variance(feat[0], feat[1]);
   const Plane final_feat = filter_features(feat_mean, feat_mean, feat_var, 2, cfg.patch_radius, 0.5f, ts, th);
@@ -546,6 +595,7 @@ std::vector<float> denoise_nfor(const DenoiseInput& in, const DenoiseConfig& cfg
       regression(combined, final_feat,
                  NlmWeights(combined, combined_var, cfg.window_radius, cfg.patch_radius, 1.0f), ts, th)
           .v;
+  add_residual(out, highlights);
   step_done(3);
   return out;
 }

@@ -6,7 +6,9 @@
 // NFOR in four steps, each a pass over the image in tiles, after firefly removal (a pixel of
 // one half brighter than twice the brightest of the other half's 5 x 5 neighbourhood is scaled
 // down to that bound: a rare path found by one half only, which the regression would spread
-// over whole windows; biased, as a clamp is):
+// over whole windows; biased, as a clamp is) and with isolated glints set aside (a pixel
+// brighter in both halves than 4 times the third brightest of its 8 neighbours is scaled down
+// to that bound, and the excess added to the result, so that it does not glow):
 //   1. Feature prefiltering: each half of each feature (albedo, normal, depth, one group at a
 //      time) filtered by non-local means (Buades et al. 2005) with weights from the other
 //      half's same group, so that noisy
