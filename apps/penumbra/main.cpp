@@ -15,6 +15,7 @@
 #include "apps/penumbra/mesh_command.h"
 #include "apps/penumbra/parse_errors.h"
 #include "apps/penumbra/progress.h"
+#include "apps/penumbra/query_command.h"
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
 #include "apps/penumbra/submit_command.h"
@@ -170,6 +171,8 @@ int main(int argc, char** argv) {
       "mesh",
       "Extract the implicit shapes of a glTF scene as triangle meshes (marching cubes) into a .glb or .gltf");
   add_mesh_options(*mesh, mesh_args);
+  QueryArgs query_args;
+  auto* query = add_query_command(app, query_args);
 
   try {
     app.parse(argc, argv);
@@ -188,6 +191,7 @@ int main(int argc, char** argv) {
     if (*submit) return run_submit_slurm(submit_args);
     if (*mesh) return run_mesh(mesh_args);
     if (*info) return run_info(info_args);
+    if (*query) return run_query(*query, query_args);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {

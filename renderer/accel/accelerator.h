@@ -142,6 +142,52 @@ struct HitFilter {
   bool operator()(const Ray& ray, const Hit& hit) const { return accept(context, ray, hit); }
 };
 
+/// The region of a spatial query other than a ray: a closed ball (centre, squared radius) or a
+/// closed axis-aligned box. A ball's radius may shrink while the query runs (a nearest-neighbour
+/// search narrows it to the k-th distance found so far).
+struct QueryRegion {
+  bool is_box = false;
+  Vec3f centre;               ///< ball
+  float radius2 = kInfinity;  ///< ball: squared radius, >= 0 (may be +inf)
+  Bounds3f box;               ///< box: non-empty, finite
+};
+
+/// Squared distance from `p` to the closed box `b` (0 inside; +inf for an empty box).
+inline float distance2(Vec3f p, const Bounds3f& b) {
+  if (b.empty()) return kInfinity;
+  float d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const float d = p[k] < b.lo[k] ? b.lo[k] - p[k] : (p[k] > b.hi[k] ? p[k] - b.hi[k] : 0.0f);
+    d2 += d * d;
+  }
+  return d2;
+}
+
+/// Rounding allowance of node pruning: a node is skipped only when its squared distance exceeds
+/// the ball's by more than this relative margin, so that rounding in distance2 never skips a
+/// primitive the exact test (which rounds too) would place inside.
+inline constexpr float kRegionPad = 1.0f + 1e-5f;
+
+/// True if the closed box `b` may hold a point of the region (a ball: distance2 within the
+/// padded squared radius; a box: the boxes overlap, faces included).
+inline bool region_meets(const QueryRegion& r, const Bounds3f& b) {
+  if (b.empty()) return false;
+  if (!r.is_box) return distance2(r.centre, b) <= r.radius2 * kRegionPad;
+  return r.box.lo.x <= b.hi.x && b.lo.x <= r.box.hi.x && r.box.lo.y <= b.hi.y && b.lo.y <= r.box.hi.y &&
+         r.box.lo.z <= b.hi.z && b.lo.z <= r.box.hi.z;
+}
+
+/// Receives the primitives a region query reaches (Accelerator::visit_region).
+class RegionVisitor {
+ public:
+  virtual ~RegionVisitor() = default;
+  /// Called with a primitive (its ids as a Hit reports them: geom_id the view's or, over
+  /// instances, the instance's index; prim_id the triangle, 0 for a shape) stored in a leaf or
+  /// cell that meets `region`. May shrink region.radius2 (never grow it). May be called more
+  /// than once for one primitive. Never throws.
+  virtual void visit(uint32_t geom_id, uint32_t prim_id, QueryRegion& region) = 0;
+};
+
 /// Most hits of one shape a filtered query tests along a ray before giving up on it.
 inline constexpr int kMaxShapeCrossings = 1024;
 
@@ -190,6 +236,14 @@ class Accelerator {
   }
   /// True iff intersect_counted() fills in TraversalCost.
   virtual bool counts_traversal() const { return false; }
+  /// Spatial queries other than rays: offers `visitor` every primitive of every leaf or cell
+  /// whose bounds meet `region` (region_meets), skipping subtrees and cells that do not. For a
+  /// ball, nearer nodes are visited first where the structure orders them, and radius2 is read
+  /// again before each node, so a visitor that shrinks it prunes what follows. Every primitive
+  /// with a point in the region is offered at least once; others may be. Deforming
+  /// meshes and moving instances are reached through their bounds over the shutter. Adds nodes
+  /// (cells) visited to `cost` when non-null. Thread-safe; never allocates, throws or logs.
+  virtual void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const = 0;
   virtual Bounds3f bounds() const = 0;
   virtual AccelStats stats() const = 0;
   /// Moves the instances of a build over instances to new maps and rebuilds only the top level

@@ -42,6 +42,25 @@ class BruteAccelerator final : public Accelerator {
     return scan(ray, hit, nullptr, &filter, true);
   }
 
+  /// Every primitive whose bounds meet the region (read again before each, as the visitor may
+  /// shrink a ball), in view and triangle order; the scan counts as one node.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (cost) ++cost->nodes;
+    for (uint32_t g = 0; g < m_meshes.size(); ++g) {
+      const auto& m = m_meshes[g];
+      if (m.shape) {
+        if (region_meets(region, shape_bounds(*m.shape))) visitor.visit(g, 0, region);
+        continue;
+      }
+      for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
+        const Bounds3f b = merge(merge(Bounds3f{m.positions[m.indices[i]], m.positions[m.indices[i]]},
+                                       m.positions[m.indices[i + 1]]),
+                                 m.positions[m.indices[i + 2]]);
+        if (region_meets(region, b)) visitor.visit(g, uint32_t(i / 3), region);
+      }
+    }
+  }
+
   Bounds3f bounds() const override { return m_bounds; }
   AccelStats stats() const override {
     AccelStats s;

@@ -676,6 +676,40 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
                       m_shapes.size());
   }
 
+  /// Depth-first walk over the nodes the region may reach, nearer side first for a ball. Nodes
+  /// store no box, so a side is skipped when the region lies beyond its plane by more than the
+  /// tolerance of step() (the build's band and the rounding of the plane's evaluation); for a
+  /// ball each pushed node keeps a lower bound on its distance from the centre, checked again
+  /// when popped, as the visitor may shrink the radius.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (m_tree.nodes.empty() || !region_meets(region, m_tree.clip)) return;
+    // The rounding of a plane's evaluation at the region's points, besides the offset's share.
+    const Vec3f mag = region.is_box ? max(abs(region.box.lo), abs(region.box.hi)) : abs(region.centre);
+    const float region_eps = 2 * m_tree.band + kDotError * (mag.x + mag.y + mag.z);
+    RegionTodo todo[kMaxDepth + 1];
+    int sp = 0;
+    RegionTodo cur{0, 0};
+    for (;;) {
+      if (ball_reaches(region, cur.distance)) {
+        const BspNode& node = m_tree.nodes[cur.node];
+        if (cost) ++cost->nodes;
+        if (node.leaf()) {
+          offer_leaf(node, region, visitor);
+        } else {
+          RegionTodo next[2];
+          const int n = region_children(node, region, region_eps, cur.distance, next);
+          if (n > 1) todo[sp++] = next[1];
+          if (n > 0) {
+            cur = next[0];
+            continue;
+          }
+        }
+      }
+      if (sp == 0) return;
+      cur = todo[--sp];
+    }
+  }
+
   std::optional<BspPlane> root_plane() const {
     if (m_tree.nodes.empty() || m_tree.nodes[0].leaf()) return std::nullopt;
     const BspNode& r = m_tree.nodes[0];
@@ -786,6 +820,60 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
     tmin = neg_ok ? n0 : p0;
     tmax = neg_ok ? n1 : p1;
     return true;
+  }
+
+  /// A node a region query has still to visit.
+  struct RegionTodo {
+    uint32_t node;
+    float distance;  // ball: lower bound on the centre's distance to the node's primitives; box: 0
+  };
+
+  /// False when `region` is a ball whose padded radius is below `distance`.
+  static bool ball_reaches(const QueryRegion& region, float distance) {
+    return region.is_box || !(distance > 0) || distance * distance <= region.radius2 * kRegionPad;
+  }
+
+  /// The children of interior `node` that `region` may reach, into next[0, returned count),
+  /// nearer first for a ball. With e the plane's tolerance (region_eps plus the offset's
+  /// rounding), the negative child holds the primitives' points with dot(n, p) - k <= e and the
+  /// positive child those with dot(n, p) - k >= -e (sides() in the build). `distance` is the
+  /// node's lower bound on the ball's distance, which its children inherit.
+  int region_children(const BspNode& node, const QueryRegion& region, float region_eps, float distance,
+                      RegionTodo* next) const {
+    const uint32_t neg = node.negative(), pos = neg + 1;
+    const float eps = region_eps + kDotError * std::fabs(node.k);
+    int count = 0;
+    if (region.is_box) {
+      // The box's range along n, each bound at the corner the signs of n pick.
+      float lo = -node.k, hi = -node.k;
+      for (int a = 0; a < 3; ++a) {
+        const float n = node.n[a];
+        lo += n * (n >= 0 ? region.box.lo[a] : region.box.hi[a]);
+        hi += n * (n >= 0 ? region.box.hi[a] : region.box.lo[a]);
+      }
+      if (lo <= eps) next[count++] = {neg, 0};
+      if (hi >= -eps) next[count++] = {pos, 0};
+      return count;
+    }
+    const Vec3f& c = region.centre;
+    const float s = node.n[0] * c.x + node.n[1] * c.y + node.n[2] * c.z - node.k;
+    // The centre's distance to each child's half-space, at least the node's.
+    const RegionTodo to_neg{neg, std::max(distance, s - eps)}, to_pos{pos, std::max(distance, -s - eps)};
+    const RegionTodo& nearer = s >= 0 ? to_pos : to_neg;
+    const RegionTodo& farther = s >= 0 ? to_neg : to_pos;
+    if (ball_reaches(region, nearer.distance)) next[count++] = nearer;
+    if (ball_reaches(region, farther.distance)) next[count++] = farther;
+    return count;
+  }
+
+  /// Offers the leaf's records whose bounds meet the region (read again before each).
+  void offer_leaf(const BspNode& node, QueryRegion& region, RegionVisitor& visitor) const {
+    const PrimitiveRecord* recs = m_tree.leaf_prims.data() + node.prim_offset;
+    for (uint32_t i = 0, n = node.count(); i < n; ++i) {
+      const PrimitiveRecord& rec = recs[i];
+      if (region_meets(region, primitive_bounds(rec)))
+        visitor.visit(rec.geom_id, is_shape(rec) ? 0 : rec.prim_id, region);
+    }
   }
 
   BspConfig m_config;

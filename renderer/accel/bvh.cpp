@@ -161,6 +161,20 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     return true;
   }
 
+  /// The region walk of the configured layout (walk_region in accel/bvh_wide.h): nodes and
+  /// leaves whose widened (binary, 4-wide) or decoded (8-wide) boxes meet the region, a ball's
+  /// nearest first; each primitive of a leaf reached is offered with its Hit ids.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (m_width == 8) return visit_region_wide(m_wide8, region, visitor, cost);
+    if (m_width == 4) return visit_region_wide(m_wide4, region, visitor, cost);
+    walk_region_binary(m_nodes, region, cost, [&](uint32_t first, uint32_t count) {
+      for (uint32_t i = first, e = first + count; i < e; ++i) {
+        const PrimitiveRecord& r = m_tris[i];
+        visitor.visit(r.geom_id, is_shape(r) ? 0 : r.prim_id, region);
+      }
+    });
+  }
+
   Bounds3f bounds() const override { return m_bounds; }
 
   AccelStats stats() const override {
@@ -246,6 +260,39 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
             if (visit(w, m_tris[i])) return true;
           return false;
         });
+  }
+
+  /// visit_region over a wide layout: leaves sit on the stack like nodes (as in the ray
+  /// traversal), each child's box taken from its parent's slot.
+  template <int W>
+  void visit_region_wide(const WideBvh<W>& bvh, QueryRegion& region, RegionVisitor& visitor,
+                         TraversalCost* cost) const {
+    if (bvh.nodes.empty()) return;
+    const auto expand = [&](const RegionEntry& e, RegionEntry* kids, Bounds3f* boxes) {
+      if (e.count > 0) {
+        visit_region_blocks(bvh.blocks, e.index, e.count, region, visitor);
+        return 0;
+      }
+      const WideNode<W>& node = bvh.nodes[e.index];
+      for (int i = 0; i < W; ++i) {
+        kids[i] = {node.child[i], node.count[i], 0};
+        boxes[i] = child_box(node, i);  // empty for an unused slot, which is then dropped
+      }
+      return W;
+    };
+    walk_region<W>(region, cost, RegionEntry{}, expand);
+  }
+
+  /// Offers the primitives of blocks [first, first + count) to `visitor`, with their Hit ids
+  /// (prim_id 0 for a shape).
+  void visit_region_blocks(const std::vector<TriangleBlock4>& blocks, uint32_t first, uint32_t count,
+                           QueryRegion& region, RegionVisitor& visitor) const {
+    for (uint32_t k = first, e = first + count; k < e; ++k)
+      for (int l = 0; l < 4; ++l) {
+        if (blocks[k].id[l] == kEmptyLane) continue;
+        const PrimitiveRecord r = m_ids.record(blocks[k], l);
+        visitor.visit(r.geom_id, is_shape(r) ? 0 : r.prim_id, region);
+      }
   }
 
   /// Appends the blocks of leaf `b` (the records tris[refs[i].index] for i in [first, first +

@@ -5,7 +5,8 @@
 // Hierarchies for Fast SIMD Ray Tracing of Incoherent Rays", EGSR 2008; and for the quantised
 // boxes Ylitie, Karras & Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed
 // Wide BVHs", HPG 2017. Traversal lives in accel/bvh_traverse.inl, compiled once per
-// instruction set.
+// instruction set. Also the region walk (Accelerator::visit_region) every BVH layout shares,
+// binary nodes included.
 #pragma once
 
 #include <cstdint>
@@ -65,6 +66,93 @@ void set_child_boxes(QuantizedNode8& node, const Bounds3f* boxes, int n);
 /// pops, and the collapsed tree is no deeper than the binary one (< kBvhStackSize levels).
 template <int W>
 inline constexpr int kWideStackSize = (W - 1) * 128 + W;
+
+/// Child i's box; empty for an unused slot.
+inline Bounds3f child_box(const Node4& n, int i) {
+  return {{n.lo[0][i], n.lo[1][i], n.lo[2][i]}, {n.hi[0][i], n.hi[1][i], n.hi[2][i]}};
+}
+
+/// Child i's box decoded with QuantizedNode8::dequantize (the float operations the build checks
+/// and the traversal repeats), so it contains the child; empty for an unused slot.
+inline Bounds3f child_box(const QuantizedNode8& n, int i) {
+  if (!((n.valid >> i) & 1)) return {};
+  return {{n.dequantize(0, n.qlo[0][i]), n.dequantize(1, n.qlo[1][i]), n.dequantize(2, n.qlo[2][i])},
+          {n.dequantize(0, n.qhi[0][i]), n.dequantize(1, n.qhi[1][i]), n.dequantize(2, n.qhi[2][i])}};
+}
+
+/// A node or leaf waiting on a region walk's stack: two words its layout reads (a node index,
+/// or a leaf's first block and block count) and the squared distance of its box from a ball's
+/// centre (0 for a box region), which orders the walk and is tested again when popped.
+struct RegionEntry {
+  uint32_t index = 0, count = 0;
+  float d2 = 0;
+};
+
+/// region_meets(region, box), also giving the box's squared distance `d2` from a ball's centre
+/// (0 for a box region).
+inline bool region_key(const QueryRegion& region, const Bounds3f& box, float& d2) {
+  d2 = 0;
+  if (region.is_box || box.empty()) return region_meets(region, box);
+  d2 = distance2(region.centre, box);
+  return d2 <= region.radius2 * kRegionPad;
+}
+
+/// The walk of Accelerator::visit_region over a tree of at most W children per node, shared by
+/// every BVH layout (binary nodes are W = 2). Depth first from `root` (whose box meets the
+/// region): expand(entry, children, boxes) offers a leaf entry's primitives to the visitor and
+/// returns 0, or writes the entries and conservative boxes of an interior node's children and
+/// returns their number. Children whose box does not meet the region are dropped, the others
+/// pushed far to near (insertion sort on the stack), so a ball's nearest child is popped first
+/// and ties keep the children's order. A popped entry is tested again, as the visitor may have
+/// shrunk the ball since its push. Adds each entry expanded to cost->nodes when `cost` is
+/// non-null. Never allocates: the stack has the ray traversal's bound (each level adds at most
+/// W - 1 entries).
+template <int W, typename Expand>
+void walk_region(QueryRegion& region, TraversalCost* cost, RegionEntry root, Expand&& expand) {
+  RegionEntry stack[kWideStackSize<W>];
+  int sp = 0;
+  stack[sp++] = root;
+  RegionEntry kids[W];
+  Bounds3f boxes[W];
+  while (sp > 0) {
+    const RegionEntry e = stack[--sp];
+    if (!region.is_box && !(e.d2 <= region.radius2 * kRegionPad)) continue;
+    if (cost) ++cost->nodes;
+    const int n = expand(e, kids, boxes);
+    const int base = sp;
+    for (int i = n - 1; i >= 0; --i) {
+      if (!region_key(region, boxes[i], kids[i].d2)) continue;
+      int j = sp++;
+      for (; j > base && stack[j - 1].d2 < kids[i].d2; --j) stack[j] = stack[j - 1];
+      stack[j] = kids[i];
+    }
+  }
+}
+
+/// walk_region over flattened binary nodes (BvhNode of accel/bvh_build.h, node 0 the root:
+/// boxes in the nodes, an interior node's first child next in the array and its second at
+/// `offset`, a leaf's primitives [offset, offset + count)). on_leaf(first, count) offers a
+/// leaf's primitives to the visitor.
+template <typename BinaryNodes, typename OnLeaf>
+void walk_region_binary(const BinaryNodes& nodes, QueryRegion& region, TraversalCost* cost,
+                        OnLeaf&& on_leaf) {
+  if (nodes.empty()) return;
+  const auto box = [&](uint32_t i) { return Bounds3f{nodes[i].lo, nodes[i].hi}; };
+  RegionEntry root;
+  if (!region_key(region, box(0), root.d2)) return;
+  walk_region<2>(region, cost, root, [&](const RegionEntry& e, RegionEntry* kids, Bounds3f* boxes) {
+    const auto& node = nodes[e.index];
+    if (node.count > 0) {
+      on_leaf(uint32_t(node.offset), uint32_t(node.count));
+      return 0;
+    }
+    kids[0].index = e.index + 1;
+    kids[1].index = node.offset;
+    boxes[0] = box(kids[0].index);
+    boxes[1] = box(kids[1].index);
+    return 2;
+  });
+}
 
 /// Whether this CPU (and its operating system) runs AVX2 code: the 8-wide traversal's
 /// requirement, checked once at run time so one binary serves farm nodes of every generation.

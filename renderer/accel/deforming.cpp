@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "renderer/accel/bvh_build.h"
+#include "renderer/accel/bvh_wide.h"
 #include "renderer/accel/stats.h"
 #include "renderer/accel/triangle.h"
 
@@ -70,6 +71,19 @@ class DeformingAccelerator final : public Accelerator {
   bool occluded(const Ray& ray, const HitFilter& filter) const override {
     Hit hit;
     return query(ray, hit, nullptr, &filter, true);
+  }
+  /// Region queries test each node's box over all time (its linear bounds merged), so a
+  /// triangle is reached wherever it is during the shutter.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    const auto leaf = [&](uint32_t first, uint32_t count) {
+      for (uint32_t k = first; k < first + count; ++k) {
+        const TriangleId& id = m_ids[m_prims[k]];
+        visitor.visit(id.geom, id.prim, region);
+      }
+    };
+    if (!m_exhaustive) return walk_region_binary(m_nodes, region, cost, leaf);
+    if (cost) ++cost->nodes;
+    if (region_meets(region, widen_for_rounding(m_bounds))) leaf(0, uint32_t(m_prims.size()));
   }
   Bounds3f bounds() const override { return m_bounds; }
 
@@ -167,6 +181,14 @@ class DeformingAccelerator final : public Accelerator {
         }
     }
     for (Bounds3f& b : m_lbounds) b = widen_for_rounding(b);
+    // Each node's box over all time, which region queries test: its widened linear bounds at
+    // every step merged (a vertex between two steps lies within their boxes' hull).
+    for (size_t i = 0; i < m_nodes.size(); ++i) {
+      Bounds3f all;
+      for (uint32_t s = 0; s < segments; ++s) all = merge(merge(all, lbound(i, s, 0)), lbound(i, s, 1));
+      m_nodes[i].lo = all.lo;
+      m_nodes[i].hi = all.hi;
+    }
   }
 
   const Bounds3f& lbound(size_t node, uint32_t segment, uint32_t end) const {
@@ -259,7 +281,8 @@ class DeformingAccelerator final : public Accelerator {
   uint32_t m_steps = 0;
   bool m_exhaustive = false;
   std::vector<uint32_t> m_prims;    // triangle indices in leaf order
-  std::vector<BvhNode> m_nodes;     // topology (split by step-averaged boxes); traversal reads m_lbounds
+  std::vector<BvhNode> m_nodes;     // topology (split by step-averaged boxes); lo, hi: the box over
+                                    // all time (region queries); ray traversal reads m_lbounds
   std::vector<Bounds3f> m_lbounds;  // node x segment x {start, end}: linear bounds
   Bounds3f m_bounds;
   uint64_t m_depth = 0;

@@ -16,6 +16,9 @@
 #include <type_traits>
 #include <vector>
 
+#include "renderer/accel/bvh_build.h"
+#include "renderer/accel/bvh_wide.h"
+#include "renderer/accel/region_map.h"
 #include "renderer/accel/stats.h"
 
 namespace penumbra {
@@ -221,6 +224,37 @@ void attach_shape(RTCScene scene, const Shape* shape, unsigned id) {
   throw_if_error("attaching a shape");
 }
 
+/// How much a world-space point query's radius must exceed a ball's so that Embree's query
+/// inside an instance with world-to-object map `to_object` covers the ball's image; 1 when
+/// Embree's own radius is enough. Embree 3 (similarityTransform in its affinespace.h) takes a
+/// map whose columns are orthogonal and of equal squared length to within an absolute 1e-5 for
+/// a similarity of scale D (its first column's length); it then culls the instance's nodes with
+/// the world radius R itself and its primitives with R D, where the ball's image needs
+/// R sigma (sigma the map's largest stretch, more than D for a small map with unequal
+/// columns): so R must be max(sigma, sigma / D) times the ball's radius. Other maps it bounds
+/// by the box of the radius's cube, which covers the ball. The tests here are looser (1e-4,
+/// absolute and relative), so that no map Embree's rounding of the inverse makes pass is missed.
+double similarity_radius_scale(const Affine3f& to_object) {
+  Vec3f c[3];
+  for (int j = 0; j < 3; ++j) c[j] = {to_object.m[0][j], to_object.m[1][j], to_object.m[2][j]};
+  const auto dot_d = [](Vec3f a, Vec3f b) {
+    return double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z;
+  };
+  const double d[3] = {dot_d(c[0], c[0]), dot_d(c[1], c[1]), dot_d(c[2], c[2])};
+  const double tol = 1e-4 * (1 + std::max(d[0], std::max(d[1], d[2])));
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (std::fabs(dot_d(c[i], c[j])) > tol || std::fabs(d[i] - d[j]) > tol) return 1;
+  }
+  const double sigma = std::sqrt(stretch2(to_object));
+  return d[0] > 0 ? std::max(1.0, std::max(sigma, sigma / std::sqrt(d[0]))) : kInfinity;
+}
+
+/// The largest factor by which visit_region() widens Embree's query radius for the instances
+/// Embree queries itself (similarity_radius_scale); instances needing more are queried apart,
+/// in their own scene.
+constexpr double kMaxQueryScale = 1.001;
+
 /// The largest origin or direction coordinate handed to Embree, object-space rays included:
 /// under Embree's FLT_LARGE (1.8e18) with room for the rounding of its instance transforms.
 constexpr double kEmbreeRayLimit = 1e18;
@@ -247,6 +281,7 @@ class EmbreeAccelerator final : public Accelerator {
       : m_config(config) {
     validate(config);
     check_motion_steps(meshes);
+    note_mesh_regions(meshes);
     const BuildTimer timer;
     const int64_t bytes_before = device_bytes();
     take_error();
@@ -271,12 +306,10 @@ class EmbreeAccelerator final : public Accelerator {
       const InstanceKind kind = m_layout.kinds.back();
       Affine3f inverse_map;
       if (kind == InstanceKind::Identity) {
-        if (world == m_scene) {
-          attach_geometry(m_scene, mesh, id);
-        } else {
-          attach_geometry(world, mesh, unsigned(m_world_ids.size()));
-          m_world_ids.push_back(id);
-        }
+        const unsigned world_id = world == m_scene ? id : unsigned(m_world_ids.size());
+        attach_geometry(world, mesh, world_id);
+        keep_buffers(world, world_id, inst.mesh);
+        if (world != m_scene) m_world_ids.push_back(id);
         continue;
       }
       if (kind == InstanceKind::Singular) {  // an empty mesh keeps the id
@@ -289,6 +322,8 @@ class EmbreeAccelerator final : public Accelerator {
         object = new_scene();
         m_objects.push_back(object);
         attach_geometry(object, mesh, 0);
+        keep_buffers(object, 0, inst.mesh);
+        m_mesh_regions[inst.mesh].object = object;
         rtcCommitScene(object);
         throw_if_error("building an instanced mesh (rtcCommitScene)");
       }
@@ -304,6 +339,7 @@ class EmbreeAccelerator final : public Accelerator {
     throw_if_error("building the scene (rtcCommitScene)");
     m_bytes = uint64_t(std::max<int64_t>(0, device_bytes() - bytes_before));
     read_bounds();
+    index_regions(instances);
     m_build_seconds = timer.seconds();
   }
 
@@ -336,6 +372,28 @@ class EmbreeAccelerator final : public Accelerator {
     return any_hit(ray, ctx.rtc, &ctx.units);
   }
 
+  /// Embree's point query (rtcPointQuery at time 0) over the whole scene, whose callback
+  /// offers each primitive it reaches (not the placeholders of empty meshes and singular
+  /// instances) and narrows Embree's radius as the visitor shrinks a ball; then the instances
+  /// Embree's query may miss (RegionItem), through the BVH over their world boxes (nearer first
+  /// for a ball, the ball read again at each node). Embree's radius is the ball's padded by
+  /// kRegionPad, scaled by m_query_scale and widened by m_query_rounding; a box, or a ball
+  /// centred too far out for Embree, is queried by the ball around its part within the scene's
+  /// bounds (offering a superset). Embree's own nodes are not counted; the BVH's are.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    PointQueryState state{this, &region, &visitor, nullptr, 0, false};
+    RTCPointQuery query;
+    if (point_query(state, query)) {
+      RTCPointQueryContext context;
+      rtcInitPointQueryContext(&context);
+      rtcPointQuery(m_scene, &query, &context, &EmbreeAccelerator::offer_point_query, &state);
+    }
+    if (m_region_nodes.empty()) return;
+    walk_region_binary(m_region_nodes, region, cost, [&](uint32_t first, uint32_t count) {
+      for (uint32_t i = first; i < first + count; ++i) visit_item(m_region_items[i], region, visitor);
+    });
+  }
+
   Bounds3f bounds() const override { return m_bounds; }
 
   /// New transforms on the instance geometries, then the top scene committed again: the
@@ -358,6 +416,7 @@ class EmbreeAccelerator final : public Accelerator {
     rtcCommitScene(m_scene);
     throw_if_error("rebuilding the top level (rtcCommitScene)");
     read_bounds();
+    index_regions(instances);
     m_build_seconds = timer.seconds();
     return true;
   }
@@ -411,6 +470,276 @@ class EmbreeAccelerator final : public Accelerator {
     }
   };
   static_assert(std::is_standard_layout_v<FilterContext>);
+
+  /// What region queries know of a view: its primitives (0 when Embree holds a placeholder for
+  /// it: no triangles, or a shape without finite bounds), its box over every time step, the
+  /// Embree scene its placements instance (null if none), and for a deforming mesh the index
+  /// buffer and per-step vertex buffers of one of its Embree geometries (keep_buffers()).
+  struct MeshRegion {
+    uint32_t prims = 0;
+    uint32_t steps = 0;  // motion steps of a deforming mesh; 0 otherwise
+    Bounds3f box;        // finite vertices (or the shape's bounds), every step
+    RTCScene object = nullptr;
+    const uint32_t* indices = nullptr;
+    std::vector<const float*> vertices;  // per step, 3 floats per vertex
+  };
+
+  /// An instance whose primitives Embree's query of the whole scene may miss, and how
+  /// visit_region() reaches them instead:
+  ///  - Moving: a placement that moves (the query sees one time): every primitive, while the
+  ///    region meets its box over the shutter;
+  ///  - Deforming: a deforming mesh (likewise): each triangle whose box over every step
+  ///    (mapped by `map`, its to_world, when placed) meets the region;
+  ///  - Nested: a still placement whose map Embree would need too wide a radius for
+  ///    (similarity_radius_scale): a point query in the mesh's own scene with the region mapped
+  ///    by `map`, its to_object.
+  struct RegionItem {
+    enum Kind : uint8_t { Moving, Deforming, Nested };
+    uint32_t instance = 0;
+    Kind kind = Moving;
+    bool placed = false;  // Deforming: under `map` (else in world space)
+    Affine3f map;
+    double stretch = 1;    // Nested: the map's largest stretch, bounded above (stretch2)
+    MapRounding rounding;  // Deforming (placed), Nested: of points mapped by `map`
+    float pad = 0;         // Deforming (placed): rounding at the mesh's coordinates
+    Bounds3f box;          // world bounds over the shutter
+  };
+
+  /// One point query's state for its callback (rtcPointQuery's user pointer).
+  struct PointQueryState {
+    const EmbreeAccelerator* self;
+    QueryRegion* region;  // the caller's, in world space
+    RegionVisitor* visitor;
+    const RegionItem* item;  // a Nested instance's query in its own scene; null: the whole scene
+    double magnitude;        // the world ball's largest centre coordinate (rounding allowances)
+    bool shrinks;            // a ball queried as it is: Embree's radius follows radius2 down
+  };
+
+  /// The point queries' callback: offers the primitive with the ids intersect() reports, and
+  /// returns true when it narrowed Embree's radius (in the queried scene's space) to a shrunk
+  /// ball.
+  static bool offer_point_query(RTCPointQueryFunctionArguments* args) {
+    const PointQueryState& state = *static_cast<const PointQueryState*>(args->userPtr);
+    const EmbreeAccelerator& self = *state.self;
+    const RTCPointQueryContext& context = *args->context;
+    const uint32_t id =
+        state.item ? state.item->instance
+                   : self.instance_of(args->geomID, context.instStackSize > 0 ? context.instID[0]
+                                                                              : RTC_INVALID_GEOMETRY_ID);
+    if (id >= self.m_layout.kinds.size() || args->primID >= self.prims_of(id)) return false;
+    QueryRegion& region = *state.region;
+    const float before = region.radius2;
+    state.visitor->visit(id, args->primID, region);
+    if (!state.shrinks || !(region.radius2 < before)) return false;
+    const float radius = self.query_radius(state, region.radius2);
+    if (!(radius < args->query->radius)) return false;
+    args->query->radius = radius;
+    return true;
+  }
+
+  /// The primitives of instance `id` as built (0 for a singular one).
+  uint32_t prims_of(uint32_t id) const {
+    return m_layout.kinds[id] == InstanceKind::Singular ? 0 : m_mesh_regions[m_layout.meshes[id]].prims;
+  }
+
+  /// Embree's radius for a world ball of squared radius `radius2`, padded by kRegionPad and
+  /// rounded up: in the whole scene scaled by m_query_scale and widened by m_query_rounding; in
+  /// a Nested instance's scene stretched by its map and widened by the map's rounding.
+  float query_radius(const PointQueryState& state, float radius2) const {
+    const double r = std::sqrt(double(radius2) * double(kRegionPad));
+    const RegionItem* item = state.item;
+    const double radius = item ? r * item->stretch + item->rounding.at(state.magnitude)
+                               : r * m_query_scale + m_query_rounding.at(state.magnitude);
+    return float(radius * (1 + 1e-6));
+  }
+
+  /// Fills `q` for the query of the whole scene (state.item null) or of a Nested instance's
+  /// scene; false when nothing there can be in the region. A ball whose centre Embree can take
+  /// (mapped into every instance) is queried as it is, setting state.shrinks; otherwise the
+  /// part of the region's box within the queried scene's bounds, by its circumscribed ball.
+  bool point_query(PointQueryState& state, RTCPointQuery& q) const {
+    const QueryRegion& region = *state.region;
+    const RegionItem* item = state.item;
+    q.time = 0;
+    state.shrinks = false;
+    Bounds3f b = region.box;
+    if (!region.is_box) {
+      const Vec3f c = region.centre;
+      if (std::isnan(c.x) || std::isnan(c.y) || std::isnan(c.z)) return false;  // no point is near
+      state.magnitude = max_component(abs(c));
+      const Vec3f p = item ? apply_point(item->map, c) : c;
+      const double reach =
+          item ? max_component(abs(p)) : m_inverse_scale * state.magnitude + m_inverse_offset;
+      if (is_finite(c) && is_finite(p) && reach <= kEmbreeRayLimit) {
+        q.x = p.x, q.y = p.y, q.z = p.z;
+        q.radius = query_radius(state, region.radius2);
+        state.shrinks = true;
+        return true;
+      }
+      const float r = float(std::sqrt(double(region.radius2) * double(kRegionPad)) * (1 + 1e-6));
+      b = std::isinf(r) ? m_bounds : Bounds3f{c - Vec3f{r, r, r}, c + Vec3f{r, r, r}};
+    }
+    Bounds3f scene = m_bounds;
+    if (item) {  // the box in the instance's space, widened by the mapping's rounding
+      b = penumbra::intersect(b, item->box);
+      if (!(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return false;
+      const float pad = float(item->rounding.at(max_component(max(abs(b.lo), abs(b.hi)))));
+      b = transform_bounds(item->map, b);
+      b = {b.lo - Vec3f{pad, pad, pad}, b.hi + Vec3f{pad, pad, pad}};
+      scene = m_mesh_regions[m_layout.meshes[item->instance]].box;
+    }
+    b = penumbra::intersect(b, scene);
+    if (!(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return false;  // also NaN
+    const Vec3f c = b.center();
+    double r2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max(double(c[k]) - b.lo[k], double(b.hi[k]) - c[k]);
+      r2 += d * d;
+    }
+    q.x = c.x, q.y = c.y, q.z = c.z;
+    const double r = std::sqrt(r2) * (1 + 1e-5);
+    q.radius = float(item ? r : r * m_query_scale + m_query_rounding.at(max_component(abs(c))));
+    return true;
+  }
+
+  /// The part of visit_region() for one RegionItem whose box meets the region.
+  void visit_item(const RegionItem& item, QueryRegion& region, RegionVisitor& visitor) const {
+    if (!region_meets(region, item.box)) return;
+    const MeshRegion& mesh = m_mesh_regions[m_layout.meshes[item.instance]];
+    if (item.kind == RegionItem::Nested) {
+      PointQueryState state{this, &region, &visitor, &item, 0, false};
+      RTCPointQuery query;
+      if (!mesh.object || !point_query(state, query)) return;
+      RTCPointQueryContext context;
+      rtcInitPointQueryContext(&context);
+      rtcPointQuery(mesh.object, &query, &context, &EmbreeAccelerator::offer_point_query, &state);
+      return;
+    }
+    if (item.kind == RegionItem::Moving || mesh.vertices.empty()) {
+      for (uint32_t p = 0; p < mesh.prims && region_meets(region, item.box); ++p)
+        visitor.visit(item.instance, p, region);
+      return;
+    }
+    for (uint32_t p = 0; p < mesh.prims; ++p) {
+      Bounds3f b;
+      for (const float* v : mesh.vertices)
+        for (size_t k = 0; k < 3; ++k) {
+          const float* x = v + 3 * size_t(mesh.indices[3 * size_t(p) + k]);
+          b = merge(b, Vec3f{x[0], x[1], x[2]});
+        }
+      if (item.placed) {
+        b = transform_bounds(item.map, b);
+        b = {b.lo - Vec3f{item.pad, item.pad, item.pad}, b.hi + Vec3f{item.pad, item.pad, item.pad}};
+      }
+      if (region_meets(region, b)) visitor.visit(item.instance, p, region);
+    }
+  }
+
+  /// m_mesh_regions from the views (before any geometry is attached).
+  void note_mesh_regions(std::span<const GeometryView> meshes) {
+    m_mesh_regions.assign(meshes.size(), MeshRegion{});
+    for (size_t g = 0; g < meshes.size(); ++g) {
+      const GeometryView& view = meshes[g];
+      MeshRegion& mesh = m_mesh_regions[g];
+      if (view.shape) {
+        const Bounds3f b = shape_bounds(*view.shape);
+        if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) mesh.prims = 1, mesh.box = b;
+        continue;
+      }
+      const size_t triangles = view.indices.size() / 3;
+      if (view.positions.empty() || triangles == 0) continue;
+      mesh.prims = uint32_t(triangles);
+      if (view.deforms()) mesh.steps = view.motion_steps;
+      for (const Vec3f p : view.deforms() ? view.motion_positions : view.positions)
+        if (is_finite(p)) mesh.box = merge(mesh.box, p);
+    }
+  }
+
+  /// Keeps the buffers of a deforming mesh's first Embree geometry (`id` in `scene`), which
+  /// visit_item() reads (the scene keeps the geometry alive).
+  void keep_buffers(RTCScene scene, unsigned id, uint32_t mesh) {
+    MeshRegion& m = m_mesh_regions[mesh];
+    if (m.steps == 0 || m.prims == 0 || !m.vertices.empty()) return;
+    RTCGeometry geom = rtcGetGeometry(scene, id);
+    m.indices = static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+    for (unsigned k = 0; k < m.steps; ++k)
+      m.vertices.push_back(
+          static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, k)));
+    throw_if_error("reading a deforming mesh's buffers");
+  }
+
+  /// The RegionItem of instance `i` under its current placement `inst`, if it needs one; else
+  /// widens m_query_scale and m_query_rounding for Embree's query inside it (placed instances).
+  bool region_item(uint32_t i, const InstanceView& inst, RegionItem& item) {
+    const MeshRegion& mesh = m_mesh_regions[m_layout.meshes[i]];
+    const InstanceKind kind = m_layout.kinds[i];
+    if (kind == InstanceKind::Singular || mesh.prims == 0) return false;
+    item.instance = i;
+    if (kind == InstanceKind::Identity) {
+      item.kind = RegionItem::Deforming;
+      item.box = mesh.box;
+      return mesh.steps > 0;
+    }
+    if (!inst.motion.empty()) {
+      item.box = motion_bounds(inst.motion, mesh.box);
+      return true;
+    }
+    Affine3f to_object;
+    if (!inverse(inst.to_world, to_object)) return false;
+    if (mesh.steps > 0) {
+      item.kind = RegionItem::Deforming;
+      item.placed = true;
+      item.map = inst.to_world;
+      item.rounding = map_rounding(inst.to_world);
+      item.pad = float(item.rounding.at(max_component(max(abs(mesh.box.lo), abs(mesh.box.hi)))));
+      const Bounds3f b = transform_bounds(inst.to_world, mesh.box);
+      item.box = {b.lo - Vec3f{item.pad, item.pad, item.pad}, b.hi + Vec3f{item.pad, item.pad, item.pad}};
+      return true;
+    }
+    const double scale = similarity_radius_scale(to_object);
+    if (scale > kMaxQueryScale) {
+      item.kind = RegionItem::Nested;
+      item.map = to_object;
+      item.stretch = std::sqrt(stretch2(to_object));
+      item.rounding = map_rounding(to_object);
+      item.box = transform_bounds(inst.to_world, mesh.box);
+      return true;
+    }
+    m_query_scale = std::max(m_query_scale, scale * (1 + 1e-4));  // with room for Embree's rounding
+    // Embree maps the query point into the instance with an error within map_rounding(to_object),
+    // which to_world stretches by at most sqrt(stretch2(to_world)) back in world units.
+    const double stretch = std::sqrt(stretch2(inst.to_world));
+    const MapRounding r = map_rounding(to_object);
+    m_query_rounding.per_unit = std::max(m_query_rounding.per_unit, stretch * r.per_unit);
+    m_query_rounding.offset = std::max(m_query_rounding.offset, stretch * r.offset);
+    return false;
+  }
+
+  /// m_region_items and their BVH, m_query_scale and m_query_rounding for the instances'
+  /// current placements. An item whose world box is not finite (its mesh mapped past the float
+  /// range) is left out.
+  void index_regions(std::span<const InstanceView> instances) {
+    m_query_scale = 1;
+    m_query_rounding = {};
+    std::vector<RegionItem> items;
+    for (uint32_t i = 0; i < instances.size(); ++i)
+      if (RegionItem item; region_item(i, instances[i], item)) {
+        item.box = widen_for_rounding(item.box);  // as rounding may place a mapped point outside
+        items.push_back(item);
+      }
+    m_region_items.clear();
+    m_region_nodes.clear();
+    std::vector<BvhBuildRef> refs;
+    for (uint32_t i = 0; i < items.size(); ++i)
+      if (!items[i].box.empty() && is_finite(items[i].box.lo) && is_finite(items[i].box.hi))
+        refs.emplace_back(items[i].box, i);
+    if (refs.empty()) return;
+    BvhConfig config;
+    config.max_leaf_size = 1;  // an item may cost a whole query of its own
+    const auto root = build_bvh_tree(refs, config);
+    for (const BvhBuildRef& r : refs) m_region_items.push_back(items[r.index]);
+    flatten_bvh(*root, m_region_nodes);
+  }
 
   /// The instance index a hit reports as geom_id, from Embree's geometry and instance ids.
   uint32_t instance_of(unsigned geom_id, unsigned inst_id) const {
@@ -636,6 +965,11 @@ class EmbreeAccelerator final : public Accelerator {
   std::vector<uint32_t> m_world_ids;              // world scene geometry id -> instance index
   std::vector<std::unique_ptr<Shape>> m_shapes;   // the user geometries' shapes (stable addresses)
   InstanceLayout m_layout;                        // every instance's mesh and kind, as built
+  std::vector<MeshRegion> m_mesh_regions;         // per view: what region queries need of it
+  std::vector<RegionItem> m_region_items;         // instances Embree's query may miss, in BVH leaf order
+  std::vector<BvhNode> m_region_nodes;            // BVH over their world boxes (index_regions)
+  double m_query_scale = 1;      // Embree's query radius per ball radius (similarity_radius_scale)
+  MapRounding m_query_rounding;  // Embree's mapping of the point into instances, in world units
   Bounds3f m_bounds;
   double m_inverse_scale = 1;   // largest row sum of |to_object| over placed instances (1: the world)
   double m_inverse_offset = 0;  // largest |translation| of a placed instance's to_object

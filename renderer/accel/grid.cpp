@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -150,7 +152,142 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     return s;
   }
 
+  /// The top grid's cells that meet the region, descending into sub-grids (visit_level).
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (!m_levels.empty()) visit_level(0, region, visitor, cost);
+  }
+
  private:
+  // ---- Region queries ---------------------------------------------------------------------------
+
+  /// The cell of level `g` holding coordinate x along axis k, clamped into the grid (x may be
+  /// infinite, never NaN).
+  static int cell_index(const GridLevel& g, int k, double x) {
+    if (!(g.cell_size[k] > 0)) return 0;
+    return int(std::clamp(std::floor((x - g.lo[k]) / g.cell_size[k]), 0.0, double(g.res[k] - 1)));
+  }
+
+  /// The cells of level `g` that the box [lo, hi] covers, per axis, clamped into the grid.
+  static void cell_range(const GridLevel& g, const double lo[3], const double hi[3], int first[3],
+                         int last[3]) {
+    for (int k = 0; k < 3; ++k) {
+      first[k] = cell_index(g, k, lo[k]);
+      last[k] = cell_index(g, k, hi[k]);
+    }
+  }
+
+  /// Level `li` (the top grid, or a sub-grid a cell of its parent holds): nothing if its box
+  /// does not meet the region; for a box, the cells it covers; for a ball, the cells in shells
+  /// around its centre (visit_shells); for a ball with a non-finite centre, every cell that meets
+  /// it. Recursion follows the sub-grids, at most GridConfig::max_depth levels deep.
+  void visit_level(uint32_t li, QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const {
+    const GridLevel& g = m_levels[li];
+    if (!region_meets(region, g.box)) return;
+    if (!region.is_box && is_finite(region.centre)) {
+      visit_shells(g, region, visitor, cost);
+      return;
+    }
+    const Bounds3f& b = region.is_box ? region.box : g.box;
+    const double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+    int first[3], last[3];
+    cell_range(g, lo, hi, first, last);
+    for (int z = first[2]; z <= last[2]; ++z)
+      for (int y = first[1]; y <= last[1]; ++y)
+        for (int x = first[0]; x <= last[0]; ++x) visit_cell(g, x, y, z, region, visitor, cost);
+  }
+
+  /// A ball over level `g`, in Chebyshev rings d = 0, 1, 2, ... of cells around c0, the cell of
+  /// the centre clamped into the grid. Each ring is limited to the cells covered by the ball's
+  /// bounding box at the current radius. Stops when the nearest point a ring's cells may hold
+  /// lies beyond the current radius (padded as region_meets pads), or when the ring has no
+  /// cell within that box (then neither have the rings after it, as the radius never grows).
+  void visit_shells(const GridLevel& g, QueryRegion& region, RegionVisitor& visitor,
+                    TraversalCost* cost) const {
+    const double p[3] = {region.centre.x, region.centre.y, region.centre.z};
+    int c0[3];
+    double out2[3];  // squared distance from the centre to the grid's slab along each axis
+    for (int k = 0; k < 3; ++k) {
+      c0[k] = cell_index(g, k, p[k]);
+      const double hi = g.lo[k] + g.res[k] * g.cell_size[k];
+      const double o = p[k] < g.lo[k] ? g.lo[k] - p[k] : (p[k] > hi ? p[k] - hi : 0.0);
+      out2[k] = o * o;
+    }
+    for (int d = 0;; ++d) {
+      const double r2 = double(region.radius2) * double(kRegionPad);
+      if (ring_distance2(g, p, c0, out2, d) > r2) return;
+      const double r = std::sqrt(r2);
+      const double lo[3] = {p[0] - r, p[1] - r, p[2] - r}, hi[3] = {p[0] + r, p[1] + r, p[2] + r};
+      int first[3], last[3];  // contain c0: cell_index is monotone
+      cell_range(g, lo, hi, first, last);
+      bool reaches = d == 0;
+      for (int k = 0; k < 3; ++k) {
+        reaches = reaches || c0[k] - d >= first[k] || c0[k] + d <= last[k];
+        first[k] = std::max(first[k], c0[k] - d);
+        last[k] = std::min(last[k], c0[k] + d);
+      }
+      if (!reaches) return;
+      // Ring d: the cells of [first, last] at Chebyshev distance d from c0. A row (fixed y, z)
+      // on the ring's faces in y or z is whole; any other row holds its two ends along x.
+      for (int z = first[2]; z <= last[2]; ++z)
+        for (int y = first[1]; y <= last[1]; ++y) {
+          if (std::abs(z - c0[2]) == d || std::abs(y - c0[1]) == d) {
+            for (int x = first[0]; x <= last[0]; ++x) visit_cell(g, x, y, z, region, visitor, cost);
+            continue;
+          }
+          if (c0[0] - d >= first[0]) visit_cell(g, c0[0] - d, y, z, region, visitor, cost);
+          if (c0[0] + d <= last[0]) visit_cell(g, c0[0] + d, y, z, region, visitor, cost);
+        }
+    }
+  }
+
+  /// A lower bound on the squared distance from p to the cells of level `g` at Chebyshev
+  /// distance d from cell c0 (+inf if there are none): such a cell lies d cells from c0 along
+  /// some axis k, so beyond the plane on that side of the cells within d - 1 of c0, and inside
+  /// the grid along the other axes (out2: p's squared distance to the grid's slab per axis).
+  static double ring_distance2(const GridLevel& g, const double p[3], const int c0[3], const double out2[3],
+                               int d) {
+    if (d == 0) return out2[0] + out2[1] + out2[2];
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const double others = out2[0] + out2[1] + out2[2] - out2[k];
+      if (c0[k] + d <= int(g.res[k]) - 1) {
+        const double gap = std::max(0.0, g.lo[k] + (c0[k] + d) * g.cell_size[k] - p[k]);
+        best = std::min(best, gap * gap + others);
+      }
+      if (c0[k] - d >= 0) {
+        const double gap = std::max(0.0, p[k] - (g.lo[k] + (c0[k] - d + 1) * g.cell_size[k]));
+        best = std::min(best, gap * gap + others);
+      }
+    }
+    return best;
+  }
+
+  /// Cell (x, y, z) of level `g`, if its box (rounded outward to float) meets the region:
+  /// counted, then its sub-grid visited (visit_level) or each of its primitives offered.
+  void visit_cell(const GridLevel& g, int x, int y, int z, QueryRegion& region, RegionVisitor& visitor,
+                  TraversalCost* cost) const {
+    const int idx[3] = {x, y, z};
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = g.lo[k] + idx[k] * g.cell_size[k];
+      hi[k] = g.lo[k] + (idx[k] + 1) * g.cell_size[k];
+    }
+    if (!region_meets(region, outward_box(lo, hi))) return;
+    if (cost) ++cost->nodes;
+    const size_t c = g.first_cell + (size_t(z) * g.res[1] + size_t(y)) * g.res[0] + size_t(x);
+    const uint32_t begin = m_offsets[c];
+    if (begin & kChildBit) {
+      visit_level(m_refs[begin & kOffsetMask], region, visitor, cost);
+      return;
+    }
+    for (uint32_t i = begin, e = m_offsets[c + 1] & kOffsetMask; i < e; ++i) {
+      const PrimitiveRecord& rec = m_tris[m_refs[i]];
+      visitor.visit(rec.geom_id, is_shape(rec) ? 0u : rec.prim_id, region);
+    }
+  }
+
+  // ---- Ray traversal ----------------------------------------------------------------------------
+
   /// 3D-DDA over the cells the ray crosses, front to back, descending into sub-grids.
   /// `visit(w, tri)` is called once per triangle (mailboxed) and returns true to stop (any-hit).
   /// `best` is the current closest hit distance (updated by the visitor for closest-hit
@@ -231,6 +368,8 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
           (g.lo[k] + (cell[k] + (step[k] > 0 ? 1 : 0)) * g.cell_size[k] - double(ray.org[k])) * inv_dir[k];
     }
   }
+
+  // ---- Build ------------------------------------------------------------------------------------
 
   void build() {
     // The top grid spans the bounds widened by the rounding band (see common.h).

@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "renderer/accel/bvh_build.h"
+#include "renderer/accel/bvh_wide.h"
 #include "renderer/accel/common.h"
 #include "renderer/accel/deforming.h"
+#include "renderer/accel/region_map.h"
 #include "renderer/accel/stats.h"
 
 namespace penumbra {
@@ -115,6 +117,17 @@ class TwoLevelAccelerator final : public Accelerator {
       ShapeHit sh;
       const auto accept = [&](float t) { return filter(ray, Hit{t, 0, 0, item.instance, 0}); };
       return intersect_shape_accepted(m_shapes[item.shape], local, accept, sh, nullptr);
+    });
+  }
+
+  /// Depth-first walk over the top level's boxes (those over the whole shutter) that meet the
+  /// region (read again at each node, as the visitor may shrink a ball), nearer child first for a
+  /// ball; each item met offers its placed shape, or runs its bottom level's visit_region with
+  /// the region in the item's space (ItemRegion).
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (m_nodes.empty()) return;
+    walk_region_binary(m_nodes, region, cost, [&](uint32_t first, uint32_t count) {
+      for (uint32_t i = first; i < first + count; ++i) visit_item(m_items[i], region, visitor, cost);
     });
   }
 
@@ -297,6 +310,87 @@ class TwoLevelAccelerator final : public Accelerator {
     }
     HitFilter filter() const { return {&ItemFilter::accept, this}; }
   };
+
+  /// The caller's visitor as an item's bottom level sees it: `local` is the query's region in
+  /// the item's space, geom_id is mapped to the instance index, and a ball shrunk by the caller's
+  /// visitor (in world space) narrows `local` to match. In the item's space the world region
+  /// becomes: itself in the world levels; for a still placement, the ball about to_object(c)
+  /// with the radius times the map's largest stretch (stretch2), or the box of the world box's
+  /// mapped corners (of its part within the item's box), each widened by the mapping's
+  /// rounding; for a moving placement, which has no one map, the bottom level's whole box (so
+  /// its every primitive is offered while the world region meets the item's box over the
+  /// shutter). Boxes are cut to the bottom level's box, so they stay finite.
+  class ItemRegion final : public RegionVisitor {
+   public:
+    ItemRegion(QueryRegion& world, RegionVisitor& outer, const TwoLevelAccelerator& self, const Item& item,
+               const Bounds3f& box)
+        : m_world(world), m_outer(outer), m_self(self), m_item(item), m_box(box) {
+      m_local = world;
+      if (in_world(item.instance)) return;
+      const Bounds3f level = self.m_levels[item.level]->bounds();
+      if (item.motion != kStill || world.is_box) {
+        m_local.is_box = true;
+        m_local.box = level;
+        if (item.motion == kStill) {  // the part of the box within the item's, mapped
+          const Bounds3f part = penumbra::intersect(world.box, box);
+          const Bounds3f b = transform_bounds(item.to_object, part);
+          const float pad =
+              float(map_rounding(item.to_object).at(max_component(max(abs(part.lo), abs(part.hi)))));
+          m_local.box =
+              penumbra::intersect(level, Bounds3f{b.lo - Vec3f{pad, pad, pad}, b.hi + Vec3f{pad, pad, pad}});
+        }
+        return;
+      }
+      m_local.centre = apply_point(item.to_object, world.centre);
+      m_stretch = std::sqrt(stretch2(item.to_object));
+      m_slack = map_rounding(item.to_object).at(max_component(abs(world.centre)));
+      m_local.radius2 = local_radius2(world.radius2);
+    }
+
+    /// False when the region in the item's space holds nothing of its bottom level.
+    bool reaches_level() const { return !m_local.is_box || !m_local.box.empty(); }
+
+    void visit(uint32_t geom_id, uint32_t prim_id, QueryRegion&) override {
+      if (!region_meets(m_world, m_box)) return;  // a ball shrunk away from the item
+      const float before = m_world.radius2;
+      m_outer.visit(m_self.instance_of(m_item.instance, geom_id), prim_id, m_world);
+      if (m_local.is_box || !(m_world.radius2 < before)) return;
+      m_local.radius2 = std::min(m_local.radius2, local_radius2(m_world.radius2));
+    }
+
+    /// The region in the item's space, for the bottom level's visit_region().
+    QueryRegion& local() { return m_local; }
+
+   private:
+    /// The squared radius in the item's space of a world ball of squared radius `world_radius2`,
+    /// rounded up.
+    float local_radius2(float world_radius2) const {
+      if (in_world(m_item.instance)) return world_radius2;
+      const double r = m_stretch * std::sqrt(double(world_radius2)) + m_slack;
+      return float(r * r * (1 + 1e-6));
+    }
+
+    QueryRegion& m_world;
+    RegionVisitor& m_outer;
+    const TwoLevelAccelerator& m_self;
+    const Item& m_item;
+    const Bounds3f& m_box;  // the item's world box, widened for rounding
+    QueryRegion m_local;
+    double m_stretch = 1;  // the map's largest stretch, bounded above (still placements)
+    double m_slack = 0;    // the mapped centre's rounding
+  };
+
+  /// The part of visit_region() for one item of a top-level leaf.
+  void visit_item(const Item& item, QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const {
+    const Bounds3f box = widen_for_rounding(item.box);  // as the top level's nodes are
+    if (!region_meets(region, box)) return;
+    if (item.level == kShapeLevel) {
+      visitor.visit(item.instance, 0, region);
+      return;
+    }
+    ItemRegion mapped(region, visitor, *this, item, box);
+    if (mapped.reaches_level()) m_levels[item.level]->visit_region(mapped.local(), mapped, cost);
+  }
 
   /// The instance index a hit of item `instance`'s bottom level reports as geom_id.
   uint32_t instance_of(uint32_t instance, uint32_t level_geom_id) const {

@@ -271,10 +271,54 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
                       m_shapes.size());
   }
 
+  /// Depth first from the root, whose box is m_tree.clip; a child's box is its parent's cut at
+  /// the split. Both children are taken, the one on the centre's side of the split first for a
+  /// ball (the other is pushed); each node is tested against the region when it is reached, so
+  /// a radius shrunk meanwhile prunes the pushed ones.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (m_tree.nodes.empty()) return;
+    RegionTodo todo[kMaxDepth + 1];  // each interior node on the path pushes one child
+    int sp = 0;
+    RegionTodo cur{0,
+                   {m_tree.clip.lo.x, m_tree.clip.lo.y, m_tree.clip.lo.z},
+                   {m_tree.clip.hi.x, m_tree.clip.hi.y, m_tree.clip.hi.z}};
+    for (;;) {
+      if (region_meets(region, cur.box())) {
+        const KdNode& node = m_tree.nodes[cur.node];
+        if (cost) ++cost->nodes;
+        if (!node.leaf()) {
+          const int axis = node.axis();
+          RegionTodo below = cur, above = cur;
+          below.node = node.below();
+          below.hi[axis] = node.split;
+          above.node = node.below() + 1;
+          above.lo[axis] = node.split;
+          const bool below_first = region.is_box || region.centre[axis] <= node.split;
+          todo[sp++] = below_first ? above : below;
+          cur = below_first ? below : above;
+          continue;
+        }
+        const PrimitiveRecord* recs = m_tree.leaf_prims.data() + node.prim_offset;
+        for (uint32_t i = 0; i < node.count(); ++i)
+          visitor.visit(recs[i].geom_id, is_shape(recs[i]) ? 0u : recs[i].prim_id, region);
+      }
+      if (sp == 0) return;
+      cur = todo[--sp];
+    }
+  }
+
  private:
   struct Todo {
     uint32_t node;
     float tmin, tmax;
+  };
+
+  /// A node of a region query and its box (plain arrays: the stack is never initialised as a
+  /// whole).
+  struct RegionTodo {
+    uint32_t node;
+    float lo[3], hi[3];
+    Bounds3f box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
   };
 
   /// The ray's origin, direction and reciprocal direction as arrays, so a node step reads its

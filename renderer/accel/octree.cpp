@@ -232,6 +232,40 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
                       m_shapes.size());
   }
 
+  /// Depth first from the root, whose box is m_tree.bounds; empty leaves are left out. A ball
+  /// takes an interior node's children nearest first (distance2 to their boxes); each node is
+  /// tested against the region when it is reached, so a radius shrunk meanwhile prunes the
+  /// pushed ones.
+  void visit_region(QueryRegion& region, RegionVisitor& visitor, TraversalCost* cost) const override {
+    if (m_tree.nodes.empty()) return;
+    RegionTodo todo[kStackSize];
+    int sp = 0;
+    RegionTodo cur{0,
+                   {m_tree.bounds.lo.x, m_tree.bounds.lo.y, m_tree.bounds.lo.z},
+                   {m_tree.bounds.hi.x, m_tree.bounds.hi.y, m_tree.bounds.hi.z}};
+    for (;;) {
+      if (region_meets(region, cur.box())) {
+        const OctNode& node = m_tree.nodes[cur.node];
+        if (cost) ++cost->nodes;
+        if (node.leaf()) {
+          const PrimitiveRecord* recs = m_tree.leaf_prims.data() + node.index;
+          for (uint32_t i = 0; i < node.count; ++i)
+            visitor.visit(recs[i].geom_id, is_shape(recs[i]) ? 0u : recs[i].prim_id, region);
+        } else {
+          RegionTodo kids[8];
+          const int n = region_children(node, cur, region, kids);
+          if (n > 0) {
+            for (int i = n - 1; i >= 1; --i) todo[sp++] = kids[i];
+            cur = kids[0];
+            continue;
+          }
+        }
+      }
+      if (sp == 0) return;
+      cur = todo[--sp];
+    }
+  }
+
  private:
   /// A node to visit: its index, the part [t0, t1] of the ray that may lie in it, and its box
   /// (plain arrays: the traversal stack is never initialised as a whole).
@@ -239,6 +273,13 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
     uint32_t node;
     float t0, t1;
     float lo[3], hi[3];
+  };
+
+  /// A node of a region query and its box (plain arrays, as in Todo).
+  struct RegionTodo {
+    uint32_t node;
+    float lo[3], hi[3];
+    Bounds3f box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
   };
 
   /// The build tree over `prims` (null if there are none).
@@ -350,6 +391,36 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
       out[i].t1 = e;
       for (int k = 0; k < 3; ++k)
         child_range(cur.lo[k], mid[k], cur.hi[k], m_tree.band, (c >> k) & 1, out[i].lo[k], out[i].hi[k]);
+    }
+    return n;
+  }
+
+  /// The children of interior node `node` (box in `cur`) that meet `region`, written to `out`:
+  /// for a ball in order of distance2 from the centre to their boxes (ties in child order), for
+  /// a box in child order; returns their number. Empty leaves are left out.
+  int region_children(const OctNode& node, const RegionTodo& cur, const QueryRegion& region,
+                      RegionTodo* out) const {
+    float mid[3];
+    for (int k = 0; k < 3; ++k) mid[k] = centre(cur.lo[k], cur.hi[k]);
+    float key[8];
+    int n = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (m_tree.nodes[node.index + c].count == 0) continue;  // an empty leaf
+      RegionTodo kid;
+      kid.node = node.index + uint32_t(c);
+      for (int k = 0; k < 3; ++k)
+        child_range(cur.lo[k], mid[k], cur.hi[k], m_tree.band, (c >> k) & 1, kid.lo[k], kid.hi[k]);
+      const Bounds3f b = kid.box();
+      if (!region_meets(region, b)) continue;
+      const float d2 = region.is_box ? 0.0f : distance2(region.centre, b);
+      // Insertion by distance, after the children at the same distance.
+      int i = n++;
+      for (; i > 0 && key[i - 1] > d2; --i) {
+        out[i] = out[i - 1];
+        key[i] = key[i - 1];
+      }
+      out[i] = kid;
+      key[i] = d2;
     }
     return n;
   }
