@@ -1,6 +1,7 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
 // `info`, assemble farm tiles with `merge`, denoise an EXR with `denoise`, render job files with `batch` and
-// submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`. This
+// submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`, ask it
+// spatial questions with `query`. This
 // file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1
 // a failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a
 // parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
