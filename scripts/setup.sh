@@ -30,32 +30,34 @@ case "$mode" in
     ;;
   test)
     # The suite runs in two stages, each check once, in the stage where it tells the most.
-    # Release (build/): everything, except the scripts labelled bad-input when the sanitizer
-    # stage follows.
+    # Release (build/): everything but the Catch2 files' light cases (label unit) and the
+    # scripts labelled bad-input, when the sanitizer stage follows.
     # Sanitize (build-sanitize/, ASan + UBSan; SANITIZE=0 skips it, and the Release stage then
-    # runs everything): the unit tests and the scripts that feed the command hostile input, where
-    # a memory error is what a test must catch:
-    # - the scripts labelled bad-input run here only: cli.hostile_input (every malformed corpus
-    #   file), cli.job_hardening (hostile job files), cli.output_safety (unwritable, hostile and
+    # runs everything): the unit tests' light cases and the scripts that feed the command hostile
+    # input, where a memory error is what a test must catch:
+    # - the scripts labelled bad-input: cli.hostile_input (every malformed corpus file),
+    #   cli.job_hardening (hostile job files), cli.output_safety (unwritable, hostile and
     #   half-written outputs);
-    # - unit test cases tagged [heavy] (the accelerator and raster cross-checks over every corpus
-    #   model and at huge and tiny coordinates, the renders with every accelerator, the grid's
-    #   stadium, the corpus's counts and materials re-read after every file has loaded here, and
-    #   the statistical estimates of many samples: BSDF albedo furnaces, the path tracer's
-    #   convergence rate, the refitted BVH against brute force, the noise bounds) are filtered out
-    #   of this build's ctest commands;
-    # - the other scripts run in Release only: they render the shipped scenes through the
-    #   command's options, paths the unit tests take here too; so do the Slurm tests (daemons
-    #   around the same commands), the Blender checks, install and package, Python (an
-    #   instrumented module cannot load into Debian's uninstrumented python3), the benchmark's
-    #   smoke runs and tests (measurement code, not built here), and the format, OCIO-config,
+    # - every unit test case not tagged [heavy].
+    # In Release only:
+    # - the cases tagged [heavy] (label unit-heavy: the accelerator and raster cross-checks over
+    #   every corpus model and at huge and tiny coordinates, the renders with every accelerator,
+    #   the grid's stadium, the corpus's counts and materials re-read after every file has
+    #   loaded, the denoiser's error on a shipped scene, and the statistical estimates of many
+    #   samples: BSDF albedo furnaces, the path tracer's convergence rate, the refitted BVH
+    #   against brute force, the noise bounds), too slow under the sanitizers;
+    # - the other scripts: they render the shipped scenes through the command's options, paths
+    #   the unit tests take under the sanitizers; so do the Slurm tests (daemons around the same
+    #   commands), the Blender checks, install and package, Python (an instrumented module cannot
+    #   load into Debian's uninstrumented python3), the benchmark's smoke runs and tests
+    #   (measurement code, not built there; label benchmark-unit), and the format, OCIO-config,
     #   layering and documentation checks (the same in any build).
     if [ "${SANITIZE:-1}" != 0 ]; then
-      ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" -LE '^bad-input$'
+      ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" -LE '^(bad-input|unit)$'
       SAN_DIR="${SAN_BUILD_DIR:-build-sanitize}"
       cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DPENUMBRA_BUILD_PYTHON=OFF
       cmake --build "$SAN_DIR" -j "$JOBS" --target penumbra renderer_tests io_tests render_tests
-      ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" -L '^(unit|bad-input)$' -E '^benchmarks/'
+      ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS" -L '^(unit|bad-input)$'
     else
       ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
     fi
