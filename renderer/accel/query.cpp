@@ -254,7 +254,8 @@ bool primitive_meets_box(const QueryScene& scene, uint32_t geom_id, uint32_t pri
     const Bounds3f b = shape_bounds(*pl.view->shape);
     Bounds3f world;
     for (int i = 0; i < 8; ++i)
-      world = merge(world, to_world(pl, {i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z}));
+      world = merge(
+          world, to_world(pl, {i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z}));
     const Bounds3f common = intersect(world, box);
     return !b.empty() && !common.empty() && shape_meets_box(pl, common, 6);
   }
