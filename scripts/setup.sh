@@ -35,9 +35,8 @@ case "$mode" in
     # Sanitize (build-sanitize/, ASan + UBSan; SANITIZE=0 skips it, and the Release stage then
     # runs everything): the unit tests' light cases and the scripts that feed the command hostile
     # input, where a memory error is what a test must catch:
-    # - the scripts labelled bad-input: cli.hostile_input (every malformed corpus file),
-    #   cli.job_hardening (hostile job files), cli.output_safety (unwritable, hostile and
-    #   half-written outputs);
+    # - the scripts labelled bad-input: cli.hostile_input (every malformed corpus file) and
+    #   cli.job_hardening (hostile job files);
     # - every unit test case not tagged [heavy].
     # In Release only:
     # - the cases tagged [heavy] (label unit-heavy: the accelerator and raster cross-checks over

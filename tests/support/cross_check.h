@@ -473,7 +473,7 @@ inline void check_all(const std::string& scene, std::span<const GeometryView> vi
   const Accelerator& embree = find(all, "embree");
   const float scale = length(bounds_of(views).extent());
   const uint64_t tris = std::max<uint64_t>(1, brute.stats().triangles);
-  const size_t stride = std::max<size_t>(1, size_t(tris * rays.size() / 200'000'000ull) + 1);
+  const size_t stride = std::max<size_t>(1, size_t(tris * rays.size() / 100'000'000ull) + 1);
   std::vector<Ray> subset;
   for (size_t i = 0; i < rays.size(); i += stride) subset.push_back(rays[i]);
   const Reference by_brute = reference(brute, subset);
