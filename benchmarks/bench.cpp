@@ -33,14 +33,18 @@
 
 #include "benchmarks/chart.h"
 #include "benchmarks/machine.h"
+#include "benchmarks/queries.h"
 #include "benchmarks/report.h"
 #include "benchmarks/sah.h"
 #include "benchmarks/scenegen.h"
+#include "benchmarks/timing.h"
 #include "io/files/atomic_file.h"
 #include "io/files/error.h"
+#include "io/files/points_file.h"
 #include "io/gltf/loader.h"
 #include "io/image/image_output.h"
 #include "io/mesh/ply_loader.h"
+#include "io/mesh/point_cloud.h"
 #include "render/accel_params.h"
 #include "render/session.h"
 #include "renderer/accel/embree.h"
@@ -59,17 +63,11 @@ using namespace penumbra;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::median;
+using bench::median_seconds;
 using bench::Row;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
-}
+using bench::seconds_since;
 
 struct RaySet {
   std::string kind;  // primary, shadow, diffuse, random, motion
@@ -227,6 +225,23 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
       if (count.empty() || *end != 0)
         throw std::invalid_argument(spec + ": triangle count '" + count + "' is not a number");
     }
+    if (rest.substr(0, colon) == "cloud") {
+      // A point set: a third in a few dense clusters, the rest uniform in the unit cube.
+      const uint64_t count = n ? n : 1000000;
+      if (count > (1ull << 28)) throw std::invalid_argument(spec + ": more than 2^28 points");
+      std::mt19937 rng{uint32_t(seed)};
+      std::uniform_real_distribution<float> u(-1, 1);
+      std::normal_distribution<float> g(0, 0.03f);
+      std::vector<Vec3f> centres;
+      for (int c = 0; c < 16; ++c) centres.push_back({u(rng), u(rng), u(rng)});
+      std::vector<Vec3f> pts(count);
+      for (uint64_t i = 0; i < count; ++i)
+        pts[i] = i % 3 ? Vec3f{u(rng), u(rng), u(rng)} : centres[i % 16] + Vec3f{g(rng), g(rng), g(rng)};
+      Scene scene;
+      add_world_mesh(scene, make_point_set(std::move(pts), "cloud"));
+      name = "cloud-" + std::to_string(count / 1000) + "k";
+      return scene;
+    }
     Scene scene = bench::generate_scene(rest.substr(0, colon), seed, n);
     name = rest.substr(0, colon) + "-" +
            (scene.shapes.empty() ? std::to_string(count_triangles(scene) / 1000) + "k"
@@ -234,25 +249,13 @@ Scene load_bench_scene(const std::string& spec, uint64_t seed, std::string& name
     return scene;
   }
   name = std::filesystem::path(spec).filename().string();
-  if (std::filesystem::path(spec).extension() == ".ply") return load_ply(spec);
+  if (std::filesystem::path(spec).extension() == ".ply") return load_ply_or_points(spec, size_t(1) << 28);
+  if (is_point_cloud_file(spec)) return load_point_cloud(spec, size_t(1) << 28);
   // Flattened: the benchmark measures single-level structures over world-space triangles
   // (geom_id = mesh index).
   GltfLoadOptions options;
   options.flatten = true;
   return load_gltf(spec, options).scene;
-}
-
-/// The median seconds of `repeats` calls of fn after one warm-up call.
-template <typename Fn>
-double median_seconds(int repeats, Fn&& fn) {
-  fn();
-  std::vector<double> t;
-  for (int i = 0; i < repeats; ++i) {
-    const auto t0 = Clock::now();
-    fn();
-    t.push_back(seconds_since(t0));
-  }
-  return median(t);
 }
 
 /// The shaded raster preview of `loaded` as `penumbra render --integrator raster` renders it,
@@ -830,6 +833,8 @@ struct BenchOptions {
   bool raster = false, tradeoffs = false;
   std::string refit_file;
   int refit_frames = 240;
+  std::vector<std::string> queries;  ///< --queries: the kinds
+  int query_count = 20000, k = 8;
   std::string command;  ///< the command line as typed, for the JSON
 };
 
@@ -884,6 +889,17 @@ void add_bench_options(CLI::App& app, BenchOptions& o) {
                  "and under the rebuild policy (bvh.refit_max_growth): update times, SAH and work per ray");
   app.add_option("--refit-frames", o.refit_frames, "frames spanning the animation for --refit (default 240)")
       ->check(CLI::Range(1, 100000));
+  app.add_option(
+         "--queries", o.queries,
+         "instead of the rays: spatial queries per structure, comma separated: nearest (the nearest "
+         "primitive), knn (the --k nearest points of the scene's point sets, or of its vertices), within "
+         "(a radius of 1% of the diagonal), overlap (boxes 2% of it); queries per second on the first "
+         "--threads count, build time, memory, answers checked against brute force, nanoflann beside "
+         "knn; scenes also gen:cloud:N (N points) and point files (.npy, .txt, .xyz, .ply vertices)")
+      ->delimiter(',');
+  app.add_option("--query-count", o.query_count, "query points per kind for --queries (default 20000)")
+      ->check(CLI::Range(1, 100000000));
+  app.add_option("--k", o.k, "neighbours per knn query (default 8)")->check(CLI::Range(1, 1024));
   app.add_flag("--raster", o.raster,
                "instead of the structures: frames per second of primary visibility at --width x --height, "
                "rasterised against Embree's and the BVH's camera rays, and the shaded raster preview");
@@ -913,6 +929,28 @@ std::optional<int> run_mode(const BenchOptions& o) {
                            o.svg, o.command);
     }
     if (o.raster) return run_raster(o.scenes, o.seed, o.width, o.height, o.threads, o.builds, o.repeats);
+    if (!o.queries.empty()) {
+      AccelConfig config;
+      for (const auto& p : o.params) apply_accel_param(config, p);
+      validate(config);
+      bench::QueryBenchConfig q;
+      q.kinds = o.queries;
+      q.accels = o.accels;
+      q.count = o.query_count;
+      q.k = o.k;
+      q.threads = o.threads[0];
+      q.builds = o.builds;
+      q.repeats = o.repeats;
+      q.seed = o.seed;
+      q.csv = o.csv;
+      std::vector<std::pair<std::string, Scene>> scenes;
+      for (const auto& spec : o.scenes) {
+        std::string name;
+        Scene scene = load_bench_scene(spec, o.seed, name);
+        scenes.emplace_back(name, std::move(scene));
+      }
+      return bench::run_queries(scenes, config, q);
+    }
   } catch (const std::exception& e) {
     return report_error(e);
   }

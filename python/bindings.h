@@ -1,6 +1,7 @@
 // The pieces of the `penumbra` Python module, one function per concern, called by the module's
 // initialiser (penumbra_module.cpp): the Scene with its inspection records (scene_bindings.cpp),
-// render settings, renders and their files (render_bindings.cpp).
+// render settings, renders and their files (render_bindings.cpp), spatial queries and picking
+// (query_bindings.cpp).
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -34,5 +35,13 @@ SceneClass bind_scene(py::module_& m);
 
 /// penumbra.RenderSettings, penumbra.RenderResult, Scene.render and Scene.render_to_file.
 void bind_render(py::module_& m, SceneClass& scene);
+
+/// A copy of `settings` (None: the defaults) with the keywords applied as render settings.
+/// TypeError unless `settings` is None or a RenderSettings, or for an unknown keyword.
+RenderSettings settings_from(const py::object& settings, const py::kwargs& kw);
+
+/// penumbra.load_points, Scene.nearest, Scene.within, Scene.overlap, Scene.intersect and
+/// Scene.pick.
+void bind_queries(py::module_& m, SceneClass& scene);
 
 }  // namespace penumbra::python

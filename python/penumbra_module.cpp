@@ -60,4 +60,5 @@ PYBIND11_MODULE(penumbra, m) {
   register_errors(m);
   auto scene = penumbra::python::bind_scene(m);
   penumbra::python::bind_render(m, scene);
+  penumbra::python::bind_queries(m, scene);
 }

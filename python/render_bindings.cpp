@@ -75,8 +75,8 @@ int int_in_range(const py::handle& v, int lo, const std::string& what) {
   return i.cast<int>();
 }
 
-/// A copy of `settings` (None: the defaults) with the keywords applied. TypeError unless
-/// `settings` is None or a RenderSettings.
+}  // namespace
+
 RenderSettings settings_from(const py::object& settings, const py::kwargs& kw) {
   if (!settings.is_none() && !py::isinstance<RenderSettings>(settings))
     throw py::type_error("settings must be a penumbra.RenderSettings or None, not " + type_name(settings));
@@ -84,6 +84,8 @@ RenderSettings settings_from(const py::object& settings, const py::kwargs& kw) {
   apply_keywords(s, kw);
   return s.cast<RenderSettings>();
 }
+
+namespace {
 
 /// None, one grey value or three values as an optional colour.
 std::optional<Vec3f> colour_from(const py::object& v, const char* name) {

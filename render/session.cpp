@@ -193,30 +193,41 @@ IntegratorType PreparedRender::integrator() const {
                                        : IntegratorType::Whitted;
 }
 
-PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& o) {
+RenderView render_view(const Scene& scene, const RenderSpec& spec, const PrepareOptions& o) {
   validate(spec);
-  PreparedRender p;
-  Scene& scene = loaded.scene;
-  p.camera_index = o.camera_index >= -1  ? o.camera_index
+  RenderView v;
+  v.camera_index = o.camera_index >= -1  ? o.camera_index
                    : spec.camera.empty() ? (scene.cameras.empty() ? -1 : 0)
                                          : find_camera(scene, spec.camera, o.scene_file);
-  const Camera* chosen = p.camera_index >= 0 ? &scene.cameras[size_t(p.camera_index)] : nullptr;
+  const Camera* chosen = v.camera_index >= 0 ? &scene.cameras[size_t(v.camera_index)] : nullptr;
   const float hint = chosen && chosen->aspect > 0 ? chosen->aspect : 16.0f / 9.0f;
-  p.spec = resolve(spec, hint);
-  p.config = make_render_config(p.spec);
-  validate(p.config);
-  const uint64_t env_budget = o.charge_budget ? o.charge_budget(p.config) : o.env_budget;
-  const RenderConfig& cfg = p.config;
-  p.camera = o.place  ? o.place(scene, p.camera_index, cfg.width, cfg.height)
+  v.spec = resolve(spec, hint);
+  v.config = make_render_config(v.spec);
+  validate(v.config);
+  const RenderConfig& cfg = v.config;
+  v.camera = o.place  ? o.place(scene, v.camera_index, cfg.width, cfg.height)
              : chosen ? *chosen
                       : frame_bounds(compute_bounds(scene), float(cfg.width) / float(cfg.height));
   try {
-    validate_camera(p.camera, cfg.width, cfg.height);
+    validate_camera(v.camera, cfg.width, cfg.height);
   } catch (const std::invalid_argument& e) {
     throw InputError(o.scene_file,
-                     p.camera_index >= 0 ? "cameras[" + std::to_string(p.camera_index) + "]" : "the view",
+                     v.camera_index >= 0 ? "cameras[" + std::to_string(v.camera_index) + "]" : "the view",
                      e.what());
   }
+  return v;
+}
+
+PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const PrepareOptions& o) {
+  Scene& scene = loaded.scene;
+  RenderView view = render_view(scene, spec, o);
+  PreparedRender p;
+  p.camera_index = view.camera_index;
+  p.spec = std::move(view.spec);
+  p.config = view.config;
+  p.camera = view.camera;
+  const uint64_t env_budget = o.charge_budget ? o.charge_budget(p.config) : o.env_budget;
+  const RenderConfig& cfg = p.config;
   set_lens(p, scene, o.scene_file);
   if (p.spec.motion_blur && p.integrator() == IntegratorType::Raster)
     p.warnings.push_back(

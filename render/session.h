@@ -86,6 +86,21 @@ struct MotionFrames {
   const Scene& next_scene(const Scene& render) const { return same_scene ? render : next.scene; }
 };
 
+/// The image a render sees and the camera it sees it through: the first step of prepare_render.
+struct RenderView {
+  RenderSpec spec;  ///< resolved (resolve())
+  RenderConfig config;
+  Camera camera;          ///< placed (options.place, the scene's camera, or framing the bounds), pinhole
+  int camera_index = -1;  ///< into the scene's cameras; -1: none
+};
+
+/// validate(spec), the camera (options.camera_index, else spec.camera through find_camera, else
+/// the first), the spec resolved for its aspect hint, the RenderConfig, and the camera placed by
+/// options.place (or the scene's, or framed on the bounds) and checked by validate_camera. The
+/// lens (depth of field), lights and motion are prepare_render's. Throws std::invalid_argument
+/// for settings and InputError for the camera, naming options.scene_file.
+RenderView render_view(const Scene& scene, const RenderSpec& spec, const PrepareOptions& options);
+
 /// A render ready to run: everything resolved, the scene's lights set up.
 struct PreparedRender {
   RenderSpec spec;  ///< resolved (resolve())

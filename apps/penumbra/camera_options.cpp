@@ -5,9 +5,12 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/scene_setup.h"
+#include "io/files/error.h"
+#include "renderer/scene/camera.h"
 
 namespace penumbra::cli {
 
@@ -313,6 +316,21 @@ Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int wi
     throw UsageError(
         std::string("camera (--near, --far, --fov, --focal-length, --ortho or the placement): ") + e.what());
   }
+}
+
+ChosenView choose_view(const Scene& scene, const std::string& file, const std::string& camera,
+                       const CameraArgs& args, int width, int height, long long frame) {
+  ChosenView v;
+  v.rig = check_camera_args(args, frame);
+  v.index = base_camera_index(scene, camera, args, file);
+  std::tie(v.width, v.height) = image_size(width, height, aspect_hint(scene, v.index));
+  v.camera = choose_camera(v.rig, scene, v.index, v.width, v.height);
+  try {
+    validate_camera(v.camera, v.width, v.height);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(file, v.index >= 0 ? "cameras[" + std::to_string(v.index) + "]" : "the view", e.what());
+  }
+  return v;
 }
 
 }  // namespace penumbra::cli

@@ -60,4 +60,18 @@ float aspect_hint(const Scene& scene, int index);
 Camera choose_camera(const CameraRig& rig, const Scene& scene, int index, int width, int height,
                      const Bounds3f* bounds = nullptr);
 
+/// The camera a render with these flags uses, with what chose it.
+struct ChosenView {
+  Camera camera;
+  CameraRig rig;
+  int index = -1;  ///< the scene camera it starts from (base_camera_index), -1: none
+  int width = 0, height = 0;
+};
+
+/// check_camera_args(args, frame), base_camera_index, image_size(width, height) for that
+/// camera's aspect hint and choose_camera, then validate_camera (failures: InputError naming
+/// `file` and the camera): the camera `render` places for the same flags.
+ChosenView choose_view(const Scene& scene, const std::string& file, const std::string& camera,
+                       const CameraArgs& args, int width, int height, long long frame = 0);
+
 }  // namespace penumbra::cli

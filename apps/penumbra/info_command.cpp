@@ -15,6 +15,7 @@
 #include "render/session.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/scene/camera.h"
+#include "renderer/scene/volume.h"
 
 namespace penumbra::cli {
 
@@ -247,7 +248,8 @@ nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loa
   j["instances"] = {{"count", s.instances.size()},
                     {"world_space", s.instances.size() - placed},
                     {"placed", placed},
-                    {"triangles", count_triangles(s)}};
+                    {"triangles", count_triangles(s)},
+                    {"points", count_points(s)}};
   std::vector<size_t> shape_uses(s.shapes.size(), 0);
   for (const Instance& inst : s.instances)
     if (inst.shape >= 0) ++shape_uses[size_t(inst.shape)];
@@ -349,6 +351,66 @@ nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loa
   return j;
 }
 
+/// What an instance is, for the volumes section: "mesh NAME" or the shape's kind.
+std::string instance_what(const Scene& s, const Instance& inst) {
+  return inst.shape >= 0 ? std::string(shape_kind_name(s.shapes[size_t(inst.shape)].shape.kind))
+                         : "mesh \"" + s.meshes[size_t(inst.mesh)].name + "\"";
+}
+
+std::string node_name(const LoadedScene& loaded, int node) {
+  return node >= 0 && size_t(node) < loaded.info.node_names.size() ? loaded.info.node_names[size_t(node)]
+                                                                   : "";
+}
+
+nlohmann::ordered_json volumes_json(const LoadedScene& loaded) {
+  using J = nlohmann::ordered_json;
+  const Scene& s = loaded.scene;
+  J list = J::array();
+  for (const InstanceVolume& v : instance_volumes(s)) {
+    const Instance& inst = s.instances[v.instance];
+    J e{{"instance", v.instance},
+        {"node", inst.node},
+        {"node_name", node_name(loaded, inst.node)},
+        {"kind", inst.shape >= 0 ? shape_kind_name(s.shapes[size_t(inst.shape)].shape.kind) : "mesh"},
+        {"closed", v.closed},
+        {"volume", v.closed ? J(v.volume) : J()},
+        {"error", v.closed ? J(v.error) : J()}};
+    if (inst.shape < 0) {
+      e["mesh"] = inst.mesh;
+      e["inward"] = v.inward;
+      e["open_edges"] = v.open_edges;
+      e["bad_edges"] = v.bad_edges;
+    }
+    list.push_back(std::move(e));
+  }
+  return list;
+}
+
+void print_volumes(const LoadedScene& loaded) {
+  const Scene& s = loaded.scene;
+  const std::vector<InstanceVolume> vols = instance_volumes(s);
+  double total = 0;
+  size_t closed = 0;
+  for (const InstanceVolume& v : vols)
+    if (v.closed) total += v.volume, ++closed;
+  std::printf("volumes      %zu of %zu instances closed, %.6g enclosed in all\n", closed, vols.size(), total);
+  for (const InstanceVolume& v : vols) {
+    const Instance& inst = s.instances[v.instance];
+    std::string text;
+    if (v.closed)
+      text = format("%.6g", v.volume) + (v.error > 0 ? format(" +- %.2g", v.error) : std::string()) +
+             (v.inward ? " (faces inwards)" : "");
+    else if (inst.shape >= 0)
+      text = "not closed";
+    else
+      text =
+          format("not closed (%llu open edges, %llu shared by more than two faces or the same way)",
+                 static_cast<unsigned long long>(v.open_edges), static_cast<unsigned long long>(v.bad_edges));
+    std::printf("  [%u] node %d \"%s\", %s: %s\n", v.instance, inst.node,
+                node_name(loaded, inst.node).c_str(), instance_what(s, inst).c_str(), text.c_str());
+  }
+}
+
 }  // namespace
 
 void add_info_options(CLI::App& info, InfoArgs& a) {
@@ -369,6 +431,10 @@ void add_info_options(CLI::App& info, InfoArgs& a) {
       ->check(CLI::Range(1, 16384));
   info.add_option("--height", a.height, "as for render: the image height")->check(CLI::Range(1, 16384));
   info.add_option("--frame", a.frame, "the --turntable frame the view section describes (default 0)");
+  info.add_flag(
+      "--volumes", a.volumes,
+      "add each instance's enclosed volume: closed meshes by the divergence theorem, analytic shapes "
+      "exactly, implicit ones with an error bound");
   add_camera_options(info, a.cam);
 }
 
@@ -390,8 +456,9 @@ int run_info(const InfoArgs& a) {
   spec.accel_params = a.accel_params;
   if (a.json) {
     const auto accel = build_structure(s, spec, false).accel;
-    const std::string doc = info_json(file, loaded, view, accel->stats())
-                                .dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+    nlohmann::ordered_json j = info_json(file, loaded, view, accel->stats());
+    if (a.volumes) j["volumes"] = volumes_json(loaded);
+    const std::string doc = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
     std::printf("%s\n", doc.c_str());
     return kExitOk;
   }
@@ -411,6 +478,9 @@ int run_info(const InfoArgs& a) {
   std::printf("instances    %zu (%zu in world space, %zu placed by a transform), %llu triangles rendered\n",
               s.instances.size(), s.instances.size() - placed, placed,
               static_cast<unsigned long long>(count_triangles(s)));
+  if (const uint64_t points = count_points(s))
+    std::printf("point sets   %llu points (glTF POINTS: answered by penumbra query, not rendered)\n",
+                static_cast<unsigned long long>(points));
   print_shapes(s, i);
   std::printf("materials    %zu\n", s.materials.size());
   for (size_t k = 0; k < s.materials.size(); ++k) {
@@ -479,6 +549,7 @@ int run_info(const InfoArgs& a) {
     std::printf("  (Embree does not report its node statistics)\n");
   }
   std::printf("warnings     %zu\n", loaded.warnings.size());
+  if (a.volumes) print_volumes(loaded);
   return kExitOk;
 }
 

@@ -17,6 +17,7 @@ struct InfoArgs {
   std::vector<std::string> accel_params;
   int scene = -1;
   bool allow_external = false, flatten = false, json = false;
+  bool volumes = false;       ///< add each instance's enclosed volume
   std::string camera;         ///< as render's --camera
   int width = 0, height = 0;  ///< as render's: the image the view is described for
   std::string frame;          ///< the turntable frame (default 0)

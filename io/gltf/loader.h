@@ -94,7 +94,7 @@ struct LoadedScene {
 
 /// Loads `file`. A file in another 3D format (OBJ, FBX, USD, PLY, ...: check_gltf_file_format)
 /// is refused naming the format before it is parsed. Throws InputError (file + JSON path +
-/// reason) for anything malformed or hostile; degenerate but harmless content (points/lines primitives, NaN
+/// reason) for anything malformed or hostile; degenerate but harmless content (lines primitives, NaN
 /// vertices, missing images) produces a warning instead and is skipped.
 LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& options = {});
 

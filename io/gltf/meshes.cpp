@@ -93,6 +93,10 @@ std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Prim
       const bool odd = i % 2;
       tris.insert(tris.end(), {raw[i], raw[i + (odd ? 2 : 1)], raw[i + (odd ? 1 : 2)]});
     }
+  } else if (prim.mode == 0) {
+    ctx.charge(uint64_t(raw.size()) * 12, where, "a point set's degenerate triangles need");
+    tris.reserve(raw.size() * 3);
+    for (uint32_t i : raw) tris.insert(tris.end(), {i, i, i});
   } else {
     for (size_t i = 1; i + 1 < raw.size(); ++i) tris.insert(tris.end(), {raw[i], raw[i + 1], raw[0]});
   }
@@ -257,12 +261,16 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   const std::string where = idx("meshes", mesh_index) + "." + idx("primitives", pi);
   LocalPrimitive out;
   // Mode and material.
-  if (prim.mode >= 0 && prim.mode <= 3) {
-    ctx.warn(where, "points/lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
+  if (prim.mode >= 1 && prim.mode <= 3) {
+    ctx.warn(where, "lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
     return out;
   }
-  if (prim.mode != 4 && prim.mode != 5 && prim.mode != 6)
-    ctx.fail(where, "invalid mode " + std::to_string(prim.mode));
+  if (prim.mode == 0) {
+    out.points = true;
+    ctx.warn(where,
+             "POINTS primitive (mode 0): a point set for spatial queries (penumbra query), not rendered");
+  }
+  if (prim.mode < 0 || prim.mode > 6) ctx.fail(where, "invalid mode " + std::to_string(prim.mode));
   if (prim.material < -1 || prim.material >= int(ctx.model.materials.size()))
     ctx.fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
                                       std::to_string(ctx.model.materials.size()) + " materials)");
@@ -284,7 +292,7 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   out.indices = triangle_list(ctx, prim, where, nv);
   read_vertex_attributes(ctx, prim, where, nv, raw);
   if (out.indices.empty()) {
-    ctx.warn(where, "no triangles; skipped");
+    ctx.warn(where, out.points ? "no points; skipped" : "no triangles; skipped");
     return out;
   }
   // Validation and conversion.
@@ -390,6 +398,7 @@ bool place_primitive(const GltfContext& ctx, const LocalPrimitive& local, const 
   out.name = (mesh.name.empty() ? idx("meshes", size_t(e.mesh)) : mesh.name) + "[" + std::to_string(pi) + "]";
   out.node = e.node;
   out.material = local.material;
+  out.points = local.points;
   std::vector<Vec3f> lp, ln;
   morph(local, *e.morph, lp, ln);
   const bool skinned = !e.joint_mats->empty() && !local.joints.empty();

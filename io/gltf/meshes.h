@@ -31,6 +31,7 @@ struct LocalPrimitive {
   std::vector<std::array<uint16_t, 4>> joints;                       ///< JOINTS_0 (skinning), empty if absent
   std::vector<Vec4f> weights;                                        ///< WEIGHTS_0
   int material = -1;
+  bool points = false;  ///< POINTS: one degenerate triangle (i, i, i) per point (Mesh::points)
   bool usable = false;  ///< false: skipped with a warning
 };
 
@@ -44,7 +45,8 @@ uint64_t declared_placements(const GltfContext& ctx, int node);
 /// Throws InputError naming the attribute for malformed instance data.
 std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Transform& world);
 
-/// Every primitive of every mesh, [mesh][primitive]. Points and lines, primitives without
+/// Every primitive of every mesh, [mesh][primitive]. POINTS become point sets (Mesh::points).
+/// Lines, primitives without
 /// POSITION or triangles, and NaN positions are kept unusable with a warning; malformed
 /// accessors, modes, materials and attribute counts throw InputError naming the primitive.
 std::vector<std::vector<LocalPrimitive>> decode_meshes(const GltfContext& ctx);

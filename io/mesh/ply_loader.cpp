@@ -233,20 +233,43 @@ void read_elements(std::ifstream& in, const Header& h, const std::string& file, 
 
 }  // namespace
 
-Scene load_ply(const std::filesystem::path& path) {
+namespace {
+
+Scene read_ply(const std::filesystem::path& path, bool points, size_t max_points) {
   const std::string file = path.string();
   const uint64_t file_bytes = check_input_file(path, "", kMaxPlyBytes);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(file, "", "cannot open");
   const Header header = read_header(in, file);
+  if (points)
+    for (const Element& e : header.elements)
+      if (e.name == "vertex" && e.count > max_points)
+        throw InputError(
+            file, "element vertex",
+            std::to_string(e.count) + " vertices exceed the limit of " + std::to_string(max_points));
   Mesh mesh;
   mesh.name = path.stem().string();
   read_elements(in, header, file, file_bytes, mesh);
-  if (mesh.indices.empty()) throw InputError(file, "element face", "no triangles");
-  mesh.normals = compute_smooth_normals(mesh.positions, mesh.indices);
   Scene scene;
+  if (mesh.indices.empty()) {
+    if (!points) throw InputError(file, "element face", "no triangles");
+    if (mesh.positions.empty()) throw InputError(file, "element vertex", "no vertices");
+    add_world_mesh(scene, make_point_set(std::move(mesh.positions), mesh.name));
+    return scene;
+  }
+  mesh.normals = compute_smooth_normals(mesh.positions, mesh.indices);
   add_world_mesh(scene, std::move(mesh));
   return scene;
+}
+
+}  // namespace
+
+Scene load_ply(const std::filesystem::path& path) {
+  return read_ply(path, false, 0);
+}
+
+Scene load_ply_or_points(const std::filesystem::path& path, size_t max_points) {
+  return read_ply(path, true, max_points);
 }
 
 }  // namespace penumbra

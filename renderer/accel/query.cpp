@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "renderer/accel/grid.h"
@@ -330,6 +331,52 @@ void nearest_batch(const Accelerator& accel, const QueryScene& scene, std::span<
                         for (size_t i = r.begin(); i < r.end(); ++i)
                           counts[i] = uint32_t(nearest(accel, scene, points[i], k, max_distance,
                                                        std::span(out).subspan(i * size_t(k), size_t(k))));
+                      });
+  });
+}
+
+bool within_batch(const Accelerator& accel, const QueryScene& scene, std::span<const Vec3f> points,
+                  float radius, int threads, size_t max_matches, std::vector<PrimitiveMatch>& out,
+                  std::vector<size_t>& offsets) {
+  out.clear();
+  offsets.assign(points.size() + 1, 0);
+  std::vector<std::vector<PrimitiveMatch>> each(points.size());
+  std::atomic<size_t> total{0};
+  std::atomic<bool> over{false};
+  tbb::task_arena arena(thread_count(threads));
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, points.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i < r.end() && !over.load(std::memory_order_relaxed); ++i) {
+            within(accel, scene, points[i], radius, each[i]);
+            if (total.fetch_add(each[i].size(), std::memory_order_relaxed) + each[i].size() > max_matches) {
+              over = true;
+              each[i] = {};
+            }
+          }
+        });
+  });
+  if (over) {
+    offsets.clear();
+    return false;
+  }
+  out.reserve(total);
+  for (size_t i = 0; i < points.size(); ++i) {
+    out.insert(out.end(), each[i].begin(), each[i].end());
+    offsets[i + 1] = out.size();
+  }
+  return true;
+}
+
+void intersect_batch(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits, int threads) {
+  tbb::task_arena arena(thread_count(threads));
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i < r.end(); ++i) {
+                          hits[i] = Hit{};
+                          if (!accel.intersect(rays[i], hits[i])) hits[i].geom_id = Hit::kInvalidId;
+                        }
                       });
   });
 }

@@ -73,4 +73,16 @@ void nearest_batch(const Accelerator& accel, const QueryScene& scene, std::span<
                    float max_distance, int threads, std::vector<PrimitiveMatch>& out,
                    std::vector<uint32_t>& counts);
 
+/// within() for every point of `points` on `threads` workers (0: all cores): point i's matches
+/// are out[offsets[i], offsets[i + 1]) (offsets has points.size() + 1 entries). Returns false,
+/// with out and offsets empty, when the points meet more than `max_matches` primitives in all.
+/// The same output for any thread count.
+bool within_batch(const Accelerator& accel, const QueryScene& scene, std::span<const Vec3f> points,
+                  float radius, int threads, size_t max_matches, std::vector<PrimitiveMatch>& out,
+                  std::vector<size_t>& offsets);
+
+/// The closest hit of every ray (hits[i], geom_id == Hit::kInvalidId on a miss; hits.size() >=
+/// rays.size()) on `threads` workers (0: all cores). The same output for any thread count.
+void intersect_batch(const Accelerator& accel, std::span<const Ray> rays, std::span<Hit> hits, int threads);
+
 }  // namespace penumbra

@@ -73,6 +73,18 @@ int add_world_mesh(Scene& scene, Mesh mesh) {
   return index;
 }
 
+Mesh make_point_set(std::vector<Vec3f> points, std::string name) {
+  Mesh m;
+  m.name = std::move(name);
+  m.points = true;
+  m.indices.resize(points.size() * 3);
+  for (size_t i = 0; i < points.size(); ++i)
+    m.indices[3 * i] = m.indices[3 * i + 1] = m.indices[3 * i + 2] = uint32_t(i);
+  m.normals.assign(points.size(), Vec3f{0, 0, 1});
+  m.positions = std::move(points);
+  return m;
+}
+
 Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   std::vector<Bounds3f> mesh_bounds(scene.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i)
@@ -106,7 +118,16 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
 uint64_t count_triangles(const Scene& scene) {
   uint64_t n = 0;
   for (const Instance& inst : scene.instances)
-    if (inst.shape < 0) n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+    if (inst.shape < 0 && !scene.meshes[size_t(inst.mesh)].points)
+      n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+  return n;
+}
+
+uint64_t count_points(const Scene& scene) {
+  uint64_t n = 0;
+  for (const Instance& inst : scene.instances)
+    if (inst.shape < 0 && scene.meshes[size_t(inst.mesh)].points)
+      n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
   return n;
 }
 

@@ -91,8 +91,12 @@ struct Mesh {
   std::vector<Vec2f> uvs1;        ///< TEXCOORD_1, empty if absent
   std::vector<Vec4f> colors;      ///< COLOR_0 as linear RGBA, empty if absent
   std::vector<uint32_t> indices;  ///< 3 per triangle, counter-clockwise = front
-  int material = -1;              ///< index into Scene::materials, -1 = default material
-  int node = -1;                  ///< glTF node of a flattened mesh, -1 if shared or not from glTF
+  /// A point set (glTF POINTS, a point file): one degenerate triangle (i, i, i) per point, so
+  /// that every structure indexes it and the spatial queries measure the points exactly; rays
+  /// never hit a degenerate triangle, so it is not rendered.
+  bool points = false;
+  int material = -1;  ///< index into Scene::materials, -1 = default material
+  int node = -1;      ///< glTF node of a flattened mesh, -1 if shared or not from glTF
   /// For a mesh moved into world space from a node: world -> the node's local frame, the object
   /// space of procedural textures (identity otherwise: instances place object-space meshes).
   Affine3f object_from_world;
@@ -221,6 +225,10 @@ inline int instance_material(const Scene& scene, const Instance& inst) {
 /// Appends a world-space mesh with its identity instance; returns the mesh index.
 int add_world_mesh(Scene& scene, Mesh mesh);
 
+/// A point set mesh (Mesh::points) over `points`: one degenerate triangle (i, i, i) per point,
+/// normals +Z, the default material. Requires points.size() < 2^32 / 3.
+Mesh make_point_set(std::vector<Vec3f> points, std::string name);
+
 /// World-space bounds of every instance's positions and shapes (empty box for an empty scene); exact
 /// unless the meshes placed by non-identity instances hold more than `exact_vertex_limit`
 /// vertices in all, then each such placement contributes the mapped box of its mesh
@@ -228,10 +236,13 @@ int add_world_mesh(Scene& scene, Mesh mesh);
 Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64_t(1) << 24);
 /// Shapes rendered: each shape counted once per instance.
 uint64_t count_shape_instances(const Scene& scene);
-/// Triangles rendered: each mesh counted once per instance.
+/// Triangles rendered: each mesh counted once per instance; point sets (Mesh::points) not.
 uint64_t count_triangles(const Scene& scene);
-/// Triangles stored: each mesh once.
+/// Triangles stored: each mesh once, a point set's degenerate triangles (one per point) too, as
+/// the acceleration structures store them.
 uint64_t count_stored_triangles(const Scene& scene);
+/// Points of the placed point sets, each counted once per instance.
+uint64_t count_points(const Scene& scene);
 
 /// Bytes held by the scene's arrays (mesh attributes, shapes, instances, texture pyramids), for
 /// memory budgets.

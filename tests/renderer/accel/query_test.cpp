@@ -10,7 +10,9 @@
 #include <cstring>
 #include <random>
 
+#include "benchmarks/point_kdtree.h"
 #include "renderer/accel/factory.h"
+#include "renderer/scene/scene.h"
 #include "renderer/shapes/shape_distance.h"
 #include "support/cross_check.h"
 #include "support/sdf_trees.h"
@@ -268,4 +270,69 @@ TEST_CASE("query: the structures prune: a nearest query reaches a small part of 
     CHECK(c.offered > 0);
     CHECK(c.offered < 1000);
   }
+}
+
+namespace {
+
+// Points in a unit cube and a dense cluster, all distinct.
+std::vector<Vec3f> cloud(int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::normal_distribution<float> g(0, 0.05f);
+  std::vector<Vec3f> p;
+  for (int i = 0; i < n; ++i)
+    p.push_back(i % 3 ? Vec3f{u(rng), u(rng), u(rng)} : Vec3f{0.3f + g(rng), -0.2f + g(rng), 0.1f + g(rng)});
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("query: point sets: every structure finds the k nearest points as the oracle and nanoflann do",
+          "[query][accel][crosscheck][heavy]") {
+  const Mesh m = make_point_set(cloud(3000, 11), "cloud");
+  const std::vector<GeometryView> views{{m.positions, m.indices}};
+  const QueryScene scene{views, {}};
+  const std::vector<NamedAccel> all = build_all(views);
+  check_queries("points", scene, all, 25, 4);
+  // Placed twice under a top level.
+  const std::vector<InstanceView> instances{{0, Affine3f{}}, {0, translated(Affine3f{}, {1.5f, 0, 0})}};
+  std::vector<NamedAccel> placed;
+  for (const auto& n : accelerator_names()) placed.push_back({n, make_accelerator(n, views, instances)});
+  check_queries("placed points", {views, instances}, placed, 15, 5);
+  // No ray hits a point, even one aimed straight at it.
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (const auto& a : all)
+    for (size_t i = 0; i < m.positions.size(); i += 7) {
+      const Vec3f from{u(rng) * 3, u(rng) * 3, 4};
+      Hit h;
+      CHECK_FALSE(a.accel->intersect({from, 0, normalize(m.positions[i] - from), kInfinity}, h));
+    }
+#ifdef PENUMBRA_HAVE_NANOFLANN
+  bench::PointAdaptor adaptor{m.positions};
+  bench::PointTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));  // builds the index
+  std::vector<PrimitiveMatch> got(8);
+  int compared = 0;
+  for (const Vec3f& p : cloud(200, 12)) {
+    uint32_t ids[8];
+    float d2[8];
+    const size_t n = tree.knnSearch(&p.x, 8, ids, d2);
+    REQUIRE(n == 8);
+    for (const auto& a : all) {
+      REQUIRE(nearest(*a.accel, scene, p, 8, kInfinity, got) == 8);
+      for (size_t j = 0; j < 8; ++j) {
+        INFO(a.name << " neighbour " << j);
+        CHECK(got[j].distance == Approx(std::sqrt(d2[j])).epsilon(1e-5).margin(1e-6));
+        // The same point where no other lies at nearly the same distance.
+        const bool tied =
+            (j > 0 && d2[j] - d2[j - 1] < 1e-6f * d2[j]) || (j < 7 && d2[j + 1] - d2[j] < 1e-6f * d2[j]);
+        if (!tied) CHECK(got[j].prim_id == ids[j]);
+      }
+      ++compared;
+    }
+  }
+  CHECK(compared == 200 * int(all.size()));
+#else
+  WARN("SKIP: nanoflann is not installed (libnanoflann-dev): the oracle comparison stands alone");
+#endif
 }
