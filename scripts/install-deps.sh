@@ -14,7 +14,7 @@ PACKAGES=(
   libopencolorio-dev opencolorio-tools
   libtinygltf-dev libstb-dev nlohmann-json3-dev libeigen3-dev
   libdraco-dev draco libmeshoptimizer-dev gltfpack
-  catch2 libcli11-dev libbenchmark-dev
+  catch2 libcli11-dev libbenchmark-dev libnanoflann-dev
   python3 python3-dev python3-numpy pybind11-dev help2man clang-format
 )
 case "${1:-}" in
