@@ -943,6 +943,8 @@ std::optional<int> run_mode(const BenchOptions& o) {
       q.repeats = o.repeats;
       q.seed = o.seed;
       q.csv = o.csv;
+      q.svg = o.svg;
+      q.caption = "Machine: " + bench::describe(bench::read_machine_info()) + "; " + software_line();
       std::vector<std::pair<std::string, Scene>> scenes;
       for (const auto& spec : o.scenes) {
         std::string name;

@@ -9,12 +9,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
+#include "benchmarks/chart.h"
 #include "benchmarks/point_kdtree.h"
 #include "benchmarks/timing.h"
 #include "io/files/atomic_file.h"
@@ -213,6 +215,51 @@ void write_csv(const std::string& path, const std::vector<QueryRow>& rows, int t
   });
 }
 
+// A panel per query kind and a row per scene: the queries per second of every structure.
+void write_svg(const QueryBenchConfig& o, const std::vector<QueryRow>& rows, int threads) {
+  BarChart chart;
+  chart.title = "Spatial queries: throughput per structure";
+  for (const QueryRow& r : rows)
+    if (std::find(chart.series.begin(), chart.series.end(), r.structure) == chart.series.end())
+      chart.series.push_back(r.structure);
+  for (const QueryRow& r : rows) {
+    if (std::find(chart.row_labels.begin(), chart.row_labels.end(), r.scene) != chart.row_labels.end())
+      continue;
+    chart.row_labels.push_back(r.scene);
+    std::vector<BarPanel> panels;
+    for (const std::string& kind : o.kinds) {
+      BarPanel p;
+      p.title = kind == "knn" ? "k = " + std::to_string(o.k) + " nearest points" : kind;
+      p.x_label = "query";
+      p.quantity = "throughput";
+      p.unit = "queries/s";
+      p.groups = {kind};
+      p.values.assign(1, std::vector<std::optional<Spread>>(chart.series.size()));
+      bool any = false;
+      for (const QueryRow& q : rows)
+        if (q.scene == r.scene && q.kind == kind) {
+          const size_t s =
+              size_t(std::find(chart.series.begin(), chart.series.end(), q.structure) - chart.series.begin());
+          p.values[0][s] = Spread{q.queries_per_second, q.queries_per_second, q.queries_per_second};
+          any = true;
+        }
+      if (any) panels.push_back(std::move(p));
+    }
+    chart.rows.push_back(std::move(panels));
+  }
+  chart.caption = {std::to_string(o.count) +
+                       " queries per kind (half near the geometry, half uniform over its bounds), " +
+                       std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") + ", the median of " +
+                       std::to_string(o.repeats) + " passes after a warm-up; the first " +
+                       std::to_string(o.verified) + " answers of every bar equal brute force's.",
+                   o.caption};
+  write_atomically(o.svg, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << bar_chart_svg(chart);
+    if (!f) throw std::runtime_error(o.svg + ": cannot write");
+  });
+}
+
 }  // namespace
 
 const std::vector<std::string>& query_kinds() {
@@ -226,6 +273,12 @@ int run_queries(const std::vector<std::pair<std::string, Scene>>& scenes, const 
     if (std::find(query_kinds().begin(), query_kinds().end(), kind) == query_kinds().end())
       throw std::invalid_argument("--queries: unknown query '" + kind +
                                   "' (known: nearest, knn, within, overlap)");
+  for (const std::string* out : {&o.csv, &o.svg}) {
+    const std::filesystem::path dir =
+        std::filesystem::path(*out).has_parent_path() ? std::filesystem::path(*out).parent_path() : ".";
+    if (!out->empty() && !std::filesystem::is_directory(dir))
+      throw std::invalid_argument(*out + ": directory '" + dir.string() + "' does not exist");
+  }
   const int threads = o.threads > 0 ? o.threads : thread_count(0);
   std::printf(
       "queries: %d per kind, k = %d (knn), %d thread%s, median of %d builds and %d passes; within: radius "
@@ -293,6 +346,7 @@ int run_queries(const std::vector<std::pair<std::string, Scene>>& scenes, const 
     }
   }
   if (!o.csv.empty()) write_csv(o.csv, rows, threads);
+  if (!o.svg.empty()) write_svg(o, rows, threads);
   if (wrong > 0) {
     std::fprintf(stderr,
                  "penumbra-bench: %llu query answers differ from brute force: these results do not count\n",

@@ -24,7 +24,9 @@ struct QueryBenchConfig {
   int repeats = 3;     ///< timed passes (median)
   int verified = 500;  ///< queries per kind compared with brute force
   uint64_t seed = 1;
-  std::string csv;  ///< also write the rows as CSV (atomically)
+  std::string csv;      ///< also write the rows as CSV (atomically)
+  std::string svg;      ///< also write a bar chart of the throughput as SVG (atomically)
+  std::string caption;  ///< the machine and software, under the chart
 };
 
 /// The named scenes' rows, printed as they are measured: triangle scenes answer nearest,
