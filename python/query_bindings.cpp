@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "io/files/error.h"
 #include "io/files/points_file.h"
@@ -277,16 +278,20 @@ py::object pick_pixel(SceneSession& s, int x, int y, const py::object& settings,
   return d;
 }
 
-/// Most points of a point set loaded from Python.
+/// Most points of a point set loaded from Python, and the bytes each takes with a structure (as
+/// `penumbra query` charges them).
 constexpr size_t kMaxPointSet = size_t(1) << 28;
+constexpr uint64_t kBytesPerPoint = 160;
 
-std::shared_ptr<SceneSession> load_points(const py::object& source) {
+std::shared_ptr<SceneSession> load_points(const py::object& source, std::optional<uint64_t> max_memory) {
   auto session = std::make_shared<SceneSession>();
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
     const auto path = source.cast<std::filesystem::path>();
+    const uint64_t budget = max_memory.value_or(default_memory_budget());
     session->file = path.string();
     py::gil_scoped_release release;
-    session->loaded.scene = load_point_cloud(path, kMaxPointSet);
+    session->loaded.scene =
+        load_point_cloud(path, size_t(std::min<uint64_t>(kMaxPointSet, budget / kBytesPerPoint)));
     return session;
   }
   std::vector<Vec3f> points = points_from(source, "points");
@@ -299,15 +304,16 @@ std::shared_ptr<SceneSession> load_points(const py::object& source) {
 }  // namespace
 
 void bind_queries(py::module_& m, SceneClass& scene) {
-  m.def("load_points", &load_points, py::arg("source"),
+  m.def("load_points", &load_points, py::arg("source"), py::kw_only(), py::arg("max_memory") = py::none(),
         "A Scene of one point set to query (nearest, within, overlap) in every structure: source is an array "
         "of shape (N, 3), or a file: .ply (its vertices; a PLY with faces gives its mesh), .npy (N x 3 "
-        "float32 or float64), or text (x y z per line). Point sets are not rendered. Raises "
+        "float32 or float64), or text (x y z per line); a file may hold as many points as max_memory bytes "
+        "allow at 160 bytes each (None: half the RAM, as penumbra.load). Point sets are not rendered. Raises "
         "penumbra.InputError for a malformed file, ValueError for points that are not finite.");
   const char* answers =
-      " Returns a dict of NumPy arrays: distance (float32), point (float32, 3), barycentric (float32, 2: u, "
-      "v "
-      "of the triangle's second and third vertex; 0 for shapes), instance, primitive (triangle index, 0 for "
+      " Returns a dict of NumPy arrays: distance (float32), point (float32, 3), barycentric (float32, 2: "
+      "u, v of the triangle's second and third vertex; 0 for shapes), instance, primitive (triangle index, 0 "
+      "for "
       "a shape), node, mesh, shape, material (int64; -1 where not one). accel names the structure that "
       "answers (every one gives the same answers); it is kept between queries and renders with the same "
       "accel and accel_params. The GIL is released while the query runs.";

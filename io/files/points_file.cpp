@@ -116,8 +116,9 @@ std::vector<Vec3f> read_npy_points(const std::string& path, size_t max_points) {
   }
   if (rows == 0) throw InputError(path, "header", "holds no point");
   if (rows > max_points)
-    throw InputError(path, "header",
-                     std::to_string(rows) + " points exceed the limit of " + std::to_string(max_points));
+    throw InputError(
+        path, "header",
+        std::to_string(rows) + " points exceed the limit of " + std::to_string(max_points) + " points");
   const size_t size = descr == "'<f4'" ? 4 : 8;
   std::vector<char> data(size_t(rows) * 3 * size);
   in.read(data.data(), std::streamsize(data.size()));

@@ -236,6 +236,8 @@ def test_point_files_load_as_the_array_does(tmp_path):
         np.testing.assert_array_equal(got["primitive"], want["primitive"], err_msg=name)
     with pytest.raises(ValueError, match=r"shape \(N, 3\)"):
         penumbra.load_points(np.zeros((3, 2)))
+    with pytest.raises(penumbra.InputError, match="300 points exceed the limit of 6 points"):
+        penumbra.load_points(tmp_path / "c.npy", max_memory=1000)
     (tmp_path / "bad.npy").write_bytes(b"not numpy")
     with pytest.raises(penumbra.InputError, match="is not a NumPy .npy file"):
         penumbra.load_points(tmp_path / "bad.npy")
