@@ -144,6 +144,11 @@ Transform compose_trs(const std::array<double, 3>& t, const Quat& r, const std::
 /// From 16 values in glTF's column-major order.
 Transform from_column_major(const double* values16);
 double determinant3x3(const Transform& t);
+/// Eigenvalues (`values`, unsorted) and unit eigenvectors (the columns of `vectors`, in the same
+/// order) of the symmetric 3x3 matrix `a`, which is overwritten, by cyclic Jacobi rotations
+/// (Golub & Van Loan, "Matrix Computations", sec. 8.5) until the off-diagonal part is 1e-15 of
+/// the diagonal's (relative) or 64 sweeps.
+void symmetric_eigen3(double a[3][3], double vectors[3][3], double values[3]);
 /// General inverse by cofactors; returns false (and leaves out untouched) if singular.
 bool inverse(const Transform& t, Transform& out);
 Transform transpose(const Transform& t);

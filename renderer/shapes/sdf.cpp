@@ -285,36 +285,16 @@ Vec3f sdf_normal(const SdfTree& tree, Vec3f p, float h) {
 }
 
 float max_singular_value(const Affine3f& a) {
-  // Gram matrix G = A^T A (symmetric); its largest eigenvalue is sigma_max^2. Cyclic Jacobi
-  // rotations in double converge to the eigenvalues on the diagonal.
+  // Gram matrix G = A^T A (symmetric); its largest eigenvalue is sigma_max^2.
   double g[3][3];
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) {
       g[r][c] = 0;
       for (int k = 0; k < 3; ++k) g[r][c] += double(a.m[k][r]) * double(a.m[k][c]);
     }
-  for (int sweep = 0; sweep < 32; ++sweep) {
-    const double off = g[0][1] * g[0][1] + g[0][2] * g[0][2] + g[1][2] * g[1][2];
-    if (off < 1e-30) break;
-    for (int p = 0; p < 2; ++p)
-      for (int q = p + 1; q < 3; ++q) {
-        if (std::abs(g[p][q]) < 1e-300) continue;
-        const double theta = (g[q][q] - g[p][p]) / (2 * g[p][q]);
-        const double t = (theta >= 0 ? 1 : -1) / (std::abs(theta) + std::sqrt(theta * theta + 1));
-        const double c = 1 / std::sqrt(t * t + 1), s = t * c;
-        for (int k = 0; k < 3; ++k) {  // G <- J^T G J
-          const double gkp = g[k][p], gkq = g[k][q];
-          g[k][p] = c * gkp - s * gkq;
-          g[k][q] = s * gkp + c * gkq;
-        }
-        for (int k = 0; k < 3; ++k) {
-          const double gpk = g[p][k], gqk = g[q][k];
-          g[p][k] = c * gpk - s * gqk;
-          g[q][k] = s * gpk + c * gqk;
-        }
-      }
-  }
-  const double top = std::max(g[0][0], std::max(g[1][1], g[2][2]));
+  double vectors[3][3], values[3];
+  symmetric_eigen3(g, vectors, values);
+  const double top = std::max(values[0], std::max(values[1], values[2]));
   return float(std::sqrt(std::max(top, 0.0)) * (1 + 1e-6));  // rounded up: a bound stays a bound
 }
 

@@ -2,7 +2,10 @@
 // checked against Eigen.
 #include "renderer/core/math.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -125,4 +128,27 @@ TEST_CASE("inverse refuses maps single-precision kernels cannot invert", "[math]
   CHECK_FALSE(inverse(to_affine(scale(1, 1, 0)), out));
   // One tiny axis with large others is fine while the determinant stays normal.
   CHECK(inverse(to_affine(scale(1e-20, 1e10, 1e10)), out));
+}
+
+TEST_CASE("symmetric_eigen3 equals Eigen's self-adjoint solver", "[math]") {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int trial = 0; trial < 50; ++trial) {
+    Eigen::Matrix3d m;
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) m(r, c) = m(c, r) = trial == 0 ? (r == c ? 2 : 0) : u(rng);
+    double a[3][3], v[3][3], values[3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) a[r][c] = m(r, c);
+    symmetric_eigen3(a, v, values);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m);
+    std::array<double, 3> sorted{values[0], values[1], values[2]};
+    std::sort(sorted.begin(), sorted.end());
+    for (int i = 0; i < 3; ++i) CHECK(sorted[size_t(i)] == Approx(es.eigenvalues()(i)).margin(1e-12));
+    for (int i = 0; i < 3; ++i) {  // each column is a unit eigenvector of its value
+      const Eigen::Vector3d x(v[0][i], v[1][i], v[2][i]);
+      CHECK(x.norm() == Approx(1).epsilon(1e-12));
+      CHECK((m * x - values[i] * x).norm() < 1e-11);
+    }
+  }
 }
