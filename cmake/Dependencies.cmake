@@ -8,6 +8,7 @@ find_package(nlohmann_json 3 CONFIG REQUIRED)     # nlohmann_json::nlohmann_json
 find_package(CLI11 CONFIG REQUIRED)               # CLI11::CLI11
 find_package(OpenImageIO CONFIG REQUIRED)         # OpenImageIO::OpenImageIO
 find_package(meshoptimizer CONFIG REQUIRED)       # meshoptimizer::meshoptimizer
+find_package(Qhull CONFIG REQUIRED)               # Qhull::qhull_r (reentrant C library)
 
 # Debian's OpenImageIO target lists /usr/include/opencv4, which does not exist without OpenCV.
 foreach(_oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)

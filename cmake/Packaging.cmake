@@ -1,7 +1,7 @@
 # Packaging with CPack: `cpack -G DEB` in the build folder makes penumbra_<version>_<arch>.deb of
 # everything Install.cmake installs, under /usr. Depends is computed by dpkg-shlibdeps from the
 # linked shared libraries (libembree3-3, libtbb12, libopenimageio2.4, libopencolorio2.1,
-# libimath-3-1-29, libtinygltf2d, libmeshoptimizer2d, the C/C++ runtime; OpenEXR comes through
+# libimath-3-1-29, libtinygltf2d, libmeshoptimizer2d, libqhull-r8.0, the C/C++ runtime; OpenEXR comes through
 # OpenImageIO; Draco is linked statically);
 # Recommends lists the Debian -dev packages that find_package(Penumbra) needs to link against.
 set(CPACK_PACKAGE_NAME "penumbra")
@@ -26,6 +26,6 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # The package's own libpenumbra_draco.so, found by the commands through $ORIGIN/../lib.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS_PRIVATE_DIRS "${PROJECT_BINARY_DIR}/io")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
-    "libembree-dev, libtbb-dev, libopenimageio-dev, libopencolorio-dev, libtinygltf-dev, nlohmann-json3-dev, libmeshoptimizer-dev, pkg-config")
+    "libembree-dev, libtbb-dev, libopenimageio-dev, libopencolorio-dev, libtinygltf-dev, nlohmann-json3-dev, libmeshoptimizer-dev, libqhull-dev, pkg-config")
 
 include(CPack)

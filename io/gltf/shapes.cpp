@@ -423,7 +423,9 @@ void ShapeReader::csg_planes(const json& j, const std::string& where, SdfNode& n
   if (!planes->is_array())
     fail(pw, "must be an array of [nx, ny, nz, d] planes (got " + shown(*planes) + ")");
   const size_t n = planes->size();
-  if (n < 4 || n > 64) fail(pw, "must hold 4 to 64 planes (got " + std::to_string(n) + ")");
+  if (n < 4 || n > kMaxConvexPlanes)
+    fail(pw,
+         "must hold 4 to " + std::to_string(kMaxConvexPlanes) + " planes (got " + std::to_string(n) + ")");
   m_budget.charge(n * sizeof(Vec4f), pw, std::to_string(n) + " planes need");
   node.first_plane = int(m_tree.planes.size());
   node.plane_count = int(n);

@@ -205,6 +205,15 @@ Polytope Polytope::clip(DVec3 n, double k, bool positive) const {
   return out;
 }
 
+void Polytope::triangles(std::vector<uint32_t>& indices) const {
+  for (const Face& f : m_faces)
+    for (uint32_t j = 1; j + 1 < f.count; ++j) {
+      indices.push_back(m_loops[f.begin]);
+      indices.push_back(m_loops[f.begin + j]);
+      indices.push_back(m_loops[f.begin + j + 1]);
+    }
+}
+
 void Polytope::split_areas(DVec3 n, std::span<const double> positions, std::span<double> negative,
                            std::span<double> positive) const {
   thread_local PolytopeSlicer slicer;

@@ -68,6 +68,9 @@ class Polytope {
   /// sum to zero with it.
   void split_areas(DVec3 n, std::span<const double> positions, std::span<double> negative,
                    std::span<double> positive) const;
+  /// The faces as fans of triangles, counter-clockwise seen from outside: 3 indices into
+  /// vertices() per triangle appended to `indices` (vertices no face uses stay unreferenced).
+  void triangles(std::vector<uint32_t>& indices) const;
 
  private:
   friend class PolytopeSlicer;

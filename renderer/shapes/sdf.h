@@ -79,6 +79,9 @@ struct SdfTree {
   int root = -1;
 };
 
+/// Most planes a ConvexPolyhedron node holds (a convex hull proxy's faces).
+inline constexpr size_t kMaxConvexPlanes = 4096;
+
 /// Trees deeper than this are rejected by the loader; evaluation recurses at most this deep.
 inline constexpr int kMaxSdfDepth = 64;
 

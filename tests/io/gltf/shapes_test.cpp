@@ -558,7 +558,7 @@ TEST_CASE("shapes: empty, missing or miscounted children are errors naming them"
              Contains(kCsg + ".children: must hold exactly 1 CSG node (got 2)"));
   CHECK_THAT(error_of(implicit(
                  {{"type", "convexPolyhedron"}, {"planes", {{1, 0, 0, 1}, {-1, 0, 0, 1}, {0, 1, 0, 1}}}})),
-             Contains(kCsg + ".planes: must hold 4 to 64 planes (got 3)"));
+             Contains(kCsg + ".planes: must hold 4 to 4096 planes (got 3)"));
   CHECK_THAT(error_of(implicit({{"type", "convexPolyhedron"},
                                 {"planes", {{1, 0, 0, 1}, {-1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 0, 1}}}})),
              Contains(kCsg + ".planes[3]: the normal") && Contains("non-zero"));
