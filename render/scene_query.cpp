@@ -8,6 +8,28 @@
 
 namespace penumbra {
 
+int find_node(const GltfInfo& info, const std::string& spec, const std::string& file, std::string& error) {
+  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
+    const long long i = spec.size() <= 9 ? std::stoll(spec) : -1;
+    if (i >= 0 && i < info.node_count) return int(i);
+    error = file + " has " + std::to_string(info.node_count) + " nodes (0 to " +
+            std::to_string(info.node_count - 1) + ")";
+    return -1;
+  }
+  int found = -1;
+  for (size_t i = 0; i < info.node_names.size(); ++i) {
+    if (info.node_names[i] != spec) continue;
+    if (found >= 0) {
+      error = "several nodes of " + file + " have this name (nodes " + std::to_string(found) + " and " +
+              std::to_string(i) + "); give its index";
+      return -1;
+    }
+    found = int(i);
+  }
+  if (found < 0) error = file + " has no node of that name";
+  return found;
+}
+
 SceneGeometry scene_geometry(const Scene& scene) {
   return {mesh_views(scene), instance_views(scene)};
 }

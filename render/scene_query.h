@@ -4,6 +4,7 @@
 // `penumbra query` and the Python module both call.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "render/session.h"
@@ -21,6 +22,11 @@ struct SceneGeometry {
 };
 
 SceneGeometry scene_geometry(const Scene& scene);
+
+/// The glTF node `spec` names: an index below info.node_count, or a unique node name. Returns -1
+/// with `error` set ("<file> has 4 nodes (0 to 3)", "several nodes of <file> have this name
+/// (nodes 1 and 5); give its index", "<file> has no node of that name") otherwise.
+int find_node(const GltfInfo& info, const std::string& spec, const std::string& file, std::string& error);
 
 /// The scene element behind an answer's geom_id (an instance index).
 struct MatchOwner {

@@ -1,7 +1,7 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
 // `info`, assemble farm tiles with `merge`, denoise an EXR with `denoise`, render job files with `batch` and
 // submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`, ask it
-// spatial questions with `query`. This
+// spatial questions with `query`, fit collision proxies with `proxies`. This
 // file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1
 // a failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a
 // parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
@@ -16,6 +16,7 @@
 #include "apps/penumbra/mesh_command.h"
 #include "apps/penumbra/parse_errors.h"
 #include "apps/penumbra/progress.h"
+#include "apps/penumbra/proxies_command.h"
 #include "apps/penumbra/query_command.h"
 #include "apps/penumbra/render_command.h"
 #include "apps/penumbra/scene_setup.h"
@@ -74,6 +75,38 @@ void add_mesh_options(CLI::App& mesh, MeshArgs& a) {
   mesh.add_flag("--allow-external-uris", a.allow_external,
                 "let buffer URIs reach files outside the scene's folder");
   mesh.add_flag("-q,--quiet", a.quiet, "no warnings or summary");
+}
+
+void add_proxies_options(CLI::App& proxies, ProxiesArgs& a) {
+  proxies.add_option("scene", a.scene_file, "glTF scene (.gltf or .glb)")->required();
+  proxies
+      .add_option(
+          "--kind", a.kind,
+          "sphere (minimal, Welzl), ritter (Ritter's sphere), aabb, obb, capsule, hull (convex, Qhull), "
+          "kdop, composite (a hull per connected part)")
+      ->required();
+  proxies.add_option("--node", a.node,
+                     "one proxy for this glTF node and the nodes below it (index or name); "
+                     "default: one per node that places a mesh");
+  proxies.add_option("-o,--output", a.output,
+                     "write the proxies as PENUMBRA_shapes to a .glb, or .gltf with OUT.bin beside it "
+                     "(atomically), with the scene's cameras and lights");
+  proxies.add_flag("--overlay", a.overlay,
+                   "the output keeps the scene's geometry, proxies translucent over it");
+  proxies.add_option("--kdop", a.kdop, "k of --kind kdop: 6, 14, 18 or 26 (default 26)");
+  proxies
+      .add_option("--samples", a.samples,
+                  "proxy surface samples measuring the Hausdorff distance (default 20000; 0: not measured)")
+      ->check(CLI::Range(0, 100000000));
+  proxies.add_option("--threads", a.threads, "worker threads (default: all; does not change results)")
+      ->check(CLI::Range(0, 1024));
+  proxies.add_flag("--json", a.json, "the report as JSON on stdout");
+  proxies.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
+  proxies.add_option("--max-memory", a.max_memory,
+                     "one budget for the scene and the fitting, e.g. 4G (default: half the RAM)");
+  proxies.add_flag("--allow-external-uris", a.allow_external,
+                   "let buffer URIs reach files outside the scene's folder");
+  proxies.add_flag("-q,--quiet", a.quiet, "no warnings");
 }
 
 /// A CLI11 check refusing an empty value (which would read as the option not given).
@@ -172,6 +205,10 @@ int main(int argc, char** argv) {
       "mesh",
       "Extract the implicit shapes of a glTF scene as triangle meshes (marching cubes) into a .glb or .gltf");
   add_mesh_options(*mesh, mesh_args);
+  ProxiesArgs proxies_args;
+  auto* proxies = app.add_subcommand(
+      "proxies", "Fit bounding proxies (spheres, boxes, capsules, convex hulls, k-DOPs) to a scene's nodes");
+  add_proxies_options(*proxies, proxies_args);
   QueryArgs query_args;
   auto* query = add_query_command(app, query_args);
 
@@ -193,6 +230,7 @@ int main(int argc, char** argv) {
     if (*mesh) return run_mesh(mesh_args);
     if (*info) return run_info(info_args);
     if (*query) return run_query(*query, query_args);
+    if (*proxies) return run_proxies(proxies_args);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {

@@ -18,27 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The glTF node `spec` names: an index below the node count, or a unique node name.
-int find_node(const GltfInfo& info, const std::string& spec, const std::string& file) {
-  if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
-    const long long i = spec.size() <= 9 ? std::stoll(spec) : -1;
-    if (i < 0 || i >= info.node_count)
-      throw UsageError("--node " + spec + ": " + file + " has " + std::to_string(info.node_count) +
-                       " nodes (0 to " + std::to_string(info.node_count - 1) + ")");
-    return int(i);
-  }
-  int found = -1;
-  for (size_t i = 0; i < info.node_names.size(); ++i) {
-    if (info.node_names[i] != spec) continue;
-    if (found >= 0)
-      throw UsageError("--node '" + spec + "': several nodes of " + file + " have this name (nodes " +
-                       std::to_string(found) + " and " + std::to_string(i) + "); give its index");
-    found = int(i);
-  }
-  if (found < 0) throw UsageError("--node '" + spec + "': " + file + " has no node of that name");
-  return found;
-}
-
 bool places_implicit_shape(const Scene& scene, int node) {
   for (const Instance& inst : scene.instances)
     if (inst.shape >= 0 && (node < 0 || inst.node == node) &&
@@ -77,7 +56,7 @@ int run_mesh(const MeshArgs& a) {
   check_distinct_files(outputs, inputs);
   ShapeMeshConfig config;
   config.resolution = a.resolution;
-  if (a.node) config.node = find_node(loaded.info, *a.node, a.scene_file);
+  if (a.node) config.node = find_gltf_node(loaded.info, *a.node, a.scene_file);
   if (!places_implicit_shape(loaded.scene, config.node))
     throw UsageError(a.scene_file + ": " +
                      (config.node < 0 ? std::string("the scene places no implicit shape")

@@ -7,6 +7,7 @@
 #include "apps/penumbra/cli_support.h"
 #include "io/files/error.h"
 #include "render/accel_params.h"
+#include "render/scene_query.h"
 #include "render/session.h"
 #include "renderer/accel/embree.h"
 #include "renderer/accel/factory.h"
@@ -41,6 +42,16 @@ std::string describe_scene_size(const Scene& scene) {
   if (scene.shapes.empty()) return triangles;
   return triangles + ", " + std::to_string(scene.shapes.size()) +
          (scene.shapes.size() == 1 ? " shape" : " shapes");
+}
+
+int find_gltf_node(const GltfInfo& info, const std::string& spec, const std::string& file) {
+  std::string error;
+  const int node = find_node(info, spec, file, error);
+  if (node < 0) {
+    const bool index = !spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos;
+    throw UsageError("--node " + (index ? spec : "'" + spec + "'") + ": " + error);
+  }
+  return node;
 }
 
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file) {

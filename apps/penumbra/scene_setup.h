@@ -25,6 +25,10 @@ LoadedScene load_scene(const std::string& file, int scene, bool allow_external, 
 /// triangles, 3 shapes".
 std::string describe_scene_size(const Scene& scene);
 
+/// The glTF node `spec` (not empty) names: an index below the node count, or a unique node
+/// name. Throws UsageError (as an option `--node` error) for an unknown or ambiguous node.
+int find_gltf_node(const GltfInfo& info, const std::string& spec, const std::string& file);
+
 /// The camera instance `spec` names: an index as `penumbra info` lists them, or a camera name.
 /// Throws InputError listing the cameras if there is no such camera or the name is ambiguous.
 int find_camera(const Scene& scene, const std::string& spec, const std::string& file);
