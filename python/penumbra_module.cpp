@@ -61,4 +61,5 @@ PYBIND11_MODULE(penumbra, m) {
   auto scene = penumbra::python::bind_scene(m);
   penumbra::python::bind_render(m, scene);
   penumbra::python::bind_queries(m, scene);
+  penumbra::python::bind_collision(scene);
 }

@@ -1,0 +1,153 @@
+// Scene.proxies: bounding proxies fitted to the scene's nodes (renderer/collision/scene_proxies.h,
+// what `penumbra proxies` calls), with their tightness, as dicts of NumPy arrays.
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <optional>
+#include <variant>
+
+#include "io/files/error.h"
+#include "python/bindings.h"
+#include "render/scene_query.h"
+#include "renderer/collision/scene_proxies.h"
+
+namespace penumbra::python {
+
+namespace {
+
+py::array_t<double> vec(DVec3 v) {
+  py::array_t<double> a(3);
+  double* d = a.mutable_data();
+  d[0] = v.x, d[1] = v.y, d[2] = v.z;
+  return a;
+}
+
+py::dict part_dict(const ConvexPolyhedron& c) {
+  py::array_t<double> vertices({py::ssize_t(c.vertices.size()), py::ssize_t(3)});
+  py::array_t<int64_t> triangles({py::ssize_t(c.triangles.size() / 3), py::ssize_t(3)});
+  py::array_t<double> planes({py::ssize_t(c.planes.size()), py::ssize_t(4)});
+  double* v = vertices.mutable_data();
+  for (const DVec3& p : c.vertices) *v++ = p.x, *v++ = p.y, *v++ = p.z;
+  int64_t* t = triangles.mutable_data();
+  for (uint32_t i : c.triangles) *t++ = i;
+  double* p = planes.mutable_data();
+  for (const DPlane& pl : c.planes) *p++ = pl.n.x, *p++ = pl.n.y, *p++ = pl.n.z, *p++ = pl.d;
+  py::dict d;
+  d["vertices"] = vertices;
+  d["triangles"] = triangles;
+  d["planes"] = planes;
+  d["volume"] = c.volume;
+  d["qhull_volume"] = c.qhull_volume >= 0 ? py::object(py::float_(c.qhull_volume)) : py::object(py::none());
+  d["thickened"] = c.thickened;
+  return d;
+}
+
+py::object finite_or_none(double v) {
+  return std::isfinite(v) ? py::object(py::float_(v)) : py::object(py::none());
+}
+
+py::dict proxy_dict(const NodeProxy& np, const GltfInfo& info) {
+  py::dict d;
+  const Proxy& p = np.proxy;
+  d["node"] = np.node;
+  d["name"] = size_t(np.node) < info.node_names.size() ? info.node_names[size_t(np.node)] : std::string();
+  d["kind"] = proxy_kind_name(p.kind);
+  d["vertices"] = np.vertices;
+  d["triangles"] = np.triangles;
+  switch (p.kind) {
+    case ProxyKind::Sphere:
+    case ProxyKind::Ritter:
+      d["center"] = vec(p.sphere.center);
+      d["radius"] = p.sphere.radius;
+      break;
+    case ProxyKind::Aabb:
+    case ProxyKind::Obb: {
+      d["center"] = vec(p.box.center);
+      py::array_t<double> axes({py::ssize_t(3), py::ssize_t(3)});
+      double* a = axes.mutable_data();
+      for (const DVec3& ax : p.box.axis) *a++ = ax.x, *a++ = ax.y, *a++ = ax.z;
+      d["axes"] = axes;
+      d["half_extents"] = vec(p.box.half);
+      break;
+    }
+    case ProxyKind::Capsule:
+      d["a"] = vec(p.capsule.a);
+      d["b"] = vec(p.capsule.b);
+      d["radius"] = p.capsule.radius;
+      break;
+    default: {
+      py::list parts;
+      for (const ConvexPolyhedron& c : p.parts) parts.append(part_dict(c));
+      d["parts"] = parts;
+    }
+  }
+  const ProxyTightness& t = np.tightness;
+  d["volume"] = t.proxy_volume;
+  d["mesh_volume"] = finite_or_none(t.mesh_volume);
+  d["volume_ratio"] = finite_or_none(t.volume_ratio);
+  d["hull_ratio"] = finite_or_none(t.hull_ratio);
+  d["hausdorff"] = t.hausdorff;
+  d["samples"] = t.samples;
+  return d;
+}
+
+py::list proxies(SceneSession& s, const std::string& kind,
+                 const std::optional<std::variant<int, std::string>>& node, int kdop, int64_t samples,
+                 int threads) {
+  SceneProxyConfig config;
+  if (!parse_proxy_kind(kind, config.kind)) {
+    std::string names;
+    for (int i = 0; i < kProxyKindCount; ++i)
+      names += std::string(i ? ", " : "") + proxy_kind_name(ProxyKind(i));
+    throw py::value_error("kind '" + kind + "': not a proxy kind (" + names + ")");
+  }
+  if (kdop != 6 && kdop != 14 && kdop != 18 && kdop != 26)
+    throw py::value_error("kdop " + std::to_string(kdop) + ": k must be 6, 14, 18 or 26");
+  if (samples < 0 || samples > 100000000) throw py::value_error("samples must be in [0, 10^8]");
+  if (threads < 0 || threads > 1024) throw py::value_error("threads must be in [0, 1024]");
+  config.fit.kdop = kdop;
+  config.samples = size_t(samples);
+  config.threads = threads;
+  SessionLock lock(s);
+  if (node) {
+    const std::string spec = std::holds_alternative<int>(*node) ? std::to_string(std::get<int>(*node))
+                                                                : std::get<std::string>(*node);
+    if (std::holds_alternative<int>(*node) && std::get<int>(*node) < 0)
+      throw py::value_error("node " + spec + ": not a node index");
+    std::string error;
+    config.root = find_node(s.loaded.info, spec, s.file, error);
+    if (config.root < 0) throw py::value_error("node " + spec + ": " + error);
+  }
+  std::vector<NodeProxy> fitted;
+  {
+    py::gil_scoped_release release;
+    try {
+      fitted = fit_scene_proxies(s.loaded.scene, s.loaded.info.node_parents, config);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file, "", e.what());
+    }
+  }
+  py::list out;
+  for (const NodeProxy& np : fitted) out.append(proxy_dict(np, s.loaded.info));
+  return out;
+}
+
+}  // namespace
+
+void bind_collision(SceneClass& scene) {
+  scene.def(
+      "proxies", &proxies, py::arg("kind"), py::arg("node") = py::none(), py::kw_only(), py::arg("kdop") = 26,
+      py::arg("samples") = 20000, py::arg("threads") = 0,
+      "Bounding proxies fitted to each node that places a mesh, or with node (index or name) one for "
+      "that node's subtree, as `penumbra proxies` fits them: kind is sphere (minimal), ritter, aabb, obb, "
+      "capsule, hull (Qhull), kdop (kdop = 6, 14, 18 or 26) or composite (a hull per connected "
+      "component). Returns a list of dicts, one per node: node, name, kind, vertices, triangles; the "
+      "proxy (center and radius; center, axes (3, 3) rows and half_extents; a, b and radius; or parts: "
+      "dicts of vertices (V, 3), triangles (T, 3), planes (F, 4: n, d with n.p <= d inside), volume, "
+      "qhull_volume, thickened); and its tightness: volume, mesh_volume, volume_ratio and hull_ratio "
+      "(None where the meshes are open), hausdorff (from the proxy's surface to the geometry, over "
+      "samples surface points) and samples. ValueError for an unknown kind or node.");
+}
+
+}  // namespace penumbra::python
