@@ -94,4 +94,18 @@ oiiotool "$a" --ch R,G,B --colorconvert linear sRGB \
   "$a" --ch specular_direct.R,specular_direct.G,specular_direct.B --colorconvert linear sRGB \
   --mosaic:pad=4 3x3 -d uint8 -o "$out/aov-contact-sheet.png"
 
+
+# Proxies and collisions: each proxy kind over the CSG scene's implicit shapes, meshed by
+# marching cubes (three objects: a CSG part, a blob, a torus), in rows of four.
+step "proxies.png"
+"$bin" mesh scenes/csg.gltf --resolution 40 -o "$work/csg-mesh.glb" -q >/dev/null
+tiles=()
+for kind in sphere ritter aabb obb capsule hull kdop composite; do
+  "$bin" proxies "$work/csg-mesh.glb" --kind "$kind" --samples 0 --overlay -o "$work/proxies-$kind.glb" >/dev/null
+  "$bin" render "$work/proxies-$kind.glb" --width 236 --height 120 --look-at 0,2.4,6.2 0,1,0 -o "$work/proxies-$kind.exr" \
+    --png "$work/proxies-$kind.png" -q --threads 0 >/dev/null
+  tiles+=("$work/proxies-$kind.png")
+done
+oiiotool "${tiles[@]}" --mosaic:pad=4 4x2 -d uint8 -o "$out/proxies.png"
+
 step "done: $(find "$out" -maxdepth 1 -name '*.png' | wc -l) pictures in $out"

@@ -76,8 +76,9 @@ struct NodeProxy {
 std::vector<NodeProxy> fit_scene_proxies(const Scene& scene, std::span<const int> node_parents,
                                          const SceneProxyConfig& config);
 
-/// Faces a convexPolyhedron shape holds at most (PENUMBRA_shapes' limit).
-inline constexpr size_t kMaxProxyPlanes = 4096;
+/// Faces of the largest convex part written as a convexPolyhedron shape: sphere tracing
+/// evaluates every plane at every step, so larger hulls render far faster as triangles.
+inline constexpr size_t kMaxProxyPlanes = 256;
 
 /// Appends `proxy` to `scene` as shapes placed in world space with `material`, named `name`:
 /// sphere -> a Sphere, box -> a Box rotated into the box's axes, capsule -> a Capsule whose +Y
