@@ -1,0 +1,197 @@
+// Mesh-mesh contacts: box trees, their simultaneous descent and the triangle-triangle test.
+#include "renderer/collision/mesh_contact.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+
+namespace {
+
+DVec3 min3(DVec3 a, DVec3 b) {
+  return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
+}
+DVec3 max3(DVec3 a, DVec3 b) {
+  return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
+}
+double axis(DVec3 v, int k) {
+  return k == 0 ? v.x : k == 1 ? v.y : v.z;
+}
+
+double orient(DVec3 a, DVec3 b, DVec3 c, DVec3 d) {
+  return dot(cross(b - a, c - a), d - a);
+}
+
+// Segment pq (crossing or touching the plane of abc, not lying in it) meets triangle abc.
+bool segment_meets(DVec3 p, DVec3 q, DVec3 a, DVec3 b, DVec3 c) {
+  const double s1 = orient(a, b, c, p), s2 = orient(a, b, c, q);
+  if ((s1 > 0 && s2 > 0) || (s1 < 0 && s2 < 0) || (s1 == 0 && s2 == 0)) return false;
+  const double t1 = orient(p, q, a, b), t2 = orient(p, q, b, c), t3 = orient(p, q, c, a);
+  return (t1 >= 0 && t2 >= 0 && t3 >= 0) || (t1 <= 0 && t2 <= 0 && t3 <= 0);
+}
+
+// 2-d: the signed area of (a, b, c).
+double orient2(double ax, double ay, double bx, double by, double cx, double cy) {
+  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+bool segments_meet_2d(const double* p, const double* q, const double* r, const double* s) {
+  const double d1 = orient2(r[0], r[1], s[0], s[1], p[0], p[1]),
+               d2 = orient2(r[0], r[1], s[0], s[1], q[0], q[1]);
+  const double d3 = orient2(p[0], p[1], q[0], q[1], r[0], r[1]),
+               d4 = orient2(p[0], p[1], q[0], q[1], s[0], s[1]);
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+  auto on = [](const double* a, const double* b, const double* c, double o) {  // c on segment ab
+    return o == 0 && std::min(a[0], b[0]) <= c[0] && c[0] <= std::max(a[0], b[0]) &&
+           std::min(a[1], b[1]) <= c[1] && c[1] <= std::max(a[1], b[1]);
+  };
+  return on(r, s, p, d1) || on(r, s, q, d2) || on(p, q, r, d3) || on(p, q, s, d4);
+}
+
+bool point_in_triangle_2d(const double* p, const double (*t)[2]) {
+  const double o1 = orient2(t[0][0], t[0][1], t[1][0], t[1][1], p[0], p[1]);
+  const double o2 = orient2(t[1][0], t[1][1], t[2][0], t[2][1], p[0], p[1]);
+  const double o3 = orient2(t[2][0], t[2][1], t[0][0], t[0][1], p[0], p[1]);
+  return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+
+// Two triangles in one plane (normal n): their projections on the plane's dominant axes overlap.
+bool coplanar_meet(const DVec3 (&t1)[3], const DVec3 (&t2)[3], DVec3 n) {
+  const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
+  const int drop = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+  const int u = drop == 0 ? 1 : 0, v = drop == 2 ? 1 : 2;
+  double p[3][2], q[3][2];
+  for (int i = 0; i < 3; ++i) {
+    p[i][0] = axis(t1[i], u), p[i][1] = axis(t1[i], v);
+    q[i][0] = axis(t2[i], u), q[i][1] = axis(t2[i], v);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (segments_meet_2d(p[i], p[(i + 1) % 3], q[j], q[(j + 1) % 3])) return true;
+  return point_in_triangle_2d(p[0], q) || point_in_triangle_2d(q[0], p);
+}
+
+bool boxes_meet(const ContactTree::Node& a, const ContactTree::Node& b) {
+  return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
+         b.lo.z <= a.hi.z;
+}
+
+double half_area(const ContactTree::Node& n) {
+  const DVec3 d = n.hi - n.lo;
+  return d.x * d.y + d.y * d.z + d.z * d.x;
+}
+
+}  // namespace
+
+bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f) {
+  const double s1 = orient(a, b, c, d), s2 = orient(a, b, c, e), s3 = orient(a, b, c, f);
+  if ((s1 > 0 && s2 > 0 && s3 > 0) || (s1 < 0 && s2 < 0 && s3 < 0)) return false;  // def beside abc's plane
+  const double r1 = orient(d, e, f, a), r2 = orient(d, e, f, b), r3 = orient(d, e, f, c);
+  if ((r1 > 0 && r2 > 0 && r3 > 0) || (r1 < 0 && r2 < 0 && r3 < 0)) return false;
+  const DVec3 n1 = cross(b - a, c - a), n2 = cross(e - d, f - d);
+  if (s1 == 0 && s2 == 0 && s3 == 0) {  // one plane (or abc degenerate): the 2-d test
+    const DVec3 t1[3] = {a, b, c}, t2[3] = {d, e, f};
+    const DVec3 n = dot(n1, n1) >= dot(n2, n2) ? n1 : n2;
+    return dot(n, n) > 0 && coplanar_meet(t1, t2, n);
+  }
+  return segment_meets(a, b, d, e, f) || segment_meets(b, c, d, e, f) || segment_meets(c, a, d, e, f) ||
+         segment_meets(d, e, a, b, c) || segment_meets(e, f, a, b, c) || segment_meets(f, d, a, b, c);
+}
+
+ContactTree build_contact_tree(const ContactMesh& mesh) {
+  ContactTree tree;
+  const uint32_t n = uint32_t(mesh.triangles.size() / 3);
+  if (n == 0) return tree;
+  std::vector<DVec3> lo(n), hi(n), centre(n);
+  for (uint32_t t = 0; t < n; ++t) {
+    const DVec3 a = mesh.points[mesh.triangles[3 * t]], b = mesh.points[mesh.triangles[3 * t + 1]],
+                c = mesh.points[mesh.triangles[3 * t + 2]];
+    lo[t] = min3(a, min3(b, c));
+    hi[t] = max3(a, max3(b, c));
+    centre[t] = (lo[t] + hi[t]) * 0.5;
+  }
+  tree.order.resize(n);
+  for (uint32_t t = 0; t < n; ++t) tree.order[t] = t;
+  struct Task {
+    uint32_t node, first, count;
+  };
+  std::vector<Task> stack{{0, 0, n}};
+  tree.nodes.emplace_back();
+  while (!stack.empty()) {
+    const Task task = stack.back();
+    stack.pop_back();
+    ContactTree::Node node;
+    node.lo = lo[tree.order[task.first]];
+    node.hi = hi[tree.order[task.first]];
+    DVec3 clo = centre[tree.order[task.first]], chi = clo;
+    for (uint32_t i = task.first; i < task.first + task.count; ++i) {
+      const uint32_t t = tree.order[i];
+      node.lo = min3(node.lo, lo[t]);
+      node.hi = max3(node.hi, hi[t]);
+      clo = min3(clo, centre[t]);
+      chi = max3(chi, centre[t]);
+    }
+    if (task.count <= 4) {
+      node.first = task.first;
+      node.count = task.count;
+      tree.nodes[task.node] = node;
+      continue;
+    }
+    const DVec3 ext = chi - clo;
+    const int k = ext.x >= ext.y && ext.x >= ext.z ? 0 : ext.y >= ext.z ? 1 : 2;
+    const uint32_t half = task.count / 2;
+    std::nth_element(tree.order.begin() + task.first, tree.order.begin() + task.first + half,
+                     tree.order.begin() + task.first + task.count, [&](uint32_t x, uint32_t y) {
+                       const double cx = axis(centre[x], k), cy = axis(centre[y], k);
+                       return cx < cy || (cx == cy && x < y);
+                     });
+    node.left = uint32_t(tree.nodes.size());
+    node.right = node.left + 1;
+    tree.nodes.emplace_back();
+    tree.nodes.emplace_back();
+    tree.nodes[task.node] = node;
+    stack.push_back({node.left, task.first, half});
+    stack.push_back({node.right, task.first + half, task.count - half});
+  }
+  return tree;
+}
+
+MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const ContactMesh& b,
+                           const ContactTree& tb, size_t max_pairs) {
+  MeshContacts out;
+  if (ta.nodes.empty() || tb.nodes.empty()) return out;
+  auto corner = [](const ContactMesh& m, uint32_t t, int k) {
+    return m.points[m.triangles[3 * size_t(t) + size_t(k)]];
+  };
+  std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    const ContactTree::Node& na = ta.nodes[i];
+    const ContactTree::Node& nb = tb.nodes[j];
+    ++out.node_pairs;
+    if (!boxes_meet(na, nb)) continue;
+    const bool leaf_a = na.count > 0, leaf_b = nb.count > 0;
+    if (leaf_a && leaf_b) {
+      for (uint32_t x = na.first; x < na.first + na.count; ++x)
+        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) {
+          const uint32_t s = ta.order[x], t = tb.order[y];
+          ++out.triangle_pairs;
+          if (triangles_meet(corner(a, s, 0), corner(a, s, 1), corner(a, s, 2), corner(b, t, 0),
+                             corner(b, t, 1), corner(b, t, 2)) &&
+              out.pairs.size() < max_pairs)
+            out.pairs.push_back({s, t});
+        }
+    } else if (leaf_b || (!leaf_a && half_area(na) >= half_area(nb))) {  // descend the larger
+      stack.push_back({na.left, j});
+      stack.push_back({na.right, j});
+    } else {
+      stack.push_back({i, nb.left});
+      stack.push_back({i, nb.right});
+    }
+  }
+  std::sort(out.pairs.begin(), out.pairs.end());
+  return out;
+}
+
+}  // namespace penumbra

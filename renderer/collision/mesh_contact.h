@@ -1,0 +1,54 @@
+// Mesh against mesh: the pairs of triangles of two meshes that touch or cross, found by a
+// simultaneous descent of two bounding-volume trees (Gottschalk, Lin & Manocha, "OBBTree",
+// SIGGRAPH 1996, with axis-aligned boxes) and an exact test per candidate pair in double
+// precision: two triangles meet when an edge of one meets the other, or, coplanar, when their
+// projections overlap (the edge-crossing form of Moeller, "A fast triangle-triangle
+// intersection test", JGT 2(2), 1997, with orientation determinants as Devillers & Guigue,
+// "Faster triangle-triangle intersection tests", INRIA RR-4488, 2002). Touching counts.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "renderer/accel/polytope.h"
+
+namespace penumbra {
+
+/// A triangle mesh in world space: 3 indices per triangle into `points`.
+struct ContactMesh {
+  std::span<const DVec3> points;
+  std::span<const uint32_t> triangles;
+};
+
+/// A bounding-box tree over a mesh's triangles: leaves of at most 4, split at the median of the
+/// longest axis of the centroids' box. Built from the triangles' boxes only.
+struct ContactTree {
+  struct Node {
+    DVec3 lo{}, hi{};
+    uint32_t first = 0, count = 0;  ///< leaf: order[first, first + count); inner: count 0
+    uint32_t left = 0, right = 0;   ///< inner: the children
+  };
+  std::vector<Node> nodes;      ///< root first; empty for a mesh without triangles
+  std::vector<uint32_t> order;  ///< triangle indices, leaf after leaf
+};
+
+ContactTree build_contact_tree(const ContactMesh& mesh);
+
+/// True if triangles abc and def share a point.
+bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f);
+
+/// What mesh_contacts found.
+struct MeshContacts {
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;  ///< (triangle of a, triangle of b), sorted
+  uint64_t node_pairs = 0;                           ///< box pairs tested (the broad phase)
+  uint64_t triangle_pairs = 0;                       ///< triangle pairs tested exactly
+};
+
+/// Every pair of a triangle of `a` and one of `b` that meet, with their trees (built by
+/// build_contact_tree over the same meshes). Stops adding pairs after `max_pairs` (the counts
+/// go on).
+MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const ContactMesh& b,
+                           const ContactTree& tb, size_t max_pairs = SIZE_MAX);
+
+}  // namespace penumbra

@@ -1,0 +1,88 @@
+// Tests for renderer/collision/mesh_contact: the triangle-triangle test against GJK on the two
+// triangles (random pairs, and coplanar pairs built to overlap or not), and the trees' contacts
+// against the test over every pair of two triangle soups, both ways round.
+#include "renderer/collision/mesh_contact.h"
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "renderer/collision/gjk.h"
+
+using namespace penumbra;
+
+namespace {
+
+DVec3 random_point(std::mt19937_64& rng, double spread) {
+  std::uniform_real_distribution<double> u(-spread, spread);
+  return {u(rng), u(rng), u(rng)};
+}
+
+// `n` triangles of size about `size` scattered in a cube of half side `spread`.
+void soup(std::mt19937_64& rng, int n, double size, double spread, std::vector<DVec3>& pts,
+          std::vector<uint32_t>& tris) {
+  for (int i = 0; i < n; ++i) {
+    const DVec3 c = random_point(rng, spread);
+    for (int k = 0; k < 3; ++k) {
+      tris.push_back(uint32_t(pts.size()));
+      pts.push_back(c + random_point(rng, size));
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("triangle-triangle: equals GJK on random and coplanar pairs", "[contact]") {
+  std::mt19937_64 rng(5);
+  int met = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    DVec3 t1[3], t2[3];
+    for (auto& p : t1) p = random_point(rng, 1);
+    for (auto& p : t2) p = random_point(rng, 1) + DVec3{0.8, 0, 0};
+    if (trial % 4 == 0)  // coplanar: every corner at z = 0.25
+      for (auto* t : {&t1, &t2})
+        for (auto& p : *t) p.z = 0.25;
+    const ConvexDistance d = gjk_distance({t1, 0}, {t2, 0});
+    if (!d.intersect && d.distance < 1e-9) continue;  // touching to rounding: either answer holds
+    const bool want = d.intersect;
+    met += want;
+    INFO("trial " << trial);
+    CHECK(triangles_meet(t1[0], t1[1], t1[2], t2[0], t2[1], t2[2]) == want);
+    CHECK(triangles_meet(t2[0], t2[1], t2[2], t1[0], t1[1], t1[2]) == want);
+  }
+  CHECK(met > 400);
+  CHECK(met < 3600);
+  // Touching at a shared corner, and a shared edge, counts.
+  CHECK(triangles_meet({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {-1, 0, 0}, {0, 0, 1}));
+  CHECK(triangles_meet({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {1, 0, 0}, {0, -1, 0}));
+}
+
+TEST_CASE("mesh contacts: the trees find exactly the pairs brute force finds", "[contact]") {
+  std::mt19937_64 rng(6);
+  for (int trial = 0; trial < 6; ++trial) {
+    std::vector<DVec3> pa, pb;
+    std::vector<uint32_t> ta, tb;
+    soup(rng, 400 + 100 * trial, 0.15, 2, pa, ta);
+    soup(rng, 300, 0.15, 2, pb, tb);
+    const ContactMesh a{pa, ta}, b{pb, tb};
+    const ContactTree tra = build_contact_tree(a), trb = build_contact_tree(b);
+    const MeshContacts found = mesh_contacts(a, tra, b, trb);
+    std::vector<std::pair<uint32_t, uint32_t>> want;
+    for (uint32_t s = 0; s < ta.size() / 3; ++s)
+      for (uint32_t t = 0; t < tb.size() / 3; ++t)
+        if (triangles_meet(pa[ta[3 * s]], pa[ta[3 * s + 1]], pa[ta[3 * s + 2]], pb[tb[3 * t]],
+                           pb[tb[3 * t + 1]], pb[tb[3 * t + 2]]))
+          want.push_back({s, t});
+    CHECK(found.pairs == want);
+    CHECK(!want.empty());
+    CHECK(found.triangle_pairs < uint64_t(ta.size() / 3) * (tb.size() / 3) / 10);  // the trees pruned
+    const MeshContacts back = mesh_contacts(b, trb, a, tra);
+    std::vector<std::pair<uint32_t, uint32_t>> swapped;
+    for (const auto& [s, t] : back.pairs) swapped.push_back({t, s});
+    std::sort(swapped.begin(), swapped.end());
+    CHECK(swapped == want);
+  }
+  const std::vector<DVec3> none;
+  const ContactMesh empty{none, {}};
+  CHECK(build_contact_tree(empty).nodes.empty());
+}
