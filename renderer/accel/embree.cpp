@@ -1000,6 +1000,56 @@ std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryVie
   return std::make_unique<EmbreeAccelerator>(meshes, instances, config);
 }
 
+namespace {
+
+void box_bounds(const RTCBoundsFunctionArguments* args) {
+  const Bounds3f& b = static_cast<const Bounds3f*>(args->geometryUserPtr)[args->primID];
+  *args->bounds_o = {b.lo.x, b.lo.y, b.lo.z, 0, b.hi.x, b.hi.y, b.hi.z, 0};
+}
+
+// A scene of one user geometry whose primitives are the boxes (kept alive by the caller).
+RTCScene box_scene(std::span<const Bounds3f> boxes) {
+  RTCScene scene = rtcNewScene(device());
+  RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, unsigned(boxes.size()));
+  rtcSetGeometryUserData(geom, const_cast<Bounds3f*>(boxes.data()));
+  rtcSetGeometryBoundsFunction(geom, box_bounds, nullptr);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(scene);
+  return scene;
+}
+
+struct CollideResult {
+  std::mutex mutex;
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;
+};
+
+void collect(void* user, RTCCollision* collisions, unsigned count) {
+  auto* r = static_cast<CollideResult*>(user);
+  std::lock_guard<std::mutex> lock(r->mutex);
+  for (unsigned i = 0; i < count; ++i) r->pairs.push_back({collisions[i].primID0, collisions[i].primID1});
+}
+
+}  // namespace
+
+std::vector<std::pair<uint32_t, uint32_t>> embree_collide(std::span<const Bounds3f> boxes_a,
+                                                          std::span<const Bounds3f> boxes_b) {
+  if (boxes_a.empty() || boxes_b.empty()) return {};
+  RTCScene a = box_scene(boxes_a), b = box_scene(boxes_b);
+  CollideResult result;
+  rtcCollide(a, b, collect, &result);
+  const RTCError error = rtcGetDeviceError(device());
+  rtcReleaseScene(a);
+  rtcReleaseScene(b);
+  if (error != RTC_ERROR_NONE)
+    throw std::runtime_error("embree: rtcCollide failed (error " + std::to_string(int(error)) + ")");
+  std::sort(result.pairs.begin(), result.pairs.end());
+  result.pairs.erase(std::unique(result.pairs.begin(), result.pairs.end()), result.pairs.end());
+  return std::move(result.pairs);
+}
+
 std::string embree_version() {
   const auto v = rtcGetDeviceProperty(device(), RTC_DEVICE_PROPERTY_VERSION);
   return std::to_string(v / 10000) + "." + std::to_string((v / 100) % 100) + "." + std::to_string(v % 100);

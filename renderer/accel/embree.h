@@ -7,6 +7,8 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "renderer/accel/accelerator.h"
 
@@ -42,6 +44,13 @@ std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryVie
 std::unique_ptr<Accelerator> make_embree_accelerator(std::span<const GeometryView> meshes,
                                                      std::span<const InstanceView> instances,
                                                      const EmbreeConfig& config = {});
+
+/// Embree's collision broad phase: rtcCollide over two scenes of user geometries with one box
+/// per primitive (`boxes_a`, `boxes_b`), every pair (index into boxes_a, index into boxes_b)
+/// whose boxes Embree reports as overlapping, sorted and without repeats. Throws
+/// std::runtime_error if Embree fails.
+std::vector<std::pair<uint32_t, uint32_t>> embree_collide(std::span<const Bounds3f> boxes_a,
+                                                          std::span<const Bounds3f> boxes_b);
 
 /// The process-wide Embree device's version string (e.g. "3.13.5").
 std::string embree_version();

@@ -1,12 +1,15 @@
 // Tests for renderer/collision/mesh_contact: the triangle-triangle test against GJK on the two
 // triangles (random pairs, and coplanar pairs built to overlap or not), and the trees' contacts
-// against the test over every pair of two triangle soups, both ways round.
+// against the test over every pair of two triangle soups, both ways round, and after Embree's
+// rtcCollide broad phase.
 #include "renderer/collision/mesh_contact.h"
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <random>
 
+#include "renderer/accel/embree.h"
 #include "renderer/collision/gjk.h"
 
 using namespace penumbra;
@@ -28,6 +31,23 @@ void soup(std::mt19937_64& rng, int n, double size, double spread, std::vector<D
       pts.push_back(c + random_point(rng, size));
     }
   }
+}
+
+// Each triangle's box in single precision, rounded outwards.
+std::vector<Bounds3f> triangle_boxes(const std::vector<DVec3>& p, const std::vector<uint32_t>& t) {
+  std::vector<Bounds3f> boxes;
+  auto down = [](double v) { return std::nextafter(float(v), -INFINITY); };
+  auto up = [](double v) { return std::nextafter(float(v), INFINITY); };
+  for (size_t i = 0; i < t.size(); i += 3) {
+    Bounds3f b;
+    for (int k = 0; k < 3; ++k) {
+      const DVec3 q = p[t[i + size_t(k)]];
+      b = merge(b, Vec3f{down(q.x), down(q.y), down(q.z)});
+      b = merge(b, Vec3f{up(q.x), up(q.y), up(q.z)});
+    }
+    boxes.push_back(b);
+  }
+  return boxes;
 }
 
 }  // namespace
@@ -81,6 +101,14 @@ TEST_CASE("mesh contacts: the trees find exactly the pairs brute force finds", "
     for (const auto& [s, t] : back.pairs) swapped.push_back({t, s});
     std::sort(swapped.begin(), swapped.end());
     CHECK(swapped == want);
+
+    // Embree's rtcCollide as the broad phase, the same exact test after it: the same pairs.
+    std::vector<std::pair<uint32_t, uint32_t>> embree;
+    for (const auto& [s, t] : embree_collide(triangle_boxes(pa, ta), triangle_boxes(pb, tb)))
+      if (triangles_meet(pa[ta[3 * s]], pa[ta[3 * s + 1]], pa[ta[3 * s + 2]], pb[tb[3 * t]],
+                         pb[tb[3 * t + 1]], pb[tb[3 * t + 2]]))
+        embree.push_back({s, t});
+    CHECK(embree == want);
   }
   const std::vector<DVec3> none;
   const ContactMesh empty{none, {}};
