@@ -8,6 +8,9 @@ namespace penumbra {
 
 namespace {
 
+/// Distances below this fraction of the Minkowski difference's size count as touching.
+constexpr double kTouch = 1e-10;
+
 double length(DVec3 v) {
   return std::sqrt(dot(v, v));
 }
@@ -170,7 +173,7 @@ ConvexDistance gjk_distance(const ConvexCore& a, const ConvexCore& b) {
   for (int it = 0; it < 128; ++it) {
     out.iterations = it + 1;
     const double v2 = dot(v, v);
-    if (v2 <= 1e-30 * std::max(scale, 1e-300)) {
+    if (v2 <= kTouch * kTouch * std::max(scale, 1e-300)) {
       out.intersect = true;
       break;
     }
@@ -200,7 +203,8 @@ ConvexDistance gjk_distance(const ConvexCore& a, const ConvexCore& b) {
     if (!progress) break;  // no progress (rounding): v is the answer
   }
   const double core = out.intersect ? 0 : length(v);
-  if (core <= a.radius + b.radius) {
+  // The origin on the simplex to rounding (it may lie in a face's plane): the cores touch.
+  if (core <= a.radius + b.radius + kTouch * std::sqrt(scale)) {
     out.intersect = true;
     out.distance = 0;
   } else {

@@ -25,7 +25,7 @@ struct ConvexCore {
 
 /// The result of gjk_distance.
 struct ConvexDistance {
-  bool intersect = false;  ///< the sets meet (touching within the tolerance counts)
+  bool intersect = false;  ///< the sets meet (closer than 1e-10 of their Minkowski difference's size counts)
   double distance = 0;     ///< the least distance between them; 0 when they meet
   DVec3 a{}, b{};          ///< closest points on each set (when they do not meet)
   int iterations = 0;

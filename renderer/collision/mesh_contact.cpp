@@ -55,16 +55,21 @@ bool point_in_triangle_2d(const double* p, const double (*t)[2]) {
   return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
 
-// Two triangles in one plane (normal n): their projections on the plane's dominant axes overlap.
-bool coplanar_meet(const DVec3 (&t1)[3], const DVec3 (&t2)[3], DVec3 n) {
+// Two triangles in one plane (normal n) projected on the plane's two dominant axes.
+void project_2d(const DVec3 (&t1)[3], const DVec3 (&t2)[3], DVec3 n, double (&p)[3][2], double (&q)[3][2]) {
   const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
   const int drop = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
   const int u = drop == 0 ? 1 : 0, v = drop == 2 ? 1 : 2;
-  double p[3][2], q[3][2];
   for (int i = 0; i < 3; ++i) {
     p[i][0] = axis(t1[i], u), p[i][1] = axis(t1[i], v);
     q[i][0] = axis(t2[i], u), q[i][1] = axis(t2[i], v);
   }
+}
+
+// Two triangles in one plane (normal n): their projections on the plane's dominant axes overlap.
+bool coplanar_meet(const DVec3 (&t1)[3], const DVec3 (&t2)[3], DVec3 n) {
+  double p[3][2], q[3][2];
+  project_2d(t1, t2, n, p, q);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (segments_meet_2d(p[i], p[(i + 1) % 3], q[j], q[(j + 1) % 3])) return true;
@@ -96,6 +101,36 @@ bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f) {
   }
   return segment_meets(a, b, d, e, f) || segment_meets(b, c, d, e, f) || segment_meets(c, a, d, e, f) ||
          segment_meets(d, e, a, b, c) || segment_meets(e, f, a, b, c) || segment_meets(f, d, a, b, c);
+}
+
+DVec3 triangle_contact_point(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f) {
+  DVec3 sum{0, 0, 0};
+  int n = 0;
+  const DVec3 t1[3] = {a, b, c}, t2[3] = {d, e, f};
+  const bool coplanar = orient(a, b, c, d) == 0 && orient(a, b, c, e) == 0 && orient(a, b, c, f) == 0;
+  if (!coplanar) {
+    auto crossings = [&](const DVec3(&s)[3], const DVec3(&t)[3]) {
+      for (int i = 0; i < 3; ++i) {
+        const DVec3 p = s[i], q = s[(i + 1) % 3];
+        if (!segment_meets(p, q, t[0], t[1], t[2])) continue;
+        const double sp = orient(t[0], t[1], t[2], p), sq = orient(t[0], t[1], t[2], q);
+        const double u = sp == sq ? 0.5 : sp / (sp - sq);
+        sum = sum + p + (q - p) * u;
+        ++n;
+      }
+    };
+    crossings(t1, t2);
+    crossings(t2, t1);
+  } else {
+    double p[3][2], q[3][2];
+    project_2d(t1, t2, cross(b - a, c - a), p, q);
+    for (int i = 0; i < 3; ++i) {
+      if (point_in_triangle_2d(p[i], q)) sum = sum + t1[i], ++n;
+      if (point_in_triangle_2d(q[i], p)) sum = sum + t2[i], ++n;
+    }
+  }
+  if (n == 0) return (a + b + c) * (1.0 / 3);
+  return sum * (1.0 / n);
 }
 
 ContactTree build_contact_tree(const ContactMesh& mesh) {
@@ -177,10 +212,11 @@ MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const Co
         for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) {
           const uint32_t s = ta.order[x], t = tb.order[y];
           ++out.triangle_pairs;
-          if (triangles_meet(corner(a, s, 0), corner(a, s, 1), corner(a, s, 2), corner(b, t, 0),
-                             corner(b, t, 1), corner(b, t, 2)) &&
-              out.pairs.size() < max_pairs)
-            out.pairs.push_back({s, t});
+          if (!triangles_meet(corner(a, s, 0), corner(a, s, 1), corner(a, s, 2), corner(b, t, 0),
+                              corner(b, t, 1), corner(b, t, 2)))
+            continue;
+          ++out.meeting;
+          if (out.pairs.size() < max_pairs) out.pairs.push_back({s, t});
         }
     } else if (leaf_b || (!leaf_a && half_area(na) >= half_area(nb))) {  // descend the larger
       stack.push_back({na.left, j});

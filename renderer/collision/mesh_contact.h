@@ -38,16 +38,22 @@ ContactTree build_contact_tree(const ContactMesh& mesh);
 /// True if triangles abc and def share a point.
 bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f);
 
+/// A point two meeting triangles share: the mean of the points where an edge of one crosses
+/// the other (triangles in one plane: the mean of the corners of each lying in the other; when
+/// only their edges cross, the first triangle's centroid, which may lie outside the second).
+DVec3 triangle_contact_point(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f);
+
 /// What mesh_contacts found.
 struct MeshContacts {
   std::vector<std::pair<uint32_t, uint32_t>> pairs;  ///< (triangle of a, triangle of b), sorted
   uint64_t node_pairs = 0;                           ///< box pairs tested (the broad phase)
   uint64_t triangle_pairs = 0;                       ///< triangle pairs tested exactly
+  uint64_t meeting = 0;                              ///< pairs that meet (kept or not)
 };
 
 /// Every pair of a triangle of `a` and one of `b` that meet, with their trees (built by
-/// build_contact_tree over the same meshes). Stops adding pairs after `max_pairs` (the counts
-/// go on).
+/// build_contact_tree over the same meshes). Keeps at most `max_pairs` pairs, the first met in
+/// the descent (the counts go on).
 MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const ContactMesh& b,
                            const ContactTree& tb, size_t max_pairs = SIZE_MAX);
 

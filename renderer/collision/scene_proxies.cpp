@@ -28,15 +28,6 @@ double abs_det(const Affine3f& a) {
   return std::abs(d);
 }
 
-// True if `node` is `root` or below it (parent links followed at most once per node).
-bool in_subtree(int node, int root, std::span<const int> parents) {
-  for (size_t steps = 0; node >= 0 && steps <= parents.size(); ++steps) {
-    if (node == root) return true;
-    node = size_t(node) < parents.size() ? parents[size_t(node)] : -1;
-  }
-  return false;
-}
-
 double length(DVec3 v) {
   return std::sqrt(dot(v, v));
 }
@@ -103,6 +94,14 @@ void append_polyhedron(Scene& scene, const ConvexPolyhedron& part, int material,
 
 }  // namespace
 
+bool node_in_subtree(int node, int ancestor, std::span<const int> parents) {
+  for (size_t steps = 0; node >= 0 && steps <= parents.size(); ++steps) {
+    if (node == ancestor) return true;
+    node = size_t(node) < parents.size() ? parents[size_t(node)] : -1;
+  }
+  return false;
+}
+
 std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int> node_parents, int root) {
   std::vector<NodeGeometry> out;
   std::vector<int> entry_of_node;  // root < 0: glTF node -> index into out, -1 none yet
@@ -114,7 +113,7 @@ std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int>
     if (node < 0) continue;
     NodeGeometry* g = nullptr;
     if (root >= 0) {
-      if (!in_subtree(node, root, node_parents)) continue;
+      if (!node_in_subtree(node, root, node_parents)) continue;
       if (out.empty()) {
         out.emplace_back();
         out.back().node = root;

@@ -28,6 +28,10 @@ struct NodeGeometry {
   uint64_t instances = 0;  ///< mesh instances gathered
 };
 
+/// True if `node` is `ancestor` or lies below it (`parents`: each glTF node's parent, -1 for a
+/// root; parent links are followed at most once per node, so a cycle ends).
+bool node_in_subtree(int node, int ancestor, std::span<const int> parents);
+
 /// The geometry of each node that places a mesh (`root` < 0; instances not from glTF are left
 /// out), or of the subtree under node `root` as one entry (empty if it places no mesh).
 /// `node_parents` holds each glTF node's parent (-1 for a root). Shapes are not gathered.

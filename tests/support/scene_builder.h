@@ -9,6 +9,19 @@
 
 namespace penumbra::test {
 
+/// The cube [-half, half]^3 with 8 shared vertices and 12 triangles facing outwards.
+inline Mesh cube_mesh(float half) {
+  Mesh m;
+  m.name = "cube";
+  for (int i = 0; i < 8; ++i)
+    m.positions.push_back({i & 1 ? half : -half, i & 2 ? half : -half, i & 4 ? half : -half});
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces)
+    for (int k : {0, 1, 2, 0, 2, 3}) m.indices.push_back(uint32_t(f[k]));
+  return m;
+}
+
 /// Adds an axis-aligned rectangle with normal +z (or -z if `flip`) at height z, spanning
 /// [x0, x1] x [y0, y1], made of two triangles; returns its mesh index (== its instance index when every mesh
 /// is added this way).

@@ -224,6 +224,17 @@ TEST_CASE("penetration depth: closed forms, and the least translation that separ
   CHECK(len(pb.direction - DVec3{0, 0, -1}) < 1e-12);
   CHECK_FALSE(penetration(b1, moved(b2, {0, 0, -0.31})).intersect);
 
+  // The origin in the plane of a simplex face (symmetric boxes sharing their y and z centre):
+  // a thin wall and a cube overlapping it by 0.05 meet, with that depth.
+  Proxy wall, cube;
+  wall.kind = cube.kind = ProxyKind::Aabb;
+  wall.box.center = {0, 0, 5};
+  wall.box.half = {0.05000000074505806, 1, 1};
+  cube.box.center = {0.5, 0, 5};
+  cube.box.half = {0.5, 0.5, 0.5};
+  CHECK(proxy_distance(wall, cube).intersect);
+  CHECK(penetration(wall, cube).depth == Approx(0.05).epsilon(1e-6));
+
   std::mt19937_64 rng(4);
   int tested = 0;
   for (int trial = 0; trial < 300; ++trial) {
@@ -249,4 +260,38 @@ TEST_CASE("penetration depth: closed forms, and the least translation that separ
     }
   }
   CHECK(tested > 100);
+}
+
+TEST_CASE("GJK on boxes snapped to a grid: every degenerate contact against the closed form", "[gjk]") {
+  // Coordinates on a 0.25 grid put the origin on faces, edges and corners of the simplices.
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<int> pos(-8, 8), size(1, 6);
+  int met = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    Proxy a, b;
+    a.kind = b.kind = ProxyKind::Aabb;
+    a.box.center = {0.25 * pos(rng), 0.25 * pos(rng), 0.25 * pos(rng)};
+    a.box.half = {0.125 * size(rng), 0.125 * size(rng), 0.125 * size(rng)};
+    b.box.center = {0.25 * pos(rng), 0.25 * pos(rng), 0.25 * pos(rng)};
+    b.box.half = {0.125 * size(rng), 0.125 * size(rng), 0.125 * size(rng)};
+    double gap2 = 0, depth = INFINITY;
+    const double ca[3] = {a.box.center.x, a.box.center.y, a.box.center.z},
+                 cb[3] = {b.box.center.x, b.box.center.y, b.box.center.z};
+    const double ha[3] = {a.box.half.x, a.box.half.y, a.box.half.z},
+                 hb[3] = {b.box.half.x, b.box.half.y, b.box.half.z};
+    for (int k = 0; k < 3; ++k) {
+      const double gap = std::abs(ca[k] - cb[k]) - ha[k] - hb[k];
+      if (gap > 0) gap2 += gap * gap;
+      depth = std::min(depth, -gap);
+    }
+    const ConvexDistance d = proxy_distance(a, b);
+    INFO("trial " << trial);
+    CHECK(d.intersect == (gap2 == 0));
+    if (gap2 > 0) CHECK(d.distance == Approx(std::sqrt(gap2)).epsilon(1e-9));
+    if (gap2 == 0) {
+      ++met;
+      CHECK(penetration(a, b).depth == Approx(depth).margin(1e-12));
+    }
+  }
+  CHECK(met > 100);
 }

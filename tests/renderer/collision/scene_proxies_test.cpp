@@ -17,19 +17,7 @@ using namespace penumbra::test;
 
 namespace {
 
-// The cube [-1, 1]^3, 8 shared vertices, triangles facing outwards.
-Mesh cube_mesh() {
-  Mesh m;
-  m.name = "cube";
-  for (int i = 0; i < 8; ++i)
-    m.positions.push_back({i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f});
-  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : faces)
-    for (int k : {0, 1, 2, 0, 2, 3}) m.indices.push_back(uint32_t(f[k]));
-  return m;
-}
-
+// A uniform scale by s, then a move by t.
 Affine3f scale_translate(float s, Vec3f t) {
   Affine3f a;
   for (int r = 0; r < 3; ++r) {
@@ -42,7 +30,7 @@ Affine3f scale_translate(float s, Vec3f t) {
 // Node 0 places the cube as it is; node 1, its child, the cube scaled by 2 and moved.
 Scene two_cubes() {
   Scene s;
-  s.meshes.push_back(cube_mesh());
+  s.meshes.push_back(cube_mesh(1));
   s.instances.push_back(make_instance(0, Affine3f{}, 0));
   s.instances.push_back(make_instance(0, scale_translate(2, {10, 0, 0}), 1));
   return s;

@@ -1,0 +1,53 @@
+// Static (discrete, a posteriori) collision detection over a scene's nodes at one pose: the
+// world-space geometry of each node that places a mesh, a broad phase by sweep and prune over
+// their boxes (Cohen, Lin, Manocha & Ponamgi, "I-COLLIDE", I3D 1995), pairs that the node
+// hierarchy joins (one node below the other) left out unless asked, and a narrow phase on the
+// triangles (mesh_contact: exact) or on fitted proxies (gjk: distance and penetration depth).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "renderer/collision/proxy.h"
+#include "renderer/scene/scene.h"
+
+namespace penumbra {
+
+/// What collide_scene tests.
+struct CollideConfig {
+  bool mesh = true;                  ///< narrow phase on the triangles; false: on proxies of `kind`
+  ProxyKind kind = ProxyKind::Hull;  ///< the proxies' kind when !mesh
+  ProxyConfig fit;                   ///< their fitting
+  bool include_children = false;     ///< also test pairs where one node lies below the other
+};
+
+/// Two nodes that touch or interpenetrate.
+struct NodeContact {
+  int a = -1, b = -1;           ///< glTF nodes, a < b
+  double depth = NAN;           ///< proxies: the penetration depth (0 when touching); meshes: NaN
+  DVec3 direction{};            ///< proxies: unit, moving b by depth along it separates them
+  DVec3 point{};                ///< a point where they meet
+  uint64_t triangle_pairs = 0;  ///< meshes: the pairs of triangles that meet
+};
+
+/// What collide_scene found, with the work of each phase.
+struct CollideReport {
+  std::vector<NodeContact> contacts;  ///< sorted by (a, b)
+  uint64_t nodes = 0;                 ///< nodes with geometry
+  uint64_t broad_pairs = 0;           ///< node pairs whose world boxes overlap
+  uint64_t family_pairs = 0;          ///< of those, pairs the hierarchy joins, left out
+  uint64_t narrow_tests = 0;          ///< node pairs tested exactly
+  uint64_t triangle_tests = 0;        ///< meshes: triangle pairs tested
+};
+
+/// The pairs of overlapping boxes among `boxes` (i < j), sorted: sweep and prune along x, then
+/// the y and z intervals.
+std::vector<std::pair<uint32_t, uint32_t>> sweep_and_prune(std::span<const Bounds3f> boxes);
+
+/// Every pair of nodes whose geometry touches or interpenetrates at the scene's pose. Throws
+/// std::invalid_argument naming the node if its geometry cannot be fitted (proxies).
+CollideReport collide_scene(const Scene& scene, std::span<const int> parents, const CollideConfig& config);
+
+}  // namespace penumbra
