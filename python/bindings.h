@@ -44,7 +44,7 @@ RenderSettings settings_from(const py::object& settings, const py::kwargs& kw);
 /// Scene.pick.
 void bind_queries(py::module_& m, SceneClass& scene);
 
-/// Scene.proxies.
+/// Scene.proxies and Scene.collide.
 void bind_collision(SceneClass& scene);
 
 }  // namespace penumbra::python

@@ -1,5 +1,6 @@
-// Scene.proxies: bounding proxies fitted to the scene's nodes (renderer/collision/scene_proxies.h,
-// what `penumbra proxies` calls), with their tightness, as dicts of NumPy arrays.
+// Scene.proxies and Scene.collide: bounding proxies fitted to the scene's nodes with their
+// tightness, and the nodes that touch (renderer/collision/scene_proxies.h, scene_collide.h, what
+// `penumbra proxies` and `penumbra collide` call), as dicts of NumPy arrays.
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -10,6 +11,7 @@
 #include "io/files/error.h"
 #include "python/bindings.h"
 #include "render/scene_query.h"
+#include "renderer/collision/scene_collide.h"
 #include "renderer/collision/scene_proxies.h"
 
 namespace penumbra::python {
@@ -133,9 +135,61 @@ py::list proxies(SceneSession& s, const std::string& kind,
   return out;
 }
 
+py::dict collide(SceneSession& s, const std::string& proxy, bool include_children, int kdop) {
+  CollideConfig config;
+  config.include_children = include_children;
+  if (proxy != "mesh") {
+    config.mesh = false;
+    if (!parse_proxy_kind(proxy, config.kind))
+      throw py::value_error("proxy '" + proxy + "': not mesh or a proxy kind");
+  }
+  if (kdop != 6 && kdop != 14 && kdop != 18 && kdop != 26)
+    throw py::value_error("kdop " + std::to_string(kdop) + ": k must be 6, 14, 18 or 26");
+  config.fit.kdop = kdop;
+  SessionLock lock(s);
+  CollideReport r;
+  {
+    py::gil_scoped_release release;
+    try {
+      r = collide_scene(s.loaded.scene, s.loaded.info.node_parents, config);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file, "", e.what());
+    }
+  }
+  py::list contacts;
+  for (const NodeContact& c : r.contacts) {
+    py::dict d;
+    d["a"] = c.a;
+    d["b"] = c.b;
+    d["a_name"] = size_t(c.a) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(c.a)] : "";
+    d["b_name"] = size_t(c.b) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(c.b)] : "";
+    d["point"] = vec(c.point);
+    d["depth"] = finite_or_none(c.depth);
+    d["direction"] = std::isfinite(c.depth) ? py::object(vec(c.direction)) : py::object(py::none());
+    d["triangle_pairs"] = c.triangle_pairs;
+    contacts.append(d);
+  }
+  py::dict out;
+  out["contacts"] = contacts;
+  out["nodes"] = r.nodes;
+  out["broad_pairs"] = r.broad_pairs;
+  out["family_pairs"] = r.family_pairs;
+  out["narrow_tests"] = r.narrow_tests;
+  out["triangle_tests"] = r.triangle_tests;
+  return out;
+}
+
 }  // namespace
 
 void bind_collision(SceneClass& scene) {
+  scene.def(
+      "collide", &collide, py::kw_only(), py::arg("proxy") = "mesh", py::arg("include_children") = false,
+      py::arg("kdop") = 26,
+      "The nodes that touch or interpenetrate at the scene's pose, as `penumbra collide` finds them: a "
+      "sweep and prune over the nodes' boxes, pairs the hierarchy joins left out unless include_children, "
+      "and an exact test on the triangles (proxy='mesh') or on fitted proxies (a proxy kind, which also "
+      "gives depth and direction). Returns a dict: contacts (a list of dicts: a, b, a_name, b_name, point, "
+      "depth, direction, triangle_pairs), nodes, broad_pairs, family_pairs, narrow_tests, triangle_tests.");
   scene.def(
       "proxies", &proxies, py::arg("kind"), py::arg("node") = py::none(), py::kw_only(), py::arg("kdop") = 26,
       py::arg("samples") = 20000, py::arg("threads") = 0,

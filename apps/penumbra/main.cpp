@@ -1,7 +1,8 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
 // `info`, assemble farm tiles with `merge`, denoise an EXR with `denoise`, render job files with `batch` and
 // submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`, ask it
-// spatial questions with `query`, fit collision proxies with `proxies`. This
+// spatial questions with `query`, fit collision proxies with `proxies` and find collisions with
+// `collide`. This
 // file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1
 // a failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a
 // parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
@@ -11,6 +12,7 @@
 
 #include "apps/penumbra/batch_command.h"
 #include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/collide_command.h"
 #include "apps/penumbra/info_command.h"
 #include "apps/penumbra/merge_command.h"
 #include "apps/penumbra/mesh_command.h"
@@ -107,6 +109,29 @@ void add_proxies_options(CLI::App& proxies, ProxiesArgs& a) {
   proxies.add_flag("--allow-external-uris", a.allow_external,
                    "let buffer URIs reach files outside the scene's folder");
   proxies.add_flag("-q,--quiet", a.quiet, "no warnings");
+}
+
+void add_collide_options(CLI::App& collide, CollideArgs& a) {
+  collide.add_option("scene", a.scene_file, "glTF scene (.gltf or .glb)")->required();
+  collide.add_option("--proxy", a.proxy,
+                     "the narrow phase: mesh (the triangles, exact; default) or a proxy kind fitted to each "
+                     "node (sphere, ritter, aabb, obb, capsule, hull, kdop, composite), which also gives the "
+                     "penetration depth");
+  collide.add_option("--kdop", a.kdop, "k of --proxy kdop: 6, 14, 18 or 26 (default 26)");
+  collide.add_option(
+      "--frames", a.frames,
+      "test frames A to B inclusive (A-B, A-B:STEP or N), each at time N / --fps; default: the "
+      "file's static pose");
+  collide.add_option("--fps", a.fps, "frames per second of --frames (default 24)");
+  collide.add_flag("--include-children", a.include_children,
+                   "also test pairs where one node lies below the other in the hierarchy");
+  collide.add_flag("--json", a.json, "the report as JSON on stdout");
+  collide.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
+  collide.add_option("--max-memory", a.max_memory,
+                     "one budget for the scene and the tests, e.g. 4G (default: half the RAM)");
+  collide.add_flag("--allow-external-uris", a.allow_external,
+                   "let buffer URIs reach files outside the scene's folder");
+  collide.add_flag("-q,--quiet", a.quiet, "no warnings");
 }
 
 /// A CLI11 check refusing an empty value (which would read as the option not given).
@@ -209,6 +234,10 @@ int main(int argc, char** argv) {
   auto* proxies = app.add_subcommand(
       "proxies", "Fit bounding proxies (spheres, boxes, capsules, convex hulls, k-DOPs) to a scene's nodes");
   add_proxies_options(*proxies, proxies_args);
+  CollideArgs collide_args;
+  auto* collide = app.add_subcommand(
+      "collide", "List the nodes of a glTF scene that touch or interpenetrate, at its pose or at each frame");
+  add_collide_options(*collide, collide_args);
   QueryArgs query_args;
   auto* query = add_query_command(app, query_args);
 
@@ -231,6 +260,7 @@ int main(int argc, char** argv) {
     if (*info) return run_info(info_args);
     if (*query) return run_query(*query, query_args);
     if (*proxies) return run_proxies(proxies_args);
+    if (*collide) return run_collide(collide_args);
   } catch (const InputError& e) {
     return report("error", e.what(), kExitInput);
   } catch (const UsageError& e) {

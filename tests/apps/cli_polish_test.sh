@@ -51,7 +51,7 @@ done
 expect 0 "Usage: .*info" -- "$bin" info --help
 for args in "render" "render $d" "render $d -o $work/a.exr --spp 0" "render $d -o $work/a.exr --width abc" \
             "render $d -o $work/a.exr --frame 1 --time 2" "render $d -o $work/a.exr --crop 1 2" \
-            "info" "merge" "batch" "mesh $d -o $work/m.glb" "submit slurm" "proxies $d"; do
+            "info" "merge" "batch" "mesh $d -o $work/m.glb" "submit slurm" "proxies $d" "collide"; do
   # shellcheck disable=SC2086
   "$bin" $args >"$work/out" 2>"$work/err"; rc=$?
   [ "$rc" -eq 2 ] && ok || fail "penumbra $args: exit $rc, want 2"
@@ -59,7 +59,7 @@ for args in "render" "render $d" "render $d -o $work/a.exr --spp 0" "render $d -
 done
 expect_err 2 "penumbra: error: scene is required" -- "$bin" render
 expect_err 2 "penumbra: error: --spp: Value 0 not in range 1 to 65536" -- "$bin" render "$d" -o "$work/a.exr" --spp 0
-expect_err 2 "penumbra: error: a command is required: render, info, merge, denoise, batch, submit, mesh, proxies, query (penumbra --help describes them)" -- "$bin"
+expect_err 2 "penumbra: error: a command is required: render, info, merge, denoise, batch, submit, mesh, proxies, collide, query (penumbra --help describes them)" -- "$bin"
 expect_err 2 "penumbra: error: a command is required for submit: slurm (penumbra submit --help describes them)" -- "$bin" submit
 # Errors after parsing (bad input) and warnings carry the same prefixes.
 expect_err 2 "penumbra: error: $work/missing.gltf: file not found" -- "$bin" info "$work/missing.gltf"

@@ -107,3 +107,22 @@ def test_refusals(default_scene):
         default_scene.proxies("kdop", kdop=7)
     with pytest.raises(ValueError, match="samples"):
         default_scene.proxies("obb", samples=-1)
+
+
+def test_collide_equals_the_command(default_scene, cli):
+    for proxy in ("mesh", "obb"):
+        r = default_scene.collide(proxy=proxy)
+        doc = json.loads(subprocess.run([cli, "collide", str(SCENES / "default.gltf"), "--proxy", proxy, "--json", "-q"],
+                                        check=True, capture_output=True, text=True).stdout)
+        frame = doc["frames"][0]
+        assert [(c["a"], c["b"]) for c in r["contacts"]] == [(c["a"], c["b"]) for c in frame["contacts"]]
+        for key in ("nodes", "broad_pairs", "family_pairs", "narrow_tests", "triangle_tests"):
+            assert r[key] == frame[key]
+        assert r["narrow_tests"] + r["family_pairs"] == r["broad_pairs"]
+        for c in r["contacts"]:
+            assert c["a"] < c["b"]
+            assert (c["depth"] is None) == (proxy == "mesh")
+            if proxy == "obb":
+                assert c["depth"] >= 0 and abs(np.linalg.norm(c["direction"]) - 1) < 1e-9
+    with pytest.raises(ValueError, match="not mesh or a proxy kind"):
+        default_scene.collide(proxy="cube")

@@ -1,0 +1,153 @@
+// `penumbra collide`.
+#include "apps/penumbra/collide_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "apps/penumbra/cli_support.h"
+#include "apps/penumbra/scene_setup.h"
+#include "io/farm/frame_outputs.h"
+#include "io/files/error.h"
+#include "renderer/collision/scene_collide.h"
+
+namespace penumbra::cli {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+/// Bytes held per placed vertex while testing: double copies, trees or proxies.
+constexpr uint64_t kBytesPerVertex = 256;
+
+Json dvec(DVec3 v) {
+  return Json::array({v.x, v.y, v.z});
+}
+
+std::string node_name(const GltfInfo& info, int node) {
+  return size_t(node) < info.node_names.size() ? info.node_names[size_t(node)] : std::string();
+}
+
+Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time) {
+  Json j;
+  j["frame"] = frame ? Json(*frame) : Json();
+  j["time"] = frame ? Json(time) : Json();  // null: the file's static pose
+  j["nodes"] = r.nodes;
+  j["broad_pairs"] = r.broad_pairs;
+  j["family_pairs"] = r.family_pairs;
+  j["narrow_tests"] = r.narrow_tests;
+  j["triangle_tests"] = r.triangle_tests;
+  Json list = Json::array();
+  for (const NodeContact& c : r.contacts) {
+    Json e;
+    e["a"] = c.a;
+    e["a_name"] = node_name(info, c.a);
+    e["b"] = c.b;
+    e["b_name"] = node_name(info, c.b);
+    e["point"] = dvec(c.point);
+    e["depth"] = std::isfinite(c.depth) ? Json(c.depth) : Json();
+    e["direction"] = std::isfinite(c.depth) ? dvec(c.direction) : Json();
+    e["triangle_pairs"] = c.triangle_pairs;
+    list.push_back(e);
+  }
+  j["contacts"] = list;
+  return j;
+}
+
+void print_frame(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time) {
+  if (frame) std::printf("frame %lld (time %.6g s): ", (long long)*frame, time);
+  std::printf(
+      "%llu nodes, broad phase %llu pairs (%llu joined by the hierarchy, left out), narrow phase %llu "
+      "tests, %zu contact%s\n",
+      (unsigned long long)r.nodes, (unsigned long long)r.broad_pairs, (unsigned long long)r.family_pairs,
+      (unsigned long long)r.narrow_tests, r.contacts.size(), r.contacts.size() == 1 ? "" : "s");
+  for (const NodeContact& c : r.contacts) {
+    std::printf("  '%s' (%d) and '%s' (%d) at (%.6g, %.6g, %.6g)", node_name(info, c.a).c_str(), c.a,
+                node_name(info, c.b).c_str(), c.b, c.point.x, c.point.y, c.point.z);
+    if (std::isfinite(c.depth))
+      std::printf(", depth %.6g\n", c.depth);
+    else
+      std::printf(", %llu triangle pairs\n", (unsigned long long)c.triangle_pairs);
+  }
+}
+
+}  // namespace
+
+int run_collide(const CollideArgs& a) {
+  CollideConfig config;
+  config.include_children = a.include_children;
+  if (a.proxy != "mesh") {
+    config.mesh = false;
+    if (!parse_proxy_kind(a.proxy, config.kind)) {
+      std::string names = "mesh";
+      for (int i = 0; i < kProxyKindCount; ++i) names += std::string(", ") + proxy_kind_name(ProxyKind(i));
+      throw UsageError("--proxy " + a.proxy + ": not mesh or a proxy kind (" + names + ")");
+    }
+  }
+  if (a.kdop != 6 && a.kdop != 14 && a.kdop != 18 && a.kdop != 26)
+    throw UsageError("--kdop " + std::to_string(a.kdop) + ": k must be 6, 14, 18 or 26");
+  config.fit.kdop = a.kdop;
+  if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
+  std::optional<FrameRange> range;
+  if (a.frames) {
+    try {
+      range = parse_frame_range(*a.frames);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }
+  const uint64_t budget = memory_budget(a.max_memory);
+  std::optional<double> first_time;
+  if (range) first_time = double(range->first) / a.fps;
+  set_phase("loading the scene");
+  LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, a.quiet, first_time,
+                                  range.has_value());
+  uint64_t placed = 0;
+  for (const Instance& inst : loaded.scene.instances)
+    if (inst.mesh >= 0) placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
+  const uint64_t scene_bytes = scene_memory_bytes(loaded.scene);
+  if (placed * kBytesPerVertex > budget - std::min(budget, scene_bytes))
+    throw UsageError(a.scene_file + ": testing " + human_count(placed) + " placed vertices needs " +
+                     human_count(placed * kBytesPerVertex) +
+                     "B beside the scene, over the budget (--max-memory)");
+
+  Json frames = Json::array();
+  auto run_frame = [&](std::optional<int64_t> frame, double time) {
+    set_phase("testing for collisions");
+    CollideReport report;
+    try {
+      report = collide_scene(loaded.scene, loaded.info.node_parents, config);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.scene_file, "", e.what());
+    }
+    if (a.json)
+      frames.push_back(frame_json(report, loaded.info, frame, time));
+    else
+      print_frame(report, loaded.info, frame, time);
+  };
+  if (!range) {
+    run_frame(std::nullopt, 0);
+  } else {
+    for (int64_t f = range->first; f <= range->last; f += range->step) {
+      const double t = double(f) / a.fps;
+      if (f != range->first && loaded.info.animation_count != 0) {
+        set_phase("posing the scene");
+        if (!loaded.animation || !pose_gltf_scene(*loaded.animation, t, loaded.scene))
+          loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, true, t, true);
+      }
+      run_frame(f, t);
+    }
+  }
+  if (a.json) {
+    Json doc;
+    doc["scene"] = a.scene_file;
+    doc["proxy"] = a.proxy;
+    if (config.kind == ProxyKind::Kdop && !config.mesh) doc["k"] = a.kdop;
+    doc["include_children"] = a.include_children;
+    doc["frames"] = frames;
+    std::printf("%s\n", doc.dump(2).c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace penumbra::cli

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# `penumbra collide` end to end on a generated scene of unit cubes: A at the origin with a child
+# half its size inside it, B overlapping A by 0.2 along x (and the child by 0.35), C far away, a
+# thin wall, and a cube animated through the wall at constant speed:
+# - the meshes' contacts are exactly (A, B) and (child, B); the parent-child pair is left out
+#   (counted) unless --include-children; each contact point lies in both boxes;
+# - with --proxy obb (a cube's OBB is the cube) the penetration depths are 0.2 and 0.35;
+# - over --frames 0-24 at 24 fps the moving cube meets the wall at exactly the frames where
+#   their x extents overlap (10 to 14), with meshes and with proxies;
+# - bad input exits 2 naming the option: an unknown proxy kind, a bad k, a bad range or fps.
+# Usage: collide_test.sh PENUMBRA_BINARY WORK_DIR
+set -u
+bin="$1"; work="$2"
+rm -rf "$work"; mkdir -p "$work"
+fails=0; passes=0
+source "$(dirname "$0")/expect.sh"
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+py=/usr/bin/python3
+
+scene="$work/cubes.gltf"
+"$py" - "$scene" <<'PY'
+import base64, json, struct, sys
+v = [(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
+f = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+idx = [i for q in f for i in (q[0], q[1], q[2], q[0], q[2], q[3])]
+times, moves = [0.0, 1.0], [(-3, 0, 5), (3, 0, 5)]
+blob = (b"".join(struct.pack("<3f", *p) for p in v) + struct.pack(f"<{len(idx)}I", *idx) +
+        struct.pack("<2f", *times) + b"".join(struct.pack("<3f", *p) for p in moves))
+views = [{"buffer": 0, "byteOffset": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 144},
+         {"buffer": 0, "byteOffset": 240, "byteLength": 8}, {"buffer": 0, "byteOffset": 248, "byteLength": 24}]
+accessors = [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [-0.5] * 3, "max": [0.5] * 3},
+             {"bufferView": 1, "componentType": 5125, "count": 36, "type": "SCALAR"},
+             {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+             {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}]
+doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 2, 3, 4, 5]}],
+       "nodes": [{"name": "A", "mesh": 0, "children": [1]},
+                 {"name": "A child", "mesh": 0, "translation": [0.4, 0, 0], "scale": [0.5, 0.5, 0.5]},
+                 {"name": "B", "mesh": 0, "translation": [0.8, 0, 0]},
+                 {"name": "C", "mesh": 0, "translation": [10, 0, 0]},
+                 {"name": "wall", "mesh": 0, "translation": [0, 0, 5], "scale": [0.1, 2, 2]},
+                 {"name": "mover", "mesh": 0, "translation": [-3, 0, 5]}],
+       "meshes": [{"name": "cube", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+       "animations": [{"samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}],
+                       "channels": [{"sampler": 0, "target": {"node": 5, "path": "translation"}}]}],
+       "accessors": accessors, "bufferViews": views,
+       "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]}
+json.dump(doc, open(sys.argv[1], "w"))
+PY
+
+# check_json WHAT PYTHON-CHECK ARGS...: runs collide --json with ARGS and the check on its document `d`.
+check_json() {
+  local what="$1" check="$2"; shift 2
+  if ! "$bin" collide "$scene" --json "$@" >"$work/c.json" 2>"$work/err"; then
+    fail "$what: collide $* exited $?"; sed 's/^/  | /' "$work/err" | head -3; return
+  fi
+  if "$py" - "$work/c.json" "$check" <<'PY'; then passes=$((passes + 1)); else fail "$what"; fi
+import json, sys
+d = json.load(open(sys.argv[1]))
+def pairs(frame): return [(c["a"], c["b"]) for c in frame["contacts"]]
+def inside(p, centre, half): return all(abs(p[k] - centre[k]) <= half[k] + 1e-6 for k in range(3))
+ok = eval(sys.argv[2])
+if not ok: print("  document:", json.dumps(d)[:600], file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+}
+
+# 1. The meshes at the static pose.
+check_json "mesh contacts" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)] and d["frames"][0]["family_pairs"] == 1'
+check_json "mesh contacts with children" 'pairs(d["frames"][0]) == [(0, 1), (0, 2), (1, 2)] and d["frames"][0]["family_pairs"] == 0' --include-children
+check_json "contact points in both boxes" 'all(inside(c["point"], [0, 0, 0], [0.5] * 3) and inside(c["point"], [0.8, 0, 0], [0.5] * 3) for c in d["frames"][0]["contacts"] if c["b"] == 2) and all(c["depth"] is None and c["triangle_pairs"] > 0 for c in d["frames"][0]["contacts"])'
+check_json "broad phase counts" 'd["frames"][0]["nodes"] == 6 and d["frames"][0]["broad_pairs"] == 3 and d["frames"][0]["narrow_tests"] == 2 and d["frames"][0]["frame"] is None'
+# 2. Oriented boxes of cubes are the cubes: exact penetration depths.
+check_json "OBB depths" '[(c["a"], c["b"], round(c["depth"], 6)) for c in d["frames"][0]["contacts"]] == [(0, 2, 0.2), (1, 2, 0.35)] and all(abs(abs(c["direction"][0]) - 1) < 1e-9 for c in d["frames"][0]["contacts"])' --proxy obb
+check_json "sphere proxies" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)]' --proxy sphere
+# 3. The moving cube meets the wall at frames 10 to 14 of 0-24.
+for proxy in mesh obb hull; do
+  check_json "frames ($proxy)" '[f["frame"] for f in d["frames"] if (4, 5) in pairs(f)] == list(range(10, 15)) and len(d["frames"]) == 25 and all(pairs(f)[:2] == [(0, 2), (1, 2)] for f in d["frames"])' --frames 0-24 --proxy "$proxy"
+done
+expect 0 "frame 12 \(time 0.5 s\): 6 nodes, broad phase 4 pairs \(1 joined by the hierarchy, left out\), narrow phase 3 tests, 3 contacts" -- "$bin" collide "$scene" --frames 12
+expect 0 "'A' \(0\) and 'B' \(2\) at .*, depth 0.2" -- "$bin" collide "$scene" --proxy aabb
+
+# 4. Refusals.
+expect 2 "--proxy cube: not mesh or a proxy kind \(mesh, sphere" -- "$bin" collide "$scene" --proxy cube
+expect 2 "--kdop 7: k must be 6, 14, 18 or 26" -- "$bin" collide "$scene" --proxy kdop --kdop 7
+expect 2 "--frames" -- "$bin" collide "$scene" --frames 5-2
+expect 2 "--fps must be a finite number > 0" -- "$bin" collide "$scene" --frames 0-2 --fps 0
+
+echo "collide: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]
