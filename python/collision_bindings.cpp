@@ -106,7 +106,7 @@ py::list proxies(SceneSession& s, const std::string& kind,
   }
   if (kdop != 6 && kdop != 14 && kdop != 18 && kdop != 26)
     throw py::value_error("kdop " + std::to_string(kdop) + ": k must be 6, 14, 18 or 26");
-  if (samples < 0 || samples > 100000000) throw py::value_error("samples must be in [0, 10^8]");
+  if (samples < 0 || samples > 10000000) throw py::value_error("samples must be in [0, 10^7]");
   if (threads < 0 || threads > 1024) throw py::value_error("threads must be in [0, 1024]");
   config.fit.kdop = kdop;
   config.samples = size_t(samples);

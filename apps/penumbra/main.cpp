@@ -97,9 +97,11 @@ void add_proxies_options(CLI::App& proxies, ProxiesArgs& a) {
                    "the output keeps the scene's geometry, proxies translucent over it");
   proxies.add_option("--kdop", a.kdop, "k of --kind kdop: 6, 14, 18 or 26 (default 26)");
   proxies
-      .add_option("--samples", a.samples,
-                  "proxy surface samples measuring the Hausdorff distance (default 20000; 0: not measured)")
-      ->check(CLI::Range(0, 100000000));
+      .add_option(
+          "--samples", a.samples,
+          "proxy surface samples measuring the Hausdorff distance (default 20000; 0: not measured; at "
+          "most 10^7, 96 bytes each charged to --max-memory)")
+      ->check(CLI::Range(0, 10000000));
   proxies.add_option("--threads", a.threads, "worker threads (default: all; does not change results)")
       ->check(CLI::Range(0, 1024));
   proxies.add_flag("--json", a.json, "the report as JSON on stdout");

@@ -26,6 +26,9 @@ namespace {
 /// input and the query structure.
 constexpr uint64_t kBytesPerVertex = 256;
 
+/// Bytes held per surface sample of the Hausdorff distance: the point twice and its match.
+constexpr uint64_t kBytesPerSample = 96;
+
 Json dvec(DVec3 v) {
   return Json::array({v.x, v.y, v.z});
 }
@@ -155,9 +158,10 @@ int run_proxies(const ProxiesArgs& a) {
   for (const Instance& inst : loaded.scene.instances)
     if (inst.mesh >= 0) placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
   const uint64_t scene_bytes = scene_memory_bytes(loaded.scene);
-  if (placed * kBytesPerVertex > budget - std::min(budget, scene_bytes))
-    throw UsageError(a.scene_file + ": fitting proxies to " + human_count(placed) +
-                     " placed vertices needs " + human_count(placed * kBytesPerVertex) +
+  const uint64_t needed = placed * kBytesPerVertex + uint64_t(a.samples) * kBytesPerSample;
+  if (needed > budget - std::min(budget, scene_bytes))
+    throw UsageError(a.scene_file + ": fitting proxies to " + human_count(placed) + " placed vertices with " +
+                     human_count(uint64_t(a.samples)) + " samples needs " + human_count(needed) +
                      "B beside the scene, over the budget (--max-memory)");
 
   set_phase("fitting proxies");

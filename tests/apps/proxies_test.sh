@@ -191,7 +191,9 @@ json.dump({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"
            "bufferViews": [{"buffer": 0, "byteLength": 24 * n}, {"buffer": 0, "byteOffset": 24 * n, "byteLength": 4 * len(idx)}],
            "buffers": [{"byteLength": len(blob), "uri": "big.bin"}]}, open(sys.argv[1], "w"))
 PY
-expect 2 "60.0k placed vertices needs .* over the budget \(--max-memory\)" -- "$bin" proxies "$work/big.gltf" --kind obb --max-memory 12M
+expect 2 "60.0k placed vertices with 20.0k samples needs .* over the budget \(--max-memory\)" -- "$bin" proxies "$work/big.gltf" --kind obb --max-memory 12M
+expect 2 "with 10.00M samples needs .* over the budget" -- "$bin" proxies "$scene" --kind sphere --samples 10000000 --max-memory 100M
+expect 2 "--samples: Value 10000001 not in range" -- "$bin" proxies "$scene" --kind sphere --samples 10000001
 [ ! -e "$work/x.png" ] && passes=$((passes + 1)) || fail "a refused run wrote x.png"
 printf '{"asset": {"version": "2.0"}, "nodes": [{"name": "lonely"}], "scenes": [{"nodes": [0]}]}' >"$work/empty.gltf"
 expect 2 "no node places a mesh" -- "$bin" proxies "$work/empty.gltf" --kind sphere
