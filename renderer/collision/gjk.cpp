@@ -245,6 +245,7 @@ ProxyCores::ProxyCores(const Proxy& proxy) {
     case ProxyKind::Ritter:
       storage.push_back({proxy.sphere.center});
       cores.push_back({storage.back(), proxy.sphere.radius});
+      part.push_back(0);
       return;
     case ProxyKind::Aabb:
     case ProxyKind::Obb: {
@@ -252,15 +253,20 @@ ProxyCores::ProxyCores(const Proxy& proxy) {
       box_corners(proxy.box, c);
       storage.emplace_back(c, c + 8);
       cores.push_back({storage.back(), 0});
+      part.push_back(0);
       return;
     }
     case ProxyKind::Capsule:
       storage.push_back({proxy.capsule.a, proxy.capsule.b});
       cores.push_back({storage.back(), proxy.capsule.radius});
+      part.push_back(0);
       return;
     default:
-      for (const ConvexPolyhedron& part : proxy.parts)
-        if (!part.vertices.empty()) cores.push_back({part.vertices, 0});
+      for (size_t k = 0; k < proxy.parts.size(); ++k)
+        if (!proxy.parts[k].vertices.empty()) {
+          cores.push_back({proxy.parts[k].vertices, 0});
+          part.push_back(k);
+        }
   }
 }
 
@@ -330,7 +336,7 @@ Penetration penetration(const Proxy& a, const Proxy& b) {
         p.depth = A.radius + B.radius - core.distance;
         p.direction = (core.b - core.a) * (1 / core.distance);
       } else {
-        const CoreFeatures fa = features_of(a, i), fb = features_of(b, j);
+        const CoreFeatures fa = features_of(a, ca.part[i]), fb = features_of(b, cb.part[j]);
         std::vector<DVec3> axes = fa.normals;
         axes.insert(axes.end(), fb.normals.begin(), fb.normals.end());
         const double pairs = double(fa.edges.size()) * double(fb.edges.size());

@@ -43,6 +43,7 @@ struct ProxyCores {
   ProxyCores(const ProxyCores&) = delete;
   ProxyCores& operator=(const ProxyCores&) = delete;
   std::vector<ConvexCore> cores;
+  std::vector<size_t> part;  ///< per core: its index in Proxy::parts (0 for the other kinds)
   std::list<std::vector<DVec3>> storage;
 };
 
