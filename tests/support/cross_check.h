@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -29,13 +30,17 @@ struct NamedAccel {
   std::unique_ptr<Accelerator> accel;
 };
 
-/// Every back end over `views`, the BVH in each width and with spatial splits, in
-/// accelerator_names() order ("brute"
-/// keeps references: views must outlive the result).
-inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views,
-                                         const AccelConfig& config = {}) {
+/// Which back ends a check builds besides Embree and brute force (which it always builds):
+/// those `keep` accepts by name; all when it is empty.
+using AccelFilter = std::function<bool(const std::string&)>;
+
+/// Every back end over `views` that `keep` accepts, the BVH in each width and with spatial
+/// splits, in accelerator_names() order ("brute" keeps references: views must outlive the result).
+inline std::vector<NamedAccel> build_all(std::span<const GeometryView> views, const AccelConfig& config = {},
+                                         const AccelFilter& keep = {}) {
   std::vector<NamedAccel> out;
   for (const auto& n : accelerator_names()) {
+    if (keep && n != "embree" && n != "brute" && !keep(n)) continue;
     out.push_back({n, make_accelerator(n, views, config)});
     if (n != "bvh" || config.bvh.width != 0) continue;
     // Every BVH width, not only the CPU's widest that "bvh" builds by default.
@@ -467,8 +472,9 @@ inline Bounds3f bounds_of(std::span<const GeometryView> views) {
 /// Brute force costs rays x triangles, so on big models it answers every k-th ray only
 /// (at most ~2e8 triangle tests); Embree answers all of them.
 inline void check_all(const std::string& scene, std::span<const GeometryView> views,
-                      const std::vector<Ray>& rays, const AccelConfig& config = {}) {
-  const auto all = build_all(views, config);
+                      const std::vector<Ray>& rays, const AccelConfig& config = {},
+                      const AccelFilter& keep = {}) {
+  const auto all = build_all(views, config, keep);
   const Accelerator& brute = find(all, "brute");
   const Accelerator& embree = find(all, "embree");
   const float scale = length(bounds_of(views).extent());
@@ -498,13 +504,14 @@ inline void check_all(const std::string& scene, std::span<const GeometryView> vi
 
 /// The standard ray collection (camera, random, bounces, on-surface, shadow, bad) for a scene.
 inline void check_scene(const std::string& scene, std::span<const GeometryView> views,
-                        std::vector<Vec3f> lights, int scale = 1, std::vector<Ray> extra = {}) {
+                        std::vector<Vec3f> lights, int scale = 1, std::vector<Ray> extra = {},
+                        const AccelFilter& keep = {}) {
   const Bounds3f b = bounds_of(views);
   if (lights.empty()) lights = lights_around(b);
   const auto embree = make_accelerator("embree", views);
   std::vector<Ray> rays = all_rays(*embree, views, b, lights, scale, 20261122u);
   rays.insert(rays.end(), extra.begin(), extra.end());
-  check_all(scene, views, rays);
+  check_all(scene, views, rays, {}, keep);
 }
 
 // ---- Synthetic geometry -------------------------------------------------------------------------
@@ -605,7 +612,7 @@ inline Flattened flatten(std::span<const GeometryView> meshes, std::span<const I
 /// object-space rays meet the same watertight test).
 inline void check_instanced(const std::string& scene, std::span<const GeometryView> meshes,
                             std::span<const InstanceView> instances, std::vector<Vec3f> lights,
-                            uint32_t seed = 7) {
+                            uint32_t seed = 7, const AccelFilter& keep = {}) {
   const Flattened flat = flatten(meshes, instances);
   const Bounds3f b = bounds_of(flat.views);
   if (lights.empty()) lights = lights_around(b);
@@ -616,6 +623,7 @@ inline void check_instanced(const std::string& scene, std::span<const GeometryVi
   const Reference by_brute = reference(*brute, rays);
   const float scale = length(b.extent());
   for (const auto& name : accelerator_names()) {
+    if (keep && name != "embree" && name != "brute" && !keep(name)) continue;
     const auto a = make_accelerator(name, meshes, instances);
     const auto rf = cross_check(*a, by_flat, flat.views, scale, false, 1e-4f);
     INFO(summary(scene + ": " + name + " over instances vs brute over the flattened scene", rf));
