@@ -1,6 +1,7 @@
 // Scene.proxies and Scene.collide: bounding proxies fitted to the scene's nodes with their
-// tightness, and the nodes that touch (renderer/collision/scene_proxies.h, scene_collide.h, what
-// `penumbra proxies` and `penumbra collide` call), as dicts of NumPy arrays.
+// tightness, the nodes that touch, and the first contacts of moving nodes up to a later time
+// (renderer/collision/scene_proxies.h, scene_collide.h, continuous.h: what `penumbra proxies`
+// and `penumbra collide` call), as dicts of NumPy arrays.
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -9,8 +10,10 @@
 #include <variant>
 
 #include "io/files/error.h"
+#include "io/gltf/loader.h"
 #include "python/bindings.h"
 #include "render/scene_query.h"
+#include "renderer/collision/continuous.h"
 #include "renderer/collision/scene_collide.h"
 #include "renderer/collision/scene_proxies.h"
 
@@ -135,9 +138,65 @@ py::list proxies(SceneSession& s, const std::string& kind,
   return out;
 }
 
-py::dict collide(SceneSession& s, const std::string& proxy, bool include_children, int kdop) {
+std::string node_name(const SceneSession& s, int node) {
+  return size_t(node) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(node)] : "";
+}
+
+py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0, double t1) {
+  py::list contacts;
+  for (const SweptContact& c : r.contacts) {
+    py::dict d;
+    d["a"] = c.a;
+    d["b"] = c.b;
+    d["a_name"] = node_name(s, c.a);
+    d["b_name"] = node_name(s, c.b);
+    d["time"] = t0 + c.u * (t1 - t0);
+    d["fraction"] = c.u;
+    d["point"] = vec(c.point);
+    d["normal"] = vec(c.normal);
+    d["converged"] = c.converged;
+    contacts.append(d);
+  }
+  py::dict out;
+  out["contacts"] = contacts;
+  out["to_time"] = t1;
+  out["nodes"] = r.nodes;
+  out["moving_nodes"] = r.moving_nodes;
+  out["nonrigid_nodes"] = r.nonrigid_nodes;
+  out["broad_pairs"] = r.broad_pairs;
+  out["family_pairs"] = r.family_pairs;
+  out["narrow_tests"] = r.narrow_tests;
+  out["advancement_steps"] = r.steps;
+  return out;
+}
+
+// The first contacts between the session's pose and its animation posed at `until`.
+py::dict continuous(SceneSession& s, const CollideConfig& config, double until) {
+  if (config.mesh)
+    throw py::value_error("until: continuous detection advances proxies, not meshes: pass proxy=KIND");
+  if (!std::isfinite(until)) throw py::value_error("until must be a finite number of seconds");
+  if (!s.loaded.animation)
+    throw py::value_error("until: the scene must be loaded with time= and keep_animation=True");
+  ContinuousReport r;
+  {
+    py::gil_scoped_release release;
+    Scene end = s.loaded.scene;
+    if (!pose_gltf_scene(*s.loaded.animation, until, end))
+      throw py::value_error("until: the animation changes more than placements at that time");
+    try {
+      r = collide_continuous(s.loaded.scene, end, s.loaded.info.node_parents, config);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(s.file, "", e.what());
+    }
+  }
+  return swept_dict(r, s, s.time, until);
+}
+
+py::dict collide(SceneSession& s, const std::string& proxy, bool include_children, int kdop,
+                 std::optional<double> until, bool volumes) {
   CollideConfig config;
   config.include_children = include_children;
+  config.volumes = volumes;
   if (proxy != "mesh") {
     config.mesh = false;
     if (!parse_proxy_kind(proxy, config.kind))
@@ -147,6 +206,8 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
     throw py::value_error("kdop " + std::to_string(kdop) + ": k must be 6, 14, 18 or 26");
   config.fit.kdop = kdop;
   SessionLock lock(s);
+  std::optional<py::dict> swept;
+  if (until) swept = continuous(s, config, *until);
   CollideReport r;
   {
     py::gil_scoped_release release;
@@ -161,12 +222,15 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
     py::dict d;
     d["a"] = c.a;
     d["b"] = c.b;
-    d["a_name"] = size_t(c.a) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(c.a)] : "";
-    d["b_name"] = size_t(c.b) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(c.b)] : "";
+    d["a_name"] = node_name(s, c.a);
+    d["b_name"] = node_name(s, c.b);
     d["point"] = vec(c.point);
     d["depth"] = finite_or_none(c.depth);
     d["direction"] = std::isfinite(c.depth) ? py::object(vec(c.direction)) : py::object(py::none());
     d["triangle_pairs"] = c.triangle_pairs;
+    d["volume"] = volumes ? py::object(py::float_(c.volume.volume)) : py::object(py::none());
+    d["volume_error"] = volumes ? py::object(py::float_(c.volume.error)) : py::object(py::none());
+    d["volume_exact"] = volumes ? py::object(py::bool_(c.volume.exact)) : py::object(py::none());
     contacts.append(d);
   }
   py::dict out;
@@ -176,6 +240,7 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
   out["family_pairs"] = r.family_pairs;
   out["narrow_tests"] = r.narrow_tests;
   out["triangle_tests"] = r.triangle_tests;
+  out["continuous"] = swept ? py::object(*swept) : py::object(py::none());
   return out;
 }
 
@@ -184,12 +249,20 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
 void bind_collision(SceneClass& scene) {
   scene.def(
       "collide", &collide, py::kw_only(), py::arg("proxy") = "mesh", py::arg("include_children") = false,
-      py::arg("kdop") = 26,
+      py::arg("kdop") = 26, py::arg("until") = py::none(), py::arg("volumes") = false,
       "The nodes that touch or interpenetrate at the scene's pose, as `penumbra collide` finds them: a "
       "sweep and prune over the nodes' boxes, pairs the hierarchy joins left out unless include_children, "
       "and an exact test on the triangles (proxy='mesh') or on fitted proxies (a proxy kind, which also "
       "gives depth and direction). Returns a dict: contacts (a list of dicts: a, b, a_name, b_name, point, "
-      "depth, direction, triangle_pairs), nodes, broad_pairs, family_pairs, narrow_tests, triangle_tests.");
+      "depth, direction, triangle_pairs, and with volumes=True volume, volume_error, volume_exact: the "
+      "volume the pair shares as `collide --volumes` measures it), nodes, broad_pairs, family_pairs, "
+      "narrow_tests, triangle_tests, and continuous. With until (seconds; a proxy kind; the scene loaded "
+      "with time= and "
+      "keep_animation=True), continuous holds the first contacts of nodes that move rigidly from the "
+      "scene's pose to its animation at until, as `penumbra collide --continuous` finds them between two "
+      "frames (the scene itself is not moved): a dict of contacts (a, b, a_name, b_name, time, fraction, "
+      "point, normal, converged), to_time, nodes, moving_nodes, nonrigid_nodes, broad_pairs, family_pairs, "
+      "narrow_tests, advancement_steps; else None.");
   scene.def(
       "proxies", &proxies, py::arg("kind"), py::arg("node") = py::none(), py::kw_only(), py::arg("kdop") = 26,
       py::arg("samples") = 20000, py::arg("threads") = 0,

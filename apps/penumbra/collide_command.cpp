@@ -9,6 +9,7 @@
 #include "apps/penumbra/scene_setup.h"
 #include "io/farm/frame_outputs.h"
 #include "io/files/error.h"
+#include "renderer/collision/continuous.h"
 #include "renderer/collision/scene_collide.h"
 
 namespace penumbra::cli {
@@ -19,6 +20,10 @@ using Json = nlohmann::ordered_json;
 
 /// Bytes held per placed vertex while testing: double copies, trees or proxies.
 constexpr uint64_t kBytesPerVertex = 256;
+/// --volumes on meshes: bytes per placed triangle of the solids (BSP nodes and fragments, BVH).
+constexpr uint64_t kSolidBytesPerTriangle = 512;
+/// --volumes: bytes per cell of the quadrature (two levels held at a time).
+constexpr uint64_t kBytesPerCell = 50;
 
 Json dvec(DVec3 v) {
   return Json::array({v.x, v.y, v.z});
@@ -28,7 +33,8 @@ std::string node_name(const GltfInfo& info, int node) {
   return size_t(node) < info.node_names.size() ? info.node_names[size_t(node)] : std::string();
 }
 
-Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time) {
+Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time,
+                bool volumes) {
   Json j;
   j["frame"] = frame ? Json(*frame) : Json();
   j["time"] = frame ? Json(time) : Json();  // null: the file's static pose
@@ -48,13 +54,19 @@ Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int6
     e["depth"] = std::isfinite(c.depth) ? Json(c.depth) : Json();
     e["direction"] = std::isfinite(c.depth) ? dvec(c.direction) : Json();
     e["triangle_pairs"] = c.triangle_pairs;
+    if (volumes) {
+      e["volume"] = c.volume.volume;
+      e["volume_error"] = c.volume.error;
+      e["volume_exact"] = c.volume.exact;
+    }
     list.push_back(e);
   }
   j["contacts"] = list;
   return j;
 }
 
-void print_frame(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time) {
+void print_frame(const CollideReport& r, const GltfInfo& info, std::optional<int64_t> frame, double time,
+                 bool volumes) {
   if (frame) std::printf("frame %lld (time %.6g s): ", (long long)*frame, time);
   std::printf(
       "%llu nodes, broad phase %llu pairs (%llu joined by the hierarchy, left out), narrow phase %llu "
@@ -65,10 +77,69 @@ void print_frame(const CollideReport& r, const GltfInfo& info, std::optional<int
     std::printf("  '%s' (%d) and '%s' (%d) at (%.6g, %.6g, %.6g)", node_name(info, c.a).c_str(), c.a,
                 node_name(info, c.b).c_str(), c.b, c.point.x, c.point.y, c.point.z);
     if (std::isfinite(c.depth))
-      std::printf(", depth %.6g\n", c.depth);
+      std::printf(", depth %.6g", c.depth);
     else
-      std::printf(", %llu triangle pairs\n", (unsigned long long)c.triangle_pairs);
+      std::printf(", %llu triangle pairs", (unsigned long long)c.triangle_pairs);
+    if (volumes && c.volume.exact)
+      std::printf(", volume %.6g (exact)", c.volume.volume);
+    else if (volumes)
+      std::printf(", volume %.6g +- %.2g", c.volume.volume, c.volume.error);
+    std::printf("\n");
   }
+}
+
+Json node_list(const std::vector<int>& nodes, const GltfInfo& info) {
+  Json list = Json::array();
+  for (int n : nodes) list.push_back(Json{{"node", n}, {"name", node_name(info, n)}});
+  return list;
+}
+
+// The first contacts between frame `from` (time t0) and the next sampled frame `to` (time t1).
+Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1) {
+  Json j;
+  j["to_frame"] = to;
+  j["to_time"] = t1;
+  j["nodes"] = r.nodes;
+  j["moving_nodes"] = r.moving_nodes;
+  j["nonrigid_nodes"] = node_list(r.nonrigid_nodes, info);
+  j["broad_pairs"] = r.broad_pairs;
+  j["family_pairs"] = r.family_pairs;
+  j["narrow_tests"] = r.narrow_tests;
+  j["advancement_steps"] = r.steps;
+  Json list = Json::array();
+  for (const SweptContact& c : r.contacts) {
+    Json e;
+    e["a"] = c.a;
+    e["a_name"] = node_name(info, c.a);
+    e["b"] = c.b;
+    e["b_name"] = node_name(info, c.b);
+    e["time"] = t0 + c.u * (t1 - t0);
+    e["fraction"] = c.u;
+    e["point"] = dvec(c.point);
+    e["normal"] = dvec(c.normal);
+    e["converged"] = c.converged;
+    list.push_back(e);
+  }
+  j["contacts"] = list;
+  return j;
+}
+
+void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1) {
+  std::printf(
+      "  swept to frame %lld: %llu nodes (%llu moving, %zu not rigid, left out), broad phase %llu pairs "
+      "(%llu "
+      "joined by the hierarchy, left out), %llu advanced in %llu steps, %zu first contact%s\n",
+      (long long)to, (unsigned long long)r.nodes, (unsigned long long)r.moving_nodes, r.nonrigid_nodes.size(),
+      (unsigned long long)r.broad_pairs, (unsigned long long)r.family_pairs,
+      (unsigned long long)r.narrow_tests, (unsigned long long)r.steps, r.contacts.size(),
+      r.contacts.size() == 1 ? "" : "s");
+  for (int n : r.nonrigid_nodes)
+    std::printf("    '%s' (%d) does not move rigidly\n", node_name(info, n).c_str(), n);
+  for (const SweptContact& c : r.contacts)
+    std::printf(
+        "    '%s' (%d) and '%s' (%d) first touch at time %.9g s (%.6g of the way) at (%.6g, %.6g, %.6g)%s\n",
+        node_name(info, c.a).c_str(), c.a, node_name(info, c.b).c_str(), c.b, t0 + c.u * (t1 - t0), c.u,
+        c.point.x, c.point.y, c.point.z, c.converged ? "" : " or later (the step limit ran out)");
 }
 
 }  // namespace
@@ -87,6 +158,7 @@ int run_collide(const CollideArgs& a) {
   if (a.kdop != 6 && a.kdop != 14 && a.kdop != 18 && a.kdop != 26)
     throw UsageError("--kdop " + std::to_string(a.kdop) + ": k must be 6, 14, 18 or 26");
   config.fit.kdop = a.kdop;
+  config.volumes = a.volumes;
   if (!(std::isfinite(a.fps) && a.fps > 0)) throw UsageError("--fps must be a finite number > 0");
   std::optional<FrameRange> range;
   if (a.frames) {
@@ -96,20 +168,35 @@ int run_collide(const CollideArgs& a) {
       throw UsageError(e.what());
     }
   }
+  if (a.continuous) {
+    if (config.mesh)
+      throw UsageError(
+          "--continuous advances convex proxies, not meshes: add --proxy KIND (e.g. hull, obb, "
+          "sphere, composite)");
+    if (!range || range->last - range->first < range->step)
+      throw UsageError("--continuous needs --frames with two frames or more (A-B or A-B:STEP)");
+  }
   const uint64_t budget = memory_budget(a.max_memory);
   std::optional<double> first_time;
   if (range) first_time = double(range->first) / a.fps;
   set_phase("loading the scene");
   LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, a.quiet, first_time,
                                   range.has_value());
-  uint64_t placed = 0;
+  uint64_t placed = 0, triangles = 0;
   for (const Instance& inst : loaded.scene.instances)
-    if (inst.mesh >= 0) placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
-  const uint64_t scene_bytes = scene_memory_bytes(loaded.scene);
-  if (placed * kBytesPerVertex > budget - std::min(budget, scene_bytes))
+    if (inst.mesh >= 0) {
+      placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
+      triangles += loaded.scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+    }
+  // --continuous holds the previous frame's pose as well.
+  const uint64_t scene_bytes = scene_memory_bytes(loaded.scene) * (a.continuous ? 2 : 1);
+  uint64_t testing = placed * kBytesPerVertex;
+  if (a.volumes)
+    testing +=
+        config.volume.max_cells * kBytesPerCell + (config.mesh ? triangles * kSolidBytesPerTriangle : 0);
+  if (testing > budget - std::min(budget, scene_bytes))
     throw UsageError(a.scene_file + ": testing " + human_count(placed) + " placed vertices needs " +
-                     human_count(placed * kBytesPerVertex) +
-                     "B beside the scene, over the budget (--max-memory)");
+                     human_count(testing) + "B beside the scene, over the budget (--max-memory)");
 
   Json frames = Json::array();
   auto run_frame = [&](std::optional<int64_t> frame, double time) {
@@ -121,22 +208,39 @@ int run_collide(const CollideArgs& a) {
       throw InputError(a.scene_file, "", e.what());
     }
     if (a.json)
-      frames.push_back(frame_json(report, loaded.info, frame, time));
+      frames.push_back(frame_json(report, loaded.info, frame, time, a.volumes));
     else
-      print_frame(report, loaded.info, frame, time);
+      print_frame(report, loaded.info, frame, time, a.volumes);
   };
   if (!range) {
     run_frame(std::nullopt, 0);
   } else {
+    std::optional<Scene> previous;  // --continuous: the last frame's pose
     for (int64_t f = range->first; f <= range->last; f += range->step) {
       const double t = double(f) / a.fps;
+      if (a.continuous && f != range->first) previous = loaded.scene;
       if (f != range->first && loaded.info.animation_count != 0) {
         set_phase("posing the scene");
         if (!loaded.animation || !pose_gltf_scene(*loaded.animation, t, loaded.scene))
           loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, true, t, true);
       }
+      if (previous) {
+        set_phase("advancing moving nodes");
+        const double t0 = double(f - range->step) / a.fps;
+        ContinuousReport swept;
+        try {
+          swept = collide_continuous(*previous, loaded.scene, loaded.info.node_parents, config);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(a.scene_file, "", e.what());
+        }
+        if (a.json)
+          frames.back()["continuous"] = swept_json(swept, loaded.info, f, t0, t);
+        else
+          print_swept(swept, loaded.info, f, t0, t);
+      }
       run_frame(f, t);
     }
+    if (a.continuous && a.json) frames.back()["continuous"] = nullptr;  // no next frame
   }
   if (a.json) {
     Json doc;
@@ -144,6 +248,8 @@ int run_collide(const CollideArgs& a) {
     doc["proxy"] = a.proxy;
     if (config.kind == ProxyKind::Kdop && !config.mesh) doc["k"] = a.kdop;
     doc["include_children"] = a.include_children;
+    doc["volumes"] = a.volumes;
+    doc["continuous"] = a.continuous;
     doc["frames"] = frames;
     std::printf("%s\n", doc.dump(2).c_str());
   }

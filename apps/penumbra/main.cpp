@@ -127,6 +127,14 @@ void add_collide_options(CLI::App& collide, CollideArgs& a) {
   collide.add_option("--fps", a.fps, "frames per second of --frames (default 24)");
   collide.add_flag("--include-children", a.include_children,
                    "also test pairs where one node lies below the other in the hierarchy");
+  collide.add_flag(
+      "--volumes", a.volumes,
+      "also the volume each contact's pair shares: exact for polyhedral proxies and two spheres, "
+      "else (meshes, which must be closed; capsules) with a stated error bound");
+  collide.add_flag(
+      "--continuous", a.continuous,
+      "also the first contact between each frame and the next of nodes that move rigidly (conservative "
+      "advancement on the --proxy kind; needs --frames with two frames or more)");
   collide.add_flag("--json", a.json, "the report as JSON on stdout");
   collide.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
   collide.add_option("--max-memory", a.max_memory,

@@ -83,6 +83,8 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
   std::vector<uint8_t> have_tree(nodes.size(), 0);
   std::vector<Proxy> proxies(nodes.size());
   std::vector<uint8_t> have_proxy(nodes.size(), 0);
+  std::vector<SolidMesh> solids(nodes.size());
+  std::vector<uint8_t> have_solid(nodes.size(), 0);
   for (const auto& [i, j] : candidates) {
     const NodeGeometry& ga = nodes[i];
     const NodeGeometry& gb = nodes[j];
@@ -113,6 +115,18 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
       };
       contact.point = triangle_contact_point(corner(ma, s, 0), corner(ma, s, 1), corner(ma, s, 2),
                                              corner(mb, t, 0), corner(mb, t, 1), corner(mb, t, 2));
+      if (config.volumes) {
+        for (uint32_t k : {fi, si})
+          if (!have_solid[k]) {
+            try {
+              solids[k] = build_solid_mesh(nodes[k].positions, nodes[k].triangles, config.solid);
+            } catch (const std::invalid_argument& e) {
+              throw std::invalid_argument("node " + std::to_string(nodes[k].node) + ": " + e.what());
+            }
+            have_solid[k] = 1;
+          }
+        contact.volume = mesh_intersection_volume(solids[fi], solids[si], config.volume);
+      }
     } else {
       for (uint32_t k : {fi, si})
         if (!have_proxy[k]) {
@@ -128,6 +142,7 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
       contact.depth = p.depth;
       contact.direction = p.direction;
       contact.point = proxy_contact_point(proxies[si], p);
+      if (config.volumes) contact.volume = proxy_intersection_volume(proxies[fi], proxies[si], config.volume);
     }
     report.contacts.push_back(contact);
   }

@@ -2,7 +2,8 @@
 // world-space geometry of each node that places a mesh, a broad phase by sweep and prune over
 // their boxes (Cohen, Lin, Manocha & Ponamgi, "I-COLLIDE", I3D 1995), pairs that the node
 // hierarchy joins (one node below the other) left out unless asked, and a narrow phase on the
-// triangles (mesh_contact: exact) or on fitted proxies (gjk: distance and penetration depth).
+// triangles (mesh_contact: exact) or on fitted proxies (gjk: distance and penetration depth),
+// and optionally the volume of each interpenetration (shared_volume.h).
 #pragma once
 
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "renderer/collision/proxy.h"
+#include "renderer/collision/shared_volume.h"
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
@@ -21,6 +23,11 @@ struct CollideConfig {
   ProxyKind kind = ProxyKind::Hull;  ///< the proxies' kind when !mesh
   ProxyConfig fit;                   ///< their fitting
   bool include_children = false;     ///< also test pairs where one node lies below the other
+  bool volumes = false;              ///< measure each contact's interpenetration volume
+  VolumeConfig volume;               ///< how (meshes, and proxies without a closed form)
+  /// Meshes' solids for volumes (each node's mesh must be closed); the partition's quadratic
+  /// time on convex parts is capped at 10^9 polygon tests.
+  SolidBspConfig solid{.max_classifications = 1000000000};
 };
 
 /// Two nodes that touch or interpenetrate.
@@ -30,6 +37,7 @@ struct NodeContact {
   DVec3 direction{};            ///< proxies: unit, moving b by depth along it separates them
   DVec3 point{};                ///< a point where they meet
   uint64_t triangle_pairs = 0;  ///< meshes: the pairs of triangles that meet
+  VolumeEstimate volume;        ///< with CollideConfig::volumes: the volume they share
 };
 
 /// What collide_scene found, with the work of each phase.
@@ -47,7 +55,9 @@ struct CollideReport {
 std::vector<std::pair<uint32_t, uint32_t>> sweep_and_prune(std::span<const Bounds3f> boxes);
 
 /// Every pair of nodes whose geometry touches or interpenetrates at the scene's pose. Throws
-/// std::invalid_argument naming the node if its geometry cannot be fitted (proxies).
+/// std::invalid_argument naming the node if its geometry cannot be fitted (proxies) or, for
+/// volumes on meshes, is not a closed mesh (build_solid_mesh's checks) or needs more than the
+/// solid's budget.
 CollideReport collide_scene(const Scene& scene, std::span<const int> parents, const CollideConfig& config);
 
 }  // namespace penumbra

@@ -7,7 +7,14 @@
 # - with --proxy obb (a cube's OBB is the cube) the penetration depths are 0.2 and 0.35;
 # - over --frames 0-24 at 24 fps the moving cube meets the wall at exactly the frames where
 #   their x extents overlap (10 to 14), with meshes and with proxies;
-# - bad input exits 2 naming the option: an unknown proxy kind, a bad k, a bad range or fps.
+# - --volumes: A and B share 0.2 x 1 x 1, the child and B 0.35 x 0.5 x 0.5: exactly on boxes,
+#   within the stated bound on the meshes;
+# - with --continuous over frames 0 and 24 (both miss the wall), the mover's first contact with
+#   the wall is at the analytic time: its face reaches x = -0.05 at t = 2.45 / 6 s (boxes); the
+#   bounding spheres (radii sqrt(3) / 2 and sqrt(2.0025)) meet earlier; the still nodes are not
+#   advanced; the text report names it;
+# - bad input exits 2 naming the option: an unknown proxy kind, a bad k, a bad range or fps,
+#   --continuous on meshes or on one frame.
 # Usage: collide_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -72,6 +79,11 @@ check_json "broad phase counts" 'd["frames"][0]["nodes"] == 6 and d["frames"][0]
 # 2. Oriented boxes of cubes are the cubes: exact penetration depths.
 check_json "OBB depths" '[(c["a"], c["b"], round(c["depth"], 6)) for c in d["frames"][0]["contacts"]] == [(0, 2, 0.2), (1, 2, 0.35)] and all(abs(abs(c["direction"][0]) - 1) < 1e-9 for c in d["frames"][0]["contacts"])' --proxy obb
 check_json "sphere proxies" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)]' --proxy sphere
+# Shared volumes.
+check_json "volumes (obb)" '[(c["a"], c["b"], round(c["volume"], 6), c["volume_exact"]) for c in d["frames"][0]["contacts"]] == [(0, 2, 0.2, True), (1, 2, 0.0875, True)] and d["volumes"]' --proxy obb --volumes
+check_json "volumes (meshes)" '[(c["a"], c["b"]) for c in d["frames"][0]["contacts"]] == [(0, 2), (1, 2)] and all(abs(c["volume"] - v) <= c["volume_error"] and c["volume_error"] < 0.1 * v and not c["volume_exact"] for c, v in zip(d["frames"][0]["contacts"], (0.2, 0.0875)))' --volumes
+expect 0 "'A' \\(0\\) and 'B' \\(2\\) at .*, depth 0.2, volume 0.2 \\(exact\\)" -- "$bin" collide "$scene" --proxy aabb --volumes
+
 # 3. The moving cube meets the wall at frames 10 to 14 of 0-24.
 for proxy in mesh obb hull; do
   check_json "frames ($proxy)" '[f["frame"] for f in d["frames"] if (4, 5) in pairs(f)] == list(range(10, 15)) and len(d["frames"]) == 25 and all(pairs(f)[:2] == [(0, 2), (1, 2)] for f in d["frames"])' --frames 0-24 --proxy "$proxy"
@@ -79,11 +91,21 @@ done
 expect 0 "frame 12 \(time 0.5 s\): 6 nodes, broad phase 4 pairs \(1 joined by the hierarchy, left out\), narrow phase 3 tests, 3 contacts" -- "$bin" collide "$scene" --frames 12
 expect 0 "'A' \(0\) and 'B' \(2\) at .*, depth 0.2" -- "$bin" collide "$scene" --proxy aabb
 
-# 4. Refusals.
+# 4. Continuous detection between two frames that both miss the wall.
+swept='d["frames"][0]["continuous"]'
+check_json "continuous (obb)" "pairs($swept) == [(4, 5)] and abs($swept[\"contacts\"][0][\"time\"] - 2.45 / 6) < 1e-4 and pairs(d[\"frames\"][0]) == pairs(d[\"frames\"][1]) == [(0, 2), (1, 2)] and $swept[\"moving_nodes\"] == 1 and $swept[\"narrow_tests\"] == 1 and $swept[\"to_frame\"] == 24 and d[\"frames\"][1][\"continuous\"] is None and $swept[\"contacts\"][0][\"converged\"]" --frames 0-24:24 --proxy obb --continuous
+check_json "continuous (sphere)" "pairs($swept) == [(4, 5)] and abs($swept[\"contacts\"][0][\"time\"] - (3 - 3 ** 0.5 / 2 - 2.0025 ** 0.5) / 6) < 1e-4 and abs($swept[\"contacts\"][0][\"normal\"][0] + 1) < 1e-6" --frames 0-24:24 --proxy sphere --continuous
+check_json "continuous over every frame" "[f[\"frame\"] for f in d[\"frames\"] if f[\"continuous\"] and pairs(f[\"continuous\"]) == [(4, 5)]] == list(range(9, 15))" --frames 0-24 --proxy hull --continuous
+expect 0 "swept to frame 24: 6 nodes \\(1 moving, 0 not rigid, left out\\), broad phase 1 pairs" -- "$bin" collide "$scene" --frames 0-24:24 --proxy aabb --continuous
+expect 0 "'wall' \\(4\\) and 'mover' \\(5\\) first touch at time 0.40833" -- "$bin" collide "$scene" --frames 0-24:24 --proxy aabb --continuous
+
+# 5. Refusals.
 expect 2 "--proxy cube: not mesh or a proxy kind \(mesh, sphere" -- "$bin" collide "$scene" --proxy cube
 expect 2 "--kdop 7: k must be 6, 14, 18 or 26" -- "$bin" collide "$scene" --proxy kdop --kdop 7
 expect 2 "--frames" -- "$bin" collide "$scene" --frames 5-2
 expect 2 "--fps must be a finite number > 0" -- "$bin" collide "$scene" --frames 0-2 --fps 0
+expect 2 "--continuous advances convex proxies, not meshes: add --proxy KIND" -- "$bin" collide "$scene" --frames 0-2 --continuous
+expect 2 "--continuous needs --frames with two frames or more" -- "$bin" collide "$scene" --proxy obb --frames 3 --continuous
 
 echo "collide: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

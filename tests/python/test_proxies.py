@@ -3,7 +3,9 @@
 # than Ritter's, the OBB no larger than the AABB, the 6-DOP is the AABB (of a node that is not
 # flat) and the hull's volume is Qhull's; a subtree's proxy holds its nodes; the answers equal `penumbra proxies --json`'s; and
 # bad kinds, nodes and parameters raise ValueError.
+import base64
 import json
+import struct
 import subprocess
 
 import numpy as np
@@ -126,3 +128,71 @@ def test_collide_equals_the_command(default_scene, cli):
                 assert c["depth"] >= 0 and abs(np.linalg.norm(c["direction"]) - 1) < 1e-9
     with pytest.raises(ValueError, match="not mesh or a proxy kind"):
         default_scene.collide(proxy="cube")
+
+
+def test_volumes_equal_the_command(default_scene, cli):
+    """Scene.collide(volumes=True) measures what `penumbra collide --volumes` does; without it the
+    volumes are None."""
+    r = default_scene.collide(proxy="obb", volumes=True)
+    doc = json.loads(subprocess.run([cli, "collide", str(SCENES / "default.gltf"), "--proxy", "obb", "--volumes", "--json",
+                                     "-q"], check=True, capture_output=True, text=True).stdout)
+    theirs = doc["frames"][0]["contacts"]
+    assert len(r["contacts"]) == len(theirs)
+    for mine, other in zip(r["contacts"], theirs):
+        assert mine["volume"] == other["volume"] and mine["volume_exact"] and mine["volume_error"] == 0
+        assert mine["volume"] >= 0
+    assert all(c["volume"] is None for c in default_scene.collide(proxy="obb")["contacts"])
+
+
+def write_tunnel_scene(path):
+    """A wall 0.1 thick at x = 0 and a unit cube animated from x = -3 to x = 3 over one second
+    while turning a quarter about x."""
+    v = [(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
+    f = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    idx = [i for q in f for i in (q[0], q[1], q[2], q[0], q[2], q[3])]
+    s = 0.5 ** 0.5
+    blob = (b"".join(struct.pack("<3f", *p) for p in v) + struct.pack(f"<{len(idx)}I", *idx) +
+            struct.pack("<2f", 0, 1) + struct.pack("<6f", -3, 0, 0, 3, 0, 0) + struct.pack("<8f", 0, 0, 0, 1, s, 0, 0, s))
+    views = [(0, 96), (96, 144), (240, 8), (248, 24), (272, 32)]
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [-0.5] * 3, "max": [0.5] * 3},
+                 {"bufferView": 1, "componentType": 5125, "count": 36, "type": "SCALAR"},
+                 {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+                 {"bufferView": 4, "componentType": 5126, "count": 2, "type": "VEC4"}]
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+           "nodes": [{"name": "wall", "mesh": 0, "scale": [0.1, 4, 4]}, {"name": "mover", "mesh": 0, "translation": [-3, 0, 0]}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+           "animations": [{"samplers": [{"input": 2, "output": 3}, {"input": 2, "output": 4}],
+                           "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}},
+                                        {"sampler": 1, "target": {"node": 1, "path": "rotation"}}]}],
+           "accessors": accessors,
+           "bufferViews": [{"buffer": 0, "byteOffset": o, "byteLength": n} for o, n in views],
+           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]}
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_continuous_equals_the_command(cli, tmp_path):
+    """Scene.collide(until=) on a cube that turns as it passes through a wall equals `penumbra
+    collide --continuous` between the same two frames, finds the analytic time (the cube's x
+    extent does not change as it turns about x: it touches at t = 2.45 / 6), and leaves the
+    scene at its pose."""
+    path = write_tunnel_scene(tmp_path / "tunnel.gltf")
+    scene = penumbra.load(path, time=0.0, keep_animation=True, quiet=True)
+    r = scene.collide(proxy="hull", until=1.0)["continuous"]
+    doc = json.loads(subprocess.run([cli, "collide", str(path), "--frames", "0-24:24", "--proxy", "hull", "--continuous",
+                                     "--json", "-q"], check=True, capture_output=True, text=True).stdout)
+    swept = doc["frames"][0]["continuous"]
+    assert swept["to_time"] == r["to_time"] == 1.0
+    assert r["moving_nodes"] == swept["moving_nodes"] == 1
+    for key in ("nodes", "broad_pairs", "family_pairs", "narrow_tests", "advancement_steps"):
+        assert r[key] == swept[key]
+    assert [(c["a"], c["b"]) for c in r["contacts"]] == [(c["a"], c["b"]) for c in swept["contacts"]] == [(0, 1)]
+    assert abs(r["contacts"][0]["time"] - swept["contacts"][0]["time"]) < 1e-12
+    assert abs(r["contacts"][0]["time"] - 2.45 / 6) < 1e-4
+    assert scene.collide(proxy="hull")["contacts"] == []  # still at time 0
+    assert scene.collide(proxy="hull")["continuous"] is None
+    with pytest.raises(ValueError, match="not meshes"):
+        scene.collide(until=1.0)
+    with pytest.raises(ValueError, match="keep_animation"):
+        penumbra.load(path, quiet=True).collide(proxy="obb", until=1.0)

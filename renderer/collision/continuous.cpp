@@ -1,0 +1,267 @@
+// Continuous collision detection by conservative advancement.
+#include "renderer/collision/continuous.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "renderer/collision/scene_proxies.h"
+#include "renderer/core/quaternion.h"
+
+namespace penumbra {
+
+namespace {
+
+double length(DVec3 v) {
+  return std::sqrt(dot(v, v));
+}
+
+// The rotation matrix of the fraction u of m's turn.
+Transform turn_at(const RigidMotion& m, double u) {
+  return rotate(slerp(Quat{}, m.rotation, u));
+}
+
+DVec3 apply3(const Transform& r, DVec3 v) {
+  const auto& a = r.m;
+  return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
+          a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
+}
+
+// The largest distance of the cores' points from `center`, and the largest core radius.
+void reach(const MovingCores& c, DVec3 center, double& points, double& radius) {
+  points = 0, radius = 0;
+  for (size_t i = 0; i < c.rest.size(); ++i) {
+    for (const DVec3& p : c.rest[i]) points = std::max(points, length(p - center));
+    radius = std::max(radius, c.cores[i].radius);
+  }
+}
+
+}  // namespace
+
+RigidMotion make_rigid_motion(DVec3 center0, DVec3 center1, const Quat& rotation) {
+  RigidMotion m;
+  m.center0 = center0;
+  m.center1 = center1;
+  Quat q = normalize(rotation);
+  if (q.w < 0) q = {-q.x, -q.y, -q.z, -q.w};
+  m.rotation = q;
+  m.angle = 2 * std::atan2(std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z), q.w);
+  return m;
+}
+
+DVec3 move_point(const RigidMotion& m, DVec3 p, double u) {
+  return m.center0 + (m.center1 - m.center0) * u + apply3(turn_at(m, u), p - m.center0);
+}
+
+MovingCores::MovingCores(const ProxyCores& from) {
+  for (const ConvexCore& c : from.cores) {
+    rest.emplace_back(c.points.begin(), c.points.end());
+    posed.push_back(rest.back());
+  }
+  for (size_t i = 0; i < posed.size(); ++i) cores.push_back({posed[i], from.cores[i].radius});
+}
+
+void MovingCores::pose(const RigidMotion& motion, double u) {
+  const Transform r = turn_at(motion, u);
+  const DVec3 c = motion.center0 + (motion.center1 - motion.center0) * u;
+  for (size_t i = 0; i < rest.size(); ++i)
+    for (size_t k = 0; k < rest[i].size(); ++k) posed[i][k] = c + apply3(r, rest[i][k] - motion.center0);
+}
+
+FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b, const RigidMotion& mb,
+                           const AdvancementConfig& config) {
+  double rho_a, rad_a, rho_b, rad_b;
+  reach(a, ma.center0, rho_a, rad_a);
+  reach(b, mb.center0, rho_b, rad_b);
+  // Velocities per unit u: b's approach to a along n is dot(va - vb, n) from the centres plus
+  // at most angle x rho from each turn (a chord is no longer than its arc).
+  const DVec3 va = ma.center1 - ma.center0, vb = mb.center1 - mb.center0;
+  const double spin = ma.angle * rho_a + mb.angle * rho_b;
+  const double size = rho_a + rad_a + rho_b + rad_b + length(va - vb);
+  const double touch = config.tolerance * std::max(size, 1e-300);
+  FirstContact out;
+  double u = 0;
+  DVec3 normal{0, 0, 0};
+  for (int step = 0; step < config.max_steps; ++step) {
+    out.steps = step + 1;
+    a.pose(ma, u);
+    b.pose(mb, u);
+    double advance = INFINITY, nearest = INFINITY;
+    DVec3 nearest_normal{0, 0, 0};
+    for (const ConvexCore& ca : a.cores)
+      for (const ConvexCore& cb : b.cores) {
+        const ConvexDistance d = gjk_distance(ca, cb);
+        if (d.intersect || d.distance <= touch) {
+          out.hit = true;
+          out.u = u;
+          out.point = (d.a + d.b) * 0.5;
+          out.normal = normal;
+          return out;
+        }
+        const DVec3 gap = d.b - d.a;
+        const double g = length(gap);
+        const DVec3 n = g > 0 ? gap * (1 / g) : DVec3{0, 0, 0};
+        const double mu = dot(va - vb, n) + spin;
+        if (mu > 0) advance = std::min(advance, d.distance / mu);
+        if (d.distance < nearest) nearest = d.distance, nearest_normal = n;
+      }
+    normal = nearest_normal;
+    if (!std::isfinite(advance)) return out;  // nothing approaches
+    // Touching exactly at the interval's end is a contact; beyond it (to rounding) there is none.
+    const double next = u + advance;
+    if (u >= 1 || next > 1 + 1e-12) {
+      out.u = 1;
+      return out;
+    }
+    u = std::min(next, 1.0);
+  }
+  out.hit = true;
+  out.converged = false;
+  out.u = u;
+  out.normal = normal;
+  return out;
+}
+
+namespace {
+
+const Instance* first_instance(const Scene& scene, int node) {
+  for (const Instance& inst : scene.instances) {
+    if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size()) continue;
+    if ((inst.node >= 0 ? inst.node : scene.meshes[size_t(inst.mesh)].node) == node) return &inst;
+  }
+  return nullptr;
+}
+
+// The rigid motion that carries a node's start points p0 to its end points p1, from the map
+// between its first instance's placements, checked on every point; false when the map is not
+// a rotation and a translation or some point does not follow it.
+bool rigid_motion_of(const Scene& start, const Scene& end, const NodeGeometry& g0, const NodeGeometry& g1,
+                     RigidMotion& motion) {
+  if (g0.points.size() != g1.points.size() || g0.points.empty()) return false;
+  const Instance* i0 = first_instance(start, g0.node);
+  const Instance* i1 = first_instance(end, g1.node);
+  if (!i0 || !i1) return false;
+  Transform inv0;
+  if (!inverse(to_transform(i0->to_world), inv0)) return false;
+  const Transform map = to_transform(i1->to_world) * inv0;
+  // The linear part must be a rotation (to the rounding of single-precision placements).
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += map.m[k][r] * map.m[k][c];
+      if (std::abs(s - (r == c ? 1 : 0)) > 1e-4) return false;
+    }
+  if (determinant3x3(map) <= 0) return false;
+  DVec3 lo = g0.points[0], hi = g0.points[0];
+  for (const DVec3& p : g0.points) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const DVec3 c0 = (lo + hi) * 0.5;
+  const DVec3 c1 = apply3(map, c0) + DVec3{map.m[0][3], map.m[1][3], map.m[2][3]};
+  motion = make_rigid_motion(c0, c1, quat_from_matrix(map));
+  const Transform r = rotate(motion.rotation);
+  const double tolerance = 1e-5 * (length(hi - lo) + length(c0) + length(c1));
+  for (size_t k = 0; k < g0.points.size(); ++k)
+    if (length(c1 + apply3(r, g0.points[k] - c0) - g1.points[k]) > tolerance) return false;
+  return true;
+}
+
+// The box a node's points sweep: its centre's path grown by their largest distance from it.
+Bounds3f swept_box(const NodeGeometry& g, const RigidMotion& m) {
+  double rho = 0;
+  for (const DVec3& p : g.points) rho = std::max(rho, length(p - m.center0));
+  rho = rho * (1 + 1e-6) + 1e-30;
+  const DVec3 lo{std::min(m.center0.x, m.center1.x) - rho, std::min(m.center0.y, m.center1.y) - rho,
+                 std::min(m.center0.z, m.center1.z) - rho};
+  const DVec3 hi{std::max(m.center0.x, m.center1.x) + rho, std::max(m.center0.y, m.center1.y) + rho,
+                 std::max(m.center0.z, m.center1.z) + rho};
+  return {{std::nextafter(float(lo.x), -INFINITY), std::nextafter(float(lo.y), -INFINITY),
+           std::nextafter(float(lo.z), -INFINITY)},
+          {std::nextafter(float(hi.x), INFINITY), std::nextafter(float(hi.y), INFINITY),
+           std::nextafter(float(hi.z), INFINITY)}};
+}
+
+}  // namespace
+
+ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::span<const int> parents,
+                                    const CollideConfig& config, const AdvancementConfig& advance) {
+  if (config.mesh)
+    throw std::invalid_argument("continuous collision detection runs on proxies, not on meshes");
+  ContinuousReport report;
+  std::vector<NodeGeometry> all0 = node_geometry(start, parents, -1);
+  std::vector<NodeGeometry> all1 = node_geometry(end, parents, -1);
+  std::vector<const NodeGeometry*> at_end;  // glTF node -> its geometry at the end
+  for (const NodeGeometry& g : all1) {
+    if (size_t(g.node) >= at_end.size()) at_end.resize(size_t(g.node) + 1, nullptr);
+    at_end[size_t(g.node)] = &g;
+  }
+  std::vector<const NodeGeometry*> nodes;
+  std::vector<RigidMotion> motions;
+  for (const NodeGeometry& g : all0) {
+    if (g.points.empty()) continue;
+    const NodeGeometry* e = size_t(g.node) < at_end.size() ? at_end[size_t(g.node)] : nullptr;
+    if (!e || e->points.empty()) continue;
+    ++report.nodes;
+    RigidMotion m;
+    if (!rigid_motion_of(start, end, g, *e, m)) {
+      report.nonrigid_nodes.push_back(g.node);
+      continue;
+    }
+    nodes.push_back(&g);
+    motions.push_back(m);
+  }
+  std::vector<uint8_t> moving(nodes.size());
+  std::vector<Bounds3f> boxes;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const RigidMotion& m = motions[i];
+    moving[i] =
+        m.angle > 0 || m.center0.x != m.center1.x || m.center0.y != m.center1.y || m.center0.z != m.center1.z;
+    report.moving_nodes += moving[i];
+    boxes.push_back(swept_box(*nodes[i], m));
+  }
+  std::sort(report.nonrigid_nodes.begin(), report.nonrigid_nodes.end());
+  const std::vector<std::pair<uint32_t, uint32_t>> candidates = sweep_and_prune(boxes);
+  std::vector<std::unique_ptr<MovingCores>> cores(nodes.size());
+  for (const auto& [i, j] : candidates) {
+    if (!moving[i] && !moving[j]) continue;  // neither moves: the static test at the start decides
+    ++report.broad_pairs;
+    const int na = nodes[i]->node, nb = nodes[j]->node;
+    if (!config.include_children && (node_in_subtree(na, nb, parents) || node_in_subtree(nb, na, parents))) {
+      ++report.family_pairs;
+      continue;
+    }
+    ++report.narrow_tests;
+    for (uint32_t k : {i, j})
+      if (!cores[k]) {
+        try {
+          const Proxy proxy = fit_proxy(config.kind, nodes[k]->points, nodes[k]->triangles, config.fit);
+          cores[k] = std::make_unique<MovingCores>(ProxyCores(proxy));
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument("node " + std::to_string(nodes[k]->node) + ": " + e.what());
+        }
+      }
+    const bool swap = na > nb;
+    const uint32_t first = swap ? j : i, second = swap ? i : j;
+    const FirstContact c =
+        first_contact(*cores[first], motions[first], *cores[second], motions[second], advance);
+    report.steps += uint64_t(c.steps);
+    if (!c.hit) continue;
+    SweptContact s;
+    s.a = std::min(na, nb);
+    s.b = std::max(na, nb);
+    s.u = c.u;
+    s.point = c.point;
+    s.normal = c.normal;
+    s.converged = c.converged;
+    report.contacts.push_back(s);
+  }
+  std::sort(report.contacts.begin(), report.contacts.end(), [](const SweptContact& x, const SweptContact& y) {
+    return x.a < y.a || (x.a == y.a && x.b < y.b);
+  });
+  return report;
+}
+
+}  // namespace penumbra
