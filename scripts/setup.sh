@@ -49,7 +49,8 @@ case "$mode" in
     #   the unit tests take under the sanitizers; so do the Slurm tests (daemons around the same
     #   commands), the Blender checks, install and package, Python (an instrumented module cannot
     #   load into Debian's uninstrumented python3), the benchmark's smoke runs and tests
-    #   (measurement code, not built there; label benchmark-unit), and the format, OCIO-config,
+    #   (measurement code, not built there; label benchmark-unit), the FCL and CGAL oracles
+    #   (label oracle: test-only libraries, not built there), and the format, OCIO-config,
     #   layering and documentation checks (the same in any build).
     if [ "${SANITIZE:-1}" != 0 ]; then
       ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" -LE '^(bad-input|unit)$'
