@@ -143,26 +143,36 @@ std::string node_name(const SceneSession& s, int node) {
 }
 
 py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0, double t1) {
-  py::list contacts;
-  for (const SweptContact& c : r.contacts) {
+  auto contacts = [&](const std::vector<SweptContact>& from) {
+    py::list list;
+    for (const SweptContact& c : from) {
+      py::dict d;
+      d["a"] = c.a;
+      d["b"] = c.b;
+      d["a_name"] = node_name(s, c.a);
+      d["b_name"] = node_name(s, c.b);
+      d["time"] = t0 + c.u * (t1 - t0);
+      d["fraction"] = c.u;
+      d["point"] = vec(c.point);
+      d["normal"] = vec(c.normal);
+      list.append(d);
+    }
+    return list;
+  };
+  py::list nonrigid;
+  for (int n : r.nonrigid_nodes) {
     py::dict d;
-    d["a"] = c.a;
-    d["b"] = c.b;
-    d["a_name"] = node_name(s, c.a);
-    d["b_name"] = node_name(s, c.b);
-    d["time"] = t0 + c.u * (t1 - t0);
-    d["fraction"] = c.u;
-    d["point"] = vec(c.point);
-    d["normal"] = vec(c.normal);
-    d["converged"] = c.converged;
-    contacts.append(d);
+    d["node"] = n;
+    d["name"] = node_name(s, n);
+    nonrigid.append(d);
   }
   py::dict out;
-  out["contacts"] = contacts;
+  out["contacts"] = contacts(r.contacts);
+  out["undecided"] = contacts(r.undecided);
   out["to_time"] = t1;
   out["nodes"] = r.nodes;
   out["moving_nodes"] = r.moving_nodes;
-  out["nonrigid_nodes"] = r.nonrigid_nodes;
+  out["nonrigid_nodes"] = nonrigid;
   out["broad_pairs"] = r.broad_pairs;
   out["family_pairs"] = r.family_pairs;
   out["narrow_tests"] = r.narrow_tests;
@@ -176,7 +186,10 @@ py::dict continuous(SceneSession& s, const CollideConfig& config, double until) 
     throw py::value_error("until: continuous detection advances proxies, not meshes: pass proxy=KIND");
   if (!std::isfinite(until)) throw py::value_error("until must be a finite number of seconds");
   if (!s.loaded.animation)
-    throw py::value_error("until: the scene must be loaded with time= and keep_animation=True");
+    throw py::value_error(
+        "until: the scene must be loaded with time= and keep_animation=True, and its animation must move "
+        "only "
+        "placements (no skins or morph targets)");
   ContinuousReport r;
   {
     py::gil_scoped_release release;
@@ -261,7 +274,8 @@ void bind_collision(SceneClass& scene) {
       "keep_animation=True), continuous holds the first contacts of nodes that move rigidly from the "
       "scene's pose to its animation at until, as `penumbra collide --continuous` finds them between two "
       "frames (the scene itself is not moved): a dict of contacts (a, b, a_name, b_name, time, fraction, "
-      "point, normal, converged), to_time, nodes, moving_nodes, nonrigid_nodes, broad_pairs, family_pairs, "
+      "point, normal), undecided (pairs whose advancement ran out of budget: no contact before time), "
+      "to_time, nodes, moving_nodes, nonrigid_nodes (dicts of node, name), broad_pairs, family_pairs, "
       "narrow_tests, advancement_steps; else None.");
   scene.def(
       "proxies", &proxies, py::arg("kind"), py::arg("node") = py::none(), py::kw_only(), py::arg("kdop") = 26,

@@ -106,21 +106,24 @@ Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, dou
   j["family_pairs"] = r.family_pairs;
   j["narrow_tests"] = r.narrow_tests;
   j["advancement_steps"] = r.steps;
-  Json list = Json::array();
-  for (const SweptContact& c : r.contacts) {
-    Json e;
-    e["a"] = c.a;
-    e["a_name"] = node_name(info, c.a);
-    e["b"] = c.b;
-    e["b_name"] = node_name(info, c.b);
-    e["time"] = t0 + c.u * (t1 - t0);
-    e["fraction"] = c.u;
-    e["point"] = dvec(c.point);
-    e["normal"] = dvec(c.normal);
-    e["converged"] = c.converged;
-    list.push_back(e);
-  }
-  j["contacts"] = list;
+  auto contacts = [&](const std::vector<SweptContact>& from) {
+    Json list = Json::array();
+    for (const SweptContact& c : from) {
+      Json e;
+      e["a"] = c.a;
+      e["a_name"] = node_name(info, c.a);
+      e["b"] = c.b;
+      e["b_name"] = node_name(info, c.b);
+      e["time"] = t0 + c.u * (t1 - t0);  // undecided: no contact before it
+      e["fraction"] = c.u;
+      e["point"] = dvec(c.point);
+      e["normal"] = dvec(c.normal);
+      list.push_back(e);
+    }
+    return list;
+  };
+  j["contacts"] = contacts(r.contacts);
+  j["undecided"] = contacts(r.undecided);
   return j;
 }
 
@@ -137,9 +140,13 @@ void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, do
     std::printf("    '%s' (%d) does not move rigidly\n", node_name(info, n).c_str(), n);
   for (const SweptContact& c : r.contacts)
     std::printf(
-        "    '%s' (%d) and '%s' (%d) first touch at time %.9g s (%.6g of the way) at (%.6g, %.6g, %.6g)%s\n",
+        "    '%s' (%d) and '%s' (%d) first touch at time %.9g s (%.6g of the way) at (%.6g, %.6g, %.6g)\n",
         node_name(info, c.a).c_str(), c.a, node_name(info, c.b).c_str(), c.b, t0 + c.u * (t1 - t0), c.u,
-        c.point.x, c.point.y, c.point.z, c.converged ? "" : " or later (the step limit ran out)");
+        c.point.x, c.point.y, c.point.z);
+  for (const SweptContact& c : r.undecided)
+    std::printf(
+        "    '%s' (%d) and '%s' (%d) undecided: no contact before time %.9g s, the step budget ran out\n",
+        node_name(info, c.a).c_str(), c.a, node_name(info, c.b).c_str(), c.b, t0 + c.u * (t1 - t0));
 }
 
 }  // namespace

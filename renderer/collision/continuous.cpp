@@ -78,13 +78,18 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
   // Velocities per unit u: b's approach to a along n is dot(va - vb, n) from the centres plus
   // at most angle x rho from each turn (a chord is no longer than its arc).
   const DVec3 va = ma.center1 - ma.center0, vb = mb.center1 - mb.center0;
-  const double spin = ma.angle * rho_a + mb.angle * rho_b;
+  // (1 + 1e-4): slerp turns nearly equal orientations by normalised linear interpolation, whose
+  // speed exceeds the constant rate by a relative angle^2 / 8 at most.
+  const double spin = (ma.angle * rho_a + mb.angle * rho_b) * (1 + 1e-4);
   const double size = rho_a + rad_a + rho_b + rad_b + length(va - vb);
   const double touch = config.tolerance * std::max(size, 1e-300);
   FirstContact out;
   double u = 0;
   DVec3 normal{0, 0, 0};
-  for (int step = 0; step < config.max_steps; ++step) {
+  const uint64_t pairs = uint64_t(a.cores.size()) * b.cores.size();
+  const int steps = int(
+      std::min<uint64_t>(uint64_t(config.max_steps), config.max_distances / std::max<uint64_t>(pairs, 1)));
+  for (int step = 0; step < std::max(steps, 1); ++step) {
     out.steps = step + 1;
     a.pose(ma, u);
     b.pose(mb, u);
@@ -117,8 +122,7 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
     }
     u = std::min(next, 1.0);
   }
-  out.hit = true;
-  out.converged = false;
+  out.converged = false;  // undecided: no contact before u, none proved after it
   out.u = u;
   out.normal = normal;
   return out;
@@ -126,22 +130,25 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
 
 namespace {
 
-const Instance* first_instance(const Scene& scene, int node) {
+// Each glTF node's first mesh instance (nullptr for none).
+std::vector<const Instance*> first_instances(const Scene& scene) {
+  std::vector<const Instance*> out;
   for (const Instance& inst : scene.instances) {
     if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size()) continue;
-    if ((inst.node >= 0 ? inst.node : scene.meshes[size_t(inst.mesh)].node) == node) return &inst;
+    const int node = inst.node >= 0 ? inst.node : scene.meshes[size_t(inst.mesh)].node;
+    if (node < 0) continue;
+    if (size_t(node) >= out.size()) out.resize(size_t(node) + 1, nullptr);
+    if (!out[size_t(node)]) out[size_t(node)] = &inst;
   }
-  return nullptr;
+  return out;
 }
 
 // The rigid motion that carries a node's start points p0 to its end points p1, from the map
 // between its first instance's placements, checked on every point; false when the map is not
 // a rotation and a translation or some point does not follow it.
-bool rigid_motion_of(const Scene& start, const Scene& end, const NodeGeometry& g0, const NodeGeometry& g1,
+bool rigid_motion_of(const Instance* i0, const Instance* i1, const NodeGeometry& g0, const NodeGeometry& g1,
                      RigidMotion& motion) {
   if (g0.points.size() != g1.points.size() || g0.points.empty()) return false;
-  const Instance* i0 = first_instance(start, g0.node);
-  const Instance* i1 = first_instance(end, g1.node);
   if (!i0 || !i1) return false;
   Transform inv0;
   if (!inverse(to_transform(i0->to_world), inv0)) return false;
@@ -160,10 +167,21 @@ bool rigid_motion_of(const Scene& start, const Scene& end, const NodeGeometry& g
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
   const DVec3 c0 = (lo + hi) * 0.5;
+  // Every point where it was: still (the map between equal placements is the identity only to
+  // rounding, which would count as a motion).
+  bool still = true;
+  for (size_t k = 0; k < g0.points.size() && still; ++k)
+    still = g0.points[k].x == g1.points[k].x && g0.points[k].y == g1.points[k].y &&
+            g0.points[k].z == g1.points[k].z;
+  if (still) {
+    motion = make_rigid_motion(c0, c0, Quat{});
+    return true;
+  }
   const DVec3 c1 = apply3(map, c0) + DVec3{map.m[0][3], map.m[1][3], map.m[2][3]};
   motion = make_rigid_motion(c0, c1, quat_from_matrix(map));
   const Transform r = rotate(motion.rotation);
-  const double tolerance = 1e-5 * (length(hi - lo) + length(c0) + length(c1));
+  // Single-precision placements round each point by about 6e-8 of its distance from the origin.
+  const double tolerance = 1e-5 * length(hi - lo) + 1e-6 * (length(c0) + length(c1));
   for (size_t k = 0; k < g0.points.size(); ++k)
     if (length(c1 + apply3(r, g0.points[k] - c0) - g1.points[k]) > tolerance) return false;
   return true;
@@ -198,6 +216,10 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     if (size_t(g.node) >= at_end.size()) at_end.resize(size_t(g.node) + 1, nullptr);
     at_end[size_t(g.node)] = &g;
   }
+  const std::vector<const Instance*> placed0 = first_instances(start), placed1 = first_instances(end);
+  auto placement = [](const std::vector<const Instance*>& v, int node) {
+    return size_t(node) < v.size() ? v[size_t(node)] : nullptr;
+  };
   std::vector<const NodeGeometry*> nodes;
   std::vector<RigidMotion> motions;
   for (const NodeGeometry& g : all0) {
@@ -206,7 +228,7 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     if (!e || e->points.empty()) continue;
     ++report.nodes;
     RigidMotion m;
-    if (!rigid_motion_of(start, end, g, *e, m)) {
+    if (!rigid_motion_of(placement(placed0, g.node), placement(placed1, g.node), g, *e, m)) {
       report.nonrigid_nodes.push_back(g.node);
       continue;
     }
@@ -248,7 +270,7 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     const FirstContact c =
         first_contact(*cores[first], motions[first], *cores[second], motions[second], advance);
     report.steps += uint64_t(c.steps);
-    if (!c.hit) continue;
+    if (!c.hit && c.converged) continue;
     SweptContact s;
     s.a = std::min(na, nb);
     s.b = std::max(na, nb);
@@ -256,11 +278,12 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     s.point = c.point;
     s.normal = c.normal;
     s.converged = c.converged;
-    report.contacts.push_back(s);
+    (c.hit ? report.contacts : report.undecided).push_back(s);
   }
-  std::sort(report.contacts.begin(), report.contacts.end(), [](const SweptContact& x, const SweptContact& y) {
-    return x.a < y.a || (x.a == y.a && x.b < y.b);
-  });
+  for (std::vector<SweptContact>* list : {&report.contacts, &report.undecided})
+    std::sort(list->begin(), list->end(), [](const SweptContact& x, const SweptContact& y) {
+      return x.a < y.a || (x.a == y.a && x.b < y.b);
+    });
   return report;
 }
 

@@ -56,7 +56,9 @@ struct AdvancementConfig {
   /// sum of the largest distances of their cores' points from their centres, and the distance
   /// the centres travel).
   double tolerance = 1e-9;
-  int max_steps = 10000;  ///< steps before giving up with a lower bound on the time of contact
+  int max_steps = 10000;  ///< steps before giving up, undecided, with a lower bound on the time of contact
+  /// GJK distances (steps x pairs of cores) before giving up, undecided, likewise.
+  uint64_t max_distances = 20000000;
 };
 
 /// The first contact of two moving bodies within one interval.
@@ -71,7 +73,8 @@ struct FirstContact {
 
 /// The first u in [0, 1] at which `a` moving by `ma` and `b` moving by `mb` touch, by
 /// conservative advancement; they touch at u = 0 if they meet there. Both must hold at least
-/// one core.
+/// one core. Bodies that turn while staying close without touching may need many steps: past
+/// the budget the answer is undecided (converged false).
 FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b, const RigidMotion& mb,
                            const AdvancementConfig& config = {});
 
@@ -81,19 +84,20 @@ struct SweptContact {
   double u = 0;           ///< the fraction of the interval at first contact
   DVec3 point{};          ///< where they touch
   DVec3 normal{};         ///< unit, from a towards b just before contact (0 when touching at the start)
-  bool converged = true;  ///< false: u is a lower bound (the step limit ran out)
+  bool converged = true;  ///< false: undecided (in ContinuousReport::undecided): no contact before u
 };
 
 /// What collide_continuous found, with the work of each phase.
 struct ContinuousReport {
-  std::vector<SweptContact> contacts;  ///< sorted by (a, b)
-  uint64_t nodes = 0;                  ///< nodes with geometry in both poses
-  uint64_t moving_nodes = 0;           ///< of those, nodes that move between the poses
-  std::vector<int> nonrigid_nodes;     ///< nodes whose geometry does not move rigidly (left out)
-  uint64_t broad_pairs = 0;            ///< node pairs whose swept boxes overlap
-  uint64_t family_pairs = 0;           ///< of those, pairs the hierarchy joins, left out
-  uint64_t narrow_tests = 0;           ///< node pairs advanced
-  uint64_t steps = 0;                  ///< advancement steps over every pair
+  std::vector<SweptContact> contacts;   ///< sorted by (a, b)
+  std::vector<SweptContact> undecided;  ///< pairs whose advancement ran out of budget, sorted by (a, b)
+  uint64_t nodes = 0;                   ///< nodes with geometry in both poses
+  uint64_t moving_nodes = 0;            ///< of those, nodes whose points move between the poses
+  std::vector<int> nonrigid_nodes;      ///< nodes whose geometry does not move rigidly (left out)
+  uint64_t broad_pairs = 0;             ///< node pairs whose swept boxes overlap
+  uint64_t family_pairs = 0;            ///< of those, pairs the hierarchy joins, left out
+  uint64_t narrow_tests = 0;            ///< node pairs advanced
+  uint64_t steps = 0;                   ///< advancement steps over every pair
 };
 
 /// The first contacts between the poses `start` (u = 0) and `end` (u = 1) of the same scene

@@ -65,6 +65,17 @@ DVec3 proxy_contact_point(const Proxy& b, const Penetration& p) {
   return best - p.direction * radius + p.direction * (0.5 * p.depth);
 }
 
+// The solid of one placed mesh of a node: its triangles over its own (contiguous) vertices.
+SolidMesh instance_solid(const NodeGeometry& g, size_t instance, const SolidBspConfig& config) {
+  const auto first = g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[instance]);
+  const auto last = g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[instance + 1]);
+  const uint32_t lo = *std::min_element(first, last), hi = *std::max_element(first, last);
+  std::vector<uint32_t> local;
+  for (auto it = first; it != last; ++it) local.push_back(*it - lo);
+  return build_solid_mesh(std::span<const Vec3f>(g.positions.data() + lo, size_t(hi - lo) + 1), local,
+                          config);
+}
+
 }  // namespace
 
 CollideReport collide_scene(const Scene& scene, std::span<const int> parents, const CollideConfig& config) {
@@ -83,7 +94,7 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
   std::vector<uint8_t> have_tree(nodes.size(), 0);
   std::vector<Proxy> proxies(nodes.size());
   std::vector<uint8_t> have_proxy(nodes.size(), 0);
-  std::vector<SolidMesh> solids(nodes.size());
+  std::vector<std::vector<SolidMesh>> solids(nodes.size());  // per node, one per placed mesh
   std::vector<uint8_t> have_solid(nodes.size(), 0);
   for (const auto& [i, j] : candidates) {
     const NodeGeometry& ga = nodes[i];
@@ -119,13 +130,17 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
         for (uint32_t k : {fi, si})
           if (!have_solid[k]) {
             try {
-              solids[k] = build_solid_mesh(nodes[k].positions, nodes[k].triangles, config.solid);
+              const NodeGeometry& g = nodes[k];
+              for (size_t part = 0; part + 1 < g.instance_triangles.size(); ++part)
+                if (g.instance_triangles[part] < g.instance_triangles[part + 1])
+                  solids[k].push_back(instance_solid(g, part, config.solid));
             } catch (const std::invalid_argument& e) {
               throw std::invalid_argument("node " + std::to_string(nodes[k].node) + ": " + e.what());
             }
             have_solid[k] = 1;
           }
-        contact.volume = mesh_intersection_volume(solids[fi], solids[si], config.volume);
+        if (!solids[fi].empty() && !solids[si].empty())
+          contact.volume = mesh_intersection_volume(solids[fi], solids[si], config.volume);
       }
     } else {
       for (uint32_t k : {fi, si})

@@ -26,6 +26,9 @@ struct NodeGeometry {
   /// placement, summed); NaN when some placed mesh is not closed or is a point set.
   double enclosed_volume = NAN;
   uint64_t instances = 0;  ///< mesh instances gathered
+  /// Per gathered mesh instance, where its triangles start in `triangles` (3 indices each); a
+  /// last entry holds the end.
+  std::vector<size_t> instance_triangles{0};
 };
 
 /// True if `node` is `ancestor` or lies below it (`parents`: each glTF node's parent, -1 for a

@@ -209,9 +209,30 @@ double ball_intersection_volume(const BoundingSphere& a, const BoundingSphere& b
   return std::numbers::pi * s * s * (d * d + 2 * d * (r1 + r2) - 3 * (r1 - r2) * (r1 - r2)) / (12 * d);
 }
 
+namespace {
+
+// True if no two of the parts share a volume (touching faces share none).
+bool parts_disjoint(const std::vector<PlanePart>& parts) {
+  for (size_t i = 0; i < parts.size(); ++i)
+    for (size_t j = i + 1; j < parts.size(); ++j) {
+      const DBox box = meet(parts[i].box, parts[j].box);
+      if (box.empty()) continue;
+      const DVec3 e = box.hi - box.lo;
+      // Rounding on a shared face leaves slivers far below this.
+      const double sliver = 1e-9 * std::max({e.x, e.y, e.z, 1e-300}) * std::max({e.x, e.y, e.z, 1e-300}) *
+                            std::max({e.x, e.y, e.z, 1e-300});
+      if (convex_intersection_volume(parts[i].planes, parts[j].planes, outward(box)) > sliver) return false;
+    }
+  return true;
+}
+
+}  // namespace
+
 VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const VolumeConfig& config) {
   VolumeEstimate out;
-  if (polyhedral(a.kind) && polyhedral(b.kind)) {
+  const bool disjoint = (a.kind != ProxyKind::Composite || parts_disjoint(plane_parts(a))) &&
+                        (b.kind != ProxyKind::Composite || parts_disjoint(plane_parts(b)));
+  if (polyhedral(a.kind) && polyhedral(b.kind) && disjoint) {
     out.exact = true;
     const std::vector<PlanePart> pa = plane_parts(a), pb = plane_parts(b);
     for (const PlanePart& x : pa)
@@ -232,22 +253,35 @@ VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const V
   return cell_quadrature(ProxyDistance(a), ProxyDistance(b), region, 1e-12 * scale, target, config.max_cells);
 }
 
-VolumeEstimate mesh_intersection_volume(const SolidMesh& a, const SolidMesh& b, const VolumeConfig& config) {
-  DBox ba, bb;
-  ba.add(to_dvec(a.bounds.lo)), ba.add(to_dvec(a.bounds.hi));
-  bb.add(to_dvec(b.bounds.lo)), bb.add(to_dvec(b.bounds.hi));
-  const DBox region = meet(ba, bb);
+VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<const SolidMesh> b,
+                                        const VolumeConfig& config) {
+  // A union of solids: inside if inside any, at the least distance of them outside.
+  struct Union {
+    std::span<const SolidMesh> meshes;
+    DBox box;
+    double volume = 0, tolerance = 0;
+    explicit Union(std::span<const SolidMesh> m) : meshes(m) {
+      for (const SolidMesh& s : m) {
+        box.add(to_dvec(s.bounds.lo)), box.add(to_dvec(s.bounds.hi));
+        volume = std::max(volume, s.bsp.volume);
+        tolerance = std::max(tolerance, s.bsp.tolerance);
+      }
+    }
+    double operator()(DVec3 p) const {
+      const Vec3f q{float(p.x), float(p.y), float(p.z)};
+      double best = INFINITY;
+      for (const SolidMesh& s : meshes) best = std::min(best, double(solid_mesh_signed_distance(s, q)));
+      return best;
+    }
+  };
+  const Union ua(a), ub(b);
+  const DBox region = meet(ua.box, ub.box);
   // Distances are single precision at points rounded to float, and points within the solid
   // BSP's tolerance of a surface may answer either way.
   const double scale = length(region.lo) + length(region.hi) + length(region.hi - region.lo);
-  const double margin = 2 * std::max(a.bsp.tolerance, b.bsp.tolerance) + 1e-6 * scale;
-  auto distance = [](const SolidMesh& m) {
-    return [&m](DVec3 p) {
-      return double(solid_mesh_signed_distance(m, {float(p.x), float(p.y), float(p.z)}));
-    };
-  };
-  const double target = config.relative_error * std::min(a.bsp.volume, b.bsp.volume);
-  return cell_quadrature(distance(a), distance(b), region, margin, target, config.max_cells);
+  const double margin = 2 * std::max(ua.tolerance, ub.tolerance) + 1e-6 * scale;
+  const double target = config.relative_error * std::min(ua.volume, ub.volume);
+  return cell_quadrature(ua, ub, region, margin, target, config.max_cells);
 }
 
 }  // namespace penumbra

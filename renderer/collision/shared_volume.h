@@ -48,13 +48,14 @@ double convex_intersection_volume(std::span<const DPlane> a, std::span<const DPl
 double ball_intersection_volume(const BoundingSphere& a, const BoundingSphere& b);
 
 /// The volume two proxies share: exact for polyhedral kinds (aabb, obb, hull, kdop; composites
-/// part by part, summed: exact when a composite's parts do not overlap each other, an upper
-/// bound when they do) and for two spheres; the cell quadrature for pairs with a capsule or
-/// with one sphere.
+/// part by part, summed, when no two parts of a composite overlap) and for two spheres; the
+/// cell quadrature for the rest (a capsule, one sphere, a composite whose parts overlap).
 VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const VolumeConfig& config = {});
 
-/// The volume two closed meshes (as solids) share, by the cell quadrature.
-VolumeEstimate mesh_intersection_volume(const SolidMesh& a, const SolidMesh& b,
+/// The volume two solids share, each the union of closed meshes (a node placing several meshes,
+/// or copies of one: each its own solid, so that overlapping or mirrored parts stay sound), by
+/// the cell quadrature. Both spans must hold at least one mesh.
+VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<const SolidMesh> b,
                                         const VolumeConfig& config = {});
 
 }  // namespace penumbra

@@ -143,7 +143,7 @@ TEST_CASE("CGAL's exact intersection volume lies within mesh_intersection_volume
     const double want = cgal_volume(a, b);
     const SolidMesh sa = build_solid_mesh(a.positions, a.triangles),
                     sb = build_solid_mesh(b.positions, b.triangles);
-    const VolumeEstimate got = mesh_intersection_volume(sa, sb);
+    const VolumeEstimate got = mesh_intersection_volume({&sa, 1}, {&sb, 1});
     INFO("CGAL " << want << ", here " << got.volume << " +- " << got.error);
     CHECK(want > 0.01);
     CHECK(std::abs(got.volume - want) <= got.error + 1e-9 * want);

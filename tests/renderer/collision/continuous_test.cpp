@@ -104,6 +104,14 @@ TEST_CASE("first_contact: a turning bar against a sphere, in closed form", "[con
   const double want = (std::numbers::pi / 4 - std::asin(1.0 / 6)) / (std::numbers::pi / 2);
   CHECK(c.u == Approx(want).margin(1e-7));
   CHECK(c.steps > 2);  // turning: the bound is not exact, so advancement takes several steps
+  // Two steps are not enough to reach it: undecided, with no contact before the last u.
+  AdvancementConfig short_budget;
+  short_budget.max_steps = 2;
+  const FirstContact cut = first_contact(a, turn, b, still, short_budget);
+  CHECK_FALSE(cut.hit);
+  CHECK_FALSE(cut.converged);
+  CHECK(cut.u > 0);
+  CHECK(cut.u < want);
   // Turning the other way it sweeps 90 degrees away from the sphere: no contact.
   const RigidMotion away =
       make_rigid_motion({0, 0, 0}, {0, 0, 0}, quat_axis_angle(0, 0, 1, -std::numbers::pi / 4));
@@ -158,14 +166,16 @@ TEST_CASE("first_contact agrees with dense sampling on random hulls and motions"
 }
 
 TEST_CASE("collide_continuous: a cube tunnels through a wall between two poses", "[continuous]") {
-  // Node 0: a wall 0.1 thick at x = 0; node 1: a unit cube from x = -3 to x = 3 while turning
+  // Node 0: a wall 0.1 thick at x = 0, turned about x (the same placement in both poses: still);
+  // node 1: a unit cube from x = -3 to x = 3 while turning
   // a quarter about x (its faces stay square to the wall's, so it first touches the wall when
   // its centre is at x = -0.55); node 2: a cube that doubles in size (not rigid); node 3: a
   // still cube touching the wall.
   Scene start, end;
   for (Scene* s : {&start, &end}) {
     s->meshes.push_back(cube_mesh(0.5f));
-    s->instances.push_back(make_instance(0, placed(scale(0.1, 4, 4)), 0));
+    s->instances.push_back(
+        make_instance(0, placed(rotate(quat_axis_angle(1, 0, 0, 0.3)) * scale(0.1, 4, 4)), 0));
   }
   const Quat quarter = quat_axis_angle(1, 0, 0, std::numbers::pi / 2);
   start.instances.push_back(make_instance(0, placed(translate(-3, 0, 0)), 1));

@@ -113,6 +113,28 @@ TEST_CASE("convex pairs: boxes and the octagon of a turned square, exactly", "[s
   CHECK(hulls.volume == Approx(0.7 * 0.8 * 0.9).epsilon(1e-9));
 }
 
+TEST_CASE("a composite whose parts overlap is measured as their union", "[shared-volume]") {
+  // Parts [0, 1]^3 and [0.5, 1.5] x [0, 1]^2: the union is [0, 1.5] x [0, 1]^2; a box over
+  // x in [0.25, 1.25] shares 1 with it (summing the parts would give 1.5).
+  auto cube = [](double x0, double x1) {
+    std::vector<DVec3> p;
+    for (int i = 0; i < 8; ++i) p.push_back({i & 1 ? x1 : x0, i & 2 ? 1.0 : 0.0, i & 4 ? 1.0 : 0.0});
+    return fit_proxy(ProxyKind::Hull, p).parts[0];
+  };
+  Proxy composite;
+  composite.kind = ProxyKind::Composite;
+  composite.parts = {cube(0, 1), cube(0.5, 1.5)};
+  const VolumeEstimate v = proxy_intersection_volume(composite, box_proxy({0.75, 0.5, 0.5}, {0.5, 0.5, 0.5}));
+  CHECK_FALSE(v.exact);
+  CHECK(std::abs(v.volume - 1) <= v.error);
+  CHECK(v.error < 0.05);
+  // Parts that only touch: exact.
+  composite.parts = {cube(0, 1), cube(1, 2)};
+  const VolumeEstimate w = proxy_intersection_volume(composite, box_proxy({1, 0.5, 0.5}, {0.5, 0.5, 0.5}));
+  CHECK(w.exact);
+  CHECK(w.volume == Approx(1).epsilon(1e-9));
+}
+
 TEST_CASE("cell quadrature: a half ball and a half capsule within the stated bound", "[shared-volume]") {
   Proxy ball;
   ball.kind = ProxyKind::Sphere;
@@ -154,7 +176,7 @@ TEST_CASE("mesh volumes: icospheres and star polyhedra against the tetrahedra or
     const SolidMesh a = build_solid_mesh(c.a.positions, c.a.indices),
                     b = build_solid_mesh(c.b.positions, c.b.indices);
     const double want = star_oracle(c.a, c.ca, c.b, c.cb);
-    const VolumeEstimate got = mesh_intersection_volume(a, b);
+    const VolumeEstimate got = mesh_intersection_volume({&a, 1}, {&b, 1});
     CHECK(want > 0.05);
     CHECK(std::abs(got.volume - want) <= got.error + 1e-9);
     CHECK(got.error <= 2e-2 * std::min(a.bsp.volume, b.bsp.volume));
@@ -163,7 +185,7 @@ TEST_CASE("mesh volumes: icospheres and star polyhedra against the tetrahedra or
   const SolidMesh a = build_solid_mesh(sphere.positions, sphere.indices);
   const TriMesh far = moved(sphere, {5, 0, 0});
   const SolidMesh b = build_solid_mesh(far.positions, far.indices);
-  const VolumeEstimate none = mesh_intersection_volume(a, b);
+  const VolumeEstimate none = mesh_intersection_volume({&a, 1}, {&b, 1});
   CHECK(none.volume == 0);
   CHECK(none.error == 0);
 }
@@ -188,6 +210,20 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   REQUIRE(boxes.contacts.size() == 1);
   CHECK(boxes.contacts[0].volume.exact);
   CHECK(boxes.contacts[0].volume.volume == Approx(0.225).epsilon(1e-6));
+  // Node 1 placing two overlapping cubes, one of them mirrored (wound inwards in world space):
+  // their union spans x in [0.25, 1.75], so node 0 shares 0.25 x 1 x 1 with it.
+  Scene two = s;
+  Affine3f mirrored = at;
+  mirrored.m[0][0] = -1, mirrored.m[0][3] = 1.25f, mirrored.m[1][3] = 0;
+  two.instances.push_back(make_instance(0, mirrored, 1));
+  two.instances[1].to_world.m[1][3] = 0;
+  two.instances[1] = make_instance(0, two.instances[1].to_world, 1);
+  config.mesh = true;
+  const CollideReport union_of = collide_scene(two, parents, config);
+  REQUIRE(union_of.contacts.size() == 1);
+  const VolumeEstimate& u = union_of.contacts[0].volume;
+  CHECK(std::abs(u.volume - 0.25) <= u.error + 1e-6);
+  CHECK(u.error < 0.05);
   // An open mesh (a cube without its top) has no inside: refused, naming the node.
   Mesh open = cube_mesh(0.5f);
   open.indices.resize(open.indices.size() - 6);
