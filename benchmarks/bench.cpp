@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "benchmarks/chart.h"
+#include "benchmarks/collision.h"
 #include "benchmarks/machine.h"
 #include "benchmarks/queries.h"
 #include "benchmarks/report.h"
@@ -830,7 +831,7 @@ struct BenchOptions {
   uint64_t seed = 1;
   std::vector<int> mc_resolutions;
   int noise_count = 0;
-  bool raster = false, tradeoffs = false;
+  bool raster = false, tradeoffs = false, collision = false;
   std::string refit_file;
   int refit_frames = 240;
   std::vector<std::string> queries;  ///< --queries: the kinds
@@ -900,6 +901,12 @@ void add_bench_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--query-count", o.query_count, "query points per kind for --queries (default 20000)")
       ->check(CLI::Range(1, 100000000));
   app.add_option("--k", o.k, "neighbours per knn query (default 8)")->check(CLI::Range(1, 1024));
+  app.add_flag(
+      "--collision", o.collision,
+      "instead of the rays: collision queries on each model (its meshes as one body): per proxy kind "
+      "the fit time, bytes, distance tests per second and tightness; tests per second for every pair "
+      "of kinds; the model against a turned copy at increasing overlap by the own trees, Embree's "
+      "rtcCollide and FCL (when built with it), which must agree");
   app.add_flag("--raster", o.raster,
                "instead of the structures: frames per second of primary visibility at --width x --height, "
                "rasterised against Embree's and the BVH's camera rays, and the shaded raster preview");
@@ -913,7 +920,7 @@ int report_error(const std::exception& e) {
   return input ? 2 : 1;
 }
 
-/// --noise, --marching-cubes, --refit, --tradeoffs or --raster: the mode's exit code; nullopt
+/// --noise, --marching-cubes, --refit, --tradeoffs, --collision, --raster or --queries: the mode's exit code; nullopt
 /// when none is asked for (the main table).
 std::optional<int> run_mode(const BenchOptions& o) {
   if (o.noise_count > 0) return run_noise(o.noise_count, o.repeats);
@@ -927,6 +934,20 @@ std::optional<int> run_mode(const BenchOptions& o) {
         return run_refit(o.refit_file, o.refit_frames, config, o.width, o.height, o.threads[0], o.csv);
       return run_tradeoffs(o.scenes, o.seed, o.accels, config, o.width, o.height, o.builds, o.repeats, o.csv,
                            o.svg, o.command);
+    }
+    if (o.collision) {
+      bench::CollisionBenchConfig c;
+      c.builds = o.builds;
+      c.repeats = o.repeats;
+      c.seed = o.seed;
+      c.csv = o.csv;
+      std::vector<std::pair<std::string, Scene>> scenes;
+      for (const auto& spec : o.scenes) {
+        std::string name;
+        Scene scene = load_bench_scene(spec, o.seed, name);
+        scenes.emplace_back(name, std::move(scene));
+      }
+      return bench::run_collision(scenes, c);
     }
     if (o.raster) return run_raster(o.scenes, o.seed, o.width, o.height, o.threads, o.builds, o.repeats);
     if (!o.queries.empty()) {
