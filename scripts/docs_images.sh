@@ -95,14 +95,22 @@ oiiotool "$a" --ch R,G,B --colorconvert linear sRGB \
   --mosaic:pad=4 3x3 -d uint8 -o "$out/aov-contact-sheet.png"
 
 
-# Proxies and collisions: each proxy kind over the CSG scene's implicit shapes, meshed by
-# marching cubes (three objects: a CSG part, a blob, a torus), in rows of four.
+# Proxies and collisions: each proxy kind over the corpus's Duck (a Khronos sample model), in rows
+# of four: sphere, Ritter, AABB, OBB; capsule, hull, 26-DOP, composite. Without the corpus, over
+# the CSG scene's implicit shapes meshed by marching cubes.
 step "proxies.png"
-"$bin" mesh scenes/csg.gltf --resolution 40 -o "$work/csg-mesh.glb" -q >/dev/null
+model="${PENUMBRA_CORPUS:-$src/../shared/corpus}/valid/Duck/glTF-Binary/Duck.glb"
+view=(--orbit 35,20)
+if [ ! -f "$model" ]; then
+  step "proxies.png: no corpus Duck at $model (set PENUMBRA_CORPUS): the meshed CSG scene instead"
+  "$bin" mesh scenes/csg.gltf --resolution 40 -o "$work/csg-mesh.glb" -q >/dev/null
+  model="$work/csg-mesh.glb"
+  view=(--look-at 0,2.4,6.2 0,1,0)
+fi
 tiles=()
 for kind in sphere ritter aabb obb capsule hull kdop composite; do
-  "$bin" proxies "$work/csg-mesh.glb" --kind "$kind" --samples 0 --overlay -o "$work/proxies-$kind.glb" >/dev/null
-  "$bin" render "$work/proxies-$kind.glb" --width 236 --height 120 --look-at 0,2.4,6.2 0,1,0 -o "$work/proxies-$kind.exr" \
+  "$bin" proxies "$model" --kind "$kind" --samples 0 --overlay -o "$work/proxies-$kind.glb" >/dev/null
+  "$bin" render "$work/proxies-$kind.glb" --width 236 --height 160 "${view[@]}" -o "$work/proxies-$kind.exr" \
     --png "$work/proxies-$kind.png" -q --threads 0 >/dev/null
   tiles+=("$work/proxies-$kind.png")
 done
