@@ -14,7 +14,8 @@
 #   bounding spheres (radii sqrt(3) / 2 and sqrt(2.0025)) meet earlier; the still nodes are not
 #   advanced; the text report names it;
 # - bad input exits 2 naming the option: an unknown proxy kind, a bad k, a bad range or fps,
-#   --continuous on meshes or on one frame.
+#   --continuous on meshes or on one frame; --volumes on an open mesh names the file, the node
+#   and an open edge.
 # Usage: collide_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
 bin="$1"; work="$2"
@@ -106,6 +107,22 @@ expect 2 "--frames" -- "$bin" collide "$scene" --frames 5-2
 expect 2 "--fps must be a finite number > 0" -- "$bin" collide "$scene" --frames 0-2 --fps 0
 expect 2 "--continuous advances convex proxies, not meshes: add --proxy KIND" -- "$bin" collide "$scene" --frames 0-2 --continuous
 expect 2 "--continuous needs --frames with two frames or more" -- "$bin" collide "$scene" --proxy obb --frames 3 --continuous
+# The same cubes with B's top two triangles left out: open.
+"$py" - "$scene" "$work/open.gltf" <<'PY'
+import base64, json, struct, sys
+doc = json.load(open(sys.argv[1]))
+blob = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+idx = list(struct.unpack("<36I", blob[96:240]))
+blob += struct.pack("<30I", *idx[6:])
+doc["bufferViews"].append({"buffer": 0, "byteOffset": len(blob) - 120, "byteLength": 120})
+doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5125, "count": 30, "type": "SCALAR"})
+doc["meshes"].append({"name": "open cube", "primitives": [{"attributes": {"POSITION": 0}, "indices": len(doc["accessors"]) - 1}]})
+doc["nodes"][2]["mesh"] = len(doc["meshes"]) - 1
+doc["buffers"][0] = {"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}
+json.dump(doc, open(sys.argv[2], "w"))
+PY
+expect 2 "penumbra: error: $work/open.gltf: .*node 2: .*not closed: edge" -- "$bin" collide "$work/open.gltf" --volumes
+expect 0 "'A' \\(0\\) and 'B' \\(2\\)" -- "$bin" collide "$work/open.gltf"
 
 echo "collide: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]
