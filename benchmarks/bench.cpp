@@ -920,8 +920,8 @@ int report_error(const std::exception& e) {
   return input ? 2 : 1;
 }
 
-/// --noise, --marching-cubes, --refit, --tradeoffs, --collision, --raster or --queries: the mode's exit code; nullopt
-/// when none is asked for (the main table).
+/// --noise, --marching-cubes, --refit, --tradeoffs, --collision, --raster or --queries: the mode's exit code;
+/// nullopt when none is asked for (the main table).
 std::optional<int> run_mode(const BenchOptions& o) {
   if (o.noise_count > 0) return run_noise(o.noise_count, o.repeats);
   try {
