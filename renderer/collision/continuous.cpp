@@ -85,7 +85,9 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
   const double touch = config.tolerance * std::max(size, 1e-300);
   FirstContact out;
   double u = 0;
-  DVec3 normal{0, 0, 0};
+  DVec3 normal{0, 0, 0};  // the nearest pair's, at the last step
+  // Per pair of cores, its direction at the last step: the one that touches gives the contact's.
+  std::vector<DVec3> pair_normal(a.cores.size() * b.cores.size(), DVec3{0, 0, 0});
   const uint64_t pairs = uint64_t(a.cores.size()) * b.cores.size();
   const int steps = int(
       std::min<uint64_t>(uint64_t(config.max_steps), config.max_distances / std::max<uint64_t>(pairs, 1)));
@@ -95,19 +97,21 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
     b.pose(mb, u);
     double advance = INFINITY, nearest = INFINITY;
     DVec3 nearest_normal{0, 0, 0};
-    for (const ConvexCore& ca : a.cores)
-      for (const ConvexCore& cb : b.cores) {
-        const ConvexDistance d = gjk_distance(ca, cb);
+    for (size_t i = 0; i < a.cores.size(); ++i)
+      for (size_t j = 0; j < b.cores.size(); ++j) {
+        const ConvexDistance d = gjk_distance(a.cores[i], b.cores[j]);
+        DVec3& last = pair_normal[i * b.cores.size() + j];
         if (d.intersect || d.distance <= touch) {
           out.hit = true;
           out.u = u;
           out.point = (d.a + d.b) * 0.5;
-          out.normal = normal;
+          out.normal = last;
           return out;
         }
         const DVec3 gap = d.b - d.a;
         const double g = length(gap);
         const DVec3 n = g > 0 ? gap * (1 / g) : DVec3{0, 0, 0};
+        last = n;
         const double mu = dot(va - vb, n) + spin;
         if (mu > 0) advance = std::min(advance, d.distance / mu);
         if (d.distance < nearest) nearest = d.distance, nearest_normal = n;
@@ -187,11 +191,11 @@ bool rigid_motion_of(const Instance* i0, const Instance* i1, const NodeGeometry&
   return true;
 }
 
-// The box a node's points sweep: its centre's path grown by their largest distance from it.
-Bounds3f swept_box(const NodeGeometry& g, const RigidMotion& m) {
-  double rho = 0;
-  for (const DVec3& p : g.points) rho = std::max(rho, length(p - m.center0));
-  rho = rho * (1 + 1e-6) + 1e-30;
+// The box a node's proxy sweeps: its centre's path grown by the cores' reach from it.
+Bounds3f swept_box(const MovingCores& cores, const RigidMotion& m) {
+  double points, radius;
+  reach(cores, m.center0, points, radius);
+  const double rho = (points + radius) * (1 + 1e-6) + 1e-30;
   const DVec3 lo{std::min(m.center0.x, m.center1.x) - rho, std::min(m.center0.y, m.center1.y) - rho,
                  std::min(m.center0.z, m.center1.z) - rho};
   const DVec3 hi{std::max(m.center0.x, m.center1.x) + rho, std::max(m.center0.y, m.center1.y) + rho,
@@ -235,18 +239,26 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     nodes.push_back(&g);
     motions.push_back(m);
   }
+  // Every rigid node's proxy, so that the broad phase bounds what the proxies sweep (they may
+  // reach beyond the vertices).
   std::vector<uint8_t> moving(nodes.size());
+  std::vector<std::unique_ptr<MovingCores>> cores(nodes.size());
   std::vector<Bounds3f> boxes;
   for (size_t i = 0; i < nodes.size(); ++i) {
     const RigidMotion& m = motions[i];
     moving[i] =
         m.angle > 0 || m.center0.x != m.center1.x || m.center0.y != m.center1.y || m.center0.z != m.center1.z;
     report.moving_nodes += moving[i];
-    boxes.push_back(swept_box(*nodes[i], m));
+    try {
+      const Proxy proxy = fit_proxy(config.kind, nodes[i]->points, nodes[i]->triangles, config.fit);
+      cores[i] = std::make_unique<MovingCores>(ProxyCores(proxy));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("node " + std::to_string(nodes[i]->node) + ": " + e.what());
+    }
+    boxes.push_back(swept_box(*cores[i], m));
   }
   std::sort(report.nonrigid_nodes.begin(), report.nonrigid_nodes.end());
   const std::vector<std::pair<uint32_t, uint32_t>> candidates = sweep_and_prune(boxes);
-  std::vector<std::unique_ptr<MovingCores>> cores(nodes.size());
   for (const auto& [i, j] : candidates) {
     if (!moving[i] && !moving[j]) continue;  // neither moves: the static test at the start decides
     ++report.broad_pairs;
@@ -256,15 +268,6 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
       continue;
     }
     ++report.narrow_tests;
-    for (uint32_t k : {i, j})
-      if (!cores[k]) {
-        try {
-          const Proxy proxy = fit_proxy(config.kind, nodes[k]->points, nodes[k]->triangles, config.fit);
-          cores[k] = std::make_unique<MovingCores>(ProxyCores(proxy));
-        } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument("node " + std::to_string(nodes[k]->node) + ": " + e.what());
-        }
-      }
     const bool swap = na > nb;
     const uint32_t first = swap ? j : i, second = swap ? i : j;
     const FirstContact c =

@@ -102,8 +102,8 @@ struct ContinuousReport {
 
 /// The first contacts between the poses `start` (u = 0) and `end` (u = 1) of the same scene
 /// (the same instances in the same order, posed at two times): proxies of `config.kind` are
-/// fitted to each node's geometry at the start, each node moves rigidly as described in the
-/// banner, and a broad phase over the boxes each node sweeps comes before conservative
+/// fitted to each rigid node's geometry at the start, each node moves rigidly as described in
+/// the banner, and a broad phase over the boxes each proxy sweeps comes before conservative
 /// advancement on the pairs. Nodes whose vertices do not follow one rigid motion (skinning,
 /// morphing, changing scale) are listed in nonrigid_nodes and left out. config.mesh must be
 /// false. Throws std::invalid_argument naming the node if its geometry cannot be fitted.
