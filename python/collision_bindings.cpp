@@ -143,7 +143,7 @@ std::string node_name(const SceneSession& s, int node) {
 }
 
 py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0, double t1) {
-  auto contacts = [&](const std::vector<SweptContact>& from) {
+  auto contacts = [&](const std::vector<SweptContact>& from, bool touching) {
     py::list list;
     for (const SweptContact& c : from) {
       py::dict d;
@@ -153,8 +153,10 @@ py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0,
       d["b_name"] = node_name(s, c.b);
       d["time"] = t0 + c.u * (t1 - t0);
       d["fraction"] = c.u;
-      d["point"] = vec(c.point);
-      d["normal"] = vec(c.normal);
+      if (touching) {
+        d["point"] = vec(c.point);
+        d["normal"] = vec(c.normal);
+      }
       list.append(d);
     }
     return list;
@@ -167,8 +169,8 @@ py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0,
     nonrigid.append(d);
   }
   py::dict out;
-  out["contacts"] = contacts(r.contacts);
-  out["undecided"] = contacts(r.undecided);
+  out["contacts"] = contacts(r.contacts, true);
+  out["undecided"] = contacts(r.undecided, false);
   out["to_time"] = t1;
   out["nodes"] = r.nodes;
   out["moving_nodes"] = r.moving_nodes;
@@ -274,7 +276,8 @@ void bind_collision(SceneClass& scene) {
       "keep_animation=True), continuous holds the first contacts of nodes that move rigidly from the "
       "scene's pose to its animation at until, as `penumbra collide --continuous` finds them between two "
       "frames (the scene itself is not moved): a dict of contacts (a, b, a_name, b_name, time, fraction, "
-      "point, normal), undecided (pairs whose advancement ran out of budget: no contact before time), "
+      "point, normal), undecided (a, b, a_name, b_name, time, fraction: pairs whose advancement ran out of "
+      "budget, with no contact before time), "
       "to_time, nodes, moving_nodes, nonrigid_nodes (dicts of node, name), broad_pairs, family_pairs, "
       "narrow_tests, advancement_steps; else None.");
   scene.def(

@@ -106,7 +106,7 @@ Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, dou
   j["family_pairs"] = r.family_pairs;
   j["narrow_tests"] = r.narrow_tests;
   j["advancement_steps"] = r.steps;
-  auto contacts = [&](const std::vector<SweptContact>& from) {
+  auto contacts = [&](const std::vector<SweptContact>& from, bool touching) {
     Json list = Json::array();
     for (const SweptContact& c : from) {
       Json e;
@@ -116,14 +116,16 @@ Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, dou
       e["b_name"] = node_name(info, c.b);
       e["time"] = t0 + c.u * (t1 - t0);  // undecided: no contact before it
       e["fraction"] = c.u;
-      e["point"] = dvec(c.point);
-      e["normal"] = dvec(c.normal);
+      if (touching) {
+        e["point"] = dvec(c.point);
+        e["normal"] = dvec(c.normal);
+      }
       list.push_back(e);
     }
     return list;
   };
-  j["contacts"] = contacts(r.contacts);
-  j["undecided"] = contacts(r.undecided);
+  j["contacts"] = contacts(r.contacts, true);
+  j["undecided"] = contacts(r.undecided, false);
   return j;
 }
 

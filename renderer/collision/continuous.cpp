@@ -86,12 +86,16 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
   FirstContact out;
   double u = 0;
   DVec3 normal{0, 0, 0};  // the nearest pair's, at the last step
-  // Per pair of cores, its direction at the last step: the one that touches gives the contact's.
-  std::vector<DVec3> pair_normal(a.cores.size() * b.cores.size(), DVec3{0, 0, 0});
+  double previous = -1;   // the last step's u (none yet)
   const uint64_t pairs = uint64_t(a.cores.size()) * b.cores.size();
   const int steps = int(
       std::min<uint64_t>(uint64_t(config.max_steps), config.max_distances / std::max<uint64_t>(pairs, 1)));
-  for (int step = 0; step < std::max(steps, 1); ++step) {
+  if (steps == 0) {  // not even one step fits the budget: undecided from the start
+    out.converged = false;
+    out.u = 0;
+    return out;
+  }
+  for (int step = 0; step < steps; ++step) {
     out.steps = step + 1;
     a.pose(ma, u);
     b.pose(mb, u);
@@ -100,18 +104,24 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
     for (size_t i = 0; i < a.cores.size(); ++i)
       for (size_t j = 0; j < b.cores.size(); ++j) {
         const ConvexDistance d = gjk_distance(a.cores[i], b.cores[j]);
-        DVec3& last = pair_normal[i * b.cores.size() + j];
         if (d.intersect || d.distance <= touch) {
           out.hit = true;
           out.u = u;
           out.point = (d.a + d.b) * 0.5;
-          out.normal = last;
+          if (previous >= 0) {
+            // The normal of the pair that touches, from the last step (before contact).
+            a.pose(ma, previous);
+            b.pose(mb, previous);
+            const ConvexDistance before = gjk_distance(a.cores[i], b.cores[j]);
+            const DVec3 gap = before.b - before.a;
+            const double g = length(gap);
+            out.normal = g > 0 ? gap * (1 / g) : normal;
+          }
           return out;
         }
         const DVec3 gap = d.b - d.a;
         const double g = length(gap);
         const DVec3 n = g > 0 ? gap * (1 / g) : DVec3{0, 0, 0};
-        last = n;
         const double mu = dot(va - vb, n) + spin;
         if (mu > 0) advance = std::min(advance, d.distance / mu);
         if (d.distance < nearest) nearest = d.distance, nearest_normal = n;
@@ -124,6 +134,7 @@ FirstContact first_contact(MovingCores& a, const RigidMotion& ma, MovingCores& b
       out.u = 1;
       return out;
     }
+    previous = u;
     u = std::min(next, 1.0);
   }
   out.converged = false;  // undecided: no contact before u, none proved after it

@@ -2,6 +2,7 @@
 #include "renderer/collision/scene_collide.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -65,15 +66,33 @@ DVec3 proxy_contact_point(const Proxy& b, const Penetration& p) {
   return best - p.direction * radius + p.direction * (0.5 * p.depth);
 }
 
-// The solid of one placed mesh of a node: its triangles over its own (contiguous) vertices.
-SolidMesh instance_solid(const NodeGeometry& g, size_t instance, const SolidBspConfig& config) {
-  const auto first = g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[instance]);
-  const auto last = g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[instance + 1]);
-  const uint32_t lo = *std::min_element(first, last), hi = *std::max_element(first, last);
-  std::vector<uint32_t> local;
-  for (auto it = first; it != last; ++it) local.push_back(*it - lo);
-  return build_solid_mesh(std::span<const Vec3f>(g.positions.data() + lo, size_t(hi - lo) + 1), local,
-                          config);
+// The solids of a node for volumes: one per placement, the instances that share it (a glTF
+// mesh's primitives, which may each be open where they meet) taken together, so that copies
+// placed apart, overlapping or mirrored stay separate solids whose union is sound.
+std::vector<SolidMesh> placement_solids(const NodeGeometry& g, const SolidBspConfig& config) {
+  const size_t n = g.instance_to_world.size();
+  std::vector<uint8_t> taken(n, 0);
+  std::vector<SolidMesh> out;
+  for (size_t i = 0; i < n; ++i) {
+    if (taken[i]) continue;
+    std::vector<uint32_t> tris;
+    for (size_t j = i; j < n; ++j) {
+      if (taken[j] || std::memcmp(&g.instance_to_world[i], &g.instance_to_world[j], sizeof(Affine3f)) != 0)
+        continue;
+      taken[j] = 1;
+      tris.insert(tris.end(), g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[j]),
+                  g.triangles.begin() + std::ptrdiff_t(g.instance_triangles[j + 1]));
+    }
+    if (tris.empty()) continue;
+    // Over the span of vertices the triangles use (vertices between them that they do not use
+    // are ignored by the solid's build).
+    const uint32_t lo = *std::min_element(tris.begin(), tris.end());
+    const uint32_t hi = *std::max_element(tris.begin(), tris.end());
+    for (uint32_t& t : tris) t -= lo;
+    out.push_back(
+        build_solid_mesh(std::span<const Vec3f>(g.positions.data() + lo, size_t(hi - lo) + 1), tris, config));
+  }
+  return out;
 }
 
 }  // namespace
@@ -94,7 +113,7 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
   std::vector<uint8_t> have_tree(nodes.size(), 0);
   std::vector<Proxy> proxies(nodes.size());
   std::vector<uint8_t> have_proxy(nodes.size(), 0);
-  std::vector<std::vector<SolidMesh>> solids(nodes.size());  // per node, one per placed mesh
+  std::vector<std::vector<SolidMesh>> solids(nodes.size());  // per node, one per placement
   std::vector<uint8_t> have_solid(nodes.size(), 0);
   for (const auto& [i, j] : candidates) {
     const NodeGeometry& ga = nodes[i];
@@ -130,10 +149,7 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
         for (uint32_t k : {fi, si})
           if (!have_solid[k]) {
             try {
-              const NodeGeometry& g = nodes[k];
-              for (size_t part = 0; part + 1 < g.instance_triangles.size(); ++part)
-                if (g.instance_triangles[part] < g.instance_triangles[part + 1])
-                  solids[k].push_back(instance_solid(g, part, config.solid));
+              solids[k] = placement_solids(nodes[k], config.solid);
             } catch (const std::invalid_argument& e) {
               throw std::invalid_argument("node " + std::to_string(nodes[k].node) + ": " + e.what());
             }

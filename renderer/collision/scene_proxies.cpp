@@ -149,6 +149,7 @@ std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int>
     g->enclosed_volume = v < 0 ? NAN : g->enclosed_volume + v * abs_det(inst.to_world);
     ++g->instances;
     g->instance_triangles.push_back(g->triangles.size());
+    g->instance_to_world.push_back(inst.to_world);
   }
   std::sort(out.begin(), out.end(),
             [](const NodeGeometry& a, const NodeGeometry& b) { return a.node < b.node; });

@@ -29,6 +29,7 @@ struct NodeGeometry {
   /// Per gathered mesh instance, where its triangles start in `triangles` (3 indices each); a
   /// last entry holds the end.
   std::vector<size_t> instance_triangles{0};
+  std::vector<Affine3f> instance_to_world;  ///< per gathered mesh instance, its placement
 };
 
 /// True if `node` is `ancestor` or lies below it (`parents`: each glTF node's parent, -1 for a

@@ -116,6 +116,7 @@ bool ball(ProxyKind k) {
 struct PlanePart {
   std::vector<DPlane> planes;
   DBox box;
+  double volume = 0;
 };
 
 std::vector<PlanePart> plane_parts(const Proxy& p) {
@@ -133,6 +134,7 @@ std::vector<PlanePart> plane_parts(const Proxy& p) {
     DVec3 corners[8];
     box_corners(p.box, corners);
     for (const DVec3& c : corners) part.box.add(c);
+    part.volume = 8 * p.box.half.x * p.box.half.y * p.box.half.z;
     out.push_back(std::move(part));
     return out;
   }
@@ -140,6 +142,7 @@ std::vector<PlanePart> plane_parts(const Proxy& p) {
     if (c.vertices.empty()) continue;
     PlanePart part;
     part.planes = c.planes;
+    part.volume = c.volume;
     for (const DVec3& v : c.vertices) part.box.add(v);
     out.push_back(std::move(part));
   }
@@ -217,10 +220,8 @@ bool parts_disjoint(const std::vector<PlanePart>& parts) {
     for (size_t j = i + 1; j < parts.size(); ++j) {
       const DBox box = meet(parts[i].box, parts[j].box);
       if (box.empty()) continue;
-      const DVec3 e = box.hi - box.lo;
       // Rounding on a shared face leaves slivers far below this.
-      const double sliver = 1e-9 * std::max({e.x, e.y, e.z, 1e-300}) * std::max({e.x, e.y, e.z, 1e-300}) *
-                            std::max({e.x, e.y, e.z, 1e-300});
+      const double sliver = 1e-9 * std::min(parts[i].volume, parts[j].volume);
       if (convex_intersection_volume(parts[i].planes, parts[j].planes, outward(box)) > sliver) return false;
     }
   return true;
@@ -230,9 +231,9 @@ bool parts_disjoint(const std::vector<PlanePart>& parts) {
 
 VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const VolumeConfig& config) {
   VolumeEstimate out;
-  const bool disjoint = (a.kind != ProxyKind::Composite || parts_disjoint(plane_parts(a))) &&
-                        (b.kind != ProxyKind::Composite || parts_disjoint(plane_parts(b)));
-  if (polyhedral(a.kind) && polyhedral(b.kind) && disjoint) {
+  if (polyhedral(a.kind) && polyhedral(b.kind) &&
+      (a.kind != ProxyKind::Composite || parts_disjoint(plane_parts(a))) &&
+      (b.kind != ProxyKind::Composite || parts_disjoint(plane_parts(b)))) {
     out.exact = true;
     const std::vector<PlanePart> pa = plane_parts(a), pb = plane_parts(b);
     for (const PlanePart& x : pa)
@@ -270,7 +271,15 @@ VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<
     double operator()(DVec3 p) const {
       const Vec3f q{float(p.x), float(p.y), float(p.z)};
       double best = INFINITY;
-      for (const SolidMesh& s : meshes) best = std::min(best, double(solid_mesh_signed_distance(s, q)));
+      for (const SolidMesh& s : meshes) {
+        // A mesh whose box is farther than the best answer cannot lower it (its signed distance
+        // is at least the distance to its box).
+        const Vec3f lo = s.bounds.lo - q, hi = q - s.bounds.hi;
+        const double dx = std::max({0.0f, lo.x, hi.x}), dy = std::max({0.0f, lo.y, hi.y}),
+                     dz = std::max({0.0f, lo.z, hi.z});
+        if (std::sqrt(dx * dx + dy * dy + dz * dz) >= best) continue;
+        best = std::min(best, double(solid_mesh_signed_distance(s, q)));
+      }
       return best;
     }
   };

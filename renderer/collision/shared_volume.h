@@ -54,7 +54,8 @@ VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const V
 
 /// The volume two solids share, each the union of closed meshes (a node placing several meshes,
 /// or copies of one: each its own solid, so that overlapping or mirrored parts stay sound), by
-/// the cell quadrature. Both spans must hold at least one mesh.
+/// the cell quadrature. An empty span is an empty solid (volume 0). The union's distance skips
+/// the meshes whose boxes lie farther than the nearest answer so far.
 VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<const SolidMesh> b,
                                         const VolumeConfig& config = {});
 

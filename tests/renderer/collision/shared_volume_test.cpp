@@ -224,6 +224,19 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   const VolumeEstimate& u = union_of.contacts[0].volume;
   CHECK(std::abs(u.volume - 0.25) <= u.error + 1e-6);
   CHECK(u.error < 0.05);
+  // Node 1 as one cube split into two primitives (two meshes placed alike, each open alone, as
+  // a glTF mesh split by material): one solid, the same 0.225 as the whole cube.
+  Scene split = s;
+  Mesh first = cube_mesh(0.5f), second = cube_mesh(0.5f);
+  first.indices.resize(18);
+  second.indices.erase(second.indices.begin(), second.indices.begin() + 18);
+  split.meshes.push_back(first);
+  split.meshes.push_back(second);
+  split.instances[1] = make_instance(int(split.meshes.size()) - 2, at, 1);
+  split.instances.push_back(make_instance(int(split.meshes.size()) - 1, at, 1));
+  const CollideReport halves = collide_scene(split, parents, config);
+  REQUIRE(halves.contacts.size() == 1);
+  CHECK(std::abs(halves.contacts[0].volume.volume - 0.225) <= halves.contacts[0].volume.error + 1e-6);
   // An open mesh (a cube without its top) has no inside: refused, naming the node.
   Mesh open = cube_mesh(0.5f);
   open.indices.resize(open.indices.size() - 6);
