@@ -207,7 +207,7 @@ int mesh_table(const std::string& name, const NodeGeometry& body, const Collisio
       "(ms, median of %d; pairs: meeting triangle pairs)\n",
       name.c_str(), c.repeats);
   std::printf("%8s %10s %12s %12s %12s %12s %12s %10s\n", "overlap", "pairs", "own build", "own query",
-              "embree", "fcl build", "fcl query", "agree");
+              "embree b+q", "fcl build", "fcl query", "agree");
   int wrong = 0;
   const ContactMesh ma{body.points, body.triangles};
   std::vector<double> own_builds;
