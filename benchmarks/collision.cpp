@@ -25,10 +25,6 @@ namespace penumbra::bench {
 
 namespace {
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 // Every placed mesh of the scene as one body.
 NodeGeometry whole_body(const Scene& scene) {
   NodeGeometry body;

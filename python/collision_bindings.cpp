@@ -199,7 +199,8 @@ py::dict continuous(SceneSession& s, const CollideConfig& config, double until) 
     if (!pose_gltf_scene(*s.loaded.animation, until, end))
       throw py::value_error("until: the animation changes more than placements at that time");
     try {
-      r = collide_continuous(s.loaded.scene, end, s.loaded.info.node_parents, config);
+      r = collide_continuous(s.loaded.scene, end,
+                             {s.loaded.info.node_parents, s.loaded.info.node_skin_joints}, config);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file, "", e.what());
     }
@@ -227,7 +228,7 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
   {
     py::gil_scoped_release release;
     try {
-      r = collide_scene(s.loaded.scene, s.loaded.info.node_parents, config);
+      r = collide_scene(s.loaded.scene, {s.loaded.info.node_parents, s.loaded.info.node_skin_joints}, config);
     } catch (const std::invalid_argument& e) {
       throw InputError(s.file, "", e.what());
     }
@@ -241,6 +242,8 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
     d["b_name"] = node_name(s, c.b);
     d["point"] = vec(c.point);
     d["depth"] = finite_or_none(c.depth);
+    d["depth_error"] =
+        std::isfinite(c.depth) ? py::object(py::float_(c.depth_error)) : py::object(py::none());
     d["direction"] = std::isfinite(c.depth) ? py::object(vec(c.direction)) : py::object(py::none());
     d["triangle_pairs"] = c.triangle_pairs;
     d["volume"] = volumes ? py::object(py::float_(c.volume.volume)) : py::object(py::none());
@@ -266,10 +269,12 @@ void bind_collision(SceneClass& scene) {
       "collide", &collide, py::kw_only(), py::arg("proxy") = "mesh", py::arg("include_children") = false,
       py::arg("kdop") = 26, py::arg("until") = py::none(), py::arg("volumes") = false,
       "The nodes that touch or interpenetrate at the scene's pose, as `penumbra collide` finds them: a "
-      "sweep and prune over the nodes' boxes, pairs the hierarchy joins left out unless include_children, "
+      "sweep and prune over the nodes' boxes, pairs the hierarchy or a skin joins left out unless "
+      "include_children, "
       "and an exact test on the triangles (proxy='mesh') or on fitted proxies (a proxy kind, which also "
       "gives depth and direction). Returns a dict: contacts (a list of dicts: a, b, a_name, b_name, point, "
-      "depth, direction, triangle_pairs, and with volumes=True volume, volume_error, volume_exact: the "
+      "depth, depth_error, direction, triangle_pairs, and with volumes=True volume, volume_error, "
+      "volume_exact: the "
       "volume the pair shares as `collide --volumes` measures it), nodes, broad_pairs, family_pairs, "
       "narrow_tests, triangle_tests, and continuous. With until (seconds; a proxy kind; the scene loaded "
       "with time= and "

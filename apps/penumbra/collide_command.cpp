@@ -52,6 +52,7 @@ Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int6
     e["b_name"] = node_name(info, c.b);
     e["point"] = dvec(c.point);
     e["depth"] = std::isfinite(c.depth) ? Json(c.depth) : Json();
+    e["depth_error"] = std::isfinite(c.depth) ? Json(c.depth_error) : Json();
     e["direction"] = std::isfinite(c.depth) ? dvec(c.direction) : Json();
     e["triangle_pairs"] = c.triangle_pairs;
     if (volumes) {
@@ -69,16 +70,18 @@ void print_frame(const CollideReport& r, const GltfInfo& info, std::optional<int
                  bool volumes) {
   if (frame) std::printf("frame %lld (time %.6g s): ", (long long)*frame, time);
   std::printf(
-      "%llu nodes, broad phase %llu pairs (%llu joined by the hierarchy, left out), narrow phase %llu "
+      "%llu nodes, broad phase %llu pairs (%llu joined by the hierarchy or a skin, left out), narrow phase "
+      "%llu "
       "tests, %zu contact%s\n",
       (unsigned long long)r.nodes, (unsigned long long)r.broad_pairs, (unsigned long long)r.family_pairs,
       (unsigned long long)r.narrow_tests, r.contacts.size(), r.contacts.size() == 1 ? "" : "s");
   for (const NodeContact& c : r.contacts) {
     std::printf("  '%s' (%d) and '%s' (%d) at (%.6g, %.6g, %.6g)", node_name(info, c.a).c_str(), c.a,
                 node_name(info, c.b).c_str(), c.b, c.point.x, c.point.y, c.point.z);
-    if (std::isfinite(c.depth))
-      std::printf(", depth %.6g", c.depth);
-    else
+    if (std::isfinite(c.depth)) std::printf(", depth %.6g", c.depth);
+    if (std::isfinite(c.depth) && c.depth_error > 0) std::printf(" (+ at most %.2g)", c.depth_error);
+    // Meshes: an open mesh's depth is NaN, a closed one's has its sample spacing.
+    if (!std::isfinite(c.depth) || c.depth_error > 0)
       std::printf(", %llu triangle pairs", (unsigned long long)c.triangle_pairs);
     if (volumes && c.volume.exact)
       std::printf(", volume %.6g (exact)", c.volume.volume);
@@ -133,7 +136,7 @@ void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, do
   std::printf(
       "  swept to frame %lld: %llu nodes (%llu moving, %zu not rigid, left out), broad phase %llu pairs "
       "(%llu "
-      "joined by the hierarchy, left out), %llu advanced in %llu steps, %zu first contact%s\n",
+      "joined by the hierarchy or a skin, left out), %llu advanced in %llu steps, %zu first contact%s\n",
       (long long)to, (unsigned long long)r.nodes, (unsigned long long)r.moving_nodes, r.nonrigid_nodes.size(),
       (unsigned long long)r.broad_pairs, (unsigned long long)r.family_pairs,
       (unsigned long long)r.narrow_tests, (unsigned long long)r.steps, r.contacts.size(),
@@ -212,7 +215,7 @@ int run_collide(const CollideArgs& a) {
     set_phase("testing for collisions");
     CollideReport report;
     try {
-      report = collide_scene(loaded.scene, loaded.info.node_parents, config);
+      report = collide_scene(loaded.scene, {loaded.info.node_parents, loaded.info.node_skin_joints}, config);
     } catch (const std::invalid_argument& e) {
       throw InputError(a.scene_file, "", e.what());
     }
@@ -238,7 +241,8 @@ int run_collide(const CollideArgs& a) {
         const double t0 = double(f - range->step) / a.fps;
         ContinuousReport swept;
         try {
-          swept = collide_continuous(*previous, loaded.scene, loaded.info.node_parents, config);
+          swept = collide_continuous(*previous, loaded.scene,
+                                     {loaded.info.node_parents, loaded.info.node_skin_joints}, config);
         } catch (const std::invalid_argument& e) {
           throw InputError(a.scene_file, "", e.what());
         }

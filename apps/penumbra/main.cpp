@@ -126,7 +126,8 @@ void add_collide_options(CLI::App& collide, CollideArgs& a) {
       "file's static pose");
   collide.add_option("--fps", a.fps, "frames per second of --frames (default 24)");
   collide.add_flag("--include-children", a.include_children,
-                   "also test pairs where one node lies below the other in the hierarchy");
+                   "also test pairs the node hierarchy or a skin joins (one node below the other; a skinned "
+                   "mesh and the nodes at or below its joints)");
   collide.add_flag(
       "--volumes", a.volumes,
       "also the volume each contact's pair shares: exact for polyhedral proxies and two spheres, "

@@ -95,6 +95,13 @@ void describe(const tinygltf::Model& model, GltfInfo& info) {
   for (size_t i = 0; i < model.nodes.size(); ++i)
     for (int c : model.nodes[i].children)
       if (c >= 0 && size_t(c) < model.nodes.size() && size_t(c) != i) info.node_parents[size_t(c)] = int(i);
+  info.node_skin_joints.assign(model.nodes.size(), {});
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const int skin = model.nodes[i].skin;
+    if (skin < 0 || size_t(skin) >= model.skins.size()) continue;
+    for (int j : model.skins[size_t(skin)].joints)
+      if (j >= 0 && size_t(j) < model.nodes.size()) info.node_skin_joints[i].push_back(j);
+  }
   info.mesh_count = int(model.meshes.size());
   for (size_t i = 0; i < model.meshes.size(); ++i) {
     const auto& m = model.meshes[i];

@@ -67,6 +67,7 @@ struct GltfInfo {
   std::vector<std::string> camera_instances;        ///< "name (perspective, node 3)" in scene order
   std::vector<std::string> node_names;              ///< each node's name, or "nodes[i]" if unnamed
   std::vector<int> node_parents;                    ///< each node's parent node, -1 for a root
+  std::vector<std::vector<int>> node_skin_joints;   ///< per node, the joints of its skin (empty: none)
   std::vector<std::filesystem::path> source_files;  ///< every file read: the glTF/GLB first, then each
                                                     ///< external buffer and image file, in load order
   /// The SHA-256 of each source_files entry's bytes as the loader read them (same order).

@@ -13,10 +13,6 @@ namespace {
 
 constexpr double kSnap = 1e-13;  // relative distance within which a point lies on a cutting plane
 
-double length(DVec3 a) {
-  return std::sqrt(dot(a, a));
-}
-
 /// Twice the area vector of the polygon `pts` (any order of iteration that visits it once).
 struct AreaAccumulator {
   DVec3 first{}, prev{}, sum{};
@@ -316,6 +312,26 @@ void PolytopeSlicer::areas(double k, double& negative, double& positive) {
   cap = std::max(0.0, cap);
   negative = neg + cap;
   positive = pos + cap;
+}
+
+DVec3 closest_on_triangle(DVec3 p, DVec3 a, DVec3 b, DVec3 c) {
+  const DVec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const DVec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const DVec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 }  // namespace penumbra

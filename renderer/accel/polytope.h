@@ -5,6 +5,7 @@
 // change a tree's quality, never an answer.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -31,6 +32,13 @@ inline DVec3 operator*(DVec3 a, double s) {
 inline double dot(DVec3 a, DVec3 b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
+inline double length(DVec3 a) {
+  return std::sqrt(dot(a, a));
+}
+
+/// The nearest point of triangle abc to p, by the Voronoi region of p (Ericson, "Real-Time
+/// Collision Detection", 2005, 5.1.5).
+DVec3 closest_on_triangle(DVec3 p, DVec3 a, DVec3 b, DVec3 c);
 inline DVec3 cross(DVec3 a, DVec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }

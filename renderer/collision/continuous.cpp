@@ -14,10 +14,6 @@ namespace penumbra {
 
 namespace {
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 // The rotation matrix of the fraction u of m's turn.
 Transform turn_at(const RigidMotion& m, double u) {
   return rotate(slerp(Quat{}, m.rotation, u));
@@ -219,13 +215,13 @@ Bounds3f swept_box(const MovingCores& cores, const RigidMotion& m) {
 
 }  // namespace
 
-ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::span<const int> parents,
+ContinuousReport collide_continuous(const Scene& start, const Scene& end, const NodeLinks& links,
                                     const CollideConfig& config, const AdvancementConfig& advance) {
   if (config.mesh)
     throw std::invalid_argument("continuous collision detection runs on proxies, not on meshes");
   ContinuousReport report;
-  std::vector<NodeGeometry> all0 = node_geometry(start, parents, -1);
-  std::vector<NodeGeometry> all1 = node_geometry(end, parents, -1);
+  std::vector<NodeGeometry> all0 = node_geometry(start, links.parents, -1);
+  std::vector<NodeGeometry> all1 = node_geometry(end, links.parents, -1);
   std::vector<const NodeGeometry*> at_end;  // glTF node -> its geometry at the end
   for (const NodeGeometry& g : all1) {
     if (size_t(g.node) >= at_end.size()) at_end.resize(size_t(g.node) + 1, nullptr);
@@ -274,7 +270,7 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::s
     if (!moving[i] && !moving[j]) continue;  // neither moves: the static test at the start decides
     ++report.broad_pairs;
     const int na = nodes[i]->node, nb = nodes[j]->node;
-    if (!config.include_children && (node_in_subtree(na, nb, parents) || node_in_subtree(nb, na, parents))) {
+    if (!config.include_children && nodes_joined(na, nb, links)) {
       ++report.family_pairs;
       continue;
     }

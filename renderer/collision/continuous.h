@@ -95,7 +95,7 @@ struct ContinuousReport {
   uint64_t moving_nodes = 0;            ///< of those, nodes whose points move between the poses
   std::vector<int> nonrigid_nodes;      ///< nodes whose geometry does not move rigidly (left out)
   uint64_t broad_pairs = 0;             ///< node pairs whose swept boxes overlap
-  uint64_t family_pairs = 0;            ///< of those, pairs the hierarchy joins, left out
+  uint64_t family_pairs = 0;            ///< of those, pairs the hierarchy or a skin joins, left out
   uint64_t narrow_tests = 0;            ///< node pairs advanced
   uint64_t steps = 0;                   ///< advancement steps over every pair
 };
@@ -107,7 +107,7 @@ struct ContinuousReport {
 /// advancement on the pairs. Nodes whose vertices do not follow one rigid motion (skinning,
 /// morphing, changing scale) are listed in nonrigid_nodes and left out. config.mesh must be
 /// false. Throws std::invalid_argument naming the node if its geometry cannot be fitted.
-ContinuousReport collide_continuous(const Scene& start, const Scene& end, std::span<const int> parents,
+ContinuousReport collide_continuous(const Scene& start, const Scene& end, const NodeLinks& links,
                                     const CollideConfig& config, const AdvancementConfig& advance = {});
 
 }  // namespace penumbra

@@ -11,10 +11,6 @@ namespace {
 /// Distances below this fraction of the Minkowski difference's size count as touching.
 constexpr double kTouch = 1e-10;
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 DVec3 support(std::span<const DVec3> points, DVec3 d) {
   DVec3 best = points[0];
   double best_dot = dot(best, d);

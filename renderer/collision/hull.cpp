@@ -17,10 +17,6 @@ namespace penumbra {
 
 namespace {
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 // Volume and area of the triangles, and every triangle's winding made outward for its plane.
 void finish_polyhedron(ConvexPolyhedron& poly) {
   poly.volume = poly.area = 0;

@@ -230,4 +230,132 @@ MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const Co
   return out;
 }
 
+namespace {
+
+double box_distance2(const ContactTree::Node& n, DVec3 p) {
+  const double dx = std::max({n.lo.x - p.x, 0.0, p.x - n.hi.x}),
+               dy = std::max({n.lo.y - p.y, 0.0, p.y - n.hi.y}),
+               dz = std::max({n.lo.z - p.z, 0.0, p.z - n.hi.z});
+  return dx * dx + dy * dy + dz * dz;
+}
+
+constexpr int kTreeStack = 128;  // the median split halves each level: depth <= log2(triangles) + 1
+
+// Which of abc the ray (p, d) crosses (Woop, Benthin & Wald 2013, in double): 0 none, +1 or -1
+// as it leaves through the front or the back, 2 when it passes through an edge or a corner
+// (or p lies on the triangle's plane inside it). kx, ky, kz and the shear s come from d.
+int ray_crossing(DVec3 p, DVec3 a, DVec3 b, DVec3 c, int kx, int ky, int kz, const double (&s)[3]) {
+  const DVec3 ra = a - p, rb = b - p, rc = c - p;
+  const double az = axis(ra, kz), bz = axis(rb, kz), cz = axis(rc, kz);
+  const double ax = axis(ra, kx) - s[0] * az, ay = axis(ra, ky) - s[1] * az;
+  const double bx = axis(rb, kx) - s[0] * bz, by = axis(rb, ky) - s[1] * bz;
+  const double cx = axis(rc, kx) - s[0] * cz, cy = axis(rc, ky) - s[1] * cz;
+  const double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return 0;
+  const double det = u + v + w;
+  if (det == 0) return 0;  // the ray runs in the triangle's plane: its neighbours decide
+  const double t = (u * az + v * bz + w * cz) * s[2];
+  if (t * det < 0) return 0;  // behind p
+  if (u == 0 || v == 0 || w == 0 || t == 0) return 2;
+  // det > 0: the corners run counter-clockwise seen from the ray's origin: the winding's front
+  // faces p, and the ray enters through it.
+  return det > 0 ? -1 : 1;
+}
+
+}  // namespace
+
+MeshClosest mesh_closest(const ContactMesh& mesh, const ContactTree& tree, DVec3 p) {
+  MeshClosest best;
+  if (tree.nodes.empty()) return best;
+  double best2 = INFINITY;
+  uint32_t stack[kTreeStack];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const ContactTree::Node& n = tree.nodes[stack[--top]];
+    if (box_distance2(n, p) >= best2) continue;
+    if (n.count > 0) {
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+        const uint32_t t = tree.order[k];
+        const DVec3 q =
+            closest_on_triangle(p, mesh.points[mesh.triangles[3 * t]], mesh.points[mesh.triangles[3 * t + 1]],
+                                mesh.points[mesh.triangles[3 * t + 2]]);
+        const DVec3 d = q - p;
+        if (dot(d, d) < best2) best2 = dot(d, d), best.point = q, best.triangle = t;
+      }
+      continue;
+    }
+    const double dl = box_distance2(tree.nodes[n.left], p), dr = box_distance2(tree.nodes[n.right], p);
+    if (top + 2 > kTreeStack) continue;  // unreachable for trees of fewer than 2^126 triangles
+    // The nearer child is popped first.
+    stack[top++] = dl <= dr ? n.right : n.left;
+    stack[top++] = dl <= dr ? n.left : n.right;
+  }
+  best.distance = std::sqrt(best2);
+  return best;
+}
+
+bool mesh_winding(const ContactMesh& mesh, const ContactTree& tree, std::span<const int8_t> orientation,
+                  DVec3 p, int& winding) {
+  // Directions with no simple ratio between their components, so that rays from points on a
+  // grid graze edges only by accident.
+  static constexpr DVec3 kDirections[] = {{0.5773912, 0.6194032, 0.5318711},
+                                          {-0.3861104, 0.8342313, -0.3935311},
+                                          {0.7210447, -0.2491683, -0.6465149}};
+  if (tree.nodes.empty()) {
+    winding = 0;
+    return true;
+  }
+  for (const DVec3& d : kDirections) {
+    // Woop et al.'s per-ray set-up: the dominant axis becomes z, x and y follow it cyclically
+    // (swapped when d.z < 0 to keep the winding), and the shear constants.
+    const double ad[3] = {std::abs(d.x), std::abs(d.y), std::abs(d.z)};
+    const int kz = ad[0] >= ad[1] && ad[0] >= ad[2] ? 0 : ad[1] >= ad[2] ? 1 : 2;
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+    if (axis(d, kz) < 0) std::swap(kx, ky);
+    const double s[3] = {axis(d, kx) / axis(d, kz), axis(d, ky) / axis(d, kz), 1 / axis(d, kz)};
+    const DVec3 inv{1 / d.x, 1 / d.y, 1 / d.z};
+    int count = 0;
+    bool grazed = false;
+    uint32_t stack[kTreeStack];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0 && !grazed) {
+      const ContactTree::Node& n = tree.nodes[stack[--top]];
+      // The slab test for the ray (t >= 0), widened by a relative margin so that rounding
+      // never drops a box the ray touches.
+      double t0 = 0, t1 = INFINITY;
+      for (int k = 0; k < 3 && t0 <= t1; ++k) {
+        const double o = axis(p, k), i = axis(inv, k);
+        double a = (axis(n.lo, k) - o) * i, b = (axis(n.hi, k) - o) * i;
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a - 1e-9 * std::abs(a)), t1 = std::min(t1, b + 1e-9 * std::abs(b));
+      }
+      if (t0 > t1) continue;
+      if (n.count > 0) {
+        for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+          const uint32_t t = tree.order[k];
+          const int c =
+              ray_crossing(p, mesh.points[mesh.triangles[3 * t]], mesh.points[mesh.triangles[3 * t + 1]],
+                           mesh.points[mesh.triangles[3 * t + 2]], kx, ky, kz, s);
+          if (c == 2) {
+            grazed = true;
+            break;
+          }
+          count += c * (orientation.empty() ? 1 : orientation[t]);
+        }
+        continue;
+      }
+      if (top + 2 > kTreeStack) continue;
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+    }
+    if (!grazed) {
+      winding = count;
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace penumbra

@@ -7,6 +7,7 @@
 // "Faster triangle-triangle intersection tests", INRIA RR-4488, 2002). Touching counts.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -56,5 +57,28 @@ struct MeshContacts {
 /// the descent (the counts go on).
 MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const ContactMesh& b,
                            const ContactTree& tb, size_t max_pairs = SIZE_MAX);
+
+/// The nearest point of a mesh's surface to p (distance INFINITY for a mesh without triangles).
+struct MeshClosest {
+  double distance = INFINITY;
+  DVec3 point{};
+  uint32_t triangle = 0;
+};
+
+/// The closest point of `mesh` to p by a walk of its tree (nearer box first, boxes farther than
+/// the best so far skipped; point-triangle distances as Ericson, "Real-Time Collision
+/// Detection", 2005, 5.1.5). Never allocates or throws.
+MeshClosest mesh_closest(const ContactMesh& mesh, const ContactTree& tree, DVec3 p);
+
+/// The winding number of closed meshes around p: the signed count of their triangles that a ray
+/// from p crosses (+1 where the ray leaves through a triangle's front, the side its winding
+/// faces), each triangle's sign multiplied by `orientation` (+1 or -1 per triangle; empty: all
+/// +1). For closed outward-wound solids it counts the solids holding p, so p lies in their
+/// union when it is positive. The ray test is the watertight one of Woop, Benthin & Wald
+/// (JCGT 2(1), 2013) in double precision; a ray through an edge or a vertex is cast again along
+/// another of a fixed set of directions. Returns false (winding unset) if every direction
+/// grazes, or p lies on a triangle. Never allocates or throws.
+bool mesh_winding(const ContactMesh& mesh, const ContactTree& tree, std::span<const int8_t> orientation,
+                  DVec3 p, int& winding);
 
 }  // namespace penumbra

@@ -17,9 +17,6 @@ namespace {
 
 constexpr double kPiD = std::numbers::pi;
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
 DVec3 normalized(DVec3 v) {
   const double l = length(v);
   return l > 0 ? v * (1 / l) : DVec3{0, 0, 0};

@@ -95,11 +95,119 @@ std::vector<SolidMesh> placement_solids(const NodeGeometry& g, const SolidBspCon
   return out;
 }
 
+// Calls f(point) for samples of the triangles of `g` whose boxes meet `region`: each triangle's
+// barycentric grid of n x n similar sub-triangles, n the smallest making every edge at most h
+// (its corners included), so every point of those triangles lies within h of a sample. Returns
+// the samples' count (with f empty: only counts).
+template <class F>
+uint64_t surface_samples(const NodeGeometry& g, const Bounds3f& region, double h, F&& f) {
+  uint64_t count = 0;
+  for (size_t t = 0; t + 2 < g.triangles.size(); t += 3) {
+    const DVec3 a = g.points[g.triangles[t]], b = g.points[g.triangles[t + 1]],
+                c = g.points[g.triangles[t + 2]];
+    if (std::max({a.x, b.x, c.x}) < region.lo.x || std::min({a.x, b.x, c.x}) > region.hi.x ||
+        std::max({a.y, b.y, c.y}) < region.lo.y || std::min({a.y, b.y, c.y}) > region.hi.y ||
+        std::max({a.z, b.z, c.z}) < region.lo.z || std::min({a.z, b.z, c.z}) > region.hi.z)
+      continue;
+    const double edge = std::max({length(b - a), length(c - b), length(a - c)});
+    const uint64_t n = std::max<uint64_t>(1, uint64_t(std::ceil(std::min(edge / h, 1e6))));
+    count += (n + 1) * (n + 2) / 2;
+    if constexpr (!std::is_same_v<std::decay_t<F>, std::nullptr_t>) {
+      for (uint64_t i = 0; i <= n; ++i)
+        for (uint64_t j = 0; i + j <= n; ++j) {
+          const double u = double(i) / double(n), v = double(j) / double(n);
+          f(a * (1 - u - v) + b * u + c * v);
+        }
+    }
+  }
+  return count;
+}
+
+// Per triangle of a closed node, +1 or -1 so that each placement's meshes (the instances
+// sharing one placement, as placement_solids groups them) wind outward: the sign of their
+// signed volume (a mirrored placement or an inward-wound file gives a negative one).
+std::vector<int8_t> outward_orientation(const NodeGeometry& g) {
+  std::vector<int8_t> out(g.triangles.size() / 3, 1);
+  const size_t n = g.instance_to_world.size();
+  std::vector<uint8_t> taken(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (taken[i]) continue;
+    std::vector<size_t> group;
+    for (size_t j = i; j < n; ++j)
+      if (!taken[j] && std::memcmp(&g.instance_to_world[i], &g.instance_to_world[j], sizeof(Affine3f)) == 0)
+        taken[j] = 1, group.push_back(j);
+    double volume = 0;
+    for (size_t j : group)
+      for (size_t t = g.instance_triangles[j]; t + 2 < g.instance_triangles[j + 1]; t += 3)
+        volume +=
+            dot(g.points[g.triangles[t]], cross(g.points[g.triangles[t + 1]], g.points[g.triangles[t + 2]]));
+    if (volume >= 0) continue;
+    for (size_t j : group)
+      for (size_t t = g.instance_triangles[j]; t < g.instance_triangles[j + 1]; t += 3) out[t / 3] = -1;
+  }
+  return out;
+}
+
+// A closed node as a solid: its triangles, their tree and outward orientation.
+struct NodeSolid {
+  ContactMesh mesh;
+  const ContactTree* tree = nullptr;
+  std::span<const int8_t> orientation;
+};
+
+// The deepest sample of one node's surface inside another's solid (the union of its closed
+// meshes: a positive winding number).
+struct Deepest {
+  bool inside = false;  // some sample lies inside
+  double depth = 0;     // its distance to the nearest surface of the solid
+  DVec3 point{};        // the sample
+  DVec3 toward{};       // unit, from the sample to that nearest surface point (zero on it)
+};
+
+Deepest deepest_inside(const NodeGeometry& from, const NodeSolid& into, const Bounds3f& region, double h) {
+  Deepest best;
+  surface_samples(from, region, h, [&](DVec3 p) {
+    int winding = 0;
+    if (!mesh_winding(into.mesh, *into.tree, into.orientation, p, winding) || winding <= 0) return;
+    const MeshClosest c = mesh_closest(into.mesh, *into.tree, p);
+    if (best.inside && c.distance <= best.depth) return;
+    best.inside = true, best.depth = c.distance, best.point = p;
+    best.toward = c.distance > 0 ? (c.point - p) * (1 / c.distance) : DVec3{0, 0, 0};
+  });
+  return best;
+}
+
+// Mesh penetration depth of two closed nodes: the deepest sample of either surface inside the
+// other, the sample spacing chosen within the budget over the region both boxes share. Sets
+// depth and depth_error (0 and the spacing when no sample of either lies inside the other:
+// then it returns false), direction and, when `set_point`, the point.
+bool mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& b, const NodeSolid& sb,
+                uint64_t budget, bool set_point, NodeContact& contact) {
+  const Bounds3f region = intersect(box_of(a.points), box_of(b.points));
+  if (region.lo.x > region.hi.x || region.lo.y > region.hi.y || region.lo.z > region.hi.z) return false;
+  const Vec3f extent = region.hi - region.lo;
+  double h = std::max(double(std::max({extent.x, extent.y, extent.z})) / 64, 1e-12);
+  while (surface_samples(a, region, h, nullptr) + surface_samples(b, region, h, nullptr) > budget) h *= 1.5;
+  contact.depth = 0;
+  contact.depth_error = h;
+  const Deepest in_b = deepest_inside(a, sb, region, h);  // a's surface inside b
+  const Deepest in_a = deepest_inside(b, sa, region, h);  // b's surface inside a
+  if (!in_b.inside && !in_a.inside) return false;
+  const bool use_b = in_b.inside && (!in_a.inside || in_b.depth >= in_a.depth);
+  const Deepest& d = use_b ? in_b : in_a;
+  contact.depth = d.depth;
+  // a's point in b: moving b by depth against `toward` brings b's nearest surface onto it;
+  // b's point in a: moving b along `toward` carries it onto a's surface.
+  contact.direction = use_b ? d.toward * -1.0 : d.toward;
+  if (set_point) contact.point = d.point;
+  return true;
+}
+
 }  // namespace
 
-CollideReport collide_scene(const Scene& scene, std::span<const int> parents, const CollideConfig& config) {
+CollideReport collide_scene(const Scene& scene, const NodeLinks& links, const CollideConfig& config) {
   CollideReport report;
-  std::vector<NodeGeometry> nodes = node_geometry(scene, parents, -1);
+  std::vector<NodeGeometry> nodes = node_geometry(scene, links.parents, -1);
   nodes.erase(
       std::remove_if(nodes.begin(), nodes.end(), [](const NodeGeometry& g) { return g.points.empty(); }),
       nodes.end());
@@ -115,11 +223,11 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
   std::vector<uint8_t> have_proxy(nodes.size(), 0);
   std::vector<std::vector<SolidMesh>> solids(nodes.size());  // per node, one per placement
   std::vector<uint8_t> have_solid(nodes.size(), 0);
+  std::vector<std::vector<int8_t>> orientation(nodes.size());  // closed nodes' outward_orientation
   for (const auto& [i, j] : candidates) {
     const NodeGeometry& ga = nodes[i];
     const NodeGeometry& gb = nodes[j];
-    if (!config.include_children &&
-        (node_in_subtree(ga.node, gb.node, parents) || node_in_subtree(gb.node, ga.node, parents))) {
+    if (!config.include_children && nodes_joined(ga.node, gb.node, links)) {
       ++report.family_pairs;
       continue;
     }
@@ -137,14 +245,27 @@ CollideReport collide_scene(const Scene& scene, std::span<const int> parents, co
       const ContactMesh ma{first.points, first.triangles}, mb{second.points, second.triangles};
       const MeshContacts found = mesh_contacts(ma, trees[fi], mb, trees[si], kMaxKeptPairs);
       report.triangle_tests += found.triangle_pairs;
-      if (found.pairs.empty()) continue;
-      contact.triangle_pairs = found.meeting;
-      const auto [s, t] = found.pairs.front();
-      auto corner = [](const ContactMesh& m, uint32_t tri, int k) {
-        return m.points[m.triangles[3 * tri + k]];
-      };
-      contact.point = triangle_contact_point(corner(ma, s, 0), corner(ma, s, 1), corner(ma, s, 2),
-                                             corner(mb, t, 0), corner(mb, t, 1), corner(mb, t, 2));
+      const bool met = !found.pairs.empty();
+      // Closed nodes are solids: one may hold the other without their surfaces meeting, and
+      // their contact has a depth.
+      const bool closed = std::isfinite(first.enclosed_volume) && std::isfinite(second.enclosed_volume);
+      if (!met && !closed) continue;
+      if (met) {
+        contact.triangle_pairs = found.meeting;
+        const auto [s, t] = found.pairs.front();
+        auto corner = [](const ContactMesh& m, uint32_t tri, int k) {
+          return m.points[m.triangles[3 * tri + k]];
+        };
+        contact.point = triangle_contact_point(corner(ma, s, 0), corner(ma, s, 1), corner(ma, s, 2),
+                                               corner(mb, t, 0), corner(mb, t, 1), corner(mb, t, 2));
+      }
+      if (closed) {
+        for (uint32_t k : {fi, si})
+          if (orientation[k].empty()) orientation[k] = outward_orientation(nodes[k]);
+        const NodeSolid sa{ma, &trees[fi], orientation[fi]}, sb{mb, &trees[si], orientation[si]};
+        const bool inside = mesh_depth(first, sa, second, sb, config.depth_samples, !met, contact);
+        if (!met && !inside) continue;
+      }
       if (config.volumes) {
         for (uint32_t k : {fi, si})
           if (!have_solid[k]) {

@@ -1,9 +1,11 @@
 // Static (discrete, a posteriori) collision detection over a scene's nodes at one pose: the
 // world-space geometry of each node that places a mesh, a broad phase by sweep and prune over
 // their boxes (Cohen, Lin, Manocha & Ponamgi, "I-COLLIDE", I3D 1995), pairs that the node
-// hierarchy joins (one node below the other) left out unless asked, and a narrow phase on the
-// triangles (mesh_contact: exact) or on fitted proxies (gjk: distance and penetration depth),
-// and optionally the volume of each interpenetration (shared_volume.h).
+// hierarchy or a skin joins (nodes_joined) left out unless asked, and a narrow phase on the
+// triangles (mesh_contact: exact; closed meshes also as solids, for a solid inside another
+// and the depth of the deepest surface point inside the other) or on fitted proxies (gjk:
+// distance and penetration depth), and optionally the volume of each interpenetration
+// (shared_volume.h).
 #pragma once
 
 #include <cmath>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "renderer/collision/proxy.h"
+#include "renderer/collision/scene_proxies.h"
 #include "renderer/collision/shared_volume.h"
 #include "renderer/scene/scene.h"
 
@@ -22,20 +25,34 @@ struct CollideConfig {
   bool mesh = true;                  ///< narrow phase on the triangles; false: on proxies of `kind`
   ProxyKind kind = ProxyKind::Hull;  ///< the proxies' kind when !mesh
   ProxyConfig fit;                   ///< their fitting
-  bool include_children = false;     ///< also test pairs where one node lies below the other
+  bool include_children = false;     ///< also test pairs the hierarchy or a skin joins (nodes_joined)
   bool volumes = false;              ///< measure each contact's interpenetration volume
   VolumeConfig volume;               ///< how (meshes, and proxies without a closed form)
   /// Meshes' solids for volumes (each node's mesh must be closed); the partition's quadratic
   /// time on convex parts is capped at 10^9 polygon tests.
   SolidBspConfig solid{.max_classifications = 1000000000};
+  /// Meshes' penetration depth: surface samples per node pair at most (the spacing, and so
+  /// NodeContact::depth_error, grows until they fit).
+  uint64_t depth_samples = uint64_t(1) << 18;
 };
 
 /// Two nodes that touch or interpenetrate.
 struct NodeContact {
-  int a = -1, b = -1;           ///< glTF nodes, a < b
-  double depth = NAN;           ///< proxies: the penetration depth (0 when touching); meshes: NaN
-  DVec3 direction{};            ///< proxies: unit, moving b by depth along it separates them
-  DVec3 point{};                ///< a point where they meet
+  int a = -1, b = -1;  ///< glTF nodes, a < b
+  /// Proxies: the penetration depth (0 when touching). Closed meshes: the depth of the deepest
+  /// point of either surface inside the other solid, sampled (a lower bound on the distance
+  /// either must move to come apart; exact when a vertex goes deepest, as in a box sunk into a
+  /// floor); NaN when a mesh is open.
+  double depth = NAN;
+  /// Meshes: the true deepest point lies at most this much deeper than `depth` (the samples'
+  /// spacing: every surface point lies within it of a sample); 0 for proxies.
+  double depth_error = 0;
+  /// Unit, moving b by depth along it separates them (proxies), or moves the deepest point out
+  /// (meshes; zero when no sample lies inside).
+  DVec3 direction{};
+  /// A point where they meet (meshes: where two triangles meet; when one solid holds the other
+  /// without their surfaces meeting, the deepest sample).
+  DVec3 point{};
   uint64_t triangle_pairs = 0;  ///< meshes: the pairs of triangles that meet
   VolumeEstimate volume;        ///< with CollideConfig::volumes: the volume they share
 };
@@ -45,7 +62,7 @@ struct CollideReport {
   std::vector<NodeContact> contacts;  ///< sorted by (a, b)
   uint64_t nodes = 0;                 ///< nodes with geometry
   uint64_t broad_pairs = 0;           ///< node pairs whose world boxes overlap
-  uint64_t family_pairs = 0;          ///< of those, pairs the hierarchy joins, left out
+  uint64_t family_pairs = 0;          ///< of those, pairs the hierarchy or a skin joins, left out
   uint64_t narrow_tests = 0;          ///< node pairs tested exactly
   uint64_t triangle_tests = 0;        ///< meshes: triangle pairs tested
 };
@@ -58,6 +75,6 @@ std::vector<std::pair<uint32_t, uint32_t>> sweep_and_prune(std::span<const Bound
 /// std::invalid_argument naming the node if its geometry cannot be fitted (proxies) or, for
 /// volumes on meshes, is not a closed mesh (build_solid_mesh's checks) or needs more than the
 /// solid's budget.
-CollideReport collide_scene(const Scene& scene, std::span<const int> parents, const CollideConfig& config);
+CollideReport collide_scene(const Scene& scene, const NodeLinks& links, const CollideConfig& config);
 
 }  // namespace penumbra

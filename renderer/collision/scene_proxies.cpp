@@ -28,10 +28,6 @@ double abs_det(const Affine3f& a) {
   return std::abs(d);
 }
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 Affine3f frame_to_world(DVec3 x, DVec3 y, DVec3 z, DVec3 origin) {
   Affine3f a;
   const DVec3 cols[4] = {x, y, z, origin};
@@ -99,6 +95,20 @@ bool node_in_subtree(int node, int ancestor, std::span<const int> parents) {
     if (node == ancestor) return true;
     node = size_t(node) < parents.size() ? parents[size_t(node)] : -1;
   }
+  return false;
+}
+
+bool nodes_joined(int a, int b, const NodeLinks& links) {
+  if (node_in_subtree(a, b, links.parents) || node_in_subtree(b, a, links.parents)) return true;
+  auto joints_of = [&](int n) {
+    return n >= 0 && size_t(n) < links.skin_joints.size() ? std::span<const int>(links.skin_joints[size_t(n)])
+                                                          : std::span<const int>();
+  };
+  const std::span<const int> ja = joints_of(a), jb = joints_of(b);
+  for (int j : ja)
+    if (node_in_subtree(b, j, links.parents) || std::find(jb.begin(), jb.end(), j) != jb.end()) return true;
+  for (int j : jb)
+    if (node_in_subtree(a, j, links.parents)) return true;
   return false;
 }
 

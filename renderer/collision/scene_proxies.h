@@ -36,6 +36,18 @@ struct NodeGeometry {
 /// root; parent links are followed at most once per node, so a cycle ends).
 bool node_in_subtree(int node, int ancestor, std::span<const int> parents);
 
+/// How a file's glTF nodes are joined: by the hierarchy and by skins.
+struct NodeLinks {
+  std::span<const int> parents;                   ///< each node's parent, -1 for a root
+  std::span<const std::vector<int>> skin_joints;  ///< per node, the joints of its skin (empty: none)
+};
+
+/// True if the file joins nodes a and b: one lies below the other, or a skin joins them (a
+/// skinned node and a node at or below one of its skin's joints, or two skinned nodes whose
+/// skins share a joint). Their contact is by design (a character's hand and the sword its hand
+/// bone carries, a body and the clothes skinned to its skeleton).
+bool nodes_joined(int a, int b, const NodeLinks& links);
+
 /// The geometry of each node that places a mesh (`root` < 0; instances not from glTF are left
 /// out), or of the subtree under node `root` as one entry (empty if it places no mesh).
 /// `node_parents` holds each glTF node's parent (-1 for a root). Shapes are not gathered.

@@ -15,10 +15,6 @@ namespace penumbra {
 
 namespace {
 
-double length(DVec3 v) {
-  return std::sqrt(dot(v, v));
-}
-
 DVec3 min3(DVec3 a, DVec3 b) {
   return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "renderer/accel/polytope.h"
+
 namespace penumbra {
 
 namespace {
@@ -488,25 +490,11 @@ struct BvhBuild {
   }
 };
 
-// Closest point of triangle abc to p (Ericson 2005, 5.1.5): by the Voronoi region of p.
+// Closest point of triangle abc to p (polytope.h).
 D3 closest_on_triangle(D3 p, D3 a, D3 b, D3 c) {
-  const D3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const D3 bp = p - b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const D3 cp = p - c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
+  auto d = [](D3 v) { return DVec3{v.x, v.y, v.z}; };
+  const DVec3 q = penumbra::closest_on_triangle(d(p), d(a), d(b), d(c));
+  return {q.x, q.y, q.z};
 }
 
 double box_distance2(const SolidMeshBvhNode& n, D3 p) {

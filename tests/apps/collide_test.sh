@@ -3,7 +3,11 @@
 # half its size inside it, B overlapping A by 0.2 along x (and the child by 0.35), C far away, a
 # thin wall, and a cube animated through the wall at constant speed:
 # - the meshes' contacts are exactly (A, B) and (child, B); the parent-child pair is left out
-#   (counted) unless --include-children; each contact point lies in both boxes;
+#   (counted) unless --include-children; each contact point lies in both boxes; the depths
+#   (closed meshes: the deepest surface point inside the other) are the x overlaps 0.2 and
+#   0.35 within their stated sample spacing;
+# - a skinned cube and a cube below its skin's joint, overlapping by 0.2: left out as joined
+#   unless --include-children;
 # - with --proxy obb (a cube's OBB is the cube) the penetration depths are 0.2 and 0.35;
 # - over --frames 0-24 at 24 fps the moving cube meets the wall at exactly the frames where
 #   their x extents overlap (10 to 14), with meshes and with proxies;
@@ -75,8 +79,39 @@ PY
 # 1. The meshes at the static pose.
 check_json "mesh contacts" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)] and d["frames"][0]["family_pairs"] == 1'
 check_json "mesh contacts with children" 'pairs(d["frames"][0]) == [(0, 1), (0, 2), (1, 2)] and d["frames"][0]["family_pairs"] == 0' --include-children
-check_json "contact points in both boxes" 'all(inside(c["point"], [0, 0, 0], [0.5] * 3) and inside(c["point"], [0.8, 0, 0], [0.5] * 3) for c in d["frames"][0]["contacts"] if c["b"] == 2) and all(c["depth"] is None and c["triangle_pairs"] > 0 for c in d["frames"][0]["contacts"])'
+check_json "contact points in both boxes" 'all(inside(c["point"], [0, 0, 0], [0.5] * 3) and inside(c["point"], [0.8, 0, 0], [0.5] * 3) for c in d["frames"][0]["contacts"] if c["b"] == 2) and all(c["triangle_pairs"] > 0 for c in d["frames"][0]["contacts"])'
+# Closed cubes: the deepest surface point inside the other is as deep as the x overlap.
+check_json "mesh depths" 'all(want - c["depth_error"] <= c["depth"] <= want + 1e-6 and c["depth_error"] <= 0.02 for c, want in zip(d["frames"][0]["contacts"], (0.2, 0.35)))'
 check_json "broad phase counts" 'd["frames"][0]["nodes"] == 6 and d["frames"][0]["broad_pairs"] == 3 and d["frames"][0]["narrow_tests"] == 2 and d["frames"][0]["frame"] is None'
+# A skinned cube and a cube below its joint's child, overlapping it: a skin joins them.
+skinned="$work/skinned.gltf"
+"$py" - "$skinned" <<'PY'
+import base64, json, struct, sys
+v = [(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
+f = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+idx = [i for q in f for i in (q[0], q[1], q[2], q[0], q[2], q[3])]
+blob = (b"".join(struct.pack("<3f", *p) for p in v) + struct.pack(f"<{len(idx)}I", *idx) +
+        bytes(32) + b"".join(struct.pack("<4f", 1, 0, 0, 0) for _ in v))
+views = [{"buffer": 0, "byteOffset": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 144},
+         {"buffer": 0, "byteOffset": 240, "byteLength": 32}, {"buffer": 0, "byteOffset": 272, "byteLength": 128}]
+accessors = [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [-0.5] * 3, "max": [0.5] * 3},
+             {"bufferView": 1, "componentType": 5125, "count": 36, "type": "SCALAR"},
+             {"bufferView": 2, "componentType": 5121, "count": 8, "type": "VEC4"},
+             {"bufferView": 3, "componentType": 5126, "count": 8, "type": "VEC4"}]
+doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+       "nodes": [{"name": "body", "mesh": 1, "skin": 0},
+                 {"name": "bone", "children": [2]},
+                 {"name": "sword", "mesh": 0, "translation": [0.8, 0, 0]}],
+       "skins": [{"joints": [1]}],
+       "meshes": [{"name": "cube", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]},
+                  {"name": "skinned cube", "primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 2, "WEIGHTS_0": 3}, "indices": 1}]}],
+       "accessors": accessors, "bufferViews": views,
+       "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]}
+json.dump(doc, open(sys.argv[1], "w"))
+PY
+expect 0 "2 nodes, broad phase 1 pairs \(1 joined by the hierarchy or a skin, left out\), narrow phase 0 tests, 0 contacts" -- "$bin" collide "$skinned"
+expect 0 "'body' \(0\) and 'sword' \(2\) at .*, depth 0.2" -- "$bin" collide "$skinned" --include-children
+
 # 2. Oriented boxes of cubes are the cubes: exact penetration depths.
 check_json "OBB depths" '[(c["a"], c["b"], round(c["depth"], 6)) for c in d["frames"][0]["contacts"]] == [(0, 2, 0.2), (1, 2, 0.35)] and all(abs(abs(c["direction"][0]) - 1) < 1e-9 for c in d["frames"][0]["contacts"])' --proxy obb
 check_json "sphere proxies" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)]' --proxy sphere
@@ -89,7 +124,7 @@ expect 0 "'A' \\(0\\) and 'B' \\(2\\) at .*, depth 0.2, volume 0.2 \\(exact\\)" 
 for proxy in mesh obb hull; do
   check_json "frames ($proxy)" '[f["frame"] for f in d["frames"] if (4, 5) in pairs(f)] == list(range(10, 15)) and len(d["frames"]) == 25 and all(pairs(f)[:2] == [(0, 2), (1, 2)] for f in d["frames"])' --frames 0-24 --proxy "$proxy"
 done
-expect 0 "frame 12 \(time 0.5 s\): 6 nodes, broad phase 4 pairs \(1 joined by the hierarchy, left out\), narrow phase 3 tests, 3 contacts" -- "$bin" collide "$scene" --frames 12
+expect 0 "frame 12 \(time 0.5 s\): 6 nodes, broad phase 4 pairs \(1 joined by the hierarchy or a skin, left out\), narrow phase 3 tests, 3 contacts" -- "$bin" collide "$scene" --frames 12
 expect 0 "'A' \(0\) and 'B' \(2\) at .*, depth 0.2" -- "$bin" collide "$scene" --proxy aabb
 
 # 4. Continuous detection between two frames that both miss the wall.

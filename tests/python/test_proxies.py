@@ -121,9 +121,9 @@ def test_collide_equals_the_command(default_scene, cli):
         for key in ("nodes", "broad_pairs", "family_pairs", "narrow_tests", "triangle_tests"):
             assert r[key] == frame[key]
         assert r["narrow_tests"] + r["family_pairs"] == r["broad_pairs"]
-        for c in r["contacts"]:
+        for c, fc in zip(r["contacts"], frame["contacts"]):
             assert c["a"] < c["b"]
-            assert (c["depth"] is None) == (proxy == "mesh")
+            assert c["depth"] == fc["depth"] and c["depth_error"] == fc["depth_error"]
             if proxy == "obb":
                 assert c["depth"] >= 0 and abs(np.linalg.norm(c["direction"]) - 1) < 1e-9
     with pytest.raises(ValueError, match="not mesh or a proxy kind"):

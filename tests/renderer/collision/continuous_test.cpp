@@ -187,7 +187,7 @@ TEST_CASE("collide_continuous: a cube tunnels through a wall between two poses",
   CollideConfig config;
   config.mesh = false;
   config.kind = ProxyKind::Obb;
-  const ContinuousReport r = collide_continuous(start, end, parents, config);
+  const ContinuousReport r = collide_continuous(start, end, {parents}, config);
   CHECK(r.nodes == 4);
   CHECK(r.moving_nodes == 1);
   CHECK(r.nonrigid_nodes == std::vector<int>{2});
@@ -201,12 +201,12 @@ TEST_CASE("collide_continuous: a cube tunnels through a wall between two poses",
   CHECK(r.narrow_tests == 2);
   // The mover made a child of the wall: the pair is left out unless asked.
   const std::vector<int> child{-1, 0, -1, -1};
-  const ContinuousReport f = collide_continuous(start, end, child, config);
+  const ContinuousReport f = collide_continuous(start, end, {child}, config);
   CHECK(f.family_pairs == 1);
   CHECK(f.contacts.size() == 1);
   config.include_children = true;
-  CHECK(collide_continuous(start, end, child, config).contacts.size() == 2);
+  CHECK(collide_continuous(start, end, {child}, config).contacts.size() == 2);
   // Meshes are not advanced.
   CollideConfig mesh;
-  CHECK_THROWS_AS(collide_continuous(start, end, parents, mesh), std::invalid_argument);
+  CHECK_THROWS_AS(collide_continuous(start, end, {parents}, mesh), std::invalid_argument);
 }

@@ -114,3 +114,71 @@ TEST_CASE("mesh contacts: the trees find exactly the pairs brute force finds", "
   const ContactMesh empty{none, {}};
   CHECK(build_contact_tree(empty).nodes.empty());
 }
+
+namespace {
+
+// Closed boxes [lo, hi] as 12 outward-wound triangles each, appended.
+void add_box(DVec3 lo, DVec3 hi, std::vector<DVec3>& pts, std::vector<uint32_t>& tris) {
+  const uint32_t base = uint32_t(pts.size());
+  for (int i = 0; i < 8; ++i) pts.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces)
+    for (int k : {0, 1, 2, 0, 2, 3}) tris.push_back(base + uint32_t(f[k]));
+}
+
+// The distance from p to the surface of the box [lo, hi].
+double box_surface_distance(DVec3 p, DVec3 lo, DVec3 hi) {
+  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x}), dy = std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+               dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+  if (dx > 0 || dy > 0 || dz > 0) return std::sqrt(dx * dx + dy * dy + dz * dz);
+  return std::min({p.x - lo.x, hi.x - p.x, p.y - lo.y, hi.y - p.y, p.z - lo.z, hi.z - p.z});
+}
+
+}  // namespace
+
+TEST_CASE("mesh winding and closest point: two overlapping boxes", "[contact]") {
+  const DVec3 lo1{-1, -1, -1}, hi1{1, 1, 1}, lo2{0.5, -0.5, -0.5}, hi2{2, 0.5, 0.5};
+  std::vector<DVec3> pts;
+  std::vector<uint32_t> tris;
+  add_box(lo1, hi1, pts, tris);
+  add_box(lo2, hi2, pts, tris);
+  const ContactMesh mesh{pts, tris};
+  const ContactTree tree = build_contact_tree(mesh);
+  // The second box wound inward, its orientation -1, counts as the first does.
+  std::vector<uint32_t> flipped = tris;
+  for (size_t t = 36; t < flipped.size(); t += 3) std::swap(flipped[t + 1], flipped[t + 2]);
+  std::vector<int8_t> orientation(24, 1);
+  std::fill(orientation.begin() + 12, orientation.end(), int8_t(-1));
+  const ContactMesh mesh_flipped{pts, flipped};
+  const ContactTree tree_flipped = build_contact_tree(mesh_flipped);
+  auto in = [](DVec3 p, DVec3 lo, DVec3 hi) {
+    return p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y && p.z > lo.z && p.z < hi.z;
+  };
+  std::mt19937_64 rng(4);
+  int decided = 0, inside_both = 0;
+  for (int i = 0; i < 4000; ++i) {
+    // Random points, and points on a grid of the boxes' own coordinates (rays from them would
+    // run along faces and through edges in axis directions).
+    const DVec3 p =
+        i % 2 ? random_point(rng, 2.5) : DVec3{-2.5 + 0.25 * (i % 21), -1.5 + 0.25 * (i / 21 % 13), 0.25};
+    int w = 0;
+    const bool ok = mesh_winding(mesh, tree, {}, p, w);
+    const bool on_surface = box_surface_distance(p, lo1, hi1) == 0 || box_surface_distance(p, lo2, hi2) == 0;
+    if (on_surface) continue;
+    REQUIRE(ok);
+    ++decided;
+    CHECK(w == int(in(p, lo1, hi1)) + int(in(p, lo2, hi2)));
+    int wf = 0;
+    REQUIRE(mesh_winding(mesh_flipped, tree_flipped, orientation, p, wf));
+    CHECK(wf == w);
+    inside_both += w == 2;
+    const MeshClosest c = mesh_closest(mesh, tree, p);
+    CHECK(
+        c.distance ==
+        Approx(std::min(box_surface_distance(p, lo1, hi1), box_surface_distance(p, lo2, hi2))).margin(1e-12));
+    CHECK(std::abs(length(c.point - p) - c.distance) <= 1e-12);
+  }
+  CHECK(decided > 3500);
+  CHECK(inside_both > 20);
+}

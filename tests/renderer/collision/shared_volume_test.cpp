@@ -200,13 +200,13 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   const std::vector<int> parents{-1, -1};
   CollideConfig config;
   config.volumes = true;
-  const CollideReport meshes = collide_scene(s, parents, config);
+  const CollideReport meshes = collide_scene(s, {parents}, config);
   REQUIRE(meshes.contacts.size() == 1);
   const VolumeEstimate& v = meshes.contacts[0].volume;  // 0.25 x 0.9 x 1
   CHECK(std::abs(v.volume - 0.225) <= v.error + 1e-6);
   config.mesh = false;
   config.kind = ProxyKind::Aabb;
-  const CollideReport boxes = collide_scene(s, parents, config);
+  const CollideReport boxes = collide_scene(s, {parents}, config);
   REQUIRE(boxes.contacts.size() == 1);
   CHECK(boxes.contacts[0].volume.exact);
   CHECK(boxes.contacts[0].volume.volume == Approx(0.225).epsilon(1e-6));
@@ -219,7 +219,7 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   two.instances[1].to_world.m[1][3] = 0;
   two.instances[1] = make_instance(0, two.instances[1].to_world, 1);
   config.mesh = true;
-  const CollideReport union_of = collide_scene(two, parents, config);
+  const CollideReport union_of = collide_scene(two, {parents}, config);
   REQUIRE(union_of.contacts.size() == 1);
   const VolumeEstimate& u = union_of.contacts[0].volume;
   CHECK(std::abs(u.volume - 0.25) <= u.error + 1e-6);
@@ -234,7 +234,7 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   split.meshes.push_back(second);
   split.instances[1] = make_instance(int(split.meshes.size()) - 2, at, 1);
   split.instances.push_back(make_instance(int(split.meshes.size()) - 1, at, 1));
-  const CollideReport halves = collide_scene(split, parents, config);
+  const CollideReport halves = collide_scene(split, {parents}, config);
   REQUIRE(halves.contacts.size() == 1);
   CHECK(std::abs(halves.contacts[0].volume.volume - 0.225) <= halves.contacts[0].volume.error + 1e-6);
   // An open mesh (a cube without its top) has no inside: refused, naming the node.
@@ -244,7 +244,7 @@ TEST_CASE("collide_scene measures the volumes of its contacts", "[shared-volume]
   s.instances[1] = make_instance(1, at, 1);
   config.mesh = true;
   try {
-    collide_scene(s, parents, config);
+    collide_scene(s, {parents}, config);
     FAIL("an open mesh was measured");
   } catch (const std::invalid_argument& e) {
     CHECK_THAT(e.what(), Catch::Contains("node 1") && Catch::Contains("not closed"));
