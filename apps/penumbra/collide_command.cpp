@@ -194,12 +194,8 @@ int run_collide(const CollideArgs& a) {
   set_phase("loading the scene");
   LoadedScene loaded = load_scene(a.scene_file, a.scene, a.allow_external, false, budget, a.quiet, first_time,
                                   range.has_value());
-  uint64_t placed = 0, triangles = 0;
-  for (const Instance& inst : loaded.scene.instances)
-    if (inst.mesh >= 0) {
-      placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
-      triangles += loaded.scene.meshes[size_t(inst.mesh)].indices.size() / 3;
-    }
+  const ShapeTrianglesCount count = placed_geometry_count(loaded.scene);
+  const uint64_t placed = count.vertices, triangles = count.triangles;
   // --continuous holds the previous frame's pose as well.
   const uint64_t scene_bytes = scene_memory_bytes(loaded.scene) * (a.continuous ? 2 : 1);
   uint64_t testing = placed * kBytesPerVertex;

@@ -154,9 +154,7 @@ int run_proxies(const ProxiesArgs& a) {
   config.samples = size_t(a.samples);
   config.threads = a.threads;
   if (a.node) config.root = find_gltf_node(loaded.info, *a.node, a.scene_file);
-  uint64_t placed = 0;
-  for (const Instance& inst : loaded.scene.instances)
-    if (inst.mesh >= 0) placed += loaded.scene.meshes[size_t(inst.mesh)].positions.size();
+  const uint64_t placed = placed_geometry_count(loaded.scene).vertices;
   const uint64_t scene_bytes = scene_memory_bytes(loaded.scene);
   const uint64_t needed = placed * kBytesPerVertex + uint64_t(a.samples) * kBytesPerSample;
   if (needed > budget - std::min(budget, scene_bytes))

@@ -27,7 +27,7 @@ struct CollideConfig {
   ProxyConfig fit;                   ///< their fitting
   bool include_children = false;     ///< also test pairs the hierarchy or a skin joins (nodes_joined)
   bool volumes = false;              ///< measure each contact's interpenetration volume
-  VolumeConfig volume;               ///< how (meshes, and proxies without a closed form)
+  SharedVolumeConfig volume;         ///< how (meshes, and proxies without a closed form)
   /// Meshes' solids for volumes (each node's mesh must be closed); the partition's quadratic
   /// time on convex parts is capped at 10^9 polygon tests.
   SolidBspConfig solid{.max_classifications = 1000000000};

@@ -20,6 +20,15 @@ DVec3 place(const Affine3f& a, Vec3f p) {
   return out;
 }
 
+// The Frobenius norm of the placement's linear part: at least the largest factor by which it
+// stretches a length.
+double linear_norm(const Affine3f& a) {
+  double sum = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) sum += double(a.m[r][c]) * a.m[r][c];
+  return std::sqrt(sum);
+}
+
 double abs_det(const Affine3f& a) {
   const auto& m = a.m;
   const double d = double(m[0][0]) * (double(m[1][1]) * m[2][2] - double(m[1][2]) * m[2][1]) -
@@ -112,18 +121,54 @@ bool nodes_joined(int a, int b, const NodeLinks& links) {
   return false;
 }
 
-std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int> node_parents, int root) {
+std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int> node_parents, int root,
+                                        const ShapeTrianglesConfig& shapes) {
   std::vector<NodeGeometry> out;
   std::vector<int> entry_of_node;  // root < 0: glTF node -> index into out, -1 none yet
   std::vector<double> mesh_volume_cache(scene.meshes.size(), -2);  // -2: not measured, -1: open
+  std::vector<ShapeTriangles> shape_cache(scene.shapes.size());
+  std::vector<double> shape_volume(scene.shapes.size(), -2);
   for (const Instance& inst : scene.instances) {
-    if (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size()) continue;
-    const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-    const int node = inst.node >= 0 ? inst.node : mesh.node;
+    const bool is_shape = inst.shape >= 0 && size_t(inst.shape) < scene.shapes.size();
+    if (!is_shape && (inst.mesh < 0 || size_t(inst.mesh) >= scene.meshes.size())) continue;
+    const int own_node =
+        is_shape ? scene.shapes[size_t(inst.shape)].node : scene.meshes[size_t(inst.mesh)].node;
+    const int node = inst.node >= 0 ? inst.node : own_node;
     if (node < 0) continue;
+    if (root >= 0 && !node_in_subtree(node, root, node_parents)) continue;
+    // The triangles placed: a mesh's, or a shape's tessellation (made once per shape).
+    std::span<const Vec3f> positions;
+    std::span<const uint32_t> indices;
+    bool points = false;
+    double volume = -1;  // object space, -1 when open
+    double error = 0;
+    if (is_shape) {
+      const SceneShape& ss = scene.shapes[size_t(inst.shape)];
+      ShapeTriangles& t = shape_cache[size_t(inst.shape)];
+      double& v = shape_volume[size_t(inst.shape)];
+      if (v == -2) {
+        try {
+          t = shape_triangles(ss.shape, shapes);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument("node " + std::to_string(node) + ": shape '" + ss.name +
+                                      "': " + e.what());
+        }
+        const MeshVolume mv = mesh_volume(t.positions, t.indices);
+        v = t.closed && mv.closed ? std::abs(mv.signed_volume) : -1;
+      }
+      positions = t.positions, indices = t.indices, volume = v;
+      error = t.error * linear_norm(inst.to_world);
+    } else {
+      const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+      double& v = mesh_volume_cache[size_t(inst.mesh)];
+      if (v == -2) {
+        const MeshVolume mv = mesh_volume(mesh.positions, mesh.indices);
+        v = mv.closed && !mesh.points ? std::abs(mv.signed_volume) : -1;
+      }
+      positions = mesh.positions, indices = mesh.indices, points = mesh.points, volume = v;
+    }
     NodeGeometry* g = nullptr;
     if (root >= 0) {
-      if (!node_in_subtree(node, root, node_parents)) continue;
       if (out.empty()) {
         out.emplace_back();
         out.back().node = root;
@@ -141,29 +186,40 @@ std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int>
       g = &out[size_t(entry_of_node[size_t(node)])];
     }
     const uint32_t base = uint32_t(g->points.size());
-    for (const Vec3f& p : mesh.positions) {
+    for (const Vec3f& p : positions) {
       g->points.push_back(place(inst.to_world, p));
       const DVec3& w = g->points.back();
       g->positions.push_back({float(w.x), float(w.y), float(w.z)});
     }
-    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-      const uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
+    for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+      const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
       g->measured.insert(g->measured.end(), {base + a, base + b, base + c});
-      if (!mesh.points) g->triangles.insert(g->triangles.end(), {base + a, base + b, base + c});
+      if (!points) g->triangles.insert(g->triangles.end(), {base + a, base + b, base + c});
     }
-    double& v = mesh_volume_cache[size_t(inst.mesh)];
-    if (v == -2) {
-      const MeshVolume mv = mesh_volume(mesh.positions, mesh.indices);
-      v = mv.closed && !mesh.points ? std::abs(mv.signed_volume) : -1;
-    }
-    g->enclosed_volume = v < 0 ? NAN : g->enclosed_volume + v * abs_det(inst.to_world);
+    g->enclosed_volume = volume < 0 ? NAN : g->enclosed_volume + volume * abs_det(inst.to_world);
     ++g->instances;
+    g->shapes += is_shape;
+    g->shape_error = std::max(g->shape_error, error);
     g->instance_triangles.push_back(g->triangles.size());
     g->instance_to_world.push_back(inst.to_world);
   }
   std::sort(out.begin(), out.end(),
             [](const NodeGeometry& a, const NodeGeometry& b) { return a.node < b.node; });
   return out;
+}
+
+ShapeTrianglesCount placed_geometry_count(const Scene& scene, const ShapeTrianglesConfig& shapes) {
+  ShapeTrianglesCount n;
+  for (const Instance& inst : scene.instances) {
+    ShapeTrianglesCount one;
+    if (inst.shape >= 0 && size_t(inst.shape) < scene.shapes.size())
+      one = shape_triangles_count(scene.shapes[size_t(inst.shape)].shape, shapes);
+    else if (inst.mesh >= 0 && size_t(inst.mesh) < scene.meshes.size())
+      one = {scene.meshes[size_t(inst.mesh)].positions.size(),
+             scene.meshes[size_t(inst.mesh)].indices.size() / 3};
+    n.vertices += one.vertices, n.triangles += one.triangles;
+  }
+  return n;
 }
 
 ProxyTightness proxy_tightness(const Proxy& proxy, const NodeGeometry& geometry, size_t samples, int threads,

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "renderer/collision/proxy.h"
+#include "renderer/collision/shape_triangles.h"
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
@@ -25,11 +26,15 @@ struct NodeGeometry {
   /// The enclosed volume of the placed meshes (each closed mesh's MeshVolume x |det| of its
   /// placement, summed); NaN when some placed mesh is not closed or is a point set.
   double enclosed_volume = NAN;
-  uint64_t instances = 0;  ///< mesh instances gathered
+  uint64_t instances = 0;  ///< mesh and shape instances gathered
+  uint64_t shapes = 0;     ///< of those, shapes (as shape_triangles)
+  /// The shapes' tessellations lie within this distance of their true surfaces (each one's
+  /// ShapeTriangles::error times its placement's largest stretch, bounded by the Frobenius norm).
+  double shape_error = 0;
   /// Per gathered mesh instance, where its triangles start in `triangles` (3 indices each); a
   /// last entry holds the end.
   std::vector<size_t> instance_triangles{0};
-  std::vector<Affine3f> instance_to_world;  ///< per gathered mesh instance, its placement
+  std::vector<Affine3f> instance_to_world;  ///< per gathered instance, its placement
 };
 
 /// True if `node` is `ancestor` or lies below it (`parents`: each glTF node's parent, -1 for a
@@ -48,10 +53,17 @@ struct NodeLinks {
 /// bone carries, a body and the clothes skinned to its skeleton).
 bool nodes_joined(int a, int b, const NodeLinks& links);
 
-/// The geometry of each node that places a mesh (`root` < 0; instances not from glTF are left
-/// out), or of the subtree under node `root` as one entry (empty if it places no mesh).
-/// `node_parents` holds each glTF node's parent (-1 for a root). Shapes are not gathered.
-std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int> node_parents, int root);
+/// The geometry of each node that places a mesh or a shape (`root` < 0; instances not from glTF
+/// are left out), or of the subtree under node `root` as one entry (empty if it places
+/// neither). Shapes are taken as their shape_triangles(shape, `shapes`). `node_parents` holds
+/// each glTF node's parent (-1 for a root). Throws std::invalid_argument naming the node and
+/// the shape if a shape cannot be tessellated (an unbounded implicit shape).
+std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int> node_parents, int root,
+                                        const ShapeTrianglesConfig& shapes = {});
+
+/// What node_geometry gathers over the whole scene (meshes' vertices and triangles, shapes'
+/// shape_triangles_count), for memory budgets.
+ShapeTrianglesCount placed_geometry_count(const Scene& scene, const ShapeTrianglesConfig& shapes = {});
 
 /// How tight a proxy is around its node's geometry.
 struct ProxyTightness {

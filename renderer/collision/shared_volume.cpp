@@ -225,7 +225,7 @@ bool parts_disjoint(const std::vector<PlanePart>& parts) {
 
 }  // namespace
 
-VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const VolumeConfig& config) {
+VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const SharedVolumeConfig& config) {
   VolumeEstimate out;
   if (polyhedral(a.kind) && polyhedral(b.kind) &&
       (a.kind != ProxyKind::Composite || parts_disjoint(plane_parts(a))) &&
@@ -251,7 +251,7 @@ VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const V
 }
 
 VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<const SolidMesh> b,
-                                        const VolumeConfig& config) {
+                                        const SharedVolumeConfig& config) {
   // A union of solids: inside if inside any, at the least distance of them outside.
   struct Union {
     std::span<const SolidMesh> meshes;

@@ -34,7 +34,7 @@ struct VolumeEstimate {
 /// | relative_error | 1e-2    | stop when error <= relative_error x the smaller solid's volume |
 /// | max_cells      | 2^21    | cells evaluated at most (the error bound says what remains);   |
 /// |                |         | a level's cells take 25 bytes each, two levels at a time       |
-struct VolumeConfig {
+struct SharedVolumeConfig {
   double relative_error = 1e-2;
   uint64_t max_cells = uint64_t(1) << 21;
 };
@@ -50,13 +50,14 @@ double ball_intersection_volume(const BoundingSphere& a, const BoundingSphere& b
 /// The volume two proxies share: exact for polyhedral kinds (aabb, obb, hull, kdop; composites
 /// part by part, summed, when no two parts of a composite overlap) and for two spheres; the
 /// cell quadrature for the rest (a capsule, one sphere, a composite whose parts overlap).
-VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b, const VolumeConfig& config = {});
+VolumeEstimate proxy_intersection_volume(const Proxy& a, const Proxy& b,
+                                         const SharedVolumeConfig& config = {});
 
 /// The volume two solids share, each the union of closed meshes (a node placing several meshes,
 /// or copies of one: each its own solid, so that overlapping or mirrored parts stay sound), by
 /// the cell quadrature. An empty span is an empty solid (volume 0). The union's distance skips
 /// the meshes whose boxes lie farther than the nearest answer so far.
 VolumeEstimate mesh_intersection_volume(std::span<const SolidMesh> a, std::span<const SolidMesh> b,
-                                        const VolumeConfig& config = {});
+                                        const SharedVolumeConfig& config = {});
 
 }  // namespace penumbra

@@ -8,6 +8,8 @@
 #   0.35 within their stated sample spacing;
 # - a skinned cube and a cube below its skin's joint, overlapping by 0.2: left out as joined
 #   unless --include-children;
+# - analytic shapes (a sphere and a box sharing 0.5 along x, a capsule apart) collide as their
+#   tessellations, with the depth 0.5 within the sample spacing and the tessellation's error;
 # - with --proxy obb (a cube's OBB is the cube) the penetration depths are 0.2 and 0.35;
 # - over --frames 0-24 at 24 fps the moving cube meets the wall at exactly the frames where
 #   their x extents overlap (10 to 14), with meshes and with proxies;
@@ -111,6 +113,23 @@ json.dump(doc, open(sys.argv[1], "w"))
 PY
 expect 0 "2 nodes, broad phase 1 pairs \(1 joined by the hierarchy or a skin, left out\), narrow phase 0 tests, 0 contacts" -- "$bin" collide "$skinned"
 expect 0 "'body' \(0\) and 'sword' \(2\) at .*, depth 0.2" -- "$bin" collide "$skinned" --include-children
+
+# Analytic shapes (PENUMBRA_shapes) collide as their tessellations: a unit sphere and a 2 x 2 x 2
+# box at x = 1.5 share 0.5 along x; a capsule far away touches neither.
+shapes="$work/shapes.gltf"
+"$py" - "$shapes" <<'PY'
+import json, sys
+shape = lambda name, s, t: {"name": name, "translation": t, "extensions": {"PENUMBRA_shapes": s}}
+doc = {"asset": {"version": "2.0"}, "extensionsUsed": ["PENUMBRA_shapes"], "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+       "nodes": [shape("ball", {"type": "sphere", "radius": 1}, [0, 0, 0]),
+                 shape("crate", {"type": "box", "size": [2, 2, 2]}, [1.5, 0, 0]),
+                 shape("pill", {"type": "capsule", "radius": 0.3, "height": 1.2}, [20, 0, 0])]}
+json.dump(doc, open(sys.argv[1], "w"))
+PY
+scene_saved="$scene"; scene="$shapes"
+check_json "analytic shapes" 'pairs(d["frames"][0]) == [(0, 1)] and d["frames"][0]["nodes"] == 3 and 0.5 - d["frames"][0]["contacts"][0]["depth_error"] - 0.01 <= d["frames"][0]["contacts"][0]["depth"] <= 0.51'
+check_json "analytic shapes (boxes)" 'pairs(d["frames"][0]) == [(0, 1)] and abs(d["frames"][0]["contacts"][0]["depth"] - 0.5) < 0.01' --proxy aabb
+scene="$scene_saved"
 
 # 2. Oriented boxes of cubes are the cubes: exact penetration depths.
 check_json "OBB depths" '[(c["a"], c["b"], round(c["depth"], 6)) for c in d["frames"][0]["contacts"]] == [(0, 2, 0.2), (1, 2, 0.35)] and all(abs(abs(c["direction"][0]) - 1) < 1e-9 for c in d["frames"][0]["contacts"])' --proxy obb

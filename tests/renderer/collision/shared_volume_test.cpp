@@ -153,7 +153,7 @@ TEST_CASE("cell quadrature: a half ball and a half capsule within the stated bou
   const double want_cap = kPiD * 0.25 * 1 + want;  // half the cylinder and one hemisphere
   CHECK(std::abs(cap.volume - want_cap) <= cap.error);
   // A coarse budget: a looser bound, still holding the answer.
-  VolumeConfig coarse;
+  SharedVolumeConfig coarse;
   coarse.max_cells = 5000;
   const VolumeEstimate rough = proxy_intersection_volume(ball, slab, coarse);
   CHECK(rough.cells <= 5000);
