@@ -142,7 +142,7 @@ std::string node_name(const SceneSession& s, int node) {
   return size_t(node) < s.loaded.info.node_names.size() ? s.loaded.info.node_names[size_t(node)] : "";
 }
 
-py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0, double t1) {
+py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0, double t1, bool mesh) {
   auto contacts = [&](const std::vector<SweptContact>& from, bool touching) {
     py::list list;
     for (const SweptContact& c : from) {
@@ -178,14 +178,12 @@ py::dict swept_dict(const ContinuousReport& r, const SceneSession& s, double t0,
   out["broad_pairs"] = r.broad_pairs;
   out["family_pairs"] = r.family_pairs;
   out["narrow_tests"] = r.narrow_tests;
-  out["advancement_steps"] = r.steps;
+  out[mesh ? "triangle_pairs" : "advancement_steps"] = r.steps;
   return out;
 }
 
 // The first contacts between the session's pose and its animation posed at `until`.
 py::dict continuous(SceneSession& s, const CollideConfig& config, double until) {
-  if (config.mesh)
-    throw py::value_error("until: continuous detection advances proxies, not meshes: pass proxy=KIND");
   if (!std::isfinite(until)) throw py::value_error("until must be a finite number of seconds");
   if (!s.loaded.animation)
     throw py::value_error(
@@ -205,7 +203,7 @@ py::dict continuous(SceneSession& s, const CollideConfig& config, double until) 
       throw InputError(s.file, "", e.what());
     }
   }
-  return swept_dict(r, s, s.time, until);
+  return swept_dict(r, s, s.time, until, config.mesh);
 }
 
 py::dict collide(SceneSession& s, const std::string& proxy, bool include_children, int kdop,
@@ -276,15 +274,17 @@ void bind_collision(SceneClass& scene) {
       "depth, depth_error, direction, triangle_pairs, and with volumes=True volume, volume_error, "
       "volume_exact: the "
       "volume the pair shares as `collide --volumes` measures it), nodes, broad_pairs, family_pairs, "
-      "narrow_tests, triangle_tests, and continuous. With until (seconds; a proxy kind; the scene loaded "
+      "narrow_tests, triangle_tests, and continuous. With until (seconds; the scene loaded "
       "with time= and "
-      "keep_animation=True), continuous holds the first contacts of nodes that move rigidly from the "
+      "keep_animation=True), continuous holds the first contacts of moving nodes (meshes: any vertex motion; "
+      "proxies: rigid nodes) from the "
       "scene's pose to its animation at until, as `penumbra collide --continuous` finds them between two "
       "frames (the scene itself is not moved): a dict of contacts (a, b, a_name, b_name, time, fraction, "
       "point, normal), undecided (a, b, a_name, b_name, time, fraction: pairs whose advancement ran out of "
       "budget, with no contact before time), "
       "to_time, nodes, moving_nodes, nonrigid_nodes (dicts of node, name), broad_pairs, family_pairs, "
-      "narrow_tests, advancement_steps; else None.");
+      "narrow_tests, and advancement_steps (proxies) or triangle_pairs (meshes: swept triangle pairs "
+      "tested); else None.");
   scene.def(
       "proxies", &proxies, py::arg("kind"), py::arg("node") = py::none(), py::kw_only(), py::arg("kdop") = 26,
       py::arg("samples") = 20000, py::arg("threads") = 0,

@@ -98,7 +98,8 @@ Json node_list(const std::vector<int>& nodes, const GltfInfo& info) {
 }
 
 // The first contacts between frame `from` (time t0) and the next sampled frame `to` (time t1).
-Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1) {
+Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1,
+                bool mesh) {
   Json j;
   j["to_frame"] = to;
   j["to_time"] = t1;
@@ -108,7 +109,7 @@ Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, dou
   j["broad_pairs"] = r.broad_pairs;
   j["family_pairs"] = r.family_pairs;
   j["narrow_tests"] = r.narrow_tests;
-  j["advancement_steps"] = r.steps;
+  j[mesh ? "triangle_pairs" : "advancement_steps"] = r.steps;
   auto contacts = [&](const std::vector<SweptContact>& from, bool touching) {
     Json list = Json::array();
     for (const SweptContact& c : from) {
@@ -132,17 +133,20 @@ Json swept_json(const ContinuousReport& r, const GltfInfo& info, int64_t to, dou
   return j;
 }
 
-void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1) {
+void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, double t0, double t1,
+                 bool mesh) {
   std::printf(
-      "  swept to frame %lld: %llu nodes (%llu moving, %zu not rigid, left out), broad phase %llu pairs "
-      "(%llu "
-      "joined by the hierarchy or a skin, left out), %llu advanced in %llu steps, %zu first contact%s\n",
+      "  swept to frame %lld: %llu nodes (%llu moving, %zu %s, left out), broad phase %llu pairs (%llu "
+      "joined "
+      "by the hierarchy or a skin, left out), %llu %s %llu %s, %zu first contact%s\n",
       (long long)to, (unsigned long long)r.nodes, (unsigned long long)r.moving_nodes, r.nonrigid_nodes.size(),
-      (unsigned long long)r.broad_pairs, (unsigned long long)r.family_pairs,
-      (unsigned long long)r.narrow_tests, (unsigned long long)r.steps, r.contacts.size(),
-      r.contacts.size() == 1 ? "" : "s");
+      mesh ? "changing their triangles" : "not rigid", (unsigned long long)r.broad_pairs,
+      (unsigned long long)r.family_pairs, (unsigned long long)r.narrow_tests,
+      mesh ? "swept over" : "advanced in", (unsigned long long)r.steps, mesh ? "triangle pairs" : "steps",
+      r.contacts.size(), r.contacts.size() == 1 ? "" : "s");
   for (int n : r.nonrigid_nodes)
-    std::printf("    '%s' (%d) does not move rigidly\n", node_name(info, n).c_str(), n);
+    std::printf("    '%s' (%d) %s\n", node_name(info, n).c_str(), n,
+                mesh ? "changes its triangles between the frames" : "does not move rigidly");
   for (const SweptContact& c : r.contacts)
     std::printf(
         "    '%s' (%d) and '%s' (%d) first touch at time %.9g s (%.6g of the way) at (%.6g, %.6g, %.6g)\n",
@@ -181,10 +185,6 @@ int run_collide(const CollideArgs& a) {
     }
   }
   if (a.continuous) {
-    if (config.mesh)
-      throw UsageError(
-          "--continuous advances convex proxies, not meshes: add --proxy KIND (e.g. hull, obb, "
-          "sphere, composite)");
     if (!range || range->last - range->first < range->step)
       throw UsageError("--continuous needs --frames with two frames or more (A-B or A-B:STEP)");
   }
@@ -243,9 +243,9 @@ int run_collide(const CollideArgs& a) {
           throw InputError(a.scene_file, "", e.what());
         }
         if (a.json)
-          frames.back()["continuous"] = swept_json(swept, loaded.info, f, t0, t);
+          frames.back()["continuous"] = swept_json(swept, loaded.info, f, t0, t, config.mesh);
         else
-          print_swept(swept, loaded.info, f, t0, t);
+          print_swept(swept, loaded.info, f, t0, t, config.mesh);
       }
       run_frame(f, t);
     }

@@ -134,8 +134,10 @@ void add_collide_options(CLI::App& collide, CollideArgs& a) {
       "else (meshes, which must be closed; capsules) with a stated error bound");
   collide.add_flag(
       "--continuous", a.continuous,
-      "also the first contact between each frame and the next of nodes that move rigidly (conservative "
-      "advancement on the --proxy kind; needs --frames with two frames or more)");
+      "also the first contact between each frame and the next: on meshes, of every node whose vertices move "
+      "(each on a straight line; exact vertex-face and edge-edge times), on proxies, of nodes that move "
+      "rigidly "
+      "(conservative advancement); needs --frames with two frames or more");
   collide.add_flag("--json", a.json, "the report as JSON on stdout");
   collide.add_option("--scene", a.scene, "glTF scene index")->check(CLI::Range(0, 1 << 30));
   collide.add_option("--max-memory", a.max_memory,

@@ -1,4 +1,5 @@
-// Continuous collision detection by conservative advancement.
+// Continuous collision detection: conservative advancement on proxies, the swept meshes'
+// first contacts on triangles.
 #include "renderer/collision/continuous.h"
 
 #include <algorithm>
@@ -7,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "renderer/collision/mesh_ccd.h"
+#include "renderer/collision/mesh_contact.h"
 #include "renderer/collision/scene_proxies.h"
 #include "renderer/core/quaternion.h"
 
@@ -215,13 +218,102 @@ Bounds3f swept_box(const MovingCores& cores, const RigidMotion& m) {
 
 }  // namespace
 
+namespace {
+
+void sort_by_nodes(ContinuousReport& report) {
+  for (std::vector<SweptContact>* list : {&report.contacts, &report.undecided})
+    std::sort(list->begin(), list->end(), [](const SweptContact& x, const SweptContact& y) {
+      return x.a < y.a || (x.a == y.a && x.b < y.b);
+    });
+}
+
+// Meshes: every node whose triangles are the same in both poses, its vertices moving on
+// straight lines; the broad phase over the boxes of both poses; a contact at the start by the
+// static test, else the first by mesh_first_contact.
+ContinuousReport continuous_meshes(const Scene& start, const Scene& end, const NodeLinks& links,
+                                   const CollideConfig& config) {
+  ContinuousReport report;
+  const std::vector<NodeGeometry> all0 = node_geometry(start, links.parents, -1, config.shapes);
+  const std::vector<NodeGeometry> all1 = node_geometry(end, links.parents, -1, config.shapes);
+  std::vector<const NodeGeometry*> at_end;  // glTF node -> its geometry at the end
+  for (const NodeGeometry& g : all1) {
+    if (size_t(g.node) >= at_end.size()) at_end.resize(size_t(g.node) + 1, nullptr);
+    at_end[size_t(g.node)] = &g;
+  }
+  std::vector<std::pair<const NodeGeometry*, const NodeGeometry*>> nodes;
+  std::vector<uint8_t> moving;
+  std::vector<Bounds3f> boxes;
+  for (const NodeGeometry& g : all0) {
+    if (g.points.empty()) continue;
+    const NodeGeometry* e = size_t(g.node) < at_end.size() ? at_end[size_t(g.node)] : nullptr;
+    if (!e || e->points.empty()) continue;
+    ++report.nodes;
+    if (e->points.size() != g.points.size() || e->triangles != g.triangles) {
+      report.nonrigid_nodes.push_back(g.node);
+      continue;
+    }
+    nodes.push_back({&g, e});
+    bool moves = false;
+    for (size_t k = 0; k < g.points.size() && !moves; ++k)
+      moves = g.points[k].x != e->points[k].x || g.points[k].y != e->points[k].y ||
+              g.points[k].z != e->points[k].z;
+    moving.push_back(moves);
+    report.moving_nodes += moves;
+    boxes.push_back(merge(points_box(g.points), points_box(e->points)));
+  }
+  std::vector<ContactTree> trees(nodes.size());  // at the start, made on first use
+  std::vector<uint8_t> have_tree(nodes.size(), 0);
+  for (const auto& [i, j] : sweep_and_prune(boxes)) {
+    if (!moving[i] && !moving[j]) continue;  // neither moves: the static test at the start decides
+    ++report.broad_pairs;
+    const int na = nodes[i].first->node, nb = nodes[j].first->node;
+    if (!config.include_children && nodes_joined(na, nb, links)) {
+      ++report.family_pairs;
+      continue;
+    }
+    ++report.narrow_tests;
+    const uint32_t first = na < nb ? i : j, second = na < nb ? j : i;
+    const NodeGeometry &a0 = *nodes[first].first, &a1 = *nodes[first].second;
+    const NodeGeometry &b0 = *nodes[second].first, &b1 = *nodes[second].second;
+    SweptContact s;
+    s.a = std::min(na, nb);
+    s.b = std::max(na, nb);
+    for (uint32_t k : {first, second})
+      if (!have_tree[k])
+        trees[k] = build_contact_tree({nodes[k].first->points, nodes[k].first->triangles}), have_tree[k] = 1;
+    const ContactMesh ma{a0.points, a0.triangles}, mb{b0.points, b0.triangles};
+    const MeshContacts at_start = mesh_contacts(ma, trees[first], mb, trees[second], 1);
+    if (!at_start.pairs.empty()) {
+      const auto [x, y] = at_start.pairs.front();
+      auto corner = [](const ContactMesh& m, uint32_t t, int k) { return m.points[m.triangles[3 * t + k]]; };
+      s.u = 0;
+      s.point = triangle_contact_point(corner(ma, x, 0), corner(ma, x, 1), corner(ma, x, 2), corner(mb, y, 0),
+                                       corner(mb, y, 1), corner(mb, y, 2));
+      report.contacts.push_back(s);
+      continue;
+    }
+    const MeshFirstContact c =
+        mesh_first_contact({a0.points, a1.points, a0.triangles}, {b0.points, b1.points, b0.triangles});
+    report.steps += c.triangle_pairs;
+    if (!c.hit) continue;
+    s.u = c.u;
+    s.point = c.point;
+    s.normal = c.normal;
+    report.contacts.push_back(s);
+  }
+  std::sort(report.nonrigid_nodes.begin(), report.nonrigid_nodes.end());
+  sort_by_nodes(report);
+  return report;
+}
+
+}  // namespace
+
 ContinuousReport collide_continuous(const Scene& start, const Scene& end, const NodeLinks& links,
                                     const CollideConfig& config, const AdvancementConfig& advance) {
-  if (config.mesh)
-    throw std::invalid_argument("continuous collision detection runs on proxies, not on meshes");
+  if (config.mesh) return continuous_meshes(start, end, links, config);
   ContinuousReport report;
-  std::vector<NodeGeometry> all0 = node_geometry(start, links.parents, -1);
-  std::vector<NodeGeometry> all1 = node_geometry(end, links.parents, -1);
+  std::vector<NodeGeometry> all0 = node_geometry(start, links.parents, -1, config.shapes);
+  std::vector<NodeGeometry> all1 = node_geometry(end, links.parents, -1, config.shapes);
   std::vector<const NodeGeometry*> at_end;  // glTF node -> its geometry at the end
   for (const NodeGeometry& g : all1) {
     if (size_t(g.node) >= at_end.size()) at_end.resize(size_t(g.node) + 1, nullptr);
@@ -290,10 +382,7 @@ ContinuousReport collide_continuous(const Scene& start, const Scene& end, const 
     s.converged = c.converged;
     (c.hit ? report.contacts : report.undecided).push_back(s);
   }
-  for (std::vector<SweptContact>* list : {&report.contacts, &report.undecided})
-    std::sort(list->begin(), list->end(), [](const SweptContact& x, const SweptContact& y) {
-      return x.a < y.a || (x.a == y.a && x.b < y.b);
-    });
+  sort_by_nodes(report);
   return report;
 }
 

@@ -1,15 +1,14 @@
-// Continuous (dynamic, a priori) collision detection: the first time two moving rigid bodies
-// touch between two poses, so that a body that passes through a thin wall between two sampled
-// frames is caught. Each body is a fitted convex proxy (ProxyCores) moved by a rigid motion;
-// the time of first contact comes from conservative advancement (Mirtich, "Impulse-based
-// Dynamic Simulation of Rigid Body Systems", PhD thesis, UC Berkeley, 1996): at each step the
-// distance d between the bodies, measured by GJK, and a bound mu on how fast any point of one
-// can approach the other along the closest direction n give a time d / mu during which they
-// cannot meet; the bound is |v . n| + omega_a rho_a + omega_b rho_b for linear velocities v,
-// angular speeds omega and the bodies' largest distances rho from their centres of rotation
-// (Zhang, Lee & Kim, "Interactive continuous collision detection for non-convex polyhedra",
-// The Visual Computer 22(9), 2006). Between two poses each node moves along a straight line of
-// its centre while turning about it at a constant rate (slerp).
+// Continuous (dynamic, a priori) collision detection: the first time two moving bodies touch
+// between two poses, so that a body that passes through a thin wall between two sampled frames
+// is caught. On meshes, by the exact times of mesh_ccd.h. On proxies, each body is a fitted convex proxy
+// (ProxyCores) moved by a rigid motion; the time of first contact comes from conservative advancement
+// (Mirtich, "Impulse-based Dynamic Simulation of Rigid Body Systems", PhD thesis, UC Berkeley, 1996): at each
+// step the distance d between the bodies, measured by GJK, and a bound mu on how fast any point of one can
+// approach the other along the closest direction n give a time d / mu during which they cannot meet; the
+// bound is |v . n| + omega_a rho_a + omega_b rho_b for linear velocities v, angular speeds omega and the
+// bodies' largest distances rho from their centres of rotation (Zhang, Lee & Kim, "Interactive continuous
+// collision detection for non-convex polyhedra", The Visual Computer 22(9), 2006). Between two poses each
+// node moves along a straight line of its centre while turning about it at a constant rate (slerp).
 #pragma once
 
 #include <cstdint>
@@ -93,20 +92,27 @@ struct ContinuousReport {
   std::vector<SweptContact> undecided;  ///< pairs whose advancement ran out of budget, sorted by (a, b)
   uint64_t nodes = 0;                   ///< nodes with geometry in both poses
   uint64_t moving_nodes = 0;            ///< of those, nodes whose points move between the poses
-  std::vector<int> nonrigid_nodes;      ///< nodes whose geometry does not move rigidly (left out)
+  std::vector<int> nonrigid_nodes;      ///< nodes left out: not rigid (proxies), changing triangles (meshes)
   uint64_t broad_pairs = 0;             ///< node pairs whose swept boxes overlap
   uint64_t family_pairs = 0;            ///< of those, pairs the hierarchy or a skin joins, left out
   uint64_t narrow_tests = 0;            ///< node pairs advanced
-  uint64_t steps = 0;                   ///< advancement steps over every pair
+  uint64_t steps = 0;                   ///< advancement steps over every pair (meshes: swept triangle pairs)
 };
 
 /// The first contacts between the poses `start` (u = 0) and `end` (u = 1) of the same scene
-/// (the same instances in the same order, posed at two times): proxies of `config.kind` are
-/// fitted to each rigid node's geometry at the start, each node moves rigidly as described in
-/// the banner, and a broad phase over the boxes each proxy sweeps comes before conservative
-/// advancement on the pairs. Nodes whose vertices do not follow one rigid motion (skinning,
-/// morphing, changing scale) are listed in nonrigid_nodes and left out. config.mesh must be
-/// false. Throws std::invalid_argument naming the node if its geometry cannot be fitted.
+/// (the same instances in the same order, posed at two times).
+/// Proxies (!config.mesh): proxies of `config.kind` are fitted to each rigid node's geometry at
+/// the start, each node moves rigidly as described in the banner, and a broad phase over the
+/// boxes each proxy sweeps comes before conservative advancement on the pairs. Nodes whose
+/// vertices do not follow one rigid motion (skinning, morphing, changing scale) are listed in
+/// nonrigid_nodes and left out.
+/// Meshes (config.mesh): every vertex moves on a straight line between its two positions (any
+/// motion: rigid, skinned, morphed); a broad phase over the boxes of both poses, then pairs that
+/// meet at the start (mesh_contacts) touch at u = 0, the others' first contact comes from
+/// mesh_first_contact (exact vertex-face and edge-edge times); nodes whose triangles differ
+/// between the poses are listed in nonrigid_nodes and left out; `steps` counts the triangle
+/// pairs whose swept boxes overlap.
+/// Throws std::invalid_argument naming the node if its geometry cannot be fitted.
 ContinuousReport collide_continuous(const Scene& start, const Scene& end, const NodeLinks& links,
                                     const CollideConfig& config, const AdvancementConfig& advance = {});
 

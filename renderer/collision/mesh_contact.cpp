@@ -76,16 +76,6 @@ bool coplanar_meet(const DVec3 (&t1)[3], const DVec3 (&t2)[3], DVec3 n) {
   return point_in_triangle_2d(p[0], q) || point_in_triangle_2d(q[0], p);
 }
 
-bool boxes_meet(const ContactTree::Node& a, const ContactTree::Node& b) {
-  return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
-         b.lo.z <= a.hi.z;
-}
-
-double half_area(const ContactTree::Node& n) {
-  const DVec3 d = n.hi - n.lo;
-  return d.x * d.y + d.y * d.z + d.z * d.x;
-}
-
 }  // namespace
 
 bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f) {
@@ -194,38 +184,17 @@ ContactTree build_contact_tree(const ContactMesh& mesh) {
 MeshContacts mesh_contacts(const ContactMesh& a, const ContactTree& ta, const ContactMesh& b,
                            const ContactTree& tb, size_t max_pairs) {
   MeshContacts out;
-  if (ta.nodes.empty() || tb.nodes.empty()) return out;
   auto corner = [](const ContactMesh& m, uint32_t t, int k) {
     return m.points[m.triangles[3 * size_t(t) + size_t(k)]];
   };
-  std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 0}};
-  while (!stack.empty()) {
-    const auto [i, j] = stack.back();
-    stack.pop_back();
-    const ContactTree::Node& na = ta.nodes[i];
-    const ContactTree::Node& nb = tb.nodes[j];
-    ++out.node_pairs;
-    if (!boxes_meet(na, nb)) continue;
-    const bool leaf_a = na.count > 0, leaf_b = nb.count > 0;
-    if (leaf_a && leaf_b) {
-      for (uint32_t x = na.first; x < na.first + na.count; ++x)
-        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) {
-          const uint32_t s = ta.order[x], t = tb.order[y];
-          ++out.triangle_pairs;
-          if (!triangles_meet(corner(a, s, 0), corner(a, s, 1), corner(a, s, 2), corner(b, t, 0),
-                              corner(b, t, 1), corner(b, t, 2)))
-            continue;
-          ++out.meeting;
-          if (out.pairs.size() < max_pairs) out.pairs.push_back({s, t});
-        }
-    } else if (leaf_b || (!leaf_a && half_area(na) >= half_area(nb))) {  // descend the larger
-      stack.push_back({na.left, j});
-      stack.push_back({na.right, j});
-    } else {
-      stack.push_back({i, nb.left});
-      stack.push_back({i, nb.right});
-    }
-  }
+  out.node_pairs = for_overlapping_leaves(ta, tb, [&](uint32_t s, uint32_t t) {
+    ++out.triangle_pairs;
+    if (!triangles_meet(corner(a, s, 0), corner(a, s, 1), corner(a, s, 2), corner(b, t, 0), corner(b, t, 1),
+                        corner(b, t, 2)))
+      return;
+    ++out.meeting;
+    if (out.pairs.size() < max_pairs) out.pairs.push_back({s, t});
+  });
   std::sort(out.pairs.begin(), out.pairs.end());
   return out;
 }

@@ -36,6 +36,44 @@ struct ContactTree {
 
 ContactTree build_contact_tree(const ContactMesh& mesh);
 
+/// The simultaneous descent of two trees: calls leaf(s, t) for every pair of a triangle s of
+/// ta and t of tb whose leaves' boxes overlap, descending the node with the larger box first
+/// when both are inner nodes. Returns the box pairs tested. Holds a stack of node pairs.
+template <class Leaf>
+uint64_t for_overlapping_leaves(const ContactTree& ta, const ContactTree& tb, Leaf&& leaf) {
+  if (ta.nodes.empty() || tb.nodes.empty()) return 0;
+  auto meet = [](const ContactTree::Node& a, const ContactTree::Node& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
+           b.lo.z <= a.hi.z;
+  };
+  auto half_area = [](const ContactTree::Node& n) {
+    const DVec3 d = n.hi - n.lo;
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+  };
+  uint64_t tested = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    const ContactTree::Node& na = ta.nodes[i];
+    const ContactTree::Node& nb = tb.nodes[j];
+    ++tested;
+    if (!meet(na, nb)) continue;
+    const bool leaf_a = na.count > 0, leaf_b = nb.count > 0;
+    if (leaf_a && leaf_b) {
+      for (uint32_t x = na.first; x < na.first + na.count; ++x)
+        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) leaf(ta.order[x], tb.order[y]);
+    } else if (leaf_b || (!leaf_a && half_area(na) >= half_area(nb))) {
+      stack.push_back({na.left, j});
+      stack.push_back({na.right, j});
+    } else {
+      stack.push_back({i, nb.left});
+      stack.push_back({i, nb.right});
+    }
+  }
+  return tested;
+}
+
 /// True if triangles abc and def share a point.
 bool triangles_meet(DVec3 a, DVec3 b, DVec3 c, DVec3 d, DVec3 e, DVec3 f);
 

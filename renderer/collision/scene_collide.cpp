@@ -37,12 +37,7 @@ std::vector<std::pair<uint32_t, uint32_t>> sweep_and_prune(std::span<const Bound
   return pairs;
 }
 
-namespace {
-
-// Triangle pairs kept per node pair (the contact point comes from the first; all are counted).
-constexpr size_t kMaxKeptPairs = 1;
-
-Bounds3f box_of(std::span<const DVec3> points) {
+Bounds3f points_box(std::span<const DVec3> points) {
   Bounds3f b;
   for (const DVec3& p : points) {
     b = merge(b, Vec3f{std::nextafter(float(p.x), -INFINITY), std::nextafter(float(p.y), -INFINITY),
@@ -52,6 +47,11 @@ Bounds3f box_of(std::span<const DVec3> points) {
   }
   return b;
 }
+
+namespace {
+
+// Triangle pairs kept per node pair (the contact point comes from the first; all are counted).
+constexpr size_t kMaxKeptPairs = 1;
 
 // A point of b's core deepest in a along the penetration: b's support point against the
 // direction, moved half the depth back.
@@ -183,7 +183,7 @@ Deepest deepest_inside(const NodeGeometry& from, const NodeSolid& into, const Bo
 // then it returns false), direction and, when `set_point`, the point.
 bool mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& b, const NodeSolid& sb,
                 uint64_t budget, bool set_point, NodeContact& contact) {
-  const Bounds3f region = intersect(box_of(a.points), box_of(b.points));
+  const Bounds3f region = intersect(points_box(a.points), points_box(b.points));
   if (region.lo.x > region.hi.x || region.lo.y > region.hi.y || region.lo.z > region.hi.z) return false;
   const Vec3f extent = region.hi - region.lo;
   double h = std::max(double(std::max({extent.x, extent.y, extent.z})) / 64, 1e-12);
@@ -207,13 +207,13 @@ bool mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& 
 
 CollideReport collide_scene(const Scene& scene, const NodeLinks& links, const CollideConfig& config) {
   CollideReport report;
-  std::vector<NodeGeometry> nodes = node_geometry(scene, links.parents, -1);
+  std::vector<NodeGeometry> nodes = node_geometry(scene, links.parents, -1, config.shapes);
   nodes.erase(
       std::remove_if(nodes.begin(), nodes.end(), [](const NodeGeometry& g) { return g.points.empty(); }),
       nodes.end());
   report.nodes = nodes.size();
   std::vector<Bounds3f> boxes;
-  for (const NodeGeometry& g : nodes) boxes.push_back(box_of(g.points));
+  for (const NodeGeometry& g : nodes) boxes.push_back(points_box(g.points));
   const std::vector<std::pair<uint32_t, uint32_t>> candidates = sweep_and_prune(boxes);
   report.broad_pairs = candidates.size();
   // Narrow-phase data, made once per node on first use.

@@ -34,6 +34,7 @@ struct CollideConfig {
   /// Meshes' penetration depth: surface samples per node pair at most (the spacing, and so
   /// NodeContact::depth_error, grows until they fit).
   uint64_t depth_samples = uint64_t(1) << 18;
+  ShapeTrianglesConfig shapes;  ///< how nodes' shapes become triangles
 };
 
 /// Two nodes that touch or interpenetrate.
@@ -66,6 +67,9 @@ struct CollideReport {
   uint64_t narrow_tests = 0;          ///< node pairs tested exactly
   uint64_t triangle_tests = 0;        ///< meshes: triangle pairs tested
 };
+
+/// The box of `points` in single precision, rounded outward so that it holds them.
+Bounds3f points_box(std::span<const DVec3> points);
 
 /// The pairs of overlapping boxes among `boxes` (i < j), sorted: sweep and prune along x, then
 /// the y and z intervals.

@@ -15,12 +15,13 @@
 #   their x extents overlap (10 to 14), with meshes and with proxies;
 # - --volumes: A and B share 0.2 x 1 x 1, the child and B 0.35 x 0.5 x 0.5: exactly on boxes,
 #   within the stated bound on the meshes;
-# - with --continuous over frames 0 and 24 (both miss the wall), the mover's first contact with
+# - with --continuous over frames 0 and 24 (both miss the wall), on meshes (exactly) and on
+#   proxies, the mover's first contact with
 #   the wall is at the analytic time: its face reaches x = -0.05 at t = 2.45 / 6 s (boxes); the
 #   bounding spheres (radii sqrt(3) / 2 and sqrt(2.0025)) meet earlier; the still nodes are not
 #   advanced; the text report names it;
 # - bad input exits 2 naming the option: an unknown proxy kind, a bad k, a bad range or fps,
-#   --continuous on meshes or on one frame; --volumes on an open mesh names the file, the node
+#   --continuous on one frame; --volumes on an open mesh names the file, the node
 #   and an open edge.
 # Usage: collide_test.sh PENUMBRA_BINARY WORK_DIR
 set -u
@@ -153,13 +154,15 @@ check_json "continuous (sphere)" "pairs($swept) == [(4, 5)] and abs($swept[\"con
 check_json "continuous over every frame" "[f[\"frame\"] for f in d[\"frames\"] if f[\"continuous\"] and pairs(f[\"continuous\"]) == [(4, 5)]] == list(range(9, 15))" --frames 0-24 --proxy hull --continuous
 expect 0 "swept to frame 24: 6 nodes \\(1 moving, 0 not rigid, left out\\), broad phase 1 pairs" -- "$bin" collide "$scene" --frames 0-24:24 --proxy aabb --continuous
 expect 0 "'wall' \\(4\\) and 'mover' \\(5\\) first touch at time 0.40833" -- "$bin" collide "$scene" --frames 0-24:24 --proxy aabb --continuous
+# On the meshes: the exact time (the vertices move on straight lines, as the mover does).
+check_json "continuous (meshes)" "pairs($swept) == [(4, 5)] and abs($swept[\"contacts\"][0][\"time\"] - 2.45 / 6) < 1e-9 and $swept[\"triangle_pairs\"] > 0 and abs($swept[\"contacts\"][0][\"point\"][0] + 0.05) < 1e-6" --frames 0-24:24 --continuous
+expect 0 "swept to frame 24: 6 nodes \\(1 moving, 0 changing their triangles, left out\\), broad phase 1 pairs .* swept over [0-9]+ triangle pairs, 1 first contact" -- "$bin" collide "$scene" --frames 0-24:24 --continuous
 
 # 5. Refusals.
 expect 2 "--proxy cube: not mesh or a proxy kind \(mesh, sphere" -- "$bin" collide "$scene" --proxy cube
 expect 2 "--kdop 7: k must be 6, 14, 18 or 26" -- "$bin" collide "$scene" --proxy kdop --kdop 7
 expect 2 "--frames" -- "$bin" collide "$scene" --frames 5-2
 expect 2 "--fps must be a finite number > 0" -- "$bin" collide "$scene" --frames 0-2 --fps 0
-expect 2 "--continuous advances convex proxies, not meshes: add --proxy KIND" -- "$bin" collide "$scene" --frames 0-2 --continuous
 expect 2 "--continuous needs --frames with two frames or more" -- "$bin" collide "$scene" --proxy obb --frames 3 --continuous
 # The same cubes with B's top two triangles left out: open.
 "$py" - "$scene" "$work/open.gltf" <<'PY'

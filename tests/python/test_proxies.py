@@ -174,9 +174,9 @@ def write_tunnel_scene(path):
 
 def test_continuous_equals_the_command(cli, tmp_path):
     """Scene.collide(until=) on a cube that turns as it passes through a wall equals `penumbra
-    collide --continuous` between the same two frames, finds the analytic time (the cube's x
-    extent does not change as it turns about x: it touches at t = 2.45 / 6), and leaves the
-    scene at its pose."""
+    collide --continuous` between the same two frames, on proxies and on meshes, finds the
+    analytic time (the cube's x extent does not change as it turns about x: it touches at
+    t = 2.45 / 6), and leaves the scene at its pose."""
     path = write_tunnel_scene(tmp_path / "tunnel.gltf")
     scene = penumbra.load(path, time=0.0, keep_animation=True, quiet=True)
     r = scene.collide(proxy="hull", until=1.0)["continuous"]
@@ -192,7 +192,12 @@ def test_continuous_equals_the_command(cli, tmp_path):
     assert abs(r["contacts"][0]["time"] - 2.45 / 6) < 1e-4
     assert scene.collide(proxy="hull")["contacts"] == []  # still at time 0
     assert scene.collide(proxy="hull")["continuous"] is None
-    with pytest.raises(ValueError, match="not meshes"):
-        scene.collide(until=1.0)
+    # On the meshes: the exact time, as the command finds it.
+    m = scene.collide(until=1.0)["continuous"]
+    mdoc = json.loads(subprocess.run([cli, "collide", str(path), "--frames", "0-24:24", "--continuous", "--json", "-q"],
+                                     check=True, capture_output=True, text=True).stdout)["frames"][0]["continuous"]
+    assert [(c["a"], c["b"]) for c in m["contacts"]] == [(c["a"], c["b"]) for c in mdoc["contacts"]] == [(0, 1)]
+    assert abs(m["contacts"][0]["time"] - 2.45 / 6) < 1e-9
+    assert m["triangle_pairs"] == mdoc["triangle_pairs"] > 0
     with pytest.raises(ValueError, match="keep_animation"):
         penumbra.load(path, quiet=True).collide(proxy="obb", until=1.0)

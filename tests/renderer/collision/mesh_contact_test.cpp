@@ -11,8 +11,10 @@
 
 #include "renderer/accel/embree.h"
 #include "renderer/collision/gjk.h"
+#include "support/box_triangles.h"
 
 using namespace penumbra;
+using namespace penumbra::test;
 
 namespace {
 
@@ -117,16 +119,6 @@ TEST_CASE("mesh contacts: the trees find exactly the pairs brute force finds", "
 
 namespace {
 
-// Closed boxes [lo, hi] as 12 outward-wound triangles each, appended.
-void add_box(DVec3 lo, DVec3 hi, std::vector<DVec3>& pts, std::vector<uint32_t>& tris) {
-  const uint32_t base = uint32_t(pts.size());
-  for (int i = 0; i < 8; ++i) pts.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
-  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : faces)
-    for (int k : {0, 1, 2, 0, 2, 3}) tris.push_back(base + uint32_t(f[k]));
-}
-
 // The distance from p to the surface of the box [lo, hi].
 double box_surface_distance(DVec3 p, DVec3 lo, DVec3 hi) {
   const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x}), dy = std::max({lo.y - p.y, 0.0, p.y - hi.y}),
@@ -141,8 +133,8 @@ TEST_CASE("mesh winding and closest point: two overlapping boxes", "[contact]") 
   const DVec3 lo1{-1, -1, -1}, hi1{1, 1, 1}, lo2{0.5, -0.5, -0.5}, hi2{2, 0.5, 0.5};
   std::vector<DVec3> pts;
   std::vector<uint32_t> tris;
-  add_box(lo1, hi1, pts, tris);
-  add_box(lo2, hi2, pts, tris);
+  add_box_triangles(lo1, hi1, pts, tris);
+  add_box_triangles(lo2, hi2, pts, tris);
   const ContactMesh mesh{pts, tris};
   const ContactTree tree = build_contact_tree(mesh);
   // The second box wound inward, its orientation -1, counts as the first does.
