@@ -150,12 +150,18 @@ std::string render_script(const PreparedJob& pj, const SubmitArgs& a, const Reso
   s += "# A failed unit is run again up to " + std::to_string(a.retries) +
        " times; bad input (exit 2) and a cancel or interrupt (130, 143: Slurm requeues what it preempts) are "
        "not.\n";
-  s += "retries=" + std::to_string(a.retries) + "\nattempt=0\n";
+  s += "# A cancel signals every process of the task: the shell outlives it (the trap) and waits for\n"
+       "# penumbra to stop gracefully (the frame marked unfinished, its resume state written, no\n"
+       "# temporaries), since the task ends, and its processes are killed, when the shell exits.\n";
+  s += "retries=" + std::to_string(a.retries) + "\nattempt=0\nstopped=0\n";
+  s += "trap 'stopped=1' TERM INT HUP\n";
   s += "while :; do\n";
   s += "  " + quoted(exe) + " batch " + quoted(pj.job.file.string()) +
-       " --unit \"$SLURM_ARRAY_TASK_ID\" --skip-existing" + batch_options(a) + "\n";
-  s += "  rc=$?\n";
+       " --unit \"$SLURM_ARRAY_TASK_ID\" --skip-existing" + batch_options(a) + " &\n";
+  s += "  pid=$!\n";
+  s += "  while :; do wait \"$pid\"; rc=$?; kill -0 \"$pid\" 2>/dev/null || break; done\n";
   s += "  case \"$rc\" in 0 | 2 | 130 | 143) exit \"$rc\" ;; esac\n";
+  s += "  if [ \"$stopped\" = 1 ]; then exit \"$rc\"; fi\n";
   s += "  if [ \"$attempt\" -ge \"$retries\" ]; then exit \"$rc\"; fi\n";
   s += "  attempt=$((attempt + 1))\n";
   s += "  echo \"penumbra: unit $SLURM_ARRAY_TASK_ID exited with $rc; attempt $((attempt + 1)) of "

@@ -193,7 +193,7 @@ slurm_cluster_stop() {
   for pid in $SLURM_CLUSTER_PIDS; do kill -TERM "$pid" 2>/dev/null; done
   holders="$(slurm_cluster_holders "$dir")"
   for pid in $holders; do kill -TERM "$pid" 2>/dev/null; done
-  if ! slurm_cluster_wait_exit 20 $SLURM_CLUSTER_PIDS $holders; then
+  if ! slurm_cluster_wait_exit 2 $SLURM_CLUSTER_PIDS $holders; then
     for pid in $SLURM_CLUSTER_PIDS $holders; do kill -KILL "$pid" 2>/dev/null; done
     slurm_cluster_wait_exit 5 $SLURM_CLUSTER_PIDS $holders
   fi

@@ -27,7 +27,7 @@ fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
 # The job: sh010 the fly-through (a camera flight and a turning box: the local batch poses one
 # loaded scene, each farm task loads its frame) with the Whitted integrator, sh020 path traced
-# and slow enough (about a second per frame) for a task to be caught running.
+# and slow enough (a few seconds per frame on one thread) for a task to be caught running.
 write_job() {  # write_job FILE OUTPUT_FOLDER
   cat >"$1" <<EOF
 {
@@ -38,7 +38,7 @@ write_job() {  # write_job FILE OUTPUT_FOLDER
      "output": "$2/sh010.####.exr", "png": "$2/sh010.####.png", "settings": {"spp": 2}},
     {"name": "sh020", "scene": "$src/scenes/spheres.gltf", "frames": "1-3", "tiles": 4, "tile_frames": "2",
      "output": "$2/sh020.####.exr", "png": "$2/sh020.####.png",
-     "settings": {"integrator": "path", "spp": 256, "width": 96, "height": 54, "aov": ["Z", "N"], "denoise": true}}
+     "settings": {"integrator": "path", "spp": 48, "width": 96, "height": 54, "aov": ["Z", "N"], "denoise": true}}
   ]
 }
 EOF
