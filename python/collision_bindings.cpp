@@ -242,6 +242,7 @@ py::dict collide(SceneSession& s, const std::string& proxy, bool include_childre
     d["depth"] = finite_or_none(c.depth);
     d["depth_error"] =
         std::isfinite(c.depth) ? py::object(py::float_(c.depth_error)) : py::object(py::none());
+    d["shape_error"] = c.shape_error;
     d["direction"] = std::isfinite(c.depth) ? py::object(vec(c.direction)) : py::object(py::none());
     d["triangle_pairs"] = c.triangle_pairs;
     d["volume"] = volumes ? py::object(py::float_(c.volume.volume)) : py::object(py::none());
@@ -271,13 +272,14 @@ void bind_collision(SceneClass& scene) {
       "include_children, "
       "and an exact test on the triangles (proxy='mesh') or on fitted proxies (a proxy kind, which also "
       "gives depth and direction). Returns a dict: contacts (a list of dicts: a, b, a_name, b_name, point, "
-      "depth, depth_error, direction, triangle_pairs, and with volumes=True volume, volume_error, "
+      "depth, depth_error, shape_error, direction, triangle_pairs, and with volumes=True volume, "
+      "volume_error, "
       "volume_exact: the "
       "volume the pair shares as `collide --volumes` measures it), nodes, broad_pairs, family_pairs, "
       "narrow_tests, triangle_tests, and continuous. With until (seconds; the scene loaded "
       "with time= and "
-      "keep_animation=True), continuous holds the first contacts of moving nodes (meshes: any vertex motion; "
-      "proxies: rigid nodes) from the "
+      "keep_animation=True: animations that move placements), continuous holds the first contacts of moving "
+      "nodes (meshes: exact; proxies: nodes that move rigidly) from the "
       "scene's pose to its animation at until, as `penumbra collide --continuous` finds them between two "
       "frames (the scene itself is not moved): a dict of contacts (a, b, a_name, b_name, time, fraction, "
       "point, normal), undecided (a, b, a_name, b_name, time, fraction: pairs whose advancement ran out of "

@@ -53,6 +53,7 @@ Json frame_json(const CollideReport& r, const GltfInfo& info, std::optional<int6
     e["point"] = dvec(c.point);
     e["depth"] = std::isfinite(c.depth) ? Json(c.depth) : Json();
     e["depth_error"] = std::isfinite(c.depth) ? Json(c.depth_error) : Json();
+    e["shape_error"] = c.shape_error;
     e["direction"] = std::isfinite(c.depth) ? dvec(c.direction) : Json();
     e["triangle_pairs"] = c.triangle_pairs;
     if (volumes) {

@@ -37,7 +37,7 @@ inline double length(DVec3 a) {
 }
 
 /// The nearest point of triangle abc to p, by the Voronoi region of p (Ericson, "Real-Time
-/// Collision Detection", 2005, 5.1.5).
+/// Collision Detection", 2005, 5.1.5); finite for triangles without area (repeated corners).
 DVec3 closest_on_triangle(DVec3 p, DVec3 a, DVec3 b, DVec3 c);
 inline DVec3 cross(DVec3 a, DVec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};

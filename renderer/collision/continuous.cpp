@@ -261,8 +261,13 @@ ContinuousReport continuous_meshes(const Scene& start, const Scene& end, const N
     report.moving_nodes += moves;
     boxes.push_back(merge(points_box(g.points), points_box(e->points)));
   }
-  std::vector<ContactTree> trees(nodes.size());  // at the start, made on first use
+  // Per node, made on first use: the contact tree at the start, the outward orientation (closed
+  // nodes) and the swept tree.
+  std::vector<ContactTree> trees(nodes.size());
   std::vector<uint8_t> have_tree(nodes.size(), 0);
+  std::vector<std::vector<int8_t>> orientation(nodes.size());
+  std::vector<SweptTree> swept(nodes.size());
+  std::vector<uint8_t> have_swept(nodes.size(), 0);
   for (const auto& [i, j] : sweep_and_prune(boxes)) {
     if (!moving[i] && !moving[j]) continue;  // neither moves: the static test at the start decides
     ++report.broad_pairs;
@@ -283,17 +288,36 @@ ContinuousReport continuous_meshes(const Scene& start, const Scene& end, const N
         trees[k] = build_contact_tree({nodes[k].first->points, nodes[k].first->triangles}), have_tree[k] = 1;
     const ContactMesh ma{a0.points, a0.triangles}, mb{b0.points, b0.triangles};
     const MeshContacts at_start = mesh_contacts(ma, trees[first], mb, trees[second], 1);
+    s.u = 0;
     if (!at_start.pairs.empty()) {
       const auto [x, y] = at_start.pairs.front();
-      auto corner = [](const ContactMesh& m, uint32_t t, int k) { return m.points[m.triangles[3 * t + k]]; };
-      s.u = 0;
+      auto corner = [](const ContactMesh& m, uint32_t t, int k) {
+        return m.points[m.triangles[3 * size_t(t) + size_t(k)]];
+      };
       s.point = triangle_contact_point(corner(ma, x, 0), corner(ma, x, 1), corner(ma, x, 2), corner(mb, y, 0),
                                        corner(mb, y, 1), corner(mb, y, 2));
       report.contacts.push_back(s);
       continue;
     }
-    const MeshFirstContact c =
-        mesh_first_contact({a0.points, a1.points, a0.triangles}, {b0.points, b1.points, b0.triangles});
+    // Closed nodes: one may start wholly inside the other.
+    if (std::isfinite(a0.enclosed_volume) && std::isfinite(b0.enclosed_volume)) {
+      for (uint32_t k : {first, second})
+        if (orientation[k].empty()) orientation[k] = outward_orientation(*nodes[k].first);
+      const DVec3* held = vertex_inside(a0, b0, trees[second], orientation[second]);
+      if (!held) held = vertex_inside(b0, a0, trees[first], orientation[first]);
+      if (held) {
+        s.point = *held;
+        report.contacts.push_back(s);
+        continue;
+      }
+    }
+    const MovingMesh ma01{a0.points, a1.points, a0.triangles}, mb01{b0.points, b1.points, b0.triangles};
+    for (uint32_t k : {first, second})
+      if (!have_swept[k])
+        swept[k] =
+            build_swept_tree({nodes[k].first->points, nodes[k].second->points, nodes[k].first->triangles}),
+        have_swept[k] = 1;
+    const MeshFirstContact c = mesh_first_contact(ma01, swept[first], mb01, swept[second]);
     report.steps += c.triangle_pairs;
     if (!c.hit) continue;
     s.u = c.u;

@@ -14,8 +14,10 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "renderer/accel/polytope.h"
+#include "renderer/collision/mesh_contact.h"
 
 namespace penumbra {
 
@@ -32,12 +34,23 @@ struct MeshCcdConfig {
   double tolerance = 1e-9;
 };
 
+/// A moving mesh's triangles' swept boxes (each the box of its corners in both poses) as a
+/// tree, for mesh_first_contact; made once per mesh and used against many.
+struct SweptTree {
+  std::vector<DVec3> corners;      ///< per triangle, its swept box's lower and upper corner
+  std::vector<uint32_t> segments;  ///< per triangle, (lower, upper, upper): what the tree is built over
+  ContactTree tree;                ///< empty when the mesh has no triangles or its poses differ in size
+};
+
+/// The swept tree of `m` (empty when start and end differ in size).
+SweptTree build_swept_tree(const MovingMesh& m);
+
 /// The first contact of two moving meshes in one interval.
 struct MeshFirstContact {
   bool hit = false;
   double u = 1;    ///< the fraction of the interval at first contact (hit), else 1
   DVec3 point{};   ///< hit: where they touch (the vertex, or the midpoint of the two edges' closest points)
-  DVec3 normal{};  ///< hit: unit, the face's normal or the edges' cross product, from a towards b
+  DVec3 normal{};  ///< hit: unit, from a towards b just before contact (zero when touching at u = 0)
   uint32_t triangle_a = 0, triangle_b = 0;  ///< hit: the triangles that touch first
   uint64_t triangle_pairs = 0;              ///< triangle pairs whose swept boxes overlap (tested)
   uint64_t feature_tests = 0;               ///< vertex-face and edge-edge cubics solved
@@ -47,7 +60,12 @@ struct MeshFirstContact {
 /// within the tolerance at a coplanar feature; meshes already crossing at the start with no
 /// feature coplanar then are the static test's to find). A pair of features that stays
 /// coplanar through the interval (a vertex sliding in the plane of a face) is not detected by
-/// its cubic; its neighbouring features are. Never throws; allocates the two trees.
+/// its cubic; its neighbouring features are. `sa` and `sb` are a's and b's swept trees. Meshes
+/// whose poses differ in size have no contact. Never throws.
+MeshFirstContact mesh_first_contact(const MovingMesh& a, const SweptTree& sa, const MovingMesh& b,
+                                    const SweptTree& sb, const MeshCcdConfig& config = {});
+
+/// The same, building both swept trees.
 MeshFirstContact mesh_first_contact(const MovingMesh& a, const MovingMesh& b,
                                     const MeshCcdConfig& config = {});
 

@@ -95,37 +95,56 @@ std::vector<SolidMesh> placement_solids(const NodeGeometry& g, const SolidBspCon
   return out;
 }
 
-// Calls f(point) for samples of the triangles of `g` whose boxes meet `region`: each triangle's
-// barycentric grid of n x n similar sub-triangles, n the smallest making every edge at most h
-// (its corners included), so every point of those triangles lies within h of a sample. Returns
-// the samples' count (with f empty: only counts).
+// Samples of the part of g's surface inside `region`: each triangle split into four at its
+// edges' midpoints until its longest edge is at most h, the pieces whose boxes miss the region
+// dropped, and f(point) called for the three corners of every piece kept (a corner shared by
+// pieces once per piece), so every point of the surface inside the region lies within h of a
+// sample. Returns the samples' count (with f = nullptr only counts) and sets `max_edge` to the
+// longest edge of a whole triangle meeting the region: from h = max_edge on, the pieces are the
+// triangles themselves.
 template <class F>
-uint64_t surface_samples(const NodeGeometry& g, const Bounds3f& region, double h, F&& f) {
+uint64_t surface_samples(const NodeGeometry& g, const Bounds3f& region, double h, F&& f, double& max_edge) {
+  struct Piece {
+    DVec3 a, b, c;
+    int level;
+  };
+  auto misses = [&](const Piece& p) {
+    return std::max({p.a.x, p.b.x, p.c.x}) < region.lo.x || std::min({p.a.x, p.b.x, p.c.x}) > region.hi.x ||
+           std::max({p.a.y, p.b.y, p.c.y}) < region.lo.y || std::min({p.a.y, p.b.y, p.c.y}) > region.hi.y ||
+           std::max({p.a.z, p.b.z, p.c.z}) < region.lo.z || std::min({p.a.z, p.b.z, p.c.z}) > region.hi.z;
+  };
+  auto longest = [](const Piece& p) {
+    return std::max({length(p.b - p.a), length(p.c - p.b), length(p.a - p.c)});
+  };
   uint64_t count = 0;
+  max_edge = 0;
+  std::vector<Piece> stack;
   for (size_t t = 0; t + 2 < g.triangles.size(); t += 3) {
-    const DVec3 a = g.points[g.triangles[t]], b = g.points[g.triangles[t + 1]],
-                c = g.points[g.triangles[t + 2]];
-    if (std::max({a.x, b.x, c.x}) < region.lo.x || std::min({a.x, b.x, c.x}) > region.hi.x ||
-        std::max({a.y, b.y, c.y}) < region.lo.y || std::min({a.y, b.y, c.y}) > region.hi.y ||
-        std::max({a.z, b.z, c.z}) < region.lo.z || std::min({a.z, b.z, c.z}) > region.hi.z)
-      continue;
-    const double edge = std::max({length(b - a), length(c - b), length(a - c)});
-    const uint64_t n = std::max<uint64_t>(1, uint64_t(std::ceil(std::min(edge / h, 1e6))));
-    count += (n + 1) * (n + 2) / 2;
-    if constexpr (!std::is_same_v<std::decay_t<F>, std::nullptr_t>) {
-      for (uint64_t i = 0; i <= n; ++i)
-        for (uint64_t j = 0; i + j <= n; ++j) {
-          const double u = double(i) / double(n), v = double(j) / double(n);
-          f(a * (1 - u - v) + b * u + c * v);
-        }
+    const Piece whole{g.points[g.triangles[t]], g.points[g.triangles[t + 1]], g.points[g.triangles[t + 2]],
+                      0};
+    if (misses(whole)) continue;
+    max_edge = std::max(max_edge, longest(whole));
+    stack.push_back(whole);
+    while (!stack.empty()) {
+      const Piece p = stack.back();
+      stack.pop_back();
+      if (p.level > 0 && misses(p)) continue;
+      // A piece is kept when short enough, or past 40 halvings (or not finite).
+      if (!(longest(p) > h) || p.level >= 40) {
+        count += 3;
+        if constexpr (!std::is_same_v<std::decay_t<F>, std::nullptr_t>) f(p.a), f(p.b), f(p.c);
+        continue;
+      }
+      const DVec3 ab = (p.a + p.b) * 0.5, bc = (p.b + p.c) * 0.5, ca = (p.c + p.a) * 0.5;
+      const int l = p.level + 1;
+      stack.insert(stack.end(), {{p.a, ab, ca, l}, {ab, p.b, bc, l}, {ca, bc, p.c, l}, {ab, bc, ca, l}});
     }
   }
   return count;
 }
 
-// Per triangle of a closed node, +1 or -1 so that each placement's meshes (the instances
-// sharing one placement, as placement_solids groups them) wind outward: the sign of their
-// signed volume (a mirrored placement or an inward-wound file gives a negative one).
+}  // namespace
+
 std::vector<int8_t> outward_orientation(const NodeGeometry& g) {
   std::vector<int8_t> out(g.triangles.size() / 3, 1);
   const size_t n = g.instance_to_world.size();
@@ -136,17 +155,39 @@ std::vector<int8_t> outward_orientation(const NodeGeometry& g) {
     for (size_t j = i; j < n; ++j)
       if (!taken[j] && std::memcmp(&g.instance_to_world[i], &g.instance_to_world[j], sizeof(Affine3f)) == 0)
         taken[j] = 1, group.push_back(j);
+    // The signed volume relative to one of the group's corners, so that the terms stay of the
+    // mesh's size far from the origin.
     double volume = 0;
+    bool have_ref = false;
+    DVec3 ref{};
     for (size_t j : group)
-      for (size_t t = g.instance_triangles[j]; t + 2 < g.instance_triangles[j + 1]; t += 3)
-        volume +=
-            dot(g.points[g.triangles[t]], cross(g.points[g.triangles[t + 1]], g.points[g.triangles[t + 2]]));
+      for (size_t t = g.instance_triangles[j]; t + 2 < g.instance_triangles[j + 1]; t += 3) {
+        if (!have_ref) ref = g.points[g.triangles[t]], have_ref = true;
+        volume += dot(g.points[g.triangles[t]] - ref,
+                      cross(g.points[g.triangles[t + 1]] - ref, g.points[g.triangles[t + 2]] - ref));
+      }
     if (volume >= 0) continue;
     for (size_t j : group)
       for (size_t t = g.instance_triangles[j]; t < g.instance_triangles[j + 1]; t += 3) out[t / 3] = -1;
   }
   return out;
 }
+
+const DVec3* vertex_inside(const NodeGeometry& from, const NodeGeometry& into, const ContactTree& into_tree,
+                           std::span<const int8_t> into_orientation) {
+  const Bounds3f box = points_box(into.points);
+  const ContactMesh mesh{into.points, into.triangles};
+  for (const DVec3& p : from.points) {
+    if (p.x < box.lo.x || p.x > box.hi.x || p.y < box.lo.y || p.y > box.hi.y || p.z < box.lo.z ||
+        p.z > box.hi.z)
+      continue;
+    int winding = 0;
+    if (mesh_winding(mesh, into_tree, into_orientation, p, winding) && winding > 0) return &p;
+  }
+  return nullptr;
+}
+
+namespace {
 
 // A closed node as a solid: its triangles, their tree and outward orientation.
 struct NodeSolid {
@@ -166,33 +207,42 @@ struct Deepest {
 
 Deepest deepest_inside(const NodeGeometry& from, const NodeSolid& into, const Bounds3f& region, double h) {
   Deepest best;
-  surface_samples(from, region, h, [&](DVec3 p) {
-    int winding = 0;
-    if (!mesh_winding(into.mesh, *into.tree, into.orientation, p, winding) || winding <= 0) return;
-    const MeshClosest c = mesh_closest(into.mesh, *into.tree, p);
-    if (best.inside && c.distance <= best.depth) return;
-    best.inside = true, best.depth = c.distance, best.point = p;
-    best.toward = c.distance > 0 ? (c.point - p) * (1 / c.distance) : DVec3{0, 0, 0};
-  });
+  double max_edge = 0;
+  surface_samples(
+      from, region, h,
+      [&](DVec3 p) {
+        int winding = 0;
+        if (!mesh_winding(into.mesh, *into.tree, into.orientation, p, winding) || winding <= 0) return;
+        const MeshClosest c = mesh_closest(into.mesh, *into.tree, p);
+        if (best.inside && c.distance <= best.depth) return;
+        best.inside = true, best.depth = c.distance, best.point = p;
+        best.toward = c.distance > 0 ? (c.point - p) * (1 / c.distance) : DVec3{0, 0, 0};
+      },
+      max_edge);
   return best;
 }
 
 // Mesh penetration depth of two closed nodes: the deepest sample of either surface inside the
-// other, the sample spacing chosen within the budget over the region both boxes share. Sets
-// depth and depth_error (0 and the spacing when no sample of either lies inside the other:
-// then it returns false), direction and, when `set_point`, the point.
-bool mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& b, const NodeSolid& sb,
-                uint64_t budget, bool set_point, NodeContact& contact) {
-  const Bounds3f region = intersect(points_box(a.points), points_box(b.points));
-  if (region.lo.x > region.hi.x || region.lo.y > region.hi.y || region.lo.z > region.hi.z) return false;
+// other over `region` (the part both boxes share), the spacing h grown from 1/64 of the
+// region's largest side until the samples fit the budget (or, when the triangles' corners alone
+// exceed it, those). Sets depth, depth_error (the spacing) and direction, and when no sample lies
+// inside (surfaces that only touch) depth 0; sets the point when `set_point` and one does.
+void mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& b, const NodeSolid& sb,
+                const Bounds3f& region, uint64_t budget, bool set_point, NodeContact& contact) {
   const Vec3f extent = region.hi - region.lo;
   double h = std::max(double(std::max({extent.x, extent.y, extent.z})) / 64, 1e-12);
-  while (surface_samples(a, region, h, nullptr) + surface_samples(b, region, h, nullptr) > budget) h *= 1.5;
+  for (;;) {
+    double edge_a = 0, edge_b = 0;
+    const uint64_t n =
+        surface_samples(a, region, h, nullptr, edge_a) + surface_samples(b, region, h, nullptr, edge_b);
+    if (n <= budget || h >= std::max(edge_a, edge_b)) break;
+    h *= 1.5;
+  }
   contact.depth = 0;
   contact.depth_error = h;
   const Deepest in_b = deepest_inside(a, sb, region, h);  // a's surface inside b
   const Deepest in_a = deepest_inside(b, sa, region, h);  // b's surface inside a
-  if (!in_b.inside && !in_a.inside) return false;
+  if (!in_b.inside && !in_a.inside) return;
   const bool use_b = in_b.inside && (!in_a.inside || in_b.depth >= in_a.depth);
   const Deepest& d = use_b ? in_b : in_a;
   contact.depth = d.depth;
@@ -200,7 +250,6 @@ bool mesh_depth(const NodeGeometry& a, const NodeSolid& sa, const NodeGeometry& 
   // b's point in a: moving b along `toward` carries it onto a's surface.
   contact.direction = use_b ? d.toward * -1.0 : d.toward;
   if (set_point) contact.point = d.point;
-  return true;
 }
 
 }  // namespace
@@ -262,10 +311,20 @@ CollideReport collide_scene(const Scene& scene, const NodeLinks& links, const Co
       if (closed) {
         for (uint32_t k : {fi, si})
           if (orientation[k].empty()) orientation[k] = outward_orientation(nodes[k]);
+        // Surfaces that do not meet: each connected part of one lies wholly inside or outside
+        // the other, so a vertex decides.
+        if (!met) {
+          const DVec3* held = vertex_inside(first, second, trees[si], orientation[si]);
+          if (!held) held = vertex_inside(second, first, trees[fi], orientation[fi]);
+          if (!held) continue;
+          contact.point = *held;
+        }
         const NodeSolid sa{ma, &trees[fi], orientation[fi]}, sb{mb, &trees[si], orientation[si]};
-        const bool inside = mesh_depth(first, sa, second, sb, config.depth_samples, !met, contact);
-        if (!met && !inside) continue;
+        if (config.depth_samples > 0)
+          mesh_depth(first, sa, second, sb, intersect(points_box(first.points), points_box(second.points)),
+                     config.depth_samples, !met, contact);
       }
+      contact.shape_error = std::max(first.shape_error, second.shape_error);
       if (config.volumes) {
         for (uint32_t k : {fi, si})
           if (!have_solid[k]) {

@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "renderer/collision/mesh_contact.h"
 #include "renderer/collision/proxy.h"
 #include "renderer/collision/scene_proxies.h"
 #include "renderer/collision/shared_volume.h"
@@ -32,7 +33,8 @@ struct CollideConfig {
   /// time on convex parts is capped at 10^9 polygon tests.
   SolidBspConfig solid{.max_classifications = 1000000000};
   /// Meshes' penetration depth: surface samples per node pair at most (the spacing, and so
-  /// NodeContact::depth_error, grows until they fit).
+  /// NodeContact::depth_error, grows until they fit; when the corners of the triangles inside
+  /// the pair's common box alone exceed it, those are the samples); 0: no depth.
   uint64_t depth_samples = uint64_t(1) << 18;
   ShapeTrianglesConfig shapes;  ///< how nodes' shapes become triangles
 };
@@ -52,8 +54,12 @@ struct NodeContact {
   /// (meshes; zero when no sample lies inside).
   DVec3 direction{};
   /// A point where they meet (meshes: where two triangles meet; when one solid holds the other
-  /// without their surfaces meeting, the deepest sample).
+  /// without their surfaces meeting, the deepest sample, or a vertex inside with no depth).
   DVec3 point{};
+  /// Nodes placing shapes: the points and depth are those of the shapes' triangles, which lie
+  /// within this distance of the true surfaces (NodeGeometry::shape_error, the larger of the
+  /// two); 0 for meshes.
+  double shape_error = 0;
   uint64_t triangle_pairs = 0;  ///< meshes: the pairs of triangles that meet
   VolumeEstimate volume;        ///< with CollideConfig::volumes: the volume they share
 };
@@ -70,6 +76,17 @@ struct CollideReport {
 
 /// The box of `points` in single precision, rounded outward so that it holds them.
 Bounds3f points_box(std::span<const DVec3> points);
+
+/// Per triangle of a node's geometry, +1 or -1 so that each placement's meshes (the instances
+/// sharing one placement) wind outward: the sign of their signed volume (a mirrored placement or
+/// an inward-wound file gives a negative one). For mesh_winding on closed nodes.
+std::vector<int8_t> outward_orientation(const NodeGeometry& g);
+
+/// A vertex of `from` inside the solid of the closed node `into` (mesh_winding over its contact
+/// tree `into_tree` with `into_orientation`: a positive winding number), or null. Only vertices
+/// within into's box are tested.
+const DVec3* vertex_inside(const NodeGeometry& from, const NodeGeometry& into, const ContactTree& into_tree,
+                           std::span<const int8_t> into_orientation);
 
 /// The pairs of overlapping boxes among `boxes` (i < j), sorted: sweep and prune along x, then
 /// the y and z intervals.

@@ -84,7 +84,7 @@ check_json "mesh contacts" 'pairs(d["frames"][0]) == [(0, 2), (1, 2)] and d["fra
 check_json "mesh contacts with children" 'pairs(d["frames"][0]) == [(0, 1), (0, 2), (1, 2)] and d["frames"][0]["family_pairs"] == 0' --include-children
 check_json "contact points in both boxes" 'all(inside(c["point"], [0, 0, 0], [0.5] * 3) and inside(c["point"], [0.8, 0, 0], [0.5] * 3) for c in d["frames"][0]["contacts"] if c["b"] == 2) and all(c["triangle_pairs"] > 0 for c in d["frames"][0]["contacts"])'
 # Closed cubes: the deepest surface point inside the other is as deep as the x overlap.
-check_json "mesh depths" 'all(want - c["depth_error"] <= c["depth"] <= want + 1e-6 and c["depth_error"] <= 0.02 for c, want in zip(d["frames"][0]["contacts"], (0.2, 0.35)))'
+check_json "mesh depths" 'all(want - c["depth_error"] <= c["depth"] <= want + 1e-6 and c["depth_error"] <= 0.03 for c, want in zip(d["frames"][0]["contacts"], (0.2, 0.35)))'
 check_json "broad phase counts" 'd["frames"][0]["nodes"] == 6 and d["frames"][0]["broad_pairs"] == 3 and d["frames"][0]["narrow_tests"] == 2 and d["frames"][0]["frame"] is None'
 # A skinned cube and a cube below its joint's child, overlapping it: a skin joins them.
 skinned="$work/skinned.gltf"

@@ -216,6 +216,8 @@ TEST_CASE("collide_continuous: a cube tunnels through a wall between two poses",
   CHECK((m.contacts[0].a == 0 && m.contacts[0].b == 1));
   CHECK(m.contacts[0].u == Approx(2.45 / 6).margin(1e-9));
   CHECK(m.contacts[0].point.x == Approx(-0.05).margin(1e-6));
+  CHECK(std::abs(m.contacts[0].point.y) <= std::sqrt(0.5) + 1e-6);  // on the mover, not a wall corner
+  CHECK(std::abs(m.contacts[0].point.z) <= std::sqrt(0.5) + 1e-6);
   CHECK(m.contacts[0].normal.x == Approx(-1).margin(1e-6));  // from the wall (a) towards the mover (b)
   CHECK((m.contacts[1].a == 1 && m.contacts[1].b == 3));
   CHECK(m.contacts[1].u == Approx(2.55 / 6).margin(1e-9));

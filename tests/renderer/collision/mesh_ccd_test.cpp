@@ -39,8 +39,18 @@ TEST_CASE("mesh first contact: a cube through a thin wall, face first and edge f
   REQUIRE(f.hit);
   CHECK(f.u == Approx(2.45 / 6).margin(1e-12));
   CHECK(f.point.x == Approx(-0.05).margin(1e-9));
+  CHECK(std::abs(f.point.y) <= 0.5 + 1e-9);  // on the cube's leading face
+  CHECK(std::abs(f.point.z) <= 0.5 + 1e-9);
   CHECK(f.normal.x == Approx(1).margin(1e-9));  // from the cube (a) towards the wall (b)
   CHECK(f.triangle_pairs > 0);
+  // The same with the wall as a: b's vertices meet a's face; the point is still on the cube.
+  const MeshFirstContact g = mesh_first_contact(still, {c0, c1, ct});
+  REQUIRE(g.hit);
+  CHECK(g.u == Approx(2.45 / 6).margin(1e-12));
+  CHECK(g.point.x == Approx(-0.05).margin(1e-9));
+  CHECK(std::abs(g.point.y) <= 0.5 + 1e-9);
+  CHECK(std::abs(g.point.z) <= 0.5 + 1e-9);
+  CHECK(g.normal.x == Approx(-1).margin(1e-9));
   // Turned 45 degrees about y and sent the same way: its leading edge (x = centre + sqrt(2) / 2,
   // along y) meets the wall's face at x = -0.05.
   std::vector<DVec3> turned;
@@ -50,6 +60,8 @@ TEST_CASE("mesh first contact: a cube through a thin wall, face first and edge f
   const MeshFirstContact e = mesh_first_contact({t0, t1, ct}, still);
   REQUIRE(e.hit);
   CHECK(e.u == Approx((3 - 0.05 - c) / 6).margin(1e-12));
+  CHECK(std::abs(e.point.y) <= 0.5 + 1e-9);
+  CHECK(std::abs(e.point.z) <= 1e-9);  // on the leading edge
   // Moving away from the wall: no contact.
   CHECK_FALSE(mesh_first_contact({c1, moved(cube, {5, 0, 0}), ct}, still).hit);
 }
@@ -100,4 +112,21 @@ TEST_CASE("mesh first contact agrees with a dense sampling of the static test", 
   }
   CHECK(trials > 300);
   CHECK(hits > 60);
+}
+
+TEST_CASE("mesh first contact: millimetre features in a pair a hundred metres across", "[ccd]") {
+  // a: a 2 mm triangle in the plane x = 0 moving 2 mm along +x, and a large still triangle
+  // 100 m away; b: a 6 mm triangle in the plane x = 1 mm holding a's outline. They touch
+  // halfway.
+  std::vector<DVec3> a0{{0, 0, 0},       {0, 0.002, 0},   {0, 0, 0.002},
+                        {100, 100, 100}, {101, 100, 100}, {100, 101, 100}};
+  std::vector<DVec3> a1 = a0;
+  for (int k = 0; k < 3; ++k) a1[size_t(k)].x += 0.002;
+  const std::vector<uint32_t> at{0, 1, 2, 3, 4, 5};
+  const std::vector<DVec3> b{{0.001, -0.002, -0.002}, {0.001, 0.006, -0.002}, {0.001, -0.002, 0.006}};
+  const std::vector<uint32_t> bt{0, 1, 2};
+  const MeshFirstContact f = mesh_first_contact({a0, a1, at}, {b, b, bt});
+  REQUIRE(f.hit);
+  CHECK(f.u == Approx(0.5).margin(1e-9));
+  CHECK(f.point.x == Approx(0.001).margin(1e-9));
 }

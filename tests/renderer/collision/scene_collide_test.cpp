@@ -89,7 +89,7 @@ TEST_CASE("collide_scene: two overlapping cubes, a third apart, a child", "[coll
     // which is also the distance that separates them).
     CHECK(c.depth <= 0.25 + 1e-6);
     CHECK(c.depth >= 0.25 - c.depth_error);
-    CHECK(c.depth_error <= 1.0 / 64 * (1 + 1e-6));  // the overlap box's largest side / 64
+    CHECK(c.depth_error <= 1.5 / 64 * (1 + 1e-6));  // the overlap box's largest side / 64, grown once
     CHECK(c.triangle_pairs > 0);
     CHECK(c.point.x >= 0.25 - 1e-6);  // in cube 1, which spans x in [0.25, 1.25]
     CHECK(c.point.x <= 0.5 + 1e-6);   // and in cubes 0 and 3
@@ -170,11 +170,13 @@ TEST_CASE("collide_scene: meshes' depth of a box sunk into a floor and of a box 
   CHECK((sunk.a == 0 && sunk.b == 1));
   CHECK(sunk.depth == Approx(0.1).margin(1e-5));  // a vertex is a sample: exact to rounding
   CHECK(sunk.direction.y == Approx(1).margin(1e-4));
+  CHECK(sunk.depth_error <= 0.05);
   const NodeContact& held = r.contacts[1];
   CHECK((held.a == 2 && held.b == 3));
   CHECK(held.triangle_pairs == 0);
   CHECK(held.depth <= 0.9 + 1e-5);
   CHECK(held.depth >= 0.9 - held.depth_error);
+  CHECK(held.depth_error <= 0.02);
   CHECK(held.point.z >= 9.8 - 1e-5);  // a point of the small cube
   CHECK(held.point.z <= 10.2 + 1e-5);
   CHECK(std::abs(held.point.x - 0.3) <= 0.2 + 1e-5);
@@ -218,4 +220,45 @@ TEST_CASE("collide_scene: meshes' depth is at most the convex penetration depth"
   }
   CHECK(compared >= 30);
   CHECK(equal >= 1);
+}
+
+TEST_CASE("collide_scene: meshes' depth far from the origin and over many triangles", "[collide]") {
+  // The two overlapping cubes of the first case, 10^5 away from the origin: the outward
+  // orientation and the depth do not depend on where they are.
+  Scene far;
+  far.meshes.push_back(cube_mesh(0.5f));
+  far.instances.push_back(make_instance(0, moved(1e5f, 1e5f, 0), 0));
+  far.instances.push_back(make_instance(0, moved(1e5f + 0.75f, 1e5f + 0.1f, 0), 1));
+  const std::vector<int> parents{-1, -1};
+  const CollideReport r = collide_scene(far, {parents}, CollideConfig{});
+  REQUIRE(r.contacts.size() == 1);
+  CHECK(r.contacts[0].depth <= 0.25 + 1e-6);
+  CHECK(r.contacts[0].depth >= 0.25 - r.contacts[0].depth_error);
+  CHECK(r.contacts[0].depth_error <= 0.03);
+
+  // Two spheres of 20480 triangles each (radius 1, centres 1.5 apart) with a budget of 1000
+  // samples: more triangles meet the common box than the budget holds, so their corners are the
+  // samples, and the spacing is their longest edge.
+  Scene balls;
+  Shape sphere;
+  sphere.kind = ShapeKind::Sphere, sphere.radius = 1;
+  balls.shapes.push_back({"a", sphere, -1, 0});
+  balls.shapes.push_back({"b", sphere, -1, 1});
+  balls.instances.push_back(make_shape_instance(0, moved(0, 0, 0), 0));
+  balls.instances.push_back(make_shape_instance(1, moved(1.5f, 0, 0), 1));
+  CollideConfig small;
+  small.depth_samples = 1000;
+  small.shapes.subdivisions = 5;
+  const CollideReport b = collide_scene(balls, {parents}, small);
+  REQUIRE(b.contacts.size() == 1);
+  const NodeContact& c = b.contacts[0];
+  CHECK(c.shape_error > 0);
+  CHECK(c.depth <= 0.5 + c.shape_error);
+  CHECK(c.depth >= 0.5 - c.depth_error - c.shape_error);
+  CHECK(c.depth_error < 0.1);  // an icosphere edge of 20480 faces: about 0.04
+  // No depth asked: the contact is still found, without one.
+  small.depth_samples = 0;
+  const CollideReport none = collide_scene(balls, {parents}, small);
+  REQUIRE(none.contacts.size() == 1);
+  CHECK(std::isnan(none.contacts[0].depth));
 }

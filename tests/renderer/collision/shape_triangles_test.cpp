@@ -189,4 +189,6 @@ TEST_CASE("shapes in node geometry, proxies and collisions", "[shape-triangles]"
   CHECK((c.a == 0 && c.b == 1));
   CHECK(c.depth <= 0.5 + g[0].shape_error);
   CHECK(c.depth >= 0.5 - c.depth_error - g[0].shape_error);
+  CHECK(c.depth_error <= 0.05);
+  CHECK(c.shape_error == g[0].shape_error);
 }
