@@ -204,7 +204,9 @@ TEST_CASE("collide_scene: meshes' depth is at most the convex penetration depth"
     s.instances.clear();
     s.instances.push_back(make_instance(0, rotated_moved(rng, 0, 0, 0), 0));
     s.instances.push_back(make_instance(0, rotated_moved(rng, u(rng), u(rng), u(rng)), 1));
-    const CollideReport m = collide_scene(s, {parents}, CollideConfig{});
+    CollideConfig meshes;
+    meshes.depth_samples = 1 << 14;
+    const CollideReport m = collide_scene(s, {parents}, meshes);
     CollideConfig hulls;
     hulls.mesh = false;
     const CollideReport h = collide_scene(s, {parents}, hulls);
