@@ -24,6 +24,9 @@ constexpr uint64_t kBytesPerVertex = 256;
 constexpr uint64_t kSolidBytesPerTriangle = 512;
 /// --volumes: bytes per cell of the quadrature (two levels held at a time).
 constexpr uint64_t kBytesPerCell = 50;
+/// --continuous on meshes: bytes per placed triangle of the swept trees and the start's
+/// contact trees (boxes, corners, order).
+constexpr uint64_t kSweptBytesPerTriangle = 192;
 
 Json dvec(DVec3 v) {
   return Json::array({v.x, v.y, v.z});
@@ -203,6 +206,7 @@ int run_collide(const CollideArgs& a) {
   if (a.volumes)
     testing +=
         config.volume.max_cells * kBytesPerCell + (config.mesh ? triangles * kSolidBytesPerTriangle : 0);
+  if (a.continuous && config.mesh) testing += triangles * kSweptBytesPerTriangle;
   if (testing > budget - std::min(budget, scene_bytes))
     throw UsageError(a.scene_file + ": testing " + human_count(placed) + " placed vertices needs " +
                      human_count(testing) + "B beside the scene, over the budget (--max-memory)");
