@@ -319,6 +319,11 @@ ContinuousReport continuous_meshes(const Scene& start, const Scene& end, const N
         have_swept[k] = 1;
     const MeshFirstContact c = mesh_first_contact(ma01, swept[first], mb01, swept[second]);
     report.steps += c.triangle_pairs;
+    if (!c.converged) {
+      s.converged = false;  // u = 0: nothing decided
+      report.undecided.push_back(s);
+      continue;
+    }
     if (!c.hit) continue;
     s.u = c.u;
     s.point = c.point;

@@ -111,7 +111,7 @@ struct ContinuousReport {
 /// meet at the start (mesh_contacts) touch at u = 0, the others' first contact comes from
 /// mesh_first_contact (exact vertex-face and edge-edge times); nodes whose triangles differ
 /// between the poses are listed in nonrigid_nodes and left out; `steps` counts the triangle
-/// pairs whose swept boxes overlap.
+/// pairs whose swept boxes overlap; a pair past MeshCcdConfig's budget is undecided at u = 0.
 /// Throws std::invalid_argument naming the node if its geometry cannot be fitted.
 ContinuousReport collide_continuous(const Scene& start, const Scene& end, const NodeLinks& links,
                                     const CollideConfig& config, const AdvancementConfig& advance = {});

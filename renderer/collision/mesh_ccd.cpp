@@ -184,6 +184,10 @@ MeshFirstContact mesh_first_contact(const MovingMesh& a, const SweptTree& sa, co
   double best = 2;  // past the interval: none yet
   DVec3 point{};
   for_overlapping_leaves(ta, tb, [&](uint32_t s, uint32_t t) {
+    if (out.triangle_pairs >= config.max_triangle_pairs) {
+      out.converged = false;
+      return false;
+    }
     ++out.triangle_pairs;
     const Track pa[3] = {track(a, s, 0), track(a, s, 1), track(a, s, 2)};
     const Track pb[3] = {track(b, t, 0), track(b, t, 1), track(b, t, 2)};
@@ -196,8 +200,9 @@ MeshFirstContact mesh_first_contact(const MovingMesh& a, const SweptTree& sa, co
     }
     out.feature_tests += 15;
     if (best < before) out.triangle_a = s, out.triangle_b = t;
+    return true;
   });
-  if (best > 1) return out;
+  if (best > 1 || !out.converged) return out;
   out.hit = true;
   out.u = best;
   out.point = point;

@@ -32,6 +32,10 @@ struct MeshCcdConfig {
   /// At a root of the coplanarity cubic the points meet when their distance is at most this
   /// fraction of the pair's size (the diagonal of the box both swept meshes fill).
   double tolerance = 1e-9;
+  /// Triangle pairs tested at most (15 cubics each); past it the pair is undecided
+  /// (MeshFirstContact::converged false), so that meshes sweeping through each other's bulk
+  /// cannot run for hours.
+  uint64_t max_triangle_pairs = 20000000;
 };
 
 /// A moving mesh's triangles' swept boxes (each the box of its corners in both poses) as a
@@ -54,6 +58,9 @@ struct MeshFirstContact {
   uint32_t triangle_a = 0, triangle_b = 0;  ///< hit: the triangles that touch first
   uint64_t triangle_pairs = 0;              ///< triangle pairs whose swept boxes overlap (tested)
   uint64_t feature_tests = 0;               ///< vertex-face and edge-edge cubics solved
+  /// False when max_triangle_pairs ran out: undecided, nothing is known about the interval (the
+  /// pairs are not visited in time order); hit is then false.
+  bool converged = true;
 };
 
 /// The first u in [0, 1] at which the moving meshes touch (u = 0 when they meet at the start

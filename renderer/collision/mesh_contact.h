@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "renderer/accel/polytope.h"
@@ -38,7 +39,8 @@ ContactTree build_contact_tree(const ContactMesh& mesh);
 
 /// The simultaneous descent of two trees: calls leaf(s, t) for every pair of a triangle s of
 /// ta and t of tb whose leaves' boxes overlap, descending the node with the larger box first
-/// when both are inner nodes. Returns the box pairs tested. Holds a stack of node pairs.
+/// when both are inner nodes; a leaf callback that returns bool ends the descent by returning
+/// false. Returns the box pairs tested. Holds a stack of node pairs.
 template <class Leaf>
 uint64_t for_overlapping_leaves(const ContactTree& ta, const ContactTree& tb, Leaf&& leaf) {
   if (ta.nodes.empty() || tb.nodes.empty()) return 0;
@@ -62,7 +64,13 @@ uint64_t for_overlapping_leaves(const ContactTree& ta, const ContactTree& tb, Le
     const bool leaf_a = na.count > 0, leaf_b = nb.count > 0;
     if (leaf_a && leaf_b) {
       for (uint32_t x = na.first; x < na.first + na.count; ++x)
-        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) leaf(ta.order[x], tb.order[y]);
+        for (uint32_t y = nb.first; y < nb.first + nb.count; ++y) {
+          if constexpr (std::is_same_v<decltype(leaf(ta.order[x], tb.order[y])), bool>) {
+            if (!leaf(ta.order[x], tb.order[y])) return tested;
+          } else {
+            leaf(ta.order[x], tb.order[y]);
+          }
+        }
     } else if (leaf_b || (!leaf_a && half_area(na) >= half_area(nb))) {
       stack.push_back({na.left, j});
       stack.push_back({na.right, j});

@@ -62,6 +62,13 @@ TEST_CASE("mesh first contact: a cube through a thin wall, face first and edge f
   CHECK(e.u == Approx((3 - 0.05 - c) / 6).margin(1e-12));
   CHECK(std::abs(e.point.y) <= 0.5 + 1e-9);
   CHECK(std::abs(e.point.z) <= 1e-9);  // on the leading edge
+  // A budget of one triangle pair: undecided, no contact claimed.
+  MeshCcdConfig tight;
+  tight.max_triangle_pairs = 1;
+  const MeshFirstContact u = mesh_first_contact({c0, c1, ct}, still, tight);
+  CHECK_FALSE(u.converged);
+  CHECK_FALSE(u.hit);
+  CHECK(u.triangle_pairs == 1);
   // Moving away from the wall: no contact.
   CHECK_FALSE(mesh_first_contact({c1, moved(cube, {5, 0, 0}), ct}, still).hit);
 }
