@@ -158,8 +158,9 @@ void print_swept(const ContinuousReport& r, const GltfInfo& info, int64_t to, do
         c.point.x, c.point.y, c.point.z);
   for (const SweptContact& c : r.undecided)
     std::printf(
-        "    '%s' (%d) and '%s' (%d) undecided: no contact before time %.9g s, the step budget ran out\n",
-        node_name(info, c.a).c_str(), c.a, node_name(info, c.b).c_str(), c.b, t0 + c.u * (t1 - t0));
+        "    '%s' (%d) and '%s' (%d) undecided: no contact before time %.9g s, the %s budget ran out\n",
+        node_name(info, c.a).c_str(), c.a, node_name(info, c.b).c_str(), c.b, t0 + c.u * (t1 - t0),
+        mesh ? "triangle-pair" : "step");
 }
 
 }  // namespace
