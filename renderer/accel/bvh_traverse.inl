@@ -6,10 +6,9 @@
 //
 // Closest hit: the W child boxes are slab-tested at once; the children met are pushed far to
 // near with their entry distance, and entries beyond `best` are skipped when popped. Leaves sit
-// on the stack like nodes, so blocks are tested front to back. The box test is the scalar one's
-// (common.h) in SIMD, distances padded outward by kSlabPad. On an axis the ray is parallel to
-// (1/d infinite) the distances are +-inf, or NaN (0 * inf) when the origin lies exactly on a
-// face: such a lane is inside the slab, faces included, so NaN lanes become [-inf, inf].
+// on the stack like nodes, so blocks are tested front to back. The box test is the slab test
+// (common.h) in SIMD, the entry and exit distances scaled outward by kSlabPad; an axis the ray
+// is parallel to uses a finite inverse (see BoxRay), so no distance is NaN.
 // Occlusion (AnyHit): the leaves met are tested at once, before any node is pushed, and nothing
 // is sorted: the first hit ends the query, wherever it is.
 
@@ -37,38 +36,24 @@ inline Vf vmin(Vf a, Vf b) {
 inline Vf vmax(Vf a, Vf b) {
   return _mm256_max_ps(a, b);
 }
-inline Vf vand(Vf a, Vf b) {
-  return _mm256_and_ps(a, b);
-}
-inline Vf vor(Vf a, Vf b) {
-  return _mm256_or_ps(a, b);
-}
-inline Vf vandnot(Vf a, Vf b) {
-  return _mm256_andnot_ps(a, b);
-}
-inline Vf vunord(Vf a, Vf b) {
-  return _mm256_cmp_ps(a, b, _CMP_UNORD_Q);
-}
 inline int vle_mask(Vf a, Vf b) {
   return _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ));
 }
 inline void vstore(float* p, Vf a) {
   _mm256_store_ps(p, a);
 }
-inline Vf vabs_mask() {
-  return _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+/// Byte offset within a node of the children's lower (hi = false) or upper planes on axis k.
+inline uint32_t plane_offset(int k, bool hi) {
+  return uint32_t(hi ? offsetof(QuantizedNode8, qhi) : offsetof(QuantizedNode8, qlo)) + 8 * uint32_t(k);
 }
-/// The near and far planes of the eight children on axis k, decoded as
+/// The planes of the eight children at byte offset `off` (plane_offset) on axis k, decoded as
 /// QuantizedNode8::dequantize does (the same float operations).
-inline void load_planes(const QuantizedNode8& n, int k, bool neg, Vf& near_plane, Vf& far_plane) {
-  const Vf origin = _mm256_set1_ps(n.origin[k]), scale = _mm256_set1_ps(n.scale[k]);
-  const auto decode = [&](const uint8_t* q) {
-    const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(q));
-    return _mm256_add_ps(origin, _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes)), scale));
-  };
-  const Vf lo = decode(n.qlo[k]), hi = decode(n.qhi[k]);
-  near_plane = neg ? hi : lo;
-  far_plane = neg ? lo : hi;
+inline Vf load_planes(const QuantizedNode8& n, int k, uint32_t off) {
+  const __m128i bytes =
+      _mm_loadl_epi64(reinterpret_cast<const __m128i*>(reinterpret_cast<const char*>(&n) + off));
+  return _mm256_add_ps(
+      _mm256_set1_ps(n.origin[k]),
+      _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes)), _mm256_set1_ps(n.scale[k])));
 }
 inline int valid_mask(const QuantizedNode8& n) {
   return n.valid;
@@ -97,32 +82,19 @@ inline Vf vmin(Vf a, Vf b) {
 inline Vf vmax(Vf a, Vf b) {
   return _mm_max_ps(a, b);
 }
-inline Vf vand(Vf a, Vf b) {
-  return _mm_and_ps(a, b);
-}
-inline Vf vor(Vf a, Vf b) {
-  return _mm_or_ps(a, b);
-}
-inline Vf vandnot(Vf a, Vf b) {
-  return _mm_andnot_ps(a, b);
-}
-inline Vf vunord(Vf a, Vf b) {
-  return _mm_cmpunord_ps(a, b);
-}
 inline int vle_mask(Vf a, Vf b) {
   return _mm_movemask_ps(_mm_cmple_ps(a, b));
 }
 inline void vstore(float* p, Vf a) {
   _mm_store_ps(p, a);
 }
-inline Vf vabs_mask() {
-  return _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+/// Byte offset within a node of the children's lower (hi = false) or upper planes on axis k.
+inline uint32_t plane_offset(int k, bool hi) {
+  return uint32_t(hi ? offsetof(Node4, hi) : offsetof(Node4, lo)) + 16 * uint32_t(k);
 }
-/// The near and far planes of the four children on axis k (by the direction's sign, not
-/// min/max, so an unused slot's inverted box gives an empty interval).
-inline void load_planes(const Node4& n, int k, bool neg, Vf& near_plane, Vf& far_plane) {
-  near_plane = vload(neg ? n.hi[k] : n.lo[k]);
-  far_plane = vload(neg ? n.lo[k] : n.hi[k]);
+/// The planes of the four children at byte offset `off` (plane_offset) on axis k.
+inline Vf load_planes(const Node4& n, int, uint32_t off) {
+  return vload(reinterpret_cast<const float*>(reinterpret_cast<const char*>(&n) + off));
 }
 inline int valid_mask(const Node4&) {
   return 0xf;
@@ -131,28 +103,32 @@ inline int valid_mask(const Node4&) {
 
 using Node = WideNode<kWidth>;
 
-/// Per-ray constants of the box test, broadcast to all lanes.
+/// Per-ray constants of the box test, broadcast to all lanes. A direction component of 0 gets
+/// the inverse +-FLT_MAX (signed like the zero) instead of +-inf: a plane at any distance d from
+/// the origin along that axis is then at +-d * FLT_MAX, overflowing to +-inf, and a plane through
+/// the origin at 0, never NaN; a slab that holds the origin (faces included) still gives an
+/// interval around 0 and one that does not an interval beyond any finite t or behind the ray
+/// (or, for d under 1/FLT_MAX, a far one: extra work, never a miss).
 struct BoxRay {
   Vf org[3], inv[3];
-  Vf pad, abs_mask, tnear, neg_inf, pos_inf, max_float;
-  bool parallel[3];
-  int dir_neg[3];
+  Vf down, up, tnear;
+  uint32_t near_off[3], far_off[3];  ///< plane_offset of the near and far planes, by the octant
 };
 
-inline BoxRay prepare(const RayBoxQuery& q, float tnear) {
+[[gnu::always_inline]] inline BoxRay prepare(const RayBoxQuery& q, float tnear) {
   BoxRay r;
   for (int k = 0; k < 3; ++k) {
     r.org[k] = vset(q.org[k]);
-    r.inv[k] = vset(q.inv_dir[k]);
-    r.parallel[k] = std::isinf(q.inv_dir[k]);
-    r.dir_neg[k] = q.dir_neg[k];
+    const float inv = q.inv_dir[k];
+    r.inv[k] = vset(std::isinf(inv) ? std::copysign(std::numeric_limits<float>::max(), inv) : inv);
+    // Near is the lower plane where the direction is positive (by the sign, not min/max, so an
+    // unused slot's inverted box gives an empty interval).
+    r.near_off[k] = plane_offset(k, q.dir_neg[k]);
+    r.far_off[k] = plane_offset(k, !q.dir_neg[k]);
   }
-  r.pad = vset(kSlabPad - 1.0f);
-  r.abs_mask = vabs_mask();
+  r.down = vset(2.0f - kSlabPad);
+  r.up = vset(kSlabPad);
   r.tnear = vset(tnear);
-  r.neg_inf = vset(-kInfinity);
-  r.pos_inf = vset(kInfinity);
-  r.max_float = vset(std::numeric_limits<float>::max());
   return r;
 }
 
@@ -160,26 +136,19 @@ inline BoxRay prepare(const RayBoxQuery& q, float tnear) {
 /// distances in `t_entry`.
 [[gnu::always_inline]] inline int hit_children(const Node& n, const BoxRay& r, float best, float* t_entry) {
   // The entry distance is the largest of the three near-plane distances and the exit the
-  // smallest far one; the padding is monotonic, so it is applied once, after max and min.
-  Vf tn = vset(-kInfinity), tf = vset(kInfinity);
+  // smallest far one. Each distance carries a relative rounding error (a difference, then a
+  // product), so scaling the entry down and the exit up by kSlabPad covers it whatever their
+  // signs: a negative entry moved towards 0 still lies below tnear >= 0, and a negative exit
+  // stays negative (behind the ray) as the exact one is.
+  Vf tn, tf;
   for (int k = 0; k < 3; ++k) {
-    Vf near_plane, far_plane;
-    load_planes(n, k, r.dir_neg[k], near_plane, far_plane);
-    Vf a = vmul(vsub(near_plane, r.org[k]), r.inv[k]);
-    Vf b = vmul(vsub(far_plane, r.org[k]), r.inv[k]);
-    if (r.parallel[k]) {
-      const Vf on_face = vunord(a, b);
-      a = vor(vandnot(on_face, a), vand(on_face, r.neg_inf));
-      b = vor(vandnot(on_face, b), vand(on_face, r.pos_inf));
-    }
-    tn = vmax(a, tn);
-    tf = vmin(b, tf);
+    const Vf near_plane = load_planes(n, k, r.near_off[k]), far_plane = load_planes(n, k, r.far_off[k]);
+    const Vf a = vmul(vsub(near_plane, r.org[k]), r.inv[k]);
+    const Vf b = vmul(vsub(far_plane, r.org[k]), r.inv[k]);
+    tn = k == 0 ? a : vmax(a, tn);
+    tf = k == 0 ? b : vmin(b, tf);
   }
-  // The pad is capped at FLT_MAX so an infinite distance stays infinite (inf - inf would be
-  // NaN, and an unused slot's box would then count as met).
-  tn = vsub(tn, vmin(vmul(vand(tn, r.abs_mask), r.pad), r.max_float));
-  tf = vadd(tf, vmin(vmul(vand(tf, r.abs_mask), r.pad), r.max_float));
-  const Vf t0 = vmax(tn, r.tnear), t1 = vmin(tf, vset(best));
+  const Vf t0 = vmax(vmul(tn, r.down), r.tnear), t1 = vmin(vmul(tf, r.up), vset(best));
   vstore(t_entry, t0);
   return vle_mask(t0, t1) & valid_mask(n);
 }
@@ -195,20 +164,44 @@ inline void prefetch_blocks(const TriangleBlock4* p, uint32_t count) {
   for (; c < end; c += 64) _mm_prefetch(c, _MM_HINT_T0);
 }
 
-/// Tests the `count` blocks from `first`: the SIMD filter on each block, then `visit` on every
-/// lane it keeps and on every shape. Returns true iff a visitor stopped the query. Lanes the
-/// filter discards are counted here as triangle tests; the visitor counts its own.
-template <typename Visit, typename Counter>
+/// Tests the `count` blocks from `first`: the SIMD filter on each block, then on every lane it
+/// keeps either the double-precision confirm of the whole block (block_confirm, for visitors
+/// without a hit filter) or `visit`, and `visit` on every shape. Lanes are taken in order and a
+/// closest hit narrows `best` lane by lane, as the scalar test on each lane would. Returns true
+/// iff the query ends here (any hit). Lanes the filter discards are counted here as triangle
+/// tests; the visitor counts its own.
+template <bool AnyHit, typename Visit, typename Counter>
 inline bool visit_leaf(const WideBvh<kWidth>& bvh, const PrimitiveIds& ids, uint32_t first, uint32_t count,
                        const BlockRay& br, const WatertightRay& w, const float& best, Visit& visit,
                        const Counter& counter) {
   for (uint32_t i = first, end = first + count; i < end; ++i) {
     const TriangleBlock4& b = bvh.blocks[i];
-    const int cand = block_candidates(b, br, best);
+    const BlockCandidates cand = block_candidates(b, br, best);
     counter.triangles(
-        uint32_t(__builtin_popcount(unsigned(triangle_lanes(b))) - __builtin_popcount(unsigned(cand))));
-    for (int m = cand; m; m &= m - 1)
-      if (visit(w, ids.record(b, __builtin_ctz(unsigned(m))))) return true;
+        uint32_t(__builtin_popcount(unsigned(triangle_lanes(b))) - __builtin_popcount(unsigned(cand.all))));
+    if constexpr (Visit::kUnfiltered) {
+      BlockHits h;
+      const int hits = cand.settled ? block_confirm(b, br, cand.settled, cand.positive, best, h) : 0;
+      for (int m = cand.all; m; m &= m - 1) {
+        const int l = __builtin_ctz(unsigned(m));
+        if (!((cand.settled >> l) & 1)) {
+          if (visit(w, ids.record(b, l))) return true;
+          continue;
+        }
+        visit.counted();
+        // The scalar test's range checks against the current `best`: t in double, then in float.
+        if (!((hits >> l) & 1) || !(h.t[l] <= best)) continue;
+        const float t = float(h.t[l]);
+        if (!(t >= w.tnear && t <= best)) continue;
+        if constexpr (AnyHit) return true;
+        Hit hit{t, float(h.u[l]), float(h.v[l]), 0, 0};
+        ids.triangle_ids(b.id[l], hit.geom_id, hit.prim_id);
+        visit.take(hit);
+      }
+    } else {
+      for (int m = cand.all; m; m &= m - 1)
+        if (visit(w, ids.record(b, __builtin_ctz(unsigned(m))))) return true;
+    }
     for (int m = shape_lanes(b); m; m &= m - 1)
       if (visit(w, ids.record(b, __builtin_ctz(unsigned(m))))) return true;
   }
@@ -237,7 +230,7 @@ bool traverse(const WideBvh<kWidth>& bvh, const PrimitiveIds& ids, const Ray& ra
     if (e.t > best) continue;
     counter.node();
     if (e.count > 0) {
-      if (visit_leaf(bvh, ids, e.child, e.count, br, w, best, visit, counter)) return true;
+      if (visit_leaf<AnyHit>(bvh, ids, e.child, e.count, br, w, best, visit, counter)) return true;
       continue;
     }
     const Node& n = bvh.nodes[e.child];
@@ -252,7 +245,7 @@ bool traverse(const WideBvh<kWidth>& bvh, const PrimitiveIds& ids, const Ray& ra
           continue;
         }
         counter.node();
-        if (visit_leaf(bvh, ids, n.child[c], n.count[c], br, w, best, visit, counter)) return true;
+        if (visit_leaf<AnyHit>(bvh, ids, n.child[c], n.count[c], br, w, best, visit, counter)) return true;
       }
       continue;
     }

@@ -90,7 +90,7 @@ struct RayBoxQuery {
   int dir_neg[3] = {0, 0, 0};  ///< 1 where the direction component is negative
 };
 
-inline RayBoxQuery prepare_box_query(const Ray& ray) {
+[[gnu::always_inline]] inline RayBoxQuery prepare_box_query(const Ray& ray) {
   RayBoxQuery q;
   q.org = ray.org;
   q.inv_dir = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};  // +-inf for 0
@@ -185,6 +185,45 @@ struct CountNodes {
   void triangles(uint32_t n) const { cost.triangles += n; }
 };
 
+/// The leaf visitors of TraversalAccelerator: visit(w, record) tests one primitive (true ends
+/// the query). kUnfiltered visitors (no HitFilter) also let a structure settle triangle tests
+/// itself, as the wide BVH's block test does: counted() counts such a test, and take(hit) makes
+/// a hit in the ray's range, nearer than `best` (closest) or anywhere (any), the answer.
+template <typename Filter>
+struct ClosestVisitor {
+  static constexpr bool kUnfiltered = std::is_same_v<Filter, AcceptAll>;
+  const Ray& ray;
+  const Shape* shapes;
+  float& best;
+  Hit& hit;
+  TraversalCost* cost;
+  const Filter& filter;
+  bool operator()(const WatertightRay& w, const PrimitiveRecord& rec) const {
+    intersect_leaf(ray, w, rec, shapes, best, hit, cost, filter);
+    return false;
+  }
+  void counted() const {
+    if (cost) ++cost->triangles;
+  }
+  void take(const Hit& h) const {
+    best = h.t;
+    hit = h;
+  }
+};
+
+template <typename Filter>
+struct AnyVisitor {
+  static constexpr bool kUnfiltered = std::is_same_v<Filter, AcceptAll>;
+  const Ray& ray;
+  const Shape* shapes;
+  const Filter& filter;
+  bool operator()(const WatertightRay& w, const PrimitiveRecord& rec) const {
+    return occluded_leaf(ray, w, rec, shapes, filter);
+  }
+  void counted() const {}
+  void take(const Hit&) const {}
+};
+
 /// intersect(), intersect_counted() and occluded() of the reference structures, written once
 /// over the structure's primitive records and its table of shapes (m_shapes, filled by
 /// gather_primitives):
@@ -222,13 +261,8 @@ class TraversalAccelerator : public Accelerator {
  private:
   template <typename Filter>
   bool any(const Ray& ray, const Filter& filter) const {
-    const Shape* shapes = m_shapes.data();
     return static_cast<const Derived*>(this)->traverse(
-        ray, ray.tfar,
-        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
-          return occluded_leaf(ray, w, rec, shapes, filter);
-        },
-        NoCount{}, std::true_type{});
+        ray, ray.tfar, AnyVisitor<Filter>{ray, m_shapes.data(), filter}, NoCount{}, std::true_type{});
   }
 
   template <typename Counter, typename Filter>
@@ -236,14 +270,9 @@ class TraversalAccelerator : public Accelerator {
                const Filter& filter) const {
     hit = Hit{};
     float best = ray.tfar;
-    const Shape* shapes = m_shapes.data();
     static_cast<const Derived*>(this)->traverse(
-        ray, best,
-        [&](const WatertightRay& w, const PrimitiveRecord& rec) {
-          intersect_leaf(ray, w, rec, shapes, best, hit, cost, filter);
-          return false;
-        },
-        counter, std::false_type{});
+        ray, best, ClosestVisitor<Filter>{ray, m_shapes.data(), best, hit, cost, filter}, counter,
+        std::false_type{});
     return hit.valid();
   }
 };

@@ -25,7 +25,7 @@ struct WatertightRay {
   bool valid = false;                ///< false for NaN/Inf/zero directions or tnear > tfar: such rays miss
 };
 
-inline WatertightRay prepare_watertight(const Ray& ray) {
+[[gnu::always_inline]] inline WatertightRay prepare_watertight(const Ray& ray) {
   WatertightRay w;
   const Vec3f d = ray.dir;
   if (!is_finite(d) || !is_finite(ray.org) || std::isnan(ray.tnear) || std::isnan(ray.tfar)) return w;
@@ -33,16 +33,19 @@ inline WatertightRay prepare_watertight(const Ray& ray) {
   if (w.tnear > ray.tfar) return w;
   const Vec3f ad = abs(d);
   w.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
-  if (d[w.kz] == 0) return w;
-  w.kx = (w.kz + 1) % 3;
-  w.ky = (w.kx + 1) % 3;
-  if (d[w.kz] < 0) std::swap(w.kx, w.ky);  // preserve winding
-  w.sx = d[w.kx] / d[w.kz];
-  w.sy = d[w.ky] / d[w.kz];
-  w.sz = 1.0f / d[w.kz];
-  w.dsx = double(d[w.kx]) / d[w.kz];
-  w.dsy = double(d[w.ky]) / d[w.kz];
-  w.dsz = 1.0 / d[w.kz];
+  float dv[3];
+  std::memcpy(dv, &d, sizeof dv);
+  const float dz = dv[w.kz];
+  if (dz == 0) return w;
+  w.kx = w.kz == 2 ? 0 : w.kz + 1;
+  w.ky = w.kx == 2 ? 0 : w.kx + 1;
+  if (dz < 0) std::swap(w.kx, w.ky);  // preserve winding
+  w.sx = dv[w.kx] / dz;
+  w.sy = dv[w.ky] / dz;
+  w.sz = 1.0f / dz;
+  w.dsz = 1.0 / dz;
+  w.dsx = dv[w.kx] * w.dsz;
+  w.dsy = dv[w.ky] * w.dsz;
   w.valid = true;
   return w;
 }

@@ -59,6 +59,14 @@ struct PrimitiveIds {
   /// Global index of triangle `prim` of view `geom`.
   uint32_t global(uint32_t geom, uint32_t prim) const { return first[geom] + prim; }
 
+  /// The Hit ids (view, and triangle within it) of global triangle index `id`.
+  void triangle_ids(uint32_t id, uint32_t& geom, uint32_t& prim) const {
+    // The last view whose first triangle is <= id (views without triangles share a start and
+    // come before the one holding it).
+    geom = uint32_t(std::upper_bound(first.begin(), first.end(), id) - first.begin()) - 1;
+    prim = id - first[geom];
+  }
+
   /// The record a leaf visitor sees for lane l of `b` (a shape's vertices are unused).
   PrimitiveRecord record(const TriangleBlock4& b, int l) const {
     PrimitiveRecord r;
@@ -71,11 +79,7 @@ struct PrimitiveIds {
       r.prim_id = id;
       return r;
     }
-    // The last view whose first triangle is <= id (views without triangles share a start and
-    // come before the one holding it).
-    const uint32_t lo = uint32_t(std::upper_bound(first.begin(), first.end(), id) - first.begin()) - 1;
-    r.geom_id = lo;
-    r.prim_id = id - first[lo];
+    triangle_ids(id, r.geom_id, r.prim_id);
     return r;
   }
 };
@@ -85,18 +89,26 @@ struct PrimitiveIds {
 struct BlockRay {
   __m128 org[3];
   __m128 sx, sy, sz, tnear;
+  __m128d dorg[3];        ///< the origin in double, per axis (block_confirm)
+  __m128d dsx, dsy, dsz;  ///< the shear in double (WatertightRay::dsx ...)
+  double dtnear;
   int kx, ky, kz;
 };
 
 [[gnu::always_inline]] inline BlockRay prepare_block_ray(const Ray& ray, const WatertightRay& w) {
   BlockRay r;
-  r.org[0] = _mm_set1_ps(ray.org.x);
-  r.org[1] = _mm_set1_ps(ray.org.y);
-  r.org[2] = _mm_set1_ps(ray.org.z);
+  for (int k = 0; k < 3; ++k) {
+    r.org[k] = _mm_set1_ps(component(ray.org, k));
+    r.dorg[k] = _mm_set1_pd(component(ray.org, k));
+  }
   r.sx = _mm_set1_ps(w.sx);
   r.sy = _mm_set1_ps(w.sy);
   r.sz = _mm_set1_ps(w.sz);
   r.tnear = _mm_set1_ps(w.tnear);
+  r.dsx = _mm_set1_pd(w.dsx);
+  r.dsy = _mm_set1_pd(w.dsy);
+  r.dsz = _mm_set1_pd(w.dsz);
+  r.dtnear = w.tnear;
   r.kx = w.kx, r.ky = w.ky, r.kz = w.kz;
   return r;
 }
@@ -110,12 +122,22 @@ inline __m128 load_row(const TriangleBlock4& b, int vertex, int axis) {
 }
 }  // namespace block_detail
 
+/// The lanes of block_candidates (bit l for lane l).
+struct BlockCandidates {
+  int all = 0;       ///< the triangles the scalar test may accept; it certainly rejects the others
+  int settled = 0;   ///< those of `all` whose float edge functions are final (none 0, none NaN)
+  int positive = 0;  ///< lanes whose edge functions are all positive (else all negative, if settled)
+};
+
 /// The triangle lanes of `b` that the scalar watertight test may accept with t in
-/// [tnear, tfar] (bit l for lane l); the others it certainly rejects.
-[[gnu::always_inline]] inline int block_candidates(const TriangleBlock4& b, const BlockRay& r, float tfar) {
+/// [tnear, tfar]; of them, the ones block_confirm can finish (the scalar test recomputes edge
+/// functions of exactly 0 in double, so those lanes, and NaN ones, stay with it).
+[[gnu::always_inline]] inline BlockCandidates block_candidates(const TriangleBlock4& b, const BlockRay& r,
+                                                               float tfar) {
   using namespace block_detail;
+  BlockCandidates out;
   const int lanes = triangle_lanes(b);
-  if (lanes == 0) return 0;
+  if (lanes == 0) return out;
   // Vertices minus the origin, per permuted axis, and sheared: x - s_x z, y - s_y z.
   __m128 vx[3], vy[3], vz[3], sxv[3], syv[3];
   for (int i = 0; i < 3; ++i) {
@@ -140,7 +162,8 @@ inline __m128 load_row(const TriangleBlock4& b, int vertex, int axis) {
   __m128 keep = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpneq_ps(det, zero));
   const int edge = _mm_movemask_ps(on_edge) & lanes;
   int inside = _mm_movemask_ps(keep) & lanes & ~edge;
-  if (inside == 0) return edge;  // the common case: the ray passes beside all four
+  out.all = edge;
+  if (inside == 0) return out;  // the common case: the ray passes beside all four
   // Distance early-out with twice the scalar bound; lanes with a NaN bound are kept.
   __m128 m = zero, s = zero, z = zero, zz[3];
   for (int i = 0; i < 3; ++i) {
@@ -156,7 +179,64 @@ inline __m128 load_row(const TriangleBlock4& b, int vertex, int axis) {
   const __m128 outside = _mm_or_ps(_mm_cmplt_ps(far_end, r.tnear), _mm_cmpgt_ps(near_end, _mm_set1_ps(tfar)));
   const __m128 ordered = _mm_cmpord_ps(lo, hi);
   inside &= ~_mm_movemask_ps(_mm_and_ps(outside, ordered));
-  return inside | edge;
+  const __m128 nan = _mm_or_ps(_mm_cmpunord_ps(U, V), _mm_cmpunord_ps(W, W));
+  out.all = inside | edge;
+  out.settled = inside & ~_mm_movemask_ps(nan);
+  out.positive = _mm_movemask_ps(_mm_cmpgt_ps(det, zero));
+  return out;
+}
+
+/// The double-precision part of intersect_triangle_watertight (t, u, v from the vertices
+/// relative to the origin, sheared in double, edge functions clamped to the float decision's
+/// sign) for the `lanes` of `b`, two lanes per SSE2 register, in the scalar test's operation
+/// order so each lane's results are bit-identical to it. `lanes` must be settled lanes of
+/// block_candidates (`positive` its sign mask). Writes t, u = V/det, v = W/det of each lane;
+/// returns the lanes with det != 0 and t in [tnear, tfar] (in double; the caller checks the
+/// float t as the scalar test does).
+struct BlockHits {
+  alignas(16) double t[4], u[4], v[4];
+};
+
+[[gnu::always_inline]] inline int block_confirm(const TriangleBlock4& b, const BlockRay& r, int lanes,
+                                                int positive, float tfar, BlockHits& out) {
+  const __m128d zero = _mm_setzero_pd(), tnear = _mm_set1_pd(r.dtnear), tmax = _mm_set1_pd(tfar);
+  int hits = 0;
+  for (int h = 0; h < 2; ++h) {
+    if (((lanes >> (2 * h)) & 3) == 0) continue;
+    __m128d x[3], y[3], z[3];
+    for (int i = 0; i < 3; ++i) {
+      const auto row = [&](int axis) {
+        __m128 f = _mm_load_ps(b.v[i][axis]);
+        if (h) f = _mm_movehl_ps(f, f);
+        return _mm_sub_pd(_mm_cvtps_pd(f), r.dorg[axis]);
+      };
+      const __m128d px = row(r.kx), py = row(r.ky);
+      z[i] = row(r.kz);
+      x[i] = _mm_sub_pd(px, _mm_mul_pd(r.dsx, z[i]));
+      y[i] = _mm_sub_pd(py, _mm_mul_pd(r.dsy, z[i]));
+    }
+    __m128d U = _mm_sub_pd(_mm_mul_pd(x[2], y[1]), _mm_mul_pd(y[2], x[1]));
+    __m128d V = _mm_sub_pd(_mm_mul_pd(x[0], y[2]), _mm_mul_pd(y[0], x[2]));
+    __m128d W = _mm_sub_pd(_mm_mul_pd(x[1], y[0]), _mm_mul_pd(y[1], x[0]));
+    // std::max(d, 0.0) is max_pd(0, d) and std::min(d, 0.0) is min_pd(0, d), NaN and -0 alike.
+    const __m128d pos = _mm_castsi128_pd(
+        _mm_set_epi64x(-int64_t((positive >> (2 * h + 1)) & 1), -int64_t((positive >> (2 * h)) & 1)));
+    const auto clamp = [&](__m128d d) {
+      return _mm_or_pd(_mm_and_pd(pos, _mm_max_pd(zero, d)), _mm_andnot_pd(pos, _mm_min_pd(zero, d)));
+    };
+    U = clamp(U), V = clamp(V), W = clamp(W);
+    const __m128d det = _mm_add_pd(_mm_add_pd(U, V), W);
+    const __m128d T = _mm_mul_pd(
+        r.dsz, _mm_add_pd(_mm_add_pd(_mm_mul_pd(U, z[0]), _mm_mul_pd(V, z[1])), _mm_mul_pd(W, z[2])));
+    const __m128d t = _mm_div_pd(T, det);
+    _mm_store_pd(out.t + 2 * h, t);
+    _mm_store_pd(out.u + 2 * h, _mm_div_pd(V, det));
+    _mm_store_pd(out.v + 2 * h, _mm_div_pd(W, det));
+    const __m128d ok =
+        _mm_and_pd(_mm_cmpneq_pd(det, zero), _mm_and_pd(_mm_cmpge_pd(t, tnear), _mm_cmple_pd(t, tmax)));
+    hits |= _mm_movemask_pd(ok) << (2 * h);
+  }
+  return hits & lanes;
 }
 
 }  // namespace penumbra
