@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -228,11 +229,9 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       flatten_bvh(*root, m_nodes);
       compute_stats(*root, 0);
     } else if (m_width == 4) {
-      m_wide4.blocks.reserve(refs.size() / 4 + refs.size() / 8);
-      collapse(m_wide4, tris, refs, *root, 0);
+      collapse_tree(m_wide4, tris, refs, *root);
     } else {
-      m_wide8.blocks.reserve(refs.size() / 4 + refs.size() / 8);
-      collapse(m_wide8, tris, refs, *root, 0);
+      collapse_tree(m_wide8, tris, refs, *root);
     }
     m_tally.fill(m_stats);
   }
@@ -295,11 +294,10 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       }
   }
 
-  /// Appends the blocks of leaf `b` (the records tris[refs[i].index] for i in [first, first +
-  /// count), four per block, the last one padded with empty lanes); returns the first's index.
-  uint32_t add_leaf_blocks(std::vector<TriangleBlock4>& blocks, const std::vector<PrimitiveRecord>& tris,
-                           const std::vector<BvhBuildRef>& refs, const BvhBuildNode& b) const {
-    const uint32_t first = uint32_t(blocks.size());
+  /// Writes the blocks of leaf `b` from `out` (the records tris[refs[i].index] for i in [first,
+  /// first + count), four per block, the last one padded with empty lanes).
+  void write_leaf_blocks(TriangleBlock4* out, const std::vector<PrimitiveRecord>& tris,
+                         const std::vector<BvhBuildRef>& refs, const BvhBuildNode& b) const {
     for (uint32_t i = 0; i < b.count; i += 4) {
       TriangleBlock4 blk{};
       for (uint32_t l = 0; l < 4; ++l) {
@@ -317,26 +315,107 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
           for (int a = 0; a < 3; ++a) blk.v[k][a][l] = v[k][a];
         blk.id[l] = m_ids.global(r.geom_id, r.prim_id);
       }
-      blocks.push_back(blk);
+      *out++ = blk;
     }
-    return first;
   }
 
-  /// Emits the W-wide node for interior binary node `b`: its children, with the interior child
-  /// of largest surface area replaced by its two children until there are W (or only leaves).
-  /// Fills the statistics as it goes (leaves, depth, SAH cost of the wide tree). A node's
-  /// interior children are stored next to each other (one block per parent), so siblings
-  /// share pages and the hardware prefetcher's adjacent lines. Writes node `idx` (the root: 0,
-  /// allocated here).
+  /// Blocks of the leaves below `b`.
+  static uint32_t leaf_blocks(const BvhBuildNode& b) {
+    if (!b.child[0]) return (b.count + 3) / 4;
+    return leaf_blocks(*b.child[0]) + leaf_blocks(*b.child[1]);
+  }
+
+  /// The statistics collapse() gathers (depth, SAH cost, leaves) for a part of the tree;
+  /// parts are merged in a fixed order, so the totals never depend on scheduling.
+  struct CollapseTally {
+    uint64_t max_depth = 0;
+    double sah_cost = 0, sah_node_area = 0, sah_leaf_area = 0;
+    LeafTally leaves;
+    void merge(const CollapseTally& o) {
+      max_depth = std::max(max_depth, o.max_depth);
+      sah_cost += o.sah_cost, sah_node_area += o.sah_node_area, sah_leaf_area += o.sah_leaf_area;
+      leaves.leaves += o.leaves.leaves, leaves.empty_leaves += o.leaves.empty_leaves;
+      leaves.references += o.leaves.references;
+      leaves.max_prims = std::max(leaves.max_prims, o.leaves.max_prims);
+    }
+  };
+
+  /// A subtree collapsed on its own: its root's wide node goes to slot `slot` of the tree and
+  /// the others to `nodes` (local indices, node 0 its root) until appended; its blocks to the
+  /// range from `block` reserved for it.
   template <int W>
-  void collapse(WideBvh<W>& bvh, const std::vector<PrimitiveRecord>& tris,
-                const std::vector<BvhBuildRef>& refs, const BvhBuildNode& b, uint64_t depth,
-                uint32_t idx = 0) {
-    if (bvh.nodes.empty()) bvh.nodes.emplace_back();
-    m_stats.max_depth = std::max(m_stats.max_depth, depth);
+  struct CollapseJob {
+    const BvhBuildNode* node = nullptr;
+    uint32_t slot = 0, block = 0;
+    uint64_t depth = 0;
+    std::vector<WideNode<W>> nodes;
+    CollapseTally tally;
+  };
+
+  /// Where collapse() writes: the node array of the tree or of a job, the block array (sized
+  /// beforehand) and its cursor, the statistics, and the jobs interior children at wide depth
+  /// `defer_depth` become (none when `jobs` is null).
+  template <int W>
+  struct CollapseSink {
+    std::vector<WideNode<W>>& nodes;
+    TriangleBlock4* blocks;
+    uint32_t block;
+    CollapseTally& tally;
+    std::vector<CollapseJob<W>>* jobs;
+    uint64_t defer_depth;
+  };
+
+  /// Collapses the binary tree into `bvh`: the top wide levels serially, and for trees of at
+  /// least 16 x parallel_threshold references the subtrees below them (kCollapseJobDepth) as
+  /// parallel jobs, whose nodes are then appended in a fixed order. Blocks are in depth-first
+  /// leaf order either way, each job's range reserved in advance.
+  template <int W>
+  void collapse_tree(WideBvh<W>& bvh, const std::vector<PrimitiveRecord>& tris,
+                     const std::vector<BvhBuildRef>& refs, const BvhBuildNode& root) {
+    constexpr uint64_t kCollapseJobDepth = 2;  // up to W^2 jobs
+    bvh.blocks.resize(leaf_blocks(root));
+    bvh.nodes.emplace_back();
+    std::vector<CollapseJob<W>> jobs;
+    CollapseTally top;
+    const bool parallel = refs.size() >= 16 * m_config.parallel_threshold;
+    CollapseSink<W> sink{bvh.nodes, bvh.blocks.data(), 0, top, parallel ? &jobs : nullptr, kCollapseJobDepth};
+    collapse(sink, tris, refs, root, 0, 0);
+    tbb::parallel_for(size_t(0), jobs.size(), [&](size_t j) {
+      CollapseJob<W>& job = jobs[j];
+      job.nodes.emplace_back();
+      CollapseSink<W> js{job.nodes, bvh.blocks.data(), job.block, job.tally, nullptr, 0};
+      collapse(js, tris, refs, *job.node, job.depth, 0);
+    });
+    for (CollapseJob<W>& job : jobs) {
+      const uint32_t offset = uint32_t(bvh.nodes.size()) - 1;  // local index i >= 1 goes to offset + i
+      for (WideNode<W>& n : job.nodes)
+        for (int i = 0; i < W; ++i)
+          if (n.count[i] == 0 && n.child[i] != UINT32_MAX) n.child[i] += offset;
+      bvh.nodes[job.slot] = job.nodes[0];
+      bvh.nodes.insert(bvh.nodes.end(), job.nodes.begin() + 1, job.nodes.end());
+      top.merge(job.tally);
+    }
+    m_stats.max_depth = top.max_depth;
+    m_stats.sah_cost = top.sah_cost;
+    m_stats.sah_node_area = top.sah_node_area;
+    m_stats.sah_leaf_area = top.sah_leaf_area;
+    m_tally = top.leaves;
+  }
+
+  /// Emits the W-wide node for interior binary node `b` into node `idx` of the sink: its
+  /// children, with the interior child of largest surface area replaced by its two children
+  /// until there are W (or only leaves) (Wald, Benthin & Boulos 2008). Fills the statistics as
+  /// it goes (leaves, depth, SAH cost of the wide tree). A node's interior children are stored
+  /// next to each other (one block per parent), so siblings share pages and the hardware
+  /// prefetcher's adjacent lines.
+  template <int W>
+  void collapse(CollapseSink<W>& sink, const std::vector<PrimitiveRecord>& tris,
+                const std::vector<BvhBuildRef>& refs, const BvhBuildNode& b, uint64_t depth, uint32_t idx) {
+    CollapseTally& tally = sink.tally;
+    tally.max_depth = std::max(tally.max_depth, depth);
     const double rel = m_sah_root_area > 0 ? surface_area(b.box) / m_sah_root_area : 1.0;
-    m_stats.sah_cost += rel * m_config.traversal_cost;
-    m_stats.sah_node_area += rel;
+    tally.sah_cost += rel * m_config.traversal_cost;
+    tally.sah_node_area += rel;
     const BvhBuildNode* kids[W];
     int n = 0;
     if (!b.child[0]) {
@@ -360,24 +439,31 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     }
     uint32_t child[W] = {};
     uint8_t count[W] = {};
-    uint32_t next = uint32_t(bvh.nodes.size());  // the block of this node's interior children
+    uint32_t next = uint32_t(sink.nodes.size());  // the block of this node's interior children
     for (int i = 0; i < n; ++i)
       if (kids[i]->child[0]) child[i] = next++;
-    bvh.nodes.resize(next);
+    sink.nodes.resize(next);
     for (int i = 0; i < n; ++i) {
       if (kids[i]->child[0]) {
-        collapse(bvh, tris, refs, *kids[i], depth + 1, child[i]);
+        if (sink.jobs && depth + 1 >= sink.defer_depth) {
+          sink.jobs->push_back({kids[i], child[i], sink.block, depth + 1, {}, {}});
+          sink.block += leaf_blocks(*kids[i]);
+          continue;
+        }
+        collapse(sink, tris, refs, *kids[i], depth + 1, child[i]);
         continue;
       }
-      child[i] = add_leaf_blocks(bvh.blocks, tris, refs, *kids[i]);
+      child[i] = sink.block;
+      write_leaf_blocks(sink.blocks + sink.block, tris, refs, *kids[i]);
       count[i] = uint8_t((kids[i]->count + 3) / 4);
-      m_tally.add(kids[i]->count);
-      m_stats.max_depth = std::max(m_stats.max_depth, depth + 1);
+      sink.block += count[i];
+      tally.leaves.add(kids[i]->count);
+      tally.max_depth = std::max(tally.max_depth, depth + 1);
       const double lrel = m_sah_root_area > 0 ? surface_area(kids[i]->box) / m_sah_root_area : 1.0;
-      m_stats.sah_cost += lrel * m_config.intersection_cost * count[i];
-      m_stats.sah_leaf_area += lrel * kids[i]->count;
+      tally.sah_cost += lrel * m_config.intersection_cost * count[i];
+      tally.sah_leaf_area += lrel * kids[i]->count;
     }
-    WideNode<W>& node = bvh.nodes[idx];  // after the recursion: resize may have moved it
+    WideNode<W>& node = sink.nodes[idx];  // after the recursion: resize may have moved it
     Bounds3f boxes[W];
     for (int i = 0; i < n; ++i) boxes[i] = widen_for_rounding(kids[i]->box);
     set_child_boxes(node, boxes, n);

@@ -22,7 +22,8 @@ struct BvhConfig {
   int bin_count = 16;           ///< [2, 256]: SAH bins per axis (Wald 2007 uses 16-32)
   float traversal_cost = 1.0f;  ///< > 0: cost of visiting one node (3 suits big dense meshes, see RESULTS.md)
   float intersection_cost = 1.0f;    ///< > 0: cost of one triangle test
-  size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks
+  size_t parallel_threshold = 4096;  ///< subtrees with more triangles build in parallel TBB tasks; trees
+                                     ///< of 16x as many collapse their subtrees in parallel
   int width = 0;  ///< 0 (8 if the CPU has AVX2, else 4), 2 (binary), 4 (SSE) or 8 (AVX2; refused without it)
   /// [0, 1]: spatial splits (Stich et al. 2009) are tried at nodes whose object split leaves
   /// children overlapping by more than this fraction of the root's surface area; 0 turns them

@@ -217,6 +217,42 @@ TEST_CASE("bvh: the build is the same for 1 and 2 threads", "[accel][bvh]") {
   CHECK(s1.sah_cost == s2.sah_cost);
 }
 
+TEST_CASE("bvh: subtrees collapsed in parallel give the serial collapse's tree and answers bit for bit",
+          "[accel][bvh]") {
+  // parallel_threshold 16: the 4646-triangle default scene collapses its subtrees below the
+  // second wide level as parallel jobs; 1 << 30: one serial collapse.
+  const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
+  const auto views = mesh_views(l.scene);
+  const auto brute = make_accelerator("brute", views);
+  const std::vector<Ray> rays = scene_rays(l, *brute, views);
+  for (int width : wide_widths()) {
+    BvhConfig serial, jobs;
+    serial.width = jobs.width = width;
+    serial.parallel_threshold = size_t(1) << 30;
+    jobs.parallel_threshold = 16;
+    const auto a = make_bvh_accelerator(views, serial), b = make_bvh_accelerator(views, jobs);
+    AccelStats sa = a->stats(), sb = b->stats();
+    CHECK(sa.nodes == sb.nodes);
+    CHECK(sa.leaves == sb.leaves);
+    CHECK(sa.references == sb.references);
+    CHECK(sa.max_depth == sb.max_depth);
+    CHECK(sa.bytes == sb.bytes);
+    CHECK(sa.sah_cost == Approx(sb.sah_cost).epsilon(1e-9));
+    size_t differ = 0, hits = 0;
+    for (const Ray& r : rays) {
+      Hit ha, hb;
+      const bool fa = a->intersect(r, ha), fb = b->intersect(r, hb);
+      hits += fa;
+      differ += fa != fb || (fa && (ha.t != hb.t || ha.u != hb.u || ha.v != hb.v ||
+                                    ha.geom_id != hb.geom_id || ha.prim_id != hb.prim_id));
+      differ += a->occluded(r) != b->occluded(r);
+    }
+    INFO("width " << width << ", " << rays.size() << " rays, " << hits << " hits");
+    CHECK(hits > rays.size() / 4);
+    CHECK(differ == 0);
+  }
+}
+
 namespace {
 /// Long thin triangles along the diagonal of a 20 m cube: boxes that overlap everywhere, the
 /// case spatial splits are for.
@@ -238,16 +274,71 @@ DiagonalSlivers diagonal_slivers(int n) {
   }
   return s;
 }
-}  // namespace
 
-TEST_CASE("bvh: spatial splits give brute force's answers in every width", "[accel][bvh]") {
+/// Calls fn(views, index) on the default scene (index 0) and on 2000 diagonal slivers (1).
+template <typename Fn>
+void for_default_and_slivers(Fn&& fn) {
   const LoadedScene l = load_gltf(source_dir() / "scenes/default.gltf");
   const DiagonalSlivers slivers = diagonal_slivers(2000);
   const GeometryView sliver_view = slivers.view();
   const auto default_views = mesh_views(l.scene);
-  for (int scene = 0; scene < 2; ++scene) {
-    const std::span<const GeometryView> views =
-        scene == 0 ? std::span<const GeometryView>(default_views) : std::span(&sliver_view, 1);
+  fn(std::span<const GeometryView>(default_views), 0);
+  fn(std::span<const GeometryView>(&sliver_view, 1), 1);
+}
+}  // namespace
+
+TEST_CASE("bvh: the wide layouts' block test answers as the scalar watertight test, bit for bit",
+          "[accel][bvh]") {
+  // Brute force runs intersect_triangle_watertight on each triangle; the wide layouts finish
+  // the lanes their SIMD filter keeps with block_confirm (double precision, two lanes per SSE
+  // register). Same t on every ray; same u, v where both report the same triangle (two
+  // triangles at exactly the same t may be reported either way). The slivers are where the
+  // double-precision part decides t, u and v.
+  for_default_and_slivers([](std::span<const GeometryView> views, int scene) {
+    const auto brute = make_accelerator("brute", views);
+    const Bounds3f b = brute->bounds();
+    std::vector<Ray> rays = all_rays(*brute, views, b, lights_around(b), 1, 7);
+    // Rays at the edges' midpoints and the corners of every 7th triangle, from off its plane:
+    // edge functions near 0, where the double-precision part clamps to the float decision.
+    const Vec3f from = b.hi + (b.hi - b.lo) * 0.3f;
+    for (const GeometryView& v : views)
+      for (size_t i = 0; i + 2 < v.indices.size(); i += 21) {
+        const Vec3f p[3] = {v.positions[v.indices[i]], v.positions[v.indices[i + 1]],
+                            v.positions[v.indices[i + 2]]};
+        for (int e = 0; e < 3; ++e)
+          for (const Vec3f target : {(p[e] + p[(e + 1) % 3]) * 0.5f, p[e]}) {
+            Ray r;
+            r.org = from;
+            r.dir = normalize(target - from);
+            rays.push_back(r);
+          }
+      }
+    for (int width : wide_widths()) {
+      BvhConfig c;
+      c.width = width;
+      const auto bvh = make_bvh_accelerator(views, c);
+      size_t hits = 0, differ = 0, same_triangle = 0;
+      for (const Ray& r : rays) {
+        Hit hb, hw;
+        const bool fb = brute->intersect(r, hb), fw = bvh->intersect(r, hw);
+        hits += fb;
+        differ += fb != fw || (fb && hb.t != hw.t) || brute->occluded(r) != bvh->occluded(r);
+        if (fb && fw && hb.geom_id == hw.geom_id && hb.prim_id == hw.prim_id) {
+          ++same_triangle;
+          differ += hb.u != hw.u || hb.v != hw.v;
+        }
+      }
+      INFO("scene " << scene << ", width " << width << ": " << rays.size() << " rays, " << hits << " hits, "
+                    << same_triangle << " on the same triangle");
+      CHECK(hits > 150);
+      CHECK(same_triangle > hits * 9 / 10);
+      CHECK(differ == 0);
+    }
+  });
+}
+
+TEST_CASE("bvh: spatial splits give brute force's answers in every width", "[accel][bvh]") {
+  for_default_and_slivers([](std::span<const GeometryView> views, int scene) {
     const auto brute = make_accelerator("brute", views);
     Bounds3f b = brute->bounds();
     const Reference ref = reference(*brute, all_rays(*brute, views, b, lights_around(b), 1, 5));
@@ -272,7 +363,7 @@ TEST_CASE("bvh: spatial splits give brute force's answers in every width", "[acc
         CHECK(double(s.references) <= double(s.triangles) * (1 + budget));
         CHECK_THAT(s.config, Catch::Contains("spatial_alpha"));
       }
-  }
+  });
 }
 
 TEST_CASE("bvh: spatial splits of huge diagonal strips under small objects miss nothing along their edges",
