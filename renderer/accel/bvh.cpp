@@ -233,6 +233,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     } else {
       collapse_tree(m_wide8, tris, refs, *root);
     }
+    release_bvh_tree(std::move(root));
     m_tally.fill(m_stats);
   }
 
@@ -284,8 +285,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
 
   /// Offers the primitives of blocks [first, first + count) to `visitor`, with their Hit ids
   /// (prim_id 0 for a shape).
-  void visit_region_blocks(const std::vector<TriangleBlock4>& blocks, uint32_t first, uint32_t count,
-                           QueryRegion& region, RegionVisitor& visitor) const {
+  void visit_region_blocks(const BlockArray& blocks, uint32_t first, uint32_t count, QueryRegion& region,
+                           RegionVisitor& visitor) const {
     for (uint32_t k = first, e = first + count; k < e; ++k)
       for (int l = 0; l < 4; ++l) {
         if (blocks[k].id[l] == kEmptyLane) continue;
@@ -305,7 +306,14 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
           blk.id[l] = kEmptyLane;
           continue;
         }
-        const PrimitiveRecord& r = tris[refs[b.first + i + l].index];
+        const size_t at = b.first + i + l;
+        // The records are read in leaf order, scattered over the array: fetch ahead.
+        if (at + kGatherAhead < refs.size()) {
+          const char* ahead = reinterpret_cast<const char*>(&tris[refs[at + kGatherAhead].index]);
+          _mm_prefetch(ahead, _MM_HINT_T0);
+          _mm_prefetch(ahead + sizeof(PrimitiveRecord) - 1, _MM_HINT_T0);
+        }
+        const PrimitiveRecord& r = tris[refs[at].index];
         if (is_shape(r)) {
           blk.id[l] = r.prim_id;
           continue;
@@ -318,6 +326,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       *out++ = blk;
     }
   }
+
+  static constexpr size_t kGatherAhead = 16;  // records fetched ahead by write_leaf_blocks
 
   /// Blocks of the leaves below `b`.
   static uint32_t leaf_blocks(const BvhBuildNode& b) {

@@ -528,6 +528,18 @@ std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, con
   return builder.build(root, 0);
 }
 
+namespace {
+void release_subtree(std::unique_ptr<BvhBuildNode> node, int depth) {
+  if (node && node->child[0] && depth < 10)
+    tbb::parallel_invoke([&] { release_subtree(std::move(node->child[0]), depth + 1); },
+                         [&] { release_subtree(std::move(node->child[1]), depth + 1); });
+}
+}  // namespace
+
+void release_bvh_tree(std::unique_ptr<BvhBuildNode> root) {
+  release_subtree(std::move(root), 0);
+}
+
 void split_triangle_bounds(const Vec3f v[3], const Bounds3f& box, int axis, float pos, Bounds3f& left,
                            Bounds3f& right) {
   left = right = Bounds3f{};

@@ -69,6 +69,10 @@ using ReferenceClipper =
 std::unique_ptr<BvhBuildNode> build_bvh_tree(std::vector<BvhBuildRef>& refs, const BvhConfig& config,
                                              int block = 1, const ReferenceClipper* clip = nullptr);
 
+/// Frees the tree built by build_bvh_tree, its large subtrees in parallel TBB tasks (a
+/// million-triangle tree is some 10^6 separate allocations).
+void release_bvh_tree(std::unique_ptr<BvhBuildNode> root);
+
 /// The boxes of the parts of triangle v on either side of x[axis] = pos, within `box`: the
 /// triangle's vertices and edge crossings on each side (crossings padded by their rounding
 /// error), intersected with `box`.

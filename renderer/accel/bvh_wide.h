@@ -10,7 +10,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "renderer/accel/triangle_block.h"
@@ -49,12 +51,33 @@ static_assert(sizeof(QuantizedNode8) == 128, "8-wide nodes are two cache lines")
 template <int W>
 using WideNode = std::conditional_t<W == 8, QuantizedNode8, Node4>;
 
+/// std::allocator, except that resize() leaves new elements default-initialised: for arrays of
+/// plain data a build writes in full (in parallel, so the pages are first touched there).
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+/// The leaf blocks of a wide BVH.
+using BlockArray = std::vector<TriangleBlock4, DefaultInitAllocator<TriangleBlock4>>;
+
 /// A collapsed BVH: node 0 is the root; the interior children of a node are stored next to
 /// each other; every leaf is a run of blocks.
 template <int W>
 struct WideBvh {
   std::vector<WideNode<W>> nodes;
-  std::vector<TriangleBlock4> blocks;
+  BlockArray blocks;
 };
 
 /// Writes the boxes of children [0, n) into `node` (boxes already widened for rounding);
