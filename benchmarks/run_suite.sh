@@ -3,7 +3,7 @@
 # build) and, for the Stanford models, node/npm (benchmarks/fetch_models.sh is called).
 #   benchmarks/run_suite.sh [OUT_DIR]       (default: build/bench-results)
 # Writes, per part, a table (.txt), CSV, JSON and SVG chart, and the cost heat maps, to OUT_DIR.
-# Takes about 45 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
+# Takes about 15 minutes on 2 cores. PENUMBRA_CORPUS points at the shared corpus (default
 # ../shared/corpus); corpus models are skipped when it is absent.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
