@@ -7,8 +7,8 @@
 // Closest hit: the W child boxes are slab-tested at once; the children met are pushed far to
 // near with their entry distance, and entries beyond `best` are skipped when popped. Leaves sit
 // on the stack like nodes, so blocks are tested front to back. The box test is the slab test
-// (common.h) in SIMD, the entry and exit distances scaled outward by kSlabPad; an axis the ray
-// is parallel to uses a finite inverse (see BoxRay), so no distance is NaN.
+// (common.h) in SIMD, the entry and exit distances scaled outward by kSlabPad; on an axis the
+// ray is parallel to, NaN distances drop out of the max and min (see BoxRay).
 // Occlusion (AnyHit): the leaves met are tested at once, before any node is pushed, and nothing
 // is sorted: the first hit ends the query, wherever it is.
 
@@ -103,12 +103,11 @@ inline int valid_mask(const Node4&) {
 
 using Node = WideNode<kWidth>;
 
-/// Per-ray constants of the box test, broadcast to all lanes. A direction component of 0 gets
-/// the inverse +-FLT_MAX (signed like the zero) instead of +-inf: a plane at any distance d from
-/// the origin along that axis is then at +-d * FLT_MAX, overflowing to +-inf, and a plane through
-/// the origin at 0, never NaN; a slab that holds the origin (faces included) still gives an
-/// interval around 0 and one that does not an interval beyond any finite t or behind the ray
-/// (or, for d under 1/FLT_MAX, a far one: extra work, never a miss).
+/// Per-ray constants of the box test, broadcast to all lanes. On an axis the ray is parallel to
+/// (1/d infinite) the distances are +-inf, or NaN (0 * inf) where the origin lies exactly on a
+/// plane: the max and min of hit_children take a NaN as their first operand and then return the
+/// second (MAXPS/MINPS return the second operand when one is NaN), so such a plane drops out,
+/// which is the slab test's answer for an origin inside the slab, faces included.
 struct BoxRay {
   Vf org[3], inv[3];
   Vf down, up, tnear;
@@ -119,8 +118,7 @@ struct BoxRay {
   BoxRay r;
   for (int k = 0; k < 3; ++k) {
     r.org[k] = vset(q.org[k]);
-    const float inv = q.inv_dir[k];
-    r.inv[k] = vset(std::isinf(inv) ? std::copysign(std::numeric_limits<float>::max(), inv) : inv);
+    r.inv[k] = vset(q.inv_dir[k]);
     // Near is the lower plane where the direction is positive (by the sign, not min/max, so an
     // unused slot's inverted box gives an empty interval).
     r.near_off[k] = plane_offset(k, q.dir_neg[k]);
@@ -140,13 +138,13 @@ struct BoxRay {
   // product), so scaling the entry down and the exit up by kSlabPad covers it whatever their
   // signs: a negative entry moved towards 0 still lies below tnear >= 0, and a negative exit
   // stays negative (behind the ray) as the exact one is.
-  Vf tn, tf;
+  Vf tn = vset(-kInfinity), tf = vset(kInfinity);
   for (int k = 0; k < 3; ++k) {
     const Vf near_plane = load_planes(n, k, r.near_off[k]), far_plane = load_planes(n, k, r.far_off[k]);
     const Vf a = vmul(vsub(near_plane, r.org[k]), r.inv[k]);
     const Vf b = vmul(vsub(far_plane, r.org[k]), r.inv[k]);
-    tn = k == 0 ? a : vmax(a, tn);
-    tf = k == 0 ? b : vmin(b, tf);
+    tn = vmax(a, tn);  // a NaN `a` leaves tn (see BoxRay)
+    tf = vmin(b, tf);
   }
   const Vf t0 = vmax(vmul(tn, r.down), r.tnear), t1 = vmin(vmul(tf, r.up), vset(best));
   vstore(t_entry, t0);

@@ -125,13 +125,15 @@ inline __m128 load_row(const TriangleBlock4& b, int vertex, int axis) {
 /// The lanes of block_candidates (bit l for lane l).
 struct BlockCandidates {
   int all = 0;       ///< the triangles the scalar test may accept; it certainly rejects the others
-  int settled = 0;   ///< those of `all` whose float edge functions are final (none 0, none NaN)
+  int settled = 0;   ///< those of `all` block_confirm can finish: edge functions final (none 0,
+                     ///< none NaN), distance bound clear of underflow
   int positive = 0;  ///< lanes whose edge functions are all positive (else all negative, if settled)
 };
 
 /// The triangle lanes of `b` that the scalar watertight test may accept with t in
 /// [tnear, tfar]; of them, the ones block_confirm can finish (the scalar test recomputes edge
-/// functions of exactly 0 in double, so those lanes, and NaN ones, stay with it).
+/// functions of exactly 0 in double, so those lanes, NaN ones and ones near underflow stay
+/// with it).
 [[gnu::always_inline]] inline BlockCandidates block_candidates(const TriangleBlock4& b, const BlockRay& r,
                                                                float tfar) {
   using namespace block_detail;
@@ -179,9 +181,14 @@ struct BlockCandidates {
   const __m128 outside = _mm_or_ps(_mm_cmplt_ps(far_end, r.tnear), _mm_cmpgt_ps(near_end, _mm_set1_ps(tfar)));
   const __m128 ordered = _mm_cmpord_ps(lo, hi);
   inside &= ~_mm_movemask_ps(_mm_and_ps(outside, ordered));
+  // The scalar test's own distance early-out (half this bound) only ever rejects what its
+  // double-precision t rejects too, so block_confirm can skip it; not near underflow, where
+  // subnormal products carry absolute errors the bound does not cover: such lanes (and NaN
+  // ones) stay with the scalar test.
   const __m128 nan = _mm_or_ps(_mm_cmpunord_ps(U, V), _mm_cmpunord_ps(W, W));
+  const __m128 tiny = _mm_cmplt_ps(err, _mm_set1_ps(0x1p-100f));
   out.all = inside | edge;
-  out.settled = inside & ~_mm_movemask_ps(nan);
+  out.settled = inside & ~_mm_movemask_ps(_mm_or_ps(nan, tiny));
   out.positive = _mm_movemask_ps(_mm_cmpgt_ps(det, zero));
   return out;
 }

@@ -337,6 +337,72 @@ TEST_CASE("bvh: the wide layouts' block test answers as the scalar watertight te
   });
 }
 
+TEST_CASE(
+    "bvh: wide layouts meet boxes along axis-parallel and tiny directions, and tiny geometry, as "
+    "brute force does",
+    "[accel][bvh]") {
+  // A ray along z with a direction of 1e-36 reaches a triangle at t ~ 1e36, beyond where a
+  // finite stand-in for 1/0 on x and y would close the box (the test fails with one); origins
+  // on box faces with zero components; and triangles 1e-13 across, 1e-13 from the origins,
+  // where the filter's distance bound falls below FLT_MIN and its lanes go to the scalar test.
+  std::vector<Vec3f> pos = {{-0.001f, -0.001f, 1}, {0.001f, -0.001f, 1}, {0, 0.001f, 1}, {5, 0, 1},
+                            {5.1f, 0, 1},          {5, 0.1f, 1}};
+  std::vector<uint32_t> idx = {0, 1, 2, 3, 4, 5};
+  Rng rng(5);
+  const uint32_t tiny_first = uint32_t(pos.size());
+  for (int i = 0; i < 300; ++i) {
+    const uint32_t b = uint32_t(pos.size());
+    for (int v = 0; v < 3; ++v)
+      pos.push_back(Vec3f{rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() + 1} * 1e-13f);
+    idx.insert(idx.end(), {b, b + 1, b + 2});
+  }
+  const GeometryView view{pos, idx};
+  const auto brute = make_accelerator("brute", std::span(&view, 1));
+  std::vector<Ray> rays;
+  for (float scale : {1.0f, 1e-36f}) {
+    Ray r;
+    r.dir = Vec3f{0, 0, 1} * scale;
+    rays.push_back(r);
+    for (const Vec3f org :
+         {Vec3f{0.001f, 0, 0}, Vec3f{0, -0.001f, 0.5f}, Vec3f{5, 0, 0}, Vec3f{5.1f, 0.1f, 0}}) {
+      r.org = org;  // on the boxes' faces
+      rays.push_back(r);
+    }
+  }
+  for (int i = 0; i < 3000; ++i) {
+    Ray r;
+    r.org = Vec3f{rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() * 0.5f} * 2e-13f;
+    const Vec3f target = pos[tiny_first + uint32_t(rng.next_float() * 899.0f)];
+    r.dir = normalize(target - r.org);  // t ~ 1e-13
+    rays.push_back(r);
+    // The same ray ending exactly at brute force's hit.
+    Hit h;
+    if (brute->intersect(r, h)) {
+      Ray end = r;
+      end.tfar = h.t;
+      rays.push_back(end);
+    }
+  }
+  for (int width : wide_widths()) {
+    BvhConfig c;
+    c.width = width;
+    c.max_leaf_size = 1;
+    const auto bvh = make_bvh_accelerator(std::span(&view, 1), c);
+    size_t hits = 0, differ = 0;
+    for (const Ray& r : rays) {
+      Hit hb, hw;
+      const bool fb = brute->intersect(r, hb), fw = bvh->intersect(r, hw);
+      hits += fb;
+      differ += fb != fw ||
+                (fb && (hb.t != hw.t || hb.prim_id != hw.prim_id || hb.u != hw.u || hb.v != hw.v)) ||
+                brute->occluded(r) != bvh->occluded(r);
+    }
+    INFO("width " << width << ": " << rays.size() << " rays, " << hits << " hits");
+    CHECK(hits > rays.size() / 2);
+    CHECK(differ == 0);
+  }
+}
+
 TEST_CASE("bvh: spatial splits give brute force's answers in every width", "[accel][bvh]") {
   for_default_and_slivers([](std::span<const GeometryView> views, int scene) {
     const auto brute = make_accelerator("brute", views);
