@@ -387,7 +387,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     bvh.nodes.emplace_back();
     std::vector<CollapseJob<W>> jobs;
     CollapseTally top;
-    const bool parallel = refs.size() >= 16 * m_config.parallel_threshold;
+    const bool parallel = refs.size() / 16 >= m_config.parallel_threshold;  // no overflow for any threshold
     CollapseSink<W> sink{bvh.nodes, bvh.blocks.data(), 0, top, parallel ? &jobs : nullptr, kCollapseJobDepth};
     collapse(sink, tris, refs, root, 0, 0);
     tbb::parallel_for(size_t(0), jobs.size(), [&](size_t j) {
