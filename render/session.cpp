@@ -481,6 +481,18 @@ RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, 
   return out;
 }
 
+DeepResult render_deep_image(const LoadedScene& loaded, const Accelerator& accel, const PreparedRender& p,
+                             const RenderImage& image, uint64_t max_bytes) {
+  DeepConfig deep;
+  deep.merge_tolerance = p.spec.deep_merge_tolerance;
+  deep.max_bytes = max_bytes;
+  const PathLights lights = p.path_lights();
+  const IntegratorType integrator = p.integrator();
+  const bool path = integrator == IntegratorType::Path;
+  return render_deep(loaded.scene, accel, path ? &lights : nullptr, p.camera, p.config, integrator,
+                     path ? &image.samples : nullptr, deep);
+}
+
 RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget) {
   std::lock_guard<std::mutex> lock(session.mutex);
   PrepareOptions options;
@@ -509,6 +521,7 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   const Accelerator* accel = session.structure.accel.get();
   r.image = render_image(scene, accel, r.prepared);
   r.layers = render_layers(session.loaded, accel, r.prepared);
+  if (r.prepared.spec.deep) r.deep = render_deep_image(session.loaded, *accel, r.prepared, r.image);
   if (r.prepared.spec.denoise) r.image.denoised = denoise_render(r.image, r.layers.data, r.prepared.config);
   return r;
 }

@@ -30,6 +30,7 @@
 #include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/cost_map.h"
+#include "renderer/integrators/deep_pass.h"
 #include "renderer/integrators/motion_vectors.h"
 #include "renderer/integrators/render.h"
 #include "renderer/lights/area.h"
@@ -229,6 +230,15 @@ std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInf
 RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel,
                            const PreparedRender& prepared);
 
+/// The deep image of a render with spec.deep (Whitted or path): the beauty's own camera samples
+/// traced again with their layers recorded (render_deep), each pixel taking the samples `image`
+/// took (the path tracer's adaptive counts), merged with spec.deep_merge_tolerance. The deep
+/// samples may take `max_bytes` in memory (DeepConfig::max_bytes); the result says when they would
+/// not fit.
+DeepResult render_deep_image(const LoadedScene& loaded, const Accelerator& accel,
+                             const PreparedRender& prepared, const RenderImage& image,
+                             uint64_t max_bytes = UINT64_MAX);
+
 /// A loaded scene as a front end keeps it between renders. Every access holds `mutex`.
 struct Session {
   std::string file;  ///< as given to load (the name InputError messages carry)
@@ -247,6 +257,7 @@ struct RenderResult {
   PreparedRender prepared;
   RenderImage image;
   RenderLayers layers;
+  DeepResult deep;  ///< with spec.deep: the deep image
 };
 
 /// One render of the session's scene (locking it): the scene's motion over the shutter around

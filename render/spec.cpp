@@ -77,6 +77,16 @@ std::vector<SpecField> make_fields() {
        0,
        {"ray", "map", "none"},
        "raster: light visibility by shadow rays (ray, default), shadow maps (map) or none"},
+      {"shadows",
+       &S::shadows,
+       kWhitted,
+       true,
+       0,
+       0,
+       {"on", "off"},
+       "whitted: on (default) traces shadow rays; off lights every surface as if nothing stood between it "
+       "and "
+       "the lights, so that no object shades another (primary-visibility renders for deep holdouts)"},
       {"shadow_map_size",
        &S::shadow_map_size,
        kRaster,
@@ -354,6 +364,25 @@ std::vector<SpecField> make_fields() {
        16,
        {},
        "Cryptomatte ranks (id, coverage pairs) kept per pixel (default 6: three RGBA layers)"},
+      {"deep",
+       &S::deep,
+       kWhitted | kPath,
+       false,
+       0,
+       0,
+       {},
+       "also a deep image: per pixel one sample per surface (R G B A Z ZBack id N albedo), from the beauty's own "
+       "camera samples traced again (the command's --deep FILE.exr)"},
+      {"deep_merge_tolerance",
+       &S::deep_merge_tolerance,
+       kWhitted | kPath,
+       false,
+       0,
+       1,
+       {},
+       "deep output: a surface's camera samples in a pixel merge into one deep sample when their depths "
+       "differ "
+       "by at most this fraction of the nearest one's (default 0.01; 0: equal depths only)"},
   };
 }
 
@@ -566,6 +595,8 @@ void validate(const RenderSpec& s) {
     throw std::invalid_argument("denoise needs spp >= 2 (it compares the even and odd samples)");
   if (!s.denoise && s.denoise_main != defaults.denoise_main)
     throw std::invalid_argument("denoise_main needs denoise");
+  if (!s.deep && s.deep_merge_tolerance != defaults.deep_merge_tolerance)
+    throw std::invalid_argument("deep_merge_tolerance needs deep (the command's --deep FILE.exr)");
   // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
   RenderConfig probe = make_render_config(resolve(s, 16.0f / 9.0f));
   probe.window = {};
@@ -603,6 +634,7 @@ RenderConfig make_render_config(const RenderSpec& r) {
   cfg.whitted.max_depth = r.max_depth;
   cfg.whitted.background = r.background.value_or(Vec3f{0, 0, 0});
   cfg.whitted.ambient = r.ambient.value_or(Vec3f{0.05f, 0.05f, 0.05f});
+  cfg.whitted.shadows = r.shadows == "on";
   cfg.raster.shadows = r.raster_shadows == "map"    ? RasterShadows::Map
                        : r.raster_shadows == "none" ? RasterShadows::None
                                                     : RasterShadows::Ray;

@@ -72,6 +72,9 @@ struct RenderSpec {
   std::vector<std::string> accel_params;  ///< "bvh.max_leaf_size=4", ... of `accel` only
   std::set<std::string> aovs;             ///< checked layer names (check_aovs)
   int crypto_depth = 6;                   ///< Cryptomatte ranks per pixel
+  std::string shadows = "on";          ///< whitted: on, or off (no shadow rays: lights reach every surface)
+  bool deep = false;                   ///< whitted, path: a deep image too (render_deep_image)
+  float deep_merge_tolerance = 0.01f;  ///< deep: relative depth within which one surface's records merge
 };
 
 /// The integrators a setting applies to (a bit mask).

@@ -155,15 +155,18 @@ bool survives_roulette(SampleStream& samples, Vec3f& beta) {
 
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups) {
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups,
+                    DeepTrace* deep) {
   const LazyDifferential lazy{[](const void* ctx) { return *static_cast<const RayDifferential*>(ctx); }, &rd};
-  return path_radiance(scene, accel, lights, cfg, camera_ray, lazy, samples, coverage, counts, groups);
+  return path_radiance(scene, accel, lights, cfg, camera_ray, lazy, samples, coverage, counts, groups, deep);
 }
 
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const LazyDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups) {
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups,
+                    DeepTrace* deep) {
   ++counts.camera;
+  DeepHit first;  // the surface the camera ray stops at (key 0: none)
   coverage = 0;
   PathRadiance path;
   path.clamp_indirect = cfg.clamp_indirect;
@@ -202,7 +205,15 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       continue;
     }
     seg.layers = 0;
-    if (vertex == 0) coverage = 1;
+    if (vertex == 0) {
+      coverage = 1;
+      if (deep) {
+        const Instance& inst = scene.instances[si.instance];
+        first = {
+            si.instance + 1, inst.node >= 0 ? uint32_t(inst.node) + 1 : 0, deep->depth_of(si.p), 1, {}, mp.ns,
+            mp.base_color};
+      }
+    }
 
     // Emitter hit.
     add_emission(ctx, seg, hit, si, mp, vertex, path);
@@ -236,6 +247,11 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     seg.ray.dir = wi;
     seg.ray.time = si.time;
     ++counts.reflection;
+  }
+  if (deep && (first.key != 0 || max_component(path.radiance) > 0)) {
+    first.radiance = path.radiance;
+    if (first.key == 0) first.depth = kInfinity;
+    deep->add(first);
   }
   return path.radiance;
 }

@@ -19,6 +19,7 @@
 
 #include "renderer/accel/accelerator.h"
 #include "renderer/core/sampler.h"
+#include "renderer/film/deep.h"
 #include "renderer/integrators/direct_lighting.h"
 #include "renderer/integrators/light_groups.h"
 #include "renderer/integrators/ray_counts.h"
@@ -62,13 +63,17 @@ struct LazyDifferential {
 /// (may be invalid). `coverage` is 1 if the path hit a surface, 0 if the camera ray escaped
 /// (then the environment is returned). Draws its random numbers from `samples`.
 /// Non-finite contributions are dropped. With `groups`, also adds each contribution to its
-/// light group. Thread-safe; never allocates, throws or logs.
+/// light group. With `deep`, records the sample's whole radiance (indirect light included) on the
+/// first surface it did not pass (coverage 1), or, escaped, as the background. Thread-safe; never
+/// allocates, throws or logs.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const RayDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr,
+                    DeepTrace* deep = nullptr);
 /// As above, with the differentials made only if the first hit's material reads them.
 Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                     const PathConfig& cfg, const Ray& camera_ray, const LazyDifferential& rd,
-                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr);
+                    SampleStream& samples, float& coverage, RayCounts& counts, LightGroups* groups = nullptr,
+                    DeepTrace* deep = nullptr);
 
 }  // namespace penumbra

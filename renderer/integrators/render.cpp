@@ -128,18 +128,23 @@ Ray camera_sample_ray(const Camera& camera, const RenderConfig& config, Integrat
   return sample_ray(camera, camera_raster(camera, config.width, config.height), cs, cs.film);
 }
 
+Vec3f whitted_sample(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                     const RenderConfig& config, int x, int y, uint32_t s, float& coverage, RayCounts& counts,
+                     DeepTrace* deep) {
+  const CameraSample cs = whitted_camera_sample(camera, config, x, y, s);
+  RayDifferential rd;
+  const Ray ray = camera_ray(camera, config, cs, differential_step(config.spp), rd);
+  return whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts, deep);
+}
+
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4], RayCounts& counts) {
   const uint32_t n = uint32_t(config.spp);
-  const float step = differential_step(config.spp);
   Vec3f sum{0, 0, 0};
   float alpha = 0;
   for (uint32_t s = 0; s < n; ++s) {
-    const CameraSample cs = whitted_camera_sample(camera, config, x, y, s);
-    RayDifferential rd;
-    const Ray ray = camera_ray(camera, config, cs, step, rd);
     float coverage = 0;
-    sum += whitted_radiance(scene, accel, config.whitted, ray, rd, coverage, counts);
+    sum += whitted_sample(scene, accel, camera, config, x, y, s, coverage, counts);
     alpha += coverage;
   }
   // The plain mean of the pixel's samples.
@@ -203,17 +208,15 @@ namespace {
 // Per-pixel accumulators of the path tracer.
 using PixelAccum = PathAccumulators::Pixel;
 
-// Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`,
-// kLightGroupChannels sums, and the odd-numbered samples' RGBA to `odd`, if not null).
-void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+}  // namespace
+
+Vec3f path_sample(const Scene& scene, const Accelerator& accel, const PathLights& lights,
                   const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
-                  uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr,
-                  double* odd = nullptr) {
-  const float step = differential_step(config.spp);
+                  uint32_t s, float& coverage, RayCounts& counts, LightGroups* groups, DeepTrace* deep) {
   // The differential rays of camera ray p, made only for a first hit that needs them.
   struct Footprint {
     const Camera& camera;
-    const CameraRaster& raster;
+    CameraRaster raster;
     CameraSample cs;
     float step;
   };
@@ -224,15 +227,28 @@ void path_samples(const Scene& scene, const Accelerator& accel, const PathLights
     const Ray ry = sample_ray(f.camera, f.raster, f.cs, {p.x, p.y + f.step});
     return RayDifferential{true, rx.org, rx.dir, ry.org, ry.dir};
   };
+  SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
   const CameraRaster raster = camera_raster(camera, config.width, config.height);
+  const Footprint fp{camera, raster, take_path_camera_sample(camera, config, x, y, samples),
+                     differential_step(config.spp)};
+  const Ray ray = sample_ray(camera, raster, fp.cs, fp.cs.film);
+  return path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples, coverage,
+                       counts, groups, deep);
+}
+
+namespace {
+
+// Adds samples [s0, s1) of pixel (x, y) to `acc` (and their light groups to `groups`,
+// kLightGroupChannels sums, and the odd-numbered samples' RGBA to `odd`, if not null).
+void path_samples(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                  const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
+                  uint32_t s0, uint32_t s1, PixelAccum& acc, RayCounts& counts, double* groups = nullptr,
+                  double* odd = nullptr) {
   for (uint32_t s = s0; s < s1; ++s) {
-    SampleStream samples = make_sample_stream(config.sampler, uint32_t(x), uint32_t(y), s, config.seed);
-    const Footprint fp{camera, raster, take_path_camera_sample(camera, config, x, y, samples), step};
-    const Ray ray = sample_ray(camera, raster, fp.cs, fp.cs.film);
     float coverage = 0;
     LightGroups lg;
-    const Vec3f l = path_radiance(scene, accel, lights, pc, ray, LazyDifferential{make_rd, &fp}, samples,
-                                  coverage, counts, groups ? &lg : nullptr);
+    const Vec3f l = path_sample(scene, accel, lights, camera, config, pc, x, y, s, coverage, counts,
+                                groups ? &lg : nullptr);
     if (groups) add_light_groups(lg, groups);
     acc.rgba[0] += l.x;
     acc.rgba[1] += l.y;

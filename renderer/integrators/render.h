@@ -49,6 +49,21 @@ Film render_whitted(const Scene& scene, const Accelerator& accel, const Camera& 
 void render_whitted_pixel(const Scene& scene, const Accelerator& accel, const Camera& camera,
                           const RenderConfig& config, int x, int y, float rgba[4], RayCounts& counts);
 
+/// Camera sample `s` of pixel (x, y) exactly as render_whitted takes it (its position, lens
+/// point and time, its differentials): the radiance, its coverage, and with `deep` the layers it
+/// composited. `config` as render_whitted uses it (hit_filter only where the scene needs it).
+Vec3f whitted_sample(const Scene& scene, const Accelerator& accel, const Camera& camera,
+                     const RenderConfig& config, int x, int y, uint32_t s, float& coverage, RayCounts& counts,
+                     DeepTrace* deep = nullptr);
+
+/// Camera sample `s` of pixel (x, y) exactly as render_path takes it (its own sample stream),
+/// with path tracer settings `pc` (hit_filter only where the scene needs it): the radiance, its
+/// coverage, the light groups and the deep record when asked for.
+Vec3f path_sample(const Scene& scene, const Accelerator& accel, const PathLights& lights,
+                  const Camera& camera, const RenderConfig& config, const PathConfig& pc, int x, int y,
+                  uint32_t s, float& coverage, RayCounts& counts, LightGroups* groups = nullptr,
+                  DeepTrace* deep = nullptr);
+
 /// A path-traced image with its per-pixel statistics.
 struct PathImage {
   Film film;                      ///< mean of each pixel's samples (RGBA, premultiplied);

@@ -104,6 +104,7 @@ struct Tracer {
   const Accelerator& accel;
   const WhittedConfig& cfg;
   RayCounts& counts;
+  DeepTrace* deep = nullptr;  // the camera ray's layers, when recorded
 
   // Radiance along `ray`; `weight` is the ray's contribution to the pixel (for pruning);
   // `coverage` (may be null) receives the composited coverage of this ray.
@@ -112,6 +113,9 @@ struct Tracer {
     Hit hit;
     if (!intersect_visible(scene, accel, ray, hit, cfg.hit_filter)) {
       if (coverage) *coverage = 0;
+      // On the camera ray's chain of Blend layers all weights are the transmittance in front.
+      if (coverage && deep && max_component(cfg.background) > 0)
+        deep->add({0, 0, kInfinity, 0, cfg.background * weight.x, {}, {}});
       return cfg.background;
     }
     SurfaceInteraction si = make_interaction(scene, ray, hit);
@@ -129,12 +133,19 @@ struct Tracer {
     }
     if (coverage) *coverage = a + (1 - a) * behind_coverage;
     if (!(a > 0)) return behind;
-    if (mp.unlit) return mp.base_color * a + behind * (1 - a);  // KHR_materials_unlit
+    if (mp.unlit) {  // KHR_materials_unlit
+      if (coverage && deep) record(si, mp, mp.base_color, a * weight.x);
+      return mp.base_color * a + behind * (1 - a);
+    }
 
     const WhittedParams w = whitted_params(mp);
     const Vec3f v = normalize(-ray.dir);
     const ShadowRayVisibility shadows{scene, accel, cfg.hit_filter};
-    Vec3f radiance = whitted_local(scene, cfg, si, mp, w, v, shadows.visibility(), counts);
+    constexpr LightVisibility unoccluded{
+        [](const void*, int, const SurfaceInteraction&, const LightSample&, RayCounts&) { return 1.0f; },
+        nullptr};
+    Vec3f radiance =
+        whitted_local(scene, cfg, si, mp, w, v, cfg.shadows ? shadows.visibility() : unoccluded, counts);
 
     // Ideal mirror reflection, unless its weight on the pixel is below min_reflectance.
     const Vec3f rweight = weight * w.kr * a;
@@ -153,7 +164,15 @@ struct Tracer {
       radiance += w.kr * trace(refl, reflect_differential(si, rd, v, n, r), depth + 1, 0, rweight, nullptr);
     }
     radiance += transmitted(ray, rd, si, mp, w, depth, weight * a);
+    if (coverage && deep) record(si, mp, radiance, a * weight.x);
     return radiance * a + behind * (1 - a);
+  }
+
+  // A layer of the camera ray: its surface, the coverage it takes and the radiance it sends.
+  void record(const SurfaceInteraction& si, const MaterialPoint& mp, Vec3f radiance, float taken) {
+    const Instance& inst = scene.instances[si.instance];
+    deep->add({si.instance + 1, inst.node >= 0 ? uint32_t(inst.node) + 1 : 0, deep->depth_of(si.p), taken,
+               radiance * taken, mp.ns, mp.base_color});
   }
 
   // The ideal transmission: refracted by Snell's law into a volume (total internal reflection
@@ -178,9 +197,10 @@ struct Tracer {
 }  // namespace
 
 Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const WhittedConfig& cfg,
-                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts) {
+                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts,
+                       DeepTrace* deep) {
   ++counts.camera;
-  Tracer tracer{scene, accel, cfg, counts};
+  Tracer tracer{scene, accel, cfg, counts, deep};
   return tracer.trace(camera_ray, rd, 0, 0, {1, 1, 1}, &coverage);
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "renderer/accel/accelerator.h"
+#include "renderer/film/deep.h"
 #include "renderer/integrators/ray_counts.h"
 #include "renderer/lights/punctual.h"
 #include "renderer/materials/material.h"
@@ -55,6 +56,8 @@ struct WhittedConfig {
                                        ///< layers count as opaque
   bool hit_filter = true;              ///< false skips alpha/back-face filtering of hits: a speed-up,
                                        ///< valid only when scene_needs_hit_filter() is false
+  bool shadows = true;                 ///< false: every light reaches every surface unoccluded (no
+                                       ///< shadow rays), so no object darkens another
 };
 
 /// How much of a punctual light reaches a surface point: transmittance(context, light index,
@@ -95,9 +98,12 @@ Vec3f whitted_local(const Scene& scene, const WhittedConfig& cfg, const SurfaceI
 /// (integrators/visibility.h) and
 /// h = (v + l)/|v + l|; n is the normal-mapped shading normal. A Blend surface of coverage a
 /// contributes a L + (1 - a) L(behind), front to back. The 1/pi and (p+8)/(8 pi) factors normalise the lobes
-/// so that kd and ks are albedos under glTF's physical light units. Thread-safe; never allocates, throws or
-/// logs.
+/// so that kd and ks are albedos under glTF's physical light units. With `deep`, each layer the
+/// camera ray composites is recorded (its coverage a x the transmittance in front, and its
+/// radiance L x that coverage), and a non-black background seen past them. Thread-safe; never
+/// allocates, throws or logs.
 Vec3f whitted_radiance(const Scene& scene, const Accelerator& accel, const WhittedConfig& cfg,
-                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts);
+                       const Ray& camera_ray, const RayDifferential& rd, float& coverage, RayCounts& counts,
+                       DeepTrace* deep = nullptr);
 
 }  // namespace penumbra

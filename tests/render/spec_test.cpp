@@ -83,6 +83,7 @@ TEST_CASE("spec: every identity field changes the identity, the others do not", 
       if (needs_aperture(f)) base.aperture_radius = 0.5f;
       if (needs_motion_blur(f)) base.motion_blur = true;
       if (f.name == std::string("denoise_main")) base.denoise = true;
+      if (f.name == std::string("deep_merge_tolerance")) base.deep = true;
       const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
       RenderSpec changed = base;
       perturb(changed, f);
@@ -221,6 +222,26 @@ TEST_CASE("spec: the lens takes one aperture, one focus, and its other settings 
       if (f.name == std::string(field)) perturb(pinhole, f);
     CHECK_THROWS_WITH(validate(pinhole), Catch::Contains(std::string(field) + " needs depth of field"));
   }
+}
+
+TEST_CASE("spec: deep needs a ray-traced integrator, and its tolerance needs deep", "[spec]") {
+  RenderSpec s = with_integrator("whitted");
+  s.deep_merge_tolerance = 0.05f;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("deep_merge_tolerance needs deep"));
+  s.deep = true;
+  REQUIRE_NOTHROW(validate(s));
+  s.integrator = "path";
+  REQUIRE_NOTHROW(validate(s));
+  s.integrator = "raster";
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("needs integrator 'whitted' or 'path'"));
+  s = with_integrator("whitted");
+  s.deep = true;
+  s.deep_merge_tolerance = -0.1f;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("deep_merge_tolerance must be in [0, 1]"));
+  // The deep image does not change the beauty: not part of the identity.
+  const Camera cam = frame_bounds(Bounds3f{{-1, -1, -1}, {1, 1, 1}}, 1.5f);
+  CHECK(canonical_text(render_identity(resolve(s, 1.5f), cam, {})) ==
+        canonical_text(render_identity(resolve(with_integrator("whitted"), 1.5f), cam, {})));
 }
 
 TEST_CASE("spec: denoise keeps the halves, needs two samples, and denoise_main needs it", "[spec]") {
