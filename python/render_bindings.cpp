@@ -413,6 +413,28 @@ void bind_result(py::module_& m) {
           "every "
           "AOV of the render with the command's channel names.")
       .def(
+          "write_deep_exr",
+          [](const ResultPtr& r, const std::filesystem::path& path, const std::string& compression) {
+            check_exr_path(path);
+            if (!r->settings.deep) throw py::value_error("write_deep_exr needs a render with deep=True");
+            ExrWriteOptions o;
+            o.compression = compression;
+            py::gil_scoped_release release;
+            write_render_deep_exr(*r, path, o);
+          },
+          py::arg("path"), py::kw_only(), py::arg("compression") = "zips",
+          "Writes the deep EXR `penumbra render --deep` writes (atomically; needs deep=True): per pixel one "
+          "sample per surface with R, G, B, A, Z, ZBack, id, N.X/Y/Z and albedo.R/G/B in float.")
+      .def_property_readonly(
+          "deep_samples",
+          [](const RenderOutput& r) -> py::object {
+            if (!r.settings.deep) return py::none();
+            py::array_t<uint32_t> counts({py::ssize_t(r.deep.height), py::ssize_t(r.deep.width)});
+            std::copy(r.deep.counts.begin(), r.deep.counts.end(), counts.mutable_data());
+            return counts;
+          },
+          "with deep=True: the deep samples per pixel (uint32 h x w); else None")
+      .def(
           "write_display",
           [](const ResultPtr& r, const std::filesystem::path& path, const std::string& ocio_config,
              const std::string& display, const std::string& view_name, const std::string& look,

@@ -9,6 +9,7 @@
 
 #include "io/files/error.h"
 #include "io/gltf/id_manifest.h"
+#include "io/image/deep_exr.h"
 #include "io/image/environment_io.h"
 #include "io/image/exr_denoise.h"
 #include "render/exr_layers.h"
@@ -98,11 +99,14 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   out.id_manifest = std::move(r.layers.id_manifest);
   out.vector = std::move(r.layers.vector);
   out.velocity = std::move(r.layers.velocity);
+  out.deep = std::move(r.deep.image);
   return out;
 }
 
-void write_render_exr(const RenderOutput& out, const std::filesystem::path& path,
-                      const ExrWriteOptions& options) {
+namespace {
+
+/// The attributes of a render's EXRs.
+ExrOptions render_exr_options(const RenderOutput& out, const ExrWriteOptions& options) {
   const RenderConfig& cfg = out.config;
   ExrOptions exr;
   exr.half = options.half;
@@ -116,6 +120,19 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
       {"penumbra:filter", std::string(filter_name(cfg.filter.type)) + " " + std::to_string(cfg.filter.width)},
       {"penumbra:version", PENUMBRA_VERSION}};
   exr.metadata.insert(exr.metadata.end(), options.metadata.begin(), options.metadata.end());
+  return exr;
+}
+
+}  // namespace
+
+void write_render_deep_exr(const RenderOutput& out, const std::filesystem::path& path,
+                           const ExrWriteOptions& options) {
+  write_deep_exr(out.deep, path, render_exr_options(out, options));
+}
+
+void write_render_exr(const RenderOutput& out, const std::filesystem::path& path,
+                      const ExrWriteOptions& options) {
+  ExrOptions exr = render_exr_options(out, options);
   add_layer_channels(exr, out.aovs,
                      {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector,
                       &out.velocity, &out.halves},

@@ -73,6 +73,7 @@ struct RenderOutput {
   std::vector<float> velocity;    ///< with "velocity": kVelocityChannels per pixel
   std::vector<float> samples_f;   ///< `samples` as floats, for the EXR
   std::string id_manifest;        ///< JSON: object id -> node name, material id -> material name
+  DeepImage deep;                 ///< with settings.deep: the deep image (render_deep_image)
   RenderStats stats;
 };
 
@@ -97,5 +98,10 @@ struct ExrWriteOptions {
 /// variance.X, the light groups' .RGB, vector.XYZW) and the settings as metadata. Throws as write_exr.
 void write_render_exr(const RenderOutput& output, const std::filesystem::path& path,
                       const ExrWriteOptions& options);
+
+/// The deep EXR `penumbra render --deep` writes for these settings (write_deep_exr) with the same
+/// metadata as write_render_exr. Requires a render with settings.deep.
+void write_render_deep_exr(const RenderOutput& output, const std::filesystem::path& path,
+                           const ExrWriteOptions& options);
 
 }  // namespace penumbra::python

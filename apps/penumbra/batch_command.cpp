@@ -29,6 +29,7 @@ const std::map<std::string, std::string>& reserved_settings() {
   static const std::map<std::string, std::string> m = {
       {"output", "the shot's \"output\""},
       {"png", "the shot's \"png\""},
+      {"deep", "the shot's \"deep\""},
       {"no-png", "the shot's \"png\" (a shot without one writes no display image)"},
       {"camera", "the shot's \"camera\""},
       {"frame", "the shot's \"frames\""},
@@ -72,6 +73,10 @@ std::vector<std::string> render_command_line(const Job& job, const JobShot& shot
     argv.push_back("--no-png");
   else
     argv.insert(argv.end(), {"--png", shot.png});
+  if (!shot.deep.empty()) {
+    const std::string deep = t.frame ? substitute_frame(shot.deep, *t.frame) : shot.deep;
+    argv.insert(argv.end(), {"--deep", t.tiles > 1 ? tile_part_path(deep, t.tile, t.tiles).string() : deep});
+  }
   if (!shot.stats_json.empty() && t.tiles == 1) argv.insert(argv.end(), {"--stats-json", shot.stats_json});
   if (!shot.camera.empty()) argv.insert(argv.end(), {"--camera", shot.camera});
   if (t.range && shot.frames) argv.insert(argv.end(), {"--frames", shot.frames_text});
@@ -231,13 +236,20 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
       write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
     return true;
   }
-  std::vector<fs::path> parts;
+  const fs::path final_deep =
+      shot.deep.empty() ? fs::path() : fs::path(substitute_frame(shot.deep, u.frame.value_or(0)));
+  std::vector<fs::path> parts, deep_parts;
   std::string missing;
   bool any = false;
   for (int t = 0; t < u.tiles; ++t) {
     parts.push_back(tile_part_path(final_exr, t, u.tiles));
     any = any || fs::exists(parts.back(), ec);
-    if (!complete(parts.back())) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
+    bool ok = complete(parts.back());
+    if (!final_deep.empty()) {
+      deep_parts.push_back(tile_part_path(final_deep, t, u.tiles));
+      ok = ok && complete(deep_parts.back());
+    }
+    if (!ok) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
   }
   if (!any && complete(final_exr)) return true;  // merged before, its stripes removed
   if (!missing.empty()) {
@@ -249,6 +261,8 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   MergeOptions options;
   options.max_memory_bytes = q.budget;
   try {
+    // The deep frame first: the flat frame's presence marks the frame merged.
+    if (!final_deep.empty()) merge_exr_parts(deep_parts, final_deep, options);
     merge_exr_parts(parts, final_exr, options);
   } catch (const InputError& e) {  // e.g. stripes of an earlier version of the job
     std::fprintf(stderr,
@@ -260,6 +274,7 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
   }
   if (!png.empty()) write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
   for (const fs::path& p : parts) fs::remove(p);
+  for (const fs::path& p : deep_parts) fs::remove(p);
   if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
     std::fprintf(stderr, "penumbra: merged %d stripes into %s\n", u.tiles, final_exr.string().c_str());
   return true;
@@ -290,7 +305,7 @@ std::vector<fs::path> create_output_folders(const PreparedJob& pj) {
   for (size_t n = 0; n < pj.units.size(); ++n) {
     const WorkUnit u = pj.units[n];
     const JobShot& shot = pj.job.shots[u.shot];
-    for (const std::string* pattern : {&shot.output, &shot.png, &shot.stats_json})
+    for (const std::string* pattern : {&shot.output, &shot.png, &shot.deep, &shot.stats_json})
       if (!pattern->empty())
         folders.insert(fs::path(u.frame ? substitute_frame(*pattern, *u.frame) : *pattern).parent_path());
   }
@@ -326,6 +341,11 @@ void unit_files(const PreparedJob& pj, size_t n, const std::vector<std::vector<s
   const fs::path exr = u.tiles > 1 ? tile_part_path(out, u.tile, u.tiles) : fs::path(out);
   f(exr.string());
   f(exr.string() + ".resume");
+  if (!shot.deep.empty()) {
+    const std::string deep = at(shot.deep);
+    f(u.tiles > 1 ? tile_part_path(deep, u.tile, u.tiles).string() : deep);
+    if (u.tile == 0 && u.tiles > 1) f(deep);
+  }
   for (const std::string& layer : crypto[u.shot]) f(crypto_sidecar_path(exr, layer).string());
   if (u.tile > 0) return;
   if (u.tiles > 1) f(out);

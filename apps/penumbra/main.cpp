@@ -1,11 +1,12 @@
 // The `penumbra` command: `render` a glTF scene to EXR and a display image, describe it with
-// `info`, assemble farm tiles with `merge`, denoise an EXR with `denoise`, render job files with `batch` and
-// submit them to Slurm with `submit slurm`, turn its implicit shapes into triangle meshes with `mesh`, ask it
-// spatial questions with `query`, fit collision proxies with `proxies` and find collisions with
-// `collide`. This
-// file wires the subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1
-// a failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every error, a
-// parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr. Only main() exits.
+// `info`, assemble farm tiles with `merge`, composite deep EXRs with `deep`, denoise an EXR with
+// `denoise`, render job files with `batch` and submit them to Slurm with `submit slurm`, turn its
+// implicit shapes into triangle meshes with `mesh`, ask it spatial questions with `query`, fit
+// collision proxies with `proxies` and find collisions with `collide`. This file wires the
+// subcommands' flags (CLI11) and maps errors to exit codes: 0 success, 2 bad input or usage, 1 a
+// failure outside the input (I/O, memory); a render ended by a signal returns 128 + signal. Every
+// error, a parse error included (parse_errors.h), is reported as "penumbra: error: ..." on stderr.
+// Only main() exits.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <new>
@@ -13,6 +14,7 @@
 #include "apps/penumbra/batch_command.h"
 #include "apps/penumbra/cli_support.h"
 #include "apps/penumbra/collide_command.h"
+#include "apps/penumbra/deep_command.h"
 #include "apps/penumbra/info_command.h"
 #include "apps/penumbra/merge_command.h"
 #include "apps/penumbra/mesh_command.h"
@@ -224,6 +226,8 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand(
       "merge", "Assemble the EXRs of --crop/--tile renders into the full frame (bit for bit)");
   add_merge_options(*merge, merge_args);
+  DeepArgs deep_args;
+  const DeepCommands deep = add_deep_command(app, deep_args);
   DenoiseArgs denoise_args;
   auto* denoise = app.add_subcommand(
       "denoise", "Denoise a path-traced EXR from its halves layers (NFOR feature regression)");
@@ -266,6 +270,7 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(render_args);
     if (*merge) return run_merge(merge_args);
+    if (*deep.deep) return run_deep(deep, deep_args);
     if (*denoise) return run_denoise(denoise_args);
     if (*batch) return run_batch(batch_args);
     if (*submit) return run_submit_slurm(submit_args);

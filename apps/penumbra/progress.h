@@ -25,6 +25,9 @@ struct RenderReport {
   const std::string& structure_update;  ///< Structure::update
   bool traced = true;                   ///< an acceleration structure was built or kept
   double load_s = 0, build_s = 0, write_s = 0;
+  bool deep = false;                    ///< a deep image was written
+  double deep_s = 0, deep_write_s = 0;  ///< tracing its samples; writing it (part of write_s)
+  uint64_t deep_samples = 0;
   double mean_spp = 0;
   bool interrupted = false;
 };

@@ -23,6 +23,7 @@
 #include "io/files/file_checks.h"
 #include "io/files/hash.h"
 #include "io/image/contact_sheet.h"
+#include "io/image/deep_exr.h"
 #include "io/image/environment_io.h"
 #include "io/image/exr_denoise.h"
 #include "render/denoise_render.h"
@@ -215,7 +216,9 @@ void setup_phase(RenderJob& job) {
       return choose_camera(rig, sc, index, w, h, &bounds->second);
     };
   }
-  o.charge_budget = [&](const RenderConfig& cfg) { return q.budget - charge_image_budget(job, cfg); };
+  o.charge_budget = [&](const RenderConfig& cfg) {
+    return job.bytes_left = q.budget - charge_image_budget(job, cfg);
+  };
   o.identity = scene_identity(a, q, job.scene_sha256);
   o.time = q.time;
   o.load_at = [&](double t) {
@@ -325,6 +328,10 @@ RenderReport report_of(const RenderJob& job) {
   r.load_s = job.load_s;
   r.build_s = job.build_s;
   r.write_s = job.write_s;
+  r.deep = job.request.deep.has_value() && !job.interrupted;
+  r.deep_s = job.deep_s;
+  r.deep_write_s = job.deep_write_s;
+  r.deep_samples = job.deep_samples;
   r.mean_spp = job.mean_spp;
   r.interrupted = job.interrupted != 0;
   return r;
@@ -336,17 +343,40 @@ std::vector<WrittenImage> written_images(const RenderJob& job) {
   std::vector<WrittenImage> w = {{"exr", q.out.string(), job.hashes.exr}};
   if (q.png) w.push_back({"png", q.png->string(), job.hashes.png});
   if (q.cost_png) w.push_back({"cost_png", q.cost_png->string(), job.hashes.cost_png});
+  if (q.deep && !job.interrupted) w.push_back({"deep", q.deep->string(), job.hashes.deep});
   return w;
 }
 
-/// The EXR with its layers, the display image, the heat map, then the statistics that record
-/// their hashes.
+/// The deep image (--deep): the beauty's camera samples traced again with their layers recorded,
+/// within what the budget leaves; throws UsageError (exit 2, before any file is written) naming
+/// --max-memory when they would not fit.
+DeepResult trace_deep(const RenderJob& job) {
+  set_phase("tracing the deep samples");
+  DeepResult deep =
+      render_deep_image(job.loaded, *job.structure.accel, job.prepared, job.image, job.bytes_left);
+  if (deep.over_budget)
+    throw UsageError(
+        "the deep image needs more than the " + format_bytes(job.bytes_left) +
+        " the --max-memory budget leaves beside the image and scene (" + std::to_string(deep.samples_found) +
+        " deep samples found before it stopped, " + format_bytes(2 * deep.bytes) +
+        " with the copy it is assembled into); raise --max-memory or " + "--deep-merge-tolerance");
+  return deep;
+}
+
+/// The EXR with its layers, the deep image, the display image, the heat map, then the statistics
+/// that record their hashes.
 void write_phase(RenderJob& job) {
   const RenderRequest& q = job.request;
   ProgressReporter progress(job.progress, "write", job.frame);
   const auto t0 = Clock::now();
   LayerBuffers buffers;
   buffers.layers = render_layers(job.loaded, job.structure.accel.get(), job.prepared);
+  // An interrupted render keeps its flat image so far; its deep image is traced once it completes.
+  const bool deep_now = q.deep && !job.interrupted;
+  const auto deep_t0 = Clock::now();
+  const DeepResult deep = deep_now ? trace_deep(job) : DeepResult{};
+  job.deep_s = seconds_since(deep_t0);
+  job.deep_samples = deep.image.samples.size();
   const ExrOptions exr = make_exr_options(job, buffers);
   set_phase("writing the outputs");
   const bool hashes = !job.args.stats_json.empty();
@@ -371,12 +401,17 @@ void write_phase(RenderJob& job) {
   } else {
     write_exr(job.image.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
   }
+  if (deep_now) {
+    const auto t = Clock::now();
+    write_deep_exr(deep.image, *q.deep, exr, hashes ? &job.hashes.deep : nullptr);
+    job.deep_write_s = seconds_since(t);
+  }
   if (q.png) write_display_image(*shown, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
   if (q.cost_png)
     write_heatmap(total_cost(buffers.layers.cost), job.prepared.config.width, job.prepared.config.height,
                   *q.cost_png, cost_caption(buffers.layers.cost, job.args.spec.accel),
                   hashes ? &job.hashes.cost_png : nullptr);
-  job.write_s = seconds_since(t0);
+  job.write_s = seconds_since(t0) - job.deep_s;
   if (hashes) write_stats_json(report_of(job), written_images(job), job.args.stats_json);
   progress.finish();
 }
@@ -402,6 +437,7 @@ int render_frame(const RenderArgs& a, RenderRequest request, std::optional<KeptS
     std::printf("%s\n", q.out.string().c_str());
     if (q.png) std::printf("%s\n", q.png->string().c_str());
     if (q.cost_png) std::printf("%s\n", q.cost_png->string().c_str());
+    if (q.deep && !job.interrupted) std::printf("%s\n", q.deep->string().c_str());
   }
   if (!job.interrupted) return kExitOk;
   if (job.frame_complete)
@@ -428,6 +464,7 @@ std::vector<std::pair<const char*, std::string RenderArgs::*>> patterned_outputs
   return {{"-o", &RenderArgs::output},
           {"--png", &RenderArgs::png},
           {"--cost-png", &RenderArgs::cost_png},
+          {"--deep", &RenderArgs::deep},
           {"--stats-json", &RenderArgs::stats_json}};
 }
 

@@ -20,7 +20,7 @@ namespace penumbra::cli {
 
 /// The SHA-256 of each image as written, when --stats-json asks for them.
 struct WrittenHashes {
-  std::string exr, png, cost_png;
+  std::string exr, png, cost_png, deep;
 };
 
 struct RenderJob {
@@ -37,11 +37,14 @@ struct RenderJob {
   std::string scene_sha256;  ///< over every file the scene loaded
   Structure structure;       ///< the acceleration structure and how this frame's came to be
   double load_s = 0, build_s = 0, write_s = 0;
-  RenderImage image;    ///< the beauty, the path tracer's layers and the statistics
-  int interrupted = 0;  ///< the signal that ended a path render early, or 0
+  double deep_s = 0, deep_write_s = 0;  ///< --deep: tracing the deep samples; writing the deep EXR
+  uint64_t deep_samples = 0;            ///< --deep: the deep image's samples
+  RenderImage image;                    ///< the beauty, the path tracer's layers and the statistics
+  int interrupted = 0;                  ///< the signal that ended a path render early, or 0
   bool frame_complete = true;
   bool remove_state = false;  ///< a completed --checkpoint/--resume render: drop OUT.exr.resume once written
   double mean_spp = 0;
+  uint64_t bytes_left = UINT64_MAX;  ///< of the --max-memory budget, once the image and scene are charged
   WrittenHashes hashes;
 };
 

@@ -36,6 +36,13 @@ void check_output_paths(const RenderArgs& a, RenderRequest& q) {
   // Each output's folder must exist and its target must be replaceable or streamable.
   resolve_output(q.out, "-o");
   if (!a.stats_json.empty()) resolve_output(a.stats_json, "--stats-json");
+  if (!a.deep.empty()) {
+    q.deep = fs::path(a.deep);
+    std::string deep_ext = q.deep->extension().string();
+    for (auto& c : deep_ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (deep_ext != ".exr") throw UsageError("--deep " + a.deep + ": the deep image must be an .exr file");
+    resolve_output(*q.deep, "--deep");
+  }
   if (!a.no_png) q.png = a.png.empty() ? fs::path(q.out).replace_extension(".png") : fs::path(a.png);
   q.display.ocio_config = a.ocio_config;
   q.display.display = a.display;
@@ -184,6 +191,7 @@ void check_output_collisions(const RenderArgs& a, RenderRequest& q) {
   }
   if (q.png) outputs.push_back({"--png", *q.png});
   if (q.cost_png) outputs.push_back({"--cost-png", *q.cost_png});
+  if (q.deep) outputs.push_back({"--deep", *q.deep});
   if (!a.stats_json.empty()) outputs.push_back({"--stats-json", a.stats_json});
   if (!q.out_streams)
     for (const std::string& layer : q.crypto)
@@ -218,6 +226,7 @@ RenderSpec render_spec(const RenderArgs& a, const RenderRequest& q) {
     spec.env_map = a.env;
   spec.accel_params = a.accel_params;
   spec.aovs = q.aovs;
+  spec.deep = q.deep.has_value();
   try {
     validate(spec);
   } catch (const std::invalid_argument& e) {
@@ -232,7 +241,7 @@ namespace {
 
 /// The flags hand-declared below, with their own parsing and messages (not from spec_fields()).
 bool hand_declared(const SpecField& f) {
-  return std::string(f.name) == "seed";
+  return std::string(f.name) == "seed" || std::string(f.name) == "deep";  // --deep takes the file
 }
 
 /// One flag per field of the render spec's table (render/spec.h): --name-with-dashes bound to
@@ -380,6 +389,9 @@ void add_output_options(CLI::App& render, RenderArgs& args) {
       "pixels to the frames 1/--fps before and after --time or --frame (vector.XYZW, Blender's Vector "
       "pass); velocity = the same surface's camera-space velocity in scene units per second "
       "(velocity.XYZ)");
+  render.add_option("--deep", args.deep,
+                    "also write a deep OpenEXR (R G B A Z ZBack id N albedo per surface and pixel) to this "
+                    ".exr path; whitted and path");
   render.add_option("--cost-png", args.cost_png,
                     "heat map path for --aov cost (default: the EXR path with .cost.png)");
 }

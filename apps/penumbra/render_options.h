@@ -33,6 +33,7 @@ struct RenderArgs {
   float exposure = 0;
   std::string compression = "zip", ocio_config, display, view, background = "0", ambient = "0.05";
   std::string max_memory, debug_pixel, cost_png;
+  std::string deep;  ///< --deep: the deep EXR's path; empty = none
   std::vector<std::string> accel_params, aovs;
   std::string command_line, look;
   std::vector<std::string> crop;  ///< x0 x1 y0 y1, pixels or fractions
@@ -69,8 +70,9 @@ struct RenderRequest {
   bool raster = false;  ///< --integrator raster
   std::filesystem::path out;
   std::optional<std::filesystem::path> png, cost_png;
-  bool out_streams = false;     ///< -o is a device or FIFO (no resume state beside it)
-  bool paths_to_stdout = true;  ///< false when an output streams to stdout
+  std::optional<std::filesystem::path> deep;  ///< --deep
+  bool out_streams = false;                   ///< -o is a device or FIFO (no resume state beside it)
+  bool paths_to_stdout = true;                ///< false when an output streams to stdout
   DisplayOptions display;
   Vec3f background, ambient;
   FilterType filter_type = FilterType::Box;

@@ -30,6 +30,11 @@ std::string stats_json_text(const RenderReport& r, const std::vector<WrittenImag
   j["accelerator"] = r.prepared.spec.accel;
   j["accelerator_update"] = r.structure_update;
   j["seconds"] = {{"load", r.load_s}, {"build", r.build_s}, {"render", stats.seconds}, {"write", r.write_s}};
+  if (r.deep) {
+    j["seconds"]["deep"] = r.deep_s;
+    j["seconds"]["deep_write"] = r.deep_write_s;
+    j["deep_samples"] = r.deep_samples;
+  }
   j["rays"] = {{"camera", stats.rays.camera},
                {"shadow", stats.rays.shadow},
                {r.prepared.spec.integrator == "path" ? "bounce" : "reflection", stats.rays.reflection},

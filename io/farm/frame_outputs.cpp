@@ -1,6 +1,7 @@
 // Frame ranges, `#` path patterns and the completeness check of a frame's EXR.
 #include "io/farm/frame_outputs.h"
 
+#include <OpenImageIO/deepdata.h>
 #include <OpenImageIO/imageio.h>
 
 #include <charconv>
@@ -124,9 +125,17 @@ bool is_complete_exr(const std::filesystem::path& path, std::string& problem) {
   std::vector<unsigned char> pixels;
   for (int sub = 0; in->seek_subimage(sub, 0); ++sub) {
     const OIIO::ImageSpec& s = in->spec();
-    if (s.deep || s.width < 1 || s.height < 1 || s.nchannels < 1) {
-      problem = "holds an empty or deep part";
+    if (s.width < 1 || s.height < 1 || s.nchannels < 1) {
+      problem = "holds an empty part";
       return false;
+    }
+    if (s.deep) {  // a deep image (render --deep): its samples must decode
+      OIIO::DeepData samples;
+      if (!in->read_native_deep_image(sub, 0, samples) || in->has_error()) {
+        problem = "is incomplete: " + in->geterror();
+        return false;
+      }
+      continue;
     }
     pixels.resize(size_t(s.image_bytes(true)));
     if (!in->read_image(sub, 0, 0, s.nchannels, OIIO::TypeDesc::UNKNOWN, pixels.data()) || in->has_error()) {

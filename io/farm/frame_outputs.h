@@ -36,7 +36,7 @@ bool has_frame_pattern(const std::string& path);
 std::string substitute_frame(const std::string& path, int64_t frame);
 
 /// True when `path` is a regular file that OpenImageIO opens as an OpenEXR, whose every part's
-/// pixels read back, that is not an unfinished render (Penumbra's settings metadata saying
+/// pixels (or deep samples) read back, that is not an unfinished render (Penumbra's settings metadata saying
 /// complete=0, or a PATH.resume state beside it); otherwise false with the reason in `problem`
 /// (missing, truncated, not an EXR, unfinished). Never throws for a bad file.
 bool is_complete_exr(const std::filesystem::path& path, std::string& problem);

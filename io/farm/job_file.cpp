@@ -48,8 +48,8 @@ std::string printable(std::string_view text) {
 namespace {
 
 constexpr const char* kTopKeys[] = {"version", "defaults", "output_root", "shots"};
-constexpr const char* kShotKeys[] = {"name", "scene",      "camera", "frames",      "output",
-                                     "png",  "stats_json", "tiles",  "tile_frames", "settings"};
+constexpr const char* kShotKeys[] = {"name",       "scene", "camera", "frames",      "output",  "png",
+                                     "stats_json", "tiles", "deep",   "tile_frames", "settings"};
 /// Largest scene file the job's up-front check accepts (the loader applies its own limits).
 constexpr uint64_t kMaxSceneFileBytes = uint64_t(1) << 40;
 
@@ -199,6 +199,8 @@ JobShot read_shot(const JobReader& r, const json& j, size_t index, const std::ve
   shot.output = r.path(r.required_string(j, "output", shot.where), shot.where + ".output").string();
   if (const std::string png = r.string_or(j, "png", shot.where); !png.empty())
     shot.png = r.path(png, shot.where + ".png").string();
+  if (const std::string deep = r.string_or(j, "deep", shot.where); !deep.empty())
+    shot.deep = r.path(deep, shot.where + ".deep").string();
   if (const std::string st = r.string_or(j, "stats_json", shot.where); !st.empty())
     shot.stats_json = r.path(st, shot.where + ".stats_json").string();
   if (const json* cam = gltf::JsonReader::find(j, "camera")) {

@@ -41,6 +41,7 @@ struct JobShot {
   std::optional<FrameRange> frames;       ///< none: one still at the file's static pose
   std::string frames_text;                ///< as written, normalised to "A-B:STEP"
   std::string output, png, stats_json;    ///< paths, '#' patterns kept; png/stats empty = none
+  std::string deep;                       ///< the deep EXR's path ('#' kept); empty = none
   int tiles = 0;                          ///< stripes per frame; 0 = not given (the job's default)
   std::optional<FrameRange> tile_frames;  ///< the frames that are tiled; none = every frame
   std::vector<JobSetting> settings;       ///< the job's defaults, then the shot's own (a key
@@ -63,7 +64,7 @@ std::string printable(std::string_view text);
 
 /// Reads and checks `file`: top-level keys `version` (1), `defaults` (settings for every
 /// shot), `output_root` (a folder every output must lie in) and `shots` (a non-empty array); per shot `name`,
-/// `scene`, `output` (required), `camera`, `frames`, `png`, `stats_json`, `tiles`, `tile_frames` and
+/// `scene`, `output` (required), `camera`, `frames`, `png`, `deep`, `stats_json`, `tiles`, `tile_frames` and
 /// `settings`. A setting is a string, a number, a boolean or an array of strings and numbers. Throws
 /// InputError naming the file and the element (`shots[1] (sh020).tiles: ...`) for malformed JSON, unknown
 /// keys, wrong types, duplicate names, bad frame ranges, a path (the job file's own included) with a control

@@ -114,7 +114,7 @@ std::string variable_attribute_problem(const std::string& type, const std::strin
 // attribute must fit in the rest of the file with the size its type has, channel lists,
 // previews and string vectors must describe their own bytes, and every data and display window
 // must be at most kMaxSide pixels per side. Throws InputError naming the file otherwise.
-void check_exr_header(const std::filesystem::path& path, uint64_t size) {
+void check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep) {
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
   unsigned char start[8] = {};
@@ -123,7 +123,8 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size) {
     throw InputError(name, "", "is not an OpenEXR file");
   const uint32_t flags = uint32_t(start[5]) << 8 | uint32_t(start[6]) << 16 | uint32_t(start[7]) << 24;
   const bool multipart = flags & 0x1000;
-  if (flags & 0x800) throw InputError(name, "", "deep images cannot be merged");
+  if ((flags & 0x800) && !deep) throw InputError(name, "", "is a deep image, the first part is not");
+  if (!(flags & 0x800) && deep) throw InputError(name, "", "is not a deep image, the first part is");
   const auto bad = [&](const std::string& what) {
     return InputError(name, "", "invalid OpenEXR header: " + what);
   };
@@ -193,7 +194,7 @@ std::vector<OIIO::ImageSpec> read_specs(OIIO::ImageInput& in, const std::string&
         sp.full_y != 0 || sp.full_width != s0.full_width || sp.full_height != s0.full_height ||
         sp.depth != 1 || sp.z != 0)
       throw InputError(name, "", "its parts have different windows");
-    if (sp.deep) throw InputError(name, "", "deep images cannot be merged");
+    if (sp.deep && specs.size() > 1) throw InputError(name, "", "multi-part deep images cannot be merged");
     if (sp.nchannels < 1) throw InputError(name, "", "a part has no channels");
   }
   return specs;
@@ -431,6 +432,37 @@ void exr_parts::move_crypto_sidecars(const std::filesystem::path& first, const s
   }
 }
 
+namespace {
+
+// The deep parts' samples, each part's pixels copied into its place in one whole-frame deep image.
+void write_merged_deep(const std::filesystem::path& out, OIIO::ImageSpec spec,
+                       const std::vector<OIIO::ImageSpec>& specs, const std::vector<OIIO::DeepData>& data) {
+  spec.x = spec.y = 0;
+  spec.width = spec.full_width;
+  spec.height = spec.full_height;
+  spec.tile_width = spec.tile_height = 0;
+  spec.erase_attribute("openexr:chunkCount");
+  const auto frame_pixel = [&](const OIIO::ImageSpec& sp, int x, int y) {
+    return int64_t(sp.y + y) * int64_t(spec.full_width) + int64_t(sp.x + x);
+  };
+  std::vector<unsigned int> counts(size_t(spec.full_width) * size_t(spec.full_height), 0);
+  for (size_t k = 0; k < specs.size(); ++k)
+    for (int y = 0; y < specs[k].height; ++y)
+      for (int x = 0; x < specs[k].width; ++x)
+        counts[size_t(frame_pixel(specs[k], x, y))] =
+            unsigned(data[k].samples(int64_t(y) * specs[k].width + x));
+  OIIO::DeepData frame;
+  frame.init(spec);
+  frame.set_all_samples(counts);
+  for (size_t k = 0; k < specs.size(); ++k)
+    for (int y = 0; y < specs[k].height; ++y)
+      for (int x = 0; x < specs[k].width; ++x)
+        frame.copy_deep_pixel(frame_pixel(specs[k], x, y), data[k], int64_t(y) * specs[k].width + x);
+  write_deep_frame(out, spec, frame);
+}
+
+}  // namespace
+
 void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out,
                      const MergeOptions& options) {
   if (parts.empty()) throw InputError(out.string(), "", "no parts to merge");
@@ -443,9 +475,14 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
   PartIdentity first_id;                           // without options.force
   PartStatistics statistics;
   double frame_bytes = 0;
+  // Deep parts: each one's window and samples, and the bytes they hold.
+  const bool deep = is_deep_exr(parts[0]);
+  std::vector<OIIO::ImageSpec> deep_specs;
+  std::vector<OIIO::DeepData> deep_data;
+  double deep_bytes = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const std::string name = parts[k].string();
-    check_exr_header(parts[k], sizes[k]);
+    check_exr_header(parts[k], sizes[k], deep);
     auto in = open_part(name);
     const std::vector<OIIO::ImageSpec> specs = read_specs(*in, name);
     if (!options.force) {
@@ -473,7 +510,8 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
                          "the full frame and one decoded part would need " +
                              format_bytes(uint64_t(frame_bytes + part_bytes)) + ", over the " +
                              format_bytes(options.max_memory_bytes) + " limit");
-      for (const auto& sp : specs) pixels.emplace_back(size_t(image_bytes(sp, true)), 0);
+      if (!deep)  // deep samples are kept per part (deep_data)
+        for (const auto& sp : specs) pixels.emplace_back(size_t(image_bytes(sp, true)), 0);
       owner.assign(size_t(specs[0].full_width) * size_t(specs[0].full_height), -1);
     } else {
       check_layout(name, specs, first_name, full);
@@ -483,7 +521,22 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
                              format_bytes(options.max_memory_bytes) + " limit");
     }
     claim_pixels(parts, k, specs[0], owner);
-    copy_pixels(*in, name, specs, pixels);
+    if (deep) {
+      OIIO::DeepData d;
+      if (!in->read_native_deep_image(0, 0, d))
+        throw InputError(name, "", "cannot decode: " + in->geterror());
+      deep_bytes += double(d.all_data().size()) + 4.0 * double(d.pixels());
+      // The parts' samples and the frame's copy of them.
+      if (2 * deep_bytes > double(options.max_memory_bytes))
+        throw InputError(name, "",
+                         "the deep parts' samples and the frame's would need " +
+                             format_bytes(uint64_t(2 * deep_bytes)) + ", over the " +
+                             format_bytes(options.max_memory_bytes) + " limit");
+      deep_specs.push_back(specs[0]);
+      deep_data.push_back(std::move(d));
+    } else {
+      copy_pixels(*in, name, specs, pixels);
+    }
     statistics.add(specs[0]);
   }
   for (size_t f = 0; f < owner.size(); ++f)
@@ -499,6 +552,10 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     if (!spec.find_attribute("DateTime")) spec.attribute("DateTime", "");
   }
   move_crypto_sidecars(parts[0], out, full);
+  if (deep) {
+    write_merged_deep(out, full[0], deep_specs, deep_data);
+    return;
+  }
   const auto [denoise, noisy_main] = requested_denoise(full[0]);
   if (!denoise) {
     write_frame(out, full, pixels);

@@ -52,6 +52,8 @@ struct MergeOptions {
 ///  - all share the display window and the channel list (names and types) of every EXR part;
 ///  - they do not overlap and together cover the whole display window;
 ///  - the frame fits in `options.max_memory_bytes`.
+/// Deep parts (`render --deep` stripes: single-part deep files with the same channels) merge
+/// into one deep frame, each pixel's samples copied unchanged; flat and deep parts do not mix.
 /// Parts rendered with `denoise` (their settings say so) hold the noisy beauty and the halves
 /// layers: the merged frame is denoised (denoise_through_file, within the same memory bound)
 /// and written as `penumbra render --denoise` writes the whole frame.

@@ -3,6 +3,7 @@
 // the file, the parts' specs, and the atomic multi-part write.
 #pragma once
 
+#include <OpenImageIO/deepdata.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cstdint>
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "io/image/image_output.h"
+
 namespace penumbra::exr_parts {
 
 /// Bytes of one EXR part's pixels: its data window, or its display window when `full`.
@@ -18,8 +21,20 @@ double image_bytes(const OIIO::ImageSpec& spec, bool full);
 
 /// Throws InputError naming `path` unless its header (of a file of `size` bytes) is one
 /// OpenImageIO can read safely: attributes that describe their own bytes, windows of at most
-/// 65536 pixels a side.
-void check_exr_header(const std::filesystem::path& path, uint64_t size);
+/// 65536 pixels a side; not deep unless `deep`.
+void check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep = false);
+
+/// Sets the attributes every Penumbra EXR carries (colour space, software) and those of `options`
+/// (string, float and matrix metadata).
+void set_attributes(OIIO::ImageSpec& spec, const ExrOptions& options);
+
+/// Whether the file's first part is deep (any readable EXR; false if it cannot be opened).
+bool is_deep_exr(const std::filesystem::path& path);
+
+/// Writes one deep part (`spec` with spec.deep, `data` its samples) to `out` atomically, as
+/// write_frame does; `sha256`, if not null, receives the file's SHA-256.
+void write_deep_frame(const std::filesystem::path& out, const OIIO::ImageSpec& spec,
+                      const OIIO::DeepData& data, std::string* sha256 = nullptr);
 
 /// The file opened for reading; throws InputError naming it if it is not a readable OpenEXR.
 std::unique_ptr<OIIO::ImageInput> open_part(const std::string& name);

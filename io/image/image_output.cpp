@@ -18,6 +18,7 @@
 #include "io/files/checked_file.h"
 #include "io/files/error.h"
 #include "io/files/file_checks.h"
+#include "io/image/exr_parts.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 
@@ -77,12 +78,7 @@ OIIO::ImageSpec exr_spec(const Film& film, const std::filesystem::path& path, co
   spec.alpha_channel = 3;
   set_frame_window(spec, film);
   spec.attribute("compression", options.compression);
-  spec.attribute("oiio:ColorSpace", "lin_rec709");
-  spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
-  for (const auto& [k, v] : options.metadata) spec.attribute(k, v);
-  for (const auto& [k, v] : options.float_metadata) spec.attribute(k, v);
-  for (const auto& [k, m] : options.matrix_metadata)
-    spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
+  exr_parts::set_attributes(spec, options);
   return spec;
 }
 
@@ -233,6 +229,15 @@ void write_multipart(const std::filesystem::path& path, const ExrParts& parts, s
 }
 
 }  // namespace
+
+void exr_parts::set_attributes(OIIO::ImageSpec& spec, const ExrOptions& options) {
+  spec.attribute("oiio:ColorSpace", "lin_rec709");
+  spec.attribute("Software", "Penumbra " PENUMBRA_VERSION);
+  for (const auto& [k, v] : options.metadata) spec.attribute(k, v);
+  for (const auto& [k, v] : options.float_metadata) spec.attribute(k, v);
+  for (const auto& [k, m] : options.matrix_metadata)
+    spec.attribute(k, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44), m.data());
+}
 
 void write_exr(const Film& film, const std::filesystem::path& path, const ExrOptions& options,
                std::string* sha256) {

@@ -59,7 +59,7 @@ for args in "render" "render $d" "render $d -o $work/a.exr --spp 0" "render $d -
 done
 expect_err 2 "penumbra: error: scene is required" -- "$bin" render
 expect_err 2 "penumbra: error: --spp: Value 0 not in range 1 to 65536" -- "$bin" render "$d" -o "$work/a.exr" --spp 0
-expect_err 2 "penumbra: error: a command is required: render, info, merge, denoise, batch, submit, mesh, proxies, collide, query (penumbra --help describes them)" -- "$bin"
+expect_err 2 "penumbra: error: a command is required: render, info, merge, deep, denoise, batch, submit, mesh, proxies, collide, query (penumbra --help describes them)" -- "$bin"
 expect_err 2 "penumbra: error: a command is required for submit: slurm (penumbra submit --help describes them)" -- "$bin" submit
 # Errors after parsing (bad input) and warnings carry the same prefixes.
 expect_err 2 "penumbra: error: $work/missing.gltf: file not found" -- "$bin" info "$work/missing.gltf"

@@ -110,6 +110,35 @@ def test_path_layers(quads):
     assert "Z" not in a
 
 
+@pytest.mark.parametrize("integrator", ["whitted", "path"])
+def test_deep_output_has_one_sample_per_surface_and_flattens_to_the_beauty(quads, integrator, tmp_path):
+    r = quads.render(width=W, height=H, spp=16, integrator=integrator, deep=True)
+    counts = r.deep_samples
+    assert counts.shape == (H, W) and counts.dtype == np.uint32
+    front, back = column_sides()
+    if integrator == "whitted":  # a 1-pixel box filter: away from the edge, one surface, one sample
+        np.testing.assert_array_equal(counts[:, front], 1)
+        np.testing.assert_array_equal(counts[:, back], 1)
+    else:  # the 1.5-pixel Blackman-Harris filter reaches a pixel further
+        assert np.count_nonzero(counts == 1) >= (len(front) + len(back) - 2) * H
+    assert counts.max() <= 2  # two surfaces at most, however many camera samples
+    assert quads.render(width=W, height=H, spp=1).deep_samples is None
+    oiiotool = shutil.which("oiiotool")
+    if oiiotool is None:
+        pytest.skip("oiiotool is not installed")
+    r.write_deep_exr(tmp_path / "deep.exr")
+    r.write_exr(tmp_path / "flat.exr", half=False)
+    subprocess.run([oiiotool, str(tmp_path / "deep.exr"), "--flatten", "-o", str(tmp_path / "flattened.exr")],
+                   check=True)
+    diff = subprocess.run([oiiotool, str(tmp_path / "flattened.exr"), "--ch", "R,G,B,A", str(tmp_path / "flat.exr"),
+                           "--ch", "R,G,B,A", "--fail", "1e-3", "--diff"], capture_output=True, text=True)
+    assert diff.returncode == 0, diff.stdout
+    with pytest.raises(ValueError, match="deep=True"):
+        quads.render(width=8, height=6, spp=1).write_deep_exr(tmp_path / "none.exr")
+    with pytest.raises(ValueError, match="deep needs integrator"):
+        quads.render(width=8, height=6, integrator="raster", deep=True)
+
+
 def test_window_is_a_slice_of_the_frame(default_scene):
     full = default_scene.render(width=32, height=18, spp=2, aovs=["Z", "id"])
     part = default_scene.render(width=32, height=18, spp=2, aovs=["Z", "id"], window=(8, 4, 24, 16))
