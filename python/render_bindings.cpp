@@ -422,7 +422,7 @@ void bind_result(py::module_& m) {
             py::gil_scoped_release release;
             write_render_deep_exr(*r, path, o);
           },
-          py::arg("path"), py::kw_only(), py::arg("compression") = "zips",
+          py::arg("path"), py::kw_only(), py::arg("compression") = "zip",
           "Writes the deep EXR `penumbra render --deep` writes (atomically; needs deep=True): per pixel one "
           "sample per surface with R, G, B, A, Z, ZBack, id, N.X/Y/Z and albedo.R/G/B in float.")
       .def_property_readonly(

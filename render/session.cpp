@@ -521,7 +521,12 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   const Accelerator* accel = session.structure.accel.get();
   r.image = render_image(scene, accel, r.prepared);
   r.layers = render_layers(session.loaded, accel, r.prepared);
-  if (r.prepared.spec.deep) r.deep = render_deep_image(session.loaded, *accel, r.prepared, r.image);
+  if (r.prepared.spec.deep)
+    r.deep = render_deep_image(session.loaded, *accel, r.prepared, r.image, env_budget);
+  if (r.deep.over_budget)
+    throw std::invalid_argument("the deep image needs more than the " + std::to_string(env_budget >> 20) +
+                                " MiB memory budget (" + std::to_string(r.deep.samples_found) +
+                                " deep samples found before it stopped); raise deep_merge_tolerance");
   if (r.prepared.spec.denoise) r.image.denoised = denoise_render(r.image, r.layers.data, r.prepared.config);
   return r;
 }

@@ -263,8 +263,9 @@ struct RenderResult {
 /// One render of the session's scene (locking it): the scene's motion over the shutter around
 /// session.time (set_scene_motion through session.load_at, cleared without motion blur), prepare_render,
 /// build_structure (kept for the next render with the same name and parameters), render_image,
-/// render_layers, with spec.denoise the denoised beauty (denoise_render), and the default key
-/// light removed again however it ends. `env_budget` as in
+/// render_layers, with spec.deep the deep image (render_deep_image within `env_budget`; throws
+/// std::invalid_argument when it does not fit), with spec.denoise the denoised beauty
+/// (denoise_render), and the default key light removed again however it ends. `env_budget` as in
 /// PrepareOptions.
 RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env_budget);
 

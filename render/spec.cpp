@@ -376,7 +376,7 @@ std::vector<SpecField> make_fields() {
       {"deep_merge_tolerance",
        &S::deep_merge_tolerance,
        kWhitted | kPath,
-       false,
+       true,
        0,
        1,
        {},

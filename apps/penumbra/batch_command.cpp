@@ -187,6 +187,19 @@ bool complete(const fs::path& exr) {
   return is_complete_exr(exr, problem);
 }
 
+/// The deep EXR of unit `u`'s frame (its stripe with `stripe`), or empty when the shot has none.
+fs::path unit_deep(const JobShot& shot, const WorkUnit& u, bool stripe) {
+  if (shot.deep.empty()) return {};
+  const fs::path deep = substitute_frame(shot.deep, u.frame.value_or(0));
+  return stripe ? tile_part_path(deep, u.tile, u.tiles) : deep;
+}
+
+/// Whether `exr` is complete, and with it the deep EXR `deep` when there is one (written first,
+/// but a job given "deep" after its frames were rendered has none yet).
+bool complete_with_deep(const fs::path& exr, const fs::path& deep) {
+  return complete(exr) && (deep.empty() || complete(deep));
+}
+
 int list_units(const PreparedJob& pj) {
   for (size_t n = 0; n < pj.units.size(); ++n) {
     const WorkUnit u = pj.units[n];
@@ -201,7 +214,8 @@ int list_units(const PreparedJob& pj) {
 int render_unit(const PreparedJob& pj, size_t n, const BatchArgs& b) {
   const WorkUnit u = pj.units[n];
   const fs::path final_exr = unit_output(pj.job, u);
-  if (b.skip_existing && u.tiles > 1 && complete(final_exr)) {
+  if (b.skip_existing && u.tiles > 1 &&
+      complete_with_deep(final_exr, unit_deep(pj.job.shots[u.shot], u, false))) {
     if (prints_text(progress_mode(b.progress, b.quiet), b.quiet))
       std::fprintf(stderr, "penumbra: unit %zu: frame %s is complete; skipped\n", n,
                    final_exr.string().c_str());
@@ -231,13 +245,12 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
                  pj.job, shot,
                  {u.frame, false, 0, 1, true, pj.threads, pj.max_memory, pj.shot_args[u.shot].progress}));
   std::error_code ec;
-  if (b.skip_existing && complete(final_exr)) {
+  const fs::path final_deep = unit_deep(shot, u, false);
+  if (b.skip_existing && complete_with_deep(final_exr, final_deep)) {
     if (!png.empty() && !fs::exists(png, ec))  // the merge ended before its display image
       write_display_image(read_exr_beauty(final_exr, q.budget), png, q.display);
     return true;
   }
-  const fs::path final_deep =
-      shot.deep.empty() ? fs::path() : fs::path(substitute_frame(shot.deep, u.frame.value_or(0)));
   std::vector<fs::path> parts, deep_parts;
   std::string missing;
   bool any = false;
@@ -251,7 +264,7 @@ bool merge_frame(const PreparedJob& pj, size_t first, const BatchArgs& b) {
     }
     if (!ok) missing += (missing.empty() ? "" : ", ") + std::to_string(first + size_t(t));
   }
-  if (!any && complete(final_exr)) return true;  // merged before, its stripes removed
+  if (!any && complete_with_deep(final_exr, final_deep)) return true;  // merged before, its stripes removed
   if (!missing.empty()) {
     std::fprintf(stderr,
                  "penumbra: error: %s: cannot merge %s: the stripes of units %s are missing or incomplete\n",
@@ -581,7 +594,10 @@ RenderArgs unit_render_args(const PreparedJob& pj, size_t n) {
 bool unit_complete(const PreparedJob& pj, size_t n) {
   const WorkUnit u = pj.units.at(n);
   const fs::path final_exr = unit_output(pj.job, u);
-  return complete(final_exr) || (u.tiles > 1 && complete(tile_part_path(final_exr, u.tile, u.tiles)));
+  const JobShot& shot = pj.job.shots[u.shot];
+  return complete_with_deep(final_exr, unit_deep(shot, u, false)) ||
+         (u.tiles > 1 &&
+          complete_with_deep(tile_part_path(final_exr, u.tile, u.tiles), unit_deep(shot, u, true)));
 }
 
 int run_batch(const BatchArgs& b) {

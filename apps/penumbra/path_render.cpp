@@ -102,7 +102,9 @@ void run_path_render(RenderJob& job, ProgressReporter& progress) {
   if (g_stop.load()) job.interrupted = g_signal.load();
   job.frame_complete = state.complete;
   if (!job.request.state_beside_output) return;  // no resume state beside a stream or device
-  if (job.interrupted && !state.complete) {
+  // Interrupted with --deep, even in the last pass: the deep image is traced once --resume (or a
+  // job's unit) continues from the state.
+  if (job.interrupted && (!state.complete || job.request.deep)) {
     write_checkpoint(state_file, state, fingerprint);
   } else if (state.complete) {
     // Removed only after the outputs are written, so that a failed write can still resume.

@@ -46,7 +46,9 @@ constexpr uint64_t kAccelBytesPerTriangle = 96;
 /// Bytes per rendered pixel of every buffer a render keeps until its outputs are written: the
 /// film (RGBA float), the path tracer's accumulators and statistics, light groups (double sums
 /// and float means), data AOVs (14 floats), cost AOVs (3 floats), the EXR's packed channels
-/// (4 bytes each, twice with --multipart) and the display image (float RGB and its encoding).
+/// (4 bytes each, twice with --multipart), the display image (float RGB and its encoding) and
+/// with --deep one deep sample (the fewest a covered pixel has; the deep pass charges the rest as
+/// it finds them).
 uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   const bool light_groups = q.aovs.count("light") > 0;
   uint64_t b = 16;
@@ -63,6 +65,7 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
                             (q.cost_aov ? 3 : 0) + (q.aovs.empty() ? 0 : 2) + crypto;
   b += channels * 4 * (multipart ? 2 : 1);  // packed channels; --multipart also repacks them per part
   if (q.png) b += 12 + 3;
+  if (q.deep) b += 4 + 2 * sizeof(DeepSample);  // at least one deep sample a pixel, in its tile and the image
   return b;
 }
 
@@ -227,6 +230,13 @@ void setup_phase(RenderJob& job) {
   };
   o.identity.shutter = set_scene_motion(job.loaded, spec, q.time.value_or(0), a.scene_file, o.load_at);
   job.prepared = prepare_render(job.loaded, spec, o);
+  // The environment map took part of what the image and scene left (the deep pass's share).
+  if (const Environment* env = job.prepared.environment.get()) {
+    const uint64_t env_bytes =
+        (env->texels.size() * sizeof(Vec3f)) +
+        (env->marginal_cdf.size() + env->conditional_cdf.size() + env->texel_pdf.size()) * sizeof(float);
+    job.bytes_left -= std::min(job.bytes_left, env_bytes);
+  }
   if (a.quiet) return;
   if (job.progress == ProgressMode::Json)
     print_json_warnings(a.scene_file, job.prepared.warnings);
@@ -363,6 +373,18 @@ DeepResult trace_deep(const RenderJob& job) {
   return deep;
 }
 
+/// The flat EXR's metadata without what describes its layers (Cryptomatte's keys and manifest
+/// sidecars), for the deep EXR beside it.
+ExrOptions deep_exr_options(const ExrOptions& flat) {
+  ExrOptions o;
+  o.compression = flat.compression;
+  for (const auto& kv : flat.metadata)
+    if (kv.first.rfind("cryptomatte/", 0) != 0) o.metadata.push_back(kv);
+  o.float_metadata = flat.float_metadata;
+  o.matrix_metadata = flat.matrix_metadata;
+  return o;
+}
+
 /// The EXR with its layers, the deep image, the display image, the heat map, then the statistics
 /// that record their hashes.
 void write_phase(RenderJob& job) {
@@ -383,6 +405,12 @@ void write_phase(RenderJob& job) {
   for (const auto& [sidecar, text] : buffers.sidecars)
     write_atomically(
         sidecar, [&](const fs::path& temp) { write_file_checked(temp, text.data(), text.size(), sidecar); });
+  // The deep EXR first: a complete flat EXR then means its deep one was written too.
+  if (deep_now) {
+    const auto t = Clock::now();
+    write_deep_exr(deep.image, *q.deep, deep_exr_options(exr), hashes ? &job.hashes.deep : nullptr);
+    job.deep_write_s = seconds_since(t);
+  }
   const Film* shown = &job.image.film;
   Film main;
   if (job.args.spec.denoise && denoises_now(job.prepared.config)) {
@@ -400,11 +428,6 @@ void write_phase(RenderJob& job) {
     shown = &main;
   } else {
     write_exr(job.image.film, q.out, exr, hashes ? &job.hashes.exr : nullptr);
-  }
-  if (deep_now) {
-    const auto t = Clock::now();
-    write_deep_exr(deep.image, *q.deep, exr, hashes ? &job.hashes.deep : nullptr);
-    job.deep_write_s = seconds_since(t);
   }
   if (q.png) write_display_image(*shown, *q.png, q.display, hashes ? &job.hashes.png : nullptr);
   if (q.cost_png)
@@ -568,6 +591,13 @@ bool frame_done(const RenderArgs& a, const FramePlan& p, const RenderRequest& q)
     if (q.png) others.push_back(*q.png);
     if (!a.stats_json.empty()) others.push_back(a.stats_json);
     std::error_code ec;
+    std::string deep_problem;
+    if (q.deep && !is_complete_exr(*q.deep, deep_problem)) {  // written first; absent if asked for later
+      if (text)
+        std::fprintf(stderr, "penumbra: warning: %s%s %s; rendering the frame again\n", label.c_str(),
+                     q.deep->string().c_str(), deep_problem.c_str());
+      return false;
+    }
     for (const fs::path& other : others)
       if (!fs::exists(other, ec)) {
         if (text)

@@ -5,6 +5,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 #include "io/files/atomic_file.h"
@@ -39,8 +40,11 @@ void exr_parts::write_deep_frame(const std::filesystem::path& out, const OIIO::I
 }
 
 bool exr_parts::is_deep_exr(const std::filesystem::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  return in && in->spec().deep;
+  // OpenEXR's magic number, then the version field's "non-image" (deep) flag, bit 11.
+  std::ifstream in(path, std::ios::binary);
+  unsigned char start[8] = {};
+  return in.read(reinterpret_cast<char*>(start), sizeof start) && start[0] == 0x76 && start[1] == 0x2f &&
+         start[2] == 0x31 && start[3] == 0x01 && (start[5] & 0x08) != 0;
 }
 
 void write_deep_exr(const DeepImage& image, const std::filesystem::path& path, const ExrOptions& options,
@@ -78,6 +82,7 @@ void write_deep_exr(const DeepImage& image, const std::filesystem::path& path, c
 DeepImage read_deep_exr(const std::filesystem::path& path, uint64_t max_bytes) {
   const std::string name = path.string();
   const uint64_t size = check_input_file(path, "", max_bytes);
+  if (!exr_parts::is_deep_exr(path)) throw InputError(name, "", "is not a deep OpenEXR image");
   exr_parts::check_exr_header(path, size, true);
   auto in = exr_parts::open_part(name);
   const OIIO::ImageSpec spec = in->spec();

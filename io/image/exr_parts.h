@@ -28,7 +28,8 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size, bool dee
 /// (string, float and matrix metadata).
 void set_attributes(OIIO::ImageSpec& spec, const ExrOptions& options);
 
-/// Whether the file's first part is deep (any readable EXR; false if it cannot be opened).
+/// Whether the file starts as a deep OpenEXR does (its version field's non-image flag), read from
+/// its first 8 bytes before any other check; false for anything else.
 bool is_deep_exr(const std::filesystem::path& path);
 
 /// Writes one deep part (`spec` with spec.deep, `data` its samples) to `out` atomically, as

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace penumbra {
 
@@ -26,13 +27,11 @@ uint32_t DeepPixel::resolve(uint32_t samples, float tolerance, std::vector<DeepS
   m_clusters.clear();
   for (const DeepHit& h : m_hits) {
     Cluster* c = nullptr;
+    // Only the key's latest cluster can take the record: the older ones end nearer still.
     for (auto it = m_clusters.rbegin(); it != m_clusters.rend(); ++it) {
-      const bool same =
-          it->key == h.key && (h.key == 0 || h.depth - it->z_last <= tolerance * std::fabs(it->z_last));
-      if (same) {
-        c = &*it;
-        break;
-      }
+      if (it->key != h.key) continue;
+      if (h.key == 0 || h.depth - it->z_last <= tolerance * std::fabs(it->z_last)) c = &*it;
+      break;
     }
     if (!c) {
       m_clusters.push_back(Cluster{h.key, h.object, h.depth, h.depth, 0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}});
@@ -90,6 +89,22 @@ std::vector<size_t> sample_offsets(const DeepImage& img) {
   return first;
 }
 
+/// The order of samples of separate images at one pixel: by depth, equal depths by id, alpha
+/// and colour, so that merge and holdout order them alike whichever image they come from.
+bool deep_before(const DeepSample& a, const DeepSample& b) {
+  if (a.z != b.z) return a.z < b.z;
+  if (a.id != b.id) return a.id < b.id;
+  if (a.a != b.a) return a.a < b.a;
+  if (a.r != b.r) return a.r < b.r;
+  if (a.g != b.g) return a.g < b.g;
+  return a.b < b.b;
+}
+
+/// Light from no surface: the sample of alpha 0 at +inf a render's background gives.
+bool is_background(const DeepSample& s) {
+  return std::isinf(s.z);
+}
+
 /// An image with `like`'s window and no samples.
 DeepImage empty_like(const DeepImage& like) {
   DeepImage out = like;
@@ -134,11 +149,14 @@ DeepImage merge_deep(const std::vector<const DeepImage*>& images) {
   std::vector<DeepSample> pixel;
   for (size_t i = 0; i < out.counts.size(); ++i) {
     pixel.clear();
+    bool background = false;  // one image's background, not the sum of all of them
     for (size_t m = 0; m < images.size(); ++m)
-      pixel.insert(pixel.end(), images[m]->samples.begin() + ptrdiff_t(first[m][i]),
-                   images[m]->samples.begin() + ptrdiff_t(first[m][i + 1]));
-    std::stable_sort(pixel.begin(), pixel.end(),
-                     [](const DeepSample& a, const DeepSample& b) { return a.z < b.z; });
+      for (size_t k = first[m][i]; k < first[m][i + 1]; ++k) {
+        const DeepSample& s = images[m]->samples[k];
+        if (is_background(s) && std::exchange(background, true)) continue;
+        pixel.push_back(s);
+      }
+    std::stable_sort(pixel.begin(), pixel.end(), deep_before);
     out.counts[i] = uint32_t(pixel.size());
     out.samples.insert(out.samples.end(), pixel.begin(), pixel.end());
   }
@@ -153,7 +171,8 @@ Film holdout_deep(const DeepImage& src, const DeepImage& matte) {
     size_t m = matte_first[i];
     for (size_t k = first[i]; k < first[i + 1]; ++k) {
       const DeepSample& s = src.samples[k];
-      for (; m < matte_first[i + 1] && matte.samples[m].z < s.z; ++m)
+      if (is_background(s)) break;  // the background is no element's
+      for (; m < matte_first[i + 1] && deep_before(matte.samples[m], s); ++m)
         transmittance *= 1 - double(matte.samples[m].a);
       rgba[0] += transmittance * s.r;
       rgba[1] += transmittance * s.g;

@@ -91,16 +91,18 @@ Film flatten_deep(const DeepImage& deep);
 /// Whether two deep images cover the same window of the same frame.
 bool same_window(const DeepImage& a, const DeepImage& b);
 
-/// Every image's samples together, per pixel sorted front to back by Z (equal depths keep the
-/// images' order): the deep merge of separately rendered elements. Requires at least one image,
-/// all with same_window() and hard-surface samples (Z = ZBack) sorted front to back.
+/// Every image's samples together, per pixel sorted front to back by Z (equal depths by id,
+/// alpha and colour): the deep merge of separately rendered elements. Of the background samples
+/// (Z = +inf: light from no surface) only the first image's is kept, so that elements rendered
+/// against the same environment do not add it up. Requires at least one image, all with
+/// same_window() and hard-surface samples (Z = ZBack) sorted front to back.
 DeepImage merge_deep(const std::vector<const DeepImage*>& images);
 
 /// `src` held out by `matte`, flat (as Nuke's DeepHoldout): per pixel, the part of the flattened
 /// merge of the two that `src`'s samples contribute, i.e. each sample's colour and alpha times
-/// prod(1 - A) of every sample of either image in front of it (at equal depths `src`'s first).
-/// src held out by matte plus matte held out by src is the flattened merge. Same requirements as
-/// merge_deep.
+/// prod(1 - A) of every sample of either image in front of it (in merge_deep's order). The
+/// background belongs to no element: `src`'s is left out. Without backgrounds, src held out by
+/// matte plus matte held out by src is the flattened merge. Same requirements as merge_deep.
 Film holdout_deep(const DeepImage& src, const DeepImage& matte);
 
 /// The merge of one pixel's camera samples into deep samples, as the header describes it.

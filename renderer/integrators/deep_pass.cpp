@@ -61,6 +61,7 @@ DeepResult render_deep(const Scene& scene, const Accelerator& accel, const PathL
         img.counts[i] = pixel.resolve(n, deep.merge_tolerance, out);
       }
     // The tile's samples and the image they are copied into exist together for a moment.
+    out.shrink_to_fit();
     const uint64_t total = found += out.size();
     if (2 * deep_image_bytes(npix, total) > deep.max_bytes) {
       over = true;

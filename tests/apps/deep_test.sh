@@ -146,6 +146,32 @@ printf '{"version": 1, "shots": [{"name": "x", "scene": "%s", "output": "o.exr",
   "$src/scenes/spheres.gltf" >"$work/bad_job.json"
 expect 2 'deep.*must be a string' -- "$bin" batch "$work/bad_job.json" -q
 
+# A frame whose deep EXR is missing is not complete: --skip-existing and a job render it again.
+rm "$work/shots/whole_deep.exr"
+expect 0 "" -- "$bin" batch "$work/job.json" -q --skip-existing
+cmp -s "$work/shots/tiled_deep.exr" "$work/shots/whole_deep.exr" && pass || fail "a job did not render a missing deep EXR again"
+rm "$work/shots/tiled_deep.exr"
+expect 0 "" -- "$bin" batch "$work/job.json" -q --skip-existing
+[ -e "$work/shots/tiled_deep.exr" ] && pass || fail "a tiled job did not render a missing deep frame again"
+
+# An interrupted path render writes its flat image and no deep one, keeping its resume state even
+# after its last pass; --resume completes both, the deep image equal to an uninterrupted render's.
+ra=(render "$src/scenes/default.gltf" --integrator path --width 16 --height 9 --spp 2048 --no-png --reproducible)
+"$bin" "${ra[@]}" -o "$work/whole-r.exr" --deep "$work/whole-r.deep.exr" -q >/dev/null || fail "uninterrupted render"
+"$bin" "${ra[@]}" -o "$work/int.exr" --deep "$work/int.deep.exr" >"$work/out" 2>"$work/err" &
+pid=$!
+for _ in $(seq 200); do grep -q "^render" "$work/err" 2>/dev/null && break; sleep 0.05; done
+kill -INT $pid 2>/dev/null
+wait $pid; rc=$?
+if [ -e "$work/int.exr.resume" ]; then  # interrupted in time (a very fast machine may finish first)
+  [ "$rc" -eq 130 ] && [ -e "$work/int.exr" ] && [ ! -e "$work/int.deep.exr" ] && pass \
+    || fail "interrupted --deep render: exit $rc, deep image $(ls "$work"/int.deep.exr 2>&1)"
+  expect 0 "int.deep.exr" -- "$bin" "${ra[@]}" -o "$work/int.exr" --deep "$work/int.deep.exr" --resume -q
+  cmp -s "$work/int.deep.exr" "$work/whole-r.deep.exr" && pass || fail "the resumed deep image differs from the whole render's"
+else
+  echo "note: the render finished before the interrupt; resume not exercised"
+fi
+
 # 5. Frames: one deep EXR per frame.
 expect 0 "anim_deep.0002.exr" -- "$bin" render "$src/scenes/motion.gltf" -o "$work/anim.####.exr" \
   --deep "$work/anim_deep.####.exr" --frames 1-2 --width 48 --spp 2 --no-png -q
@@ -157,7 +183,7 @@ expect 2 "needs a run of '#' in --deep" -- "$bin" render "$src/scenes/motion.glt
 
 # 6. Bad requests: exit 2, nothing written.
 expect 2 "covers another window" -- "$bin" deep merge "$work/exact.a.deep.exr" "$work/part0.deep.exr" -o "$work/bad.exr"
-expect 2 "is not a deep image" -- "$bin" deep flatten "$work/exact.a.exr" -o "$work/bad.exr"
+expect 2 "is not a deep OpenEXR image" -- "$bin" deep flatten "$work/exact.a.exr" -o "$work/bad.exr"
 expect 2 "the output must be an .exr" -- "$bin" deep flatten "$work/exact.a.deep.exr" -o "$work/bad.png"
 expect 2 "input 1" -- "$bin" deep flatten "$work/exact.a.deep.exr" -o "$work/exact.a.deep.exr"
 expect 2 "over the .* limit" -- "$bin" deep merge "$work/exact.a.deep.exr" "$work/exact.b.deep.exr" -o "$work/bad.exr" --max-memory 1K

@@ -236,3 +236,25 @@ TEST_CASE("deep: flatten, merge and holdout composite as over does", "[deep]") {
   other.origin_x = 1;
   CHECK_FALSE(same_window(a, other));
 }
+
+TEST_CASE("deep: a merge keeps one background, holdouts none, and equal depths split the same way",
+          "[deep]") {
+  const DeepSample bg = sample(kInfinity, 0, 0.5f);
+  const DeepImage a = image_of({sample(2, 0.5f, 0.4f), bg});
+  const DeepImage b = image_of({sample(2, 0.5f, 0.2f), bg});  // the same depth as a's surface
+  const DeepImage m = merge_deep({&a, &b});
+  REQUIRE(m.counts[0] == 3);
+  CHECK(std::isinf(m.samples[2].z));
+  CHECK(std::isfinite(m.samples[1].z));
+  const Film fm = flatten_deep(m);
+  // The environment once, through what both surfaces leave: 0.25 of the pixel.
+  CHECK(fm.rgba[0] == Approx(0.2 + 0.5 * 0.4 + 0.25 * 0.5));
+  const Film ha = holdout_deep(a, b), hb = holdout_deep(b, a);
+  // b's sample (less red) comes first at the shared depth, in the merge and in both holdouts.
+  CHECK(hb.rgba[0] == Approx(0.2));
+  CHECK(ha.rgba[0] == Approx(0.5 * 0.4));
+  // The two holdouts and the background through both surfaces make the merge.
+  const double background[4] = {0.25 * bg.r, 0.25 * bg.g, 0.25 * bg.b, 0};
+  for (int c = 0; c < 4; ++c)
+    CHECK(ha.rgba[size_t(c)] + hb.rgba[size_t(c)] + background[c] == Approx(fm.rgba[size_t(c)]));
+}
