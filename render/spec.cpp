@@ -371,7 +371,8 @@ std::vector<SpecField> make_fields() {
        0,
        0,
        {},
-       "also a deep image: per pixel one sample per surface (R G B A Z ZBack id N albedo), from the beauty's own "
+       "also a deep image: per pixel one sample per surface (R G B A Z ZBack id N albedo), from the beauty's "
+       "own "
        "camera samples traced again (the command's --deep FILE.exr)"},
       {"deep_merge_tolerance",
        &S::deep_merge_tolerance,
