@@ -16,10 +16,6 @@
 
 namespace penumbra {
 
-bool deep_compression(const std::string& name) {
-  return name == "none" || name == "rle" || name == "zips" || name == "zip";
-}
-
 void exr_parts::write_deep_frame(const std::filesystem::path& out, const OIIO::ImageSpec& spec,
                                  const OIIO::DeepData& data, std::string* sha256) {
   write_atomically(
@@ -59,7 +55,7 @@ void write_deep_exr(const DeepImage& image, const std::filesystem::path& path, c
   spec.full_x = spec.full_y = 0;
   spec.full_width = image.full_width > 0 ? image.full_width : image.width;
   spec.full_height = image.full_height > 0 ? image.full_height : image.height;
-  spec.attribute("compression", deep_compression(options.compression) ? options.compression : "zips");
+  spec.attribute("compression", options.compression == "none" ? "none" : "zips");
   exr_parts::set_attributes(spec, options);
   const size_t npix = size_t(image.width) * size_t(image.height);
   if (image.counts.size() != npix)

@@ -14,13 +14,11 @@
 
 namespace penumbra {
 
-/// The compressions OpenEXR allows for deep data; write_deep_exr uses zips for any other.
-bool deep_compression(const std::string& name);
-
 /// Writes `image` atomically (data window = its window in the full frame) with the metadata of
-/// `options` (its string, float and matrix attributes; its compression when deep_compression
-/// accepts it, else zips). Throws std::runtime_error naming the file if OpenImageIO fails;
-/// `sha256`, if not null, receives the file's SHA-256.
+/// `options` (its string, float and matrix attributes), compressed per scanline with zip (zips),
+/// or not at all when options.compression is "none" (OpenImageIO writes deep data with these two). Throws
+/// std::runtime_error naming the file if OpenImageIO fails; `sha256`, if not null, receives the file's
+/// SHA-256.
 void write_deep_exr(const DeepImage& image, const std::filesystem::path& path, const ExrOptions& options,
                     std::string* sha256 = nullptr);
 
