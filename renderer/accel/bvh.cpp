@@ -30,14 +30,23 @@ namespace wide4 {
 #undef PENUMBRA_BVH_WIDTH
 }  // namespace wide4
 
+// The 8-wide code for AVX2: GCC's target pragma, clang's attribute pragma (clang ignores GCC's).
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace wide8 {
 #define PENUMBRA_BVH_WIDTH 8
 #include "renderer/accel/bvh_traverse.inl"
 #undef PENUMBRA_BVH_WIDTH
 }  // namespace wide8
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 bool cpu_has_avx2() {
   static const bool has = __builtin_cpu_supports("avx2");

@@ -1,8 +1,9 @@
 // Traversal of a wide BVH (accel/bvh_wide.h) for one SIMD width. This file has no include
 // guard on purpose: accel/bvh.cpp includes it twice, once with PENUMBRA_BVH_WIDTH 4 in namespace
 // wide4 (SSE, every x86-64 CPU) and once with PENUMBRA_BVH_WIDTH 8 in namespace wide8 under
-// `#pragma GCC target("avx2")`, so the 8-wide code is compiled for AVX2 and called only when
-// cpu_has_avx2() says so. Everything here is a template or inline and local to that namespace.
+// `#pragma GCC target("avx2")` (with clang, an attribute pragma giving every function that
+// target), so the 8-wide code is compiled for AVX2 and called only when cpu_has_avx2() says so.
+// Everything here is a template or inline and local to that namespace.
 //
 // Closest hit: the W child boxes are slab-tested at once; the children met are pushed far to
 // near with their entry distance, and entries beyond `best` are skipped when popped. Leaves sit
