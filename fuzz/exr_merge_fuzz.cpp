@@ -1,12 +1,16 @@
-// libFuzzer entry point for io/exr_merge's part reader. The first input byte holds the options:
+// libFuzzer entry point for io/exr_merge's part reader and io/image/deep_exr's deep reader. The
+// first input byte holds the options:
 //   bit 0: MergeOptions::force (skip the metadata comparison, reach the geometric checks);
 //   bit 1: two parts; the next 4 bytes (little-endian, taken modulo the remaining size) give
 //          the first part's length, the rest is the second part. Otherwise the rest is one part.
+//   bit 2: besides the merge, read the first part as a deep image (read_deep_exr) and composite
+//          it (flatten_deep, and with two parts merge_deep and holdout_deep when both read).
 // The parts are written as .exr files and merged to a temporary output under a 64 MiB frame
 // bound. InputError and std::runtime_error (a failed write) are expected outcomes for garbage;
 // anything else (crash, sanitizer report, other exception, leak) is a finding.
 // With PENUMBRA_FUZZ_WRITE_SEEDS=DIR set, the target writes seed inputs (pairs of stripes of one
-// frame, single- and multi-part, and a whole frame) to DIR with write_exr and exits.
+// frame, single- and multi-part, deep stripes, and a whole frame) to DIR with write_exr and
+// write_deep_exr and exits.
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
@@ -16,10 +20,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 
 #include "io/farm/render_settings.h"
 #include "io/files/error.h"
+#include "io/image/deep_exr.h"
 #include "io/image/exr_merge.h"
 #include "io/image/image_output.h"
 
@@ -64,6 +70,35 @@ std::string stripe(int y0, int y1, bool multipart, const std::string& compressio
   return read_file(path);
 }
 
+// Rows [y0, y1) of a 5x4 deep frame: pixel (x, y) holds x % 3 samples, the last of two the
+// background at +inf.
+std::string deep_stripe(int y0, int y1) {
+  penumbra::DeepImage img;
+  img.width = img.full_width = 5;
+  img.height = y1 - y0;
+  img.origin_y = y0;
+  img.full_height = 4;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < 5; ++x) {
+      img.counts.push_back(uint32_t(x % 3));
+      for (int k = 0; k < x % 3; ++k) {
+        penumbra::DeepSample s;
+        s.r = 0.25f * float(x);
+        s.a = k == 0 ? 0.5f : 0.0f;
+        s.z = s.zback = k == 0 ? 1.0f + float(y) : std::numeric_limits<float>::infinity();
+        s.id = float(x);
+        img.samples.push_back(s);
+      }
+    }
+  penumbra::ExrOptions opt;
+  const penumbra::RenderSettings settings{{{"camera", "Main"}, {"width", "5"}}};
+  opt.metadata = {{penumbra::kSceneHashAttribute, std::string(64, 'b')},
+                  {penumbra::kSettingsAttribute, penumbra::canonical_text(settings)}};
+  const fs::path path = work_dir() / "seed.exr";
+  penumbra::write_deep_exr(img, path, opt);
+  return read_file(path);
+}
+
 std::string two_parts(char flags, const std::string& a, const std::string& b) {
   const uint32_t n = uint32_t(a.size());
   std::string out(1, char(flags | 2));
@@ -80,6 +115,8 @@ void write_seeds(const fs::path& dir) {
              two_parts(0, stripe(0, 3, true, "rle"), stripe(3, 4, true, "rle")));
   write_file(dir / "seed-whole-none", std::string(1, '\0') + stripe(0, 4, false, "none"));
   write_file(dir / "seed-whole-dwaa", std::string(1, '\1') + stripe(0, 4, true, "dwaa"));
+  write_file(dir / "seed-deep-stripes", two_parts(4, deep_stripe(0, 1), deep_stripe(1, 4)));
+  write_file(dir / "seed-deep-whole", std::string(1, '\4') + deep_stripe(0, 4));
 }
 
 }  // namespace
@@ -116,6 +153,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     penumbra::merge_exr_parts(parts, work_dir() / "merged.exr", options);
   } catch (const std::runtime_error&) {  // InputError included
+  }
+  if (flags & 4) {
+    try {
+      const penumbra::DeepImage a = penumbra::read_deep_exr(parts[0], options.max_memory_bytes);
+      (void)penumbra::flatten_deep(a);
+      if (parts.size() > 1) {
+        const penumbra::DeepImage b = penumbra::read_deep_exr(parts[1], options.max_memory_bytes);
+        if (penumbra::same_window(a, b)) {
+          (void)penumbra::merge_deep({&a, &b});
+          (void)penumbra::holdout_deep(a, b);
+        }
+      }
+    } catch (const std::runtime_error&) {
+    }
   }
   return 0;
 }

@@ -4,9 +4,11 @@
 #include <OpenImageIO/deepdata.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "io/files/atomic_file.h"
 #include "io/files/checked_file.h"
@@ -33,6 +35,38 @@ void exr_parts::write_deep_frame(const std::filesystem::path& out, const OIIO::I
         });
       },
       sha256);
+}
+
+uint64_t exr_parts::check_deep_chunks(const std::filesystem::path& path, uint64_t size,
+                                      const ExrHeaderInfo& info, uint64_t pixels, uint64_t max_bytes) {
+  const std::string name = path.string();
+  if (info.multipart) throw InputError(name, "", "multi-part deep files are not read (one deep part only)");
+  const uint64_t table_end = info.end + 8 * uint64_t(std::max<int64_t>(info.chunk_count, 0));
+  if (info.chunk_count < 1 || info.chunk_count > 65536 || table_end > size)
+    throw InputError(name, "chunkCount", "the chunk table does not fit the file");
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(std::streamoff(info.end));
+  std::vector<uint64_t> offsets(size_t(info.chunk_count));
+  in.read(reinterpret_cast<char*>(offsets.data()), std::streamsize(offsets.size() * 8));
+  uint64_t total = pixels * 16;  // the counts, OpenImageIO's and OpenEXR's
+  for (size_t c = 0; c < offsets.size() && in; ++c) {
+    // y (int32), packed count table size, packed sample data size, unpacked sample data size.
+    constexpr uint64_t kChunkHeader = 4 + 3 * 8;
+    uint64_t sizes[3] = {0, 0, 0};
+    if (offsets[c] < table_end || offsets[c] > size - kChunkHeader ||
+        !in.seekg(std::streamoff(offsets[c] + 4)).read(reinterpret_cast<char*>(sizes), sizeof sizes))
+      throw InputError(name, "", "chunk " + std::to_string(c) + " lies outside the file");
+    const uint64_t left = size - offsets[c] - kChunkHeader;
+    if (sizes[0] > left || sizes[1] > left - sizes[0])
+      throw InputError(name, "", "chunk " + std::to_string(c) + " claims more bytes than the file holds");
+    if (sizes[2] > max_bytes || total > max_bytes - sizes[2])
+      throw InputError(name, "",
+                       "its samples would need more than the " + format_bytes(max_bytes) + " limit (chunk " +
+                           std::to_string(c) + " alone unpacks to " + format_bytes(sizes[2]) + ")");
+    total += sizes[2];
+  }
+  if (!in) throw InputError(name, "", "its chunk table is cut off");
+  return total;
 }
 
 bool exr_parts::is_deep_exr(const std::filesystem::path& path) {
@@ -79,10 +113,11 @@ DeepImage read_deep_exr(const std::filesystem::path& path, uint64_t max_bytes) {
   const std::string name = path.string();
   const uint64_t size = check_input_file(path, "", max_bytes);
   if (!exr_parts::is_deep_exr(path)) throw InputError(name, "", "is not a deep OpenEXR image");
-  exr_parts::check_exr_header(path, size, true);
+  const exr_parts::ExrHeaderInfo header = exr_parts::check_exr_header(path, size, true);
   auto in = exr_parts::open_part(name);
   const OIIO::ImageSpec spec = in->spec();
   if (!spec.deep) throw InputError(name, "", "is not a deep image");
+  exr_parts::check_deep_chunks(path, size, header, uint64_t(spec.width) * uint64_t(spec.height), max_bytes);
   int channel[kDeepChannels];
   for (int c = 0; c < kDeepChannels; ++c) {
     channel[c] = spec.channelindex(kDeepChannelNames[c]);

@@ -114,7 +114,8 @@ std::string variable_attribute_problem(const std::string& type, const std::strin
 // attribute must fit in the rest of the file with the size its type has, channel lists,
 // previews and string vectors must describe their own bytes, and every data and display window
 // must be at most kMaxSide pixels per side. Throws InputError naming the file otherwise.
-void check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep) {
+ExrHeaderInfo check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep) {
+  ExrHeaderInfo info;
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
   unsigned char start[8] = {};
@@ -123,6 +124,7 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size, bool dee
     throw InputError(name, "", "is not an OpenEXR file");
   const uint32_t flags = uint32_t(start[5]) << 8 | uint32_t(start[6]) << 16 | uint32_t(start[7]) << 24;
   const bool multipart = flags & 0x1000;
+  info.multipart = multipart;
   if ((flags & 0x800) && !deep) throw InputError(name, "", "is a deep image, the first part is not");
   if (!(flags & 0x800) && deep) throw InputError(name, "", "is not a deep image, the first part is");
   const auto bad = [&](const std::string& what) {
@@ -145,7 +147,11 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size, bool dee
       if (fixed > 0 && bytes != fixed)
         throw bad("attribute '" + attribute + "' of type " + type + " has " + std::to_string(bytes) +
                   " bytes, not " + std::to_string(fixed));
-      if (type == "box2i" && (attribute == "dataWindow" || attribute == "displayWindow")) {
+      if (header == 0 && type == "int" && attribute == "chunkCount" && bytes == 4) {
+        int32_t count = 0;
+        in.read(reinterpret_cast<char*>(&count), 4);
+        info.chunk_count = count;
+      } else if (type == "box2i" && (attribute == "dataWindow" || attribute == "displayWindow")) {
         int32_t box[4];
         in.read(reinterpret_cast<char*>(box), sizeof box);
         const int64_t w = int64_t(box[2]) - box[0] + 1, h = int64_t(box[3]) - box[1] + 1;
@@ -163,7 +169,8 @@ void check_exr_header(const std::filesystem::path& path, uint64_t size, bool dee
     if (!in) throw bad("cut off");
     if (!multipart || attributes == 0) {
       if (header == 0 && attributes == 0) throw bad("no attributes");
-      return;
+      info.end = uint64_t(in.tellg());
+      return info;
     }
   }
 }
@@ -482,7 +489,7 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
   double deep_bytes = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const std::string name = parts[k].string();
-    check_exr_header(parts[k], sizes[k], deep);
+    const ExrHeaderInfo header = check_exr_header(parts[k], sizes[k], deep);
     auto in = open_part(name);
     const std::vector<OIIO::ImageSpec> specs = read_specs(*in, name);
     if (!options.force) {
@@ -522,6 +529,14 @@ void merge_exr_parts(const std::vector<std::filesystem::path>& parts, const std:
     }
     claim_pixels(parts, k, specs[0], owner);
     if (deep) {
+      // What the part's chunks declare, checked before OpenEXR allocates it.
+      const double declared = double(check_deep_chunks(parts[k], sizes[k], header,
+                                                       uint64_t(specs[0].width) * uint64_t(specs[0].height),
+                                                       options.max_memory_bytes));
+      if (2 * (deep_bytes + declared) > double(options.max_memory_bytes))
+        throw InputError(name, "",
+                         "the deep parts' samples and the frame's would need more than the " +
+                             format_bytes(options.max_memory_bytes) + " limit");
       OIIO::DeepData d;
       if (!in->read_native_deep_image(0, 0, d))
         throw InputError(name, "", "cannot decode: " + in->geterror());

@@ -19,10 +19,25 @@ namespace penumbra::exr_parts {
 /// Bytes of one EXR part's pixels: its data window, or its display window when `full`.
 double image_bytes(const OIIO::ImageSpec& spec, bool full);
 
+/// What check_exr_header learnt of a file's header.
+struct ExrHeaderInfo {
+  uint64_t end = 0;          ///< the offset of the first byte after the header(s): the chunk table
+  bool multipart = false;    ///< the version field's multi-part flag
+  int64_t chunk_count = -1;  ///< the first header's chunkCount attribute, or -1 without one
+};
+
 /// Throws InputError naming `path` unless its header (of a file of `size` bytes) is one
 /// OpenImageIO can read safely: attributes that describe their own bytes, windows of at most
 /// 65536 pixels a side; not deep unless `deep`.
-void check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep = false);
+ExrHeaderInfo check_exr_header(const std::filesystem::path& path, uint64_t size, bool deep = false);
+
+/// Bytes a single-part deep scanline file (checked by check_exr_header with `info`) decodes to,
+/// bounded from its chunk table before any chunk is read: the unpacked sample data every chunk
+/// declares, and 16 bytes a pixel of `pixels` for the sample counts. Throws InputError naming the
+/// file when it is multi-part, its chunk table or a chunk's sizes point outside the file, or the
+/// bound exceeds `max_bytes` (OpenEXR allocates what a chunk declares before decoding it).
+uint64_t check_deep_chunks(const std::filesystem::path& path, uint64_t size, const ExrHeaderInfo& info,
+                           uint64_t pixels, uint64_t max_bytes);
 
 /// Sets the attributes every Penumbra EXR carries (colour space, software) and those of `options`
 /// (string, float and matrix metadata).

@@ -15,6 +15,7 @@
 #include "io/farm/render_settings.h"
 #include "io/files/error.h"
 #include "io/image/exr_merge.h"
+#include "io/image/exr_parts.h"
 #include "support/test_util.h"
 
 using namespace penumbra;
@@ -133,5 +134,36 @@ TEST_CASE("deep exr: stripes merge into the whole frame's file byte for byte", "
   CHECK_THROWS_WITH(merge_exr_parts({dir / "flat.exr", parts[0]}, dir / "mixed.exr"),
                     Contains("p0.exr") && Contains("is a deep image"));
   CHECK_FALSE(std::filesystem::exists(dir / "mixed.exr"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("deep exr: chunks that declare more than the file or the budget are refused unread", "[deep_exr]") {
+  const auto dir = test::temp_dir("deep-hostile");
+  write_deep_exr(pattern(6, 4), dir / "d.exr", identity());
+  const uint64_t size = std::filesystem::file_size(dir / "d.exr");
+  const exr_parts::ExrHeaderInfo info = exr_parts::check_exr_header(dir / "d.exr", size, true);
+  REQUIRE(info.chunk_count == 4);  // one chunk a scanline (zips)
+  std::string bytes = bytes_of(dir / "d.exr");
+  uint64_t first = 0;
+  std::memcpy(&first, &bytes[info.end], 8);
+  // The first chunk's unpacked sample size (y, packed table size, packed data size, unpacked size).
+  const auto patched = [&](size_t field, uint64_t value) {
+    std::string b = bytes;
+    std::memcpy(&b[first + 4 + 8 * field], &value, 8);
+    std::ofstream(dir / "h.exr", std::ios::binary | std::ios::trunc)
+        .write(b.data(), std::streamsize(b.size()));
+    return dir / "h.exr";
+  };
+  CHECK_THROWS_WITH(read_deep_exr(patched(2, uint64_t(1) << 40), uint64_t(1) << 30),
+                    Contains("h.exr") && Contains("limit"));
+  CHECK_THROWS_WITH(read_deep_exr(patched(1, uint64_t(1) << 40), uint64_t(1) << 30),
+                    Contains("claims more bytes than the file holds"));
+  CHECK_THROWS_WITH(merge_exr_parts({patched(2, uint64_t(1) << 40)}, dir / "m.exr"), Contains("limit"));
+  // A chunk table entry pointing past the end.
+  std::string b = bytes;
+  const uint64_t past = size + 100;
+  std::memcpy(&b[info.end], &past, 8);
+  std::ofstream(dir / "t.exr", std::ios::binary | std::ios::trunc).write(b.data(), std::streamsize(b.size()));
+  CHECK_THROWS_WITH(read_deep_exr(dir / "t.exr", uint64_t(1) << 30), Contains("outside the file"));
   std::filesystem::remove_all(dir);
 }
