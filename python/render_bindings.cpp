@@ -154,6 +154,7 @@ py::dict aov_dict(const py::object& self) {
     out["vector"] = view(self, r.vector.data(), h, w, kMotionVectorChannels, kMotionVectorChannels);
   if (r.aovs.count("velocity"))
     out["velocity"] = view(self, r.velocity.data(), h, w, kVelocityChannels, kVelocityChannels);
+  if (!r.wireframe.empty()) out["wireframe"] = view(self, r.wireframe.data(), h, w, 1, 1);
   if (r.aovs.count("halves") && !r.halves.empty() && !d.halves.empty())
     for (int half = 0; half < 2; ++half) {
       const std::string name = half ? "odd" : "even";

@@ -99,6 +99,7 @@ RenderOutput render_session(SceneSession& session, const RenderSettings& setting
   out.id_manifest = std::move(r.layers.id_manifest);
   out.vector = std::move(r.layers.vector);
   out.velocity = std::move(r.layers.velocity);
+  out.wireframe = std::move(r.layers.wireframe);
   out.deep = std::move(r.deep.image);
   return out;
 }
@@ -135,7 +136,7 @@ void write_render_exr(const RenderOutput& out, const std::filesystem::path& path
   ExrOptions exr = render_exr_options(out, options);
   add_layer_channels(exr, out.aovs,
                      {&out.data, &out.id_manifest, &out.samples_f, &out.variance, &out.groups, &out.vector,
-                      &out.velocity, &out.halves},
+                      &out.velocity, &out.halves, &out.wireframe},
                      options.half ? ChannelType::Half : ChannelType::Float);
   if (out.settings.denoise) {  // the second beauty and the attributes `penumbra denoise` writes
     const bool noisy_main = out.settings.denoise_main == "noisy";

@@ -71,6 +71,7 @@ struct RenderOutput {
   std::vector<float> groups;      ///< path with "light": kLightGroupChannels per pixel
   std::vector<float> vector;      ///< with "vector": kMotionVectorChannels per pixel
   std::vector<float> velocity;    ///< with "velocity": kVelocityChannels per pixel
+  std::vector<float> wireframe;   ///< with the wireframe setting: its coverage per pixel
   std::vector<float> samples_f;   ///< `samples` as floats, for the EXR
   std::string id_manifest;        ///< JSON: object id -> node name, material id -> material name
   DeepImage deep;                 ///< with settings.deep: the deep image (render_deep_image)

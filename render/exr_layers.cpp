@@ -32,6 +32,7 @@ void add_layer_channels(ExrOptions& exr, const std::set<std::string>& aovs, cons
                              kLightGroupChannels, g * 3 + c});
   if (aovs.count("vector")) vec("vector", "XYZW", b.vector, ChannelType::Float, kMotionVectorChannels);
   if (aovs.count("velocity")) vec("velocity", "XYZ", b.velocity, ChannelType::Float, kVelocityChannels);
+  if (b.wireframe && !b.wireframe->empty()) exr.extra.push_back({"wireframe.A", b.wireframe, colour});
   if (aovs.count("halves"))
     for (int h = 0; h < 2; ++h)
       for (int k = 0; k < kDenoiseChannelsPerHalf; ++k) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <set>
 #include <stdexcept>
 
@@ -17,6 +18,7 @@
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/integrators/visibility.h"
+#include "renderer/scene/curve_size.h"
 
 namespace penumbra {
 
@@ -54,6 +56,20 @@ std::string structure_key(const RenderSpec& spec, const Scene& scene) {
   for (const auto& p : spec.accel_params) key += " " + p;
   if (!scene.instance_motion.empty()) key += " (motion)";
   if (scene_deforms(scene)) key += " (deforming)";
+  // Point and line radii follow the camera when given in pixels: a structure is kept only for
+  // the same radii (an FNV-1a hash of their bits).
+  uint64_t h = 1469598103934665603ull;
+  bool curves = false;
+  for (const Mesh& m : scene.meshes)
+    if (renders_as_curves(m)) {
+      curves = true;
+      for (float r : m.radii) {
+        uint32_t bits;
+        std::memcpy(&bits, &r, 4);
+        h = (h ^ bits) * 1099511628211ull;
+      }
+    }
+  if (curves) key += " (curves " + std::to_string(h) + ")";
   return key;
 }
 
@@ -228,6 +244,8 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
   p.camera = view.camera;
   const uint64_t env_budget = o.charge_budget ? o.charge_budget(p.config) : o.env_budget;
   const RenderConfig& cfg = p.config;
+  set_curve_radii(scene, p.camera, cfg.height, parse_curve_size(p.spec.point_size, "point_size"),
+                  parse_curve_size(p.spec.line_width, "line_width"));
   set_lens(p, scene, o.scene_file);
   if (p.spec.motion_blur && p.integrator() == IntegratorType::Raster)
     p.warnings.push_back(
@@ -303,7 +321,7 @@ void finish_render(LoadedScene& loaded, const PreparedRender& prepared) {
 
 bool needs_structure(const RenderSpec& spec, bool probe) {
   return spec.integrator != "raster" || spec.raster_shadows == "ray" || spec.aovs.count("cost") ||
-         wants_motion_layers(spec.aovs) || !crypto_layers(spec.aovs).empty() || probe;
+         spec.wireframe || wants_motion_layers(spec.aovs) || !crypto_layers(spec.aovs).empty() || probe;
 }
 
 Structure build_structure(const Scene& scene, const RenderSpec& spec, bool world_apart, Structure previous,
@@ -433,10 +451,45 @@ std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInf
   return names;
 }
 
+WireframeConfig wireframe_config(const RenderSpec& spec, const GltfInfo& info) {
+  WireframeConfig w;
+  w.width = spec.wireframe_width;
+  w.hidden = spec.wireframe_hidden == "dim"      ? WireframeHidden::Dim
+             : spec.wireframe_hidden == "dashed" ? WireframeHidden::Dashed
+                                                 : WireframeHidden::Off;
+  size_t start = 0;
+  while (start < spec.wireframe_nodes.size()) {
+    size_t end = spec.wireframe_nodes.find(',', start);
+    if (end == std::string::npos) end = spec.wireframe_nodes.size();
+    const std::string item = spec.wireframe_nodes.substr(start, end - start);
+    start = end + 1;
+    int found = -1;
+    for (size_t i = 0; i < info.node_names.size() && found < 0; ++i)
+      if (info.node_names[i] == item) found = int(i);
+    if (found < 0 && !item.empty() && item.find_first_not_of("0123456789") == std::string::npos &&
+        item.size() < 10 && std::stoul(item) < info.node_names.size())
+      found = int(std::stoul(item));
+    if (found < 0)
+      throw std::invalid_argument("wireframe_nodes: no node '" + item + "' (the file has " +
+                                  std::to_string(info.node_names.size()) +
+                                  " nodes: give their names or indices, comma-separated)");
+    w.nodes.push_back(found);
+  }
+  return w;
+}
+
+void overlay_wireframe(RenderImage& image, const RenderLayers& layers, const PreparedRender& p) {
+  if (!p.spec.wireframe || layers.wireframe.empty()) return;
+  overlay_wireframe(image.film, layers.wireframe, parse_wireframe_color(p.spec.wireframe_color));
+}
+
 RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel, const PreparedRender& p) {
   RenderLayers out;
   const Scene& scene = loaded.scene;
   const IntegratorType integrator = p.integrator();
+  if (p.spec.wireframe)
+    out.wireframe =
+        render_wireframe(scene, *accel, p.camera, p.config, wireframe_config(p.spec, loaded.info));
   if (wants_data_aovs(p.spec.aovs))
     out.data = integrator == IntegratorType::Raster
                    ? render_raster_aovs(scene, p.camera, p.config)
@@ -521,6 +574,7 @@ RenderResult render_scene(Session& session, const RenderSpec& spec, uint64_t env
   const Accelerator* accel = session.structure.accel.get();
   r.image = render_image(scene, accel, r.prepared);
   r.layers = render_layers(session.loaded, accel, r.prepared);
+  overlay_wireframe(r.image, r.layers, r.prepared);
   if (r.prepared.spec.deep)
     r.deep = render_deep_image(session.loaded, *accel, r.prepared, r.image, env_budget);
   if (r.deep.over_budget)

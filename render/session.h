@@ -33,6 +33,7 @@
 #include "renderer/integrators/deep_pass.h"
 #include "renderer/integrators/motion_vectors.h"
 #include "renderer/integrators/render.h"
+#include "renderer/integrators/wireframe.h"
 #include "renderer/lights/area.h"
 #include "renderer/lights/environment.h"
 
@@ -207,7 +208,17 @@ struct RenderLayers {
   std::string id_manifest;                    ///< JSON names of the id layer's ids ("id")
   std::vector<float> vector;                  ///< kMotionVectorChannels per pixel of the window ("vector")
   std::vector<float> velocity;                ///< kVelocityChannels per pixel of the window ("velocity")
+  std::vector<float> wireframe;               ///< spec.wireframe: coverage per pixel of the window
 };
+
+/// The wireframe overlay's settings from a resolved spec: width, hidden edges, and the nodes
+/// spec.wireframe_nodes names (indices or names as `info` lists them). Throws
+/// std::invalid_argument naming wireframe_nodes for a node the file does not have.
+WireframeConfig wireframe_config(const RenderSpec& spec, const GltfInfo& info);
+
+/// Composites the wireframe layer (layers.wireframe) in spec.wireframe_color over the beauty;
+/// nothing without it.
+void overlay_wireframe(RenderImage& image, const RenderLayers& layers, const PreparedRender& prepared);
 
 /// The Cryptomatte layers `aovs` asks for: CryptoObject, CryptoMaterial, CryptoAsset.
 std::vector<std::string> crypto_layers(const std::set<std::string>& aovs);
@@ -226,7 +237,7 @@ std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInf
                                                const std::string& layer);
 
 /// Traces what the requested data, Cryptomatte, cost and vector layers need (the vector layer
-/// from prepared.motion; all 0 without it).
+/// from prepared.motion; all 0 without it), and the wireframe's coverage with spec.wireframe.
 RenderLayers render_layers(const LoadedScene& loaded, const Accelerator* accel,
                            const PreparedRender& prepared);
 

@@ -10,6 +10,7 @@
 #include "render/accel_params.h"
 #include "renderer/accel/factory.h"
 #include "renderer/film/filter.h"
+#include "renderer/scene/curve_size.h"
 
 #ifndef PENUMBRA_VERSION
 #define PENUMBRA_VERSION "unknown"
@@ -384,6 +385,66 @@ std::vector<SpecField> make_fields() {
        "deep output: a surface's camera samples in a pixel merge into one deep sample when their depths "
        "differ "
        "by at most this fraction of the nearest one's (default 0.01; 0: equal depths only)"},
+      {"point_size",
+       &S::point_size,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "diameter of glTF points whose file gives none (PENUMBRA_points): pixels (2px) or scene units "
+       "(0.01) (default 2px)"},
+      {"line_width",
+       &S::line_width,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "width of glTF lines whose file gives none (PENUMBRA_points): pixels (1px) or scene units (0.005) "
+       "(default 1px)"},
+      {"wireframe",
+       &S::wireframe,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "draw the triangle edges over the image, hidden ones hidden, and write them as the wireframe layer "
+       "(default off)"},
+      {"wireframe_nodes",
+       &S::wireframe_nodes,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "wireframe: the nodes whose edges are drawn, comma-separated names or indices (default: every node)"},
+      {"wireframe_width",
+       &S::wireframe_width,
+       kAnyIntegrator,
+       true,
+       0.25,
+       64,
+       {},
+       "wireframe: line width in pixels (default 1)"},
+      {"wireframe_color",
+       &S::wireframe_color,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {},
+       "wireframe: linear RGB of the lines, R,G,B (default 0,0,0)"},
+      {"wireframe_hidden",
+       &S::wireframe_hidden,
+       kAnyIntegrator,
+       true,
+       0,
+       0,
+       {"off", "dim", "dashed"},
+       "wireframe: edges behind surfaces: off (not drawn), dim (at a quarter opacity) or dashed (default "
+       "off)"},
   };
 }
 
@@ -598,10 +659,32 @@ void validate(const RenderSpec& s) {
     throw std::invalid_argument("denoise_main needs denoise");
   if (!s.deep && s.deep_merge_tolerance != defaults.deep_merge_tolerance)
     throw std::invalid_argument("deep_merge_tolerance needs deep (the command's --deep FILE.exr)");
+  parse_curve_size(s.point_size, "point_size");
+  parse_curve_size(s.line_width, "line_width");
+  parse_wireframe_color(s.wireframe_color);
+  if (s.wireframe && s.denoise)
+    throw std::invalid_argument(
+        "wireframe with denoise: the overlay would be denoised with the beauty; render the wireframe "
+        "without denoise and composite its layer (wireframe.A) over the denoised image");
+  if (!s.wireframe)
+    for (const char* name : {"wireframe_nodes", "wireframe_width", "wireframe_color", "wireframe_hidden"})
+      for (const SpecField& f : spec_fields())
+        if (f.name == std::string(name) && field_text(s, f) != field_text(defaults, f))
+          throw std::invalid_argument(std::string(name) + " needs wireframe");
   // The renderer's own range checks (tile size, threads, depths) on a stand-in size.
   RenderConfig probe = make_render_config(resolve(s, 16.0f / 9.0f));
   probe.window = {};
   validate(probe);
+}
+
+Vec3f parse_wireframe_color(const std::string& text) {
+  Vec3f c;
+  int used = 0;
+  if (std::sscanf(text.c_str(), "%f,%f,%f%n", &c.x, &c.y, &c.z, &used) != 3 || size_t(used) != text.size() ||
+      !is_finite(c) || c.x < 0 || c.y < 0 || c.z < 0)
+    throw std::invalid_argument("wireframe_color: '" + text +
+                                "' is not a colour (three finite non-negative numbers R,G,B)");
+  return c;
 }
 
 RenderSpec resolve(const RenderSpec& s, float hint) {

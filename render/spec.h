@@ -75,6 +75,13 @@ struct RenderSpec {
   std::string shadows = "on";          ///< whitted: on, or off (no shadow rays: lights reach every surface)
   bool deep = false;                   ///< whitted, path: a deep image too (render_deep_image)
   float deep_merge_tolerance = 0.01f;  ///< deep: relative depth within which one surface's records merge
+  std::string point_size = "2px";  ///< points without a size from the file: diameter, "Npx" or scene units
+  std::string line_width = "1px";  ///< lines without a width from the file: "Npx" or scene units
+  bool wireframe = false;          ///< triangle edges drawn over the image and in a wireframe layer
+  std::string wireframe_nodes;     ///< comma-separated node names or indices; empty: every node
+  float wireframe_width = 1;       ///< pixels
+  std::string wireframe_color = "0,0,0";  ///< linear RGB "r,g,b"
+  std::string wireframe_hidden = "off";   ///< edges behind surfaces: off, dim or dashed
 };
 
 /// The integrators a setting applies to (a bit mask).
@@ -122,6 +129,10 @@ std::set<std::string> check_aovs(const std::vector<std::string>& names, const st
 /// validate on a stand-in size). Throws std::invalid_argument naming the setting as the Python
 /// API spells it.
 void validate(const RenderSpec& spec);
+
+/// The colour wireframe_color names ("r,g,b", finite, >= 0). Throws std::invalid_argument naming
+/// wireframe_color otherwise.
+Vec3f parse_wireframe_color(const std::string& text);
 
 /// The spec with every default resolved for an image whose aspect follows `hint` where the width
 /// or height is open: size, spp, filter and width, depth.

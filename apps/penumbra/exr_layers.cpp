@@ -96,10 +96,11 @@ void add_part_identity(ExrOptions& exr, const RenderJob& job) {
 void add_render_channels(ExrOptions& exr, const RenderJob& job, LayerBuffers& buffers) {
   const RenderImage& image = job.image;
   if (job.request.aovs.count("samples")) buffers.samples.assign(image.samples.begin(), image.samples.end());
-  add_layer_channels(exr, job.request.aovs,
-                     {&buffers.layers.data, &buffers.layers.id_manifest, &buffers.samples, &image.variance,
-                      &image.groups, &buffers.layers.vector, &buffers.layers.velocity, &image.halves},
-                     job.args.use_float ? ChannelType::Float : ChannelType::Half);
+  add_layer_channels(
+      exr, job.request.aovs,
+      {&buffers.layers.data, &buffers.layers.id_manifest, &buffers.samples, &image.variance, &image.groups,
+       &buffers.layers.vector, &buffers.layers.velocity, &image.halves, &buffers.layers.wireframe},
+      job.args.use_float ? ChannelType::Float : ChannelType::Half);
   if (job.request.cost_aov) {
     if (buffers.layers.cost.counted) {
       exr.extra.push_back({"cost_nodes.X", &buffers.layers.cost.nodes});

@@ -39,6 +39,9 @@ std::string describe_shape(const Shape& sh) {
     case ShapeKind::Capsule:
       std::snprintf(buf, sizeof buf, "(radius %.4g, height %.4g)", sh.radius, 2 * sh.half_height);
       break;
+    case ShapeKind::Segment:
+      std::snprintf(buf, sizeof buf, "(radius %.4g, length %.4g)", sh.radius, length(sh.p1 - sh.p0));
+      break;
     case ShapeKind::Implicit:
       std::snprintf(buf, sizeof buf, "(%zu CSG node%s)", sh.sdf.nodes.size(),
                     sh.sdf.nodes.size() == 1 ? "" : "s");
@@ -249,7 +252,8 @@ nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loa
                     {"world_space", s.instances.size() - placed},
                     {"placed", placed},
                     {"triangles", count_triangles(s)},
-                    {"points", count_points(s)}};
+                    {"points", count_points(s)},
+                    {"line_segments", count_line_segments(s)}};
   std::vector<size_t> shape_uses(s.shapes.size(), 0);
   for (const Instance& inst : s.instances)
     if (inst.shape >= 0) ++shape_uses[size_t(inst.shape)];
@@ -479,8 +483,15 @@ int run_info(const InfoArgs& a) {
               s.instances.size(), s.instances.size() - placed, placed,
               static_cast<unsigned long long>(count_triangles(s)));
   if (const uint64_t points = count_points(s))
-    std::printf("point sets   %llu points (glTF POINTS: answered by penumbra query, not rendered)\n",
-                static_cast<unsigned long long>(points));
+    std::printf(
+        "points       %llu (glTF POINTS: rendered as spheres of --point-size unless the file sizes "
+        "them; point files: for penumbra query)\n",
+        static_cast<unsigned long long>(points));
+  if (const uint64_t segments = count_line_segments(s))
+    std::printf(
+        "lines        %llu segments (glTF LINES, LINE_LOOP, LINE_STRIP: rendered as capsules of "
+        "--line-width unless the file sizes them)\n",
+        static_cast<unsigned long long>(segments));
   print_shapes(s, i);
   std::printf("materials    %zu\n", s.materials.size());
   for (size_t k = 0; k < s.materials.size(); ++k) {

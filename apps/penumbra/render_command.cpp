@@ -393,6 +393,7 @@ void write_phase(RenderJob& job) {
   const auto t0 = Clock::now();
   LayerBuffers buffers;
   buffers.layers = render_layers(job.loaded, job.structure.accel.get(), job.prepared);
+  overlay_wireframe(job.image, buffers.layers, job.prepared);
   // An interrupted render keeps its flat image so far; its deep image is traced once it completes.
   const bool deep_now = q.deep && !job.interrupted;
   const auto deep_t0 = Clock::now();

@@ -39,6 +39,7 @@ std::vector<std::string> supported_gltf_extensions() {
   out.push_back("KHR_texture_basisu");
   out.push_back(gltf::kShapesExtension);
   out.push_back(gltf::kProceduralExtension);
+  out.push_back(gltf::kPointsExtension);
   return out;
 }
 

@@ -97,6 +97,23 @@ std::vector<uint32_t> triangle_list(const GltfContext& ctx, const tinygltf::Prim
     ctx.charge(uint64_t(raw.size()) * 12, where, "a point set's degenerate triangles need");
     tris.reserve(raw.size() * 3);
     for (uint32_t i : raw) tris.insert(tris.end(), {i, i, i});
+  } else if (prim.mode >= 1 && prim.mode <= 3) {
+    // LINES pairs its indices; LINE_STRIP joins each to the next; LINE_LOOP closes the strip.
+    const char* kind = prim.mode == 1 ? "LINES" : (prim.mode == 2 ? "LINE_LOOP" : "LINE_STRIP");
+    const std::string count = std::to_string(raw.size()) + (prim.indices >= 0 ? " indices" : " vertices");
+    if (prim.mode == 1 && raw.size() % 2)
+      ctx.fail(where, std::string(kind) + " with an odd count (" + count + "): every segment needs two");
+    if (prim.mode != 1 && raw.size() == 1)
+      ctx.fail(where, std::string(kind) + " with one vertex: a line needs at least two");
+    const size_t segments =
+        prim.mode == 1 ? raw.size() / 2 : (raw.size() < 2 ? 0 : raw.size() - 1 + (prim.mode == 2 ? 1 : 0));
+    ctx.charge(uint64_t(segments) * 12, where, "a line set's segments need");
+    tris.reserve(segments * 3);
+    for (size_t s = 0; s < segments; ++s) {
+      const uint32_t a = prim.mode == 1 ? raw[2 * s] : raw[s];
+      const uint32_t b = prim.mode == 1 ? raw[2 * s + 1] : raw[(s + 1) % raw.size()];
+      tris.insert(tris.end(), {a, b, b});
+    }
   } else {
     for (size_t i = 1; i + 1 < raw.size(); ++i) tris.insert(tris.end(), {raw[i], raw[i + 1], raw[0]});
   }
@@ -256,21 +273,47 @@ void convert_surface_attributes(const GltfContext& ctx, const RawAttributes& raw
   }
 }
 
+// The radii of a point or line primitive from PENUMBRA_points: half the per-vertex "_WIDTH"
+// attribute, else half the extension's "width" for every vertex; empty without either.
+std::vector<float> read_widths(const GltfContext& ctx, const tinygltf::Primitive& prim,
+                               const std::string& where, size_t nv) {
+  std::vector<float> radii;
+  if (auto it = prim.attributes.find("_WIDTH"); it != prim.attributes.end()) {
+    const std::string at = where + ".attributes._WIDTH";
+    const std::vector<double> w =
+        read_accessor(ctx, it->second, at, {TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
+    if (w.size() != nv) ctx.fail(at, "count differs from POSITION count");
+    radii.resize(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      if (!(w[i] > 0) || !std::isfinite(w[i]) || w[i] > 1e18)
+        ctx.fail(at, "width " + std::to_string(w[i]) + " of vertex " + std::to_string(i) +
+                         " is not a finite positive number");
+      radii[i] = float(w[i] / 2);
+    }
+    return radii;
+  }
+  const auto ext = prim.extensions.find(kPointsExtension);
+  if (ext == prim.extensions.end()) return radii;
+  const std::string at = where + ".extensions." + kPointsExtension;
+  if (!ext->second.IsObject()) ctx.fail(at, "not an object");
+  for (const std::string& key : ext->second.Keys())
+    if (key != "width") ctx.fail(at, "unknown key '" + key + "' (known: width)");
+  if (!ext->second.Has("width")) return radii;
+  const tinygltf::Value& v = ext->second.Get("width");
+  const double w = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+  if (!(w > 0) || !std::isfinite(w) || w > 1e18) ctx.fail(at + ".width", "not a finite positive number");
+  radii.assign(nv, float(w / 2));
+  return radii;
+}
+
 LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_t pi) {
   const auto& prim = ctx.model.meshes[mesh_index].primitives[pi];
   const std::string where = idx("meshes", mesh_index) + "." + idx("primitives", pi);
   LocalPrimitive out;
   // Mode and material.
-  if (prim.mode >= 1 && prim.mode <= 3) {
-    ctx.warn(where, "lines primitive (mode " + std::to_string(prim.mode) + ") skipped");
-    return out;
-  }
-  if (prim.mode == 0) {
-    out.points = true;
-    ctx.warn(where,
-             "POINTS primitive (mode 0): a point set for spatial queries (penumbra query), not rendered");
-  }
   if (prim.mode < 0 || prim.mode > 6) ctx.fail(where, "invalid mode " + std::to_string(prim.mode));
+  out.points = prim.mode == 0;
+  out.lines = prim.mode >= 1 && prim.mode <= 3;
   if (prim.material < -1 || prim.material >= int(ctx.model.materials.size()))
     ctx.fail(where + ".material", "material index " + std::to_string(prim.material) + " out of range (" +
                                       std::to_string(ctx.model.materials.size()) + " materials)");
@@ -278,6 +321,9 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   // Positions, then indices and topology, then the other attributes.
   const auto pos_it = prim.attributes.find("POSITION");
   if (pos_it == prim.attributes.end()) {
+    if (out.points || out.lines)
+      ctx.fail(where,
+               std::string(out.points ? "POINTS" : "a lines primitive") + " without a POSITION attribute");
     ctx.warn(where, "no POSITION attribute; skipped");
     return out;
   }
@@ -291,8 +337,10 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   if (nv >= 0xffffffffu) ctx.fail(where, "too many vertices");
   out.indices = triangle_list(ctx, prim, where, nv);
   read_vertex_attributes(ctx, prim, where, nv, raw);
+  if (out.points || out.lines) out.radii = read_widths(ctx, prim, where, nv);
   if (out.indices.empty()) {
-    ctx.warn(where, out.points ? "no points; skipped" : "no triangles; skipped");
+    ctx.warn(where,
+             out.points ? "no points; skipped" : (out.lines ? "no lines; skipped" : "no triangles; skipped"));
     return out;
   }
   // Validation and conversion.
@@ -386,6 +434,22 @@ void add_tangents(const GltfContext& ctx, const LocalPrimitive& local, const Tra
   }
 }
 
+// The material points and lines without NORMAL render with: the glTF spec (3.7.2.1) has them
+// unlit, base colour (times COLOR_0) only. An unlit copy of `material` (the default material for
+// -1), made once per material.
+int unlit_material(const GltfContext& ctx, int material) {
+  auto& materials = ctx.out.scene.materials;
+  const std::string name = (material >= 0 ? materials[size_t(material)].name : std::string("default")) +
+                           " (points and lines without normals: unlit)";
+  for (size_t i = 0; i < materials.size(); ++i)
+    if (materials[i].unlit && materials[i].name == name) return int(i);
+  Material m = material >= 0 ? materials[size_t(material)] : Material{};
+  m.name = name;
+  m.unlit = true;
+  materials.push_back(std::move(m));
+  return int(materials.size() - 1);
+}
+
 // One usable primitive placed by `world` (or skinned), as a Mesh; false if its world-space
 // positions are not usable (warned about).
 bool place_primitive(const GltfContext& ctx, const LocalPrimitive& local, const Emit& e, size_t pi,
@@ -397,8 +461,16 @@ bool place_primitive(const GltfContext& ctx, const LocalPrimitive& local, const 
              "a placed copy needs");
   out.name = (mesh.name.empty() ? idx("meshes", size_t(e.mesh)) : mesh.name) + "[" + std::to_string(pi) + "]";
   out.node = e.node;
-  out.material = local.material;
+  out.material = (local.points || local.lines) && local.normals.empty() ? unlit_material(ctx, local.material)
+                                                                        : local.material;
   out.points = local.points;
+  out.lines = local.lines;
+  if (!local.radii.empty()) {  // the file's sizes, scaled as the placement scales lengths
+    const float scale = float(std::cbrt(std::fabs(determinant3x3(world))));
+    out.radii.resize(local.radii.size());
+    for (size_t i = 0; i < local.radii.size(); ++i) out.radii[i] = local.radii[i] * scale;
+    out.file_radii = true;
+  }
   std::vector<Vec3f> lp, ln;
   morph(local, *e.morph, lp, ln);
   const bool skinned = !e.joint_mats->empty() && !local.joints.empty();

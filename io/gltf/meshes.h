@@ -31,8 +31,10 @@ struct LocalPrimitive {
   std::vector<std::array<uint16_t, 4>> joints;                       ///< JOINTS_0 (skinning), empty if absent
   std::vector<Vec4f> weights;                                        ///< WEIGHTS_0
   int material = -1;
-  bool points = false;  ///< POINTS: one degenerate triangle (i, i, i) per point (Mesh::points)
-  bool usable = false;  ///< false: skipped with a warning
+  bool points = false;       ///< POINTS: one degenerate triangle (i, i, i) per point (Mesh::points)
+  bool lines = false;        ///< LINES, LINE_LOOP, LINE_STRIP: one (a, b, b) per segment (Mesh::lines)
+  std::vector<float> radii;  ///< points and lines: the file's radii (PENUMBRA_points), else empty
+  bool usable = false;       ///< false: skipped with a warning
 };
 
 /// The number of placements EXT_mesh_gpu_instancing declares on `node`: the largest count of its
@@ -45,10 +47,17 @@ uint64_t declared_placements(const GltfContext& ctx, int node);
 /// Throws InputError naming the attribute for malformed instance data.
 std::vector<Transform> placements_of(const GltfContext& ctx, int node, const Transform& world);
 
-/// Every primitive of every mesh, [mesh][primitive]. POINTS become point sets (Mesh::points).
-/// Lines, primitives without
-/// POSITION or triangles, and NaN positions are kept unusable with a warning; malformed
-/// accessors, modes, materials and attribute counts throw InputError naming the primitive.
+/// The primitive extension giving points and lines their size: {"width": w > 0} in the mesh's
+/// units (a point's diameter, a line's width), or per vertex in a SCALAR float attribute
+/// "_WIDTH" (> 0), which wins.
+inline constexpr const char* kPointsExtension = "PENUMBRA_points";
+
+/// Every primitive of every mesh, [mesh][primitive]. POINTS become point sets (Mesh::points),
+/// LINES, LINE_LOOP and LINE_STRIP line sets (Mesh::lines), with the file's radii if it gives
+/// them. Triangle primitives without POSITION or triangles, and NaN positions are kept unusable
+/// with a warning; malformed accessors, modes, materials, attribute counts, widths, a LINES
+/// index count that is odd, a strip or loop of one vertex, and points or lines without POSITION
+/// throw InputError naming the primitive.
 std::vector<std::vector<LocalPrimitive>> decode_meshes(const GltfContext& ctx);
 
 /// Places the mesh of every use (in order) into ctx.out.scene. A mesh placed more than once, or

@@ -237,6 +237,7 @@ void ShapeReader::analytic(const json& ext, const std::string& where, Shape& sha
       shape.half_height = number_or(ext, "height", where, 1, Bound::NonNegative) / 2;
       break;
     case ShapeKind::Implicit:
+    case ShapeKind::Segment:
       break;
   }
 }

@@ -18,14 +18,27 @@
 
 namespace penumbra {
 
-/// A read-only view of one geometry: a triangle mesh, or (when `shape` is set) one shape, which
-/// is a single primitive. geom_id in a Hit is the index of the view in the span given to the
-/// builder; prim_id is the triangle index within a mesh and 0 for a shape (whose Hit u, v are 0).
-/// Builders copy the shape; the mesh arrays are copied by every back end but brute force.
+/// What the triangles of a curve set view stand for (GeometryView::curves).
+enum class CurveKind : uint8_t {
+  None,      ///< triangles
+  Points,    ///< each triangle (i, i, i) is a sphere of radius radii[i] about positions[i]
+  Segments,  ///< each triangle (a, b, b) is a capsule of radius (radii[a] + radii[b]) / 2 about
+             ///< the segment positions[a]-positions[b] (round linear curve with constant radius)
+};
+
+/// A read-only view of one geometry: a triangle mesh, a curve set (`curves` not None: its
+/// degenerate triangles are points or line segments with radii), or (when `shape` is set) one
+/// shape, which is a single primitive. geom_id in a Hit is the index of the view in the span
+/// given to the builder; prim_id is the triangle index within a mesh or a curve set and 0 for a
+/// shape (Hit u, v are 0 for both curve elements and shapes). Builders copy the shape and the
+/// curve elements (as Segment shapes); the mesh arrays are copied by every back end but brute
+/// force.
 struct GeometryView {
   std::span<const Vec3f> positions;
-  std::span<const uint32_t> indices;  ///< 3 per triangle, each < positions.size()
-  const Shape* shape = nullptr;       ///< a shape instead of triangles (positions, indices unused)
+  std::span<const uint32_t> indices;   ///< 3 per triangle, each < positions.size()
+  const Shape* shape = nullptr;        ///< a shape instead of triangles (positions, indices unused)
+  CurveKind curves = CurveKind::None;  ///< the triangles stand for points or segments
+  std::span<const float> radii;        ///< curves: one radius (>= 0) per position
   /// Deformation motion blur: `motion_steps` >= 2 copies of the positions (step after step,
   /// motion_steps x positions.size() entries) spread evenly over Ray::time 0 to 1, each vertex
   /// linearly interpolated between the two steps around a ray's time (interpolate_vertex). 0 (and
@@ -34,7 +47,9 @@ struct GeometryView {
   std::span<const Vec3f> motion_positions;
   uint32_t motion_steps = 0;
 
-  bool deforms() const { return motion_steps >= 2 && !shape; }
+  bool deforms() const { return motion_steps >= 2 && !shape && curves == CurveKind::None; }
+  /// Curve elements (points or segments) of a curve set view; 0 otherwise.
+  size_t curve_count() const { return curves == CurveKind::None || shape ? 0 : indices.size() / 3; }
 };
 
 /// One placement of a geometry: the mesh's triangles (or the shape) mapped by `to_world` (object
@@ -187,6 +202,15 @@ class RegionVisitor {
   /// than once for one primitive. Never throws.
   virtual void visit(uint32_t geom_id, uint32_t prim_id, QueryRegion& region) = 0;
 };
+
+/// Element `i` of a curve set view as the Segment shape every back end tests (a sphere for a
+/// point); its radius is not finite or negative, and it is never hit, when the radii say so.
+inline Shape curve_element(const GeometryView& v, size_t i) {
+  const uint32_t a = v.indices[3 * i], b = v.indices[3 * i + 1];
+  const float r = v.curves == CurveKind::Points ? v.radii[a] : 0.5f * (v.radii[a] + v.radii[b]);
+  return make_segment_shape(v.positions[a], v.curves == CurveKind::Points ? v.positions[a] : v.positions[b],
+                            r, uint32_t(i));
+}
 
 /// Most hits of one shape a filtered query tests along a ray before giving up on it.
 inline constexpr int kMaxShapeCrossings = 1024;

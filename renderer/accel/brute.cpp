@@ -8,6 +8,11 @@
 namespace penumbra {
 namespace {
 
+// The elements of a curve set view that have radii (none without).
+size_t curve_elements(const GeometryView& m) {
+  return m.radii.size() < m.positions.size() ? 0 : m.curve_count();
+}
+
 class BruteAccelerator final : public Accelerator {
  public:
   explicit BruteAccelerator(std::span<const GeometryView> meshes) : m_meshes(meshes.begin(), meshes.end()) {
@@ -16,6 +21,14 @@ class BruteAccelerator final : public Accelerator {
         const Bounds3f b = shape_bounds(*m.shape);
         if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) m_bounds = merge(m_bounds, b);
         ++m_shapes;
+        continue;
+      }
+      if (m.curves != CurveKind::None) {
+        m_shapes += m.curve_count();
+        for (size_t i = 0; i < curve_elements(m); ++i) {
+          const Bounds3f b = shape_bounds(curve_element(m, i));
+          if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) m_bounds = merge(m_bounds, b);
+        }
         continue;
       }
       for (Vec3f p : m.positions) m_bounds = merge(m_bounds, p);
@@ -50,6 +63,14 @@ class BruteAccelerator final : public Accelerator {
       const auto& m = m_meshes[g];
       if (m.shape) {
         if (region_meets(region, shape_bounds(*m.shape))) visitor.visit(g, 0, region);
+        continue;
+      }
+      if (m.curves != CurveKind::None) {
+        for (size_t i = 0; i < curve_elements(m); ++i) {
+          const Bounds3f b = shape_bounds(curve_element(m, i));
+          if (is_finite(b.lo) && is_finite(b.hi) && region_meets(region, b))
+            visitor.visit(g, uint32_t(i), region);
+        }
         continue;
       }
       for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
@@ -95,6 +116,23 @@ class BruteAccelerator final : public Accelerator {
           tfar = sh.t;
           hit = {sh.t, 0, 0, g, 0};
           if (any_hit) return true;
+        }
+        continue;
+      }
+      if (m.curves != CurveKind::None) {
+        for (size_t i = 0; i < curve_elements(m); ++i) {
+          const Shape s = curve_element(m, i);
+          const Bounds3f b = shape_bounds(s);
+          if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) continue;
+          Ray r = ray;
+          r.tfar = tfar;
+          ShapeHit sh;
+          const auto accept = [&](float t) { return !filter || (*filter)(ray, Hit{t, 0, 0, g, s.element}); };
+          if (intersect_shape_accepted(s, r, accept, sh, cost)) {
+            tfar = sh.t;
+            hit = {sh.t, 0, 0, g, s.element};
+            if (any_hit) return true;
+          }
         }
         continue;
       }

@@ -872,7 +872,7 @@ class BspAccelerator final : public TraversalAccelerator<BspAccelerator> {
     for (uint32_t i = 0, n = node.count(); i < n; ++i) {
       const PrimitiveRecord& rec = recs[i];
       if (region_meets(region, primitive_bounds(rec)))
-        visitor.visit(rec.geom_id, is_shape(rec) ? 0 : rec.prim_id, region);
+        visitor.visit(rec.geom_id, record_prim_id(rec, m_shapes.data()), region);
     }
   }
 

@@ -107,7 +107,7 @@ std::vector<uint32_t> first_triangles(std::span<const GeometryView> views) {
   uint64_t n = 0;
   for (size_t g = 0; g < views.size(); ++g) {
     first[g] = uint32_t(n);
-    if (!views[g].shape) n += views[g].indices.size() / 3;
+    if (!views[g].shape && views[g].curves == CurveKind::None) n += views[g].indices.size() / 3;
     if (n >= kShapeBit) throw std::invalid_argument("bvh: more than 2^31 - 1 triangles");
   }
   first[views.size()] = uint32_t(n);
@@ -144,6 +144,8 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
   /// leaf that holds it, which still contains its parts) and the SAH statistics.
   bool refit(std::span<const GeometryView> views) override {
     if (!m_complete || views.size() != m_view_prims.size()) return false;
+    for (const GeometryView& v : views)  // records are one per view or per triangle
+      if (v.curves != CurveKind::None) return false;
     std::vector<uint32_t> start(views.size());  // index of view g's first record
     uint32_t n = 0;
     for (size_t g = 0; g < views.size(); ++g) {
@@ -180,7 +182,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
     walk_region_binary(m_nodes, region, cost, [&](uint32_t first, uint32_t count) {
       for (uint32_t i = first, e = first + count; i < e; ++i) {
         const PrimitiveRecord& r = m_tris[i];
-        visitor.visit(r.geom_id, is_shape(r) ? 0 : r.prim_id, region);
+        visitor.visit(r.geom_id, record_prim_id(r, m_shapes.data()), region);
       }
     });
   }
@@ -300,7 +302,7 @@ class BvhAccelerator final : public TraversalAccelerator<BvhAccelerator> {
       for (int l = 0; l < 4; ++l) {
         if (blocks[k].id[l] == kEmptyLane) continue;
         const PrimitiveRecord r = m_ids.record(blocks[k], l);
-        visitor.visit(r.geom_id, is_shape(r) ? 0 : r.prim_id, region);
+        visitor.visit(r.geom_id, record_prim_id(r, m_shapes.data()), region);
       }
   }
 

@@ -4,6 +4,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <stdexcept>
+
 namespace penumbra {
 
 std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> views,
@@ -15,16 +17,30 @@ std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> vie
     offset[g + 1] = offset[g] + (views[g].shape ? 1 : views[g].indices.size() / 3);
   std::vector<PrimitiveRecord> records(offset.back());
   std::vector<uint8_t> keep(records.size(), 1);
+  auto add_shape = [&](size_t at, uint32_t g, const Shape& s) {
+    const Bounds3f b = shape_bounds(s);
+    if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) {
+      keep[at] = 0;
+      return;
+    }
+    records[at] = {b.lo, b.hi, Vec3f{}, g, kShapeBit | uint32_t(shapes.size())};
+    shapes.push_back(s);
+  };
   for (uint32_t g = 0; g < views.size(); ++g) {
     const auto& m = views[g];
     if (m.shape) {
-      const Bounds3f b = shape_bounds(*m.shape);
-      if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) {
-        keep[offset[g]] = 0;
+      add_shape(offset[g], g, *m.shape);
+      continue;
+    }
+    if (m.curves != CurveKind::None) {
+      if (m.radii.size() < m.positions.size()) {  // no radii: nothing to hit
+        std::fill(keep.begin() + ptrdiff_t(offset[g]), keep.begin() + ptrdiff_t(offset[g + 1]), 0);
         continue;
       }
-      records[offset[g]] = {b.lo, b.hi, Vec3f{}, g, kShapeBit | uint32_t(shapes.size())};
-      shapes.push_back(*m.shape);
+      if (shapes.size() + m.curve_count() >= kShapeBit)
+        throw std::invalid_argument("more than 2^31 - 1 shapes");
+      shapes.reserve(shapes.size() + m.curve_count());
+      for (size_t i = 0; i < m.curve_count(); ++i) add_shape(offset[g] + i, g, curve_element(m, i));
       continue;
     }
     const size_t n = offset[g + 1] - offset[g];

@@ -44,15 +44,21 @@ std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> vie
 inline uint64_t count_input_triangles(std::span<const GeometryView> views) {
   uint64_t n = 0;
   for (const auto& m : views)
-    if (!m.shape) n += m.indices.size() / 3;
+    if (!m.shape && m.curves == CurveKind::None) n += m.indices.size() / 3;
   return n;
 }
 
-/// Shapes in `views`.
+/// Shapes in `views`, each element of a curve set counted.
 inline uint64_t count_input_shapes(std::span<const GeometryView> views) {
   uint64_t n = 0;
-  for (const auto& m : views) n += m.shape != nullptr;
+  for (const auto& m : views) n += m.shape != nullptr ? 1 : m.curve_count();
   return n;
+}
+
+/// The prim_id a Hit reports for a record: the triangle's, or the shape's element (0 for a
+/// shape of its own, the index of a curve set's point or segment).
+inline uint32_t record_prim_id(const PrimitiveRecord& r, const Shape* shapes) {
+  return is_shape(r) ? shapes[r.prim_id & ~kShapeBit].element : r.prim_id;
 }
 
 /// The box a builder sees for a primitive: the triangle's vertices, or the shape's bounds.
@@ -147,10 +153,11 @@ inline bool intersect_leaf(const Ray& ray, const WatertightRay& w, const Primiti
     Ray r = ray;
     r.tfar = tfar;
     ShapeHit sh;
-    const auto accept = [&](float t) { return filter(ray, Hit{t, 0, 0, rec.geom_id, 0}); };
-    if (!intersect_shape_accepted(shapes[rec.prim_id & ~kShapeBit], r, accept, sh, cost)) return false;
+    const Shape& shape = shapes[rec.prim_id & ~kShapeBit];
+    const auto accept = [&](float t) { return filter(ray, Hit{t, 0, 0, rec.geom_id, shape.element}); };
+    if (!intersect_shape_accepted(shape, r, accept, sh, cost)) return false;
     tfar = sh.t;
-    hit = {sh.t, 0, 0, rec.geom_id, 0};
+    hit = {sh.t, 0, 0, rec.geom_id, shape.element};
     return true;
   }
   if (cost) ++cost->triangles;

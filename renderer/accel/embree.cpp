@@ -140,12 +140,18 @@ void attach_triangles(RTCScene scene, const GeometryView& mesh, unsigned id) {
   throw_if_error("attaching geometry");
 }
 
-/// Embree's user-geometry callbacks for one Shape (geometryUserPtr), called with one ray at a
-/// time (rtcIntersect1 / rtcOccluded1): bounds, closest hit, any hit, each through the shared
-/// per-kind shape test.
+/// Embree's user-geometry callbacks for an array of Shapes (geometryUserPtr; primitive i is
+/// shape i: one for a shape of its own, a curve set's elements), called with one ray at a time
+/// (rtcIntersect1 / rtcOccluded1): bounds, closest hit, any hit, each through the shared
+/// per-kind shape test. A shape without finite bounds gets an invalid box, which Embree skips.
 void user_shape_bounds(const RTCBoundsFunctionArguments* args) {
-  const Bounds3f b = shape_bounds(*static_cast<const Shape*>(args->geometryUserPtr));
+  const Bounds3f b = shape_bounds(static_cast<const Shape*>(args->geometryUserPtr)[args->primID]);
   RTCBounds* o = args->bounds_o;
+  if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) {
+    o->lower_x = o->lower_y = o->lower_z = kInfinity;
+    o->upper_x = o->upper_y = o->upper_z = -kInfinity;
+    return;
+  }
   o->lower_x = b.lo.x, o->lower_y = b.lo.y, o->lower_z = b.lo.z;
   o->upper_x = b.hi.x, o->upper_y = b.hi.y, o->upper_z = b.hi.z;
 }
@@ -190,8 +196,8 @@ void user_shape_intersect(const RTCIntersectFunctionNArguments* args) {
                            rtcFilterIntersection);
   };
   ShapeHit sh;
-  if (!intersect_shape_accepted(*static_cast<const Shape*>(args->geometryUserPtr), r, accept, sh, nullptr))
-    return;
+  const Shape& shape = static_cast<const Shape*>(args->geometryUserPtr)[args->primID];
+  if (!intersect_shape_accepted(shape, r, accept, sh, nullptr)) return;
   rh->ray.tfar = sh.t;
   rh->hit = shape_candidate(args->geomID, args->primID, args->context);
 }
@@ -205,16 +211,19 @@ void user_shape_occluded(const RTCOccludedFunctionNArguments* args) {
     return offer_shape_hit(args, args->ray, ray->tfar, t, rtcFilterOcclusion);
   };
   ShapeHit sh;
-  if (intersect_shape_accepted(*static_cast<const Shape*>(args->geometryUserPtr), r, accept, sh, nullptr))
-    ray->tfar = -kInfinity;
+  const Shape& shape = static_cast<const Shape*>(args->geometryUserPtr)[args->primID];
+  if (intersect_shape_accepted(shape, r, accept, sh, nullptr)) ray->tfar = -kInfinity;
 }
 
-/// A new user geometry of one primitive over `shape` (which must outlive it), committed and
-/// attached to `scene` as `id`.
-void attach_shape(RTCScene scene, const Shape* shape, unsigned id) {
+/// A new user geometry over `count` shapes from `shapes` (which must outlive it; primitive i is
+/// shape i), committed and attached to `scene` as `id`. A curve set's elements come this way:
+/// Embree 3's own round linear curves join consecutive segments (neighbour flags) and leave out
+/// a segment's starting cap, so they would not be the disjoint capsules of a glTF LINES
+/// primitive; the user geometry tests them by the one exact test every back end shares.
+void attach_shapes(RTCScene scene, const Shape* shapes, size_t count, unsigned id) {
   RTCGeometry geom = rtcNewGeometry(device(), RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, const_cast<Shape*>(shape));
+  rtcSetGeometryUserPrimitiveCount(geom, unsigned(count));
+  rtcSetGeometryUserData(geom, const_cast<Shape*>(shapes));
   rtcSetGeometryBoundsFunction(geom, user_shape_bounds, nullptr);
   rtcSetGeometryIntersectFunction(geom, user_shape_intersect);
   rtcSetGeometryOccludedFunction(geom, user_shape_occluded);
@@ -430,7 +439,7 @@ class EmbreeAccelerator final : public Accelerator {
                                         : "high") +
                (m_world_id != RTC_INVALID_GEOMETRY_ID ? ", identity placements apart" : "");
     s.triangles = m_triangles;
-    s.shapes = m_shapes.size();
+    s.shapes = m_shapes.size() + m_curve_count;
     s.instances = m_instances;
     s.bytes = m_bytes;
     s.build_seconds = m_build_seconds;
@@ -646,6 +655,15 @@ class EmbreeAccelerator final : public Accelerator {
         if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) mesh.prims = 1, mesh.box = b;
         continue;
       }
+      if (view.curves != CurveKind::None) {
+        if (view.radii.size() < view.positions.size() || view.curve_count() == 0) continue;
+        mesh.prims = uint32_t(view.curve_count());
+        for (size_t i = 0; i < view.curve_count(); ++i) {
+          const Bounds3f b = shape_bounds(curve_element(view, i));
+          if (!b.empty() && is_finite(b.lo) && is_finite(b.hi)) mesh.box = merge(mesh.box, b);
+        }
+        continue;
+      }
       const size_t triangles = view.indices.size() / 3;
       if (view.positions.empty() || triangles == 0) continue;
       mesh.prims = uint32_t(triangles);
@@ -841,12 +859,25 @@ class EmbreeAccelerator final : public Accelerator {
     RTCBounds b;
     rtcGetSceneBounds(m_scene, &b);
     m_bounds = Bounds3f{};
-    if (m_triangles + m_shapes.size() > 0)
+    if (m_triangles + m_shapes.size() + m_curve_count > 0)
       m_bounds = {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}};
   }
 
   /// Attaches a view as triangles, or its shape (copied) as user geometry.
   void attach_geometry(RTCScene scene, const GeometryView& view, unsigned id) {
+    if (view.curves != CurveKind::None && !view.shape) {
+      if (view.radii.size() < view.positions.size() || view.curve_count() == 0) {
+        attach_triangles(scene, GeometryView{}, id);
+        return;
+      }
+      auto elements = std::make_unique<std::vector<Shape>>();
+      elements->reserve(view.curve_count());
+      for (size_t i = 0; i < view.curve_count(); ++i) elements->push_back(curve_element(view, i));
+      m_curve_count += elements->size();
+      attach_shapes(scene, elements->data(), elements->size(), id);
+      m_curve_sets.push_back(std::move(elements));
+      return;
+    }
     if (!view.shape) {
       attach_triangles(scene, view, id);
       m_triangles += view.indices.size() / 3;
@@ -858,7 +889,7 @@ class EmbreeAccelerator final : public Accelerator {
       attach_triangles(scene, GeometryView{}, id);
       return;
     }
-    attach_shape(scene, m_shapes.back().get(), id);
+    attach_shapes(scene, m_shapes.back().get(), 1, id);
   }
 
   /// Adds a placed instance's world-to-object map to the reach of Embree's instanced rays.
@@ -964,12 +995,14 @@ class EmbreeAccelerator final : public Accelerator {
   unsigned m_world_id = RTC_INVALID_GEOMETRY_ID;  // the world scene's instance in the top scene, if any
   std::vector<uint32_t> m_world_ids;              // world scene geometry id -> instance index
   std::vector<std::unique_ptr<Shape>> m_shapes;   // the user geometries' shapes (stable addresses)
-  InstanceLayout m_layout;                        // every instance's mesh and kind, as built
-  std::vector<MeshRegion> m_mesh_regions;         // per view: what region queries need of it
-  std::vector<RegionItem> m_region_items;         // instances Embree's query may miss, in BVH leaf order
-  std::vector<BvhNode> m_region_nodes;            // BVH over their world boxes (index_regions)
-  double m_query_scale = 1;      // Embree's query radius per ball radius (similarity_radius_scale)
-  MapRounding m_query_rounding;  // Embree's mapping of the point into instances, in world units
+  std::vector<std::unique_ptr<std::vector<Shape>>> m_curve_sets;  // curve sets' elements, likewise
+  uint64_t m_curve_count = 0;                                     // elements of the curve sets
+  InstanceLayout m_layout;                                        // every instance's mesh and kind, as built
+  std::vector<MeshRegion> m_mesh_regions;                         // per view: what region queries need of it
+  std::vector<RegionItem> m_region_items;  // instances Embree's query may miss, in BVH leaf order
+  std::vector<BvhNode> m_region_nodes;     // BVH over their world boxes (index_regions)
+  double m_query_scale = 1;                // Embree's query radius per ball radius (similarity_radius_scale)
+  MapRounding m_query_rounding;            // Embree's mapping of the point into instances, in world units
   Bounds3f m_bounds;
   double m_inverse_scale = 1;   // largest row sum of |to_object| over placed instances (1: the world)
   double m_inverse_offset = 0;  // largest |translation| of a placed instance's to_object

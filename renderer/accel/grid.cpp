@@ -282,7 +282,7 @@ class GridAccelerator final : public TraversalAccelerator<GridAccelerator> {
     }
     for (uint32_t i = begin, e = m_offsets[c + 1] & kOffsetMask; i < e; ++i) {
       const PrimitiveRecord& rec = m_tris[m_refs[i]];
-      visitor.visit(rec.geom_id, is_shape(rec) ? 0u : rec.prim_id, region);
+      visitor.visit(rec.geom_id, record_prim_id(rec, m_shapes.data()), region);
     }
   }
 

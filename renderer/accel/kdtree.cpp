@@ -300,7 +300,7 @@ class KdTreeAccelerator final : public TraversalAccelerator<KdTreeAccelerator> {
         }
         const PrimitiveRecord* recs = m_tree.leaf_prims.data() + node.prim_offset;
         for (uint32_t i = 0; i < node.count(); ++i)
-          visitor.visit(recs[i].geom_id, is_shape(recs[i]) ? 0u : recs[i].prim_id, region);
+          visitor.visit(recs[i].geom_id, record_prim_id(recs[i], m_shapes.data()), region);
       }
       if (sp == 0) return;
       cur = todo[--sp];

@@ -250,7 +250,7 @@ class OctreeAccelerator final : public TraversalAccelerator<OctreeAccelerator> {
         if (node.leaf()) {
           const PrimitiveRecord* recs = m_tree.leaf_prims.data() + node.index;
           for (uint32_t i = 0; i < node.count; ++i)
-            visitor.visit(recs[i].geom_id, is_shape(recs[i]) ? 0u : recs[i].prim_id, region);
+            visitor.visit(recs[i].geom_id, record_prim_id(recs[i], m_shapes.data()), region);
         } else {
           RegionTodo kids[8];
           const int n = region_children(node, cur, region, kids);

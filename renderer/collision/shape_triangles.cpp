@@ -101,6 +101,20 @@ ShapeTriangles shape_triangles(const Shape& shape, const ShapeTrianglesConfig& c
       return round_shape(shape.radius, 0, config.subdivisions);
     case ShapeKind::Capsule:
       return round_shape(shape.radius, shape.half_height, config.subdivisions);
+    case ShapeKind::Segment: {  // the capsule turned onto the axis p0-p1
+      const Vec3f d = shape.p1 - shape.p0;
+      const float len = length(d);
+      out = round_shape(shape.radius, 0.5 * len, config.subdivisions);
+      const Vec3f a = len > 0 ? d / len : Vec3f{0, 1, 0};
+      Vec3f e1, e2;
+      orthonormal_basis(a, e1, e2);
+      const Vec3f mid = (shape.p0 + shape.p1) * 0.5f;
+      for (Vec3f& q : out.positions) q = mid + e1 * q.x + a * q.y + e2 * q.z;
+      // (e1, a, e2) may be left-handed: keep the faces counter-clockwise seen from outside.
+      if (dot(cross(e1, a), e2) < 0)
+        for (size_t i = 0; i < out.indices.size(); i += 3) std::swap(out.indices[i + 1], out.indices[i + 2]);
+      return out;
+    }
     case ShapeKind::Plane: {
       const float x = shape.half_size.x, z = shape.half_size.z;
       out.positions = {{-x, 0, -z}, {x, 0, -z}, {x, 0, z}, {-x, 0, z}};
@@ -146,6 +160,7 @@ ShapeTrianglesCount shape_triangles_count(const Shape& shape, const ShapeTriangl
       return {8, 12};
     case ShapeKind::Sphere:
     case ShapeKind::Capsule:
+    case ShapeKind::Segment:
       return {faces / 2 + 2, faces};
     case ShapeKind::Plane:
       return {4, 2};

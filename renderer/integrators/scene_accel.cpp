@@ -8,6 +8,10 @@ std::vector<GeometryView> mesh_views(const Scene& scene) {
   views.reserve(scene.meshes.size() + scene.shapes.size());
   for (const auto& m : scene.meshes) {
     views.push_back({m.positions, m.indices});
+    if (renders_as_curves(m)) {
+      views.back().curves = m.points ? CurveKind::Points : CurveKind::Segments;
+      views.back().radii = m.radii;
+    }
     if (m.motion_steps >= 2) {
       views.back().motion_positions = m.motion_positions;
       views.back().motion_steps = m.motion_steps;

@@ -160,11 +160,101 @@ void setup_clipped(const Pipeline& pl, const ClipVertex cv[3], uint32_t instance
   }
 }
 
+/// Sides of the polygon a point is drawn as (its area that of the point's disc).
+constexpr int kPointSides = 16;
+
+/// Triangles each element of a rendered point or line set is drawn with: a segment's quad (2),
+/// a point's polygon fan; 1 for a triangle mesh's triangles.
+uint32_t pieces_per_element(const Mesh& mesh) {
+  if (!renders_as_curves(mesh)) return 1;
+  return mesh.points ? kPointSides - 2 : 2;
+}
+
+/// Triangle `piece` of element `prim` of a rendered point or line set, as clip-space vertices
+/// (barycentrics 0): a segment as a quad facing the viewer, as wide as its capsule and reaching
+/// its radius past each end (square caps); a point as a kPointSides-gon facing the viewer with
+/// the area of its disc. Both lie at the front of the sphere or capsule (the axis moved one
+/// radius towards the eye), where a ray through the axis meets it.
+void curve_piece(const Pipeline& pl, const Instance& inst, const Mesh& mesh, uint32_t prim, uint32_t piece,
+                 ClipVertex cv[3]) {
+  const uint32_t ia = mesh.indices[3 * size_t(prim)], ib = mesh.indices[3 * size_t(prim) + 1];
+  const Transform mv = pl.view.view * to_transform(inst.to_world);
+  const double scale =
+      inst.identity ? 1.0 : std::cbrt(std::fabs(determinant3x3(to_transform(inst.to_world))));
+  auto view_point = [&](Vec3f p, double out[3]) {
+    for (int r = 0; r < 3; ++r)
+      out[r] =
+          mv.m[size_t(r)][0] * p.x + mv.m[size_t(r)][1] * p.y + mv.m[size_t(r)][2] * p.z + mv.m[size_t(r)][3];
+  };
+  double a[3], b[3];
+  view_point(mesh.positions[ia], a);
+  view_point(mesh.positions[mesh.points ? ia : ib], b);
+  const double ra = mesh.radii[ia] * scale, rb = mesh.points ? ra : mesh.radii[ib] * scale;
+  const double r = mesh.points ? ra : 0.5 * (ra + rb);
+  const bool ortho = pl.view.projection.m[3][3] != 0;
+  // Towards the eye from the element's middle.
+  double e[3] = {0, 0, 1};
+  if (!ortho) {
+    const double m[3] = {-(a[0] + b[0]) / 2, -(a[1] + b[1]) / 2, -(a[2] + b[2]) / 2};
+    const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    if (len > 0) e[0] = m[0] / len, e[1] = m[1] / len, e[2] = m[2] / len;
+  }
+  double corner[3][3];
+  if (mesh.points) {
+    // The fan (centre-free): vertices 0, piece + 1, piece + 2 of the polygon.
+    double s[3] = {e[1], -e[0], 0};  // any unit vector across e
+    double sl = std::sqrt(s[0] * s[0] + s[1] * s[1]);
+    if (!(sl > 1e-6)) s[0] = 1, s[1] = 0, sl = 1;
+    s[0] /= sl, s[1] /= sl;
+    const double t[3] = {e[1] * s[2] - e[2] * s[1], e[2] * s[0] - e[0] * s[2], e[0] * s[1] - e[1] * s[0]};
+    const double R = r * std::sqrt(2 * M_PI / (kPointSides * std::sin(2 * M_PI / kPointSides)));
+    const uint32_t k[3] = {0, piece + 1, piece + 2};
+    for (int v = 0; v < 3; ++v) {
+      const double ang = 2 * M_PI * k[v] / kPointSides, c = std::cos(ang) * R, sn = std::sin(ang) * R;
+      for (int i = 0; i < 3; ++i) corner[v][i] = a[i] + e[i] * r + s[i] * c + t[i] * sn;
+    }
+  } else {
+    double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double dl = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (dl > 0) d[0] /= dl, d[1] /= dl, d[2] /= dl;
+    double s[3] = {d[1] * e[2] - d[2] * e[1], d[2] * e[0] - d[0] * e[2], d[0] * e[1] - d[1] * e[0]};
+    double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    if (!(sl > 1e-9)) s[0] = e[1], s[1] = -e[0], s[2] = 0, sl = std::sqrt(e[0] * e[0] + e[1] * e[1]);
+    if (!(sl > 1e-9)) s[0] = 1, s[1] = 0, s[2] = 0, sl = 1;
+    double quad[4][3];
+    for (int i = 0; i < 3; ++i) {
+      const double pa = a[i] - d[i] * r + e[i] * r, pb = b[i] + d[i] * r + e[i] * r, si = s[i] / sl * r;
+      quad[0][i] = pa - si, quad[1][i] = pb - si, quad[2][i] = pb + si, quad[3][i] = pa + si;
+    }
+    const int k[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int v = 0; v < 3; ++v)
+      for (int i = 0; i < 3; ++i) corner[v][i] = quad[k[piece][v]][i];
+  }
+  for (int v = 0; v < 3; ++v) {
+    cv[v] = ClipVertex{};
+    cv[v].p = to_clip(pl.view.projection, corner[v]);
+    cv[v].depth = float(-corner[v][2]);
+  }
+}
+
 /// Clipping and setup of triangle `prim` of mesh instance `instance`, whose vertices the vertex
-/// stage transformed; appends its screen-space triangles to `out`.
+/// stage transformed (or of piece `prim` % pieces of element `prim` / pieces of a point or
+/// line set); appends its screen-space triangles to `out`.
 void setup_source_triangle(const Pipeline& pl, const Vertices& vs, uint32_t instance, uint32_t prim,
                            Kind kind, bool cull, std::vector<SetupTriangle>& out, RasterStats& st) {
   const Instance& inst = pl.scene.instances[instance];
+  const Mesh& mesh = pl.scene.meshes[size_t(inst.mesh)];
+  if (renders_as_curves(mesh)) {
+    const uint32_t pieces = pieces_per_element(mesh), element = prim / pieces;
+    ClipVertex cv[3];
+    curve_piece(pl, inst, mesh, element, prim % pieces, cv);
+    const size_t before = out.size();
+    setup_clipped(pl, cv, instance, element, kind, false, false, out);
+    if (out.size() == before) ++st.culled;
+    ++st.triangles_in;
+    st.triangles_setup += out.size() - before;
+    return;
+  }
   const uint32_t* index = &pl.scene.meshes[size_t(inst.mesh)].indices[size_t(prim) * 3];
   const uint64_t base = vs.first[instance];
   ClipVertex cv[3];
@@ -262,9 +352,11 @@ SetupTriangles setup_triangles(const Pipeline& pl, tbb::task_arena& arena, Raste
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
     if (inst.shape >= 0) continue;
+    const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+    if ((mesh.points || mesh.lines) && !renders_as_curves(mesh)) continue;  // for spatial queries only
     mesh_instances.push_back(uint32_t(i));
     first.push_back(total);
-    total += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
+    total += mesh.indices.size() / 3 * pieces_per_element(mesh);
   }
   // A batch of n source triangles makes at most 7 n setup triangles (a clipped polygon has at
   // most 9 vertices); the ids of every batch and of the shapes fit 32 bits.
@@ -746,7 +838,11 @@ float guard_band(const RasterView& view, const RasterPass& pass) {
 }  // namespace
 
 uint64_t raster_memory_bytes(const Scene& scene, const RasterPass& pass) {
-  const uint64_t tris = count_triangles(scene);
+  uint64_t tris = count_triangles(scene);
+  for (const Instance& inst : scene.instances)
+    if (inst.shape < 0 && renders_as_curves(scene.meshes[size_t(inst.mesh)]))
+      tris += scene.meshes[size_t(inst.mesh)].indices.size() / 3 *
+              pieces_per_element(scene.meshes[size_t(inst.mesh)]);
   const uint64_t samples =
       uint64_t(pass.tile_size) * uint64_t(pass.tile_size) * uint64_t(std::max(1, pass.spp));
   const uint64_t per_sample = sizeof(Vec2f) + sizeof(FixedPoint) + 16 + sizeof(RasterFragment) + 4;

@@ -67,6 +67,62 @@ SurfaceInteraction make_shape_interaction(const Scene& scene, const Instance& in
   return si;
 }
 
+// Element `prim` of a rendered point or line set as the Segment shape the structures test.
+Shape curve_shape(const Mesh& mesh, uint32_t prim) {
+  const uint32_t a = mesh.indices[3 * size_t(prim)], b = mesh.indices[3 * size_t(prim) + 1];
+  const float r = mesh.points ? mesh.radii[a] : 0.5f * (mesh.radii[a] + mesh.radii[b]);
+  return make_segment_shape(mesh.positions[a], mesh.points ? mesh.positions[a] : mesh.positions[b], r, prim);
+}
+
+// A hit on a point's sphere or a segment's capsule: the capsule's normal, the vertex data
+// interpolated along the segment at the nearest axis point (a point's own), no tangents.
+SurfaceInteraction make_curve_interaction(const Scene& scene, const Instance& inst, const Ray& ray,
+                                          const Hit& hit, const WorldTriangle& tri) {
+  const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const Shape shape = curve_shape(mesh, hit.prim_id);
+  SurfaceInteraction si;
+  si.instance = hit.geom_id;
+  si.time = ray.time;
+  si.mesh = uint32_t(inst.mesh);
+  si.prim = hit.prim_id;
+  si.tri = tri;
+  si.material = mesh.material;
+  const Ray obj = to_object_ray(inst, ray);
+  // A hit from a drawn stand-in (the raster preview's quads and polygons lie on the element's
+  // front) moves onto the exact surface where the ray meets it within a diameter.
+  float t = hit.t;
+  Ray probe = obj;
+  probe.tnear = 0;
+  probe.tfar = kInfinity;
+  ShapeHit exact;
+  const float reach = 2 * shape.radius / std::max(length(obj.dir), 1e-30f);
+  if (intersect_shape(shape, probe, exact) && std::fabs(exact.t - t) <= reach) t = exact.t;
+  const Vec3f p = snap_to_shape(shape, obj.org + obj.dir * t);
+  const ShapeSurface surf = shape_surface(shape, p, 1e-4f);
+  si.p = inst.identity ? p : apply_point(inst.to_world, p);
+  Vec3f n = world_normal(inst, surf.n);
+  if (!(dot(n, n) > 0) || !is_finite(n)) n = normalize(-ray.dir);
+  const uint32_t a = tri.index[0], b = tri.index[1];
+  const float s = mesh.points ? 0.0f : surf.uv.x, w = 1 - s;
+  auto lerp2 = [&](const std::vector<Vec2f>& t) -> Vec2f {
+    return {t[a].x * w + t[b].x * s, t[a].y * w + t[b].y * s};
+  };
+  if (mesh.uvs.size() == mesh.positions.size()) si.uv[0] = lerp2(mesh.uvs);
+  if (mesh.uvs1.size() == mesh.positions.size()) si.uv[1] = lerp2(mesh.uvs1);
+  if (mesh.colors.size() == mesh.positions.size()) {
+    const Vec4f ca = mesh.colors[a], cb = mesh.colors[b];
+    si.color = {ca.x * w + cb.x * s, ca.y * w + cb.y * s, ca.z * w + cb.z * s, ca.w * w + cb.w * s};
+  }
+  const Bounds3f box = shape_bounds(shape);
+  const float obj_len = length(obj.dir), scale = obj_len > 0 ? length(ray.dir) / obj_len : 1.0f;
+  const float size = box.empty() ? 0.0f : max_component(box.extent()) * scale;
+  si.spawn_offset = 64 * 0x1p-23f * (max_component(abs(si.p)) + size);
+  si.back_face = dot(n, ray.dir) > 0;
+  if (si.back_face) n = -n;
+  si.ng = si.ns = n;
+  return si;
+}
+
 void shape_differentials(const Scene& scene, SurfaceInteraction& si) {
   Instance posed;
   const Instance& inst = instance_at(scene, si.instance, si.time, posed);
@@ -91,6 +147,11 @@ Vec3f spawn_origin(const SurfaceInteraction& si, Vec3f dir) {
 Vec3f hit_front_normal(const Scene& scene, const Ray& ray, const Hit& hit) {
   Instance posed;
   const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
+  if (inst.shape < 0 && renders_as_curves(scene.meshes[size_t(inst.mesh)])) {
+    const Shape shape = curve_shape(scene.meshes[size_t(inst.mesh)], hit.prim_id);
+    const Ray obj = to_object_ray(inst, ray);
+    return normalize(world_normal(inst, shape_surface(shape, obj.org + obj.dir * hit.t, 1e-4f).n));
+  }
   if (inst.shape < 0) return world_triangle(scene, inst, hit.prim_id, ray.time).ng;
   const SceneShape& ss = scene.shapes[size_t(inst.shape)];
   float world_tol = 0;
@@ -112,6 +173,7 @@ SurfaceInteraction make_interaction(const Scene& scene, const Ray& ray, const Hi
   const Instance& inst = instance_at(scene, hit.geom_id, ray.time, posed);
   if (inst.shape >= 0) return make_shape_interaction(scene, inst, ray, hit);
   const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  if (renders_as_curves(mesh)) return make_curve_interaction(scene, inst, ray, hit, tri);
   const uint32_t i0 = tri.index[0], i1 = tri.index[1], i2 = tri.index[2];
   const float w = 1.0f - hit.u - hit.v;
   SurfaceInteraction si;

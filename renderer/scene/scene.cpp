@@ -1,6 +1,8 @@
 // Scene helpers: instances, bounds, counts, world triangles, normals and tangents.
 #include "renderer/scene/scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -87,8 +89,16 @@ Mesh make_point_set(std::vector<Vec3f> points, std::string name) {
 
 Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   std::vector<Bounds3f> mesh_bounds(scene.meshes.size());
-  for (size_t i = 0; i < scene.meshes.size(); ++i)
-    for (Vec3f p : scene.meshes[i].positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& m = scene.meshes[i];
+    for (Vec3f p : m.positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
+    if (renders_as_curves(m) && !mesh_bounds[i].empty()) {  // spheres and capsules reach past their axes
+      float r = 0;
+      for (float x : m.radii)
+        if (std::isfinite(x)) r = std::max(r, x);
+      mesh_bounds[i] = {mesh_bounds[i].lo - Vec3f{r, r, r}, mesh_bounds[i].hi + Vec3f{r, r, r}};
+    }
+  }
   // Placed meshes: every vertex mapped (exact) while that stays cheap, else the mapped corners
   // of the mesh's box (conservative), so a million placements of a big mesh cost no more
   // than a million boxes.
@@ -106,7 +116,7 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     if (inst.identity) {
       b = merge(b, mesh_bounds[size_t(inst.mesh)]);
-    } else if (exact) {
+    } else if (exact && !renders_as_curves(m)) {
       for (Vec3f p : m.positions) b = merge(b, apply_point(inst.to_world, p));
     } else {
       b = merge(b, transform_bounds(inst.to_world, mesh_bounds[size_t(inst.mesh)]));
@@ -115,20 +125,28 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   return b;
 }
 
-uint64_t count_triangles(const Scene& scene) {
+namespace {
+// Triangles (degenerate ones for point and line sets) of the mesh instances `keep` accepts.
+template <typename Keep>
+uint64_t count_placed(const Scene& scene, Keep keep) {
   uint64_t n = 0;
   for (const Instance& inst : scene.instances)
-    if (inst.shape < 0 && !scene.meshes[size_t(inst.mesh)].points)
+    if (inst.shape < 0 && keep(scene.meshes[size_t(inst.mesh)]))
       n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
   return n;
 }
+}  // namespace
+
+uint64_t count_triangles(const Scene& scene) {
+  return count_placed(scene, [](const Mesh& m) { return !m.points && !m.lines; });
+}
+
+uint64_t count_line_segments(const Scene& scene) {
+  return count_placed(scene, [](const Mesh& m) { return m.lines; });
+}
 
 uint64_t count_points(const Scene& scene) {
-  uint64_t n = 0;
-  for (const Instance& inst : scene.instances)
-    if (inst.shape < 0 && scene.meshes[size_t(inst.mesh)].points)
-      n += scene.meshes[size_t(inst.mesh)].indices.size() / 3;
-  return n;
+  return count_placed(scene, [](const Mesh& m) { return m.points; });
 }
 
 uint64_t count_shape_instances(const Scene& scene) {
@@ -142,7 +160,8 @@ uint64_t scene_memory_bytes(const Scene& scene) {
   uint64_t total = bytes(scene.instances) + bytes(scene.materials) + bytes(scene.lights);
   for (const Mesh& m : scene.meshes)
     total += bytes(m.positions) + bytes(m.normals) + bytes(m.tangents) + bytes(m.uvs) + bytes(m.uvs1) +
-             bytes(m.colors) + bytes(m.indices) + bytes(m.motion_positions) + bytes(m.motion_normals);
+             bytes(m.colors) + bytes(m.indices) + bytes(m.motion_positions) + bytes(m.motion_normals) +
+             bytes(m.radii);
   total += bytes(scene.shapes);
   for (const SceneShape& s : scene.shapes) {
     total += bytes(s.shape.sdf.nodes) + bytes(s.shape.sdf.planes) + bytes(s.shape.sdf.displacements);

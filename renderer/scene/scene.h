@@ -95,6 +95,16 @@ struct Mesh {
   /// that every structure indexes it and the spatial queries measure the points exactly; rays
   /// never hit a degenerate triangle, so it is not rendered.
   bool points = false;
+  /// A line set (glTF LINES, LINE_LOOP, LINE_STRIP): one degenerate triangle (a, b, b) per
+  /// segment a-b, which triangle code never hits and spatial queries measure exactly.
+  bool lines = false;
+  /// Points and lines: one radius (>= 0) per position, in the mesh's space. With radii a point
+  /// set is rendered as spheres and a line set as capsules about its segments (a segment's
+  /// radius is the mean of its ends'); without, they serve spatial queries only.
+  std::vector<float> radii;
+  /// Points and lines: radii the file gave (PENUMBRA_points), kept; false: the render sets them
+  /// from its point size and line width (set_curve_radii).
+  bool file_radii = false;
   int material = -1;  ///< index into Scene::materials, -1 = default material
   int node = -1;      ///< glTF node of a flattened mesh, -1 if shared or not from glTF
   /// For a mesh moved into world space from a node: world -> the node's local frame, the object
@@ -225,6 +235,11 @@ inline int instance_material(const Scene& scene, const Instance& inst) {
 /// Appends a world-space mesh with its identity instance; returns the mesh index.
 int add_world_mesh(Scene& scene, Mesh mesh);
 
+/// A point or line set that is rendered: Mesh::points or Mesh::lines with a radius per position.
+inline bool renders_as_curves(const Mesh& m) {
+  return (m.points || m.lines) && !m.radii.empty() && m.radii.size() == m.positions.size();
+}
+
 /// A point set mesh (Mesh::points) over `points`: one degenerate triangle (i, i, i) per point,
 /// normals +Z, the default material. Requires points.size() < 2^32 / 3.
 Mesh make_point_set(std::vector<Vec3f> points, std::string name);
@@ -236,13 +251,15 @@ Mesh make_point_set(std::vector<Vec3f> points, std::string name);
 Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit = uint64_t(1) << 24);
 /// Shapes rendered: each shape counted once per instance.
 uint64_t count_shape_instances(const Scene& scene);
-/// Triangles rendered: each mesh counted once per instance; point sets (Mesh::points) not.
+/// Triangles rendered: each mesh counted once per instance; point and line sets not.
 uint64_t count_triangles(const Scene& scene);
 /// Triangles stored: each mesh once, a point set's degenerate triangles (one per point) too, as
 /// the acceleration structures store them.
 uint64_t count_stored_triangles(const Scene& scene);
 /// Points of the placed point sets, each counted once per instance.
 uint64_t count_points(const Scene& scene);
+/// Segments of the placed line sets, each counted once per instance.
+uint64_t count_line_segments(const Scene& scene);
 
 /// Bytes held by the scene's arrays (mesh attributes, shapes, instances, texture pyramids), for
 /// memory budgets.

@@ -169,6 +169,12 @@ ShapeVolume shape_volume(const Shape& shape, const VolumeConfig& config) {
       v.volume = pi * r * r * 2.0 * shape.half_height + 4.0 / 3.0 * pi * r * r * r;
       break;
     }
+    case ShapeKind::Segment: {
+      v.closed = true;
+      const double r = shape.radius;
+      v.volume = pi * r * r * double(length(shape.p1 - shape.p0)) + 4.0 / 3.0 * pi * r * r * r;
+      break;
+    }
     case ShapeKind::Plane:
     case ShapeKind::Disk:
       break;

@@ -64,6 +64,37 @@ double intersect_capsule(const DRay& r, double radius, double h) {
   return best;
 }
 
+// The capsule about p0-p1: the ray in a frame whose +Y runs along the axis from its midpoint,
+// then intersect_capsule (a point, p0 == p1, is a sphere: any frame).
+double intersect_segment(const DRay& r, Vec3f p0, Vec3f p1, double radius) {
+  const double mx = 0.5 * (double(p0.x) + p1.x), my = 0.5 * (double(p0.y) + p1.y),
+               mz = 0.5 * (double(p0.z) + p1.z);
+  double ax = double(p1.x) - p0.x, ay = double(p1.y) - p0.y, az = double(p1.z) - p0.z;
+  const double len = std::sqrt(ax * ax + ay * ay + az * az);
+  if (len > 0) {
+    ax /= len, ay /= len, az /= len;
+  } else {
+    ax = 0, ay = 1, az = 0;
+  }
+  // An orthonormal frame (e1, a, e2) about the axis (Duff et al. 2017).
+  const double sign = std::copysign(1.0, az), a = -1 / (sign + az), b = ax * ay * a;
+  const double e1[3] = {1 + sign * ax * ax * a, sign * b, -sign * ax};
+  const double e2[3] = {b, sign + ay * ay * a, -ay};
+  const double o[3] = {r.ox - mx, r.oy - my, r.oz - mz};
+  auto along = [](const double* e, const double* v) { return e[0] * v[0] + e[1] * v[1] + e[2] * v[2]; };
+  const double axis[3] = {ax, ay, az}, d[3] = {r.dx, r.dy, r.dz};
+  const DRay local{along(e1, o),   along(axis, o), along(e2, o), along(e1, d),
+                   along(axis, d), along(e2, d),   r.tmin,       r.tmax};
+  return intersect_capsule(local, radius, 0.5 * len);
+}
+
+// The nearest point of the segment p0-p1 to p, as the parameter from p0 (0) to p1 (1).
+float segment_param(Vec3f p0, Vec3f p1, Vec3f p) {
+  const Vec3f d = p1 - p0;
+  const float dd = dot(d, d);
+  return dd > 0 ? std::clamp(dot(p - p0, d) / dd, 0.0f, 1.0f) : 0.0f;
+}
+
 double intersect_box(const DRay& r, Vec3f half) {
   const double o[3] = {r.ox, r.oy, r.oz}, d[3] = {r.dx, r.dy, r.dz}, hs[3] = {half.x, half.y, half.z};
   double t_in = -kInfinity, t_out = kInfinity;
@@ -283,6 +314,8 @@ const char* shape_kind_name(ShapeKind kind) {
       return "capsule";
     case ShapeKind::Implicit:
       return "implicit";
+    case ShapeKind::Segment:
+      return "segment";
   }
   return "unknown";
 }
@@ -303,6 +336,16 @@ Shape make_implicit_shape(SdfTree tree, const SphereTraceConfig& trace) {
   return s;
 }
 
+Shape make_segment_shape(Vec3f p0, Vec3f p1, float radius, uint32_t element) {
+  Shape s;
+  s.kind = ShapeKind::Segment;
+  s.p0 = p0;
+  s.p1 = p1;
+  s.radius = radius;
+  s.element = element;
+  return s;
+}
+
 Bounds3f shape_bounds(const Shape& s) {
   switch (s.kind) {
     case ShapeKind::Sphere:
@@ -319,6 +362,11 @@ Bounds3f shape_bounds(const Shape& s) {
     }
     case ShapeKind::Implicit:
       return s.sdf_bounds;
+    case ShapeKind::Segment: {
+      if (!(s.radius >= 0)) return {};
+      const Vec3f r{s.radius, s.radius, s.radius};
+      return {min(s.p0, s.p1) - r, max(s.p0, s.p1) + r};
+    }
   }
   return {};
 }
@@ -348,6 +396,9 @@ bool intersect_shape(const Shape& s, const Ray& ray, ShapeHit& hit) {
       break;
     case ShapeKind::Capsule:
       t = intersect_capsule(r, s.radius, s.half_height);
+      break;
+    case ShapeKind::Segment:
+      t = intersect_segment(r, s.p0, s.p1, s.radius);
       break;
     case ShapeKind::Implicit:
       break;
@@ -406,6 +457,14 @@ ShapeSurface shape_surface(const Shape& s, Vec3f p, float h) {
       out.has_uv = true;
       break;
     }
+    case ShapeKind::Segment: {
+      const float u = segment_param(s.p0, s.p1, p);
+      const Vec3f n = p - (s.p0 + (s.p1 - s.p0) * u);
+      out.n = dot(n, n) > 0 ? normalize(n) : Vec3f{0, 1, 0};
+      out.uv = {u, 0};
+      out.has_uv = true;
+      break;
+    }
     case ShapeKind::Implicit:
       out.n = sdf_gradient_normal(s.sdf, p);
       if (!is_finite(out.n) || dot(out.n, out.n) == 0) out.n = sdf_normal(s.sdf, p, h);
@@ -424,6 +483,11 @@ Vec3f snap_to_shape(const Shape& s, Vec3f p) {
     case ShapeKind::Plane:
     case ShapeKind::Disk:
       return {p.x, 0, p.z};
+    case ShapeKind::Segment: {  // radially from the nearest axis point
+      const Vec3f c = s.p0 + (s.p1 - s.p0) * segment_param(s.p0, s.p1, p);
+      const float r = length(p - c);
+      return r > 0 ? c + (p - c) * (s.radius / r) : p;
+    }
     case ShapeKind::Box: {  // onto the face nearest relative to the half extents
       const Vec3f q{std::abs(p.x) / s.half_size.x, std::abs(p.y) / s.half_size.y,
                     std::abs(p.z) / s.half_size.z};

@@ -20,12 +20,14 @@ enum class ShapeKind : uint8_t {
   Box,       ///< |x|, |y|, |z| <= half_size
   Capsule,   ///< points within radius of the segment (0, -half_height, 0)-(0, half_height, 0)
   Implicit,  ///< the zero set of sdf (f < 0 inside), sphere traced
+  Segment,   ///< points within radius of the segment p0-p1 (a sphere about p0 when p1 == p0): one
+             ///< line segment or point of a curve set (GeometryView::curves), in its view's space
 };
 
 /// Number of ShapeKind values.
-inline constexpr int kShapeKindCount = 6;
+inline constexpr int kShapeKindCount = 7;
 
-/// "sphere", "plane", "disk", "box", "capsule", "implicit".
+/// "sphere", "plane", "disk", "box", "capsule", "implicit", "segment".
 const char* shape_kind_name(ShapeKind kind);
 
 /// One shape in its object space. Make implicit shapes with make_implicit_shape() so that
@@ -39,7 +41,14 @@ struct Shape {
   float lipschitz = 1;       ///< Implicit: sdf_lipschitz(sdf)
   Bounds3f sdf_bounds;       ///< Implicit: a box holding every point with f <= 0
   SphereTraceConfig trace;   ///< Implicit: step budget and tolerances
+  Vec3f p0, p1;              ///< Segment: the axis' end points
+  uint32_t element = 0;      ///< the prim_id a hit on it reports: a Segment's index in its curve
+                             ///< set; 0 for a shape of its own
 };
+
+/// A Segment shape: the capsule of `radius` about p0-p1 (a sphere when they are equal) that
+/// reports prim_id `element`.
+Shape make_segment_shape(Vec3f p0, Vec3f p1, float radius, uint32_t element);
 
 /// An implicit shape over `tree` with its Lipschitz bound and bounds computed. The bounds are
 /// empty when the tree's inside is not bounded (a complement or half-space not intersected
@@ -75,7 +84,8 @@ struct ShapeSurface {
   bool has_uv = false;  ///< sphere: (phi / 2 pi, theta / pi) with phi around +Y from +X and
                         ///< theta from +Y, v increasing downwards as glTF images do; plane and disk:
                         ///< (x, z) mapped from [-size, size] to [0, 1]; box: the hit face's two
-                        ///< other axes; capsule: (phi / 2 pi, height); implicit: none
+                        ///< other axes; capsule: (phi / 2 pi, height); segment: (the nearest
+                        ///< axis point's place from p0 (0) to p1 (1), 0); implicit: none
 };
 
 /// The shape's surface data at `p` (a point returned by intersect_shape). Implicit shapes take

@@ -65,6 +65,12 @@ Vec3f closest_point_on_shape(const Shape& s, Vec3f p) {
       const Vec3f axis{0, std::clamp(p.y, -s.half_height, s.half_height), 0};
       return on_ball(axis, s.radius, p);
     }
+    case ShapeKind::Segment: {
+      const Vec3f d = s.p1 - s.p0;
+      const float dd = dot(d, d);
+      const float u = dd > 0 ? std::clamp(dot(p - s.p0, d) / dd, 0.0f, 1.0f) : 0.0f;
+      return on_ball(s.p0 + d * u, s.radius, p);
+    }
     case ShapeKind::Implicit:
       return closest_on_implicit(s, p);
   }

@@ -87,6 +87,8 @@ float shape_area(const Shape& shape) {
       return 8 * (h.x * h.y + h.y * h.z + h.z * h.x);
     case ShapeKind::Capsule:
       return 4 * kPi * r * (shape.half_height + r);
+    case ShapeKind::Segment:
+      return 4 * kPi * r * (0.5f * length(shape.p1 - shape.p0) + r);
     case ShapeKind::Implicit:
       return 0;
   }
@@ -114,6 +116,18 @@ ShapePoint sample_shape_area(const Shape& shape, Vec2f u) {
       return sample_box(shape.half_size, u);
     case ShapeKind::Capsule:
       return sample_capsule(shape.radius, shape.half_height, u);
+    case ShapeKind::Segment: {  // the capsule's sample turned onto the axis p0-p1
+      const Vec3f d = shape.p1 - shape.p0;
+      const float len = length(d);
+      const ShapePoint c = sample_capsule(shape.radius, 0.5f * len, u);
+      const Vec3f a = len > 0 ? d / len : Vec3f{0, 1, 0};
+      Vec3f e1, e2;
+      orthonormal_basis(a, e1, e2);
+      const Vec3f mid = (shape.p0 + shape.p1) * 0.5f;
+      s.p = mid + e1 * c.p.x + a * c.p.y + e2 * c.p.z;
+      s.n = e1 * c.n.x + a * c.n.y + e2 * c.n.z;
+      return s;
+    }
     case ShapeKind::Implicit:
       break;
   }

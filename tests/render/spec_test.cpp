@@ -23,6 +23,18 @@ void perturb(RenderSpec& s, const SpecField& f) {
             s.*member = "3,4";
             return;
           }
+          if (f.name == std::string("point_size") || f.name == std::string("line_width")) {
+            s.*member = "0.25";
+            return;
+          }
+          if (f.name == std::string("wireframe_nodes")) {
+            s.*member = "0,Cube";
+            return;
+          }
+          if (f.name == std::string("wireframe_color")) {
+            s.*member = "1,0.5,0";
+            return;
+          }
           for (const auto& c : f.choices)
             if (c != s.*member && !(f.name == std::string("integrator"))) {
               s.*member = c;
@@ -62,6 +74,34 @@ bool needs_aperture(const SpecField& f) {
 
 }  // namespace
 
+TEST_CASE("spec: point and line sizes and wireframe settings are checked", "[spec]") {
+  RenderSpec s;
+  for (const char* bad : {"0", "-1px", "px", "2 px", "nan", "1e40", "2pxx", ""}) {
+    s.point_size = bad;
+    INFO(bad);
+    CHECK_THROWS_WITH(validate(s), Catch::Contains("point_size"));
+  }
+  s.point_size = "3px";
+  s.line_width = "inf";
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("line_width"));
+  s.line_width = "0.01";
+  CHECK_NOTHROW(validate(s));
+  s.wireframe_width = 3;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe_width needs wireframe"));
+  s.wireframe = true;
+  CHECK_NOTHROW(validate(s));
+  for (const char* bad : {"1,2", "1,2,3,4", "-1,0,0", "a,b,c", "nan,0,0"}) {
+    s.wireframe_color = bad;
+    INFO(bad);
+    CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe_color"));
+  }
+  s.wireframe_color = "0.2,1,0";
+  const Vec3f c = parse_wireframe_color(s.wireframe_color);
+  CHECK((c.x == 0.2f && c.y == 1 && c.z == 0));
+  s.wireframe_hidden = "sometimes";
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe_hidden"));
+}
+
 TEST_CASE("spec: every field has a flag name and a help line", "[spec]") {
   std::set<std::string> names;
   for (const SpecField& f : spec_fields()) {
@@ -84,6 +124,7 @@ TEST_CASE("spec: every identity field changes the identity, the others do not", 
       if (needs_motion_blur(f)) base.motion_blur = true;
       if (f.name == std::string("denoise_main")) base.denoise = true;
       if (f.name == std::string("deep_merge_tolerance")) base.deep = true;
+      if (std::string(f.name).rfind("wireframe_", 0) == 0) base.wireframe = true;
       const RenderSettings reference = render_identity(resolve(base, 1.5f), cam, {});
       RenderSpec changed = base;
       perturb(changed, f);

@@ -271,13 +271,94 @@ TEST_CASE("bad camera and light parameters are errors naming them", "[io][gltf][
   REQUIRE_THROWS_WITH(write_and_load(w, "cam2"), Contains("nodes[0].camera"));
 }
 
-TEST_CASE("points and lines are skipped with a warning and unknown required extensions fail",
+TEST_CASE("every primitive mode loads: LINES, LINE_LOOP, LINE_STRIP as segments, POINTS as points",
           "[io][gltf][quick]") {
+  // Four vertices 0..3; each mode's segments as (a, b, b) triangles, points as (i, i, i).
+  const std::vector<std::pair<int, std::vector<uint32_t>>> modes = {{0, {0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3}},
+                                                                    {1, {0, 1, 1, 2, 3, 3}},
+                                                                    {2, {0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 0, 0}},
+                                                                    {3, {0, 1, 1, 1, 2, 2, 2, 3, 3}}};
+  for (const auto& [mode, expected] : modes) {
+    GltfWriter w;
+    w.node({{"mesh", w.mesh(w.positions(test::quad_positions()), -1, mode)}});
+    const LoadedScene l = write_and_load(w, "mode" + std::to_string(mode));
+    INFO("mode " << mode);
+    REQUIRE(l.scene.meshes.size() == 1);
+    const Mesh& m = l.scene.meshes[0];
+    CHECK(m.points == (mode == 0));
+    CHECK(m.lines == (mode != 0));
+    CHECK(m.indices == expected);
+    CHECK(m.radii.empty());  // sizes come from the render (point_size, line_width)
+    CHECK_FALSE(m.file_radii);
+    // Without NORMAL they are unlit (glTF 3.7.2.1).
+    REQUIRE(m.material >= 0);
+    CHECK(l.scene.materials[size_t(m.material)].unlit);
+    CHECK(count_triangles(l.scene) == 0);
+  }
+}
+
+TEST_CASE("point and line widths from PENUMBRA_points and _WIDTH, scaled by the node", "[io][gltf][quick]") {
+  GltfWriter w;
+  const int mesh = w.mesh(w.positions(test::quad_positions()), -1, 0);
+  w.j["meshes"][size_t(mesh)]["primitives"][0]["extensions"] = {{"PENUMBRA_points", {{"width", 0.5}}}};
+  w.node({{"mesh", mesh}, {"scale", {2, 2, 2}}});
+  LoadedScene l = write_and_load(w, "width");
+  REQUIRE(l.scene.meshes.size() == 1);
+  CHECK(l.scene.meshes[0].file_radii);
+  CHECK(l.scene.meshes[0].radii == std::vector<float>(4, 0.5f));  // half of 0.5, times 2
+  const int widths = w.floats({0.1f, 0.2f, 0.3f, 0.4f}, "SCALAR", 1);
+  w.j["meshes"][size_t(mesh)]["primitives"][0]["attributes"]["_WIDTH"] = widths;
+  l = write_and_load(w, "width_attribute");
+  REQUIRE(l.scene.meshes.size() == 1);
+  CHECK(l.scene.meshes[0].radii == std::vector<float>{0.1f, 0.2f, 0.3f, 0.4f});
+}
+
+TEST_CASE("malformed points and lines are errors naming the primitive", "[io][gltf][hostile][quick]") {
+  {  // LINES with an odd count
+    GltfWriter w;
+    w.node({{"mesh", w.mesh(w.positions({0, 0, 0, 1, 0, 0, 0, 1, 0}), -1, 1)}});
+    REQUIRE_THROWS_WITH(write_and_load(w, "odd"),
+                        Contains("meshes[0].primitives[0]") && Contains("LINES with an odd count"));
+  }
+  for (int mode : {2, 3}) {  // a loop or strip of one vertex
+    GltfWriter w;
+    w.node({{"mesh", w.mesh(w.positions({0, 0, 0}), -1, mode)}});
+    REQUIRE_THROWS_WITH(write_and_load(w, "one" + std::to_string(mode)),
+                        Contains("meshes[0].primitives[0]") && Contains("one vertex"));
+  }
+  {  // POINTS without POSITION
+    GltfWriter w;
+    w.j["meshes"].push_back({{"primitives", {{{"attributes", nlohmann::json::object()}, {"mode", 0}}}}});
+    w.node({{"mesh", 0}});
+    REQUIRE_THROWS_WITH(write_and_load(w, "nopos"),
+                        Contains("meshes[0].primitives[0]") && Contains("without a POSITION"));
+  }
+  for (const nlohmann::json& width : {nlohmann::json(0.0), nlohmann::json(-1.0), nlohmann::json("wide")}) {
+    GltfWriter w;
+    const int mesh = w.mesh(w.positions(test::quad_positions()), -1, 1);
+    w.j["meshes"][size_t(mesh)]["primitives"][0]["extensions"] = {{"PENUMBRA_points", {{"width", width}}}};
+    w.node({{"mesh", mesh}});
+    INFO(width.dump());
+    REQUIRE_THROWS_WITH(write_and_load(w, "width"), Contains("PENUMBRA_points.width"));
+  }
+  {  // an unknown key, a non-positive per-vertex width
+    GltfWriter w;
+    const int mesh = w.mesh(w.positions(test::quad_positions()), -1, 0);
+    w.j["meshes"][size_t(mesh)]["primitives"][0]["extensions"] = {{"PENUMBRA_points", {{"radius", 1}}}};
+    w.node({{"mesh", mesh}});
+    REQUIRE_THROWS_WITH(write_and_load(w, "key"),
+                        Contains("PENUMBRA_points") && Contains("unknown key 'radius'"));
+    w.j["meshes"][size_t(mesh)]["primitives"][0].erase("extensions");
+    w.j["meshes"][size_t(mesh)]["primitives"][0]["attributes"]["_WIDTH"] =
+        w.floats({0.1f, 0.0f, 0.3f, 0.4f}, "SCALAR", 1);
+    REQUIRE_THROWS_WITH(write_and_load(w, "vertex_width"),
+                        Contains("attributes._WIDTH") && Contains("vertex 1"));
+  }
+}
+
+TEST_CASE("unknown required extensions fail", "[io][gltf][quick]") {
   GltfWriter w;
   w.node({{"mesh", w.mesh(w.positions(test::quad_positions()), -1, 1)}});
-  const LoadedScene l = write_and_load(w, "lines");
-  CHECK(l.scene.meshes.empty());
-  REQUIRE_FALSE(l.warnings.empty());
   w.j["extensionsRequired"] = {"EXT_not_a_real_extension"};
   w.j["extensionsUsed"] = {"EXT_not_a_real_extension"};
   REQUIRE_THROWS_WITH(write_and_load(w, "draco"),
