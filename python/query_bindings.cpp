@@ -308,7 +308,8 @@ void bind_queries(py::module_& m, SceneClass& scene) {
         "A Scene of one point set to query (nearest, within, overlap) in every structure: source is an array "
         "of shape (N, 3), or a file: .ply (its vertices; a PLY with faces gives its mesh), .npy (N x 3 "
         "float32 or float64), or text (x y z per line); a file may hold as many points as max_memory bytes "
-        "allow at 160 bytes each (None: half the RAM, as penumbra.load). Point sets are not rendered. Raises "
+        "allow at 160 bytes each (None: half the RAM, as penumbra.load). Rendered, the points are spheres "
+        "of the render's point_size. Raises "
         "penumbra.InputError for a malformed file, ValueError for points that are not finite.");
   const char* answers =
       " Returns a dict of NumPy arrays: distance (float32), point (float32, 3), barycentric (float32, 2: "

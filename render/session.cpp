@@ -244,6 +244,7 @@ PreparedRender prepare_render(LoadedScene& loaded, const RenderSpec& spec, const
   p.camera = view.camera;
   const uint64_t env_budget = o.charge_budget ? o.charge_budget(p.config) : o.env_budget;
   const RenderConfig& cfg = p.config;
+  if (p.spec.wireframe) wireframe_config(p.spec, loaded.info);  // names the nodes before any work
   set_curve_radii(scene, p.camera, cfg.height, parse_curve_size(p.spec.point_size, "point_size"),
                   parse_curve_size(p.spec.line_width, "line_width"));
   set_lens(p, scene, o.scene_file);

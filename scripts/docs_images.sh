@@ -40,6 +40,11 @@ render default-raster scenes/default.gltf --width 480 --integrator raster
 render csg scenes/csg.gltf --width 480
 render spheres scenes/spheres.gltf --width 480 --max-depth 8
 render procedural scenes/procedural.gltf --width 480
+# glTF points and lines (path traced, and the raster preview with the wireframe of the box and
+# the floor, hidden edges dashed).
+render curves-path scenes/curves.gltf --width 480 --integrator path --spp 32
+render curves-wireframe scenes/curves.gltf --width 480 --integrator raster --wireframe \
+  --wireframe-nodes box,floor --wireframe-hidden dashed --wireframe-color 1,0.8,0
 # Depth of field: the focus study focused near and far (cameras).
 render focus-near scenes/focus.gltf --width 320 --integrator path --spp 48 --aperture-radius 0.08 \
   --aperture-blades 6 --focus-distance 3.2

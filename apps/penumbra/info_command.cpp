@@ -483,10 +483,8 @@ int run_info(const InfoArgs& a) {
               s.instances.size(), s.instances.size() - placed, placed,
               static_cast<unsigned long long>(count_triangles(s)));
   if (const uint64_t points = count_points(s))
-    std::printf(
-        "points       %llu (glTF POINTS: rendered as spheres of --point-size unless the file sizes "
-        "them; point files: for penumbra query)\n",
-        static_cast<unsigned long long>(points));
+    std::printf("points       %llu (rendered as spheres of --point-size unless the file sizes them)\n",
+                static_cast<unsigned long long>(points));
   if (const uint64_t segments = count_line_segments(s))
     std::printf(
         "lines        %llu segments (glTF LINES, LINE_LOOP, LINE_STRIP: rendered as capsules of "

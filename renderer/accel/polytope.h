@@ -10,42 +10,14 @@
 #include <span>
 #include <vector>
 
+#include "renderer/core/dvec3.h"
 #include "renderer/core/math.h"
 
 namespace penumbra {
 
-/// A point or vector in double precision. Trivially constructible (uninitialised by default, so
-/// that scratch arrays of points cost nothing): write DVec3{} for zero.
-struct DVec3 {
-  double x, y, z;
-};
-
-inline DVec3 operator+(DVec3 a, DVec3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-inline DVec3 operator-(DVec3 a, DVec3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-inline DVec3 operator*(DVec3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-inline double dot(DVec3 a, DVec3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-inline double length(DVec3 a) {
-  return std::sqrt(dot(a, a));
-}
-
 /// The nearest point of triangle abc to p, by the Voronoi region of p (Ericson, "Real-Time
 /// Collision Detection", 2005, 5.1.5); finite for triangles without area (repeated corners).
 DVec3 closest_on_triangle(DVec3 p, DVec3 a, DVec3 b, DVec3 c);
-inline DVec3 cross(DVec3 a, DVec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline DVec3 to_dvec(Vec3f v) {
-  return {v.x, v.y, v.z};
-}
-
 /// A closed convex polyhedron stored as its faces: convex polygons over a shared vertex list,
 /// each counter-clockwise seen from outside, with its outward unit normal and area. The default
 /// polytope is empty. Planes are (n, k) with n of any non-zero length: dot(n, p) - k >= 0 is the

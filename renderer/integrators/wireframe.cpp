@@ -164,17 +164,21 @@ std::vector<float> render_wireframe(const Scene& scene, const Accelerator& accel
     const Instance& inst = scene.instances[instance];
     const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
     const size_t triangles = mesh.indices.size() / 3;
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, triangles, 256), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t t = r.begin(); t < r.end(); ++t) {
-            const WorldTriangle tri = world_triangle(scene, inst, uint32_t(t));
-            for (int k = 0; k < 3; ++k) {
-              const uint32_t a = tri.index[k], b = tri.index[(k + 1) % 3];
-              if (a == b) continue;
-              draw_edge(scene, pr, centres, wire, instance, a, b, tri.p[k], tri.p[(k + 1) % 3], alpha);
-            }
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 256),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t t = r.begin(); t < r.end(); ++t) {
+                          const WorldTriangle tri = world_triangle(scene, inst, uint32_t(t));
+                          for (int k = 0; k < 3; ++k) {
+                            // Each edge from its lower vertex index: the triangles sharing it dash it alike.
+                            const int k1 = (k + 1) % 3;
+                            const bool up = tri.index[k] < tri.index[k1];
+                            const int i0 = up ? k : k1, i1 = up ? k1 : k;
+                            if (tri.index[i0] == tri.index[i1]) continue;
+                            draw_edge(scene, pr, centres, wire, instance, tri.index[i0], tri.index[i1],
+                                      tri.p[i0], tri.p[i1], alpha);
+                          }
+                        }
+                      });
   }
   return alpha;
 }

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "renderer/core/dvec3.h"
 #include "renderer/materials/material.h"
 #include "renderer/raster/clip.h"
 #include "renderer/raster/edge.h"
@@ -21,7 +22,7 @@ namespace {
 /// How a triangle's fragments are tested.
 enum class Kind : uint8_t { Opaque, Mask, Blend };
 
-/// A triangle after clipping and the viewport map, in screen space (100 bytes).
+/// A triangle after clipping and the viewport map, in screen space (104 bytes).
 struct SetupTriangle {
   int32_t x[3], y[3];  ///< fixed-point raster vertices, ordered so that the area is positive
   float iw[3];         ///< 1 / w of each vertex (perspective-correct interpolation)
@@ -30,6 +31,8 @@ struct SetupTriangle {
   uint32_t instance, prim;
   int32_t px0, py0, px1, py1;  ///< pixels [px0, px1) x [py0, py1) whose samples it may cover
   Kind kind;
+  bool disc = false;  ///< a point's or a segment end's square: (bu, bv) are its local coordinates,
+                      ///< and only samples with bu^2 + bv^2 <= 1 are covered
 };
 
 /// A shape instance, ray-cast over its projected bounds.
@@ -160,81 +163,98 @@ void setup_clipped(const Pipeline& pl, const ClipVertex cv[3], uint32_t instance
   }
 }
 
-/// Sides of the polygon a point is drawn as (its area that of the point's disc).
-constexpr int kPointSides = 16;
-
-/// Triangles each element of a rendered point or line set is drawn with: a segment's quad (2),
-/// a point's polygon fan; 1 for a triangle mesh's triangles.
+/// Triangles each element of a rendered point or line set is drawn with: a point's square (its
+/// disc cut out per sample); a segment's quad and a square at each end; 1 for a triangle
+/// mesh's triangles.
 uint32_t pieces_per_element(const Mesh& mesh) {
   if (!renders_as_curves(mesh)) return 1;
-  return mesh.points ? kPointSides - 2 : 2;
+  return mesh.points ? 2 : 6;
 }
 
-/// Triangle `piece` of element `prim` of a rendered point or line set, as clip-space vertices
-/// (barycentrics 0): a segment as a quad facing the viewer, as wide as its capsule and reaching
-/// its radius past each end (square caps); a point as a kPointSides-gon facing the viewer with
-/// the area of its disc. Both lie at the front of the sphere or capsule (the axis moved one
-/// radius towards the eye), where a ray through the axis meets it.
-void curve_piece(const Pipeline& pl, const Instance& inst, const Mesh& mesh, uint32_t prim, uint32_t piece,
+/// `a` normalised, or `fallback` when it has (almost) no length.
+DVec3 unit_or(DVec3 a, DVec3 fallback) {
+  const double n = length(a);
+  return n > 1e-12 ? a * (1 / n) : fallback;
+}
+
+/// Triangle `piece` (0 or 1) of the quad with corners q[0..3] (counter-clockwise), with each
+/// corner's local coordinates `local` (the disc test's; zero for a segment's body).
+void quad_piece(const DVec3 q[4], const float local[4][2], uint32_t piece, DVec3 out[3],
+                float out_local[3][2]) {
+  const int k[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  for (int v = 0; v < 3; ++v) {
+    out[v] = q[k[piece][v]];
+    out_local[v][0] = local[k[piece][v]][0];
+    out_local[v][1] = local[k[piece][v]][1];
+  }
+}
+
+/// Triangle `piece` of element `prim` of a rendered point or line set, as clip-space vertices,
+/// drawn facing the viewer along the silhouette of the sphere or capsule (so that raster and ray
+/// tracing cover the same samples): a point as the square about its silhouette's disc,
+/// with the square's local coordinates (corners at (+-1, +-1)) in the vertices' barycentrics so
+/// that the fragment stage keeps the samples inside the disc (returns true); a segment as a quad
+/// as wide as its capsule between its ends (false) and such a disc at each end (true): the
+/// capsule's round caps and joints.
+bool curve_piece(const Pipeline& pl, const Instance& inst, const Mesh& mesh, uint32_t prim, uint32_t piece,
                  ClipVertex cv[3]) {
   const uint32_t ia = mesh.indices[3 * size_t(prim)], ib = mesh.indices[3 * size_t(prim) + 1];
   const Transform mv = pl.view.view * to_transform(inst.to_world);
   const double scale =
       inst.identity ? 1.0 : std::cbrt(std::fabs(determinant3x3(to_transform(inst.to_world))));
-  auto view_point = [&](Vec3f p, double out[3]) {
-    for (int r = 0; r < 3; ++r)
-      out[r] =
-          mv.m[size_t(r)][0] * p.x + mv.m[size_t(r)][1] * p.y + mv.m[size_t(r)][2] * p.z + mv.m[size_t(r)][3];
+  auto view_point = [&](Vec3f p) {
+    const auto& m = mv.m;
+    return DVec3{m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+                 m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+                 m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
   };
-  double a[3], b[3];
-  view_point(mesh.positions[ia], a);
-  view_point(mesh.positions[mesh.points ? ia : ib], b);
-  const double ra = mesh.radii[ia] * scale, rb = mesh.points ? ra : mesh.radii[ib] * scale;
-  const double r = mesh.points ? ra : 0.5 * (ra + rb);
+  const DVec3 a = view_point(mesh.positions[ia]), b = view_point(mesh.positions[mesh.points ? ia : ib]);
+  const double r = (mesh.points ? mesh.radii[ia] : 0.5 * (double(mesh.radii[ia]) + mesh.radii[ib])) * scale;
   const bool ortho = pl.view.projection.m[3][3] != 0;
-  // Towards the eye from the element's middle.
-  double e[3] = {0, 0, 1};
-  if (!ortho) {
-    const double m[3] = {-(a[0] + b[0]) / 2, -(a[1] + b[1]) / 2, -(a[2] + b[2]) / 2};
-    const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-    if (len > 0) e[0] = m[0] / len, e[1] = m[1] / len, e[2] = m[2] / len;
-  }
-  double corner[3][3];
-  if (mesh.points) {
-    // The fan (centre-free): vertices 0, piece + 1, piece + 2 of the polygon.
-    double s[3] = {e[1], -e[0], 0};  // any unit vector across e
-    double sl = std::sqrt(s[0] * s[0] + s[1] * s[1]);
-    if (!(sl > 1e-6)) s[0] = 1, s[1] = 0, sl = 1;
-    s[0] /= sl, s[1] /= sl;
-    const double t[3] = {e[1] * s[2] - e[2] * s[1], e[2] * s[0] - e[0] * s[2], e[0] * s[1] - e[1] * s[0]};
-    const double R = r * std::sqrt(2 * M_PI / (kPointSides * std::sin(2 * M_PI / kPointSides)));
-    const uint32_t k[3] = {0, piece + 1, piece + 2};
-    for (int v = 0; v < 3; ++v) {
-      const double ang = 2 * M_PI * k[v] / kPointSides, c = std::cos(ang) * R, sn = std::sin(ang) * R;
-      for (int i = 0; i < 3; ++i) corner[v][i] = a[i] + e[i] * r + s[i] * c + t[i] * sn;
-    }
+  DVec3 corner[3];
+  float local[3][2];
+  const bool disc = mesh.points || piece >= 2;
+  if (disc) {
+    // The sphere's silhouette: the circle where the cone from the eye touches it, r^2 / d in
+    // front of the centre with radius r sqrt(1 - r^2 / d^2) (the centre's plane and r seen
+    // orthographically).
+    const DVec3 c = !mesh.points && piece >= 4 ? b : a;
+    const double d = ortho ? kInfinity : length(c);
+    const DVec3 e = ortho ? DVec3{0, 0, 1} : unit_or(c * -1, DVec3{0, 0, 1});
+    const double k = ortho || !(d > r) ? 0.0 : r / d;
+    const DVec3 s = unit_or(cross(e, DVec3{0, 1, 0}), unit_or(cross(e, DVec3{1, 0, 0}), DVec3{1, 0, 0})) *
+                    (r * std::sqrt(1 - k * k));
+    const DVec3 t = cross(e, s), f = c + e * (r * k);
+    const DVec3 q[4] = {f - s - t, f + s - t, f + s + t, f - s + t};
+    const float lq[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    quad_piece(q, lq, piece % 2, corner, local);
   } else {
-    double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double dl = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (dl > 0) d[0] /= dl, d[1] /= dl, d[2] /= dl;
-    double s[3] = {d[1] * e[2] - d[2] * e[1], d[2] * e[0] - d[0] * e[2], d[0] * e[1] - d[1] * e[0]};
-    double sl = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    if (!(sl > 1e-9)) s[0] = e[1], s[1] = -e[0], s[2] = 0, sl = std::sqrt(e[0] * e[0] + e[1] * e[1]);
-    if (!(sl > 1e-9)) s[0] = 1, s[1] = 0, s[2] = 0, sl = 1;
-    double quad[4][3];
-    for (int i = 0; i < 3; ++i) {
-      const double pa = a[i] - d[i] * r + e[i] * r, pb = b[i] + d[i] * r + e[i] * r, si = s[i] / sl * r;
-      quad[0][i] = pa - si, quad[1][i] = pb - si, quad[2][i] = pb + si, quad[3][i] = pa + si;
+    // The cylinder's silhouette seen from the eye at distance d from the axis: the plane through
+    // the axis facing the eye, r d / sqrt(d^2 - r^2) to each side.
+    const DVec3 axis = unit_or(b - a, DVec3{0, 1, 0}), m = (a + b) * 0.5;
+    DVec3 to_eye = ortho ? DVec3{0, 0, 1} : m * -1;
+    if (!ortho) {  // the part of m -> eye across the axis
+      const double along = to_eye.x * axis.x + to_eye.y * axis.y + to_eye.z * axis.z;
+      to_eye = to_eye - axis * along;
     }
-    const int k[2][3] = {{0, 1, 2}, {0, 2, 3}};
-    for (int v = 0; v < 3; ++v)
-      for (int i = 0; i < 3; ++i) corner[v][i] = quad[k[piece][v]][i];
+    const double d = ortho ? kInfinity : length(to_eye);
+    DVec3 side = cross(axis, unit_or(to_eye, DVec3{0, 0, 1}));
+    if (!(length(side) > 1e-9)) side = cross(DVec3{0, 0, 1}, DVec3{0, 1, 0});  // the axis along the view
+    const double half = ortho || !(d > r) ? r : r * d / std::sqrt(d * d - r * r);
+    side = unit_or(side, DVec3{1, 0, 0}) * half;
+    const DVec3 q[4] = {a - side, b - side, b + side, a + side};
+    const float lq[4][2] = {};
+    quad_piece(q, lq, piece, corner, local);
   }
   for (int v = 0; v < 3; ++v) {
+    const double p[3] = {corner[v].x, corner[v].y, corner[v].z};
     cv[v] = ClipVertex{};
-    cv[v].p = to_clip(pl.view.projection, corner[v]);
-    cv[v].depth = float(-corner[v][2]);
+    cv[v].p = to_clip(pl.view.projection, p);
+    cv[v].depth = float(-corner[v].z);
+    cv[v].b[1] = local[v][0];
+    cv[v].b[2] = local[v][1];
   }
+  return disc;
 }
 
 /// Clipping and setup of triangle `prim` of mesh instance `instance`, whose vertices the vertex
@@ -247,9 +267,10 @@ void setup_source_triangle(const Pipeline& pl, const Vertices& vs, uint32_t inst
   if (renders_as_curves(mesh)) {
     const uint32_t pieces = pieces_per_element(mesh), element = prim / pieces;
     ClipVertex cv[3];
-    curve_piece(pl, inst, mesh, element, prim % pieces, cv);
+    const bool disc = curve_piece(pl, inst, mesh, element, prim % pieces, cv);
     const size_t before = out.size();
     setup_clipped(pl, cv, instance, element, kind, false, false, out);
+    for (size_t i = before; i < out.size(); ++i) out[i].disc = disc;
     if (out.size() == before) ++st.culled;
     ++st.triangles_in;
     st.triangles_setup += out.size() - before;
@@ -713,6 +734,11 @@ class TileRasterizer {
           const double sw = l0 * t.iw[0] + l1 * t.iw[1] + l2 * t.iw[2];
           const float depth = float((l0 * t.dw[0] + l1 * t.dw[1] + l2 * t.dw[2]) / sw);
           if (!closer(depth, index, b.depth[i], b.id[i])) continue;
+          if (t.disc) {  // the disc in its square, in the square's plane (perspective-correct)
+            const double u = (l0 * t.iw[0] * t.bu[0] + l1 * t.iw[1] * t.bu[1] + l2 * t.iw[2] * t.bu[2]) / sw;
+            const double v = (l0 * t.iw[0] * t.bv[0] + l1 * t.iw[1] * t.bv[1] + l2 * t.iw[2] * t.bv[2]) / sw;
+            if (u * u + v * v > 1) continue;
+          }
           if (t.kind == Kind::Mask) {
             const Vec2f uv = source_uv(t, l1, l2);
             const Material& m =

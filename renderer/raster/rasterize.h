@@ -4,8 +4,10 @@
 // a z-buffer of camera samples: a visibility buffer holding, per sample, the nearest surface's
 // instance, triangle and perspective-correct barycentrics, and the Blend surfaces in front of
 // it sorted front to back. Analytic and implicit shapes are ray-cast in the fragment stage
-// over their projected bounds (impostors). Shading is the caller's: the visibility buffer of
-// each tile is handed to a callback. No ray queries against an accelerator, no materials
+// over their projected bounds (impostors); rendered point and line sets as stand-ins facing the
+// viewer on the silhouettes of their spheres and capsules (a disc per point; a quad per segment
+// with a disc at each end), through the same z-buffer and top-left rule. Shading is the caller's: the
+// visibility buffer of each tile is handed to a callback. No ray queries against an accelerator, no materials
 // beyond coverage (alpha test and alpha mode).
 #pragma once
 

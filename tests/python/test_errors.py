@@ -66,11 +66,11 @@ def test_warnings_are_scene_warnings(tmp_path):
     p, i = quad(-1, 1, -1, 1, 0)
     path = write_gltf(tmp_path / "points.gltf", [{"mesh": 0}, {"mesh": 1}], [(p, i, None), (p, i, None)])
     gltf = json.loads(path.read_text())
-    gltf["meshes"][1]["primitives"][0]["mode"] = 0  # points: a point set, with a warning
+    del gltf["meshes"][1]["primitives"][0]["attributes"]["POSITION"]  # skipped, with a warning
     path.write_text(json.dumps(gltf))
     with pytest.warns(penumbra.SceneWarning, match="points.gltf: .*meshes\\[1\\]"):
         scene = penumbra.load(path)
-    assert len(scene.warnings) == 1 and len(scene.instances) == 2 and "POINTS" in scene.warnings[0]
+    assert len(scene.warnings) == 1 and len(scene.instances) == 1 and "POSITION" in scene.warnings[0]
     assert issubclass(penumbra.SceneWarning, UserWarning)
     import warnings
     with warnings.catch_warnings():

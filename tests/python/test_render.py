@@ -444,3 +444,68 @@ def test_vector_layer_follows_the_scenes_time():
     with pytest.warns(RuntimeWarning, match="static pose"):
         still = penumbra.load(SCENES / "flythrough.gltf").render(width=32, height=18, spp=1, aovs=["vector"])
     assert not np.any(still.aovs["vector"])
+
+
+def lines_and_points(path, width=None):
+    """An orthographic camera one unit per pixel on a 40 x 30 image (ymag 15) looking down -Z at a
+    horizontal LINES segment at y = 0.25 (node "line") and a POINTS primitive of one point at
+    (10, 8) (node "dot"); `width` sets the file's PENUMBRA_points width of both."""
+    write_gltf(path,
+               nodes=[{"name": "camera", "camera": 0, "translation": [0, 0, 5]},
+                      {"name": "line", "mesh": 0}, {"name": "dot", "mesh": 1}],
+               meshes=[([[-30, 0.25, 0], [30, 0.25, 0]], [[0, 1]], None), ([[10, 8, 0]], [[0]], None)],
+               cameras=[{"type": "orthographic",
+                         "orthographic": {"xmag": 20, "ymag": 15, "znear": 0.1, "zfar": 100}}])
+    gltf = json.loads(pathlib.Path(path).read_text())
+    gltf["meshes"][0]["primitives"][0]["mode"] = 1
+    gltf["meshes"][1]["primitives"][0]["mode"] = 0
+    if width is not None:
+        for m in gltf["meshes"]:
+            m["primitives"][0]["extensions"] = {"PENUMBRA_points": {"width": width}}
+        gltf["extensionsUsed"] = ["PENUMBRA_points"]
+    pathlib.Path(path).write_text(json.dumps(gltf))
+    return penumbra.load(path)
+
+
+@pytest.mark.parametrize("integrator", ["whitted", "path"])
+def test_lines_and_points_render_at_their_width(tmp_path, integrator):
+    s = lines_and_points(tmp_path / "lp.gltf")
+    r = s.render(width=40, height=30, spp=64, integrator=integrator, filter="box", line_width="3px",
+                 point_size="8px", aovs=["id"])
+    alpha = r.beauty[..., 3]
+    # Away from the point, each column's coverage sums to the line's 3 pixels.
+    columns = alpha[:, :25].sum(axis=0)
+    np.testing.assert_allclose(columns, 3, atol=0.15)
+    # The point: a disc of radius 4 pixels, pi 16 in all (beside the line's 15 columns of 3).
+    assert alpha[:, 25:].sum() - 3 * 15 == pytest.approx(math.pi * 16, rel=0.03)
+    # Unlit white (no NORMAL): the base colour itself where covered.
+    assert r.beauty[14, 5, :3] == pytest.approx([1, 1, 1], abs=0.05)
+    # The file's width wins over the flags: 0.5 units.
+    f = lines_and_points(tmp_path / "lpw.gltf", width=0.5).render(
+        width=40, height=30, spp=64, integrator=integrator, filter="box", line_width="3px")
+    np.testing.assert_allclose(f.beauty[..., 3][:, :25].sum(axis=0), 0.5, atol=0.1)
+    with pytest.raises(ValueError, match="line_width"):
+        s.render(width=8, height=6, line_width="-1px")
+
+
+def test_wireframe_composites_over_the_beauty_and_is_its_own_layer(quads, tmp_path):
+    plain = quads.render(width=W, height=H, spp=4)
+    wired = quads.render(width=W, height=H, spp=4, wireframe=True, wireframe_color="1,0,0", wireframe_width=2)
+    a = wired.aovs["wireframe"][..., None]
+    assert a.shape == (H, W, 1) and a.max() > 0.9 and a.min() == 0
+    expected = np.array([1, 0, 0], np.float32) * a + plain.beauty[..., :3] * (1 - a)
+    np.testing.assert_allclose(wired.beauty[..., :3], expected, atol=1e-5)
+    # Only the front node's edges: none where only the back quad is seen.
+    front_only = quads.render(width=W, height=H, spp=4, wireframe=True, wireframe_nodes="front")
+    front, back = column_sides()
+    assert front_only.aovs["wireframe"][:, back[2:]].max() == 0
+    assert "wireframe" not in plain.aovs
+    if shutil.which("oiiotool"):
+        wired.write_exr(tmp_path / "w.exr")
+        info = subprocess.run([shutil.which("oiiotool"), "--info", "-v", str(tmp_path / "w.exr")],
+                              capture_output=True, text=True, check=True).stdout
+        assert "wireframe.A" in info
+    with pytest.raises(ValueError, match="wireframe_nodes"):
+        quads.render(width=8, height=6, wireframe=True, wireframe_nodes="nosuch")
+    with pytest.raises(ValueError, match="needs wireframe"):
+        quads.render(width=8, height=6, wireframe_width=3)

@@ -14,6 +14,7 @@
 #include "io/gltf/loader.h"
 #include "renderer/integrators/render.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/scene/curve_size.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/shape.h"
 #include "support/sdf_trees.h"
@@ -307,6 +308,85 @@ TEST_CASE("cross-check: instances of analytic and implicit shapes", "[accel][cro
   check_shape_instances("shape instances", views, instances);
 }
 
+/// A polyline of `n` segments (n + 1 vertices, stored as (a, b, b) triangles) spiralling about
+/// `centre`, with radii varying along it, and a grid of points with radii of their own (all
+/// radii times `thickness`).
+struct CurveSoup {
+  std::vector<Vec3f> line_positions, point_positions;
+  std::vector<uint32_t> line_indices, point_indices;
+  std::vector<float> line_radii, point_radii;
+  CurveSoup(Vec3f centre, int n, float thickness = 1) {
+    for (int i = 0; i <= n; ++i) {
+      const float a = 0.7f * float(i);
+      line_positions.push_back(centre + Vec3f{std::cos(a), 0.15f * float(i) - 1, std::sin(a)});
+      line_radii.push_back(thickness * (0.04f + 0.01f * float(i % 5)));
+      if (i > 0) line_indices.insert(line_indices.end(), {uint32_t(i - 1), uint32_t(i), uint32_t(i)});
+    }
+    for (int x = 0; x < 6; ++x)
+      for (int z = 0; z < 6; ++z) {
+        const uint32_t i = uint32_t(point_positions.size());
+        point_positions.push_back(centre + Vec3f{0.4f * float(x) - 1, 1.5f, 0.4f * float(z) - 1});
+        point_radii.push_back(thickness * (0.06f + 0.02f * float((x + z) % 3)));
+        point_indices.insert(point_indices.end(), {i, i, i});
+      }
+  }
+  GeometryView lines() const {
+    GeometryView v{line_positions, line_indices};
+    v.curves = CurveKind::Segments;
+    v.radii = line_radii;
+    return v;
+  }
+  GeometryView points() const {
+    GeometryView v{point_positions, point_indices};
+    v.curves = CurveKind::Points;
+    v.radii = point_radii;
+    return v;
+  }
+};
+
+TEST_CASE("cross-check: line segments and points among triangles", "[accel][crosscheck][shapes]") {
+  Soup s = icosphere(2, 0.8f, {0, 0, 3});
+  s.add_plane(1, -1.5f, -5.0f, 5.0f, 6);
+  const CurveSoup curves({0, 0, 0}, 16);
+  std::vector<GeometryView> views = s.views();
+  views.push_back(curves.lines());
+  views.push_back(curves.points());
+  std::vector<Ray> extra;
+  // Down onto each point's centre and across each segment's middle.
+  for (const Vec3f p : curves.point_positions)
+    extra.push_back({p + Vec3f{0, 3, 0}, 0, {0, -1, 0}, kInfinity});
+  for (size_t i = 0; i + 1 < curves.line_positions.size(); ++i) {
+    const Vec3f m = (curves.line_positions[i] + curves.line_positions[i + 1]) * 0.5f;
+    extra.push_back({m + Vec3f{0, 0, -6}, 0, {0, 0, 1}, kInfinity});
+  }
+  check_scene("curves", views, {}, 1, extra);
+  // Each element reports its own index; u, v are 0 as for shapes.
+  for (const auto& a : build_all(views)) {
+    INFO(a.name);
+    for (size_t i = 0; i < curves.point_positions.size(); ++i) {
+      Hit h;
+      REQUIRE(a.accel->intersect({curves.point_positions[i] + Vec3f{0, 3, 0}, 0, {0, -1, 0}, kInfinity}, h));
+      CHECK(h.geom_id == views.size() - 1);
+      CHECK(h.prim_id == i);
+      CHECK(h.t == Approx(3 - curves.point_radii[i]).epsilon(1e-5));
+    }
+    CHECK(a.accel->stats().shapes == 16 + 36);
+  }
+}
+
+TEST_CASE("cross-check: instances of line and point sets", "[accel][crosscheck][shapes]") {
+  const CurveSoup curves({0, 0, 0}, 12, 3);
+  const std::vector<GeometryView> views{curves.lines(), curves.points()};
+  std::vector<InstanceView> instances;
+  for (uint32_t g = 0; g < views.size(); ++g) {
+    instances.push_back({g, translated(Affine3f{}, {3.0f * float(g), 0, 0})});
+    Affine3f m;
+    m.m[0][0] = 1.5f, m.m[1][1] = g ? -0.7f : 0.8f, m.m[2][2] = 1.1f;  // stretched; mirrored for points
+    instances.push_back({g, translated(m, {3.0f * float(g), 0, 4})});
+  }
+  check_shape_instances("curve instances", views, instances);
+}
+
 // ---- Real scenes ----------------------------------------------------------------------------------
 
 TEST_CASE("cross-check: the default scene", "[accel][crosscheck]") {
@@ -317,6 +397,20 @@ TEST_CASE("cross-check: the default scene", "[accel][crosscheck]") {
   check_scene("default.gltf", flatten(meshes, instances).views, light_positions(l.scene));
   REQUIRE(l.scene.instances.size() > l.scene.meshes.size());
   check_instanced("default.gltf", meshes, instances, light_positions(l.scene));
+}
+
+TEST_CASE("cross-check: the points and lines scene", "[accel][crosscheck][shapes]") {
+  LoadedScene l = load_gltf(source_dir() / "scenes/curves.gltf");
+  REQUIRE_FALSE(l.scene.cameras.empty());
+  // Sizes as a 480 x 270 render gives them: 2-pixel points, 1-pixel lines (the tetrahedron's
+  // 4 cm from the file).
+  set_curve_radii(l.scene, l.scene.cameras[0], 270, {2, true}, {1, true});
+  const auto views = mesh_views(l.scene);
+  REQUIRE(std::count_if(views.begin(), views.end(),
+                        [](const GeometryView& v) { return v.curves != CurveKind::None; }) == 4);
+  REQUIRE(std::all_of(l.scene.instances.begin(), l.scene.instances.end(),
+                      [](const Instance& i) { return i.identity; }));
+  check_scene("curves.gltf", views, light_positions(l.scene));
 }
 
 TEST_CASE("cross-check: Embree without the robust flag and at low and high build quality",

@@ -5,11 +5,13 @@
 #include "renderer/integrators/raster.h"
 
 #include <catch2/catch.hpp>
+#include <mutex>
 #include <sstream>
 
 #include "io/gltf/loader.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/raster/shadow_map.h"
+#include "renderer/scene/curve_size.h"
 #include "support/scene_builder.h"
 #include "support/test_util.h"
 
@@ -283,4 +285,198 @@ TEST_CASE("raster cross-check: id and Z agree with the ray tracer on every valid
     ++models;
   }
   CHECK(models >= 30);
+}
+
+// ---- Points and lines ---------------------------------------------------------------------------
+
+namespace {
+
+/// A world-space line set over `p` with segments (pairs[2k], pairs[2k + 1]), every radius `radius`.
+Mesh line_set(std::vector<Vec3f> p, const std::vector<uint32_t>& pairs, float radius, int material) {
+  Mesh m;
+  m.name = "lines";
+  m.lines = true;
+  for (size_t k = 0; k + 1 < pairs.size(); k += 2)
+    m.indices.insert(m.indices.end(), {pairs[k], pairs[k + 1], pairs[k + 1]});
+  m.radii.assign(p.size(), radius);
+  m.normals.assign(p.size(), Vec3f{0, 0, 1});
+  m.positions = std::move(p);
+  m.material = material;
+  return m;
+}
+
+/// A world-space point set over `p`, every radius `radius`.
+Mesh point_set(std::vector<Vec3f> p, float radius, int material) {
+  Mesh m = make_point_set(std::move(p), "points");
+  m.radii.assign(m.positions.size(), radius);
+  m.material = material;
+  return m;
+}
+
+/// Looking down -z from z = 10, orthographic with half height `ymag`.
+Camera ortho_camera(float ymag) {
+  Camera cam = look_at({0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 1);
+  cam.projection = Projection::Orthographic;
+  cam.ymag = ymag;
+  return cam;
+}
+
+double alpha_sum(const Film& f) {
+  double sum = 0;
+  for (size_t i = 3; i < f.rgba.size(); i += 4) sum += f.rgba[i];
+  return sum;
+}
+
+/// Among the pixels where either path sees a point or line set (instances >= `first_curve`),
+/// the fraction where both see the same instance.
+double curve_id_agreement(const Scene& s, const Camera& cam, const RenderConfig& cfg, float first_curve,
+                          int& curve_pixels) {
+  const auto accel = make_scene_accelerator("embree", s);
+  const DataAovs t = render_data_aovs(s, *accel, cam, cfg, IntegratorType::Raster);
+  const DataAovs r = render_raster_aovs(s, cam, cfg);
+  int agree = 0;
+  curve_pixels = 0;
+  for (size_t i = 0; i < t.object_id.size(); ++i) {
+    if (!(t.object_id[i] >= first_curve) && !(r.object_id[i] >= first_curve)) continue;
+    ++curve_pixels;
+    agree += t.object_id[i] == r.object_id[i];
+  }
+  return curve_pixels ? double(agree) / curve_pixels : 0.0;
+}
+
+}  // namespace
+
+TEST_CASE("lines: a horizontal line w pixels wide covers exactly w rows rasterised, w on average traced",
+          "[raster][curves][quick]") {
+  // Orthographic, one scene unit per pixel, the line a quarter pixel above the boundary between
+  // rows 15 and 16 (no pixel centre on its edges) and reaching past both sides of the image.
+  const Camera cam = ortho_camera(16);
+  for (float w : {1.0f, 2.0f, 3.0f, 4.0f, 2.5f}) {
+    Scene s;
+    const int m = add_material(s, {1, 1, 1}, 0, 1, true);
+    add_world_mesh(s, line_set({{-40, 0.25f, 0}, {40, 0.25f, 0}}, {0, 1}, 0.5f * w, m));
+    INFO("width " << w);
+    RenderConfig cfg = small_render_config(32, 32, 1, 8);
+    cfg.raster.shadows = RasterShadows::None;
+    if (w == std::floor(w)) {  // rasterised at the pixel centres: whole rows
+      CameraView cv;
+      make_camera_view(cam, 32, 32, cv);
+      RasterPass pass;
+      pass.window = {0, 0, 32, 32};
+      pass.tile_size = 8;
+      std::vector<int> rows(32, 0);
+      std::mutex lock;
+      rasterize(s, cv.view, pass, [&](const RasterTile& t) {
+        const std::lock_guard<std::mutex> hold(lock);
+        for (int y = t.pixels.y0; y < t.pixels.y1; ++y)
+          for (int x = t.pixels.x0; x < t.pixels.x1; ++x)
+            rows[size_t(x)] += t.opaque[(y - t.pixels.y0) * t.pixels.width() + (x - t.pixels.x0)].hit.valid();
+      });
+      for (int x = 0; x < 32; ++x) CHECK(rows[size_t(x)] == int(w));
+    }
+    // Traced with 256 samples a pixel: each column's coverage sums to w within sampling error.
+    cfg.spp = 256;
+    const auto accel = make_scene_accelerator("bvh", s);
+    const Film t = render_whitted(s, *accel, cam, cfg);
+    CHECK(alpha_sum(t) / 32 == Approx(w).margin(0.03));
+  }
+}
+
+TEST_CASE("points: a point's disc covers pi r^2 pixels, traced and rasterised", "[raster][curves][quick]") {
+  const Camera cam = ortho_camera(16);  // one scene unit per pixel
+  for (float r : {2.0f, 4.5f}) {
+    Scene s;
+    const int m = add_material(s, {1, 1, 1}, 0, 1, true);
+    Mesh point = point_set({{0.3f, -0.2f, 0}}, r, m);
+    point.colors = {{1, 0.25f, 0, 1}};  // COLOR_0 times the unlit white
+    add_world_mesh(s, std::move(point));
+    RenderConfig cfg = small_render_config(32, 32, 256, 8);
+    cfg.raster.shadows = RasterShadows::None;
+    const auto accel = make_scene_accelerator("kdtree", s);
+    const double area = kPi * r * r;
+    INFO("radius " << r);
+    const Film traced = render_whitted(s, *accel, cam, cfg);
+    CHECK(alpha_sum(traced) == Approx(area).epsilon(0.01));
+    cfg.spp = 64;
+    const Film raster = render_raster(s, nullptr, cam, cfg);
+    CHECK(alpha_sum(raster) == Approx(area).epsilon(0.02));
+    for (const Film* f : {&traced, &raster}) {  // the point's colour at its centre
+      CHECK(f->pixel(16, 16)[0] == Approx(1).margin(1e-3));
+      CHECK(f->pixel(16, 16)[1] == Approx(0.25f).margin(1e-3));
+      CHECK(f->pixel(16, 16)[2] == Approx(0).margin(1e-3));
+    }
+  }
+}
+
+TEST_CASE("points and lines: raster and trace see the same ids on >= 99% of their pixels",
+          "[raster][curves][crosscheck]") {
+  // A spiral polyline and, in front of it, a grid of points, before a quad, seen in perspective,
+  // 3 and 6 pixels wide at their depths. (Where a point's sphere and a segment's capsule
+  // interpenetrate, the raster preview's flat stand-ins may show the other one.)
+  Scene s;
+  const int m = add_material(s, {0.8f, 0.8f, 0.8f}, 0, 1);
+  add_quad_z(s, -3, 3, -3, 3, -1, m);
+  s.instances[0].node = 0;  // object ids: the quad 1, the lines 2, the points 3
+  std::vector<Vec3f> spiral;
+  std::vector<uint32_t> pairs;
+  for (int i = 0; i <= 40; ++i) {
+    const float a = 0.45f * float(i), rad = 0.3f + 0.05f * float(i);
+    spiral.push_back({rad * std::cos(a), rad * std::sin(a), 0.02f * float(i)});
+    if (i) pairs.insert(pairs.end(), {uint32_t(i - 1), uint32_t(i)});
+  }
+  Mesh lines = line_set(spiral, pairs, 0, m);
+  lines.node = 1;
+  add_world_mesh(s, std::move(lines));
+  std::vector<Vec3f> grid;
+  for (int x = -4; x <= 4; ++x)
+    for (int y = -4; y <= 4; ++y) grid.push_back({0.6f * float(x), 0.6f * float(y), 1.2f});
+  Mesh points = point_set(grid, 0, m);
+  points.node = 2;
+  add_world_mesh(s, std::move(points));
+  const Camera cam = look_at({0.5f, -1, 8}, {0, 0, 0}, {0, 1, 0}, 0.8f);
+  RenderConfig cfg = small_render_config(240, 180, 1, 16);
+  set_curve_radii(s, cam, cfg.height, {6, true}, {3, true});
+  REQUIRE(renders_as_curves(s.meshes[1]));
+  int pixels = 0;
+  const double agreement = curve_id_agreement(s, cam, cfg, 2, pixels);
+  INFO(pixels << " point and line pixels, " << agreement * 100 << "% agree");
+  CHECK(pixels > 1000);
+  CHECK(agreement >= 0.99);
+}
+
+TEST_CASE("points and lines: raster and trace agree on the corpus' MeshPrimitiveModes",
+          "[raster][curves][crosscheck][corpus]") {
+  const auto corpus = corpus_dir();
+  if (!corpus) return skip("no corpus (set PENUMBRA_CORPUS)");
+  LoadedScene l = load_gltf(*corpus / "valid/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf");
+  const Camera cam = default_camera(l.scene, 4.0f / 3.0f);
+  RenderConfig cfg = small_render_config(320, 240, 1, 16);
+  set_curve_radii(l.scene, cam, cfg.height, {6, true}, {2, true});
+  // Instances of point and line sets: count the pixels where either path sees one.
+  int curves = 0, first = -1;
+  for (size_t i = 0; i < l.scene.instances.size(); ++i)
+    if (renders_as_curves(l.scene.meshes[size_t(l.scene.instances[i].mesh)])) {
+      ++curves;
+      if (first < 0) first = int(i);
+    }
+  REQUIRE(curves == 4);  // POINTS, LINES, LINE_LOOP, LINE_STRIP
+  const auto accel = make_scene_accelerator("embree", l.scene);
+  const DataAovs t = render_data_aovs(l.scene, *accel, cam, cfg, IntegratorType::Raster);
+  const DataAovs r = render_raster_aovs(l.scene, cam, cfg);
+  const auto is_curve = [&](float id) {
+    for (size_t i = 0; i < l.scene.instances.size(); ++i)
+      if (renders_as_curves(l.scene.meshes[size_t(l.scene.instances[i].mesh)]) &&
+          id == float(l.scene.instances[i].node + 1))
+        return true;
+    return false;
+  };
+  int pixels = 0, agree = 0;
+  for (size_t i = 0; i < t.object_id.size(); ++i) {
+    if (!is_curve(t.object_id[i]) && !is_curve(r.object_id[i])) continue;
+    ++pixels;
+    agree += t.object_id[i] == r.object_id[i];
+  }
+  INFO(pixels << " point and line pixels, " << agree << " agree");
+  CHECK(pixels > 500);
+  CHECK(agree >= 0.99 * pixels);
 }

@@ -90,6 +90,31 @@ TEST_CASE("capsule: the side, the caps and the seam between them", "[shapes][qui
   CHECK(hit_t(c, {0.6f, 5, 0}, {0, -1, 0}) == -1);  // outside the radius, parallel to the axis
 }
 
+TEST_CASE("segment: a capsule about any axis, a sphere for a point", "[shapes][quick]") {
+  // The axis (1, 1, 1)-(3, 1, 1), radius 0.25: a ray down -y through x = 2 meets it at y = 1.25.
+  const Shape s = make_segment_shape({1, 1, 1}, {3, 1, 1}, 0.25f, 7);
+  CHECK(s.element == 7);
+  CHECK(hit_t(s, {2, 5, 1}, {0, -1, 0}) == Approx(3.75f));
+  CHECK(hit_t(s, {0, 1, 1}, {1, 0, 0}) == Approx(0.75f));  // into the cap at x = 0.75
+  CHECK(hit_t(s, {2, 1, 1}, {0, 0, 1}) == Approx(0.25f));  // from inside: the far side
+  CHECK(hit_t(s, {3.3f, 5, 1}, {0, -1, 0}) == -1);         // past the cap
+  // A tilted axis: (0, 0, 0)-(1, 1, 1); the ray through the midpoint across it.
+  const Shape t = make_segment_shape({0, 0, 0}, {1, 1, 1}, 0.1f, 0);
+  const Vec3f across = normalize(Vec3f{1, -1, 0});
+  CHECK(hit_t(t, Vec3f{0.5f, 0.5f, 0.5f} + across * 4, -across) == Approx(3.9f));
+  const ShapeSurface surf = shape_surface(t, Vec3f{0.5f, 0.5f, 0.5f} + across * 0.1f, 1e-4f);
+  CHECK(dot(surf.n, across) == Approx(1).epsilon(1e-5));
+  CHECK(surf.uv.x == Approx(0.5f));
+  // A point: the sphere of the radius about p0, its bounds and area.
+  const Shape p = make_segment_shape({0, 2, 0}, {0, 2, 0}, 0.5f, 0);
+  CHECK(hit_t(p, {0, 2, -3}, {0, 0, 1}) == Approx(2.5f));
+  CHECK(hit_t(p, {0.49f, 2, -3}, {0, 0, 1}) == Approx(3 - std::sqrt(0.25f - 0.49f * 0.49f)).epsilon(1e-4));
+  CHECK(hit_t(p, {0.51f, 2, -3}, {0, 0, 1}) == -1);
+  const Bounds3f b = shape_bounds(p);
+  CHECK((b.lo.x == -0.5f && b.hi.y == 2.5f));
+  CHECK(snap_to_shape(s, {2, 1.5f, 1}).y == Approx(1.25f));
+}
+
 TEST_CASE("shape surfaces: normals and UVs", "[shapes][quick]") {
   const Shape sphere = analytic_shape(ShapeKind::Sphere, 2);
   const ShapeSurface top = shape_surface(sphere, {0, 2, 0}, 1e-4f);
