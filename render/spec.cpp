@@ -662,6 +662,10 @@ void validate(const RenderSpec& s) {
   parse_curve_size(s.point_size, "point_size");
   parse_curve_size(s.line_width, "line_width");
   parse_wireframe_color(s.wireframe_color);
+  if (s.wireframe && s.deep)
+    throw std::invalid_argument(
+        "wireframe with deep: the deep image holds the surfaces, not the overlay; render the wireframe "
+        "layer (wireframe.A) in the flat image and composite it after the deep merge");
   if (s.wireframe && s.denoise)
     throw std::invalid_argument(
         "wireframe with denoise: the overlay would be denoised with the beauty; render the wireframe "

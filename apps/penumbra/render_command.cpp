@@ -66,6 +66,8 @@ uint64_t image_bytes_per_pixel(const RenderRequest& q, bool multipart) {
   b += channels * 4 * (multipart ? 2 : 1);  // packed channels; --multipart also repacks them per part
   if (q.png) b += 12 + 3;
   if (q.deep) b += 4 + 2 * sizeof(DeepSample);  // at least one deep sample a pixel, in its tile and the image
+  if (q.spec.wireframe)
+    b += sizeof(Hit) + 4 + 4 + 4;  // the centre rays' hits and depths, coverage, its channel
   return b;
 }
 
@@ -90,6 +92,10 @@ uint64_t charge_image_budget(const RenderJob& job, const RenderConfig& cfg) {
   const Scene& scene = job.loaded.scene;
   uint64_t scene_bytes = scene_memory_bytes(scene) + count_stored_triangles(scene) * kAccelBytesPerTriangle +
                          job.loaded.animation_bytes;
+  // A point or line set's elements are shapes in the structure: each its Shape copy besides
+  // the record a triangle has (Embree: the user geometry's copy).
+  for (const Mesh& m : scene.meshes)
+    if (m.points || m.lines) scene_bytes += uint64_t(m.indices.size() / 3) * (sizeof(Shape) + 16);
   if (job.request.raster) {
     // The rasteriser's setup triangles and tile buffers, and the shadow maps.
     scene_bytes += raster_memory_bytes(scene, camera_raster_pass(cfg));

@@ -171,16 +171,35 @@ std::vector<int> write_meshes(Writer& wr, const Scene& scene) {
     const json minmax = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
     json attributes = {{"POSITION", wr.accessor(positions.data(), positions.size() * 12, kFloat,
                                                 positions.size(), "VEC3", kArrayBuffer, minmax)}};
-    if (normals.size() == positions.size())
+    // Point and line sets: mode 0 or 1 from their degenerate triangles, widths (_WIDTH) when the
+    // file gave them, no NORMAL (points and lines without normals render unlit).
+    const bool curves = m.points || m.lines;
+    std::vector<uint32_t> curve_indices;
+    std::vector<float> widths;
+    if (curves) {
+      for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+        curve_indices.push_back(indices[t]);
+        if (m.lines) curve_indices.push_back(indices[t + 1]);
+      }
+      if (m.file_radii && m.radii.size() == positions.size()) {
+        const float scale =
+            in_frame ? std::cbrt(std::fabs(float(determinant3x3(to_transform(m.object_from_world))))) : 1.0f;
+        for (float r : m.radii) widths.push_back(2 * r * scale);
+        attributes["_WIDTH"] =
+            wr.accessor(widths.data(), widths.size() * 4, kFloat, widths.size(), "SCALAR", kArrayBuffer);
+      }
+    }
+    const std::vector<uint32_t>& written = curves ? curve_indices : indices;
+    if (normals.size() == positions.size() && !curves)
       attributes["NORMAL"] =
           wr.accessor(normals.data(), normals.size() * 12, kFloat, normals.size(), "VEC3", kArrayBuffer);
     if (m.uvs.size() == m.positions.size())
       attributes["TEXCOORD_0"] =
           wr.accessor(m.uvs.data(), m.uvs.size() * 8, kFloat, m.uvs.size(), "VEC2", kArrayBuffer);
     json prim = {{"attributes", attributes},
-                 {"indices", wr.accessor(indices.data(), indices.size() * 4, kUint32, indices.size(),
+                 {"indices", wr.accessor(written.data(), written.size() * 4, kUint32, written.size(),
                                          "SCALAR", kElementArrayBuffer)},
-                 {"mode", 4}};
+                 {"mode", m.points ? 0 : (m.lines ? 1 : 4)}};
     if (m.material >= 0 && size_t(m.material) < scene.materials.size()) prim["material"] = m.material;
     json mesh = {{"primitives", {prim}}};
     if (!m.name.empty()) mesh["name"] = m.name;

@@ -285,7 +285,7 @@ std::vector<float> read_widths(const GltfContext& ctx, const tinygltf::Primitive
     if (w.size() != nv) ctx.fail(at, "count differs from POSITION count");
     radii.resize(nv);
     for (size_t i = 0; i < nv; ++i) {
-      if (!(w[i] > 0) || !std::isfinite(w[i]) || w[i] > 1e18)
+      if (!(float(w[i] / 2) > 0) || !std::isfinite(w[i]) || w[i] > 1e18)
         ctx.fail(at, "width " + std::to_string(w[i]) + " of vertex " + std::to_string(i) +
                          " is not a finite positive number");
       radii[i] = float(w[i] / 2);
@@ -301,7 +301,8 @@ std::vector<float> read_widths(const GltfContext& ctx, const tinygltf::Primitive
   if (!ext->second.Has("width")) return radii;
   const tinygltf::Value& v = ext->second.Get("width");
   const double w = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
-  if (!(w > 0) || !std::isfinite(w) || w > 1e18) ctx.fail(at + ".width", "not a finite positive number");
+  if (!(float(w / 2) > 0) || !std::isfinite(w) || w > 1e18)
+    ctx.fail(at + ".width", "not a finite positive number");
   radii.assign(nv, float(w / 2));
   return radii;
 }

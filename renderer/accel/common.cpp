@@ -16,6 +16,9 @@ std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> vie
   for (size_t g = 0; g < views.size(); ++g)
     offset[g + 1] = offset[g] + (views[g].shape ? 1 : views[g].indices.size() / 3);
   std::vector<PrimitiveRecord> records(offset.back());
+  size_t table = shapes.size();  // the shape table's size when every shape and element is in
+  for (const GeometryView& v : views) table += v.shape ? 1 : v.curve_count();
+  shapes.reserve(table);
   std::vector<uint8_t> keep(records.size(), 1);
   auto add_shape = [&](size_t at, uint32_t g, const Shape& s) {
     const Bounds3f b = shape_bounds(s);
@@ -39,7 +42,6 @@ std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> vie
       }
       if (shapes.size() + m.curve_count() >= kShapeBit)
         throw std::invalid_argument("more than 2^31 - 1 shapes");
-      shapes.reserve(shapes.size() + m.curve_count());
       for (size_t i = 0; i < m.curve_count(); ++i) add_shape(offset[g] + i, g, curve_element(m, i));
       continue;
     }

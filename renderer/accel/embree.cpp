@@ -143,13 +143,20 @@ void attach_triangles(RTCScene scene, const GeometryView& mesh, unsigned id) {
 /// Embree's user-geometry callbacks for an array of Shapes (geometryUserPtr; primitive i is
 /// shape i: one for a shape of its own, a curve set's elements), called with one ray at a time
 /// (rtcIntersect1 / rtcOccluded1): bounds, closest hit, any hit, each through the shared
-/// per-kind shape test. A shape without finite bounds gets an invalid box, which Embree skips.
+/// per-kind shape test. A curve element without finite bounds (a radius not finite) gets an
+/// empty box at its first end point (finite: the positions are) and is never tested.
+bool has_finite_bounds(const Shape& shape) {
+  const Bounds3f b = shape_bounds(shape);
+  return !b.empty() && is_finite(b.lo) && is_finite(b.hi);
+}
+
 void user_shape_bounds(const RTCBoundsFunctionArguments* args) {
-  const Bounds3f b = shape_bounds(static_cast<const Shape*>(args->geometryUserPtr)[args->primID]);
+  const Shape& shape = static_cast<const Shape*>(args->geometryUserPtr)[args->primID];
+  const Bounds3f b = shape_bounds(shape);
   RTCBounds* o = args->bounds_o;
-  if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi)) {
-    o->lower_x = o->lower_y = o->lower_z = kInfinity;
-    o->upper_x = o->upper_y = o->upper_z = -kInfinity;
+  if (!has_finite_bounds(shape)) {
+    const Vec3f p = is_finite(shape.p0) ? shape.p0 : Vec3f{};
+    o->lower_x = o->upper_x = p.x, o->lower_y = o->upper_y = p.y, o->lower_z = o->upper_z = p.z;
     return;
   }
   o->lower_x = b.lo.x, o->lower_y = b.lo.y, o->lower_z = b.lo.z;
@@ -197,7 +204,7 @@ void user_shape_intersect(const RTCIntersectFunctionNArguments* args) {
   };
   ShapeHit sh;
   const Shape& shape = static_cast<const Shape*>(args->geometryUserPtr)[args->primID];
-  if (!intersect_shape_accepted(shape, r, accept, sh, nullptr)) return;
+  if (!has_finite_bounds(shape) || !intersect_shape_accepted(shape, r, accept, sh, nullptr)) return;
   rh->ray.tfar = sh.t;
   rh->hit = shape_candidate(args->geomID, args->primID, args->context);
 }
@@ -212,7 +219,8 @@ void user_shape_occluded(const RTCOccludedFunctionNArguments* args) {
   };
   ShapeHit sh;
   const Shape& shape = static_cast<const Shape*>(args->geometryUserPtr)[args->primID];
-  if (intersect_shape_accepted(shape, r, accept, sh, nullptr)) ray->tfar = -kInfinity;
+  if (has_finite_bounds(shape) && intersect_shape_accepted(shape, r, accept, sh, nullptr))
+    ray->tfar = -kInfinity;
 }
 
 /// A new user geometry over `count` shapes from `shapes` (which must outlive it; primitive i is

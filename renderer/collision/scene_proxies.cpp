@@ -139,8 +139,8 @@ std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int>
     // The triangles placed: a mesh's, or a shape's tessellation (made once per shape).
     std::span<const Vec3f> positions;
     std::span<const uint32_t> indices;
-    bool points = false;
-    double volume = -1;  // object space, -1 when open
+    bool points = false;  // a point or line set: measured, but no triangles to collide
+    double volume = -1;   // object space, -1 when open
     double error = 0;
     if (is_shape) {
       const SceneShape& ss = scene.shapes[size_t(inst.shape)];
@@ -165,7 +165,7 @@ std::vector<NodeGeometry> node_geometry(const Scene& scene, std::span<const int>
         const MeshVolume mv = mesh_volume(mesh.positions, mesh.indices);
         v = mv.closed && !mesh.points ? std::abs(mv.signed_volume) : -1;
       }
-      positions = mesh.positions, indices = mesh.indices, points = mesh.points, volume = v;
+      positions = mesh.positions, indices = mesh.indices, points = mesh.points || mesh.lines, volume = v;
     }
     NodeGeometry* g = nullptr;
     if (root >= 0) {

@@ -104,6 +104,18 @@ std::vector<float> render_motion_vectors(const Scene& scene, const Accelerator& 
         Instance moving;
         const Instance& inst = instance_at(scene, hit.geom_id, ray.time, moving);
         if (inst.shape >= 0) sp.object = apply_point(inst.to_object, ray.org + ray.dir * hit.t);
+        if (inst.shape < 0 && renders_as_curves(scene.meshes[size_t(inst.mesh)])) {
+          // A point or segment: the axis point nearest the hit, as the parameter along its
+          // (a, b, b) triangle's first edge.
+          const Mesh& m = scene.meshes[size_t(inst.mesh)];
+          const Vec3f a = m.positions[m.indices[3 * size_t(hit.prim_id)]],
+                      b = m.positions[m.indices[3 * size_t(hit.prim_id) + 1]];
+          const Vec3f p = inst.identity ? ray.org + ray.dir * hit.t
+                                        : apply_point(inst.to_object, ray.org + ray.dir * hit.t);
+          const float dd = dot(b - a, b - a);
+          sp.u = dd > 0 ? std::clamp(dot(p - a, b - a) / dd, 0.0f, 1.0f) : 0.0f;
+          sp.v = 0;
+        }
         const size_t pixel = size_t(y - win.y0) * w + size_t(x - win.x0);
         const Vec3f was = world_point(*previous.scene, sp), will = world_point(*next.scene, sp);
         if (velocity) {

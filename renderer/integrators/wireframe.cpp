@@ -3,11 +3,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
+
+#include "renderer/integrators/visibility.h"
 
 namespace penumbra {
 
@@ -28,19 +31,20 @@ struct Projector {
   bool ortho = false;
 
   float depth(Vec3f p) const { return dot(p - cam.eye, -cam.w); }
-  /// Raster position of `p`, whose depth is > 0 (perspective).
-  Vec2f project(Vec3f p) const {
+  /// Raster position of `p`, whose depth is > 0 (perspective), in double.
+  void project(Vec3f p, double out[2]) const {
     const Vec3f q = p - cam.eye;
-    float sx, sy;
+    double sx, sy;
     if (ortho) {
-      sx = dot(q, cam.u) / half_w;
-      sy = dot(q, cam.v) / half_h;
+      sx = double(dot(q, cam.u)) / half_w;
+      sy = double(dot(q, cam.v)) / half_h;
     } else {
-      const float z = dot(q, -cam.w);
-      sx = dot(q, cam.u) / (z * raster.tan_x);
-      sy = dot(q, cam.v) / (z * raster.tan_y);
+      const double z = dot(q, -cam.w);
+      sx = double(dot(q, cam.u)) / (z * raster.tan_x);
+      sy = double(dot(q, cam.v)) / (z * raster.tan_y);
     }
-    return {(sx + 1) * 0.5f * raster.width, (1 - sy) * 0.5f * raster.height};
+    out[0] = (sx + 1) * 0.5 * raster.width;
+    out[1] = (1 - sy) * 0.5 * raster.height;
   }
   float footprint(float depth) const {
     return ortho ? 2 * half_h / raster.height : 2 * std::max(depth, 0.0f) * raster.tan_y / raster.height;
@@ -48,7 +52,7 @@ struct Projector {
 };
 
 CentreHits trace_centres(const Scene& scene, const Accelerator& accel, const Projector& pr, PixelWindow win) {
-  (void)scene;
+  const bool filter = scene_needs_hit_filter(scene);  // alpha-masked holes and culled back faces
   CentreHits out;
   out.win = win;
   const size_t n = size_t(win.width()) * size_t(win.height());
@@ -61,7 +65,7 @@ CentreHits trace_centres(const Scene& scene, const Accelerator& accel, const Pro
         ray.time = 0.5f;
         const size_t i = size_t(y - win.y0) * size_t(win.width()) + size_t(x - win.x0);
         Hit hit;
-        if (accel.intersect(ray, hit)) {
+        if (intersect_visible(scene, accel, ray, hit, filter)) {
           out.hits[i] = hit;
           out.depth[i] = pr.depth(ray.org + ray.dir * hit.t);
         }
@@ -70,13 +74,11 @@ CentreHits trace_centres(const Scene& scene, const Accelerator& accel, const Pro
   return out;
 }
 
-/// Raises the float at `slot` to `value` (coverage is non-negative, so its bits order as it does).
+/// Raises the float at `slot` to `value` (the largest wins whatever the order: deterministic).
 void atomic_max(float& slot, float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, 4);
-  std::atomic_ref<uint32_t> ref(*reinterpret_cast<uint32_t*>(&slot));
-  uint32_t old = ref.load(std::memory_order_relaxed);
-  while (old < bits && !ref.compare_exchange_weak(old, bits, std::memory_order_relaxed)) {
+  std::atomic_ref<float> ref(slot);
+  float old = ref.load(std::memory_order_relaxed);
+  while (old < value && !ref.compare_exchange_weak(old, value, std::memory_order_relaxed)) {
   }
 }
 
@@ -87,7 +89,28 @@ bool has_edge(const Mesh& mesh, uint32_t prim, uint32_t a, uint32_t b) {
   return ha && hb;
 }
 
-/// One edge a-b (vertex indices of `mesh`, world points pa, pb) of instance `instance`.
+/// Clips the screen segment p0 + s (p1 - p0), s in [s0, s1], to the box [lo, hi] (Liang and
+/// Barsky 1984); false when nothing is left.
+bool clip_segment(const double p0[2], const double p1[2], const double lo[2], const double hi[2], double& s0,
+                  double& s1) {
+  for (int k = 0; k < 2; ++k) {
+    const double d = p1[k] - p0[k];
+    if (d == 0) {
+      if (p0[k] < lo[k] || p0[k] > hi[k]) return false;
+      continue;
+    }
+    double ta = (lo[k] - p0[k]) / d, tb = (hi[k] - p0[k]) / d;
+    if (ta > tb) std::swap(ta, tb);
+    s0 = std::max(s0, ta);
+    s1 = std::min(s1, tb);
+    if (s0 > s1) return false;
+  }
+  return true;
+}
+
+/// One edge a-b (vertex indices of its instance's mesh, world points pa, pb) of `instance`:
+/// near-clipped, projected in double, clipped to the window widened by the band, and walked row
+/// by row (column by column for steep edges) over the band only.
 void draw_edge(const Scene& scene, const Projector& pr, const CentreHits& centres,
                const WireframeConfig& wire, uint32_t instance, uint32_t a, uint32_t b, Vec3f pa, Vec3f pb,
                std::vector<float>& alpha) {
@@ -99,42 +122,53 @@ void draw_edge(const Scene& scene, const Projector& pr, const CentreHits& centre
     if (za < znear) pa = pa + (pb - pa) * ((znear - za) / (zb - za)), za = znear;
     if (zb < znear) pb = pb + (pa - pb) * ((znear - zb) / (za - zb)), zb = znear;
   }
-  const Vec2f sa = pr.project(pa), sb = pr.project(pb);
-  if (!std::isfinite(sa.x + sa.y + sb.x + sb.y)) return;
-  const float half = 0.5f * wire.width;
+  double sa[2], sb[2];
+  pr.project(pa, sa);
+  pr.project(pb, sb);
+  if (!std::isfinite(sa[0] + sa[1] + sb[0] + sb[1])) return;
+  const double half = 0.5 * wire.width, reach = half + 1;
   const PixelWindow& win = centres.win;
-  const float reach = half + 1;
-  const int x0 = std::max(win.x0, int(std::floor(std::min(sa.x, sb.x) - reach)));
-  const int x1 = std::min(win.x1, int(std::ceil(std::max(sa.x, sb.x) + reach)));
-  const int y0 = std::max(win.y0, int(std::floor(std::min(sa.y, sb.y) - reach)));
-  const int y1 = std::min(win.y1, int(std::ceil(std::max(sa.y, sb.y) + reach)));
-  if (x0 >= x1 || y0 >= y1) return;
-  const Vec2f d{sb.x - sa.x, sb.y - sa.y};
-  const float dd = d.x * d.x + d.y * d.y, len = std::sqrt(dd);
+  const double lo[2] = {win.x0 - reach, win.y0 - reach}, hi[2] = {win.x1 + reach, win.y1 + reach};
+  double s0 = 0, s1 = 1;
+  if (!clip_segment(sa, sb, lo, hi, s0, s1)) return;
+  const double d[2] = {sb[0] - sa[0], sb[1] - sa[1]};
+  const double dd = d[0] * d[0] + d[1] * d[1], len = std::sqrt(dd);
+  // Walk the major axis k over the clipped part; across it, the band reaches `across` each side.
+  const int k = std::fabs(d[0]) >= std::fabs(d[1]) ? 0 : 1, j = 1 - k;
+  const double c0[2] = {sa[0] + d[0] * s0, sa[1] + d[1] * s0}, c1[2] = {sa[0] + d[0] * s1, sa[1] + d[1] * s1};
+  const double across = std::fabs(d[k]) > 0 ? reach * len / std::fabs(d[k]) : reach;
+  const int w0[2] = {win.x0, win.y0}, w1[2] = {win.x1, win.y1};
+  const int m0 = std::max(w0[k], int(std::floor(std::min(c0[k], c1[k]) - reach)));
+  const int m1 = std::min(w1[k], int(std::ceil(std::max(c0[k], c1[k]) + reach)));
+  const double minor_lo = std::min(c0[j], c1[j]) - reach, minor_hi = std::max(c0[j], c1[j]) + reach;
   const Mesh& mesh = scene.meshes[size_t(scene.instances[instance].mesh)];
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      const Vec2f c{float(x) + 0.5f, float(y) + 0.5f};
-      float s = dd > 0 ? ((c.x - sa.x) * d.x + (c.y - sa.y) * d.y) / dd : 0.0f;
-      s = std::clamp(s, 0.0f, 1.0f);
-      const float ex = sa.x + d.x * s - c.x, ey = sa.y + d.y * s - c.y;
-      float cover = std::clamp(half + 0.5f - std::sqrt(ex * ex + ey * ey), 0.0f, 1.0f);
+  for (int m = m0; m < m1; ++m) {
+    const double centre = m + 0.5;
+    const double at = std::fabs(d[k]) > 0 ? sa[j] + d[j] * (centre - sa[k]) / d[k] : sa[j];
+    const int n0 = std::max(w0[j], int(std::floor(std::max(minor_lo, at - across))));
+    const int n1 = std::min(w1[j], int(std::ceil(std::min(minor_hi, at + across))));
+    for (int n = n0; n < n1; ++n) {
+      const int x = k == 0 ? m : n, y = k == 0 ? n : m;
+      const double cx = x + 0.5, cy = y + 0.5;
+      const double s = dd > 0 ? std::clamp(((cx - sa[0]) * d[0] + (cy - sa[1]) * d[1]) / dd, 0.0, 1.0) : 0.0;
+      const double ex = sa[0] + d[0] * s - cx, ey = sa[1] + d[1] * s - cy;
+      float cover = float(std::clamp(half + 0.5 - std::sqrt(ex * ex + ey * ey), 0.0, 1.0));
       if (cover <= 0) continue;
       // The edge's depth at s: 1 / depth is linear on screen (perspective).
-      const float z = pr.ortho ? za + (zb - za) * s : 1.0f / ((1 - s) / za + s / zb);
+      const float sf = float(s);
+      const float z = pr.ortho ? za + (zb - za) * sf : 1.0f / ((1 - sf) / za + sf / zb);
       const size_t i = size_t(y - win.y0) * size_t(win.width()) + size_t(x - win.x0);
       const Hit& h = centres.hits[i];
-      const bool visible = !h.valid() ||
-                           (h.geom_id == instance && scene.instances[instance].shape < 0 &&
-                            !renders_as_curves(mesh) && has_edge(mesh, h.prim_id, a, b)) ||
-                           z <= centres.depth[i] + 1e-3f * z + 2 * pr.footprint(z) * (half + 1);
+      const bool visible = !h.valid() || (h.geom_id == instance && has_edge(mesh, h.prim_id, a, b)) ||
+                           z <= centres.depth[i] + 1e-3f * z + 2 * pr.footprint(z) * float(half + 1);
       if (!visible) {
         if (wire.hidden == WireframeHidden::Off) continue;
         if (wire.hidden == WireframeHidden::Dim) cover *= 0.25f;
-        if (wire.hidden == WireframeHidden::Dashed && std::fmod(s * len, 8.0f) >= 4.0f) continue;
+        if (wire.hidden == WireframeHidden::Dashed && std::fmod(s * len, 8.0) >= 4.0) continue;
       }
       atomic_max(alpha[i], cover);
     }
+  }
 }
 
 }  // namespace
@@ -148,7 +182,9 @@ std::vector<float> render_wireframe(const Scene& scene, const Accelerator& accel
   pr.ortho = camera.projection == Projection::Orthographic;
   pr.half_h = camera.ymag;
   pr.half_w = camera.ymag * pr.raster.aspect;
-  const CentreHits centres = trace_centres(scene, accel, pr, win);
+  tbb::task_arena arena(thread_count(config.threads));
+  CentreHits centres;
+  arena.execute([&] { centres = trace_centres(scene, accel, pr, win); });
   std::vector<float> alpha(size_t(win.width()) * size_t(win.height()), 0.0f);
   std::vector<uint32_t> chosen;
   for (size_t i = 0; i < scene.instances.size(); ++i) {
@@ -160,26 +196,29 @@ std::vector<float> render_wireframe(const Scene& scene, const Accelerator& accel
       continue;
     chosen.push_back(uint32_t(i));
   }
-  for (uint32_t instance : chosen) {
-    const Instance& inst = scene.instances[instance];
-    const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-    const size_t triangles = mesh.indices.size() / 3;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 256),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t t = r.begin(); t < r.end(); ++t) {
-                          const WorldTriangle tri = world_triangle(scene, inst, uint32_t(t));
-                          for (int k = 0; k < 3; ++k) {
-                            // Each edge from its lower vertex index: the triangles sharing it dash it alike.
-                            const int k1 = (k + 1) % 3;
-                            const bool up = tri.index[k] < tri.index[k1];
-                            const int i0 = up ? k : k1, i1 = up ? k1 : k;
-                            if (tri.index[i0] == tri.index[i1]) continue;
-                            draw_edge(scene, pr, centres, wire, instance, tri.index[i0], tri.index[i1],
-                                      tri.p[i0], tri.p[i1], alpha);
+  arena.execute([&] {
+    for (uint32_t instance : chosen) {
+      const Instance& inst = scene.instances[instance];
+      const Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+      const size_t triangles = mesh.indices.size() / 3;
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 256),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t t = r.begin(); t < r.end(); ++t) {
+                            const WorldTriangle tri = world_triangle(scene, inst, uint32_t(t));
+                            for (int k = 0; k < 3; ++k) {
+                              // Each edge from its lower vertex index: the triangles sharing it dash it
+                              // alike.
+                              const int k1 = (k + 1) % 3;
+                              const bool up = tri.index[k] < tri.index[k1];
+                              const int i0 = up ? k : k1, i1 = up ? k1 : k;
+                              if (tri.index[i0] == tri.index[i1]) continue;
+                              draw_edge(scene, pr, centres, wire, instance, tri.index[i0], tri.index[i1],
+                                        tri.p[i0], tri.p[i1], alpha);
+                            }
                           }
-                        }
-                      });
-  }
+                        });
+    }
+  });
   return alpha;
 }
 

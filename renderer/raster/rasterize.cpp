@@ -740,13 +740,14 @@ class TileRasterizer {
             if (u * u + v * v > 1) continue;
           }
           if (t.kind == Kind::Mask) {
-            const Vec2f uv = source_uv(t, l1, l2);
+            const Vec2f uv = t.disc ? source_uv(t, 0, 0) : source_uv(t, l1, l2);
             const Material& m =
                 material_of(m_pl.scene, instance_material(m_pl.scene, m_pl.scene.instances[t.instance]));
             const float cut = m.alpha_mode == AlphaMode::Mask ? 1.0f : mask_cut;
             if (!(eval_alpha(m_pl.scene, t.instance, t.prim, uv.x, uv.y) >= cut)) continue;
           }
-          written += fragment(i, depth, index, float(l1), float(l2), t.kind, b);
+          written += t.disc ? fragment(i, depth, index, 0, 0, t.kind, b)
+                            : fragment(i, depth, index, float(l1), float(l2), t.kind, b);
         }
       }
     return written;

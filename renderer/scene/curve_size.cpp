@@ -28,7 +28,7 @@ CurveSize parse_curve_size(const std::string& text, const std::string& setting) 
   } catch (const std::exception&) {
     used = 0;
   }
-  if (number.empty() || used != number.size() || !(v > 0) || !std::isfinite(v) || v > 1e18)
+  if (number.empty() || used != number.size() || !(float(v / 2) > 0) || !std::isfinite(v) || v > 1e18)
     throw std::invalid_argument(setting + ": '" + text +
                                 "' is not a positive size (a number of scene units, or of pixels "
                                 "followed by px: 0.01, 2px)");

@@ -113,10 +113,10 @@ SurfaceInteraction make_curve_interaction(const Scene& scene, const Instance& in
     const Vec4f ca = mesh.colors[a], cb = mesh.colors[b];
     si.color = {ca.x * w + cb.x * s, ca.y * w + cb.y * s, ca.z * w + cb.z * s, ca.w * w + cb.w * s};
   }
-  const Bounds3f box = shape_bounds(shape);
+  // Rounding of the point and of the capsule's radius (not its length: a long thin segment's
+  // offset stays well inside its radius).
   const float obj_len = length(obj.dir), scale = obj_len > 0 ? length(ray.dir) / obj_len : 1.0f;
-  const float size = box.empty() ? 0.0f : max_component(box.extent()) * scale;
-  si.spawn_offset = 64 * 0x1p-23f * (max_component(abs(si.p)) + size);
+  si.spawn_offset = 64 * 0x1p-23f * (max_component(abs(si.p)) + 2 * shape.radius * scale);
   si.back_face = dot(n, ray.dir) > 0;
   if (si.back_face) n = -n;
   si.ng = si.ns = n;

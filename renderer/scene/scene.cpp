@@ -92,7 +92,9 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
     const Mesh& m = scene.meshes[i];
     for (Vec3f p : m.positions) mesh_bounds[i] = merge(mesh_bounds[i], p);
-    if (renders_as_curves(m) && !mesh_bounds[i].empty()) {  // spheres and capsules reach past their axes
+    // Spheres and capsules reach past their axes: by the file's radii (radii a render set from
+    // its camera do not move the bounds a camera is framed on).
+    if (renders_as_curves(m) && m.file_radii && !mesh_bounds[i].empty()) {
       float r = 0;
       for (float x : m.radii)
         if (std::isfinite(x)) r = std::max(r, x);
@@ -116,7 +118,7 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
     const Mesh& m = scene.meshes[size_t(inst.mesh)];
     if (inst.identity) {
       b = merge(b, mesh_bounds[size_t(inst.mesh)]);
-    } else if (exact && !renders_as_curves(m)) {
+    } else if (exact && !(renders_as_curves(m) && m.file_radii)) {
       for (Vec3f p : m.positions) b = merge(b, apply_point(inst.to_world, p));
     } else {
       b = merge(b, transform_bounds(inst.to_world, mesh_bounds[size_t(inst.mesh)]));

@@ -509,3 +509,18 @@ def test_wireframe_composites_over_the_beauty_and_is_its_own_layer(quads, tmp_pa
         quads.render(width=8, height=6, wireframe=True, wireframe_nodes="nosuch")
     with pytest.raises(ValueError, match="needs wireframe"):
         quads.render(width=8, height=6, wireframe_width=3)
+
+
+def test_a_framed_render_of_points_and_lines_is_the_same_the_second_time(tmp_path):
+    # No camera: the view frames the bounds, which the sizes a render gives in pixels must not move.
+    write_gltf(tmp_path / "framed.gltf", nodes=[{"name": "line", "mesh": 0}, {"name": "dot", "mesh": 1}],
+               meshes=[([[-1, 0, 0], [1, 0.5, 0]], [[0, 1]], None), ([[0, 1, 0.5]], [[0]], None)])
+    gltf = json.loads((tmp_path / "framed.gltf").read_text())
+    gltf["meshes"][0]["primitives"][0]["mode"] = 1
+    gltf["meshes"][1]["primitives"][0]["mode"] = 0
+    (tmp_path / "framed.gltf").write_text(json.dumps(gltf))
+    s = penumbra.load(tmp_path / "framed.gltf")
+    first = s.render(width=48, height=32, spp=4, point_size="12px", line_width="4px")
+    second = s.render(width=48, height=32, spp=4, point_size="12px", line_width="4px")
+    np.testing.assert_array_equal(first.beauty, second.beauty)
+    assert first.beauty[..., 3].sum() > 20

@@ -100,6 +100,13 @@ TEST_CASE("spec: point and line sizes and wireframe settings are checked", "[spe
   CHECK((c.x == 0.2f && c.y == 1 && c.z == 0));
   s.wireframe_hidden = "sometimes";
   CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe_hidden"));
+  s.wireframe_hidden = "dim";
+  s.deep = true;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe with deep"));
+  s.deep = false;
+  s.integrator = "path";
+  s.denoise = true;
+  CHECK_THROWS_WITH(validate(s), Catch::Contains("wireframe with denoise"));
 }
 
 TEST_CASE("spec: every field has a flag name and a help line", "[spec]") {

@@ -457,3 +457,33 @@ TEST_CASE("write_gltf: procedural textures come back through PENUMBRA_procedural
     }
   }
 }
+
+TEST_CASE("write_gltf: points and lines come back as POINTS and LINES with the file's widths",
+          "[gltf][writer]") {
+  Scene s;
+  Mesh lines;
+  lines.name = "lines";
+  lines.lines = true;
+  lines.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}};
+  lines.indices = {0, 1, 1, 1, 2, 2};
+  lines.radii = {0.1f, 0.2f, 0.3f};
+  lines.file_radii = true;
+  add_world_mesh(s, lines);
+  Mesh points = make_point_set({{0, 2, 0}, {1, 2, 0}}, "points");  // sized by the render
+  add_world_mesh(s, points);
+  const auto dir = temp_dir("gltf-writer-curves");
+  write_gltf(s, dir / "curves.gltf");
+  const LoadedScene l = load_gltf(dir / "curves.gltf");
+  REQUIRE(l.scene.meshes.size() == 2);
+  const Mesh& rl = l.scene.meshes[0];
+  CHECK(rl.lines);
+  CHECK(rl.indices == lines.indices);
+  CHECK(rl.file_radii);
+  REQUIRE(rl.radii.size() == 3);
+  for (size_t i = 0; i < 3; ++i) CHECK(rl.radii[i] == Approx(lines.radii[i]));
+  const Mesh& rp = l.scene.meshes[1];
+  CHECK(rp.points);
+  CHECK(rp.indices == points.indices);
+  CHECK(rp.radii.empty());
+  CHECK(l.scene.materials[size_t(rp.material)].unlit);  // no NORMAL written: unlit again
+}
