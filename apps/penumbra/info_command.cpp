@@ -254,6 +254,11 @@ nlohmann::ordered_json info_json(const std::string& file, const LoadedScene& loa
                     {"triangles", count_triangles(s)},
                     {"points", count_points(s)},
                     {"line_segments", count_line_segments(s)}};
+  uint64_t splats = 0;
+  for (const SplatInstance& si : s.splat_instances)
+    splats += s.splat_clouds[size_t(si.cloud)].positions.size();
+  j["splats"] = {
+      {"clouds", s.splat_clouds.size()}, {"instances", s.splat_instances.size()}, {"placed", splats}};
   std::vector<size_t> shape_uses(s.shapes.size(), 0);
   for (const Instance& inst : s.instances)
     if (inst.shape >= 0) ++shape_uses[size_t(inst.shape)];
@@ -485,6 +490,17 @@ int run_info(const InfoArgs& a) {
   if (const uint64_t points = count_points(s))
     std::printf("points       %llu (rendered as spheres of --point-size unless the file sizes them)\n",
                 static_cast<unsigned long long>(points));
+  if (!s.splat_instances.empty()) {
+    uint64_t splats = 0;
+    int degree = 0;
+    for (const SplatInstance& si : s.splat_instances)
+      splats += s.splat_clouds[size_t(si.cloud)].positions.size();
+    for (const SplatCloud& c : s.splat_clouds) degree = std::max(degree, c.sh_degree);
+    std::printf(
+        "splats       %llu in %zu placements of %zu clouds, spherical harmonics to degree %d "
+        "(KHR_gaussian_splatting: rendered as their fallback points)\n",
+        static_cast<unsigned long long>(splats), s.splat_instances.size(), s.splat_clouds.size(), degree);
+  }
   if (const uint64_t segments = count_line_segments(s))
     std::printf(
         "lines        %llu segments (glTF LINES, LINE_LOOP, LINE_STRIP: rendered as capsules of "

@@ -23,6 +23,7 @@
 #include "io/gltf/parse.h"
 #include "io/gltf/pose.h"
 #include "io/gltf/shapes.h"
+#include "io/gltf/splats.h"
 
 namespace penumbra {
 
@@ -40,6 +41,7 @@ std::vector<std::string> supported_gltf_extensions() {
   out.push_back(gltf::kShapesExtension);
   out.push_back(gltf::kProceduralExtension);
   out.push_back(gltf::kPointsExtension);
+  out.push_back(gltf::kGaussianSplatting);
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "io/gltf/accessors.h"
+#include "io/gltf/splats.h"
 
 namespace penumbra::gltf {
 
@@ -339,6 +340,22 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
   out.indices = triangle_list(ctx, prim, where, nv);
   read_vertex_attributes(ctx, prim, where, nv, raw);
   if (out.points || out.lines) out.radii = read_widths(ctx, prim, where, nv);
+  if (has_splats(prim)) {
+    out.splats = read_splats(ctx, prim, where, raw.pos);
+    out.splats->mesh = int(mesh_index);
+    out.splats->primitive = int(pi);
+    out.splats->name = idx("meshes", mesh_index) + "[" + std::to_string(pi) + "]";
+    if (raw.col.empty()) {  // the fallback points' colour: each splat's own, seen head on
+      raw.col_components = 4;
+      raw.col.resize(nv * 4);
+      for (size_t i = 0; i < nv; ++i) {
+        const Vec3f c =
+            splat_linear_color(out.splats->color_space, splat_sh_color(*out.splats, i, {0, 0, -1}));
+        raw.col[4 * i] = c.x, raw.col[4 * i + 1] = c.y, raw.col[4 * i + 2] = c.z;
+        raw.col[4 * i + 3] = out.splats->opacities[i];
+      }
+    }
+  }
   if (out.indices.empty()) {
     ctx.warn(where,
              out.points ? "no points; skipped" : (out.lines ? "no lines; skipped" : "no triangles; skipped"));
@@ -594,6 +611,37 @@ uint64_t add_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>
   return singular;
 }
 
+// The splat clouds of `primitives` (each stored once in the scene) placed by every invertible
+// placement of `node`; a skinned node's splats are not placed (warned).
+void add_splat_instances(const GltfContext& ctx, const std::vector<LocalPrimitive>& primitives,
+                         const std::vector<Transform>& placements, int node, const std::string& node_where,
+                         bool skinned) {
+  Scene& scene = ctx.out.scene;
+  for (const LocalPrimitive& p : primitives) {
+    if (!p.splats) continue;
+    if (skinned) {
+      ctx.warn(node_where, "Gaussian splats of a skinned mesh are not placed");
+      continue;
+    }
+    int cloud = -1;
+    for (size_t c = 0; c < scene.splat_clouds.size() && cloud < 0; ++c)
+      if (scene.splat_clouds[c].mesh == p.splats->mesh &&
+          scene.splat_clouds[c].primitive == p.splats->primitive)
+        cloud = int(c);
+    if (cloud < 0) {
+      ctx.charge(uint64_t(p.splats->positions.size()) * (12 + 16 + 12 + 4) + p.splats->sh.size() * 12,
+                 p.splats->name, "its Gaussian splats need");
+      scene.splat_clouds.push_back(*p.splats);
+      cloud = int(scene.splat_clouds.size()) - 1;
+    }
+    for (const Transform& world : placements) {
+      Transform inv;
+      if (!inverse(world, inv)) continue;
+      scene.splat_instances.push_back({cloud, to_affine(world), node});
+    }
+  }
+}
+
 // A node's mesh placed by `placements` (the node's world transform, or one per
 // EXT_mesh_gpu_instancing instance). shared: stored once in object space and instanced; else
 // one world-space copy per placement (skinned meshes always). Placements of a moving node left
@@ -610,6 +658,7 @@ void add_mesh(const GltfContext& ctx, const std::vector<std::vector<LocalPrimiti
   const std::vector<double> weights = morph_weights(ctx, *nodes.poses, use.mesh, use.node);
   const std::vector<Transform> no_joints;
   Emit e{use.mesh, use.node, &weights, &no_joints, nullptr};
+  add_splat_instances(ctx, primitives, placements, use.node, node_where, gnode.skin >= 0 || gnode.skin < -1);
   // A skinned mesh ignores its node's own transform (glTF 3.7.3.3).
   if (gnode.skin >= 0 || gnode.skin < -1) {
     const std::vector<Transform> joint_mats = joint_matrices(ctx, nodes, gnode.skin, node_where);

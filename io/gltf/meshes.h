@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,10 @@ struct LocalPrimitive {
   bool points = false;       ///< POINTS: one degenerate triangle (i, i, i) per point (Mesh::points)
   bool lines = false;        ///< LINES, LINE_LOOP, LINE_STRIP: one (a, b, b) per segment (Mesh::lines)
   std::vector<float> radii;  ///< points and lines: the file's radii (PENUMBRA_points), else empty
-  bool usable = false;       ///< false: skipped with a warning
+  /// KHR_gaussian_splatting: the primitive's splats (their POINTS stay as the point cloud the
+  /// extension names as fallback, coloured by the splats' own colour without COLOR_0).
+  std::optional<SplatCloud> splats;
+  bool usable = false;  ///< false: skipped with a warning
 };
 
 /// The number of placements EXT_mesh_gpu_instancing declares on `node`: the largest count of its

@@ -171,7 +171,9 @@ uint64_t scene_memory_bytes(const Scene& scene) {
   }
   for (const Texture& t : scene.textures)
     for (const MipLevel& level : t.levels) total += bytes(level.texels);
-  total += bytes(scene.procedurals);
+  total += bytes(scene.procedurals) + bytes(scene.splat_clouds) + bytes(scene.splat_instances);
+  for (const SplatCloud& c : scene.splat_clouds)
+    total += bytes(c.positions) + bytes(c.rotations) + bytes(c.scales) + bytes(c.opacities) + bytes(c.sh);
   for (const ProceduralTexture& p : scene.procedurals) total += bytes(p.base_color.stops);
   return total;
 }

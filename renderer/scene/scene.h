@@ -11,6 +11,7 @@
 #include "renderer/core/math.h"
 #include "renderer/core/motion.h"
 #include "renderer/procedural/pattern.h"
+#include "renderer/scene/splats.h"
 #include "renderer/scene/texture.h"
 #include "renderer/shapes/shape.h"
 
@@ -210,6 +211,9 @@ struct Scene {
   /// lights[i] is the light at the frame's time.
   std::vector<std::vector<Light>> light_motion;
   std::vector<Camera> cameras;
+  /// Gaussian splats (KHR_gaussian_splatting): each primitive's cloud once, placed by instances.
+  std::vector<SplatCloud> splat_clouds;
+  std::vector<SplatInstance> splat_instances;
 };
 
 /// Light `index` at ray time `time`: the scene's own entry when it does not move, else `storage`
