@@ -42,6 +42,9 @@ std::string describe_shape(const Shape& sh) {
     case ShapeKind::Segment:
       std::snprintf(buf, sizeof buf, "(radius %.4g, length %.4g)", sh.radius, length(sh.p1 - sh.p0));
       break;
+    case ShapeKind::Splat:
+      std::snprintf(buf, sizeof buf, "(opacity %.4g)", sh.opacity);
+      break;
     case ShapeKind::Implicit:
       std::snprintf(buf, sizeof buf, "(%zu CSG node%s)", sh.sdf.nodes.size(),
                     sh.sdf.nodes.size() == 1 ? "" : "s");

@@ -343,6 +343,8 @@ json shape_json(const SceneShape& ss, size_t material_count, Writer& wr) {
       break;
     case ShapeKind::Segment:
       throw InputError(file, "shapes", ss.name + ": a curve segment is written with its curve set");
+    case ShapeKind::Splat:
+      throw InputError(file, "shapes", ss.name + ": a Gaussian splat is written with its splat cloud");
     case ShapeKind::Implicit:
       if (s.sdf.root < 0) throw InputError(file, "shapes", ss.name + ": an implicit shape without a tree");
       j["csg"] = csg_json(s.sdf, s.sdf.root, wr);

@@ -345,16 +345,7 @@ LocalPrimitive decode_primitive(const GltfContext& ctx, size_t mesh_index, size_
     out.splats->mesh = int(mesh_index);
     out.splats->primitive = int(pi);
     out.splats->name = idx("meshes", mesh_index) + "[" + std::to_string(pi) + "]";
-    if (raw.col.empty()) {  // the fallback points' colour: each splat's own, seen head on
-      raw.col_components = 4;
-      raw.col.resize(nv * 4);
-      for (size_t i = 0; i < nv; ++i) {
-        const Vec3f c =
-            splat_linear_color(out.splats->color_space, splat_sh_color(*out.splats, i, {0, 0, -1}));
-        raw.col[4 * i] = c.x, raw.col[4 * i + 1] = c.y, raw.col[4 * i + 2] = c.z;
-        raw.col[4 * i + 3] = out.splats->opacities[i];
-      }
-    }
+    return out;  // rendered as splats: the extension's fallback points are not needed
   }
   if (out.indices.empty()) {
     ctx.warn(where,
@@ -531,7 +522,7 @@ void emit_primitives(const GltfContext& ctx, const std::vector<LocalPrimitive>& 
                         ? determinant3x3((*e.joint_mats)[0]) < 0
                         : determinant3x3(world) < 0;  // mirrored: keep counter-clockwise = front
   for (size_t pi = 0; pi < primitives.size(); ++pi) {
-    if (!primitives[pi].usable) continue;
+    if (!primitives[pi].usable || primitives[pi].splats) continue;
     Mesh out;
     if (!place_primitive(ctx, primitives[pi], e, pi, world, inv, flip, out)) continue;
     if (!e.object_ids) out.object_from_world = to_affine(inv);
@@ -629,7 +620,10 @@ void add_splat_instances(const GltfContext& ctx, const std::vector<LocalPrimitiv
           scene.splat_clouds[c].primitive == p.splats->primitive)
         cloud = int(c);
     if (cloud < 0) {
-      ctx.charge(uint64_t(p.splats->positions.size()) * (12 + 16 + 12 + 4) + p.splats->sh.size() * 12,
+      // The cloud, and its splats' shapes as the splat structure copies them (twice: the
+      // view's and the structure's) with a node's share.
+      ctx.charge(uint64_t(p.splats->positions.size()) * (12 + 16 + 12 + 4 + 2 * sizeof(Shape) + 64) +
+                     p.splats->sh.size() * 12,
                  p.splats->name, "its Gaussian splats need");
       scene.splat_clouds.push_back(*p.splats);
       cloud = int(scene.splat_clouds.size()) - 1;

@@ -35,8 +35,8 @@ struct LocalPrimitive {
   bool points = false;       ///< POINTS: one degenerate triangle (i, i, i) per point (Mesh::points)
   bool lines = false;        ///< LINES, LINE_LOOP, LINE_STRIP: one (a, b, b) per segment (Mesh::lines)
   std::vector<float> radii;  ///< points and lines: the file's radii (PENUMBRA_points), else empty
-  /// KHR_gaussian_splatting: the primitive's splats (their POINTS stay as the point cloud the
-  /// extension names as fallback, coloured by the splats' own colour without COLOR_0).
+  /// KHR_gaussian_splatting: the primitive's splats, rendered as splats (placed by
+  /// add_splat_instances) instead of the POINTS the extension names as fallback.
   std::optional<SplatCloud> splats;
   bool usable = false;  ///< false: skipped with a warning
 };

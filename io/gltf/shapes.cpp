@@ -238,6 +238,7 @@ void ShapeReader::analytic(const json& ext, const std::string& where, Shape& sha
       break;
     case ShapeKind::Implicit:
     case ShapeKind::Segment:
+    case ShapeKind::Splat:
       break;
   }
 }

@@ -24,6 +24,7 @@ enum class CurveKind : uint8_t {
   Points,    ///< each triangle (i, i, i) is a sphere of radius radii[i] about positions[i]
   Segments,  ///< each triangle (a, b, b) is a capsule of radius (radii[a] + radii[b]) / 2 about
              ///< the segment positions[a]-positions[b] (round linear curve with constant radius)
+  Shapes,    ///< no triangles: element i is the shape elements[i] (a splat cloud's splats)
 };
 
 /// A read-only view of one geometry: a triangle mesh, a curve set (`curves` not None: its
@@ -39,6 +40,7 @@ struct GeometryView {
   const Shape* shape = nullptr;        ///< a shape instead of triangles (positions, indices unused)
   CurveKind curves = CurveKind::None;  ///< the triangles stand for points or segments
   std::span<const float> radii;        ///< curves: one radius (>= 0) per position
+  std::span<const Shape> elements;     ///< CurveKind::Shapes: the elements (prim_id = index)
   /// Deformation motion blur: `motion_steps` >= 2 copies of the positions (step after step,
   /// motion_steps x positions.size() entries) spread evenly over Ray::time 0 to 1, each vertex
   /// linearly interpolated between the two steps around a ray's time (interpolate_vertex). 0 (and
@@ -49,7 +51,10 @@ struct GeometryView {
 
   bool deforms() const { return motion_steps >= 2 && !shape && curves == CurveKind::None; }
   /// Curve elements (points or segments) of a curve set view; 0 otherwise.
-  size_t curve_count() const { return curves == CurveKind::None || shape ? 0 : indices.size() / 3; }
+  size_t curve_count() const {
+    if (curves == CurveKind::None || shape) return 0;
+    return curves == CurveKind::Shapes ? elements.size() : indices.size() / 3;
+  }
 };
 
 /// One placement of a geometry: the mesh's triangles (or the shape) mapped by `to_world` (object
@@ -203,9 +208,15 @@ class RegionVisitor {
   virtual void visit(uint32_t geom_id, uint32_t prim_id, QueryRegion& region) = 0;
 };
 
-/// Element `i` of a curve set view as the Segment shape every back end tests (a sphere for a
-/// point); its radius is not finite or negative, and it is never hit, when the radii say so.
+/// Element `i` of a curve set view as the shape every back end tests: a Segment (a sphere for a
+/// point; its radius is not finite or negative, and it is never hit, when the radii say so), or
+/// the view's own element for CurveKind::Shapes.
 inline Shape curve_element(const GeometryView& v, size_t i) {
+  if (v.curves == CurveKind::Shapes) {
+    Shape s = v.elements[i];
+    s.element = uint32_t(i);
+    return s;
+  }
   const uint32_t a = v.indices[3 * i], b = v.indices[3 * i + 1];
   const float r = v.curves == CurveKind::Points ? v.radii[a] : 0.5f * (v.radii[a] + v.radii[b]);
   return make_segment_shape(v.positions[a], v.curves == CurveKind::Points ? v.positions[a] : v.positions[b],

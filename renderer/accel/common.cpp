@@ -14,7 +14,9 @@ std::vector<PrimitiveRecord> gather_primitives(std::span<const GeometryView> vie
   // non-finite vertex (and shapes without finite bounds) are squeezed out, order kept.
   std::vector<size_t> offset(views.size() + 1, 0);
   for (size_t g = 0; g < views.size(); ++g)
-    offset[g + 1] = offset[g] + (views[g].shape ? 1 : views[g].indices.size() / 3);
+    offset[g + 1] = offset[g] + (views[g].shape                       ? 1
+                                 : views[g].curves != CurveKind::None ? views[g].curve_count()
+                                                                      : views[g].indices.size() / 3);
   std::vector<PrimitiveRecord> records(offset.back());
   size_t table = shapes.size();  // the shape table's size when every shape and element is in
   for (const GeometryView& v : views) table += v.shape ? 1 : v.curve_count();

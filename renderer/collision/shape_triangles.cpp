@@ -115,6 +115,9 @@ ShapeTriangles shape_triangles(const Shape& shape, const ShapeTrianglesConfig& c
         for (size_t i = 0; i < out.indices.size(); i += 3) std::swap(out.indices[i + 1], out.indices[i + 2]);
       return out;
     }
+    case ShapeKind::Splat:  // a density without a surface: no triangles
+      out.closed = false;
+      return out;
     case ShapeKind::Plane: {
       const float x = shape.half_size.x, z = shape.half_size.z;
       out.positions = {{-x, 0, -z}, {x, 0, -z}, {x, 0, z}, {-x, 0, z}};
@@ -164,6 +167,8 @@ ShapeTrianglesCount shape_triangles_count(const Shape& shape, const ShapeTriangl
       return {faces / 2 + 2, faces};
     case ShapeKind::Plane:
       return {4, 2};
+    case ShapeKind::Splat:
+      return {};
     case ShapeKind::Disk:
       return {uint64_t(config.disk_segments) + 1, uint64_t(config.disk_segments)};
     case ShapeKind::Implicit: {

@@ -72,6 +72,22 @@ void AovPixel::add_hit(const Scene& scene, const SurfaceInteraction& si, const M
   m_materials.push_back(m >= 0 ? uint32_t(m) + 1 : 0);
 }
 
+void AovPixel::add_splats(Vec3f p, Vec3f n, Vec3f albedo, float depth, int node, uint32_t s) {
+  const int h = int(s & 1u);
+  ++m_half_samples[h];
+  ++m_half_hits[h];
+  m_half_albedo[h] += albedo;
+  m_half_normal[h] += n;
+  m_half_depth[h] = std::min(m_half_depth[h], depth);
+  m_albedo += albedo;
+  m_normal += n;
+  m_position += p;
+  ++m_hits;
+  m_depth = std::min(m_depth, depth);
+  m_objects.push_back(node >= 0 ? uint32_t(node) + 1 : 0);
+  m_materials.push_back(0);
+}
+
 namespace {
 // The most frequent id (ties: the smaller one).
 float majority(std::vector<uint32_t>& ids) {
@@ -184,7 +200,14 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
         for (uint32_t s = 0; s < uint32_t(config.spp); ++s) {
           const Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           Hit hit;
-          if (!intersect_visible(scene, accel, ray, hit, filter)) {
+          SplatLayer splats;
+          const bool found = intersect_visible(scene, accel, ray, hit, filter, &splats);
+          if (splats.median.valid()) {
+            const SplatPoint sp = splat_point(scene, splats, ray);
+            pixel.add_splats(sp.p, sp.n, sp.color, dot(sp.p - camera.eye, -camera.w), sp.node, s);
+            continue;
+          }
+          if (!found) {
             pixel.add_miss(s);
             continue;
           }

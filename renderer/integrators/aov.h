@@ -12,6 +12,9 @@
 //           reads it) among the samples that hit; +inf where every sample misses;
 //   ids     the id hit by most samples (ties: the smaller id); 0 = background. Object id = glTF
 //           node index + 1, material id = material index + 1 (0 = the default material).
+// Gaussian splats count where the transmittance through them falls below 1/2 (their median
+// splat, visibility.h's SplatLayer): that splat's point and ellipsoid normal, the layer's colour
+// as albedo, its node's object id and material id 0.
 
 #include <cstdint>
 #include <vector>
@@ -72,6 +75,10 @@ class AovPixel {
   /// albedo, normal and depth (denoise_feature).
   void add_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialPoint& mp, float depth,
                uint32_t s = 0, const DenoiseFeature* feature = nullptr);
+  /// Sample `s` of the pixel, whose first visible thing is a layer of Gaussian splats standing
+  /// for a surface at world point p, normal n, colour `albedo`, camera depth `depth`, glTF node
+  /// `node` (object id node + 1; material id 0). The halves record the same.
+  void add_splats(Vec3f p, Vec3f n, Vec3f albedo, float depth, int node, uint32_t s = 0);
   /// Writes pixel i; the halves too when aovs.halves is not empty.
   void store(DataAovs& aovs, size_t i, int spp);
 

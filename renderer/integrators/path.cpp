@@ -180,13 +180,28 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
                         cfg.strategy != LightStrategy::Light};
   const DirectLightingMode mode{ctx.sample_lights, ctx.bsdf_lights, cfg.hit_filter, cfg.light_sampler,
                                 cfg.light_samples};
+  Vec3f splats_seen{0, 0, 0};  // what the deep records of splats in front of the camera hold
   Segment seg;
   seg.ray = camera_ray;
   seg.ray.dir = normalize(seg.ray.dir);
 
   for (int vertex = 0;;) {
     Hit hit;
-    if (!intersect_visible(scene, accel, seg.ray, hit, cfg.hit_filter)) {
+    SplatLayer splats;
+    const bool found = intersect_visible(scene, accel, seg.ray, hit, cfg.hit_filter, &splats);
+    if (splats.count > 0) {  // Gaussian splats in front: their baked radiance, as emission
+      path.add(seg.beta * splats.radiance, vertex - 1);
+      if (vertex == 0) {  // the camera ray: coverage 1 - the transmittance so far
+        if (deep) {
+          deep->add(splat_deep_hit(scene, splats, seg.ray, *deep, 1 - coverage));
+          splats_seen += seg.beta * splats.radiance;
+        }
+        coverage = 1 - (1 - coverage) * splats.transmittance;
+      }
+      seg.beta *= splats.transmittance;
+      if (!(max_component(seg.beta) > 0)) break;
+    }
+    if (!found) {
       add_escaped(ctx, seg, vertex, path);
       break;
     }
@@ -206,13 +221,17 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     }
     seg.layers = 0;
     if (vertex == 0) {
-      coverage = 1;
-      if (deep) {
+      if (deep) {  // its weight: the transmittance of the splats in front
         const Instance& inst = scene.instances[si.instance];
-        first = {
-            si.instance + 1, inst.node >= 0 ? uint32_t(inst.node) + 1 : 0, deep->depth_of(si.p), 1, {}, mp.ns,
-            mp.base_color};
+        first = {si.instance + 1,
+                 inst.node >= 0 ? uint32_t(inst.node) + 1 : 0,
+                 deep->depth_of(si.p),
+                 1 - coverage,
+                 {},
+                 mp.ns,
+                 mp.base_color};
       }
+      coverage = 1;
     }
 
     // Emitter hit.
@@ -248,8 +267,8 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
     seg.ray.time = si.time;
     ++counts.reflection;
   }
-  if (deep && (first.key != 0 || max_component(path.radiance) > 0)) {
-    first.radiance = path.radiance;
+  if (deep && (first.key != 0 || max_component(path.radiance - splats_seen) > 0)) {
+    first.radiance = path.radiance - splats_seen;
     if (first.key == 0) first.depth = kInfinity;
     deep->add(first);
   }

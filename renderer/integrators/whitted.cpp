@@ -111,7 +111,24 @@ struct Tracer {
   Vec3f trace(const Ray& ray, const RayDifferential& rd, int depth, int layers, Vec3f weight,
               float* coverage) {
     Hit hit;
-    if (!intersect_visible(scene, accel, ray, hit, cfg.hit_filter)) {
+    SplatLayer splats;
+    const bool found = intersect_visible(scene, accel, ray, hit, cfg.hit_filter, &splats);
+    if (splats.count == 0) return shade(ray, rd, depth, layers, weight, coverage, found, hit);
+    // Gaussian splats in front: their baked radiance over what lies behind them.
+    if (coverage && deep) deep->add(splat_deep_hit(scene, splats, ray, *deep, weight.x));
+    float behind_coverage = 0;
+    Vec3f behind{0, 0, 0};
+    if (splats.transmittance > 0)
+      behind = shade(ray, rd, depth, layers, weight * splats.transmittance,
+                     coverage ? &behind_coverage : nullptr, found, hit);
+    if (coverage) *coverage = 1 - splats.transmittance + splats.transmittance * behind_coverage;
+    return splats.radiance + behind * splats.transmittance;
+  }
+
+  // Radiance along `ray` from its visible surface `hit` (found false: the background).
+  Vec3f shade(const Ray& ray, const RayDifferential& rd, int depth, int layers, Vec3f weight, float* coverage,
+              bool found, const Hit& hit) {
+    if (!found) {
       if (coverage) *coverage = 0;
       // On the camera ray's chain of Blend layers all weights are the transmittance in front.
       if (coverage && deep && max_component(cfg.background) > 0)

@@ -104,8 +104,8 @@ SurfaceInteraction make_curve_interaction(const Scene& scene, const Instance& in
   if (!(dot(n, n) > 0) || !is_finite(n)) n = normalize(-ray.dir);
   const uint32_t a = tri.index[0], b = tri.index[1];
   const float s = mesh.points ? 0.0f : surf.uv.x, w = 1 - s;
-  auto lerp2 = [&](const std::vector<Vec2f>& t) -> Vec2f {
-    return {t[a].x * w + t[b].x * s, t[a].y * w + t[b].y * s};
+  auto lerp2 = [&](const std::vector<Vec2f>& uv) -> Vec2f {
+    return {uv[a].x * w + uv[b].x * s, uv[a].y * w + uv[b].y * s};
   };
   if (mesh.uvs.size() == mesh.positions.size()) si.uv[0] = lerp2(mesh.uvs);
   if (mesh.uvs1.size() == mesh.positions.size()) si.uv[1] = lerp2(mesh.uvs1);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace penumbra {
 
@@ -56,44 +57,54 @@ Vec3f splat_linear_color(SplatColorSpace space, Vec3f c) {
   return {decode(c.x), decode(c.y), decode(c.z)};
 }
 
+Shape splat_shape(const SplatCloud& cloud, size_t i, uint32_t element) {
+  return make_splat_shape(cloud.positions[i], cloud.rotations[i], cloud.scales[i], cloud.opacities[i],
+                          element);
+}
+
 bool splat_ray_response(const SplatCloud& cloud, size_t i, const Ray& ray, float& t_max, float& alpha) {
   alpha = 0;
-  const Mat3 r = quaternion_matrix(cloud.rotations[i]);
-  const double s[3] = {cloud.scales[i].x, cloud.scales[i].y, cloud.scales[i].z};
-  if (!(s[0] > 0 && s[1] > 0 && s[2] > 0)) return false;
-  const Vec3f mu = cloud.positions[i];
-  const double o[3] = {double(ray.org.x) - mu.x, double(ray.org.y) - mu.y, double(ray.org.z) - mu.z};
-  const double d[3] = {ray.dir.x, ray.dir.y, ray.dir.z};
-  double ow[3], dw[3];  // S^-1 R^T (o - mu), S^-1 R^T d
-  for (int k = 0; k < 3; ++k) {
-    ow[k] = (r[0][size_t(k)] * o[0] + r[1][size_t(k)] * o[1] + r[2][size_t(k)] * o[2]) / s[k];
-    dw[k] = (r[0][size_t(k)] * d[0] + r[1][size_t(k)] * d[1] + r[2][size_t(k)] * d[2]) / s[k];
-  }
-  const double dd = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];
-  if (!(dd > 0)) return false;
-  const double t = -(ow[0] * dw[0] + ow[1] * dw[1] + ow[2] * dw[2]) / dd;
-  double m2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double v = ow[k] + t * dw[k];
-    m2 += v * v;
-  }
+  const Shape s = splat_shape(cloud, i, uint32_t(i));
+  double t = 0, m2 = 0, a = 0;
+  if (!(s.half_size.x >= 0) || !splat_response(s, ray, t, m2, a)) return false;
   t_max = float(t);
-  alpha = float(cloud.opacities[i] * std::exp(-0.5 * m2));
+  alpha = float(a);
   return std::isfinite(t_max) && std::isfinite(alpha);
 }
 
-Bounds3f splat_bounds(const SplatCloud& cloud, size_t i, float sigmas) {
-  // The extent of the ellipsoid along world axis a: sigmas sqrt(sum_k (R_ak s_k)^2).
-  const Mat3 r = quaternion_matrix(cloud.rotations[i]);
-  const double s[3] = {cloud.scales[i].x, cloud.scales[i].y, cloud.scales[i].z};
-  Vec3f half;
-  for (int a = 0; a < 3; ++a) {
-    double e = 0;
-    for (int k = 0; k < 3; ++k) e += (r[size_t(a)][size_t(k)] * s[k]) * (r[size_t(a)][size_t(k)] * s[k]);
-    half[a] = float(sigmas * std::sqrt(e));
+Bounds3f splat_bounds(const SplatCloud& cloud, size_t i) {
+  return shape_bounds(splat_shape(cloud, i, uint32_t(i)));
+}
+
+Vec3f fibonacci_direction(int i, int n) {
+  const double golden = 3.14159265358979323846 * (3 - std::sqrt(5.0));
+  const double y = 1 - 2 * (i + 0.5) / n, r = std::sqrt(std::max(0.0, 1 - y * y)), phi = golden * i;
+  return {float(r * std::cos(phi)), float(y), float(r * std::sin(phi))};
+}
+
+SplatCloud make_splat_sphere(const SplatSphereConfig& c) {
+  if (!(c.radius > 0) || !std::isfinite(c.radius) || c.count < 1 || !(c.tangent_scale >= 0) ||
+      !(c.normal_scale >= 0) || !(c.opacity >= 0 && c.opacity <= 1) || !is_finite(c.centre))
+    throw std::invalid_argument("splat sphere: radius > 0, count >= 1, scales >= 0, opacity in [0, 1]");
+  const float spacing = std::sqrt(4 * 3.14159265f * c.radius * c.radius / float(c.count));
+  const float st = c.tangent_scale > 0 ? c.tangent_scale : 0.6f * spacing;
+  const float sn = c.normal_scale > 0 ? c.normal_scale : st / 10;
+  SplatCloud cloud;
+  cloud.name = "splat sphere";
+  cloud.color_space = SplatColorSpace::LinRec709Display;
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3f n = fibonacci_direction(i, c.count);
+    cloud.positions.push_back(c.centre + n * c.radius);
+    // The rotation taking +z to n: axis z x n = (-n.y, n.x, 0), half-angle form (1 + n.z, axis).
+    Vec4f q{-n.y, n.x, 0, 1 + n.z};
+    const float len = std::sqrt(q.x * q.x + q.y * q.y + q.w * q.w);
+    q = len > 1e-6f ? Vec4f{q.x / len, q.y / len, 0, q.w / len} : Vec4f{1, 0, 0, 0};
+    cloud.rotations.push_back(q);
+    cloud.scales.push_back({st, st, sn});
+    cloud.opacities.push_back(c.opacity);
+    cloud.sh.push_back(n * (0.5f / 0.2820947917738781f));
   }
-  const Vec3f c = cloud.positions[i];
-  return {c - half, c + half};
+  return cloud;
 }
 
 }  // namespace penumbra

@@ -14,6 +14,7 @@
 
 #include "renderer/core/geometry.h"
 #include "renderer/core/math.h"
+#include "renderer/shapes/shape.h"
 
 namespace penumbra {
 
@@ -68,14 +69,39 @@ Vec3f splat_sh_color(const SplatCloud& cloud, size_t i, Vec3f dir);
 /// SrgbRec709Display).
 Vec3f splat_linear_color(SplatColorSpace space, Vec3f c);
 
+/// Splat i as the Splat shape the structures hold (make_splat_shape), reporting prim_id `element`.
+Shape splat_shape(const SplatCloud& cloud, size_t i, uint32_t element);
+
 /// The response of splat i along ray o + t d at its maximum (3DGRT): t* = -(o'.d')/(d'.d') in the
 /// splat's whitened frame (o' = S^-1 R^T (o - mu), d' = S^-1 R^T d), and
-/// alpha = opacity exp(-|o' + t* d'|^2 / 2). Returns false (and alpha 0) for a splat with a zero
-/// scale or a zero direction.
+/// alpha = opacity exp(-|o' + t* d'|^2 / 2) (splat_response over splat_shape: scales below 1e-3
+/// of the largest raised to it). Returns false (and alpha 0) for a splat without a positive
+/// scale or opacity, or a zero direction.
 bool splat_ray_response(const SplatCloud& cloud, size_t i, const Ray& ray, float& t_max, float& alpha);
 
-/// The box holding splat i out to `sigmas` standard deviations along each of its axes (the
+/// The box holding splat i out to kSplatSigmas standard deviations along each of its axes (the
 /// extension's ellipse kernel cuts off at 3).
-Bounds3f splat_bounds(const SplatCloud& cloud, size_t i, float sigmas = 3);
+Bounds3f splat_bounds(const SplatCloud& cloud, size_t i);
+
+/// A splat field fitted to a sphere, with a known colour pattern: the generator of test scenes
+/// and of the shipped splat scene.
+struct SplatSphereConfig {
+  Vec3f centre{0, 0, 0};
+  float radius = 1;         ///< > 0
+  int count = 2000;         ///< splats, >= 1, on a Fibonacci lattice
+  float tangent_scale = 0;  ///< standard deviation along the surface; 0: 0.6 x the lattice
+                            ///< spacing sqrt(4 pi radius^2 / count)
+  float normal_scale = 0;   ///< standard deviation across it; 0: tangent_scale / 10
+  float opacity = 1;        ///< of every splat, in [0, 1]
+};
+
+/// The sphere: splat i at centre + radius n_i (n_i the i-th Fibonacci lattice direction), its
+/// local z axis along n_i, and the colour 0.5 + 0.5 n_i from every direction (degree 0, linear
+/// BT.709: the DC coefficient is (colour - 0.5) / 0.2820948). Throws std::invalid_argument for
+/// parameters outside the ranges above.
+SplatCloud make_splat_sphere(const SplatSphereConfig& config);
+
+/// The i-th of n Fibonacci lattice directions on the unit sphere (y from near 1 down to near -1).
+Vec3f fibonacci_direction(int i, int n);
 
 }  // namespace penumbra

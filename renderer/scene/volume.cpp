@@ -177,6 +177,7 @@ ShapeVolume shape_volume(const Shape& shape, const VolumeConfig& config) {
     }
     case ShapeKind::Plane:
     case ShapeKind::Disk:
+    case ShapeKind::Splat:
       break;
     case ShapeKind::Implicit:
       v = implicit_volume(shape, config);

@@ -316,6 +316,8 @@ const char* shape_kind_name(ShapeKind kind) {
       return "implicit";
     case ShapeKind::Segment:
       return "segment";
+    case ShapeKind::Splat:
+      return "splat";
   }
   return "unknown";
 }
@@ -346,6 +348,51 @@ Shape make_segment_shape(Vec3f p0, Vec3f p1, float radius, uint32_t element) {
   return s;
 }
 
+Shape make_splat_shape(Vec3f centre, Vec4f q, Vec3f scale, float opacity, uint32_t element) {
+  Shape s;
+  s.kind = ShapeKind::Splat;
+  s.p0 = centre;
+  s.element = element;
+  const double big = std::max({double(scale.x), double(scale.y), double(scale.z)});
+  if (!(big > 0) || !std::isfinite(big) || !(opacity > 0) || !std::isfinite(opacity)) {
+    s.half_size = {-1, -1, -1};  // empty bounds: never hit
+    return s;
+  }
+  s.opacity = std::min(opacity, 1.0f);
+  const double x = q.x, y = q.y, z = q.z, w = q.w;
+  const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                          {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                          {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+  const double sd[3] = {std::max(double(scale.x), 1e-3 * big), std::max(double(scale.y), 1e-3 * big),
+                        std::max(double(scale.z), 1e-3 * big)};
+  for (int k = 0; k < 3; ++k)  // row k of S^-1 R^T is column k of R over s_k
+    s.whiten[size_t(k)] = {float(r[0][k] / sd[k]), float(r[1][k] / sd[k]), float(r[2][k] / sd[k])};
+  for (int a = 0; a < 3; ++a) {  // the ellipsoid's extent along axis a: sigmas |row a of R S|
+    double e = 0;
+    for (int k = 0; k < 3; ++k) e += (r[a][k] * sd[k]) * (r[a][k] * sd[k]);
+    s.half_size[a] = float(kSplatSigmas * std::sqrt(e) * (1 + 1e-5));
+  }
+  return s;
+}
+
+bool splat_response(const Shape& s, const Ray& ray, double& t, double& m2, double& alpha) {
+  const double o[3] = {double(ray.org.x) - s.p0.x, double(ray.org.y) - s.p0.y, double(ray.org.z) - s.p0.z};
+  const double d[3] = {ray.dir.x, ray.dir.y, ray.dir.z};
+  double ow[3], dw[3];
+  for (size_t k = 0; k < 3; ++k) {
+    const Vec3f w = s.whiten[k];
+    ow[k] = w.x * o[0] + w.y * o[1] + w.z * o[2];
+    dw[k] = w.x * d[0] + w.y * d[1] + w.z * d[2];
+  }
+  const double dd = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];
+  if (!(dd > 0)) return false;
+  t = -(ow[0] * dw[0] + ow[1] * dw[1] + ow[2] * dw[2]) / dd;
+  m2 = 0;
+  for (int k = 0; k < 3; ++k) m2 += (ow[k] + t * dw[k]) * (ow[k] + t * dw[k]);
+  alpha = s.opacity * std::exp(-0.5 * m2);
+  return std::isfinite(t) && std::isfinite(m2);
+}
+
 Bounds3f shape_bounds(const Shape& s) {
   switch (s.kind) {
     case ShapeKind::Sphere:
@@ -367,6 +414,9 @@ Bounds3f shape_bounds(const Shape& s) {
       const Vec3f r{s.radius, s.radius, s.radius};
       return {min(s.p0, s.p1) - r, max(s.p0, s.p1) + r};
     }
+    case ShapeKind::Splat:
+      if (!(s.half_size.x >= 0)) return {};
+      return {s.p0 - s.half_size, s.p0 + s.half_size};
   }
   return {};
 }
@@ -400,6 +450,13 @@ bool intersect_shape(const Shape& s, const Ray& ray, ShapeHit& hit) {
     case ShapeKind::Segment:
       t = intersect_segment(r, s.p0, s.p1, s.radius);
       break;
+    case ShapeKind::Splat: {
+      double ts = 0, m2 = 0, alpha = 0;
+      if (splat_response(s, ray, ts, m2, alpha) && m2 <= double(kSplatSigmas) * kSplatSigmas &&
+          alpha >= kSplatMinAlpha)
+        t = ts;
+      break;
+    }
     case ShapeKind::Implicit:
       break;
   }
@@ -463,6 +520,13 @@ ShapeSurface shape_surface(const Shape& s, Vec3f p, float h) {
       out.n = dot(n, n) > 0 ? normalize(n) : Vec3f{0, 1, 0};
       out.uv = {u, 0};
       out.has_uv = true;
+      break;
+    }
+    case ShapeKind::Splat: {  // the gradient of the Mahalanobis distance: W^T W (p - p0)
+      const Vec3f o = p - s.p0;
+      const Vec3f n = s.whiten[0] * dot(s.whiten[0], o) + s.whiten[1] * dot(s.whiten[1], o) +
+                      s.whiten[2] * dot(s.whiten[2], o);
+      out.n = dot(n, n) > 0 && is_finite(n) ? normalize(n) : Vec3f{0, 1, 0};
       break;
     }
     case ShapeKind::Implicit:

@@ -4,6 +4,7 @@
 // surface data (normal, UV) at a hit point. Pure geometry: no materials, no placement.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "renderer/core/geometry.h"
@@ -22,12 +23,14 @@ enum class ShapeKind : uint8_t {
   Implicit,  ///< the zero set of sdf (f < 0 inside), sphere traced
   Segment,   ///< points within radius of the segment p0-p1 (a sphere about p0 when p1 == p0): one
              ///< line segment or point of a curve set (GeometryView::curves), in its view's space
+  Splat,     ///< a 3D Gaussian about p0 (make_splat_shape), hit at its response's maximum along
+             ///< the ray where that is inside kSplatSigmas and at least kSplatMinAlpha
 };
 
 /// Number of ShapeKind values.
-inline constexpr int kShapeKindCount = 7;
+inline constexpr int kShapeKindCount = 8;
 
-/// "sphere", "plane", "disk", "box", "capsule", "implicit", "segment".
+/// "sphere", "plane", "disk", "box", "capsule", "implicit", "segment", "splat".
 const char* shape_kind_name(ShapeKind kind);
 
 /// One shape in its object space. Make implicit shapes with make_implicit_shape() so that
@@ -36,19 +39,42 @@ struct Shape {
   ShapeKind kind = ShapeKind::Sphere;
   float radius = 1;          ///< Sphere, Disk, Capsule; > 0
   float half_height = 0.5f;  ///< Capsule: half length of the axis segment; >= 0
-  Vec3f half_size{1, 1, 1};  ///< Box: half extents (> 0); Plane: x and z half sizes (> 0)
+  Vec3f half_size{1, 1, 1};  ///< Box: half extents (> 0); Plane: x and z half sizes (> 0);
+                             ///< Splat: the half extents of its box at kSplatSigmas
   SdfTree sdf;               ///< Implicit: the CSG tree, in object space
   float lipschitz = 1;       ///< Implicit: sdf_lipschitz(sdf)
   Bounds3f sdf_bounds;       ///< Implicit: a box holding every point with f <= 0
   SphereTraceConfig trace;   ///< Implicit: step budget and tolerances
-  Vec3f p0, p1;              ///< Segment: the axis' end points
-  uint32_t element = 0;      ///< the prim_id a hit on it reports: a Segment's index in its curve
-                             ///< set; 0 for a shape of its own
+  Vec3f p0, p1;              ///< Segment: the axis' end points; Splat: p0 is the centre
+  /// Splat: the rows of S^-1 R^T, which map p - p0 into the Gaussian's whitened frame (where its
+  /// density is exp(-|x|^2 / 2)).
+  std::array<Vec3f, 3> whiten{};
+  float opacity = 0;     ///< Splat: the peak opacity, in [0, 1]
+  uint32_t element = 0;  ///< the prim_id a hit on it reports: a Segment's index in its curve
+                         ///< set; 0 for a shape of its own
 };
 
 /// A Segment shape: the capsule of `radius` about p0-p1 (a sphere when they are equal) that
 /// reports prim_id `element`.
 Shape make_segment_shape(Vec3f p0, Vec3f p1, float radius, uint32_t element);
+
+/// Mahalanobis distance at which a splat's kernel ends (the extension's ellipse kernel: 3 sigma).
+inline constexpr float kSplatSigmas = 3;
+/// Responses below this are not hits (as 3D Gaussian Splatting's rasteriser skips alpha < 1/255).
+inline constexpr float kSplatMinAlpha = 1.0f / 255;
+
+/// A Splat shape: the Gaussian about `centre` with unit rotation quaternion q = (x, y, z, w)
+/// (local to view space) and standard deviations `scale` along its local axes (Sigma =
+/// R S S^T R^T), of peak `opacity`, reporting prim_id `element`. Scales below 1e-3 of the
+/// largest are raised to it (a flat splat is a thin disc); a splat without a positive finite
+/// scale or opacity gets empty bounds (never hit).
+Shape make_splat_shape(Vec3f centre, Vec4f q, Vec3f scale, float opacity, uint32_t element);
+
+/// The response of a Splat shape along `ray` at its maximum (Moenne-Loccoz et al., "3D Gaussian
+/// Ray Tracing", 2024): t* = -(o'.d') / (d'.d') in the whitened frame (o' = W (o - p0),
+/// d' = W d), `m2` = |o' + t* d'|^2 the squared Mahalanobis distance there and
+/// alpha = opacity exp(-m2 / 2). False for a zero direction or a non-finite answer.
+bool splat_response(const Shape& splat, const Ray& ray, double& t, double& m2, double& alpha);
 
 /// An implicit shape over `tree` with its Lipschitz bound and bounds computed. The bounds are
 /// empty when the tree's inside is not bounded (a complement or half-space not intersected

@@ -73,6 +73,8 @@ Vec3f closest_point_on_shape(const Shape& s, Vec3f p) {
     }
     case ShapeKind::Implicit:
       return closest_on_implicit(s, p);
+    case ShapeKind::Splat:  // a density without a surface: its centre
+      return s.p0;
   }
   return p;
 }

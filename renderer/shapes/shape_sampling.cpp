@@ -90,6 +90,7 @@ float shape_area(const Shape& shape) {
     case ShapeKind::Segment:
       return 4 * kPi * r * (0.5f * length(shape.p1 - shape.p0) + r);
     case ShapeKind::Implicit:
+    case ShapeKind::Splat:  // a density, not a surface
       return 0;
   }
   return 0;
@@ -128,6 +129,9 @@ ShapePoint sample_shape_area(const Shape& shape, Vec2f u) {
       s.n = e1 * c.n.x + a * c.n.y + e2 * c.n.z;
       return s;
     }
+    case ShapeKind::Splat:
+      s.p = shape.p0;
+      break;
     case ShapeKind::Implicit:
       break;
   }
