@@ -8,6 +8,7 @@
 
 #include "renderer/integrators/visibility.h"
 #include "renderer/raster/shadow_map.h"
+#include "renderer/raster/splat_raster.h"
 
 namespace penumbra {
 
@@ -57,6 +58,8 @@ struct Shader {
   const RenderConfig& config;
   const LightVisibility& visibility;
   Film& film;
+  std::span<const ProjectedSplat> splats;  // sorted front to back
+  const SplatBins& bins;
 
   // The local radiance of fragment f seen by the camera ray through raster position p.
   Vec3f local(const RasterFragment& f, Vec2f p, const Ray& ray, float step, float& alpha,
@@ -84,10 +87,15 @@ struct Shader {
         for (int s = 0; s < t.spp; ++s, ++i) {
           const Vec2f p = t.positions[i];
           const Ray ray = raster_ray(cv.camera, cv.raster, p.x, p.y);
-          // Front to back: each Blend layer takes its alpha of what is left, the opaque
-          // surface (or the background) the rest.
+          // Front to back: each Blend layer and each splat in front of it takes its alpha of
+          // what is left, the opaque surface (or the background) the rest.
+          SplatCursor splat = splat_cursor(splats, bins, p);
           float remaining = 1;
           for (uint32_t k = t.blend_begin[i]; k < t.blend_begin[i + 1] && remaining > 0; ++k) {
+            const float before = remaining;
+            splat.advance(t.blend[k].depth, sum, remaining);
+            coverage += before - remaining;
+            if (!(remaining > 0)) break;
             float a = 1;
             const Vec3f l = local(t.blend[k], p, ray, step, a, counts);
             if (!(a > 0)) continue;
@@ -95,6 +103,9 @@ struct Shader {
             coverage += remaining * a;
             remaining *= 1 - a;
           }
+          const float before = remaining;
+          splat.advance(t.opaque[i].hit.valid() ? t.opaque[i].depth : kInfinity, sum, remaining);
+          coverage += before - remaining;
           if (!(remaining > 0)) continue;
           if (t.opaque[i].hit.valid()) {
             float a = 1;
@@ -176,11 +187,16 @@ Film render_raster(const Scene& scene, const Accelerator* accel, const Camera& c
     visibility = {&MapVisibility::transmittance, &*map_visibility};
   }
 
+  // Gaussian splats: projected, sorted and binned once for the frame.
+  const std::vector<ProjectedSplat> splats =
+      project_splats(scene, camera, config.width, config.height, win, config.threads);
+  const SplatBins bins = bin_splats(splats, win);
+
   std::atomic<uint64_t> shadow_rays{0};
   std::atomic<int> done{0};
   const int tiles = TileScheduler(win, config.tile_size, config.threads).tile_count();
   rasterize(scene, cv.view, pass, [&](const RasterTile& tile) {
-    Shader shader{scene, cv, config, visibility, film};
+    Shader shader{scene, cv, config, visibility, film, splats, bins};
     RayCounts counts;
     shader.tile(tile, counts);
     shadow_rays += counts.shadow;
@@ -203,6 +219,9 @@ DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const Rend
   const RasterPass pass = camera_raster_pass(config);
   const PixelWindow win = pass.window;
   DataAovs a = make_data_aovs(win);
+  const std::vector<ProjectedSplat> splats =
+      project_splats(scene, camera, config.width, config.height, win, config.threads);
+  const SplatBins bins = bin_splats(splats, win);
   rasterize(scene, cv.view, pass, [&](const RasterTile& t) {
     AovPixel pixel;
     size_t i = 0;
@@ -213,12 +232,24 @@ DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const Rend
           const RasterFragment* f = t.blend_begin[i] < t.blend_begin[i + 1] ? &t.blend[t.blend_begin[i]]
                                     : t.opaque[i].hit.valid()               ? &t.opaque[i]
                                                                             : nullptr;
+          const Vec2f p = t.positions[i];
+          const Ray ray = raster_ray(camera, cv.raster, p.x, p.y);
+          // Splats in front whose transmittance falls below 1/2 stand for the surface.
+          SplatCursor splat = splat_cursor(splats, bins, p);
+          Vec3f sum{0, 0, 0};
+          float remaining = 1;
+          splat.advance(f ? f->depth : kInfinity, sum, remaining);
+          if (splat.median) {
+            const float depth = splat.median->depth;
+            const Vec3f at = ray.org + ray.dir * (depth / std::max(dot(ray.dir, -camera.w), 1e-30f));
+            const int node = scene.splat_instances[splat.median->instance].node;
+            pixel.add_splats(at, normalize(-ray.dir), sum / (1 - remaining), depth, node);
+            continue;
+          }
           if (!f) {
             pixel.add_miss();
             continue;
           }
-          const Vec2f p = t.positions[i];
-          const Ray ray = raster_ray(camera, cv.raster, p.x, p.y);
           const SurfaceInteraction si =
               fragment_interaction(scene, cv, *f, ray, 0);  // finest texels, as traced
           pixel.add_hit(scene, si, eval_material(scene, si), f->depth);

@@ -15,8 +15,6 @@
 
 namespace penumbra {
 
-/// Below this transmittance a splat layer stops: what lies behind it is hidden.
-inline constexpr float kSplatMinTransmittance = 1e-3f;
 /// Splats gathered per traversal of the splat structure (the k-buffer's size).
 inline constexpr int kSplatChunk = 16;
 /// Most splats blended along one ray; the rest are left out.

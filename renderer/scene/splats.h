@@ -49,6 +49,9 @@ struct SplatInstance {
   int node = -1;  ///< glTF node, -1 if not from glTF
 };
 
+/// Below this transmittance a layer of splats stops (3DGRT): what lies behind it is hidden.
+inline constexpr float kSplatMinTransmittance = 1e-3f;
+
 /// A symmetric 3 x 3 matrix, row-major.
 using Mat3 = std::array<std::array<double, 3>, 3>;
 
