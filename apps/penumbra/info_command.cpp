@@ -501,7 +501,7 @@ int run_info(const InfoArgs& a) {
     for (const SplatCloud& c : s.splat_clouds) degree = std::max(degree, c.sh_degree);
     std::printf(
         "splats       %llu in %zu placements of %zu clouds, spherical harmonics to degree %d "
-        "(KHR_gaussian_splatting: rendered as their fallback points)\n",
+        "(KHR_gaussian_splatting: ray traced and rasterised)\n",
         static_cast<unsigned long long>(splats), s.splat_instances.size(), s.splat_clouds.size(), degree);
   }
   if (const uint64_t segments = count_line_segments(s))

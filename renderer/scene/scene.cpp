@@ -124,6 +124,14 @@ Bounds3f compute_bounds(const Scene& scene, uint64_t exact_vertex_limit) {
       b = merge(b, transform_bounds(inst.to_world, mesh_bounds[size_t(inst.mesh)]));
     }
   }
+  // Splats: their centres, placed (the boxes of their kernels would let one wide splat of a
+  // capture decide the framing).
+  std::vector<Bounds3f> cloud_bounds(scene.splat_clouds.size());
+  for (size_t c = 0; c < scene.splat_clouds.size(); ++c)
+    for (Vec3f p : scene.splat_clouds[c].positions) cloud_bounds[c] = merge(cloud_bounds[c], p);
+  for (const SplatInstance& si : scene.splat_instances)
+    if (!cloud_bounds[size_t(si.cloud)].empty())
+      b = merge(b, transform_bounds(si.to_world, cloud_bounds[size_t(si.cloud)]));
   return b;
 }
 

@@ -248,7 +248,8 @@ inline bool renders_as_curves(const Mesh& m) {
 /// normals +Z, the default material. Requires points.size() < 2^32 / 3.
 Mesh make_point_set(std::vector<Vec3f> points, std::string name);
 
-/// World-space bounds of every instance's positions and shapes (empty box for an empty scene); exact
+/// World-space bounds of every instance's positions and shapes, and of the placed splats'
+/// centres (empty box for an empty scene); exact
 /// unless the meshes placed by non-identity instances hold more than `exact_vertex_limit`
 /// vertices in all, then each such placement contributes the mapped box of its mesh
 /// (conservative, and as cheap for a million placements as for one).
