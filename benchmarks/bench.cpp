@@ -54,6 +54,7 @@
 #include "renderer/integrators/cost_map.h"
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
+#include "renderer/integrators/visibility.h"
 #include "renderer/procedural/noise.h"
 #include "renderer/scene/camera.h"
 #include "renderer/scene/interaction.h"
@@ -71,9 +72,12 @@ using bench::Row;
 using bench::seconds_since;
 
 struct RaySet {
-  std::string kind;  // primary, shadow, diffuse, random, motion
+  std::string kind;  // primary, shadow, diffuse, random, motion, splat
   std::vector<Ray> rays;
   bool any_hit = false;  // shadow rays are occlusion queries
+  /// splat: each ray gathers and blends this scene's splats (blend_splats) from a structure
+  /// over its splat geometry.
+  const Scene* splats = nullptr;
 };
 
 Vec3f random_direction(std::mt19937& rng) {
@@ -156,7 +160,9 @@ double trace_seconds(const Accelerator& a, const RaySet& set, int threads, uint6
   tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i < r.end(); ++i) {
-                        if (set.any_hit) {
+                        if (set.splats) {
+                          result[i] = blend_splats(*set.splats, a, set.rays[i], kInfinity).count > 0;
+                        } else if (set.any_hit) {
                           result[i] = a.occluded(set.rays[i]);
                         } else {
                           Hit h;
@@ -199,10 +205,25 @@ bool same_answer(const Accelerator& a, const Accelerator& b, const Ray& r, bool 
 /// share): if `a` gives the scan's answer, Embree's own triangle test rounded the other way on
 /// that ray (a hit exactly on an edge, or at the end of the ray) and it is counted as a tie;
 /// otherwise `a` is wrong.
+/// Splat rays: the same blended radiance and transmittance within 1e-4.
+bool same_blend(const Scene& scene, const Accelerator& a, const Accelerator& b, const Ray& r) {
+  const SplatLayer x = blend_splats(scene, a, r, kInfinity), y = blend_splats(scene, b, r, kInfinity);
+  return max_component(abs(x.radiance - y.radiance)) <= 1e-4f &&
+         std::abs(x.transmittance - y.transmittance) <= 1e-4f;
+}
+
 Agreement check_against_embree(const Accelerator& a, const Accelerator& embree, const Accelerator& exact,
                                const RaySet& set, float scale) {
   Agreement g;
   for (const Ray& r : set.rays) {
+    if (set.splats) {
+      if (same_blend(*set.splats, a, embree, r)) continue;
+      if (same_blend(*set.splats, a, exact, r))
+        ++g.ties;
+      else
+        ++g.wrong;
+      continue;
+    }
     if (same_answer(a, embree, r, set.any_hit, scale)) continue;
     if (same_answer(a, exact, r, set.any_hit, scale))
       ++g.ties;
@@ -850,8 +871,9 @@ void add_bench_options(CLI::App& app, BenchOptions& o) {
                      " (default embree,bvh,kdtree,grid)")
       ->delimiter(',');
   app.add_option("--rays", o.kinds,
-                 "ray kinds: primary,shadow,diffuse,random (default), and motion (primary rays at random "
-                 "times through the scene's meshes deforming over the shutter)")
+                 "ray kinds: primary,shadow,diffuse,random (default), motion (primary rays at random "
+                 "times through the scene's meshes deforming over the shutter) and splat (primary rays "
+                 "gathering and blending the scene's Gaussian splats, or a generated sphere of 100k)")
       ->delimiter(',');
   app.add_option("--threads", o.threads, "thread counts, comma separated; 0 = all cores (default 1,0)")
       ->delimiter(',')
@@ -995,9 +1017,9 @@ AccelConfig check_table_options(const BenchOptions& o) {
   if (!o.heatmaps.empty() && !std::filesystem::is_directory(o.heatmaps))
     throw std::invalid_argument("--heatmaps: directory '" + o.heatmaps + "' does not exist");
   for (const auto& k : o.kinds)
-    if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random" && k != "motion")
+    if (k != "primary" && k != "shadow" && k != "diffuse" && k != "random" && k != "motion" && k != "splat")
       throw std::invalid_argument("--rays: unknown ray kind '" + k +
-                                  "' (known: primary, shadow, diffuse, random, motion)");
+                                  "' (known: primary, shadow, diffuse, random, motion, splat)");
   AccelConfig config;
   for (const auto& p : o.params) apply_accel_param(config, p);
   validate(config);  // every structure's parameters, as the render session checks them
@@ -1124,6 +1146,35 @@ RaySet motion_rays(const Scene& scene, int w, int h) {
   return set;
 }
 
+/// The splat rows: every structure over the scene's splats (a generated sphere of 100k splats
+/// fitted to its bounds when it has none) answering its primary rays with blend_splats.
+void measure_splats(const BenchOptions& o, const AccelConfig& config, TableScene& t, std::vector<Row>& rows) {
+  Scene& scene = t.scene;
+  if (scene.splat_instances.empty()) {
+    const Bounds3f b = compute_bounds(scene);
+    SplatSphereConfig sc;
+    sc.centre = (b.lo + b.hi) * 0.5f;
+    const Vec3f e = b.extent();
+    sc.radius = 0.3f * std::max(std::min({e.x, e.y, e.z}), 0.3f * max_component(e));
+    sc.count = 100000;
+    sc.opacity = 0.8f;
+    scene.splat_clouds.push_back(make_splat_sphere(sc));
+    scene.splat_instances.push_back({int(scene.splat_clouds.size()) - 1, Affine3f{}, -1});
+  }
+  const SplatGeometry g = splat_geometry(scene);
+  t.views = g.views;
+  t.instances = g.instances;
+  t.embree = make_accelerator("embree", t.views, t.instances);
+  t.exact = make_accelerator("brute", t.views, t.instances);
+  const Camera cam = bench_camera(scene, o.width, o.height);
+  RaySet set{"splat", {}, false, &scene};
+  for (int y = 0; y < o.height; ++y)
+    for (int x = 0; x < o.width; ++x)
+      set.rays.push_back(generate_camera_ray(cam, o.width, o.height, x + 0.5f, y + 0.5f));
+  t.sets = {std::move(set)};
+  for (const auto& accel_name : o.accels) measure_structure(o, config, t, accel_name, rows);
+}
+
 /// Every scene and structure of the main table, each row printed as it is measured (Embree's
 /// first, so that every later row shows its ratio); `embree_reference` receives the settings of
 /// the Embree every answer is checked against.
@@ -1140,14 +1191,17 @@ std::vector<Row> measure_table(const BenchOptions& o, const AccelConfig& config,
     embree_reference = t.embree->stats().config;
     std::vector<std::string> still;
     std::copy_if(o.kinds.begin(), o.kinds.end(), std::back_inserter(still),
-                 [](const std::string& k) { return k != "motion"; });
+                 [](const std::string& k) { return k != "motion" && k != "splat"; });
     t.scale = length(compute_bounds(t.scene).extent());
     if (!still.empty()) {
       t.sets = make_ray_sets(t.scene, *t.embree, o.width, o.height, still);
       for (const auto& accel_name : o.accels) measure_structure(o, config, t, accel_name, rows);
     }
-    if (still.size() == o.kinds.size()) continue;
+    if (std::count(o.kinds.begin(), o.kinds.end(), "splat")) measure_splats(o, config, t, rows);
+    if (!std::count(o.kinds.begin(), o.kinds.end(), "motion")) continue;
     // The motion rays: the same scene deforming, every structure built over it anew.
+    t.views = mesh_views(t.scene);
+    t.instances = instance_views(t.scene);
     deform_for_motion(t.scene);
     t.views = mesh_views(t.scene);
     t.embree = make_accelerator("embree", t.views, t.instances);
