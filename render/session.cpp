@@ -70,6 +70,19 @@ std::string structure_key(const RenderSpec& spec, const Scene& scene) {
       }
     }
   if (curves) key += " (curves " + std::to_string(h) + ")";
+  // Splats: a structure is kept only for the same clouds in the same places.
+  if (!scene.splat_instances.empty()) {
+    uint64_t g = 1469598103934665603ull;
+    auto mix = [&g](const void* p, size_t n) {
+      for (size_t i = 0; i < n; ++i) g = (g ^ static_cast<const uint8_t*>(p)[i]) * 1099511628211ull;
+    };
+    for (const SplatInstance& si : scene.splat_instances) {
+      mix(&si.to_world, sizeof si.to_world);
+      const uint64_t n = scene.splat_clouds[size_t(si.cloud)].positions.size();
+      mix(&n, sizeof n);
+    }
+    key += " (splats " + std::to_string(g) + ")";
+  }
   return key;
 }
 
@@ -85,14 +98,19 @@ std::shared_ptr<const Environment> choose_environment(const LoadedScene& loaded,
   return std::make_shared<Environment>();
 }
 
-/// The depth (along the view axis) of what pixel `at` shows through the pinhole, else of the
-/// scene bounds' centre; found with a brute-force scan (one ray, no build).
+/// The depth (along the view axis) of what pixel `at` shows through the pinhole (a layer of
+/// splats where its transmittance falls below 1/2), else of the scene bounds' centre; found with
+/// a brute-force scan (one ray, no build).
 float autofocus_depth(const Scene& scene, const Camera& cam, const RenderConfig& cfg, Vec2f at) {
   const std::unique_ptr<Accelerator> accel = make_scene_accelerator("brute", scene, AccelConfig{});
   const Ray ray = generate_camera_ray(cam, cfg.width, cfg.height, at.x + 0.5f, at.y + 0.5f);
   Hit hit;
+  SplatLayer splats;
   float depth = 0;
-  if (intersect_visible(scene, *accel, ray, hit, scene_needs_hit_filter(scene)))
+  const bool found = intersect_visible(scene, *accel, ray, hit, scene_needs_hit_filter(scene), &splats);
+  if (splats.median.valid())
+    depth = dot(ray.org + ray.dir * splats.median.t - cam.eye, -cam.w);
+  else if (found)
     depth = dot(ray.org + ray.dir * hit.t - cam.eye, -cam.w);
   else if (!compute_bounds(scene).empty())
     depth = dot(compute_bounds(scene).center() - cam.eye, -cam.w);

@@ -45,6 +45,10 @@ render procedural scenes/procedural.gltf --width 480
 render curves-path scenes/curves.gltf --width 480 --integrator path --spp 32
 render curves-wireframe scenes/curves.gltf --width 480 --integrator raster --wireframe \
   --wireframe-nodes box,floor --wireframe-hidden dashed --wireframe-color 1,0.8,0
+# Gaussian splats among meshes: ray traced (a mirror sphere reflecting them) and the raster
+# preview's EWA splatting.
+render splats-whitted scenes/splats.gltf --width 480
+render splats-raster scenes/splats.gltf --width 480 --integrator raster
 # Depth of field: the focus study focused near and far (cameras).
 render focus-near scenes/focus.gltf --width 320 --integrator path --spp 48 --aperture-radius 0.08 \
   --aperture-blades 6 --focus-distance 3.2

@@ -105,8 +105,9 @@ LoadedScene load_gltf(const std::filesystem::path& file, const GltfLoadOptions& 
 /// camera's eye and frame and every punctual light's position and direction become those a
 /// fresh load_gltf at `time` gives; meshes, shapes and materials are untouched. Returns false,
 /// with the scene unchanged, when the animation changes more than placements: morph-weight
-/// channels, skinned meshes, a flattened moving mesh, a placement left out as singular or huge
-/// (at the load or at `time`), another count of cameras or lights; the caller then loads the
+/// channels, skinned meshes, a flattened moving mesh, Gaussian splats placed by a moving node, a
+/// placement left out as singular or huge (at the load or at `time`), another count of cameras
+/// or lights; the caller then loads the
 /// file again. Throws InputError naming the node or the animation element as load_gltf does
 /// (non-finite or singular transforms, malformed channels), leaving the scene unchanged. When
 /// posed, `*moved_instances` (if given) is set to the number of instances of moving nodes, whose

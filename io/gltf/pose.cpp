@@ -87,6 +87,9 @@ bool pose_gltf_scene(const GltfAnimation& animation, double time, Scene& scene, 
   nodes.poses = &poses;
   nodes.moving = animation.moving;
 
+  // Splat clouds placed by a moving node: loaded anew (their structure is built with the scene).
+  for (const SplatInstance& si : scene.splat_instances)
+    if (is_moving(nodes, si.node)) return false;
   // The moving nodes' instances at `time`, checked before anything changes.
   std::map<int, std::vector<Transform>> placements;  // moving node -> its placements at `time`
   std::map<int, Bounds3f> bounds;

@@ -194,7 +194,7 @@ Vec3f path_radiance(const Scene& scene, const Accelerator& accel, const PathLigh
       if (vertex == 0) {  // the camera ray: coverage 1 - the transmittance so far
         if (deep) {
           deep->add(splat_deep_hit(scene, splats, seg.ray, *deep, 1 - coverage));
-          splats_seen += seg.beta * splats.radiance;
+          if (is_finite(splats.radiance)) splats_seen += seg.beta * splats.radiance;
         }
         coverage = 1 - (1 - coverage) * splats.transmittance;
       }

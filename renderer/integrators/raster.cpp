@@ -189,8 +189,8 @@ Film render_raster(const Scene& scene, const Accelerator* accel, const Camera& c
 
   // Gaussian splats: projected, sorted and binned once for the frame.
   const std::vector<ProjectedSplat> splats =
-      project_splats(scene, camera, config.width, config.height, win, config.threads);
-  const SplatBins bins = bin_splats(splats, win);
+      project_splats(scene, camera, config.width, config.height, win, pass.margin, config.threads);
+  const SplatBins bins = bin_splats(splats, win, pass.margin);
 
   std::atomic<uint64_t> shadow_rays{0};
   std::atomic<int> done{0};
@@ -220,8 +220,8 @@ DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const Rend
   const PixelWindow win = pass.window;
   DataAovs a = make_data_aovs(win);
   const std::vector<ProjectedSplat> splats =
-      project_splats(scene, camera, config.width, config.height, win, config.threads);
-  const SplatBins bins = bin_splats(splats, win);
+      project_splats(scene, camera, config.width, config.height, win, pass.margin, config.threads);
+  const SplatBins bins = bin_splats(splats, win, pass.margin);
   rasterize(scene, cv.view, pass, [&](const RasterTile& t) {
     AovPixel pixel;
     size_t i = 0;
@@ -243,7 +243,8 @@ DataAovs render_raster_aovs(const Scene& scene, const Camera& camera, const Rend
             const float depth = splat.median->depth;
             const Vec3f at = ray.org + ray.dir * (depth / std::max(dot(ray.dir, -camera.w), 1e-30f));
             const int node = scene.splat_instances[splat.median->instance].node;
-            pixel.add_splats(at, normalize(-ray.dir), sum / (1 - remaining), depth, node);
+            const Vec3f n = splat_normal(scene, splat.median->instance, splat.median->splat, ray.dir);
+            pixel.add_splats(at, n, sum / (1 - remaining), depth, node);
             continue;
           }
           if (!f) {

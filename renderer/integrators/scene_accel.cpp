@@ -97,14 +97,21 @@ class SceneAccelerator final : public Accelerator {
 };
 }  // namespace
 
-std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
-                                                    const AccelConfig& config) {
-  std::unique_ptr<Accelerator> surfaces =
-      make_accelerator(name, mesh_views(scene), instance_views(scene), config);
+namespace {
+// The surfaces' structure, with a structure over the scene's splats beside it when it has any.
+std::unique_ptr<Accelerator> attach_splats(std::unique_ptr<Accelerator> surfaces, std::string_view name,
+                                           const Scene& scene, const AccelConfig& config) {
   if (scene.splat_instances.empty()) return surfaces;
   auto geometry = std::make_unique<SplatGeometry>(splat_geometry(scene));
   std::unique_ptr<Accelerator> splats = make_accelerator(name, geometry->views, geometry->instances, config);
   return std::make_unique<SceneAccelerator>(std::move(surfaces), std::move(geometry), std::move(splats));
+}
+}  // namespace
+
+std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const Scene& scene,
+                                                    const AccelConfig& config) {
+  return attach_splats(make_accelerator(name, mesh_views(scene), instance_views(scene), config), name, scene,
+                       config);
 }
 
 const Accelerator* splat_accelerator(const Accelerator& accel) {
@@ -114,9 +121,16 @@ const Accelerator* splat_accelerator(const Accelerator& accel) {
 
 RefitReport refit_or_rebuild_scene(std::unique_ptr<Accelerator>& accel, double& built_sah,
                                    std::string_view name, const Scene& scene, const AccelConfig& config) {
-  auto* s = dynamic_cast<SceneAccelerator*>(accel.get());
-  std::unique_ptr<Accelerator>& surfaces = s ? s->surfaces() : accel;
-  return refit_or_rebuild(surfaces, built_sah, name, mesh_views(scene), instance_views(scene), config);
+  // The surfaces refitted or rebuilt by the policy; the splats' structure built anew over the
+  // scene's splats as they now are (a scene loaded anew may have moved or changed them).
+  if (auto* s = dynamic_cast<SceneAccelerator*>(accel.get())) {
+    std::unique_ptr<Accelerator> surfaces = std::move(s->surfaces());
+    accel = std::move(surfaces);
+  }
+  const RefitReport r =
+      refit_or_rebuild(accel, built_sah, name, mesh_views(scene), instance_views(scene), config);
+  accel = attach_splats(std::move(accel), name, scene, config);
+  return r;
 }
 
 }  // namespace penumbra

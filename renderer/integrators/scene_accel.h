@@ -41,8 +41,8 @@ std::unique_ptr<Accelerator> make_scene_accelerator(std::string_view name, const
 const Accelerator* splat_accelerator(const Accelerator& accel);
 
 /// refit_or_rebuild(accel, built_sah, name, mesh_views(scene), instance_views(scene), config):
-/// the structure of an earlier pose of `scene` refitted to this one, or built anew; the splat
-/// structure is kept (splats do not move).
+/// the structure of an earlier pose of `scene` refitted to this one, or built anew; the splats'
+/// structure is built anew over the scene's splats as they are.
 RefitReport refit_or_rebuild_scene(std::unique_ptr<Accelerator>& accel, double& built_sah,
                                    std::string_view name, const Scene& scene, const AccelConfig& config = {});
 

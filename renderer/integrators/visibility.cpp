@@ -148,27 +148,30 @@ SplatLayer blend_splats(const Scene& scene, const Accelerator& splats, const Ray
   return layer;
 }
 
-SplatPoint splat_point(const Scene& scene, const SplatLayer& layer, const Ray& ray) {
-  const Hit& h = layer.median.valid() ? layer.median : layer.first;
-  const SplatInstance& inst = scene.splat_instances[h.geom_id];
-  const SplatCloud& cloud = scene.splat_clouds[size_t(inst.cloud)];
-  SplatPoint out;
-  out.p = ray.org + ray.dir * h.t;
-  out.node = inst.node;
-  const float opacity = 1 - layer.transmittance;
-  out.color = opacity > 0 ? layer.radiance / opacity : Vec3f{};
+Vec3f splat_normal(const Scene& scene, uint32_t instance, uint32_t splat, Vec3f dir) {
+  const SplatInstance& inst = scene.splat_instances[instance];
   Affine3f inv;
-  Vec3f n = -ray.dir;
+  Vec3f n = -dir;
   if (inverse(inst.to_world, inv)) {  // the shortest axis: the largest row of S^-1 R^T
-    const Shape s = splat_shape(cloud, h.prim_id, h.prim_id);
+    const Shape s = splat_shape(scene.splat_clouds[size_t(inst.cloud)], splat, splat);
     Vec3f axis = s.whiten[0];
     for (const Vec3f& w : s.whiten)
       if (dot(w, w) > dot(axis, axis)) axis = w;
     n = apply_normal(inv, axis);
   }
-  if (!(dot(n, n) > 0) || !is_finite(n)) n = -ray.dir;
+  if (!(dot(n, n) > 0) || !is_finite(n)) n = -dir;
   n = normalize(n);
-  out.n = dot(n, ray.dir) > 0 ? -n : n;
+  return dot(n, dir) > 0 ? -n : n;
+}
+
+SplatPoint splat_point(const Scene& scene, const SplatLayer& layer, const Ray& ray) {
+  const Hit& h = layer.median.valid() ? layer.median : layer.first;
+  SplatPoint out;
+  out.p = ray.org + ray.dir * h.t;
+  out.node = scene.splat_instances[h.geom_id].node;
+  const float opacity = 1 - layer.transmittance;
+  out.color = opacity > 0 ? layer.radiance / opacity : Vec3f{};
+  out.n = splat_normal(scene, h.geom_id, h.prim_id, ray.dir);
   return out;
 }
 

@@ -43,6 +43,10 @@ struct SplatPoint {
 };
 SplatPoint splat_point(const Scene& scene, const SplatLayer& layer, const Ray& ray);
 
+/// The unit world-space shortest axis of splat `splat` of splat instance `instance`, turned to
+/// face a ray of direction `dir` (-dir for a singular placement).
+Vec3f splat_normal(const Scene& scene, uint32_t instance, uint32_t splat, Vec3f dir);
+
 /// A splat layer as a deep record of weight `weight` x its opacity, at its median (else its
 /// first) splat's depth, keyed apart from surfaces (0x80000000 + splat instance) with the
 /// instance's glTF node + 1 as object id.

@@ -95,7 +95,7 @@ bool project_splat(const Scene& scene, const Camera& camera, int width, int heig
 }
 
 std::vector<ProjectedSplat> project_splats(const Scene& scene, const Camera& camera, int width, int height,
-                                           const PixelWindow& window, int threads) {
+                                           const PixelWindow& window, float margin, int threads) {
   std::vector<std::pair<uint32_t, uint32_t>> items;
   for (uint32_t k = 0; k < scene.splat_instances.size(); ++k) {
     const size_t n = scene.splat_clouds[size_t(scene.splat_instances[k].cloud)].positions.size();
@@ -108,8 +108,8 @@ std::vector<ProjectedSplat> project_splats(const Scene& scene, const Camera& cam
     tbb::parallel_for(size_t(0), items.size(), [&](size_t k) {
       ProjectedSplat& s = all[k];
       keep[k] = project_splat(scene, camera, width, height, items[k].first, items[k].second, s) &&
-                s.hi.x >= float(window.x0) && s.lo.x <= float(window.x1) && s.hi.y >= float(window.y0) &&
-                s.lo.y <= float(window.y1);
+                s.hi.x >= float(window.x0) - margin && s.lo.x <= float(window.x1) + margin &&
+                s.hi.y >= float(window.y0) - margin && s.lo.y <= float(window.y1) + margin;
     });
   });
   size_t n = 0;
@@ -132,19 +132,22 @@ size_t SplatBins::cell_of(Vec2f p) const {
   return size_t(cy) * size_t(columns) + size_t(cx);
 }
 
-SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& window, int cell) {
+SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& window, float margin,
+                     int cell) {
   SplatBins b;
   b.window = window;
   b.cell = std::max(1, cell);
   b.columns = std::max(1, (window.width() + b.cell - 1) / b.cell);
   b.rows = std::max(1, (window.height() + b.cell - 1) / b.cell);
   const size_t cells = size_t(b.columns) * size_t(b.rows);
-  // Each splat goes to the cells its box meets (samples lie within a pixel of their own).
+  // Each splat goes to the cells its box meets, widened by how far a sample may lie outside its
+  // pixel (and a pixel more).
+  const float pad = margin + 1;
   auto range = [&](const ProjectedSplat& s, int& x0, int& x1, int& y0, int& y1) {
-    x0 = std::clamp(int(std::floor((s.lo.x - 1 - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
-    x1 = std::clamp(int(std::floor((s.hi.x + 1 - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
-    y0 = std::clamp(int(std::floor((s.lo.y - 1 - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
-    y1 = std::clamp(int(std::floor((s.hi.y + 1 - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
+    x0 = std::clamp(int(std::floor((s.lo.x - pad - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
+    x1 = std::clamp(int(std::floor((s.hi.x + pad - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
+    y0 = std::clamp(int(std::floor((s.lo.y - pad - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
+    y1 = std::clamp(int(std::floor((s.hi.y + pad - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
   };
   std::vector<uint32_t> count(cells + 1, 0);
   for (const ProjectedSplat& s : splats) {

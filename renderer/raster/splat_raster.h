@@ -43,10 +43,11 @@ struct ProjectedSplat {
 bool project_splat(const Scene& scene, const Camera& camera, int width, int height, uint32_t inst, uint32_t i,
                    ProjectedSplat& out, Sym2* covariance = nullptr);
 
-/// Every placed splat that projects (project_splat) and reaches `window`, sorted by (depth,
-/// instance, splat): the same order for any thread count.
+/// Every placed splat that projects (project_splat) and reaches `window` widened by `margin`
+/// pixels (how far samples lie outside their pixel), sorted by (depth, instance, splat): the
+/// same order for any thread count.
 std::vector<ProjectedSplat> project_splats(const Scene& scene, const Camera& camera, int width, int height,
-                                           const PixelWindow& window, int threads);
+                                           const PixelWindow& window, float margin, int threads);
 
 /// The splats of each cell x cell square of a window, in the projected order.
 struct SplatBins {
@@ -57,7 +58,10 @@ struct SplatBins {
   /// The cell holding raster position p (clamped to the window's cells).
   size_t cell_of(Vec2f p) const;
 };
-SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& window, int cell = 16);
+/// Each splat goes to the cells its box meets, widened by `margin` + 1 pixels (samples outside
+/// the window fall in its edge cells).
+SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& window, float margin,
+                     int cell = 16);
 
 /// Bytes project_splats and bin_splats may hold for `scene` (for memory budgets): each placed
 /// splat projected and referenced by up to 16 cells.

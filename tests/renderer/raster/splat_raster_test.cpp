@@ -208,3 +208,24 @@ TEST_CASE("splat raster: depth-composited with meshes, the same for any threads 
   CHECK(red[0] == Approx(1));
   CHECK(red[1] == Approx(0));
 }
+
+TEST_CASE("splat raster: a crop with a wide filter equals the same pixels of the whole frame",
+          "[splats][raster][quick]") {
+  // Samples of a 4-pixel Gaussian filter lie up to 1.5 pixels outside their pixel: splats just
+  // outside the crop still reach its edge pixels.
+  const Scene s = splat_sphere_scene(0.7f, false);
+  const Camera cam = look_at({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 0.7f);
+  RenderConfig full = small_render_config(40, 40, 4, 8);
+  full.filter.type = FilterType::Gaussian;
+  full.filter.width = 4;
+  const Film whole = render_raster(s, nullptr, cam, full);
+  RenderConfig crop = full;
+  crop.window = {13, 17, 27, 24};
+  const Film part = render_raster(s, nullptr, cam, crop);
+  for (int y = 17; y < 24; ++y)
+    for (int x = 13; x < 27; ++x)
+      for (int c = 0; c < 4; ++c) {
+        INFO(x << "," << y << " channel " << c);
+        CHECK(part.pixel(x - 13, y - 17)[c] == whole.pixel(x, y)[c]);
+      }
+}
