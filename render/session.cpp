@@ -447,26 +447,34 @@ std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInf
     return size_t(n) < info.node_names.size() ? info.node_names[size_t(n)]
                                               : "nodes[" + std::to_string(n) + "]";
   };
+  // An object's name in the object and asset layers: its node's, or its topmost ancestor's
+  // (bounded: the loader rejects cycles); `unnamed` without a node.
+  auto object_name = [&](int node, const std::string& unnamed) {
+    if (node < 0) return unnamed;
+    if (layer != "CryptoAsset") return node_name(node);
+    int root = node;
+    for (size_t step = 0; step < info.node_parents.size() && size_t(root) < info.node_parents.size() &&
+                          info.node_parents[size_t(root)] >= 0;
+         ++step)
+      root = info.node_parents[size_t(root)];
+    return node_name(root);
+  };
   std::vector<std::string> names;
-  names.reserve(scene.instances.size());
+  names.reserve(scene.instances.size() + scene.splat_instances.size());
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
     if (layer == "CryptoMaterial") {
       const int m = instance_material(scene, inst);
       names.push_back(m >= 0 ? scene.materials[size_t(m)].name : "default");
-    } else if (inst.node < 0) {
-      names.push_back("instances[" + std::to_string(i) + "]");
-    } else if (layer == "CryptoAsset") {
-      int root = inst.node;  // the topmost ancestor (bounded: the loader rejects cycles)
-      for (size_t step = 0; step < info.node_parents.size() && size_t(root) < info.node_parents.size() &&
-                            info.node_parents[size_t(root)] >= 0;
-           ++step)
-        root = info.node_parents[size_t(root)];
-      names.push_back(node_name(root));
     } else {
-      names.push_back(node_name(inst.node));
+      names.push_back(object_name(inst.node, "instances[" + std::to_string(i) + "]"));
     }
   }
+  // The splat clouds' placements, named likewise ("splats" as their material).
+  for (size_t i = 0; i < scene.splat_instances.size(); ++i)
+    names.push_back(layer == "CryptoMaterial" ? std::string("splats")
+                                              : object_name(scene.splat_instances[i].node,
+                                                            "splat_instances[" + std::to_string(i) + "]"));
   return names;
 }
 

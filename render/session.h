@@ -232,7 +232,8 @@ bool wants_motion_layers(const std::set<std::string>& aovs);
 
 /// The name each scene instance has in Cryptomatte layer `layer` (CryptoObject: its glTF node's
 /// name; CryptoMaterial: its material's name, "default" for none; CryptoAsset: its root node's
-/// name), one per scene.instances entry.
+/// name), one per scene.instances entry, then one per scene.splat_instances entry (named by
+/// their nodes likewise; "splats" in CryptoMaterial).
 std::vector<std::string> crypto_instance_names(const Scene& scene, const GltfInfo& info,
                                                const std::string& layer);
 

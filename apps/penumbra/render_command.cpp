@@ -32,6 +32,7 @@
 #include "renderer/integrators/raster.h"
 #include "renderer/integrators/scene_accel.h"
 #include "renderer/raster/shadow_map.h"
+#include "renderer/raster/splat_raster.h"
 
 namespace penumbra::cli {
 
@@ -97,8 +98,8 @@ uint64_t charge_image_budget(const RenderJob& job, const RenderConfig& cfg) {
   for (const Mesh& m : scene.meshes)
     if (m.points || m.lines) scene_bytes += uint64_t(m.indices.size() / 3) * (sizeof(Shape) + 16);
   if (job.request.raster) {
-    // The rasteriser's setup triangles and tile buffers, and the shadow maps.
-    scene_bytes += raster_memory_bytes(scene, camera_raster_pass(cfg));
+    // The rasteriser's setup triangles and tile buffers, the projected splats, and the shadow maps.
+    scene_bytes += raster_memory_bytes(scene, camera_raster_pass(cfg)) + splat_raster_bytes(scene);
     if (cfg.raster.shadows == RasterShadows::Map)
       scene_bytes += shadow_map_bytes(scene, cfg.raster.shadow_map_size);
   }

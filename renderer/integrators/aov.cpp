@@ -263,17 +263,28 @@ CryptoImage render_cryptomatte(const Scene& scene, const Accelerator& accel, con
           Ray ray = camera_sample_ray(camera, config, integrator, x, y, s);
           float remaining = 1;  // of this sample's weight, not yet given to a surface
           uint32_t given = 0;   // slots handed out
+          // Slots up to the cumulative weight given so far (with `a` more of what remains),
+          // rounded to the nearest slot, to `id`.
+          auto give = [&](float a, int id) {
+            const float total = (1 - remaining) + remaining * a;
+            const uint32_t upto = std::min(kSlots, uint32_t(std::lround(total * float(kSlots))));
+            for (; given < upto; ++given) hit_instance.push_back(id);
+            remaining *= 1 - a;
+          };
           for (int layer = 0; layer < kMaxBlendLayers && given < kSlots; ++layer) {
             Hit hit;
-            if (!intersect_visible(scene, accel, ray, hit, filter)) break;
+            SplatLayer splats;
+            const bool found = intersect_visible(scene, accel, ray, hit, filter, &splats);
+            if (splats.count > 0) {  // the splats in front, as their median (else first) splat's cloud
+              const Hit& h = splats.median.valid() ? splats.median : splats.first;
+              give(1 - splats.transmittance, int(scene.instances.size() + h.geom_id));
+              if (!(remaining > 0)) break;
+            }
+            if (!found) break;
             const SurfaceInteraction si = make_interaction(scene, ray, hit);
             const float a =
                 layer + 1 < kMaxBlendLayers ? std::clamp(eval_material(scene, si).alpha, 0.0f, 1.0f) : 1.0f;
-            // Slots up to the cumulative weight given so far, rounded to the nearest slot.
-            const float total = (1 - remaining) + remaining * a;
-            const uint32_t upto = std::min(kSlots, uint32_t(std::lround(total * float(kSlots))));
-            for (; given < upto; ++given) hit_instance.push_back(int(hit.geom_id));
-            remaining *= 1 - a;
+            give(a, int(hit.geom_id));
             if (!(remaining > 0)) break;
             ray.tnear = std::nextafter(std::max(hit.t, ray.tnear), kInfinity);
           }

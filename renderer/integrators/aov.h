@@ -101,9 +101,11 @@ DataAovs render_data_aovs(const Scene& scene, const Accelerator& accel, const Ca
 
 /// Cryptomatte: traces the same camera samples and ranks each layer's instance ids per pixel
 /// (rank_crypto_ids): a sample's weight goes to the surfaces it sees, split over Blend layers
-/// by their alpha (up to 16 layers, in eighths of a sample), so the coverage is the pixel
-/// filter's weight of each name. Requires 1 <= depth and every layer's instance_ids to cover
-/// scene.instances. Deterministic for any thread count.
+/// by their alpha (up to 16 layers, in eighths of a sample), and to the layers of Gaussian
+/// splats in front of them by their opacity (each layer to its median splat's cloud, else its
+/// first's), so the coverage is the pixel filter's weight of each name. Requires 1 <= depth and
+/// every layer's instance_ids to cover scene.instances, then scene.splat_instances.
+/// Deterministic for any thread count.
 CryptoImage render_cryptomatte(const Scene& scene, const Accelerator& accel, const Camera& camera,
                                const RenderConfig& config, IntegratorType integrator,
                                const std::vector<CryptoLayerIds>& layers, int depth);

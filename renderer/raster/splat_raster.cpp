@@ -126,9 +126,18 @@ std::vector<ProjectedSplat> project_splats(const Scene& scene, const Camera& cam
   return all;
 }
 
+namespace {
+// floor(v), clamped to [0, n - 1] before it becomes an int (a splat's box may reach far beyond
+// any int, or be NaN: then 0).
+int cell_index(float v, int n) {
+  const float f = std::floor(v);
+  return f >= 0 ? (f < float(n - 1) ? int(f) : n - 1) : 0;
+}
+}  // namespace
+
 size_t SplatBins::cell_of(Vec2f p) const {
-  const int cx = std::clamp(int(std::floor((p.x - float(window.x0)) / float(cell))), 0, columns - 1);
-  const int cy = std::clamp(int(std::floor((p.y - float(window.y0)) / float(cell))), 0, rows - 1);
+  const int cx = cell_index((p.x - float(window.x0)) / float(cell), columns);
+  const int cy = cell_index((p.y - float(window.y0)) / float(cell), rows);
   return size_t(cy) * size_t(columns) + size_t(cx);
 }
 
@@ -144,10 +153,10 @@ SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& 
   // pixel (and a pixel more).
   const float pad = margin + 1;
   auto range = [&](const ProjectedSplat& s, int& x0, int& x1, int& y0, int& y1) {
-    x0 = std::clamp(int(std::floor((s.lo.x - pad - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
-    x1 = std::clamp(int(std::floor((s.hi.x + pad - float(window.x0)) / float(b.cell))), 0, b.columns - 1);
-    y0 = std::clamp(int(std::floor((s.lo.y - pad - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
-    y1 = std::clamp(int(std::floor((s.hi.y + pad - float(window.y0)) / float(b.cell))), 0, b.rows - 1);
+    x0 = cell_index((s.lo.x - pad - float(window.x0)) / float(b.cell), b.columns);
+    x1 = cell_index((s.hi.x + pad - float(window.x0)) / float(b.cell), b.columns);
+    y0 = cell_index((s.lo.y - pad - float(window.y0)) / float(b.cell), b.rows);
+    y1 = cell_index((s.hi.y + pad - float(window.y0)) / float(b.cell), b.rows);
   };
   std::vector<uint32_t> count(cells + 1, 0);
   for (const ProjectedSplat& s : splats) {

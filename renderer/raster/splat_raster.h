@@ -63,8 +63,9 @@ struct SplatBins {
 SplatBins bin_splats(std::span<const ProjectedSplat> splats, const PixelWindow& window, float margin,
                      int cell = 16);
 
-/// Bytes project_splats and bin_splats may hold for `scene` (for memory budgets): each placed
-/// splat projected and referenced by up to 16 cells.
+/// Bytes project_splats and bin_splats hold for `scene` when each placed splat is projected and
+/// referenced by 16 cells (an estimate for memory budgets: a splat wider than 64 pixels is
+/// referenced by more).
 uint64_t splat_raster_bytes(const Scene& scene);
 
 /// The splat's alpha at raster position p: opacity exp(-q / 2), q = d^T conic d, d = p - centre;

@@ -1,13 +1,15 @@
 // Gaussian splats ray traced: one Gaussian against its closed form (the distance of the ray from
 // its centre), overlapping splats blended in depth order whatever the build order, structure,
 // thread count or tiles, a sphere of opaque splats against a sphere (depth and id AOVs), a
-// mirror reflecting splats, splats shadowing a mesh, and the path tracer seeing the same.
+// mirror reflecting splats, splats shadowing a mesh, the path tracer seeing the same, and
+// Cryptomatte coverage split between a splat and the surface behind it.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 
 #include "renderer/accel/factory.h"
+#include "renderer/film/cryptomatte.h"
 #include "renderer/integrators/aov.h"
 #include "renderer/integrators/path.h"
 #include "renderer/integrators/scene_accel.h"
@@ -50,26 +52,34 @@ Vec3f whitted(const Scene& s, const Accelerator& accel, const Ray& r, float& cov
 
 TEST_CASE("splats: one Gaussian seen along a ray is opacity exp(-d^2 / 2 sigma^2) in every structure",
           "[splats][trace][quick]") {
-  Scene s;
+  // Opacity 0.8: cut at 3 sigma (the last two rays pass 3.07 and 3.4 sigma from the centre);
+  // opacity 0.02: cut where 0.02 exp(-u^2 / 2) < 1/255, beyond u = 1.805.
   const Vec3f colour{0.9f, 0.5f, 0.1f};
-  add_splats(s, {{0, 0, -3}}, {0.5f}, {0.8f}, {colour});
-  for (const std::string& name : accelerator_names()) {
-    INFO(name);
-    const auto accel = make_scene_accelerator(name, s);
-    REQUIRE(splat_accelerator(*accel) != nullptr);
-    for (float x : {0.0f, 0.1f, 0.3f, 0.7f, 1.2f, 1.49f, 1.6f}) {
-      const Ray r{{0, 0, 0}, 0, normalize(Vec3f{x, 0.2f * x, -3}), kInfinity};
-      // The distance of the ray's line from the centre, by the cross product.
-      const float d = length(cross(r.dir, Vec3f{0, 0, -3}));
-      const float u = d / 0.5f;
-      const float alpha = u <= kSplatSigmas && 0.8f * std::exp(-0.5f * u * u) >= kSplatMinAlpha
-                              ? 0.8f * std::exp(-0.5f * u * u)
-                              : 0.0f;
-      float coverage = 0;
-      const Vec3f L = whitted(s, *accel, r, coverage);
-      CHECK(coverage == Approx(alpha).margin(1e-5));
-      check_vec(L, colour * alpha, 1e-5f);
+  for (float opacity : {0.8f, 0.02f}) {
+    Scene s;
+    add_splats(s, {{0, 0, -3}}, {0.5f}, {opacity}, {colour});
+    int cut = 0, seen = 0;
+    for (const std::string& name : accelerator_names()) {
+      INFO(name << " opacity " << opacity);
+      const auto accel = make_scene_accelerator(name, s);
+      REQUIRE(splat_accelerator(*accel) != nullptr);
+      for (float x : {0.0f, 0.1f, 0.3f, 0.7f, 0.95f, 1.2f, 1.49f, 1.6f, 1.75f, 1.95f}) {
+        const Ray r{{0, 0, 0}, 0, normalize(Vec3f{x, 0.2f * x, -3}), kInfinity};
+        // The distance of the ray's line from the centre, by the cross product.
+        const float d = length(cross(r.dir, Vec3f{0, 0, -3}));
+        const float u = d / 0.5f;
+        const float peak = opacity * std::exp(-0.5f * u * u);
+        const float alpha = u <= 3 && peak >= 1.0f / 255 ? peak : 0.0f;
+        cut += alpha == 0;
+        seen += alpha > 0;
+        float coverage = 0;
+        const Vec3f L = whitted(s, *accel, r, coverage);
+        CHECK(coverage == Approx(alpha).margin(1e-5));
+        check_vec(L, colour * alpha, 1e-5f);
+      }
     }
+    CHECK(cut > 0);
+    CHECK(seen > 0);
   }
 }
 
@@ -277,4 +287,27 @@ TEST_CASE("splats: the same image for any thread count, tile size and structure"
       worst = std::max(worst, double(std::abs(f.rgba[i] - ref.rgba[i])));
     CHECK(worst < 1e-4);
   }
+}
+
+TEST_CASE("splats: Cryptomatte gives a splat layer its opacity of a sample, the surface behind the rest",
+          "[splats][trace][quick]") {
+  // A wide splat of opacity 0.6 (sigma 20 pixels) over an opaque quad: at the splat's centre
+  // the splat's cloud takes 0.6 of the pixel, the quad 0.4 (in eighths of a sample).
+  Scene s;
+  s.instances[size_t(add_quad_z(s, -5, 5, -5, 5, -1, add_lambert(s, {0.5f, 0.5f, 0.5f})))].node = 0;
+  add_splats(s, {{0, 0, 0}}, {1}, {0.6f}, {{1, 1, 1}}, Affine3f{}, 1);
+  Camera cam = look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 2);
+  cam.projection = Projection::Orthographic;
+  cam.ymag = 0.2f;
+  const auto accel = make_scene_accelerator("bvh", s);
+  const float quad = crypto_id("quad"), cloud = crypto_id("cloud");
+  const std::vector<CryptoLayerIds> layers = {{"CryptoObject", {quad, cloud}}};
+  const CryptoImage img = render_cryptomatte(s, *accel, cam, small_render_config(4, 4, 16, 4),
+                                             IntegratorType::Whitted, layers, 2);
+  const float* p = &img.layers[0][size_t(1 * 4 + 1) * size_t(img.channels)];
+  CHECK(p[0] == cloud);
+  CHECK(p[1] == Approx(0.6f).margin(0.07f));
+  CHECK(p[2] == quad);
+  CHECK(p[3] == Approx(0.4f).margin(0.07f));
+  CHECK(p[1] + p[3] == Approx(1));
 }

@@ -190,11 +190,12 @@ TEST_CASE("splat raster: depth-composited with meshes, the same for any threads 
   const Camera cam = look_at({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 0.7f);
   RenderConfig cfg = small_render_config(48, 48, 1, 8);
   cfg.threads = 1;
-  const Film a = render_raster(s, nullptr, cam, cfg);
+  const auto accel = make_scene_accelerator("bvh", s);  // the shadow rays' structure
+  const Film a = render_raster(s, accel.get(), cam, cfg);
   RenderConfig other = cfg;
   other.threads = 2;
   other.tile_size = 5;
-  CHECK(render_raster(s, nullptr, cam, other).rgba == a.rgba);
+  CHECK(render_raster(s, accel.get(), cam, other).rgba == a.rgba);
   // The centre pixel sees the sphere's front (colour 0.5 + 0.5 n, n = +z), not the red quad.
   const float* centre = a.pixel(24, 24);
   CHECK(centre[0] == Approx(0.5f).margin(0.05f));
@@ -204,7 +205,8 @@ TEST_CASE("splat raster: depth-composited with meshes, the same for any threads 
   SplatCloud& cloud = back.splat_clouds[0];
   for (size_t i = 0; i < cloud.positions.size(); ++i)
     if (cloud.positions[i].z > 0) cloud.opacities[i] = 0;
-  const float* red = render_raster(back, nullptr, cam, cfg).pixel(24, 24);
+  const Film behind = render_raster(back, make_scene_accelerator("bvh", back).get(), cam, cfg);
+  const float* red = behind.pixel(24, 24);
   CHECK(red[0] == Approx(1));
   CHECK(red[1] == Approx(0));
 }
@@ -218,10 +220,11 @@ TEST_CASE("splat raster: a crop with a wide filter equals the same pixels of the
   RenderConfig full = small_render_config(40, 40, 4, 8);
   full.filter.type = FilterType::Gaussian;
   full.filter.width = 4;
-  const Film whole = render_raster(s, nullptr, cam, full);
+  const auto accel = make_scene_accelerator("bvh", s);
+  const Film whole = render_raster(s, accel.get(), cam, full);
   RenderConfig crop = full;
   crop.window = {13, 17, 27, 24};
-  const Film part = render_raster(s, nullptr, cam, crop);
+  const Film part = render_raster(s, accel.get(), cam, crop);
   for (int y = 17; y < 24; ++y)
     for (int x = 13; x < 27; ++x)
       for (int c = 0; c < 4; ++c) {
